@@ -1,0 +1,377 @@
+"""Velocity, power, virtual work and foot loads (course notes, seed 004, sections 2-3).
+
+Velocities three ways (notes 2.1):
+
+* **algebraic** — the differentiated closure equations, solved as a 2x2 linear
+  system per sample (:func:`fourbar_velocities`, :func:`node_velocities`);
+* **numerical** — differences along a sampled curve (:func:`finite_difference`);
+* **instant centre** — the body's instantaneous centre of rotation from two
+  points whose velocity directions are known (:func:`instant_centre`).
+
+Corrections to the notes (verified in ``tests/test_analysis.py``):
+
+* eq. (6) carries a stray ``- r_1`` term; the ground link does not move, so
+  the x-equation is ``-r2 sin(t2) w2 - r3 sin(t3) w3 + r4 sin(t4) w4 = 0``.
+* eq. (8) is a forward difference, first-order accurate and lagging by half a
+  step; :func:`finite_difference` uses central differences (second order,
+  periodic wrap for a closed cycle).
+* eq. (11) ``5 (4 pi)^2 0.01`` is an upper bound (amplitudes added);
+  :func:`fourier_acceleration` gives the true peak, which is lower.
+
+Power (notes eq. 5): with ``F_i`` the force the mechanism exerts on its load
+at point ``i`` (so ``F . V > 0`` is work done on the load) and the motor
+turning at ``w``, ``tau w eta_trans eta_link = sum_i F_i . V_i``.  Angles in
+radians, angular speeds in rad/s, torques in force x model-unit.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Mapping
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .errors import InputError
+
+if TYPE_CHECKING:
+    from .linkages.dyads import Linkage
+    from .linkages.fourbar import FourBar
+
+__all__ = [
+    "fourbar_velocities",
+    "node_velocities",
+    "point_velocities",
+    "finite_difference",
+    "instant_centre",
+    "velocity_about_centre",
+    "fourbar_instant_centre",
+    "world_velocity",
+    "input_torque",
+    "virtual_work_torque",
+    "motor_torque",
+    "static_foot_loads",
+    "fourier_acceleration",
+    "fourier_peak_bound",
+    "friction_limit",
+]
+
+Array = NDArray[np.float64]
+
+
+def _cross(a: Array, b: Array) -> Array:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _perp(v: Array) -> Array:
+    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
+
+
+# --------------------------------------------------------------------------
+# algebraic velocities
+# --------------------------------------------------------------------------
+
+
+def fourbar_velocities(
+    fb: "FourBar", theta: ArrayLike, omega2: ArrayLike = 1.0
+) -> tuple[Array, Array, NDArray[np.bool_]]:
+    """Coupler and rocker angular velocities ``(omega3, omega4, valid)``.
+
+    Notes eqs. (6)-(7), corrected (no ``r_1`` term), solved per sample with
+    ``numpy.linalg.solve`` on an ``(N, 2, 2)`` stack.  ``valid`` is false
+    where the system is singular (coupler and rocker in line: a toggle).
+    """
+    th2 = np.atleast_1d(np.asarray(theta, float))
+    w2 = np.broadcast_to(np.asarray(omega2, float), th2.shape)
+    th3, th4, ok = fb.angles(th2)
+    g = fb.dims
+    m = np.empty(th2.shape + (2, 2))
+    m[..., 0, 0] = -g.b * np.sin(th3)
+    m[..., 0, 1] = g.c * np.sin(th4)
+    m[..., 1, 0] = g.b * np.cos(th3)
+    m[..., 1, 1] = -g.c * np.cos(th4)
+    rhs = np.stack([g.a * np.sin(th2) * w2, -g.a * np.cos(th2) * w2], axis=-1)
+    det = m[..., 0, 0] * m[..., 1, 1] - m[..., 0, 1] * m[..., 1, 0]
+    sing = np.abs(det) <= 1e-12 * g.b * g.c
+    m[sing] = np.eye(2)
+    sol = np.linalg.solve(m, rhs[..., None])[..., 0]
+    return sol[..., 0], sol[..., 1], ok & ~sing
+
+
+def node_velocities(
+    link: "Linkage", q: ArrayLike, qdot: ArrayLike = 1.0
+) -> tuple[dict[str, Array], NDArray[np.bool_]]:
+    """Velocity ``(N, 2)`` of every node of a :class:`~planar.linkages.Linkage`.
+
+    Each dyad's closure conditions are differentiated and solved as a 2x2
+    linear system per sample (Cramer's rule, vectorised):
+
+    * RRR ``P``: ``(P - A) . (vP - vA) = 0`` and ``(P - B) . (vP - vB) = 0``;
+    * RRP ``P`` on the line ``p + s w`` (offset ``e``): the distance condition
+      to ``A`` and ``cross(w, P - p) = e |w|`` differentiated;
+    * Rigid: ``vP = vA + omega perp(P - A)`` with the frame's ``omega``.
+
+    With ``qdot = 1`` the results are velocity coefficients ``dX/dq``.
+    ``valid`` is false where a system is singular (a toggle) or the
+    position does not close.  Velocities are in the linkage's own frame
+    before placement; rotate them by ``placement[2]`` for the world.
+    """
+    from .linkages.dyads import RRP, RRR, Actuator, Crank, Fixed
+
+    qa = np.atleast_1d(np.asarray(q, float))
+    qd = np.broadcast_to(np.asarray(qdot, float), qa.shape)
+    pos, checks = link.solve_nodes(qa)
+    valid = np.ones(qa.shape, bool)
+    for m, _, _ in checks:
+        valid &= m
+    vel: dict[str, Array] = {}
+    for node in link.nodes:
+        if isinstance(node, Fixed):
+            vel[node.name] = np.zeros(qa.shape + (2,))
+        elif isinstance(node, Crank):
+            vel[node.name] = vel[node.centre] + qd[:, None] * _perp(pos[node.name] - pos[node.centre])
+        elif isinstance(node, Actuator):
+            ax = np.asarray(node.axis, float) / np.hypot(*node.axis)
+            vel[node.name] = vel[node.origin] + qd[:, None] * ax
+        elif isinstance(node, (RRR, RRP)):
+            P = pos[node.name]
+            r1 = P - pos[node.a]
+            b1 = (r1 * vel[node.a]).sum(-1)
+            if isinstance(node, RRR):
+                r2 = P - pos[node.b]
+                b2 = (r2 * vel[node.b]).sum(-1)
+            else:
+                p0, vp0 = pos[node.p], vel[node.p]
+                w = pos[node.q] - p0
+                vw = vel[node.q] - vp0
+                wn = np.hypot(w[:, 0], w[:, 1])
+                # cross(w, vP) = e (w . vw)/|w| - cross(vw, P - p0) + cross(w, vp0)
+                r2 = np.stack([-w[:, 1], w[:, 0]], -1)
+                b2 = node.offset * (w * vw).sum(-1) / wn - _cross(vw, P - p0) + _cross(w, vp0)
+            det = r1[:, 0] * r2[:, 1] - r1[:, 1] * r2[:, 0]
+            scale = np.hypot(*r1.T) * np.hypot(*r2.T)
+            sing = np.abs(det) <= 1e-12 * scale
+            valid &= ~sing
+            det = np.where(sing, 1.0, det)
+            vx = (b1 * r2[:, 1] - b2 * r1[:, 1]) / det
+            vy = (r1[:, 0] * b2 - r2[:, 0] * b1) / det
+            vel[node.name] = np.stack([vx, vy], -1)
+        else:  # Rigid
+            a, b = pos[node.a], pos[node.b]
+            d = b - a
+            omega = _cross(d, vel[node.b] - vel[node.a]) / (d * d).sum(-1)
+            vel[node.name] = vel[node.a] + omega[:, None] * _perp(pos[node.name] - a)
+    return vel, valid
+
+
+def point_velocities(
+    link: "Linkage", q: ArrayLike, qdot: ArrayLike = 1.0
+) -> tuple[dict[str, Array], NDArray[np.bool_]]:
+    """World velocities ``(N, 2)`` of the linkage's named points (placement applied)."""
+    vel, valid = node_velocities(link, q, qdot)
+    ang = link.placement[2]
+    c, s = np.cos(ang), np.sin(ang)
+    out = {}
+    for pname, node in link.point_nodes.items():
+        v = vel[node]
+        out[pname] = np.stack([c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1]], -1)
+    return out, valid
+
+
+# --------------------------------------------------------------------------
+# numerical velocities and instant centres
+# --------------------------------------------------------------------------
+
+
+def finite_difference(x: ArrayLike, step: float, periodic: bool = True) -> Array:
+    """Derivative of samples ``x`` (axis 0) spaced ``step`` apart, central differences.
+
+    ``periodic=True`` treats the samples as one closed cycle (the last sample
+    is followed by the first); otherwise the ends use one-sided second-order
+    differences.  Error is ``O(step^2)``.
+    """
+    x = np.asarray(x, float)
+    if periodic:
+        return (np.roll(x, -1, axis=0) - np.roll(x, 1, axis=0)) / (2.0 * step)
+    return np.gradient(x, step, axis=0, edge_order=2)
+
+
+def instant_centre(
+    p1: ArrayLike, v1: ArrayLike, p2: ArrayLike, v2: ArrayLike
+) -> tuple[Array, Array, NDArray[np.bool_]]:
+    """Instant centre of a body from two of its points and their velocities.
+
+    The centre lies on the normal to each velocity (notes 2.1.1).  Returns
+    ``(centre, omega, valid)``; ``omega`` (rad/s, CCW positive) follows from
+    ``v1 = omega perp(p1 - centre)``.  ``valid`` is false where the normals
+    are parallel (the body translates: centre at infinity, ``omega = 0``).
+    """
+    p1, v1, p2, v2 = (np.asarray(a, float) for a in (p1, v1, p2, v2))
+    n1, n2 = _perp(v1), _perp(v2)  # directions of the normals
+    den = _cross(n1, n2)
+    scale = np.hypot(*n1.T) * np.hypot(*n2.T)
+    ok = np.abs(den) > 1e-12 * np.maximum(scale, np.finfo(float).tiny)
+    s = _cross(p2 - p1, n2) / np.where(ok, den, 1.0)
+    centre = p1 + s[..., None] * n1
+    r1 = p1 - centre
+    omega = np.where(ok, _cross(r1, v1) / np.maximum((r1 * r1).sum(-1), np.finfo(float).tiny), 0.0)
+    return centre, omega, ok
+
+
+def velocity_about_centre(point: ArrayLike, centre: ArrayLike, omega: ArrayLike) -> Array:
+    """Velocity ``omega perp(point - centre)`` of a point of a body rotating about ``centre``."""
+    point, centre = np.asarray(point, float), np.asarray(centre, float)
+    return np.asarray(omega, float)[..., None] * _perp(point - centre)
+
+
+def fourbar_instant_centre(fb: "FourBar", theta: ArrayLike, omega2: float = 1.0) -> tuple[Array, Array, NDArray[np.bool_]]:
+    """The coupler's instant centre (intersection of lines O2-B and O4-C) and its omega.
+
+    Graphical method of notes 2.1.1, in the linkage's own frame.
+    """
+    th = np.atleast_1d(np.asarray(theta, float))
+    pos, _ = fb.solve_nodes(th)
+    B, C, O2, O4 = pos["B"], pos["C"], pos["O2"], pos["O4"]
+    vB = omega2 * _perp(B - O2)
+    vC_dir = _perp(C - O4)  # direction only; the magnitude is unknown
+    centre, _, ok = instant_centre(B, vB, C, vC_dir)
+    r = B - centre
+    omega = _cross(r, vB) / np.maximum((r * r).sum(-1), np.finfo(float).tiny)
+    return centre, np.where(ok, omega, 0.0), ok
+
+
+def world_velocity(v_relative: ArrayLike, v_frame: ArrayLike, omega_frame: ArrayLike = 0.0,
+                   r_from_frame_origin: ArrayLike | None = None) -> Array:
+    """Absolute velocity of a point on a moving machine (notes 2.1.4).
+
+    ``v_world = v_frame + omega_frame x r + v_relative``; with a machine that
+    only translates (``omega_frame = 0``) this is the notes' vector sum.
+    """
+    v = np.asarray(v_frame, float) + np.asarray(v_relative, float)
+    if r_from_frame_origin is not None:
+        v = v + np.asarray(omega_frame, float)[..., None] * _perp(np.asarray(r_from_frame_origin, float))
+    return v
+
+
+# --------------------------------------------------------------------------
+# power and virtual work
+# --------------------------------------------------------------------------
+
+
+def _check_eff(name: str, eta: float) -> float:
+    if not (0.0 < float(eta) <= 1.0):
+        raise InputError(name, eta, "an efficiency in (0, 1]")
+    return float(eta)
+
+
+def input_torque(
+    coefficients: ArrayLike, forces: ArrayLike, eta_trans: float = 1.0, eta_link: float = 1.0
+) -> Array:
+    """Motor torque per sample from velocity coefficients and loads (notes eq. 5).
+
+    ``coefficients`` ``(N, k, 2)`` holds ``dX_i/dq`` for ``k`` load points;
+    ``forces`` ``(N, k, 2)`` or ``(k, 2)`` the forces the mechanism exerts on
+    them.  ``tau = sum_i F_i . dX_i/dq / (eta_trans eta_link)``, so that
+    ``tau * w * eta = sum F . V`` on every sample.
+    """
+    eta = _check_eff("eta_trans", eta_trans) * _check_eff("eta_link", eta_link)
+    c = np.asarray(coefficients, float)
+    f = np.broadcast_to(np.asarray(forces, float), c.shape)
+    return (c * f).sum(axis=(-1, -2)) / eta
+
+
+def virtual_work_torque(
+    points: ArrayLike, q: ArrayLike, forces: ArrayLike, periodic: bool = True
+) -> Array:
+    """Torque by virtual work (notes eqs. 12-13): ``tau dq = sum_i F_i . dX_i``.
+
+    ``points`` ``(N, k, 2)`` sampled at evenly spaced driver values ``q``;
+    displacements by central differences (``O(dq^2)``).  Ideal (no losses).
+    """
+    P = np.asarray(points, float)
+    qa = np.asarray(q, float)
+    dq = float(qa[1] - qa[0])
+    dX = finite_difference(P, dq, periodic)
+    f = np.broadcast_to(np.asarray(forces, float), P.shape)
+    return (dX * f).sum(axis=(-1, -2))
+
+
+def motor_torque(
+    link: "Linkage", q: ArrayLike, loads: Mapping[str, ArrayLike],
+    eta_trans: float = 1.0, eta_link: float = 1.0,
+) -> tuple[Array, NDArray[np.bool_]]:
+    """Input torque a linkage needs for forces at its named points (several feet, one motor).
+
+    ``loads`` maps a named point to the force ``(2,)`` or ``(N, 2)`` the
+    mechanism exerts there (world frame).  Returns ``(tau, valid)``.
+    """
+    vel, valid = point_velocities(link, q, 1.0)
+    for name in loads:
+        if name not in vel:
+            raise InputError(f"{link.name}.loads", name, f"a named point, one of {sorted(vel)}")
+    names = list(loads)
+    coeff = np.stack([vel[n] for n in names], axis=1)
+    qa = np.atleast_1d(np.asarray(q, float))
+    forces = np.stack([np.broadcast_to(np.asarray(loads[n], float), qa.shape + (2,)) for n in names], axis=1)
+    return input_torque(coeff, forces, eta_trans, eta_link), valid
+
+
+# --------------------------------------------------------------------------
+# foot forces (notes 2.2)
+# --------------------------------------------------------------------------
+
+
+def static_foot_loads(
+    weight: float, com_x: ArrayLike, foot_x: ArrayLike, contact: ArrayLike
+) -> tuple[Array, NDArray[np.bool_]]:
+    """Normal load on each foot in contact, from weight and the centre of mass.
+
+    Vertical force balance ``sum f_i = W`` and moment balance about the
+    centre of mass ``sum f_i (x_i - x_c) = 0``, least-norm over the feet in
+    contact (statically indeterminate with three or more).  ``foot_x`` and
+    ``contact`` are ``(N, k)``.  Returns ``(loads (N, k), stable)``:
+    ``stable`` is false where the centre of mass is outside the feet's span
+    (the balance needs a negative, pulling foot) or no foot touches.
+    """
+    fx = np.atleast_2d(np.asarray(foot_x, float))
+    on = np.atleast_2d(np.asarray(contact, bool))
+    xc = np.broadcast_to(np.asarray(com_x, float), fx.shape[:1])
+    n, k = fx.shape
+    A = np.zeros((n, 2, k))
+    A[:, 0, :] = on
+    A[:, 1, :] = on * (fx - xc[:, None])
+    b = np.zeros((n, 2))
+    b[:, 0] = weight
+    f = np.einsum("nkj,nj->nk", np.linalg.pinv(A), b)
+    f = np.where(on, f, 0.0)
+    stable = on.any(1) & np.all(f >= -1e-9 * abs(weight), axis=1) & np.isclose(f.sum(1), weight)
+    return f, stable
+
+
+def fourier_acceleration(amplitudes: ArrayLike, freq_hz: float, t: ArrayLike,
+                         phases: ArrayLike | None = None) -> Array:
+    """Vertical acceleration of ``y = sum_k Y_k sin(k w t + phi_k)`` (notes eqs. 9-10).
+
+    ``y'' = -sum_k k^2 w^2 Y_k sin(k w t + phi_k)``, ``w = 2 pi freq``.
+    """
+    Y = np.asarray(amplitudes, float)
+    ph = np.zeros_like(Y) if phases is None else np.asarray(phases, float)
+    w = 2 * np.pi * freq_hz
+    k = np.arange(1, Y.size + 1)
+    tt = np.asarray(t, float)[..., None]
+    return -(k**2 * w**2 * Y * np.sin(k * w * tt + ph)).sum(-1)
+
+
+def fourier_peak_bound(amplitudes: ArrayLike, freq_hz: float) -> float:
+    """Upper bound ``w^2 sum k^2 |Y_k|`` of the peak acceleration (the notes' eq. 11)."""
+    Y = np.abs(np.asarray(amplitudes, float))
+    k = np.arange(1, Y.size + 1)
+    return float((2 * np.pi * freq_hz) ** 2 * (k**2 * Y).sum())
+
+
+def friction_limit(f_t: ArrayLike, f_n: ArrayLike, mu: float) -> tuple[Array, NDArray[np.bool_]]:
+    """Clip tangential forces to the friction cone ``|f_t| <= mu f_n``; also return where a foot slips."""
+    if mu < 0:
+        raise InputError("mu", mu, "a friction coefficient >= 0")
+    ft = np.asarray(f_t, float)
+    cap = mu * np.maximum(np.asarray(f_n, float), 0.0)
+    return np.clip(ft, -cap, cap), np.abs(ft) > cap

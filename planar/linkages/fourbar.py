@@ -1,0 +1,285 @@
+"""The four-bar linkage: closed-form position, circuits, Grashof class, limits.
+
+Conventions (issue #2): before placement the ground pivots are ``O2 = (0, 0)``
+and ``O4 = (ground, 0)``; the crank angle ``theta`` is measured
+counter-clockwise from the ground line; the crank pin is ``B``, the rocker pin
+``C``.  The coupler's frame has its origin at ``B`` and its x axis toward
+``C``; a coupler point is given in that frame.  Lengths: ``a`` crank, ``b``
+coupler, ``c`` rocker, ``d`` ground (Norton's notation, as the course notes).
+
+Circuit ``"open"``: ``C`` lies to the left of the directed diagonal
+``B -> O4`` (the quadrilateral ``O2 B C O4`` does not cross itself for the usual
+upward assembly); ``"crossed"``: to the right.  A Grashof crank keeps its
+circuit through the whole revolution (the triangle ``B C O4`` never
+degenerates), so a fixed side is branch continuity.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import InputError
+from ..model import check_positive
+from .dyads import RRR, Crank, Fixed, Link, Linkage, Rigid
+
+__all__ = ["FourBar", "grashof_class", "freudenstein_angles", "coupler_points_fast"]
+
+Array = NDArray[np.float64]
+Circuit = Literal["open", "crossed"]
+
+
+def grashof_class(a: float, b: float, c: float, d: float, tol: float = 1e-12) -> str:
+    """Grashof class of a four-bar with crank ``a``, coupler ``b``, rocker ``c``, ground ``d``.
+
+    Returns one of ``"crank-rocker"``, ``"double-crank"``, ``"double-rocker"``
+    (Grashof, coupler shortest), ``"rocker-crank"`` (Grashof, output link
+    shortest: the output turns fully, the input rocks), ``"change-point"``
+    (``s + l == p + q`` within ``tol`` of the sum) or ``"non-Grashof"``
+    (triple rocker).
+    """
+    lengths = [a, b, c, d]
+    s, l = min(lengths), max(lengths)
+    pq = sum(lengths) - s - l
+    scale = sum(lengths)
+    if abs((s + l) - pq) <= tol * scale:
+        return "change-point"
+    if s + l > pq:
+        return "non-Grashof"
+    shortest = int(np.argmin(lengths))
+    return ["crank-rocker", "double-rocker", "rocker-crank", "double-crank"][shortest]
+
+
+def freudenstein_angles(
+    a: float, b: float, c: float, d: float, theta: ArrayLike, circuit: Circuit = "open"
+) -> tuple[Array, Array, NDArray[np.bool_]]:
+    """Coupler and rocker angles ``(theta3, theta4, valid)`` by the tangent half-angle method.
+
+    Freudenstein's equation in ``t = tan(theta4 / 2)``: ``A t^2 + B t + C = 0``
+    with ``K1 = d/a, K2 = d/c, K3 = (a^2 - b^2 + c^2 + d^2) / (2 a c)``,
+    ``A = cos th - K1 - K2 cos th + K3``, ``B = -2 sin th``,
+    ``C = K1 - (K2 + 1) cos th + K3`` (Norton, as the course notes assume);
+    ``theta3`` likewise with ``K4 = d/b, K5 = (c^2 - d^2 - a^2 - b^2) / (2 a b)``.
+
+    Stable roots: ``q = -(B + sign(B) sqrt(B^2 - 4AC)) / 2`` and the two roots
+    ``q / A`` and ``C / q``; each becomes an angle as ``2 atan2(num, den)``, so
+    ``A = 0`` (``theta = pi``) is no division by zero.  Open circuit is the
+    root ``(-B - sqrt(disc)) / (2A)`` for theta4 and ``(-E - sqrt)/(2D)`` for
+    theta3, verified against the circle-circle solution in the tests.
+    """
+    th = np.asarray(theta, dtype=float)
+    ct, st = np.cos(th), np.sin(th)
+    K1, K2, K3 = d / a, d / c, (a * a - b * b + c * c + d * d) / (2 * a * c)
+    K4, K5 = d / b, (c * c - d * d - a * a - b * b) / (2 * a * b)
+    sign = -1.0 if circuit == "open" else 1.0
+
+    def half_angle(A: Array, B: Array, C: Array) -> tuple[Array, NDArray[np.bool_]]:
+        disc = B * B - 4 * A * C
+        scale = np.maximum.reduce([np.abs(B * B), np.abs(4 * A * C), np.full_like(B, 1e-300)])
+        valid = disc >= -1e-12 * scale
+        sq = np.sqrt(np.maximum(disc, 0.0))
+        sB = np.where(B >= 0, 1.0, -1.0)
+        q = -0.5 * (B + sB * sq)
+        # root_minus = (-B - sq) / 2A ; root_plus = (-B + sq) / 2A
+        # when B >= 0, q = (-B - sq)/2 so q/A is root_minus, C/q root_plus; else swapped
+        want_q_over_a = (sB > 0) == (sign < 0)
+        num = np.where(want_q_over_a, q, C)
+        den = np.where(want_q_over_a, A, q)
+        return 2.0 * np.arctan2(num, den), valid
+
+    th4, v4 = half_angle(ct - K1 - K2 * ct + K3, -2.0 * st, K1 - (K2 + 1.0) * ct + K3)
+    th3, v3 = half_angle(ct - K1 + K4 * ct + K5, -2.0 * st, K1 + (K4 - 1.0) * ct + K5)
+    return th3, th4, v3 & v4
+
+
+def coupler_points_fast(
+    a: float, b: float, c: float, d: float, u: float, v: float, theta: Array,
+    branch: float = 1.0, chunk: int = 1 << 13, threads: int = 1,
+) -> tuple[Array, NDArray[np.bool_]]:
+    """Coupler point ``(N, 2)`` and validity for crank angles ``theta``: the lean kernel.
+
+    Same closed form as :class:`FourBar` (circle-circle through the stable
+    Heron product, see :func:`planar.geometry.circle_circle`), fused and
+    evaluated in cache-sized chunks with preallocated buffers.  Used by
+    ``planar bench kinematics``; tests check it against :class:`FourBar`.
+    ``threads > 1`` splits the batch over threads (numpy releases the GIL in
+    its ufuncs); results are identical to one thread.
+    """
+    theta = np.ascontiguousarray(theta, dtype=float)
+    n = theta.shape[0]
+    out = np.empty((n, 2))
+    valid = np.empty(n, dtype=bool)
+    if threads > 1 and n >= 2 * chunk:
+        from concurrent.futures import ThreadPoolExecutor
+
+        bounds = np.linspace(0, n, threads + 1).astype(int)
+        with ThreadPoolExecutor(threads) as ex:
+            futs = [ex.submit(_coupler_kernel, a, b, c, d, u, v, theta[i:j], branch, chunk,
+                              out[i:j], valid[i:j]) for i, j in zip(bounds[:-1], bounds[1:])]
+            for f in futs:
+                f.result()
+        return out, valid
+    _coupler_kernel(a, b, c, d, u, v, theta, branch, chunk, out, valid)
+    return out, valid
+
+
+def _coupler_kernel(a, b, c, d, u, v, theta, branch, chunk, out, valid) -> None:
+    """Fill ``out`` and ``valid`` for ``theta`` (see :func:`coupler_points_fast`)."""
+    n = theta.shape[0]
+    s2, d2r = (b + c) ** 2, (b - c) ** 2
+    k = b * b - c * c
+    m = min(chunk, n) if n else 0
+    bx, by, dx, dy, dd, h, t, w = (np.empty(m) for _ in range(8))
+    for i in range(0, n, chunk):
+        j = min(i + chunk, n)
+        L = j - i
+        th = theta[i:j]
+        Bx, By, Dx, Dy, D2, H, T, W = bx[:L], by[:L], dx[:L], dy[:L], dd[:L], h[:L], t[:L], w[:L]
+        np.cos(th, out=Bx)
+        Bx *= a
+        np.sin(th, out=By)
+        By *= a
+        np.subtract(d, Bx, out=Dx)  # O4 - B
+        np.negative(By, out=Dy)
+        np.multiply(Dx, Dx, out=D2)
+        np.multiply(Dy, Dy, out=T)
+        D2 += T
+        # 4 d^2 h^2 = (s2 - d2)(d2 - d2r)
+        np.subtract(s2, D2, out=H)
+        np.subtract(D2, d2r, out=T)
+        H *= T
+        np.greater_equal(H, -1e-12 * s2 * s2, out=valid[i:j])
+        np.maximum(H, 0.0, out=H)
+        np.sqrt(H, out=H)
+        np.reciprocal(D2, out=W)  # 1 / d^2
+        H *= W  # 2 h / d
+        H *= 0.5 * branch
+        # alpha = (d2 + b^2 - c^2) / (2 d2) = 0.5 + 0.5 k / d2
+        W *= 0.5 * k
+        W += 0.5
+        # C - B = alpha * D + h * perp(D);  P - B = ((C-B) * u + perp(C-B) * v) / b
+        # (C-B)x = W Dx - H Dy ; (C-B)y = W Dy + H Dx
+        np.multiply(W, Dx, out=T)
+        T -= H * Dy  # (C-B)x
+        np.multiply(W, Dy, out=W)
+        W += H * Dx  # (C-B)y
+        ox, oy = out[i:j, 0], out[i:j, 1]
+        ub, vb = u / b, v / b
+        np.multiply(T, ub, out=ox)
+        ox -= W * vb
+        ox += Bx
+        np.multiply(W, ub, out=oy)
+        oy += T * vb
+        oy += By
+
+
+@dataclass(frozen=True)
+class _Dims:
+    a: float
+    b: float
+    c: float
+    d: float
+
+
+class FourBar(Linkage):
+    """A four-bar linkage driven by its crank (part ``crank``).
+
+    Parts: ``ground``, ``crank`` (O2 -> B), ``coupler`` (B -> C, plus the coupler
+    point), ``rocker`` (O4 -> C).  The coupler point is the named point
+    ``coupler_point``.  ``placement`` ``(x, y, angle)`` places the linkage in
+    the world frame.  Driving the input past a toggle position gives invalid
+    samples naming joint ``C``.
+    """
+
+    def __init__(
+        self,
+        ground: float,
+        crank: float,
+        coupler: float,
+        rocker: float,
+        coupler_point: Sequence[float] = (0.5, 0.0),
+        circuit: Circuit = "open",
+        placement: Sequence[float] = (0.0, 0.0, 0.0),
+        name: str = "fourbar",
+        **kw,
+    ) -> None:
+        a = check_positive(f"{name}.crank", crank)
+        b = check_positive(f"{name}.coupler", coupler)
+        c = check_positive(f"{name}.rocker", rocker)
+        d = check_positive(f"{name}.ground", ground)
+        if circuit not in ("open", "crossed"):
+            raise InputError(f"{name}.circuit", circuit, "'open' or 'crossed'")
+        self.dims = _Dims(a, b, c, d)
+        self.circuit: Circuit = circuit
+        self.branch = 1 if circuit == "open" else -1
+        self.coupler_point = (float(coupler_point[0]), float(coupler_point[1]))
+        if max(a, b, c, d) >= (a + b + c + d) - max(a, b, c, d):
+            raise InputError(
+                f"{name}.links", (a, b, c, d),
+                "the longest link shorter than the sum of the other three (else it cannot close)",
+            )
+        nodes = [
+            Fixed("O2", (0.0, 0.0)),
+            Fixed("O4", (d, 0.0)),
+            Crank("B", "O2", a),
+            RRR("C", "B", b, "O4", c, self.branch),
+            Rigid("P", "B", "C", self.coupler_point),
+        ]
+        links = [Link("crank", ("O2", "B")), Link("coupler", ("B", "C", "P")), Link("rocker", ("O4", "C"))]
+        super().__init__(name, nodes, links, points={"coupler_point": "P"}, placement=placement, **kw)
+
+    # -- classification and limits -----------------------------------------
+    @property
+    def grashof(self) -> str:
+        """Grashof class (see :func:`grashof_class`)."""
+        g = self.dims
+        return grashof_class(g.a, g.b, g.c, g.d)
+
+    def input_range(self) -> list[tuple[float, float]]:
+        """Intervals of crank angle (radians, ascending) where the linkage assembles.
+
+        ``[(0, 2 pi)]`` for a crank that turns fully.  Otherwise the ends are
+        the toggle (limit) angles where coupler and rocker fall into line:
+        ``|B - O4|^2 = a^2 + d^2 - 2 a d cos(theta) = (b +/- c)^2``.
+        """
+        g = self.dims
+        lo_c = (g.a**2 + g.d**2 - (g.b - g.c) ** 2) / (2 * g.a * g.d)
+        hi_c = (g.a**2 + g.d**2 - (g.b + g.c) ** 2) / (2 * g.a * g.d)
+        lo = float(np.arccos(np.clip(lo_c, -1, 1)))  # |B-O4| >= |b - c| for theta >= lo
+        hi = float(np.arccos(np.clip(hi_c, -1, 1)))  # |B-O4| <= b + c for theta <= hi
+        if lo > hi:
+            return []
+        if lo == 0.0 and hi == np.pi:
+            return [(0.0, 2 * np.pi)]
+        if lo == 0.0:
+            return [(-hi, hi)]
+        if hi == np.pi:
+            return [(lo, 2 * np.pi - lo)]
+        return [(lo, hi), (2 * np.pi - hi, 2 * np.pi - lo)]
+
+    def toggle_angles(self) -> Array:
+        """Crank angles (radians) at the limits of its motion; empty for a full crank."""
+        ends = [e for iv in self.input_range() for e in iv]
+        if ends == [0.0, 2 * np.pi]:
+            return np.array([])
+        return np.array(sorted(set(float(np.mod(e, 2 * np.pi)) for e in ends)))
+
+    def angles(self, theta: ArrayLike) -> tuple[Array, Array, NDArray[np.bool_]]:
+        """``(theta3, theta4, valid)``: coupler and rocker angles by the tangent half-angle method."""
+        g = self.dims
+        return freudenstein_angles(g.a, g.b, g.c, g.d, theta, self.circuit)
+
+    def transmission_angle(self, theta: ArrayLike) -> Array:
+        """Transmission angle (radians, in ``[0, pi]``) between coupler and rocker at ``C``."""
+        g = self.dims
+        th = np.asarray(theta, float)
+        bo2 = g.a**2 + g.d**2 - 2 * g.a * g.d * np.cos(th)
+        return np.arccos(np.clip((g.b**2 + g.c**2 - bo2) / (2 * g.b * g.c), -1.0, 1.0))
+
+    def coupler_curve(self, theta: ArrayLike) -> tuple[Array, NDArray[np.bool_]]:
+        """World coupler-point curve ``(N, 2)`` and validity for crank angles ``theta``."""
+        m = self.solve(theta)
+        return m.points["coupler_point"], m.valid

@@ -1,0 +1,64 @@
+"""Offset slider-crank: crank ``r`` about ``O = (0, 0)``, rod ``l``, slider on ``y = offset``.
+
+Closed form (line-circle dyad): the slider's x is
+``r cos(theta) + branch * sqrt(l^2 - (r sin(theta) - e)^2)``, computed through
+:func:`planar.geometry.line_circle` (half-chord ``sqrt((l - h)(l + h))``, no
+cancellation).  ``branch=+1`` puts the slider on the +x side.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+from ..errors import InputError
+from ..model import check_finite, check_positive
+from .dyads import RRP, Crank, Fixed, Link, Linkage
+
+__all__ = ["SliderCrank"]
+
+
+class SliderCrank(Linkage):
+    """Offset slider-crank with parts ``ground``, ``crank``, ``rod``, ``slider``.
+
+    The slider block slides (pure translation) along the ground's guide line
+    ``y = offset``; the named point ``slider_pin`` is the wrist pin.
+    """
+
+    def __init__(
+        self,
+        crank: float,
+        rod: float,
+        offset: float = 0.0,
+        branch: int = 1,
+        placement: Sequence[float] = (0.0, 0.0, 0.0),
+        name: str = "slidercrank",
+        **kw,
+    ) -> None:
+        r = check_positive(f"{name}.crank", crank)
+        l = check_positive(f"{name}.rod", rod)
+        e = float(check_finite(f"{name}.offset", offset))
+        if abs(e) >= r + l:
+            raise InputError(f"{name}.offset", offset, f"|offset| < crank + rod = {r + l:g} (else the rod never reaches the guide)")
+        self.r, self.l, self.e = r, l, e
+        span = r + l
+        nodes = [
+            Fixed("O", (0.0, 0.0)),
+            Fixed("G1", (-span, e)),
+            Fixed("G2", (2 * span, e)),
+            Crank("A", "O", r),
+            RRP("S", "A", l, "G1", "G2", branch),
+        ]
+        links = [
+            Link("crank", ("O", "A")),
+            Link("rod", ("A", "S")),
+            Link("slider", ("S",), guide=("G1", "G2")),
+        ]
+        super().__init__(name, nodes, links, points={"slider_pin": "S"}, placement=placement, **kw)
+
+    def slider_position(self, theta) -> np.ndarray:
+        """Slider x (before placement) by the textbook formula, for cross-checks."""
+        th = np.asarray(theta, float)
+        h = self.r * np.sin(th) - self.e
+        return self.r * np.cos(th) + np.sqrt(np.maximum(self.l**2 - h**2, 0.0))

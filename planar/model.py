@@ -1,0 +1,500 @@
+"""The mechanism model every consumer reads: parts, joints, driver, motion.
+
+A :class:`Mechanism` is declared once: rigid :class:`Part` objects (each with
+its outline in its own frame), joints between parts, and one :class:`Driver`.
+Its :meth:`Mechanism.solve` maps an array of driver values to a
+:class:`Motion` holding, for every part, an ``(N, 3)`` pose track
+``(x, y, angle)`` that maps the part's own frame to the world, a validity mask
+and, for every invalid sample, which joint failed and why.
+
+Units are model units (a scene says what one unit is in millimetres); angles
+are radians, counter-clockwise positive.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import TYPE_CHECKING, Any, Literal, Mapping, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .errors import InputError
+from .geometry import poses_apply
+
+if TYPE_CHECKING:  # shapely is imported only when an outline is asked for
+    import shapely
+
+__all__ = [
+    "Hole",
+    "Slot",
+    "ArcSlot",
+    "Part",
+    "Pivot",
+    "PinInSlot",
+    "PinInArcSlot",
+    "Slide",
+    "CamOnLine",
+    "Joint",
+    "Driver",
+    "Motion",
+    "Mechanism",
+    "joint_residuals",
+    "check_positive",
+    "check_finite",
+]
+
+Vec = tuple[float, float]
+Array = NDArray[np.float64]
+
+
+def check_finite(field_name: str, value: ArrayLike) -> NDArray[np.float64]:
+    """Return ``value`` as a float array or raise :class:`InputError` on NaN/inf."""
+    arr = np.asarray(value, dtype=float)
+    if not np.all(np.isfinite(arr)):
+        raise InputError(field_name, value, "finite numbers")
+    return arr
+
+
+def check_positive(field_name: str, value: float) -> float:
+    """Return ``value`` as float or raise :class:`InputError` unless finite and > 0."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(field_name, value, "a positive number") from None
+    if not np.isfinite(v) or v <= 0.0:
+        raise InputError(field_name, value, "a positive, finite length")
+    return v
+
+
+def _vec(v: ArrayLike) -> Vec:
+    a = np.asarray(v, dtype=float).reshape(2)
+    return (float(a[0]), float(a[1]))
+
+
+# --------------------------------------------------------------------------
+# Parts and their features (exact geometry, in the part's own frame)
+# --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Hole:
+    """A round hole for a pin, centred at ``centre``; ``diameter`` nominal."""
+
+    centre: Vec
+    diameter: float
+
+
+@dataclass(frozen=True)
+class Slot:
+    """A straight slot (stadium): the pin's centre travels from ``start`` to ``end``."""
+
+    start: Vec
+    end: Vec
+    width: float
+
+
+@dataclass(frozen=True)
+class ArcSlot:
+    """An arc slot about ``centre`` of mid-radius ``radius`` from ``angle0`` to ``angle1`` (CCW)."""
+
+    centre: Vec
+    radius: float
+    angle0: float
+    angle1: float
+    width: float
+
+
+Feature = Hole | Slot | ArcSlot
+
+
+@dataclass(frozen=True, eq=False)
+class Part:
+    """A rigid part.
+
+    ``hull`` lists circles ``(x, y, r)`` whose convex hull is the outer
+    profile (the paper's recipe: convex hull around the joints, rounded); it
+    is exact geometry (lines tangent to arcs) for fabrication.  ``features``
+    are holes and slots cut from it.  ``plane`` names the plane the part moves
+    in (``"xy"`` for planar parts; wind-up mechanism #8 moves in ``"xz"``).
+    """
+
+    name: str
+    hull: tuple[tuple[float, float, float], ...]
+    features: tuple[Feature, ...] = ()
+    ground: bool = False
+    plane: str = "xy"
+    #: an explicit outer polygon (own frame) replacing the rounded hull, if given
+    polygon: tuple[Vec, ...] | None = None
+
+    @cached_property
+    def outline(self) -> "shapely.Polygon":
+        """The outline as a shapely polygon with holes and slots cut out."""
+        from .outlines import part_outline
+
+        return part_outline(self)
+
+    @property
+    def area(self) -> float:
+        """Area of the outline in model units squared."""
+        return float(self.outline.area)
+
+
+# --------------------------------------------------------------------------
+# Joints
+# --------------------------------------------------------------------------
+
+
+def _pose(poses: Mapping[str, Array], part: str) -> Array:
+    return poses[part]
+
+
+def _point_line_distance(p: Array, a: Array, b: Array) -> Array:
+    """Signed distance of ``p`` from the line ``a -> b`` (left positive); ``(N,)``."""
+    d = b - a
+    n = np.hypot(d[..., 0], d[..., 1])
+    w = p - a
+    return (d[..., 0] * w[..., 1] - d[..., 1] * w[..., 0]) / n
+
+
+@dataclass(frozen=True)
+class Pivot:
+    """Revolute joint: point ``anchor_a`` of part ``a`` coincides with ``anchor_b`` of ``b``."""
+
+    name: str
+    a: str
+    anchor_a: Vec
+    b: str
+    anchor_b: Vec
+
+    def residual(self, poses: Mapping[str, Array]) -> Array:
+        """Distance between the two anchor points, per sample."""
+        pa = poses_apply(_pose(poses, self.a), self.anchor_a)
+        pb = poses_apply(_pose(poses, self.b), self.anchor_b)
+        return np.hypot(*(pa - pb).T)
+
+
+@dataclass(frozen=True)
+class PinInSlot:
+    """A pin ``pin`` on ``pin_part`` runs in a straight slot ``start -> end`` of ``slot_part``.
+
+    The residual is the pin's distance from the slot's centre line, plus how
+    far it has left the slot's length (so a slot that is too short shows).
+    """
+
+    name: str
+    pin_part: str
+    pin: Vec
+    slot_part: str
+    start: Vec
+    end: Vec
+
+    def residual(self, poses: Mapping[str, Array]) -> Array:
+        p = poses_apply(_pose(poses, self.pin_part), self.pin)
+        a = poses_apply(_pose(poses, self.slot_part), self.start)
+        b = poses_apply(_pose(poses, self.slot_part), self.end)
+        off = np.abs(_point_line_distance(p, a, b))
+        d = b - a
+        L = np.hypot(d[..., 0], d[..., 1])
+        s = ((p - a) * d).sum(-1) / L
+        beyond = np.maximum(0.0, np.maximum(-s, s - L))
+        return np.hypot(off, beyond)
+
+
+@dataclass(frozen=True)
+class PinInArcSlot:
+    """A pin on ``pin_part`` in an arc slot of ``slot_part`` (centre, mid-radius).
+
+    Kinematically the same as a pivot on a link of length ``radius`` about
+    ``centre`` (reference file); the residual is ``| |pin - centre| - radius |``.
+    """
+
+    name: str
+    pin_part: str
+    pin: Vec
+    slot_part: str
+    centre: Vec
+    radius: float
+
+    def residual(self, poses: Mapping[str, Array]) -> Array:
+        p = poses_apply(_pose(poses, self.pin_part), self.pin)
+        c = poses_apply(_pose(poses, self.slot_part), self.centre)
+        return np.abs(np.hypot(*(p - c).T) - self.radius)
+
+
+@dataclass(frozen=True)
+class Slide:
+    """Prismatic joint: ``part`` translates along ``guide``'s line without rotating.
+
+    Realised as two pins of ``part`` (``anchor`` and ``anchor + axis``, with
+    ``axis`` a vector in ``part``'s frame) sliding in one straight slot
+    ``start -> end`` of ``guide`` (the paper's support kind (h)).  The
+    residual is the larger of the two pins' distances from the slot line.
+    """
+
+    name: str
+    part: str
+    anchor: Vec
+    axis: Vec
+    guide: str
+    start: Vec
+    end: Vec
+
+    def residual(self, poses: Mapping[str, Array]) -> Array:
+        q = _pose(poses, self.part)
+        p1 = poses_apply(q, self.anchor)
+        p2 = poses_apply(q, (self.anchor[0] + self.axis[0], self.anchor[1] + self.axis[1]))
+        a = poses_apply(_pose(poses, self.guide), self.start)
+        b = poses_apply(_pose(poses, self.guide), self.end)
+        return np.maximum(np.abs(_point_line_distance(p1, a, b)), np.abs(_point_line_distance(p2, a, b)))
+
+
+@dataclass(frozen=True)
+class CamOnLine:
+    """A round cam (``centre``, ``radius`` on ``cam_part``) touching a flat face.
+
+    The face is the line ``start -> end`` on ``face_part``; residual is
+    ``| distance(centre, line) - radius |``.
+    """
+
+    name: str
+    cam_part: str
+    centre: Vec
+    radius: float
+    face_part: str
+    start: Vec
+    end: Vec
+
+    def residual(self, poses: Mapping[str, Array]) -> Array:
+        c = poses_apply(_pose(poses, self.cam_part), self.centre)
+        a = poses_apply(_pose(poses, self.face_part), self.start)
+        b = poses_apply(_pose(poses, self.face_part), self.end)
+        return np.abs(np.abs(_point_line_distance(c, a, b)) - self.radius)
+
+
+Joint = Pivot | PinInSlot | PinInArcSlot | Slide | CamOnLine
+
+
+# --------------------------------------------------------------------------
+# Driver
+# --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Driver:
+    """The single input of a mechanism.
+
+    ``kind`` is ``"rotation"`` (value in radians, counter-clockwise, about
+    ``origin`` of the ground) or ``"translation"`` (value in model units along
+    the unit ``axis``).  ``rate`` is the angular frequency in rad/s.  Over
+    time ``t`` (seconds) the driver value is
+
+    * full rotation (``amplitude is None``): ``phase + rate * t``;
+    * oscillation: ``centre + amplitude * sin(rate * t + phase)``.
+    """
+
+    part: str
+    kind: Literal["rotation", "translation"] = "rotation"
+    origin: Vec = (0.0, 0.0)
+    axis: Vec = (1.0, 0.0)
+    rate: float = 2.0 * np.pi
+    phase: float = 0.0
+    amplitude: float | None = None
+    centre: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.kind not in ("rotation", "translation"):
+            raise InputError("driver.kind", self.kind, "'rotation' or 'translation'")
+        check_positive("driver.rate", self.rate)
+        if self.kind == "translation" and self.amplitude is None:
+            raise InputError("driver.amplitude", None, "a stroke amplitude for a translation driver")
+
+    @property
+    def period(self) -> float:
+        """Seconds per cycle."""
+        return 2.0 * np.pi / self.rate
+
+    def value(self, t: ArrayLike) -> Array:
+        """Driver value at times ``t`` (s)."""
+        t = np.asarray(t, dtype=float)
+        if self.amplitude is None:
+            return self.phase + self.rate * t
+        return self.centre + self.amplitude * np.sin(self.rate * t + self.phase)
+
+    def speed(self, t: ArrayLike) -> Array:
+        """Time derivative of :meth:`value` (rad/s or units/s)."""
+        t = np.asarray(t, dtype=float)
+        if self.amplitude is None:
+            return np.full_like(t, self.rate)
+        return self.amplitude * self.rate * np.cos(self.rate * t + self.phase)
+
+    def times(self, samples_per_cycle: int = 360, cycles: float = 1.0) -> Array:
+        """Sample times covering ``cycles`` periods, end point excluded."""
+        n = int(round(samples_per_cycle * cycles))
+        if n < 1:
+            raise InputError("samples_per_cycle", samples_per_cycle, "at least one sample")
+        return np.arange(n) * (self.period / samples_per_cycle)
+
+
+# --------------------------------------------------------------------------
+# Motion
+# --------------------------------------------------------------------------
+
+
+@dataclass
+class Motion:
+    """Poses of every part over a batch of driver values.
+
+    ``poses[part]`` is ``(N, 3)``: ``x, y, angle`` of the part's frame in the
+    world.  ``valid`` is ``(N,)``.  ``fail_code[i]`` indexes ``fail_table``
+    (``-1`` where valid); each table entry is ``(joint, why)``.  Invalid
+    samples hold finite, nearest-real poses (never NaN) so they can be drawn
+    and marked.
+    """
+
+    driver: Array
+    poses: dict[str, Array]
+    valid: NDArray[np.bool_]
+    fail_code: NDArray[np.int16]
+    fail_table: list[tuple[str, str]] = field(default_factory=list)
+    points: dict[str, Array] = field(default_factory=dict)
+    t: Array | None = None
+
+    def __len__(self) -> int:
+        return int(self.driver.shape[0])
+
+    def reason(self, i: int) -> str:
+        """Why sample ``i`` is invalid (empty string when it is valid)."""
+        code = int(self.fail_code[i])
+        if code < 0:
+            return ""
+        joint, why = self.fail_table[code]
+        return f"joint {joint!r} cannot close at driver value {self.driver[i]:.6g}: {why}"
+
+    def failures(self) -> list[tuple[int, float, str, str]]:
+        """``(index, driver value, joint, why)`` for every invalid sample."""
+        idx = np.flatnonzero(~self.valid)
+        return [
+            (int(i), float(self.driver[i]), *self.fail_table[int(self.fail_code[i])]) for i in idx
+        ]
+
+    @property
+    def failed_joints(self) -> set[str]:
+        """Names of the joints that failed anywhere."""
+        codes = np.unique(self.fail_code[self.fail_code >= 0])
+        return {self.fail_table[int(c)][0] for c in codes}
+
+
+def merge_failures(
+    n: int, checks: Sequence[tuple[NDArray[np.bool_], str, str]]
+) -> tuple[NDArray[np.bool_], NDArray[np.int16], list[tuple[str, str]]]:
+    """Combine per-joint validity masks into (valid, fail_code, fail_table).
+
+    ``checks`` holds ``(valid_mask, joint, why)`` in solve order; a sample's
+    failure is attributed to the *first* joint that could not close.
+    """
+    valid = np.ones(n, dtype=bool)
+    code = np.full(n, -1, dtype=np.int16)
+    table: list[tuple[str, str]] = []
+    for mask, joint, why in checks:
+        bad = ~np.asarray(mask, dtype=bool) & valid
+        if bad.any():
+            code[bad] = len(table)
+            table.append((joint, why))
+            valid &= ~bad
+    return valid, code, table
+
+
+# --------------------------------------------------------------------------
+# Mechanism
+# --------------------------------------------------------------------------
+
+
+class Mechanism:
+    """Base class of every mechanism: parts, joints, a driver, named points.
+
+    Subclasses implement :meth:`_solve_poses`.  ``points`` maps a name (a
+    coupler point, a foot) to ``(part, (x, y))`` in that part's frame.
+    """
+
+    name: str
+    parts: tuple[Part, ...]
+    joints: tuple[Any, ...]
+    driver: Driver
+    points: dict[str, tuple[str, Vec]]
+
+    def __init__(
+        self,
+        name: str,
+        parts: Sequence[Part],
+        joints: Sequence[Any],
+        driver: Driver,
+        points: Mapping[str, tuple[str, Vec]] | None = None,
+    ) -> None:
+        self.name = name
+        self.parts = tuple(parts)
+        self.joints = tuple(joints)
+        self.driver = driver
+        self.points = dict(points or {})
+        names = [p.name for p in self.parts]
+        if len(set(names)) != len(names):
+            raise InputError(f"{name}.parts", names, "unique part names")
+        for pname, (part, _) in self.points.items():
+            if part not in names:
+                raise InputError(f"{name}.points.{pname}", part, f"one of the parts {names}")
+
+    # -- to implement ------------------------------------------------------
+    def _solve_poses(
+        self, q: Array
+    ) -> tuple[dict[str, Array], list[tuple[NDArray[np.bool_], str, str]]]:
+        """Poses for driver values ``q`` and the per-joint validity checks."""
+        raise NotImplementedError
+
+    # -- shared ------------------------------------------------------------
+    def part(self, name: str) -> Part:
+        """The part called ``name``."""
+        for p in self.parts:
+            if p.name == name:
+                return p
+        raise InputError(f"{self.name}.part", name, f"one of {[p.name for p in self.parts]}")
+
+    def solve(self, q: ArrayLike, t: ArrayLike | None = None) -> Motion:
+        """Solve all samples at once for driver values ``q`` (scalar or array)."""
+        qa = np.atleast_1d(check_finite(f"{self.name}.driver value", q)).astype(float)
+        poses, checks = self._solve_poses(qa)
+        valid, code, table = merge_failures(qa.shape[0], checks)
+        pts = {n: poses_apply(poses[part], xy) for n, (part, xy) in self.points.items()}
+        return Motion(
+            driver=qa,
+            poses=poses,
+            valid=valid,
+            fail_code=code,
+            fail_table=table,
+            points=pts,
+            t=None if t is None else np.asarray(t, dtype=float),
+        )
+
+    def run(self, samples_per_cycle: int = 360, cycles: float = 1.0) -> Motion:
+        """Solve over time with the driver's law (``cycles`` periods)."""
+        t = self.driver.times(samples_per_cycle, cycles)
+        return self.solve(self.driver.value(t), t=t)
+
+    @property
+    def size(self) -> float:
+        """Characteristic length: the largest extent of any part's hull."""
+        best = 0.0
+        for p in self.parts:
+            if p.hull:
+                h = np.asarray(p.hull)
+                ext = np.ptp(h[:, 0]) + np.ptp(h[:, 1]) + 2 * h[:, 2].max()
+                best = max(best, float(ext))
+        return best or 1.0
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} {self.name!r}: {len(self.parts)} parts, {len(self.joints)} joints>"
+
+
+def joint_residuals(mech: Mechanism, motion: Motion) -> dict[str, Array]:
+    """Residual (model units) of every joint of ``mech`` on every sample of ``motion``."""
+    return {j.name: np.asarray(j.residual(motion.poses)) for j in mech.joints}
