@@ -343,7 +343,13 @@ def static_foot_loads(
     b[:, 0] = weight
     f = np.einsum("nkj,nj->nk", np.linalg.pinv(A), b)
     f = np.where(on, f, 0.0)
-    stable = on.any(1) & np.all(f >= -1e-9 * abs(weight), axis=1) & np.isclose(f.sum(1), weight)
+    # one foot down: it carries the whole weight (moment balance is impossible: the machine tips
+    # unless the centre of mass is right above it)
+    one = on.sum(1) == 1
+    f[one] = np.where(on[one], weight, 0.0)
+    moment = np.where(on, f * (fx - xc[:, None]), 0.0).sum(1)
+    stable = (on.any(1) & np.all(f >= -1e-9 * abs(weight), axis=1)
+              & np.isclose(f.sum(1), weight) & (np.abs(moment) <= 1e-9 * abs(weight) * (1 + np.abs(fx).max(1))))
     return f, stable
 
 

@@ -60,7 +60,7 @@ def test_notes_eq3_rotation_about_a_point():
 def test_circle_circle_points_lie_on_both_circles(x1, y1, r1, x2, y2, r2, br):
     p, ok = g.circle_circle([x1, y1], r1, [x2, y2], r2, br)
     d = np.hypot(x2 - x1, y2 - y1)
-    if d > 0 and abs(r1 - r2) * (1 + 1e-9) < d < (r1 + r2) * (1 - 1e-9):
+    if d > 1e-9 * max(r1, r2) and abs(r1 - r2) * (1 + 1e-9) < d < (r1 + r2) * (1 - 1e-9):
         assert ok
     if d > (r1 + r2) * (1 + 1e-6) or d < abs(r1 - r2) * (1 - 1e-6):
         assert not ok
