@@ -138,10 +138,19 @@ def _coupler_kernel(a, b, c, d, u, v, theta, branch, chunk, out, valid) -> None:
         L = j - i
         th = theta[i:j]
         Bx, By, Dx, Dy, D2, H, T, W = bx[:L], by[:L], dx[:L], dy[:L], dd[:L], h[:L], t[:L], w[:L]
-        np.cos(th, out=Bx)
+        # crank pin by the tangent half-angle (one vectorised tan instead of cos and sin):
+        # t = tan(th/2), cos th = (1 - t^2)/(1 + t^2), sin th = 2t/(1 + t^2); t stays finite
+        # in floating point (tan of the double nearest pi/2 is 1.6e16), so no special case
+        np.multiply(th, 0.5, out=T)
+        np.tan(T, out=T)
+        np.multiply(T, T, out=W)
+        np.add(W, 1.0, out=D2)
+        np.reciprocal(D2, out=D2)  # 1/(1 + t^2)
+        np.subtract(1.0, W, out=Bx)
+        Bx *= D2
         Bx *= a
-        np.sin(th, out=By)
-        By *= a
+        np.multiply(T, D2, out=By)
+        By *= 2.0 * a
         np.subtract(d, Bx, out=Dx)  # O4 - B
         np.negative(By, out=Dy)
         np.multiply(Dx, Dx, out=D2)

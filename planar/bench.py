@@ -1,0 +1,132 @@
+"""Benchmarks a user can run (``planar bench NAME``), each against a peer in the same run.
+
+Results are ratios measured on the machine at hand, never hard-coded targets.
+``kinematics``: planar's four-bar solve against pylinkage's fastest path (its
+numba ``step_fast``) on the same linkage and the same crank angles, checking
+that both give the same coupler points.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from typing import Any, Callable
+
+import numpy as np
+
+from .errors import PlanarError
+
+__all__ = ["bench_kinematics", "BENCHMARKS"]
+
+#: the linkage both sides solve: ground, crank, coupler, rocker, coupler point (u, v)
+FOURBAR = dict(d=4.0, a=1.0, b=4.0, c=3.0, u=2.0, v=1.0)
+
+
+def _best_time(fn: Callable[[], Any], repeats: int) -> float:
+    best = math.inf
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def _pylinkage_fourbar(step: float):
+    try:
+        import pylinkage as pl
+        from pylinkage.simulation import Linkage
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise PlanarError(
+            "planar bench kinematics needs the peer library pylinkage: pip install 'planar[bench]'"
+        ) from e
+    g = FOURBAR
+    O2 = pl.Ground(0.0, 0.0, name="O2")
+    O4 = pl.Ground(g["d"], 0.0, name="O4")
+    crank = pl.Crank(anchor=O2, radius=g["a"], angular_velocity=step, name="B")
+    C = pl.RRRDyad(crank.output, O4, g["b"], g["c"], name="C")
+    # the coupler point in the coupler frame (origin B, x toward C), as polar offset from B
+    P = pl.FixedDyad(crank.output, C, math.hypot(g["u"], g["v"]), math.atan2(g["v"], g["u"]), name="P")
+    lk = Linkage([O2, O4, crank, C, P])
+    return lk
+
+
+def bench_kinematics(n: int = 2_000_000, repeats: int = 5, threads: int | None = None) -> dict[str, Any]:
+    """Throughput of the four-bar coupler-point solve, planar vs pylinkage ``step_fast``.
+
+    Both solve ``n`` crank angles ``k * 2 pi / 3600`` (k = 1..n) of the same
+    linkage (ground 4, crank 1, coupler 4, rocker 3, coupler point (2, 1)).
+    Returns steps per second for planar on one thread and on ``threads``
+    (default: all cores), for pylinkage, the ratios planar / pylinkage
+    (``ratio`` is planar's best path) and the largest coupler-point
+    difference between the two.
+    """
+    from .linkages.fourbar import FourBar, coupler_points_fast
+
+    threads = threads or os.cpu_count() or 1
+    g = FOURBAR
+    step = 2 * math.pi / 3600
+    theta = step * np.arange(1, n + 1)
+
+    # pick the open-circuit branch pylinkage assembles in
+    lk = _pylinkage_fourbar(step)
+    traj = lk.step_fast(iterations=16)
+    C0 = traj[0, 3]
+    B0 = traj[0, 2]
+    side = (g["d"] - B0[0]) * (C0[1] - B0[1]) - (0.0 - B0[1]) * (C0[0] - B0[0])
+    branch = 1.0 if side > 0 else -1.0
+
+    def run_planar(t: int) -> Callable[[], Any]:
+        return lambda: coupler_points_fast(g["a"], g["b"], g["c"], g["d"], g["u"], g["v"], theta, branch, threads=t)
+
+    def run_peer() -> Any:
+        lk2 = _pylinkage_fourbar(step)
+        return lk2.step_fast(iterations=n)
+
+    run_peer()  # numba compile (cached) outside the timing
+    run_planar(1)()
+    t_single = _best_time(run_planar(1), repeats)
+    t_multi = _best_time(run_planar(threads), repeats) if threads > 1 else t_single
+    t_peer = _best_time(run_peer, repeats)
+
+    ours, ok = run_planar(threads)()
+    peer = run_peer()[:, 4, :]
+    diff = float(np.max(np.abs(ours - peer)))
+    fb = FourBar(g["d"], g["a"], g["b"], g["c"], coupler_point=(g["u"], g["v"]),
+                 circuit="open" if branch > 0 else "crossed")
+    check = fb.solve(theta[:: max(1, n // 10000)]).points["coupler_point"]
+    diff_model = float(np.max(np.abs(check - ours[:: max(1, n // 10000)])))
+    planar_single = n / t_single
+    planar_best = n / min(t_single, t_multi)
+    peer_rate = n / t_peer
+    return {
+        "benchmark": "kinematics",
+        "n": n,
+        "threads": threads,
+        "planar_steps_per_s": planar_best,
+        "planar_single_thread_steps_per_s": planar_single,
+        "peer": "pylinkage step_fast (numba)",
+        "peer_steps_per_s": peer_rate,
+        "ratio": planar_best / peer_rate,
+        "ratio_single_thread": planar_single / peer_rate,
+        "max_abs_diff_vs_peer": diff,
+        "max_abs_diff_vs_model": diff_model,
+        "all_valid": bool(ok.all()),
+    }
+
+
+def format_kinematics(r: dict[str, Any]) -> str:
+    """Human-readable table of :func:`bench_kinematics` results."""
+    return "\n".join([
+        f"four-bar coupler points, {r['n']:,} crank angles",
+        f"  planar ({r['threads']} threads)   {r['planar_steps_per_s'] / 1e6:10.2f} M steps/s",
+        f"  planar (1 thread)     {r['planar_single_thread_steps_per_s'] / 1e6:10.2f} M steps/s",
+        f"  {r['peer']:<22}{r['peer_steps_per_s'] / 1e6:10.2f} M steps/s",
+        f"  ratio planar/peer     {r['ratio']:10.2f}  (one thread: {r['ratio_single_thread']:.2f})",
+        f"  max |planar - peer|   {r['max_abs_diff_vs_peer']:10.2e}",
+    ])
+
+
+BENCHMARKS: dict[str, tuple[Callable[..., dict[str, Any]], Callable[[dict[str, Any]], str]]] = {
+    "kinematics": (bench_kinematics, format_kinematics),
+}
