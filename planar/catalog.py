@@ -65,6 +65,19 @@ CATALOG: dict[str, Callable[[], Mechanism]] = {
 }
 
 
+def _windup(k: int) -> Callable[[], Mechanism]:
+    def make() -> Mechanism:
+        from .windup import elemental
+
+        return elemental(k)
+
+    return make
+
+
+for _k in range(1, 12):
+    CATALOG[f"windup-{_k}"] = _windup(_k)
+
+
 def get(name: str) -> Mechanism:
     """Build the catalog mechanism ``name``."""
     from .errors import InputError

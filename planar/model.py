@@ -125,6 +125,8 @@ class Part:
     features: tuple[Feature, ...] = ()
     ground: bool = False
     plane: str = "xy"
+    #: position along the normal of ``plane`` (e.g. x for a part moving in "yz")
+    offset: float = 0.0
     #: an explicit outer polygon (own frame) replacing the rounded hull, if given
     polygon: tuple[Vec, ...] | None = None
 
@@ -290,12 +292,14 @@ class Driver:
     the unit ``axis``).  ``rate`` is the angular frequency in rad/s.  Over
     time ``t`` (seconds) the driver value is
 
-    * full rotation (``amplitude is None``): ``phase + rate * t``;
+    * full rotation (``amplitude is None``): ``phase + rate * t``; for
+      ``kind="path"`` this is the phase of a closed driver path (an OzT
+      driver's step) that the mechanism maps to a pose;
     * oscillation: ``centre + amplitude * sin(rate * t + phase)``.
     """
 
     part: str
-    kind: Literal["rotation", "translation"] = "rotation"
+    kind: Literal["rotation", "translation", "path"] = "rotation"
     origin: Vec = (0.0, 0.0)
     axis: Vec = (1.0, 0.0)
     rate: float = 2.0 * np.pi
@@ -304,8 +308,8 @@ class Driver:
     centre: float = 0.0
 
     def __post_init__(self) -> None:
-        if self.kind not in ("rotation", "translation"):
-            raise InputError("driver.kind", self.kind, "'rotation' or 'translation'")
+        if self.kind not in ("rotation", "translation", "path"):
+            raise InputError("driver.kind", self.kind, "'rotation', 'translation' or 'path'")
         check_positive("driver.rate", self.rate)
         if self.kind == "translation" and self.amplitude is None:
             raise InputError("driver.amplitude", None, "a stroke amplitude for a translation driver")

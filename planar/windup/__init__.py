@@ -1,0 +1,11 @@
+"""Wind-up toy mechanisms (Song et al., SIGGRAPH Asia 2017): the 11 elemental
+mechanisms, the motion transfer table, chains and trees.
+
+See ``ERRATA.md`` beside this file for every correction to the supplement's
+equations and how it was verified.
+"""
+
+from .mechanisms import MOTIONS, ElementalMechanism, elemental
+from .params import PARAMS, params_for
+
+__all__ = ["MOTIONS", "ElementalMechanism", "elemental", "PARAMS", "params_for"]

@@ -1,0 +1,544 @@
+"""The 11 elemental mechanisms as :class:`~planar.model.Mechanism` objects.
+
+Each has three parts, ``ground``, ``driver`` and ``follower``, with outlines
+built from its parameters (cam discs, windows, slots, pins, supports: the
+convex hull around the joints, rounded, as in the paper), the paper's joint
+kinds (reference table), and a driver law for standalone use:
+
+* ``Rz`` drivers turn fully; ``Oz`` drivers oscillate by ``amplitude`` (rad);
+  ``Tx`` drivers stroke by ``amplitude`` (units);
+* ``OzT`` drivers (#10, #11) follow a closed step: the reference point moves
+  ``(a_x sin psi, a_y (cos psi - 1))`` while turning ``theta_max sin psi``
+  (``theta_max`` from the supplement's ``D_theta``), ``psi`` the driver value.
+
+View planes: #1-5, 7, 10, 11 move in xy.  #8 moves in xz; its poses are in
+``(x, z)`` coordinates and the mechanism's ``view`` is ``"xz"``.  #6 and #9
+are spatial: the driver moves in xy and the follower turns about an x-parallel
+axis, so the follower's pose is given in its own ``"yz"`` plane (``offset``
+is its x); drawings project orthographically onto xy.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InputError
+from ..geometry import poses_apply
+from ..model import (
+    ArcSlot,
+    CamOnLine,
+    Driver,
+    Hole,
+    Mechanism,
+    Part,
+    PinInArcSlot,
+    PinInSlot,
+    Pivot,
+    Slide,
+    Slot,
+)
+from . import params as P_
+from .kinematics import FORWARD, Stage
+
+__all__ = ["ElementalMechanism", "MOTIONS", "SkewContact", "elemental"]
+
+Array = NDArray[np.float64]
+
+#: (driver motion, follower motion) of each elemental mechanism
+MOTIONS: dict[int, tuple[str, str]] = {
+    1: ("Rz", "Tx"), 2: ("Rz", "Oz"), 3: ("Rz", "OzT"), 4: ("Oz", "Ty"), 5: ("Oz", "Oz"),
+    6: ("Oz", "Ox"), 7: ("Tx", "Oz"), 8: ("Tx", "Oy"), 9: ("Tx", "Ox"), 10: ("OzT", "Tx"),
+    11: ("OzT", "Oz"),
+}
+
+
+#: the joint whose closure the forward kinematics solves (named in failure reports)
+CONTACT_JOINT = {1: "cam-window", 2: "cam-window", 3: "track", 4: "pin-slot", 5: "pin-slot", 6: "edge-pin",
+                 7: "pin-slot", 8: "window-tab", 9: "slot-pin", 10: "pin-arc", 11: "pin-arc"}
+
+
+def _xy(v) -> tuple[float, float]:
+    return (float(v[0]), float(v[1]))
+
+
+def _sub(a, b) -> tuple[float, float]:
+    return (float(a[0] - b[0]), float(a[1] - b[1]))
+
+
+@dataclass(frozen=True)
+class SkewContact:
+    """A driver edge (in the xy plane) touching a follower's tilting pin (spatial #6, #9).
+
+    Residual: ``| distance(edge line, pin axis) - r |`` in 3D, from the
+    driver's pose (xy) and the follower's pose in its ``"yz"`` plane.
+    """
+
+    name: str
+    driver: str
+    edge_point: tuple[float, float]  # on the edge, driver frame
+    edge_dir: tuple[float, float]  # driver frame
+    follower: str
+    pin_x: float  # the pin's x (the follower's offset)
+    radius: float
+    plane_z: float = 0.0
+
+    def residual(self, poses) -> Array:
+        dp = poses[self.driver]
+        e0 = poses_apply(dp, self.edge_point)
+        c, s = np.cos(dp[:, 2]), np.sin(dp[:, 2])
+        ex = c * self.edge_dir[0] - s * self.edge_dir[1]
+        ey = s * self.edge_dir[0] + c * self.edge_dir[1]
+        fp = poses[self.follower]  # (y, z, alpha) of the pivot axis point
+        a = fp[:, 2]
+        P0 = np.column_stack([np.full_like(a, self.pin_x), fp[:, 0], fp[:, 1]])
+        d1 = np.column_stack([np.zeros_like(a), -np.sin(a), np.cos(a)])
+        d2 = np.column_stack([ex, ey, np.zeros_like(a)])
+        E0 = np.column_stack([e0[:, 0], e0[:, 1], np.full_like(a, self.plane_z)])
+        n = np.cross(d1, d2)
+        dist = np.abs(((E0 - P0) * n).sum(-1)) / np.linalg.norm(n, axis=1)
+        return np.abs(dist - self.radius)
+
+
+class ElementalMechanism(Mechanism):
+    """Elemental mechanism ``number`` (1-11) with parameters ``params``."""
+
+    def __init__(self, number: int, params: P_.Params | None = None, rate: float = 2 * np.pi,
+                 phase: float = 0.0, **overrides: Any) -> None:
+        if number not in FORWARD:
+            raise InputError("mechanism", number, "an elemental mechanism number 1-11")
+        self.number = number
+        self.params = params.replace(**overrides) if params is not None else P_.params_for(number, **overrides)
+        self._validate()
+        self.motion_in, self.motion_out = MOTIONS[number]
+        self.view = "xz" if number == 8 else "xy"
+        self.spatial = number in (6, 9)
+        parts, joints, driver = getattr(self, f"_build_{number}")(rate, phase)
+        super().__init__(f"#{number} {self.motion_in}->{self.motion_out}", parts, joints, driver)
+        ref = self.forward(np.zeros(1) if self.motion_in != "OzT" else np.zeros((1, 3)))
+        if not ref.valid[0]:
+            raise InputError(f"#{number}.params", self.params, f"a mechanism that assembles at rest ({ref.why})")
+
+    def _validate(self) -> None:
+        from dataclasses import fields
+
+        for f in fields(self.params):
+            v = getattr(self.params, f.name)
+            arr = np.asarray(v, dtype=float)
+            if not np.all(np.isfinite(arr)):
+                raise InputError(f"#{self.number}.{f.name}", v, "finite numbers")
+            if f.name.endswith(("r", "h", "w1", "w2", "amplitude")) and arr.ndim == 0 and arr <= 0:
+                raise InputError(f"#{self.number}.{f.name}", v, "a positive length")
+
+    # -- kinematics ---------------------------------------------------------
+    def driver_motion(self, q: Array) -> Array:
+        """The driver's motion value for driver values ``q`` (identity except for OzT paths)."""
+        if self.motion_in != "OzT":
+            return q
+        ax, ay = self.params.path
+        th = self.params.D_theta[1]
+        return np.column_stack([ax * np.sin(q), ay * (np.cos(q) - 1.0), th * np.sin(q)])
+
+    def forward(self, u: Array) -> Stage:
+        """Follower motion for driver motion ``u`` (see :mod:`planar.windup.kinematics`)."""
+        return FORWARD[self.number](self.params, np.asarray(u, float))
+
+    def _solve_poses(self, q: Array):  # type: ignore[override]
+        u = self.driver_motion(q)
+        st = self.forward(u)
+        poses = {"ground": np.zeros((q.size, 3))}
+        poses["driver"] = self._driver_pose(u)
+        poses["follower"] = self._follower_pose(st.out)
+        return poses, [(st.valid, CONTACT_JOINT[self.number], st.why)]
+
+    def _driver_pose(self, u: Array) -> Array:
+        P = self.params
+        o = (P.D_o[0], P.D_o[2]) if self.view == "xz" else _xy(P.D_o)
+        n = u.shape[0]
+        if self.motion_in in ("Rz", "Oz"):
+            return np.column_stack([np.full(n, o[0]), np.full(n, o[1]), u])
+        if self.motion_in == "Tx":
+            return np.column_stack([o[0] + u, np.full(n, o[1]), np.zeros(n)])
+        return np.column_stack([o[0] + u[:, 0], o[1] + u[:, 1], u[:, 2]])  # OzT
+
+    def _follower_pose(self, out: Array) -> Array:
+        P = self.params
+        n = out.shape[0]
+        k = self.number
+        if k in (1, 10):
+            fo = _xy(P.F_o)
+            return np.column_stack([fo[0] + out, np.full(n, fo[1]), np.zeros(n)])
+        if k == 4:
+            fo = _xy(P.F_o)
+            return np.column_stack([np.full(n, fo[0]), fo[1] + out, np.zeros(n)])
+        if k == 3:
+            fo = _xy(P.F_o)
+            return np.column_stack([fo[0] + out[:, 0], fo[1] + out[:, 1], out[:, 2]])
+        if k in (6, 9):
+            return np.column_stack([np.full(n, P.F_o[1]), np.full(n, P.F_o[2]), out])
+        if k == 8:
+            return np.column_stack([np.full(n, P.F_o[0]), np.full(n, P.F_o[2]), -out])
+        fo = _xy(P.F_o)  # 2, 5, 7, 11: pivot at F_o
+        return np.column_stack([np.full(n, fo[0]), np.full(n, fo[1]), out])
+
+    def stage(self, q: Array) -> Stage:
+        """Forward kinematics for driver values ``q`` (the standalone law applied)."""
+        return self.forward(self.driver_motion(np.asarray(q, float)))
+
+    @property
+    def size(self) -> float:
+        """Characteristic length: the extent of all joint centres and outlines."""
+        pts = []
+        for p in self.parts:
+            for x, y, r in p.hull:
+                pts.append((x, y))
+        pts_a = np.asarray(pts)
+        return float(np.max(np.ptp(pts_a, axis=0))) if len(pts_a) > 1 else 1.0
+
+    # -- travel helper --------------------------------------------------------
+    def _sweep(self, n: int = 721) -> tuple[Array, Stage]:
+        """The valid samples of one standalone cycle (to size slots and tracks)."""
+        q = self.driver.value(np.linspace(0, self.driver.period, n))
+        st = self.stage(q)
+        ok = st.valid
+        if not ok.any():
+            raise InputError(f"#{self.number}.params", self.params, f"a mechanism that moves ({st.why} everywhere)")
+        return q[ok], Stage(st.out[ok], ok[ok], st.why, {k: v[ok] for k, v in st.aux.items()})
+
+    def _driver(self, rate: float, phase: float) -> Driver:
+        P = self.params
+        kind = self.motion_in
+        if kind == "Rz":
+            return Driver("driver", "rotation", origin=_xy(P.D_o), rate=rate, phase=phase)
+        if kind == "Oz":
+            return Driver("driver", "rotation", origin=_xy(P.D_o), rate=rate, phase=phase, amplitude=P.amplitude)
+        if kind == "Tx":
+            return Driver("driver", "translation", origin=_xy(P.D_o), rate=rate, phase=phase, amplitude=P.amplitude)
+        return Driver("driver", "path", origin=_xy(P.D_o), rate=rate, phase=phase)
+
+    # -- builders: parts and joints -------------------------------------------
+    def _ground_slide(self, fo, axis, travel, pin_r, label="support"):
+        """Ground slot + follower pins for a pure translation along ``axis`` (kind (h))."""
+        ax = np.asarray(axis, float)
+        L = 4 * pin_r
+        lo, hi = travel
+        g0 = np.asarray(fo) + (lo - L) * ax
+        g1 = np.asarray(fo) + (hi + 2 * L) * ax
+        slot = Slot(_xy(g0), _xy(g1), 2 * pin_r)
+        pins = [(0.0, 0.0), _xy(L * ax)]
+        joint = Slide(f"{label}-slide", "follower", pins[0], _xy(L * ax), "ground", slot.start, slot.end)
+        return slot, pins, joint
+
+    def _build_1(self, rate, phase):
+        P = self.params
+        driver = self._driver(rate, phase)
+        self.driver = driver
+        d = float(np.hypot(*_sub(P.D_jc, P.D_o)))
+        _, st = self._sweep()
+        fo = _xy(P.F_o)
+        wc = _sub(P.D_o, fo)  # window centre in the follower frame
+        window = Slot((wc[0], wc[1] - d), (wc[0], wc[1] + d), 2 * P.D_jr)
+        slot, pins, slide = self._ground_slide(fo, (1.0, 0.0), (st.out.min(), st.out.max()), P.F_sr)
+        m = P.D_jr * 0.35
+        follower = Part("follower", ((wc[0], wc[1] - d, P.D_jr + m), (wc[0], wc[1] + d, P.D_jr + m),
+                                     (pins[0][0], pins[0][1], 2 * P.F_sr), (pins[1][0], pins[1][1], 2 * P.F_sr)),
+                        (window, Hole(pins[0], 2 * P.F_sr), Hole(pins[1], 2 * P.F_sr)))
+        drv = Part("driver", ((*_sub(P.D_jc, P.D_o), P.D_jr), (0.0, 0.0, 2 * P.D_ar)), (Hole((0.0, 0.0), 2 * P.D_ar),))
+        ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*slot.start, 2 * P.F_sr), (*slot.end, 2 * P.F_sr)),
+                      (Hole(_xy(P.D_o), 2 * P.D_ar), slot), ground=True)
+        joints = [
+            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
+            PinInSlot("cam-window", "driver", _sub(P.D_jc, P.D_o), "follower", window.start, window.end),
+            slide,
+        ]
+        return [ground, drv, follower], joints, driver
+
+    def _build_2(self, rate, phase):
+        P = self.params
+        driver = self._driver(rate, phase)
+        self.driver = driver
+        _, st = self._sweep()
+        s = _xy(P.F_o)
+        m = st.aux["m"]
+        # along-line coordinate of the cam centre in the follower frame
+        a = st.out
+        rel = m - np.asarray(s)
+        c, sn = np.cos(-a), np.sin(-a)
+        loc = np.column_stack([c * rel[:, 0] - sn * rel[:, 1], sn * rel[:, 0] + c * rel[:, 1]])
+        y0 = float(_sub(P.D_jc, s)[1])
+        x0, x1 = float(loc[:, 0].min()), float(loc[:, 0].max())
+        window = Slot((x0, y0), (x1, y0), 2 * P.D_jr)
+        mg = P.D_jr * 0.35
+        follower = Part("follower", ((0.0, 0.0, 2 * P.F_sr), (x0, y0, P.D_jr + mg), (x1, y0, P.D_jr + mg)),
+                        (Hole((0.0, 0.0), 2 * P.F_sr), window))
+        drv = Part("driver", ((*_sub(P.D_jc, P.D_o), P.D_jr), (0.0, 0.0, 2 * P.D_ar)), (Hole((0.0, 0.0), 2 * P.D_ar),))
+        ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*s, 3 * P.F_sr)),
+                      (Hole(_xy(P.D_o), 2 * P.D_ar), Hole(s, 2 * P.F_sr)), ground=True)
+        joints = [
+            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
+            Pivot("pivot", "ground", s, "follower", (0.0, 0.0)),
+            PinInSlot("cam-window", "driver", _sub(P.D_jc, P.D_o), "follower", window.start, window.end),
+        ]
+        return [ground, drv, follower], joints, driver
+
+    def _build_3(self, rate, phase):
+        P = self.params
+        driver = self._driver(rate, phase)
+        self.driver = driver
+        _, st = self._sweep()
+        p0 = _xy(P.F_o)
+        s = (p0[0] + P.S_c[0], p0[1] + P.S_c[1])
+        r = float(np.hypot(P.S_c[0], P.S_c[1]))
+        hole = _sub(P.D_jc, p0)  # the cam's hole, in the follower frame (origin at the track pin)
+        # track: an arc slot about s covering the pin's travel
+        p = st.aux["p"]
+        ang = np.unwrap(np.arctan2(p[:, 1] - s[1], p[:, 0] - s[0]))
+        pad = 1.5 * P.F_jr / r
+        track = ArcSlot(s, r, float(ang.min() - pad), float(ang.max() + pad), 2 * P.F_jr)
+        follower = Part("follower", ((0.0, 0.0, 2 * P.F_jr), (*hole, P.D_jr * 1.35)),
+                        (Hole((0.0, 0.0), 2 * P.F_jr), Hole(hole, 2 * P.D_jr)))
+        drv = Part("driver", ((*_sub(P.D_jc, P.D_o), P.D_jr), (0.0, 0.0, 2 * P.D_ar)), (Hole((0.0, 0.0), 2 * P.D_ar),))
+        ends = [(s[0] + r * np.cos(a), s[1] + r * np.sin(a)) for a in (track.angle0, track.angle1, 0.5 * (track.angle0 + track.angle1))]
+        ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), *[(x, y, 2 * P.F_jr) for x, y in ends]),
+                      (Hole(_xy(P.D_o), 2 * P.D_ar), track), ground=True)
+        joints = [
+            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
+            Pivot("cam-hole", "driver", _sub(P.D_jc, P.D_o), "follower", hole),
+            PinInArcSlot("track", "follower", (0.0, 0.0), "ground", s, r),
+        ]
+        return [ground, drv, follower], joints, driver
+
+    def _build_4(self, rate, phase):
+        P = self.params
+        driver = self._driver(rate, phase)
+        self.driver = driver
+        q, st = self._sweep()
+        fo = _xy(P.F_o)
+        pin = _xy(P.F_jc)
+        p0 = (fo[0] + pin[0], fo[1] + pin[1])
+        # the slot in the driver frame: y = Y0, x over the pin's travel
+        p = st.aux["p"]
+        rel = p - np.asarray(_xy(P.D_o))
+        c, s = np.cos(-q), np.sin(-q)
+        xs = c * rel[:, 0] - s * rel[:, 1]
+        Y0 = p0[1] - P.D_o[1]
+        slot = Slot((float(xs.min()), Y0), (float(xs.max()), Y0), 2 * P.F_jr)
+        gslot, pins, slide = self._ground_slide(fo, (0.0, 1.0), (st.out.min(), st.out.max()), P.F_sr)
+        follower = Part("follower", ((*pin, 2 * P.F_jr), (*pins[0], 2 * P.F_sr), (*pins[1], 2 * P.F_sr)),
+                        (Hole(pin, 2 * P.F_jr), Hole(pins[0], 2 * P.F_sr), Hole(pins[1], 2 * P.F_sr)))
+        drv = Part("driver", ((0.0, 0.0, 3 * P.D_ar), (slot.start[0], Y0, 2 * P.F_jr), (slot.end[0], Y0, 2 * P.F_jr)),
+                   (Hole((0.0, 0.0), 2 * P.D_ar), slot))
+        ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*gslot.start, 2 * P.F_sr), (*gslot.end, 2 * P.F_sr)),
+                      (Hole(_xy(P.D_o), 2 * P.D_ar), gslot), ground=True)
+        joints = [
+            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
+            PinInSlot("pin-slot", "follower", pin, "driver", slot.start, slot.end),
+            slide,
+        ]
+        return [ground, drv, follower], joints, driver
+
+    def _build_5(self, rate, phase):
+        P = self.params
+        driver = self._driver(rate, phase)
+        self.driver = driver
+        q, st = self._sweep()
+        s = _xy(P.F_o)
+        pin = _xy(P.F_jc)
+        p0 = (s[0] + pin[0], s[1] + pin[1])
+        d = p0[1] - P.D_o[1]
+        p = st.aux["p"]
+        rel = p - np.asarray(_xy(P.D_o))
+        c, sn = np.cos(-q), np.sin(-q)
+        xs = c * rel[:, 0] - sn * rel[:, 1]
+        slot = Slot((float(xs.min()), d), (float(xs.max()), d), 2 * P.F_jr)
+        follower = Part("follower", ((0.0, 0.0, 2 * P.F_ar), (*pin, 2 * P.F_jr)),
+                        (Hole((0.0, 0.0), 2 * P.F_ar), Hole(pin, 2 * P.F_jr)))
+        drv = Part("driver", ((0.0, 0.0, 3 * P.D_ar), (slot.start[0], d, 2 * P.F_jr), (slot.end[0], d, 2 * P.F_jr)),
+                   (Hole((0.0, 0.0), 2 * P.D_ar), slot))
+        ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*s, 3 * P.F_ar)),
+                      (Hole(_xy(P.D_o), 2 * P.D_ar), Hole(s, 2 * P.F_ar)), ground=True)
+        joints = [
+            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
+            Pivot("pivot", "ground", s, "follower", (0.0, 0.0)),
+            PinInSlot("pin-slot", "follower", pin, "driver", slot.start, slot.end),
+        ]
+        return [ground, drv, follower], joints, driver
+
+    def _spatial_follower(self, P, N: float, r: float, arm: float) -> Part:
+        """Follower of #6/#9 in its own yz plane: pivot at (0, 0), pin up to the driver's plane."""
+        top = -N  # the driver's plane, relative to the pivot axis
+        return Part("follower", ((0.0, 0.0, 2 * P.F_ar), (0.0, top, r)), (Hole((0.0, 0.0), 2 * P.F_ar),),
+                    plane="yz", offset=float(P.F_o[0]))
+
+    def _build_6(self, rate, phase):
+        P = self.params
+        driver = self._driver(rate, phase)
+        self.driver = driver
+        p0 = _xy(P.F_o)
+        r = P.F_jr
+        h = p0[1] - P.D_o[1] - r
+        ex = p0[0] - P.D_o[0]
+        N = P.F_o[2] - P.D_o[2]
+        drv = Part("driver", ((0.0, 0.0, 3 * P.D_ar), (ex - 2 * r, h - r, r), (ex + 2 * r, h - r, r)),
+                   (Hole((0.0, 0.0), 2 * P.D_ar),))
+        follower = self._spatial_follower(P, N, r, abs(N))
+        ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar),), (Hole(_xy(P.D_o), 2 * P.D_ar),), ground=True)
+        joints = [
+            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
+            SkewContact("edge-pin", "driver", (0.0, h), (1.0, 0.0), "follower", float(P.F_o[0]), r,
+                        plane_z=float(P.D_o[2])),
+        ]
+        return [ground, drv, follower], joints, driver
+
+    def _build_7(self, rate, phase):
+        P = self.params
+        driver = self._driver(rate, phase)
+        self.driver = driver
+        _, st = self._sweep()
+        s = _xy(P.F_o)
+        pin = _sub(P.D_jc, P.D_o)
+        p = st.aux["p"]
+        dist = np.hypot(p[:, 0] - s[0], p[:, 1] - s[1])
+        u = np.asarray(_sub(P.D_jc, s))
+        u = u / np.hypot(*u)
+        slot = Slot(_xy(u * dist.min()), _xy(u * dist.max()), 2 * P.D_jr)
+        follower = Part("follower", ((0.0, 0.0, 2 * P.F_ar), (*slot.start, 2 * P.D_jr), (*slot.end, 2 * P.D_jr)),
+                        (Hole((0.0, 0.0), 2 * P.F_ar), slot))
+        gslot_lo, gslot_hi = -P.amplitude, P.amplitude
+        L = 4 * P.D_sr
+        g0 = (P.D_o[0] + gslot_lo - L, P.D_o[1])
+        g1 = (P.D_o[0] + gslot_hi + 2 * L, P.D_o[1])
+        gslot = Slot(g0, g1, 2 * P.D_sr)
+        drv = Part("driver", ((0.0, 0.0, 2 * P.D_sr), (L, 0.0, 2 * P.D_sr), (*pin, 2 * P.D_jr)),
+                   (Hole((0.0, 0.0), 2 * P.D_sr), Hole((L, 0.0), 2 * P.D_sr), Hole(pin, 2 * P.D_jr)))
+        ground = Part("ground", ((*g0, 2 * P.D_sr), (*g1, 2 * P.D_sr), (*s, 3 * P.F_ar)),
+                      (gslot, Hole(s, 2 * P.F_ar)), ground=True)
+        joints = [
+            Slide("driver-slide", "driver", (0.0, 0.0), (L, 0.0), "ground", g0, g1),
+            Pivot("pivot", "ground", s, "follower", (0.0, 0.0)),
+            PinInSlot("pin-slot", "driver", pin, "follower", slot.start, slot.end),
+        ]
+        return [ground, drv, follower], joints, driver
+
+    def _build_8(self, rate, phase):
+        P = self.params
+        driver = self._driver(rate, phase)
+        self.driver = driver
+        B = (float(P.F_o[0]), float(P.F_o[2]))
+        A0 = (B[0] + P.F_jcx, B[1] + P.F_jh)
+        o = (float(P.D_o[0]), float(P.D_o[2]))
+        a_loc = _sub(A0, o)  # the window edge point in the driver frame
+        L = 4 * P.D_ar
+        g0 = (o[0] - P.amplitude - L, o[1])
+        g1 = (o[0] + P.amplitude + 2 * L, o[1])
+        gslot = Slot(g0, g1, 2 * P.D_ar)
+        # driver plate: a window whose left edge passes through the contact point A (drawn as a
+        # straight-sided slot of width D_w1; the taper to D_w2 does not change the contact)
+        w = P.D_w1
+        cx = a_loc[0] + w / 2
+        win = Slot((cx, a_loc[1] - 0.08), (cx, a_loc[1] + 0.08), w)
+        rim = w / 2 + 0.04
+        drv = Part("driver", ((0.0, 0.0, 2 * P.D_ar), (L, 0.0, 2 * P.D_ar), (cx, a_loc[1] - 0.08, rim),
+                              (cx, a_loc[1] + 0.08, rim)),
+                   (Hole((0.0, 0.0), 2 * P.D_ar), Hole((L, 0.0), 2 * P.D_ar), win))
+        follower = Part("follower", ((0.0, 0.0, 2 * P.F_ar), (0.0, P.F_jh, P.F_jr), (P.F_jcx - P.F_jr, P.F_jh, P.F_jr)),
+                        (Hole((0.0, 0.0), 2 * P.F_ar),), plane="xz")
+        ground = Part("ground", ((*g0, 2 * P.D_ar), (*g1, 2 * P.D_ar), (*B, 3 * P.F_ar)),
+                      (gslot, Hole(B, 2 * P.F_ar)), ground=True, plane="xz")
+        drv = Part(drv.name, drv.hull, drv.features, plane="xz")
+        # the tab's face in its frame (origin B, x along the tab's initial direction rotated): the follower's
+        # pose angle is psi - psi0 with psi0 the rest direction (+z); in the follower frame the tab runs
+        # along +y (z) and the face is the line x = F_jcx
+        joints = [
+            Slide("driver-slide", "driver", (0.0, 0.0), (L, 0.0), "ground", g0, g1),
+            Pivot("pivot", "ground", B, "follower", (0.0, 0.0)),
+            CamOnLine("window-tab", "driver", a_loc, 0.0, "follower", (P.F_jcx, 0.0), (P.F_jcx, P.F_jh)),
+        ]
+        return [ground, drv, follower], joints, driver
+
+    def _build_9(self, rate, phase):
+        P = self.params
+        driver = self._driver(rate, phase)
+        self.driver = driver
+        p0 = _xy(P.F_o)
+        r = P.F_jr
+        phi = P.phi
+        N = P.F_o[2] - P.D_o[2]
+        e_loc = (p0[0] - P.D_o[0], p0[1] - P.D_o[1] - r / np.cos(phi))  # on the edge, driver frame
+        L = 4 * P.D_ar
+        g0 = (P.D_o[0] - P.amplitude - L, P.D_o[1])
+        g1 = (P.D_o[0] + P.amplitude + 2 * L, P.D_o[1])
+        gslot = Slot(g0, g1, 2 * P.D_ar)
+        d = np.array([np.cos(phi), -np.sin(phi)])
+        a = np.asarray(e_loc) - 0.15 * d
+        b = np.asarray(e_loc) + 0.15 * d
+        drv = Part("driver", ((0.0, 0.0, 2 * P.D_ar), (L, 0.0, 2 * P.D_ar), (*_xy(a - [0, r]), r), (*_xy(b - [0, r]), r)),
+                   (Hole((0.0, 0.0), 2 * P.D_ar), Hole((L, 0.0), 2 * P.D_ar)))
+        follower = self._spatial_follower(P, N, r, abs(N))
+        ground = Part("ground", ((*g0, 2 * P.D_ar), (*g1, 2 * P.D_ar)), (gslot,), ground=True)
+        joints = [
+            Slide("driver-slide", "driver", (0.0, 0.0), (L, 0.0), "ground", g0, g1),
+            SkewContact("slot-pin", "driver", e_loc, _xy(d), "follower", float(P.F_o[0]), r,
+                        plane_z=float(P.D_o[2])),
+        ]
+        return [ground, drv, follower], joints, driver
+
+    def _arc_driver(self, P, qs, st, p0, R) -> tuple[Part, ArcSlot]:
+        """OzT driver plate with an arc slot of radius R about its origin, covering the pin's travel."""
+        m = st.aux["m"]
+        p = st.aux["p"]
+        q = self.driver_motion(qs)
+        ang = np.unwrap(np.arctan2(p[:, 1] - m[:, 1], p[:, 0] - m[:, 0]) - q[:, 2])
+        w = 2 * P.F_jr
+        pad = 1.5 * P.F_jr / R
+        arc = ArcSlot((0.0, 0.0), R, float(ang.min() - pad), float(ang.max() + pad), w)
+        pts = [(R * np.cos(a), R * np.sin(a)) for a in (arc.angle0, arc.angle1, 0.5 * (arc.angle0 + arc.angle1))]
+        part = Part("driver", ((0.0, 0.0, 2 * P.F_jr), *[(x, y, 1.6 * P.F_jr) for x, y in pts]), (arc,))
+        return part, arc
+
+    def _build_10(self, rate, phase):
+        P = self.params
+        driver = self._driver(rate, phase)
+        self.driver = driver
+        qs, st = self._sweep()
+        fo = _xy(P.F_o)
+        pin = _xy(P.F_jc)
+        p0 = (fo[0] + pin[0], fo[1] + pin[1])
+        R = float(np.hypot(*_sub(p0, P.D_o)))
+        drv, arc = self._arc_driver(P, qs, st, p0, R)
+        gslot, pins, slide = self._ground_slide(fo, (1.0, 0.0), (st.out.min(), st.out.max()), P.F_sr)
+        follower = Part("follower", ((*pin, 2 * P.F_jr), (*pins[0], 2 * P.F_sr), (*pins[1], 2 * P.F_sr)),
+                        (Hole(pin, 2 * P.F_jr), Hole(pins[0], 2 * P.F_sr), Hole(pins[1], 2 * P.F_sr)))
+        ground = Part("ground", ((*gslot.start, 2 * P.F_sr), (*gslot.end, 2 * P.F_sr)), (gslot,), ground=True)
+        joints = [
+            PinInArcSlot("pin-arc", "follower", pin, "driver", arc.centre, R),
+            slide,
+        ]
+        return [ground, drv, follower], joints, driver
+
+    def _build_11(self, rate, phase):
+        P = self.params
+        driver = self._driver(rate, phase)
+        self.driver = driver
+        qs, st = self._sweep()
+        s = _xy(P.F_o)
+        pin = _xy(P.F_jc)
+        p0 = (s[0] + pin[0], s[1] + pin[1])
+        R = float(np.hypot(*_sub(p0, P.D_o)))
+        drv, arc = self._arc_driver(P, qs, st, p0, R)
+        follower = Part("follower", ((0.0, 0.0, 2 * P.F_ar), (*pin, 2 * P.F_jr)),
+                        (Hole((0.0, 0.0), 2 * P.F_ar), Hole(pin, 2 * P.F_jr)))
+        ground = Part("ground", ((*s, 3 * P.F_ar),), (Hole(s, 2 * P.F_ar),), ground=True)
+        joints = [
+            Pivot("pivot", "ground", s, "follower", (0.0, 0.0)),
+            PinInArcSlot("pin-arc", "follower", pin, "driver", arc.centre, R),
+        ]
+        return [ground, drv, follower], joints, driver
+
+
+def elemental(number: int, **overrides: Any) -> ElementalMechanism:
+    """Elemental mechanism ``number`` at the supplement's defaults, with ``overrides``."""
+    return ElementalMechanism(number, **overrides)
