@@ -78,6 +78,19 @@ for _k in range(1, 12):
     CATALOG[f"windup-{_k}"] = _windup(_k)
 
 
+def _toy(name: str) -> Callable[[], Mechanism]:
+    def make() -> Mechanism:
+        from .windup import chain
+
+        return getattr(chain, name)()
+
+    return make
+
+
+CATALOG["horse"] = _toy("horse")
+CATALOG["bunny"] = _toy("bunny")
+
+
 def get(name: str) -> Mechanism:
     """Build the catalog mechanism ``name``."""
     from .errors import InputError

@@ -71,6 +71,20 @@ def _cmd_motion_catalog(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_chains(args: argparse.Namespace) -> int:
+    from .windup.table import enumerate_chains
+
+    chains = enumerate_chains(args.target, args.max_length, args.optional)
+    if args.json:
+        print(json.dumps({k: [list(c) for c in v] for k, v in chains.items()}))
+        return 0
+    for motion, cs in chains.items():
+        print(f"{motion}: {len(cs)} chains")
+        for c in cs:
+            print("   " + " -> ".join([c[0].split("->")[0]] + [p.split("->")[1] for p in c]))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     from .bench import BENCHMARKS
 
@@ -88,6 +102,13 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("-n", type=int, default=None, help="problem size (samples)")
     b.add_argument("--repeats", type=int, default=None, help="timing repeats (best is kept)")
     b.set_defaults(func=_cmd_bench)
+
+    ch = sub.add_parser("chains", help="motion transfer chains from the motor (Rz) to an end effector")
+    ch.add_argument("target", nargs="?", default=None, help="end-effector motion (Ox, Oy, Oz, Tx, Ty, Tz, OzT)")
+    ch.add_argument("--max-length", type=int, default=3, help="longest chain (default 3)")
+    ch.add_argument("--optional", action="store_true", help="include the Oy->Oy pattern the printed table lacks")
+    ch.add_argument("--json", action="store_true", help='print {"Ox": [["Rz->Tx", "Tx->Ox"], ...], ...}')
+    ch.set_defaults(func=_cmd_chains)
 
     c = sub.add_parser("catalog", help="write the motion table of a built-in mechanism")
     c.add_argument("mechanism", help="catalog name, e.g. jansen, kangaroo, slider-crank")

@@ -107,10 +107,13 @@ class ElementalMechanism(Mechanism):
     """Elemental mechanism ``number`` (1-11) with parameters ``params``."""
 
     def __init__(self, number: int, params: P_.Params | None = None, rate: float = 2 * np.pi,
-                 phase: float = 0.0, **overrides: Any) -> None:
+                 phase: float = 0.0, sizing_input: Array | None = None, **overrides: Any) -> None:
+        """``sizing_input``: the driver motions the parts must serve (slot and track lengths);
+        by default one cycle of the standalone driver law."""
         if number not in FORWARD:
             raise InputError("mechanism", number, "an elemental mechanism number 1-11")
         self.number = number
+        self._sizing_input = None if sizing_input is None else np.asarray(sizing_input, float)
         self.params = params.replace(**overrides) if params is not None else P_.params_for(number, **overrides)
         self._validate()
         self.motion_in, self.motion_out = MOTIONS[number]
@@ -200,9 +203,13 @@ class ElementalMechanism(Mechanism):
 
     # -- travel helper --------------------------------------------------------
     def _sweep(self, n: int = 721) -> tuple[Array, Stage]:
-        """The valid samples of one standalone cycle (to size slots and tracks)."""
-        q = self.driver.value(np.linspace(0, self.driver.period, n))
-        st = self.stage(q)
+        """Driver motions and follower stage of the valid samples of one cycle (to size slots, tracks)."""
+        if self._sizing_input is not None:
+            q = self._sizing_input
+            st = self.forward(q)
+        else:
+            q = self.driver_motion(self.driver.value(np.linspace(0, self.driver.period, n)))
+            st = self.forward(q)
         ok = st.valid
         if not ok.any():
             raise InputError(f"#{self.number}.params", self.params, f"a mechanism that moves ({st.why} everywhere)")
@@ -490,8 +497,7 @@ class ElementalMechanism(Mechanism):
         """OzT driver plate with an arc slot of radius R about its origin, covering the pin's travel."""
         m = st.aux["m"]
         p = st.aux["p"]
-        q = self.driver_motion(qs)
-        ang = np.unwrap(np.arctan2(p[:, 1] - m[:, 1], p[:, 0] - m[:, 0]) - q[:, 2])
+        ang = np.unwrap(np.arctan2(p[:, 1] - m[:, 1], p[:, 0] - m[:, 0]) - qs[:, 2])
         w = 2 * P.F_jr
         pad = 1.5 * P.F_jr / R
         arc = ArcSlot((0.0, 0.0), R, float(ang.min() - pad), float(ang.max() + pad), w)
