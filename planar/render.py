@@ -1,0 +1,456 @@
+"""Off-screen raster frames of a mechanism's motion (no display, no window system).
+
+Parts are drawn as filled outlines with their holes and slots cut out, pins
+as dots, the ground as a grey plate, trails of named points (coupler curves)
+and polygons swept along with a part (a foot).  Drawing happens at
+``supersample`` times the size and is reduced with a box filter, which
+antialiases every edge.  The camera fits every part over the whole motion,
+so nothing leaves the frame.  Invalid samples are drawn at their nearest real
+configuration, tinted, with the failing joint ringed and named.
+
+Coordinates: the mechanism's view plane (x right, y up); renderers flip y,
+nobody else does.  Parts that move in another plane (wind-up #6 and #9 turn
+about x) are projected orthographically onto the view plane.
+
+All geometry is transformed for every frame at once with numpy; the per-frame
+loop only issues drawing calls.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Iterator, Mapping, Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .geometry import poses_apply
+from .model import Mechanism, Motion, Part, Pivot
+
+__all__ = ["Style", "Renderer", "project", "palette_colors"]
+
+Array = NDArray[np.float64]
+RGB = tuple[int, int, int]
+
+PART_COLORS = ("#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b07aa1", "#ff9da7",
+               "#9c755f", "#bab0ac")
+
+
+def _rgb(c: str | Sequence[int]) -> RGB:
+    if isinstance(c, str):
+        c = c.lstrip("#")
+        return (int(c[0:2], 16), int(c[2:4], 16), int(c[4:6], 16))
+    return (int(c[0]), int(c[1]), int(c[2]))
+
+
+@dataclass
+class Style:
+    """How to draw: size in pixels, colours, what to show."""
+
+    width: int = 480
+    height: int = 360
+    supersample: int = 2
+    background: str = "#ffffff"
+    ground: str = "#c8c8c8"
+    outline: str = "#303030"
+    pin: str = "#202020"
+    trail: str = "#7f3fbf"
+    invalid: str = "#d62728"
+    overlay: str = "#e377c2"
+    sweep: str = "#8c564b"
+    part_colors: tuple[str, ...] = PART_COLORS
+    margin: float = 0.05
+    line_width: float = 1.2
+    #: named points whose trail is drawn (None: all of them)
+    trails: Sequence[str] | None = None
+    show_pins: bool = True
+    labels: bool = False
+
+
+def project(part: Part, pts: Array, view: str) -> Array:
+    """Points in a part's plane coordinates -> view coordinates (orthographic).
+
+    A part in plane ``"xy"`` has 3D points ``(u, v, offset)``; ``"xz"``:
+    ``(u, offset, v)``; ``"yz"``: ``(offset, u, v)``.  The view keeps two of
+    the three axes.
+    """
+    if part.plane == view:
+        return pts
+    u, v = pts[..., 0], pts[..., 1]
+    off = np.full_like(u, part.offset)
+    xyz = {"xy": (u, v, off), "xz": (u, off, v), "yz": (off, u, v)}[part.plane]
+    keep = {"xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}[view]
+    return np.stack([xyz[keep[0]], xyz[keep[1]]], axis=-1)
+
+
+def _rings(part: Part) -> list[Array]:
+    """Exterior then interiors of the part's outline, as (M, 2) arrays in its frame."""
+    poly = part.outline
+    rings = [np.asarray(poly.exterior.coords)[:-1]]
+    rings += [np.asarray(r.coords)[:-1] for r in poly.interiors]
+    return rings
+
+
+def palette_colors(style: Style, n_parts: int) -> list[RGB]:
+    """A fixed palette (<= 256 colours): base colours and their blends toward the background
+    and toward the outline, so antialiased edges quantise without dithering, identically every run."""
+    bg = np.array(_rgb(style.background), float)
+    ol = np.array(_rgb(style.outline), float)
+    base = [_rgb(c) for c in (style.background, style.ground, style.outline, style.pin, style.trail, style.invalid,
+                              style.overlay, style.sweep)]
+    base += [_rgb(style.part_colors[i % len(style.part_colors)]) for i in range(min(n_parts, len(style.part_colors)))]
+    out: list[RGB] = []
+    for c in base:
+        if c not in out:
+            out.append(c)
+    levels = (0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875)
+    for c in list(out):
+        for t in levels:
+            for other in (bg, ol):
+                b = tuple(int(round(x)) for x in (1 - t) * np.array(c, float) + t * other)
+                if b not in out and len(out) < 256:
+                    out.append(b)  # type: ignore[arg-type]
+    return out
+
+
+@dataclass
+class _Sprite:
+    """A rigid layer (a part or a swept polygon) pre-drawn once in its own frame."""
+
+    part: Part
+    rings: list[Array]  # in the part's frame
+    fill: RGB
+    fill_mask: object  # PIL "L" coverage of the fill, drawn at ``k`` pixels per unit
+    line_mask: object  # PIL "L" coverage of the outline strokes
+    origin: tuple[float, float]  # part-frame (u_min, v_max) of the sprite's top-left
+    k: float
+    tint: RGB
+
+
+@dataclass
+class Renderer:
+    """Renders ``motion`` of ``mech`` (and optionally an ``overlay`` motion) frame by frame.
+
+    ``polygons`` maps a name to ``(part, points)`` in that part's frame: drawn
+    swept with the part (the notes' foot).
+
+    How: every rigid part is drawn once, antialiased, as a sprite in its own
+    frame; a frame is the static layer (ground, other parts that do not move,
+    the trails) with each moving sprite resampled through one affine map
+    (rotation, translation, scale in a single bilinear pass).  Parts seen
+    edge-on (another plane than the view) are drawn as projected polygons.
+    """
+
+    mech: Mechanism
+    motion: Motion
+    style: Style = field(default_factory=Style)
+    overlay: Motion | None = None
+    polygons: Mapping[str, tuple[str, Array]] = field(default_factory=dict)
+    view: str | None = None
+
+    def __post_init__(self) -> None:
+        from PIL import Image, ImageDraw
+
+        self.view = self.view or getattr(self.mech, "view", "xy")
+        s = self.style
+        self.S = max(1, int(s.supersample))
+        self.W, self.H = s.width, s.height
+        world = self._world_geometry(self.motion)
+        self._fit(world)
+        self.lw = max(1.0, s.line_width)
+        # classify parts: static (pose constant), rigid sprites (in the view plane), projected
+        self.static: list[int] = []
+        self.sprites: list[tuple[int, _Sprite]] = []
+        self.projected: list[int] = []
+        for i, p in enumerate(self.mech.parts):
+            pose = self.motion.poses[p.name]
+            if np.ptp(pose, axis=0).max() <= 1e-12 * max(1.0, float(np.abs(pose).max())):
+                self.static.append(i)
+            elif p.plane == self.view:
+                self.sprites.append((i, self._sprite(p, _rings(p), self._fill(i, p))))
+            else:
+                self.projected.append(i)
+        self.world_parts = [[self._px(r) for r in rings] for rings in world["parts"]]
+        self.sweep_sprites = []
+        for n, (pname, pts) in self.polygons.items():
+            part = self.mech.part(pname)
+            self.sweep_sprites.append((pname, self._sprite(part, [np.asarray(pts, float)], _rgb(s.sweep))))
+        self.trails = {k: self._px(v) for k, v in world["trails"].items()}
+        self.pins = {k: self._px(v) for k, v in world["pins"].items()}
+        self.overlay_parts = []
+        if self.overlay is not None:
+            ow = self._world_geometry(self.overlay)
+            self.overlay_parts = [[self._px(r) for r in rings] for rings in ow["parts"]]
+        self.base = self._static_layer()
+        self.dot = {c: self._dot(_rgb(c), 2.2) for c in (s.pin, s.trail)}
+
+    # -- geometry, all frames at once --------------------------------------------
+    def _world_geometry(self, motion: Motion) -> dict:
+        parts = []
+        for p in self.mech.parts:
+            pose = motion.poses[p.name]
+            parts.append([project(p, poses_apply(pose, r), self.view) for r in _rings(p)])
+        names = self.style.trails if self.style.trails is not None else list(motion.points)
+        trails = {}
+        for n in names:
+            if n in motion.points:
+                part = self.mech.part(self.mech.points[n][0])
+                trails[n] = project(part, motion.points[n], self.view)
+        sweeps = {}
+        for n, (pname, pts) in self.polygons.items():
+            part = self.mech.part(pname)
+            sweeps[n] = project(part, poses_apply(motion.poses[pname], np.asarray(pts, float)), self.view)
+        pins = {}
+        for j in self.mech.joints:
+            if isinstance(j, Pivot):
+                part = self.mech.part(j.a)
+                pins[j.name] = project(part, poses_apply(motion.poses[j.a], j.anchor_a), self.view)
+            elif hasattr(j, "pin_part"):
+                part = self.mech.part(j.pin_part)
+                pins[j.name] = project(part, poses_apply(motion.poses[j.pin_part], j.pin), self.view)
+        return {"parts": parts, "trails": trails, "sweeps": sweeps, "pins": pins}
+
+    def _fit(self, world: dict) -> None:
+        pts = [r.reshape(-1, 2) for rings in world["parts"] for r in rings]
+        pts += [v.reshape(-1, 2) for v in world["trails"].values()]
+        pts += [v.reshape(-1, 2) for v in world["sweeps"].values()]
+        allp = np.concatenate(pts)
+        allp = allp[np.all(np.isfinite(allp), axis=1)]
+        lo, hi = allp.min(0), allp.max(0)
+        span = np.maximum(hi - lo, 1e-12)
+        m = self.style.margin
+        scale = min(self.W * (1 - 2 * m) / span[0], self.H * (1 - 2 * m) / span[1])
+        self.scale = scale
+        centre = 0.5 * (lo + hi)
+        self.origin = np.array([self.W / 2 - scale * centre[0], self.H / 2 + scale * centre[1]])
+
+    def _px(self, xy: Array) -> Array:
+        """World view coordinates -> output pixel coordinates (y flipped)."""
+        out = np.empty_like(xy)
+        out[..., 0] = self.origin[0] + self.scale * xy[..., 0]
+        out[..., 1] = self.origin[1] - self.scale * xy[..., 1]
+        return out
+
+    def _fill(self, i: int, part: Part) -> RGB:
+        if part.ground:
+            return _rgb(self.style.ground)
+        return _rgb(self.style.part_colors[(i - 1) % len(self.style.part_colors)])
+
+    # -- pre-drawn layers ------------------------------------------------------------
+    def _sprite(self, part: Part, rings: list[Array], fill: RGB) -> _Sprite:
+        from PIL import Image, ImageDraw
+
+        k = self.S * self.scale
+        pad = 2.0 * self.S * self.lw + 2
+        lo = rings[0].min(0)
+        hi = rings[0].max(0)
+        w = int(np.ceil((hi[0] - lo[0]) * k + 2 * pad)) + 1
+        h = int(np.ceil((hi[1] - lo[1]) * k + 2 * pad)) + 1
+        origin = (float(lo[0] - pad / k), float(hi[1] + pad / k))
+
+        def to_px(r: Array) -> list[tuple[float, float]]:
+            return [((u - origin[0]) * k, (origin[1] - v) * k) for u, v in r]
+
+        fill_mask = Image.new("L", (w, h), 0)
+        md = ImageDraw.Draw(fill_mask)
+        md.polygon(to_px(rings[0]), fill=255)
+        for hole in rings[1:]:
+            md.polygon(to_px(hole), fill=0)
+        line_mask = Image.new("L", (w, h), 0)
+        ld = ImageDraw.Draw(line_mask)
+        lw = max(1, int(round(self.lw * self.S)))
+        for r in rings:
+            pts = to_px(r)
+            ld.line(pts + [pts[0]], fill=255, width=lw, joint="curve")
+        tint = tuple(int(0.5 * a + 0.5 * b) for a, b in zip(fill, _rgb(self.style.invalid)))
+        # two coverage masks, resampled per frame, through which solid colours are pasted: a
+        # one-channel resample is a quarter of an RGBA one
+        return _Sprite(part, rings, fill, fill_mask, line_mask, origin, k, tint)  # type: ignore[arg-type]
+
+    def _dot(self, colour: RGB, radius: float):
+        from PIL import Image, ImageDraw
+
+        k = 4
+        r = radius * k
+        size = int(2 * r + 4)
+        img = Image.new("RGBA", (size, size), (0, 0, 0, 0))
+        ImageDraw.Draw(img).ellipse([2, 2, 2 + 2 * r, 2 + 2 * r], fill=colour + (255,))
+        small = img.resize((size // k + 1, size // k + 1), Image.Resampling.BOX)
+        return small
+
+    def _static_layer(self):
+        """Background, parts that do not move and the trails, antialiased by supersampling."""
+        from PIL import Image, ImageDraw
+
+        s = self.style
+        S = self.S
+        img = Image.new("RGB", (self.W * S, self.H * S), _rgb(s.background))
+        draw = ImageDraw.Draw(img)
+        lw = max(1, int(round(self.lw * S)))
+        for i in self.static:
+            p = self.mech.parts[i]
+            rings = [r[0] * S for r in self.world_parts[i]]
+            mask = Image.new("L", img.size, 0)
+            md = ImageDraw.Draw(mask)
+            md.polygon([tuple(q) for q in rings[0]], fill=255)
+            for hole in rings[1:]:
+                md.polygon([tuple(q) for q in hole], fill=0)
+            img.paste(self._fill(i, p), (0, 0, *img.size), mask)
+            for r in rings:
+                pts = [tuple(q) for q in r]
+                draw.line(pts + [pts[0]], fill=_rgb(s.outline), width=lw, joint="curve")
+        for tr in self.trails.values():
+            ok = self.motion.valid
+            seg = [tuple(q * S) for q, v in zip(tr, ok) if v]
+            if len(seg) > 1:
+                draw.line(seg + [seg[0]], fill=_rgb(s.trail), width=lw, joint="curve")
+        return img.reduce(S) if S > 1 else img
+
+    # -- per frame ---------------------------------------------------------------------
+    def __len__(self) -> int:
+        return len(self.motion)
+
+    def _blit(self, img, sp: _Sprite, pose: Array, tinted: bool, rings_px: list[Array] | None = None) -> None:
+        """Resample sprite ``sp`` at ``pose`` into ``img`` (one affine map, bilinear)."""
+        from PIL import Image
+
+        x, y, th = float(pose[0]), float(pose[1]), float(pose[2])
+        c, s_ = np.cos(th), np.sin(th)
+        # output bbox: transform the sprite's corners
+        sw, sh = sp.fill_mask.size
+        corners = np.array([[0, 0], [sw, 0], [0, sh], [sw, sh]], float)
+        u = sp.origin[0] + corners[:, 0] / sp.k
+        v = sp.origin[1] - corners[:, 1] / sp.k
+        wx = x + c * u - s_ * v
+        wy = y + s_ * u + c * v
+        X = self.origin[0] + self.scale * wx
+        Y = self.origin[1] - self.scale * wy
+        x0, y0 = int(np.floor(X.min())), int(np.floor(Y.min()))
+        x1, y1 = int(np.ceil(X.max())), int(np.ceil(Y.max()))
+        x0c, y0c = max(x0, 0), max(y0, 0)
+        x1c, y1c = min(x1, self.W), min(y1, self.H)
+        if x1c <= x0c or y1c <= y0c:
+            return
+        # output pixel (X, Y) -> world -> part frame -> sprite pixel
+        inv = 1.0 / self.scale
+        # world: wx = (X - ox)/s ; wy = (oy - Y)/s ; part: u = c(wx - x) + s(wy - y) ; v = -s(wx - x) + c(wy - y)
+        # sprite: sx = (u - u0) k ; sy = (v0 - v) k
+        k = sp.k
+        ox, oy = self.origin
+        a = k * c * inv
+        b = -k * s_ * inv
+        cc = k * (c * (-ox * inv - x) + s_ * (oy * inv - y) - sp.origin[0])
+        d = k * s_ * inv
+        e = k * c * inv
+        f = k * (sp.origin[1] - (-s_ * (-ox * inv - x) + c * (oy * inv - y)))
+        # shift for the bbox origin
+        cc += a * x0c + b * y0c
+        f += d * x0c + e * y0c
+        size = (x1c - x0c, y1c - y0c)
+        box = (x0c, y0c, x1c, y1c)
+        coeffs = (a, b, cc, d, e, f)
+        if rings_px is None:
+            fm = sp.fill_mask.transform(size, Image.Transform.AFFINE, coeffs, resample=Image.Resampling.BILINEAR)
+        else:
+            # the fill's edge lies under the antialiased outline, so a plain scanline fill of the
+            # projected polygon (holes cleared) looks the same and costs a fraction of a resample
+            from PIL import ImageDraw
+
+            fm = Image.new("L", size, 0)
+            md = ImageDraw.Draw(fm)
+            off = np.array([x0c, y0c], float)
+            md.polygon([tuple(q) for q in rings_px[0] - off], fill=255)
+            for hole in rings_px[1:]:
+                md.polygon([tuple(q) for q in hole - off], fill=0)
+        img.paste(sp.tint if tinted else sp.fill, box, fm)
+        lm = sp.line_mask.transform(size, Image.Transform.AFFINE, coeffs, resample=Image.Resampling.BILINEAR)
+        img.paste(_rgb(self.style.outline), box, lm)
+
+    def frame(self, i: int):
+        """Frame ``i`` as a PIL RGB image of the style's size."""
+        from PIL import ImageDraw
+
+        s = self.style
+        img = self.base.copy()
+        valid = bool(self.motion.valid[i])
+        draw = ImageDraw.Draw(img)
+        for idx in self.projected:
+            rings = self.world_parts[idx]
+            p = self.mech.parts[idx]
+            pts = [tuple(q) for q in rings[0][i]]
+            draw.polygon(pts, fill=self._fill(idx, p), outline=_rgb(s.outline))
+        for idx, sp in self.sprites:
+            rings = [r[i] for r in self.world_parts[idx]]
+            self._blit(img, sp, self.motion.poses[self.mech.parts[idx].name][i], not valid, rings)
+        for pname, sp in self.sweep_sprites:
+            self._blit(img, sp, self.motion.poses[pname][i], False)
+        for rings in self.overlay_parts:
+            for r in rings:
+                pts = [tuple(q) for q in r[i]]
+                draw.line(pts + [pts[0]], fill=_rgb(s.overlay), width=max(1, int(round(self.lw))))
+        if s.show_pins:
+            dot = self.dot[s.pin]
+            h = dot.size[0] // 2
+            for pts in self.pins.values():
+                x, y = pts[i]
+                img.paste(dot, (int(round(x)) - h, int(round(y)) - h), dot)
+        dot = self.dot[s.trail]
+        h = dot.size[0] // 2
+        for tr in self.trails.values():
+            x, y = tr[i]
+            img.paste(dot, (int(round(x)) - h, int(round(y)) - h), dot)
+        if not valid:
+            self._mark_invalid(draw, i)
+        return img
+
+    def _mark_invalid(self, draw, i: int) -> None:
+        s = self.style
+        code = int(self.motion.fail_code[i])
+        joint = self.motion.fail_table[code][0] if code >= 0 else ""
+        red = _rgb(s.invalid)
+        draw.rectangle([0, 0, self.W - 1, self.H - 1], outline=red, width=3)
+        for name, pts in self.pins.items():
+            if name == joint or name.split(":")[0] == joint or joint.endswith("." + name) or joint == name.split(".")[-1]:
+                x, y = pts[i]
+                r = 7
+                draw.ellipse([x - r, y - r, x + r, y + r], outline=red, width=2)
+        draw.text((6, 4), f"invalid: joint {joint}", fill=red)
+
+    def frames(self, progress: bool = False, threads: int | None = None, post=None) -> Iterator:
+        """All frames in order (a progress bar on a terminal when ``progress``).
+
+        Frames are independent, and Pillow releases the GIL while it
+        resamples and pastes, so ``threads`` (default: all cores) draw them
+        in parallel; the order, and every pixel, is the same as with one.
+        ``post`` (e.g. palette quantisation) is applied to each frame in the
+        same worker.
+        """
+        import os
+
+        n = len(self)
+        threads = threads or os.cpu_count() or 1
+        bar = None
+        if progress:
+            import sys
+
+            from tqdm import tqdm
+
+            bar = tqdm(total=n, desc="render", unit="frame", disable=not sys.stderr.isatty(), leave=False)
+        try:
+            work = self.frame if post is None else (lambda i: post(self.frame(i)))
+            if threads <= 1 or n < 8:
+                for i in range(n):
+                    yield work(i)
+                    if bar is not None:
+                        bar.update()
+                return
+            from concurrent.futures import ThreadPoolExecutor
+
+            with ThreadPoolExecutor(threads) as ex:
+                for img in ex.map(work, range(n)):
+                    yield img
+                    if bar is not None:
+                        bar.update()
+        finally:
+            if bar is not None:
+                bar.close()
