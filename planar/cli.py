@@ -17,33 +17,60 @@ from .errors import PlanarError
 __all__ = ["main"]
 
 
+#: the embedded default: a wind-up toy and a four-bar walking leg
+DEMO_SCENES: dict[str, dict] = {
+    "horse": {
+        "name": "horse", "angle_unit": "deg",
+        "mechanism": {"type": "toy", "left": [["Rz->OzT", "OzT->Oz"]],
+                      "right": [["Rz->OzT", "OzT->Ty"], ["Rz->OzT", "OzT->Oz"]], "phase": 180},
+        "driver": {"speed": 0.5, "samples_per_cycle": 48},
+        "render": {"width": 480, "height": 360},
+    },
+    "kangaroo-leg": {
+        "name": "kangaroo-leg",
+        "mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0,
+                      "coupler_point": [5.5, -2.0],
+                      "polygons": [{"name": "foot", "part": "coupler",
+                                    "points": [[5.1, -2.25], [6.6, -2.25], [6.6, -1.95], [5.1, -1.95]]}]},
+        "driver": {"speed": 1.0, "samples_per_cycle": 48},
+        "effects": {"loads": [{"point": "coupler_point", "force": [0.0, 10.0]}]},
+        "render": {"width": 480, "height": 360, "sweep": ["foot"]},
+        "fabrication": {"unit_mm": 15.0},
+    },
+}
+
+
 def _cmd_demo(args: argparse.Namespace) -> int:
-    """The embedded default: the kangaroo-style walking leg, its motion and torque."""
+    """The embedded default: a wind-up toy and a four-bar walking leg, animated (and cut)."""
     import numpy as np
 
     from . import analysis
-    from .catalog import kangaroo_leg
     from .fileio import write_motion_csv
+    from .scene import build_scene, parse_scene
 
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
-    leg = kangaroo_leg()
-    motion = leg.run(samples_per_cycle=args.samples)
-    csv = out / "kangaroo-leg.csv"
-    write_motion_csv(csv, leg, motion)
-    tau, _ = analysis.motor_torque(leg, motion.driver, {"coupler_point": np.array([0.0, 1.0])})
-    foot = motion.points["coupler_point"]
-    print(f"{leg.name}: four-bar {leg.grashof}, {len(motion)} samples, all valid: {bool(motion.valid.all())}")
-    print(f"  foot stride {np.ptp(foot[:, 0]):.3f} x {np.ptp(foot[:, 1]):.3f} units; "
-          f"peak torque for a unit upward foot force {np.abs(tau).max():.3f}")
-    print(f"  wrote {csv}")
-    for extra in _DEMO_EXTRAS:
-        extra(out)
+    for name, data in DEMO_SCENES.items():
+        scene = build_scene(parse_scene(data, f"<demo {name}>"), f"<demo {name}>")
+        motion = scene.motion()
+        gif = out / f"{name}.gif"
+        n = render_scene(scene, gif)
+        csv = out / f"{name}.csv"
+        write_motion_csv(csv, scene.mechanism, motion)
+        line = f"{name}: {n} frames, all valid: {bool(motion.valid.all())} -> {gif}, {csv}"
+        if name == "kangaroo-leg":
+            leg = scene.mechanism
+            loads = {l.point: np.array(l.force) for l in scene.spec.effects.loads}
+            tau, _ = analysis.motor_torque(leg, motion.driver, loads)
+            line += f"; peak motor torque {np.abs(tau).max():.3f} (force x unit) for a 10 N foot push"
+        print(line)
+        for extra in _DEMO_EXTRAS:
+            extra(scene, out)
     return 0
 
 
-#: later features append writers here (GIF, DXF) so the demo grows with the package
-_DEMO_EXTRAS: list[Callable[[Path], None]] = []
+#: later features append writers here (scene, output dir) so the demo grows with the package
+_DEMO_EXTRAS: list[Callable[..., None]] = []
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
@@ -85,6 +112,94 @@ def _cmd_chains(args: argparse.Namespace) -> int:
     return 0
 
 
+def _style(scene):
+    from .render import Style
+
+    r = scene.spec.render
+    return Style(width=r.width, height=r.height, supersample=r.supersample, background=r.background,
+                 trails=r.trails, show_pins=r.show_pins)
+
+
+def render_scene(scene, out: str | Path, overlay=None, progress: bool = True) -> int:
+    """Render a scene's analytic motion (and optionally an overlay motion) to a GIF; returns frames."""
+    from exporters.gif import frame_delay_ms, indexer, write_gif
+
+    from .render import Renderer, palette_colors
+
+    motion = scene.motion()
+    polys = {n: scene.polygons[n] for n in scene.spec.render.sweep}
+    r = Renderer(scene.mechanism, motion, _style(scene), overlay=overlay, polygons=polys)
+    pal = palette_colors(r.style, len(scene.mechanism.parts))
+    delay = frame_delay_ms(scene.mechanism.driver.period, scene.spec.driver.samples_per_cycle)
+    return write_gif(out, r.frames(progress=progress, post=indexer(pal)), delay, pal)
+
+
+def _cmd_render(args: argparse.Namespace) -> int:
+    from .scene import load_scene
+
+    scene = load_scene(args.scene)
+    overlay = None
+    if args.overlay:
+        from .simulate import simulate_scene
+
+        overlay = simulate_scene(scene).motion
+    n = render_scene(scene, args.output, overlay=overlay)
+    print(f"wrote {args.output}: {n} frames")
+    return 0
+
+
+def _cmd_motion(args: argparse.Namespace) -> int:
+    from .fileio import write_motion_csv
+    from .scene import load_scene
+
+    scene = load_scene(args.scene)
+    motion = scene.motion()
+    write_motion_csv(args.output, scene.mechanism, motion)
+    print(f"wrote {args.output}: {len(motion)} samples, {int(motion.valid.sum())} valid")
+    return 0
+
+
+def gallery_scenes(folder: Path | None = None) -> list[Path]:
+    """The gallery's scene files, sorted by name."""
+    if folder is None:
+        here = Path.cwd() / "gallery"
+        folder = here if here.is_dir() else Path(__file__).resolve().parents[1] / "gallery"
+    return sorted(folder.glob("*.toml"))
+
+
+def _cmd_gallery(args: argparse.Namespace) -> int:
+    from .scene import load_scene
+
+    src = Path(args.source) if args.source else None
+    scenes = gallery_scenes(src)
+    if not scenes:
+        from .errors import InputError
+
+        raise InputError("gallery", str(src or "gallery/"), "a folder with .toml scene files")
+    out = Path(args.output) if args.output else scenes[0].parent
+    out.mkdir(parents=True, exist_ok=True)
+    for path in scenes:
+        scene = load_scene(path)
+        target = out / (path.stem + ".gif")
+        n = render_scene(scene, target, progress=False)
+        print(f"{path.name}: {n} frames -> {target}")
+    return 0
+
+
+def _cmd_schema(args: argparse.Namespace) -> int:
+    from .fileio import atomic_write
+    from .scene import scene_schema
+
+    text = json.dumps(scene_schema(), indent=2, sort_keys=True) + "\n"
+    if args.output:
+        with atomic_write(args.output, "w") as fh:
+            fh.write(text)
+        print(f"wrote {args.output}")
+    else:
+        sys.stdout.write(text)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     from .bench import BENCHMARKS
 
@@ -93,7 +208,6 @@ def build_parser() -> argparse.ArgumentParser:
 
     d = sub.add_parser("demo", help="run the embedded default and write its outputs")
     d.add_argument("-o", "--output", default="planar-demo", help="output directory (default: planar-demo)")
-    d.add_argument("--samples", type=int, default=120, help="samples per cycle (default 120)")
     d.set_defaults(func=_cmd_demo)
 
     b = sub.add_parser("bench", help="benchmarks against a peer, measured in the same run")
@@ -109,6 +223,26 @@ def build_parser() -> argparse.ArgumentParser:
     ch.add_argument("--optional", action="store_true", help="include the Oy->Oy pattern the printed table lacks")
     ch.add_argument("--json", action="store_true", help='print {"Ox": [["Rz->Tx", "Tx->Ox"], ...], ...}')
     ch.set_defaults(func=_cmd_chains)
+
+    r = sub.add_parser("render", help="render a scene's animation to a GIF")
+    r.add_argument("scene", help="scene file (TOML)")
+    r.add_argument("-o", "--output", required=True, help="GIF file to write")
+    r.add_argument("--overlay", action="store_true", help="draw the pymunk simulation over the analytic motion")
+    r.set_defaults(func=_cmd_render)
+
+    mo = sub.add_parser("motion", help="write a scene's motion table (CSV)")
+    mo.add_argument("scene", help="scene file (TOML)")
+    mo.add_argument("-o", "--output", required=True, help="CSV file to write")
+    mo.set_defaults(func=_cmd_motion)
+
+    g = sub.add_parser("gallery", help="render every scene in gallery/ to a GIF")
+    g.add_argument("-o", "--output", default=None, help="output directory (default: beside the scenes)")
+    g.add_argument("--source", default=None, help="folder of scenes (default: the repository's gallery/)")
+    g.set_defaults(func=_cmd_gallery)
+
+    sc = sub.add_parser("schema", help="print (or write) the JSON schema of scene files")
+    sc.add_argument("-o", "--output", default=None, help="file to write (default: standard output)")
+    sc.set_defaults(func=_cmd_schema)
 
     c = sub.add_parser("catalog", help="write the motion table of a built-in mechanism")
     c.add_argument("mechanism", help="catalog name, e.g. jansen, kangaroo, slider-crank")

@@ -31,12 +31,19 @@ def test_readme_opens_with_two_commands_and_ci_runs_the_test_one():
 
 
 def test_demo_writes_outputs(tmp_path):
+    import time
+
+    t0 = time.perf_counter()
     r = run("demo", "-o", str(tmp_path))
+    elapsed = time.perf_counter() - t0
     assert r.returncode == 0, r.stderr
     csv = tmp_path / "kangaroo-leg.csv"
     header = csv.read_text().splitlines()[0].split(",")
     assert header[:2] == ["t", "driver"] and header[-1] == "valid"
     assert "coupler_point.x" in header
+    for name in ("horse", "kangaroo-leg"):
+        assert (tmp_path / f"{name}.gif").stat().st_size > 1000
+    print(f"planar demo took {elapsed:.1f} s")
 
 
 def test_user_error_exit_2_one_line_no_traceback(tmp_path):
