@@ -232,3 +232,192 @@ def format_render(r: dict[str, Any]) -> str:
 
 
 BENCHMARKS["render"] = (bench_render, format_render)
+
+
+# --------------------------------------------------------------------------- accuracy
+
+ACCURACY_GRID = {
+    "substeps": (4, 8, 16, 32, 48, 64, 96),
+    "iterations": (5, 10, 20, 40),
+    "error_bias": (1e-3, 1e-6, 1e-9),
+}
+
+
+def _pareto(points: list[tuple[float, float]]) -> list[bool]:
+    """Which (time, error) points no other point beats in both (ties count as not beaten)."""
+    out = []
+    for i, (t, e) in enumerate(points):
+        beaten = any((t2 <= t and e2 <= e and (t2 < t or e2 < e)) for j, (t2, e2) in enumerate(points) if j != i)
+        out.append(not beaten)
+    return out
+
+
+def bench_accuracy(out_dir: str = "planar-bench-accuracy", quick: bool = False, repeats: int = 2,
+                   progress: bool = True) -> dict[str, Any]:
+    """Simulation error against the analytic motion vs wall time, over the settings that trade them.
+
+    For every gallery scene pymunk can rebuild, every combination of
+    substeps per frame (i.e. the time step), solver iterations and error bias
+    runs one full cycle; the error is the largest distance between simulated
+    and analytic part points over the cycle, as a fraction of the mechanism's
+    size; the cost is wall seconds per simulated second (best of
+    ``repeats``).  Settings are ranked on the aggregate (worst error over the
+    mechanisms, total time); the Pareto frontier is marked.  Writes
+    ``accuracy.csv`` and ``accuracy.png`` in ``out_dir``.
+    """
+    import csv
+    import sys
+    from pathlib import Path
+
+    from .cli import gallery_scenes
+    from .compare import compare
+    from .scene import load_scene
+    from .simulate import DEFAULT_SETTINGS, SimSettings, SimulationError, simulate
+
+    grid = ACCURACY_GRID
+    if quick:
+        grid = {"substeps": (8, 48), "iterations": (10, 20), "error_bias": (1e-6, 1e-9)}
+    settings = [SimSettings(substeps=s, iterations=i, error_bias=b)
+                for s in grid["substeps"] for i in grid["iterations"] for b in grid["error_bias"]]
+    d = DEFAULT_SETTINGS
+    if all((x.substeps, x.iterations, x.error_bias) != (d.substeps, d.iterations, d.error_bias) for x in settings):
+        settings.append(d)
+    scenes = []
+    skipped = {}
+    for path in gallery_scenes():
+        sc = load_scene(path)
+        try:
+            simulate(sc.mechanism, sc.motion().t[:3], sc.spec.effects, SimSettings(substeps=1))
+        except SimulationError as e:
+            skipped[sc.name] = str(e)
+            continue
+        scenes.append(sc)
+    if quick:
+        scenes = scenes[:3]
+    rows = []
+    total = len(scenes) * len(settings)
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=total, desc="accuracy", unit="run", disable=not sys.stderr.isatty(), leave=False)
+    for sc in scenes:
+        ref = sc.motion()
+        sim_seconds = float(ref.t[-1] - ref.t[0])
+        for st in settings:
+            best = math.inf
+            err = math.nan
+            for _ in range(repeats):
+                r = simulate(sc.mechanism, ref.t, sc.spec.effects, st)
+                best = min(best, r.wall_time)
+                err = compare(sc.mechanism, ref, r.motion).max_rel_error if r.blowup is None else math.inf
+            rows.append({"mechanism": sc.name, "substeps": st.substeps, "iterations": st.iterations,
+                         "error_bias": st.error_bias, "dt_s": sim_seconds / (len(ref) - 1) / st.substeps,
+                         "error": err, "seconds_per_sim_second": best / sim_seconds})
+            if bar is not None:
+                bar.update()
+    if bar is not None:
+        bar.close()
+    # aggregate per setting
+    agg = []
+    for st in settings:
+        rs = [r for r in rows if (r["substeps"], r["iterations"], r["error_bias"]) ==
+              (st.substeps, st.iterations, st.error_bias)]
+        agg.append({"substeps": st.substeps, "iterations": st.iterations, "error_bias": st.error_bias,
+                    "max_error": max(r["error"] for r in rs),
+                    "seconds_per_sim_second": sum(r["seconds_per_sim_second"] for r in rs)})
+    front = _pareto([(a["seconds_per_sim_second"], a["max_error"]) for a in agg])
+    for a, f in zip(agg, front):
+        a["frontier"] = f
+        a["default"] = (a["substeps"], a["iterations"], a["error_bias"]) == (d.substeps, d.iterations, d.error_bias)
+    for sc_name in {r["mechanism"] for r in rows}:
+        rs = [r for r in rows if r["mechanism"] == sc_name]
+        for r, f in zip(rs, _pareto([(r["seconds_per_sim_second"], r["error"]) for r in rs])):
+            r["frontier"] = f
+    default = next(a for a in agg if a["default"])
+    per_mech_default = {r["mechanism"]: r["error"] for r in rows
+                        if (r["substeps"], r["iterations"], r["error_bias"]) == (d.substeps, d.iterations, d.error_bias)}
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    from .fileio import atomic_write
+
+    with atomic_write(out / "accuracy.csv", "w") as fh:
+        w = csv.DictWriter(fh, fieldnames=["mechanism", "substeps", "iterations", "error_bias", "dt_s", "error",
+                                           "seconds_per_sim_second", "frontier"])
+        w.writeheader()
+        for r in rows:
+            w.writerow(r)
+        for a in agg:
+            w.writerow({"mechanism": "ALL (worst error, total time)", "substeps": a["substeps"],
+                        "iterations": a["iterations"], "error_bias": a["error_bias"], "dt_s": "",
+                        "error": a["max_error"], "seconds_per_sim_second": a["seconds_per_sim_second"],
+                        "frontier": a["frontier"]})
+    _accuracy_chart(out / "accuracy.png", agg)
+    return {
+        "benchmark": "accuracy",
+        "mechanisms": [s.name for s in scenes],
+        "skipped": skipped,
+        "settings": len(settings),
+        "default": default,
+        "default_on_frontier": bool(default["frontier"]),
+        "default_errors": per_mech_default,
+        "frontier": [a for a in agg if a["frontier"]],
+        "csv": str(out / "accuracy.csv"),
+        "chart": str(out / "accuracy.png"),
+        # planar's analytic solve is the reference: the ratio is the rebuild's worst error at the defaults
+        "ratio": default["max_error"],
+    }
+
+
+def _accuracy_chart(path, agg: list[dict[str, Any]]) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .fileio import atomic_write
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.4), dpi=100)
+    t = np.array([a["seconds_per_sim_second"] for a in agg])
+    e = np.array([a["max_error"] for a in agg])
+    f = np.array([a["frontier"] for a in agg])
+    ax.scatter(t[~f], e[~f], s=14, c="#9a9a9a", label="setting")
+    order = np.argsort(t[f])
+    ax.plot(t[f][order], e[f][order], "-o", c="#4e79a7", ms=4, label="Pareto frontier")
+    dflt = [i for i, a in enumerate(agg) if a["default"]]
+    if dflt:
+        i = dflt[0]
+        ax.scatter([t[i]], [e[i]], s=80, facecolors="none", edgecolors="#e15759", linewidths=2, label="default")
+    ax.axhline(1e-3, ls=":", c="#e15759", lw=1)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall seconds per simulated second (all gallery mechanisms)")
+    ax.set_ylabel("worst position error / mechanism size")
+    ax.set_title("pymunk rebuild vs analytic motion")
+    ax.legend(loc="upper right", fontsize=8)
+    fig.tight_layout()
+    with atomic_write(path, "wb") as fh:
+        fig.savefig(fh, format="png", metadata={"Software": None})
+    plt.close(fig)
+
+
+def format_accuracy(r: dict[str, Any]) -> str:
+    lines = [f"pymunk rebuild vs analytic, {len(r['mechanisms'])} mechanisms x {r['settings']} settings",
+             f"  {'substeps':>8}{'iters':>7}{'err bias':>10}{'worst err':>12}{'s/sim s':>10}"]
+    for a in sorted(r["frontier"], key=lambda a: a["seconds_per_sim_second"]):
+        mark = "  <- default" if a["default"] else ""
+        lines.append(f"  {a['substeps']:>8}{a['iterations']:>7}{a['error_bias']:>10.0e}{a['max_error']:>12.2e}"
+                     f"{a['seconds_per_sim_second']:>10.3f}{mark}")
+    d = r["default"]
+    lines.append(f"  default ({d['substeps']} substeps, {d['iterations']} iterations, error bias {d['error_bias']:g}): "
+                 f"worst error {d['max_error']:.2e}, {d['seconds_per_sim_second']:.3f} s per simulated second, "
+                 f"{'on' if r['default_on_frontier'] else 'NOT on'} the frontier")
+    for k, v in sorted(r["default_errors"].items()):
+        lines.append(f"    {k:<22} {v:.2e}")
+    for k, v in r["skipped"].items():
+        lines.append(f"  skipped {k}: {v}")
+    lines.append(f"  wrote {r['csv']} and {r['chart']}")
+    return "\n".join(lines)
+
+
+BENCHMARKS["accuracy"] = (bench_accuracy, format_accuracy)

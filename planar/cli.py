@@ -79,9 +79,16 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     fn, fmt = BENCHMARKS[args.name]
     kwargs = {}
     if args.n is not None:
+        if args.name == "accuracy":
+            from .errors import InputError
+
+            raise InputError("-n", args.n, "no problem size for the accuracy benchmark (it runs the gallery)")
         kwargs["n"] = args.n
     if args.repeats is not None:
         kwargs["repeats"] = args.repeats
+    if args.name == "accuracy":
+        kwargs["out_dir"] = args.output
+        kwargs["quick"] = args.quick
     result = fn(**kwargs)
     print(json.dumps(result, indent=2) if args.json else fmt(result))
     return 0
@@ -200,6 +207,43 @@ def _cmd_schema(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from .compare import compare, format_comparison
+    from .scene import load_scene
+    from .simulate import SimSettings, simulate_scene, torque_comparison
+
+    scene = load_scene(args.scene)
+    settings = SimSettings(**{k: v for k, v in (("substeps", args.substeps), ("iterations", args.iterations),
+                                                 ("error_bias", args.error_bias)) if v is not None})
+    sim = simulate_scene(scene, settings)
+    result = compare(scene.mechanism, scene.motion(), sim.motion, threshold=args.threshold)
+    e = scene.spec.effects
+    mech = scene.mechanism
+    if (e.loads or e.gravity is not None) and mech.driver.kind == "rotation" and mech.driver.amplitude is None:
+        from .errors import PlanarError
+
+        try:
+            period_t = mech.driver.times(scene.spec.driver.samples_per_cycle, 1.0)
+            tc = torque_comparison(mech, period_t, e, settings)
+            result.torque = {k: tc[k] for k in ("peak", "max_abs_diff", "max_rel_diff", "note")}
+            if args.json:
+                result.torque.update(analytic=tc["analytic"], simulated=tc["simulated"])
+        except PlanarError as err:
+            result.notes.append(f"torque not compared: {err}")
+    if args.json:
+        d = result.to_dict()
+        d["settings"] = {"substeps": settings.substeps, "iterations": settings.iterations,
+                         "error_bias": settings.error_bias}
+        d["wall_time_s"] = sim.wall_time
+        d["built"] = {k: v for k, v in sim.built.items()}
+        print(json.dumps(d, indent=2, default=str))
+    else:
+        print(format_comparison(result))
+        print(f"  simulated in {sim.wall_time:.3f} s ({sim.steps} steps; substeps {settings.substeps}, "
+              f"iterations {settings.iterations}, error bias {settings.error_bias:g})")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     from .bench import BENCHMARKS
 
@@ -215,6 +259,8 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--json", action="store_true", help="print a JSON object (with a 'ratio' key)")
     b.add_argument("-n", type=int, default=None, help="problem size (samples)")
     b.add_argument("--repeats", type=int, default=None, help="timing repeats (best is kept)")
+    b.add_argument("-o", "--output", default="planar-bench-accuracy", help="accuracy: folder for the CSV and chart")
+    b.add_argument("--quick", action="store_true", help="accuracy: a small grid on three mechanisms")
     b.set_defaults(func=_cmd_bench)
 
     ch = sub.add_parser("chains", help="motion transfer chains from the motor (Rz) to an end effector")
@@ -243,6 +289,15 @@ def build_parser() -> argparse.ArgumentParser:
     sc = sub.add_parser("schema", help="print (or write) the JSON schema of scene files")
     sc.add_argument("-o", "--output", default=None, help="file to write (default: standard output)")
     sc.set_defaults(func=_cmd_schema)
+
+    cp = sub.add_parser("compare", help="simulate a scene in pymunk and compare with the analytic motion")
+    cp.add_argument("scene", help="scene file (TOML)")
+    cp.add_argument("--json", action="store_true", help="print JSON (each part carries max_rel_error)")
+    cp.add_argument("--threshold", type=float, default=1e-3, help="error threshold, fraction of size (1e-3)")
+    cp.add_argument("--substeps", type=int, default=None)
+    cp.add_argument("--iterations", type=int, default=None)
+    cp.add_argument("--error-bias", type=float, default=None)
+    cp.set_defaults(func=_cmd_compare)
 
     c = sub.add_parser("catalog", help="write the motion table of a built-in mechanism")
     c.add_argument("mechanism", help="catalog name, e.g. jansen, kangaroo, slider-crank")

@@ -451,7 +451,13 @@ class ElementalMechanism(Mechanism):
         drv = Part("driver", ((0.0, 0.0, 2 * P.D_ar), (L, 0.0, 2 * P.D_ar), (cx, a_loc[1] - 0.08, rim),
                               (cx, a_loc[1] + 0.08, rim)),
                    (Hole((0.0, 0.0), 2 * P.D_ar), Hole((L, 0.0), 2 * P.D_ar), win))
-        follower = Part("follower", ((0.0, 0.0, 2 * P.F_ar), (0.0, P.F_jh, P.F_jr), (P.F_jcx - P.F_jr, P.F_jh, P.F_jr)),
+        # the contact slides along the tab's face: the face must cover its travel t (distance along
+        # the tab from the pivot), which grows past F_jh as the window moves away
+        _, st = self._sweep()
+        w = st.aux["A"] - np.asarray(B)
+        t = np.sqrt(np.maximum((w * w).sum(-1) - P.F_jcx**2, 0.0))
+        t_lo, t_hi = float(t.min()) - P.F_jr, float(t.max()) + P.F_jr
+        follower = Part("follower", ((0.0, 0.0, 2 * P.F_ar), (0.0, t_hi, P.F_jr), (P.F_jcx - P.F_jr, t_hi, P.F_jr)),
                         (Hole((0.0, 0.0), 2 * P.F_ar),), plane="xz")
         ground = Part("ground", ((*g0, 2 * P.D_ar), (*g1, 2 * P.D_ar), (*B, 3 * P.F_ar)),
                       (gslot, Hole(B, 2 * P.F_ar)), ground=True, plane="xz")
@@ -462,7 +468,7 @@ class ElementalMechanism(Mechanism):
         joints = [
             Slide("driver-slide", "driver", (0.0, 0.0), (L, 0.0), "ground", g0, g1),
             Pivot("pivot", "ground", B, "follower", (0.0, 0.0)),
-            CamOnLine("window-tab", "driver", a_loc, 0.0, "follower", (P.F_jcx, 0.0), (P.F_jcx, P.F_jh)),
+            CamOnLine("window-tab", "driver", a_loc, 0.0, "follower", (P.F_jcx, t_lo), (P.F_jcx, t_hi)),
         ]
         return [ground, drv, follower], joints, driver
 
