@@ -335,6 +335,7 @@ def bench_accuracy(out_dir: str = "planar-bench-accuracy", quick: bool = False, 
         for r, f in zip(rs, _pareto([(r["seconds_per_sim_second"], r["error"]) for r in rs])):
             r["frontier"] = f
     default = next(a for a in agg if a["default"])
+    effects_cost = _effects_cost(repeats=max(3, repeats))
     per_mech_default = {r["mechanism"]: r["error"] for r in rows
                         if (r["substeps"], r["iterations"], r["error_bias"]) == (d.substeps, d.iterations, d.error_bias)}
     out = Path(out_dir)
@@ -364,9 +365,41 @@ def bench_accuracy(out_dir: str = "planar-bench-accuracy", quick: bool = False, 
         "frontier": [a for a in agg if a["frontier"]],
         "csv": str(out / "accuracy.csv"),
         "chart": str(out / "accuracy.png"),
+        "effects_cost": effects_cost,
         # planar's analytic solve is the reference: the ratio is the rebuild's worst error at the defaults
         "ratio": default["max_error"],
     }
+
+
+def _effects_cost(repeats: int = 3) -> dict[str, float]:
+    """Seconds per simulated second of one four-bar leg with different effects named.
+
+    ``none``: no [effects]; ``unused``: an [effects] table naming every effect
+    switched off (the same space is built, so it costs the same); then gravity,
+    and contact shapes with friction, which do cost.
+    """
+    from .scene import build_scene, parse_scene
+    from .simulate import simulate
+
+    base = {"mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0,
+                          "coupler_point": [2.0, 1.0]}, "driver": {"samples_per_cycle": 36}}
+    variants = {
+        "none": None,
+        "unused": {"contact": False, "springs": [], "loads": []},
+        "gravity": {"gravity": [0.0, -9.81]},
+        "contact+friction": {"contact": True, "friction": 0.6},
+    }
+    out = {}
+    for name, eff in variants.items():
+        data = dict(base)
+        if eff is not None:
+            data["effects"] = eff
+        sc = build_scene(parse_scene(data))
+        ref = sc.motion()
+        span = float(ref.t[-1] - ref.t[0])
+        best = min(simulate(sc.mechanism, ref.t, sc.spec.effects).wall_time for _ in range(repeats))
+        out[name] = best / span
+    return out
 
 
 def _accuracy_chart(path, agg: list[dict[str, Any]]) -> None:
@@ -416,6 +449,10 @@ def format_accuracy(r: dict[str, Any]) -> str:
         lines.append(f"    {k:<22} {v:.2e}")
     for k, v in r["skipped"].items():
         lines.append(f"  skipped {k}: {v}")
+    ec = r["effects_cost"]
+    lines.append("  effects cost (four-bar leg, s per simulated second): " +
+                 ", ".join(f"{k} {v:.4f}" for k, v in ec.items()) +
+                 f"; unused/none = {ec['unused'] / ec['none']:.2f}")
     lines.append(f"  wrote {r['csv']} and {r['chart']}")
     return "\n".join(lines)
 

@@ -574,19 +574,24 @@ def inverse_dynamics_torque(mech: Mechanism, t: Array, effects: "EffectsSpec | N
     tau = np.zeros(t.size)
     masses = []
     for p in mech.parts:
-        if p.ground or p.name == drv.part:
-            continue  # the driver turns steadily about its axle: no torque for its own inertia
+        if p.ground:
+            continue
+        # (the driver turns steadily about its axle: its inertia terms vanish, its weight does not)
         mass, cog, I = mass_properties(p, density)
         masses.append((p.name, cog, mass, I))
     for part, xy, mass in point_masses or []:
         masses.append((part, xy, mass, 0.0))
     for part, cog, mass, I in masses:
         X = poses_apply(m.poses[part], np.asarray(cog, float))
-        phi = np.unwrap(m.poses[part][:, 2])
+        phi = m.poses[part][:, 2]
+        fwd = np.remainder(np.roll(phi, -1) - phi + np.pi, 2 * np.pi) - np.pi  # wrapped steps
+        back = np.roll(fwd, 1)
+        dphi = (fwd + back) / (2 * dq)
+        ddphi = (fwd - back) / (dq * dq)
         dX = d1(X)
         acc = d2(X) * w * w
         tau += mass * ((acc - g) * dX).sum(-1)
-        tau += I * (d2(phi) * w * w) * d1(phi)
+        tau += I * (ddphi * w * w) * dphi
     if effects is not None:
         for load in effects.loads:
             X = m.points[load.point]
@@ -614,6 +619,8 @@ def torque_comparison(mech: Mechanism, t: Array, effects: "EffectsSpec | None",
     bias = 3.0 * peak + 1e-9
     for _ in range(4):
         sim = simulate(mech, t, effects, settings, mode="motor", torque_bias=bias)
+        if sim.blowup is not None:
+            raise SimulationError(f"{mech.name}: the motor-driven simulation {sim.motion.reason(sim.blowup[0])}")
         tau = sim.torque
         if np.all(tau[1:] < bias * 0.999):
             break

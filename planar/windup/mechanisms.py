@@ -121,9 +121,28 @@ class ElementalMechanism(Mechanism):
         self.spatial = number in (6, 9)
         parts, joints, driver = getattr(self, f"_build_{number}")(rate, phase)
         super().__init__(f"#{number} {self.motion_in}->{self.motion_out}", parts, joints, driver)
+        for label, length in self._derived_lengths():
+            if not length > 1e-12:
+                raise InputError(f"#{number}.params", self.params, f"a positive {label} (got {length:g})")
         ref = self.forward(np.zeros(1) if self.motion_in != "OzT" else np.zeros((1, 3)))
         if not ref.valid[0]:
             raise InputError(f"#{number}.params", self.params, f"a mechanism that assembles at rest ({ref.why})")
+
+    def _derived_lengths(self) -> list[tuple[str, float]]:
+        """Radii and distances the geometry needs to be non-zero (named for error messages)."""
+        P = self.params
+        k = self.number
+        out = []
+        if k in (1, 2, 3):
+            out.append(("cam eccentricity |D_jc - D_o|", float(np.hypot(*_sub(P.D_jc, P.D_o)))))
+        if k == 3:
+            out.append(("track radius |S_c|", float(np.hypot(P.S_c[0], P.S_c[1]))))
+            out.append(("cam-to-pin distance |F_o - D_jc|", float(np.hypot(*_sub(P.F_o, P.D_jc)))))
+        if k in (5, 11):
+            out.append(("pin radius |F_jc|", float(np.hypot(*P.F_jc))))
+        if k == 7:
+            out.append(("pin-to-pivot distance |F_o - D_jc|", float(np.hypot(*_sub(P.F_o, P.D_jc)))))
+        return out
 
     def _validate(self) -> None:
         from dataclasses import fields
