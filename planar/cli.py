@@ -25,6 +25,7 @@ DEMO_SCENES: dict[str, dict] = {
                       "right": [["Rz->OzT", "OzT->Ty"], ["Rz->OzT", "OzT->Oz"]], "phase": 180},
         "driver": {"speed": 0.5, "samples_per_cycle": 48},
         "render": {"width": 480, "height": 360},
+        "fabrication": {"unit_mm": 100.0},
     },
     "kangaroo-leg": {
         "name": "kangaroo-leg",
@@ -63,6 +64,9 @@ def _cmd_demo(args: argparse.Namespace) -> int:
             loads = {l.point: np.array(l.force) for l in scene.spec.effects.loads}
             tau, _ = analysis.motor_torque(leg, motion.driver, loads)
             line += f"; peak motor torque {np.abs(tau).max():.3f} (force x unit) for a 10 N foot push"
+        dxf = out / f"{name}.dxf"
+        layout = export_scene(scene, dxf=dxf)
+        line += f"; {len(layout.parts)} parts -> {dxf}"
         print(line)
         for extra in _DEMO_EXTRAS:
             extra(scene, out)
@@ -244,6 +248,58 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     return 0
 
 
+def _sheet(text: str) -> tuple[float, float]:
+    from .errors import InputError
+
+    try:
+        w, h = (float(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise InputError("--sheet", text, "WIDTHxHEIGHT in millimetres, e.g. 300x200") from None
+    if not (w > 0 and h > 0):
+        raise InputError("--sheet", text, "a positive width and height")
+    return w, h
+
+
+def export_scene(scene, dxf: str | Path | None = None, svg: str | Path | None = None, kerf: float | None = None,
+                 sheet: tuple[float, float] | None = None, preview: str | Path | None = None):
+    """Lay a scene's parts on sheets and write DXF and/or SVG (and a PNG preview of the DXF)."""
+    from .fabrication import layout_parts
+
+    fab = scene.spec.fabrication
+    layout = layout_parts(scene.mechanism, unit_mm=fab.unit_mm, kerf=fab.kerf_mm if kerf is None else kerf,
+                          pin_mm=fab.pin_diameter_mm, clearance=fab.clearance_mm, sheet=sheet or fab.sheet_mm)
+    if dxf is not None:
+        from exporters.dxf import write_dxf
+
+        write_dxf(dxf, layout)
+        if preview is not None:
+            from exporters.dxf import preview_png
+
+            preview_png(dxf, preview)
+    if svg is not None:
+        from exporters.svg import write_svg
+
+        write_svg(svg, layout)
+    return layout
+
+
+def _cmd_export(args: argparse.Namespace) -> int:
+    from .errors import InputError
+    from .scene import load_scene
+
+    if args.kerf is not None and not (0 <= args.kerf <= 2):
+        raise InputError("--kerf", args.kerf, "a kerf between 0 and 2 mm")
+    if args.preview and not args.output:
+        raise InputError("--preview", args.preview, "a DXF output (-o) to preview")
+    scene = load_scene(args.scene)
+    sheet = _sheet(args.sheet) if args.sheet else None
+    layout = export_scene(scene, args.output, args.svg, args.kerf, sheet, args.preview)
+    outs = [p for p in (args.output, args.svg, args.preview) if p]
+    print(f"{len(layout.parts)} parts on {layout.sheets} sheet(s) of {layout.sheet_size[0]:g} x "
+          f"{layout.sheet_size[1]:g} mm, kerf {layout.kerf:g} mm -> {', '.join(outs)}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     from .bench import BENCHMARKS
 
@@ -298,6 +354,15 @@ def build_parser() -> argparse.ArgumentParser:
     cp.add_argument("--iterations", type=int, default=None)
     cp.add_argument("--error-bias", type=float, default=None)
     cp.set_defaults(func=_cmd_compare)
+
+    ex = sub.add_parser("export", help="every part laid flat for a laser cutter (DXF, SVG)")
+    ex.add_argument("scene", help="scene file (TOML)")
+    ex.add_argument("-o", "--output", default=None, help="DXF file to write")
+    ex.add_argument("--svg", default=None, help="SVG file to write")
+    ex.add_argument("--kerf", type=float, default=None, help="beam width in mm (default: the scene's kerf_mm)")
+    ex.add_argument("--sheet", default=None, help="sheet size WIDTHxHEIGHT in mm (default: the scene's)")
+    ex.add_argument("--preview", default=None, help="PNG preview of the DXF (ezdxf's drawing add-on)")
+    ex.set_defaults(func=_cmd_export)
 
     c = sub.add_parser("catalog", help="write the motion table of a built-in mechanism")
     c.add_argument("mechanism", help="catalog name, e.g. jansen, kangaroo, slider-crank")

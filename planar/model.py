@@ -80,10 +80,16 @@ def _vec(v: ArrayLike) -> Vec:
 
 @dataclass(frozen=True)
 class Hole:
-    """A round hole for a pin, centred at ``centre``; ``diameter`` nominal."""
+    """A round hole centred at ``centre``; ``diameter`` nominal.
+
+    ``role="pin"``: a pivot hole whose size fabrication takes from the pin
+    (the scene's pin diameter); ``"sized"``: the mechanism's own size (an
+    axle, a cam's round hole).
+    """
 
     centre: Vec
     diameter: float
+    role: str = "sized"
 
 
 @dataclass(frozen=True)
@@ -93,6 +99,7 @@ class Slot:
     start: Vec
     end: Vec
     width: float
+    role: str = "sized"
 
 
 @dataclass(frozen=True)
@@ -104,6 +111,7 @@ class ArcSlot:
     angle0: float
     angle1: float
     width: float
+    role: str = "sized"
 
 
 Feature = Hole | Slot | ArcSlot

@@ -392,7 +392,7 @@ class Linkage(Mechanism):
                 hulls[lk.name].append((x, y, r))
                 # a hole only where a pin goes: a shared node or a pin running in a slot
                 if len(owners[nd]) > 1 or isinstance(byname[nd], RRP):
-                    feats[lk.name].append(Hole((x, y), self.pin_diameter))
+                    feats[lk.name].append(Hole((x, y), self.pin_diameter, role="pin"))
         for nd, links in owners.items():
             node = byname[nd]
             first = links[0]
@@ -427,7 +427,7 @@ class Linkage(Mechanism):
         start = base + (s0 - pad) * e
         end = base + (s1 + pad) * e
         start_t, end_t = tuple(map(float, start)), tuple(map(float, end))
-        feats[owner].append(Slot(start_t, end_t, self.pin_diameter))
+        feats[owner].append(Slot(start_t, end_t, self.pin_diameter, role="pin"))
         hulls[owner].extend([(start_t[0], start_t[1], self.width / 2), (end_t[0], end_t[1], self.width / 2)])
         for lk in links:
             if lk == owner or (guided and not any(g.name == lk for g in guided)):
@@ -438,7 +438,7 @@ class Linkage(Mechanism):
                 pins = [(anchor[0] - self.width, anchor[1]), (anchor[0] + self.width, anchor[1])]
                 for px, py in pins:
                     hulls[lk].append((px, py, self.width / 2))
-                    feats[lk].append(Hole((px, py), self.pin_diameter))
+                    feats[lk].append(Hole((px, py), self.pin_diameter, role="pin"))
                 joints.append(Slide(f"{lk}-slide", lk, pins[0], (2 * self.width, 0.0), owner, start_t, end_t))
             else:
                 joints.append(PinInSlot(f"{node.name}-slot", lk, self._anchors[lk][node.name], owner, start_t, end_t))
