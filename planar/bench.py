@@ -173,7 +173,7 @@ def _matplotlib_gif(mech, motion, path: str, width: int, height: int, delay_ms: 
     plt.close(fig)
 
 
-def bench_render(n: int = 120, repeats: int = 3, width: int = 480, height: int = 360) -> dict[str, Any]:
+def bench_render(n: int = 120, repeats: int = 5, width: int = 480, height: int = 360) -> dict[str, Any]:
     """Frames per second and GIF size: planar's renderer vs matplotlib's animation writer.
 
     Both draw the same four-bar (parts as filled outlines, coupler trail) at

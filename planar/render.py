@@ -359,9 +359,9 @@ class Renderer:
             fm = Image.new("L", size, 0)
             md = ImageDraw.Draw(fm)
             off = np.array([x0c, y0c], float)
-            md.polygon([tuple(q) for q in rings_px[0] - off], fill=255)
+            md.polygon((rings_px[0] - off).ravel().tolist(), fill=255)  # a flat list: no per-point tuples
             for hole in rings_px[1:]:
-                md.polygon([tuple(q) for q in hole - off], fill=0)
+                md.polygon((hole - off).ravel().tolist(), fill=0)
         img.paste(sp.tint if tinted else sp.fill, box, fm)
         lm = sp.line_mask.transform(size, Image.Transform.AFFINE, coeffs, resample=Image.Resampling.BILINEAR)
         img.paste(_rgb(self.style.outline), box, lm)
@@ -377,8 +377,7 @@ class Renderer:
         for idx in self.projected:
             rings = self.world_parts[idx]
             p = self.mech.parts[idx]
-            pts = [tuple(q) for q in rings[0][i]]
-            draw.polygon(pts, fill=self._fill(idx, p), outline=_rgb(s.outline))
+            draw.polygon(rings[0][i].ravel().tolist(), fill=self._fill(idx, p), outline=_rgb(s.outline))
         for idx, sp in self.sprites:
             rings = [r[i] for r in self.world_parts[idx]]
             self._blit(img, sp, self.motion.poses[self.mech.parts[idx].name][i], not valid, rings)
@@ -386,8 +385,8 @@ class Renderer:
             self._blit(img, sp, self.motion.poses[pname][i], False)
         for rings in self.overlay_parts:
             for r in rings:
-                pts = [tuple(q) for q in r[i]]
-                draw.line(pts + [pts[0]], fill=_rgb(s.overlay), width=max(1, int(round(self.lw))))
+                pts = np.vstack([r[i], r[i][:1]]).ravel().tolist()
+                draw.line(pts, fill=_rgb(s.overlay), width=max(1, int(round(self.lw))))
         if s.show_pins:
             dot = self.dot[s.pin]
             h = dot.size[0] // 2
