@@ -198,3 +198,28 @@ def test_preview_png(tmp_path):
 
     im = np.asarray(Image.open(tmp_path / "p.png").convert("RGB"))
     assert len(np.unique(im.reshape(-1, 3), axis=0)) > 3
+
+
+def test_no_duplicate_cut_entities_and_jansen_link_lengths(tmp_path):
+    scene = load_scene(GALLERY / "jansen-leg.toml")
+    export_scene(scene, tmp_path / "j.dxf", kerf=0.0)
+    doc = ezdxf.readfile(tmp_path / "j.dxf")
+    seen = set()
+    for e in doc.modelspace():
+        if e.dxf.layer in ("CUT_INNER", "CUT_OUTER"):
+            if e.dxftype() == "CIRCLE":
+                key = ("C", round(e.dxf.center.x, 6), round(e.dxf.center.y, 6), round(e.dxf.radius, 6))
+            else:
+                key = ("P",) + tuple(round(v, 6) for p in e.get_points("xyb") for v in p)
+            assert key not in seen, "duplicate cut"
+            seen.add(key)
+    groups = dict(doc.groups)
+    # Jansen's holy numbers (unit_mm = 1): each two-hole link's hole centres are its length apart
+    for name, length in {"j": 50.0, "k": 61.9, "c": 39.3, "f": 39.4, "crank": 15.0}.items():
+        cs = [e for e in groups[name] if e.dxftype() == "CIRCLE"]
+        d = math.dist((cs[0].dxf.center.x, cs[0].dxf.center.y), (cs[1].dxf.center.x, cs[1].dxf.center.y))
+        assert abs(d - length) < 1e-6, name
+    tri = sorted(math.dist((a.dxf.center.x, a.dxf.center.y), (b.dxf.center.x, b.dxf.center.y))
+                 for i, a in enumerate(c for c in groups["lower"] if c.dxftype() == "CIRCLE")
+                 for j, b in enumerate(c for c in groups["lower"] if c.dxftype() == "CIRCLE") if i < j)
+    assert np.allclose(tri, sorted([36.7, 49.0, 65.7]), atol=1e-6)

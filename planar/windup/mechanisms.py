@@ -119,29 +119,30 @@ class ElementalMechanism(Mechanism):
         self.motion_in, self.motion_out = MOTIONS[number]
         self.view = "xz" if number == 8 else "xy"
         self.spatial = number in (6, 9)
-        parts, joints, driver = getattr(self, f"_build_{number}")(rate, phase)
-        super().__init__(f"#{number} {self.motion_in}->{self.motion_out}", parts, joints, driver)
-        for label, length in self._derived_lengths():
+        for fld, label, length in self._derived_lengths():
             if not length > 1e-12:
-                raise InputError(f"#{number}.params", self.params, f"a positive {label} (got {length:g})")
+                raise InputError(f"#{number}.{fld}", getattr(self.params, fld), f"a positive {label} (got {length:g})")
         ref = self.forward(np.zeros(1) if self.motion_in != "OzT" else np.zeros((1, 3)))
         if not ref.valid[0]:
             raise InputError(f"#{number}.params", self.params, f"a mechanism that assembles at rest ({ref.why})")
+        self.driver = self._driver(rate, phase)
+        parts, joints = getattr(self, f"_build_{number}")()
+        super().__init__(f"#{number} {self.motion_in}->{self.motion_out}", parts, joints, self.driver)
 
-    def _derived_lengths(self) -> list[tuple[str, float]]:
-        """Radii and distances the geometry needs to be non-zero (named for error messages)."""
+    def _derived_lengths(self) -> list[tuple[str, str, float]]:
+        """(field, meaning, value) of radii and distances the geometry needs to be non-zero."""
         P = self.params
         k = self.number
         out = []
         if k in (1, 2, 3):
-            out.append(("cam eccentricity |D_jc - D_o|", float(np.hypot(*_sub(P.D_jc, P.D_o)))))
+            out.append(("D_jc", "cam eccentricity |D_jc - D_o|", float(np.hypot(*_sub(P.D_jc, P.D_o)))))
         if k == 3:
-            out.append(("track radius |S_c|", float(np.hypot(P.S_c[0], P.S_c[1]))))
-            out.append(("cam-to-pin distance |F_o - D_jc|", float(np.hypot(*_sub(P.F_o, P.D_jc)))))
+            out.append(("S_c", "track radius |S_c|", float(np.hypot(P.S_c[0], P.S_c[1]))))
+            out.append(("F_o", "cam-to-pin distance |F_o - D_jc|", float(np.hypot(*_sub(P.F_o, P.D_jc)))))
         if k in (5, 11):
-            out.append(("pin radius |F_jc|", float(np.hypot(*P.F_jc))))
+            out.append(("F_jc", "pin radius |F_jc|", float(np.hypot(*P.F_jc))))
         if k == 7:
-            out.append(("pin-to-pivot distance |F_o - D_jc|", float(np.hypot(*_sub(P.F_o, P.D_jc)))))
+            out.append(("F_o", "pin-to-pivot distance |F_o - D_jc|", float(np.hypot(*_sub(P.F_o, P.D_jc)))))
         return out
 
     def _validate(self) -> None:
@@ -258,10 +259,8 @@ class ElementalMechanism(Mechanism):
         joint = Slide(f"{label}-slide", "follower", pins[0], _xy(L * ax), "ground", slot.start, slot.end)
         return slot, pins, joint
 
-    def _build_1(self, rate, phase):
+    def _build_1(self):
         P = self.params
-        driver = self._driver(rate, phase)
-        self.driver = driver
         d = float(np.hypot(*_sub(P.D_jc, P.D_o)))
         _, st = self._sweep()
         fo = _xy(P.F_o)
@@ -280,12 +279,10 @@ class ElementalMechanism(Mechanism):
             PinInSlot("cam-window", "driver", _sub(P.D_jc, P.D_o), "follower", window.start, window.end),
             slide,
         ]
-        return [ground, drv, follower], joints, driver
+        return [ground, drv, follower], joints
 
-    def _build_2(self, rate, phase):
+    def _build_2(self):
         P = self.params
-        driver = self._driver(rate, phase)
-        self.driver = driver
         _, st = self._sweep()
         s = _xy(P.F_o)
         m = st.aux["m"]
@@ -308,12 +305,10 @@ class ElementalMechanism(Mechanism):
             Pivot("pivot", "ground", s, "follower", (0.0, 0.0)),
             PinInSlot("cam-window", "driver", _sub(P.D_jc, P.D_o), "follower", window.start, window.end),
         ]
-        return [ground, drv, follower], joints, driver
+        return [ground, drv, follower], joints
 
-    def _build_3(self, rate, phase):
+    def _build_3(self):
         P = self.params
-        driver = self._driver(rate, phase)
-        self.driver = driver
         _, st = self._sweep()
         p0 = _xy(P.F_o)
         s = (p0[0] + P.S_c[0], p0[1] + P.S_c[1])
@@ -335,23 +330,17 @@ class ElementalMechanism(Mechanism):
             Pivot("cam-hole", "driver", _sub(P.D_jc, P.D_o), "follower", hole),
             PinInArcSlot("track", "follower", (0.0, 0.0), "ground", s, r),
         ]
-        return [ground, drv, follower], joints, driver
+        return [ground, drv, follower], joints
 
-    def _build_4(self, rate, phase):
+    def _build_4(self):
         P = self.params
-        driver = self._driver(rate, phase)
-        self.driver = driver
         q, st = self._sweep()
         fo = _xy(P.F_o)
         pin = _xy(P.F_jc)
         p0 = (fo[0] + pin[0], fo[1] + pin[1])
         # the slot in the driver frame: y = Y0, x over the pin's travel
-        p = st.aux["p"]
-        rel = p - np.asarray(_xy(P.D_o))
-        c, s = np.cos(-q), np.sin(-q)
-        xs = c * rel[:, 0] - s * rel[:, 1]
         Y0 = p0[1] - P.D_o[1]
-        slot = Slot((float(xs.min()), Y0), (float(xs.max()), Y0), 2 * P.F_jr)
+        slot = self._driver_slot(q, st.aux["p"], Y0, 2 * P.F_jr)
         gslot, pins, slide = self._ground_slide(fo, (0.0, 1.0), (st.out.min(), st.out.max()), P.F_sr)
         follower = Part("follower", ((*pin, 2 * P.F_jr), (*pins[0], 2 * P.F_sr), (*pins[1], 2 * P.F_sr)),
                         (Hole(pin, 2 * P.F_jr), Hole(pins[0], 2 * P.F_sr), Hole(pins[1], 2 * P.F_sr)))
@@ -364,22 +353,16 @@ class ElementalMechanism(Mechanism):
             PinInSlot("pin-slot", "follower", pin, "driver", slot.start, slot.end),
             slide,
         ]
-        return [ground, drv, follower], joints, driver
+        return [ground, drv, follower], joints
 
-    def _build_5(self, rate, phase):
+    def _build_5(self):
         P = self.params
-        driver = self._driver(rate, phase)
-        self.driver = driver
         q, st = self._sweep()
         s = _xy(P.F_o)
         pin = _xy(P.F_jc)
         p0 = (s[0] + pin[0], s[1] + pin[1])
         d = p0[1] - P.D_o[1]
-        p = st.aux["p"]
-        rel = p - np.asarray(_xy(P.D_o))
-        c, sn = np.cos(-q), np.sin(-q)
-        xs = c * rel[:, 0] - sn * rel[:, 1]
-        slot = Slot((float(xs.min()), d), (float(xs.max()), d), 2 * P.F_jr)
+        slot = self._driver_slot(q, st.aux["p"], d, 2 * P.F_jr)
         follower = Part("follower", ((0.0, 0.0, 2 * P.F_ar), (*pin, 2 * P.F_jr)),
                         (Hole((0.0, 0.0), 2 * P.F_ar), Hole(pin, 2 * P.F_jr)))
         drv = Part("driver", ((0.0, 0.0, 3 * P.D_ar), (slot.start[0], d, 2 * P.F_jr), (slot.end[0], d, 2 * P.F_jr)),
@@ -391,7 +374,14 @@ class ElementalMechanism(Mechanism):
             Pivot("pivot", "ground", s, "follower", (0.0, 0.0)),
             PinInSlot("pin-slot", "follower", pin, "driver", slot.start, slot.end),
         ]
-        return [ground, drv, follower], joints, driver
+        return [ground, drv, follower], joints
+
+    def _driver_slot(self, theta: Array, pins: Array, y: float, width: float) -> Slot:
+        """The slot, parallel to x at height ``y`` in the (turning) driver's frame, covering the pin's travel."""
+        rel = pins - np.asarray(_xy(self.params.D_o))
+        c, s = np.cos(-theta), np.sin(-theta)
+        xs = c * rel[:, 0] - s * rel[:, 1]
+        return Slot((float(xs.min()), y), (float(xs.max()), y), width)
 
     def _spatial_follower(self, P, N: float, r: float, arm: float) -> Part:
         """Follower of #6/#9 in its own yz plane: pivot at (0, 0), pin up to the driver's plane."""
@@ -399,10 +389,8 @@ class ElementalMechanism(Mechanism):
         return Part("follower", ((0.0, 0.0, 2 * P.F_ar), (0.0, top, r)), (Hole((0.0, 0.0), 2 * P.F_ar),),
                     plane="yz", offset=float(P.F_o[0]))
 
-    def _build_6(self, rate, phase):
+    def _build_6(self):
         P = self.params
-        driver = self._driver(rate, phase)
-        self.driver = driver
         p0 = _xy(P.F_o)
         r = P.F_jr
         h = p0[1] - P.D_o[1] - r
@@ -417,12 +405,10 @@ class ElementalMechanism(Mechanism):
             SkewContact("edge-pin", "driver", (0.0, h), (1.0, 0.0), "follower", float(P.F_o[0]), r,
                         plane_z=float(P.D_o[2])),
         ]
-        return [ground, drv, follower], joints, driver
+        return [ground, drv, follower], joints
 
-    def _build_7(self, rate, phase):
+    def _build_7(self):
         P = self.params
-        driver = self._driver(rate, phase)
-        self.driver = driver
         _, st = self._sweep()
         s = _xy(P.F_o)
         pin = _sub(P.D_jc, P.D_o)
@@ -447,12 +433,10 @@ class ElementalMechanism(Mechanism):
             Pivot("pivot", "ground", s, "follower", (0.0, 0.0)),
             PinInSlot("pin-slot", "driver", pin, "follower", slot.start, slot.end),
         ]
-        return [ground, drv, follower], joints, driver
+        return [ground, drv, follower], joints
 
-    def _build_8(self, rate, phase):
+    def _build_8(self):
         P = self.params
-        driver = self._driver(rate, phase)
-        self.driver = driver
         B = (float(P.F_o[0]), float(P.F_o[2]))
         A0 = (B[0] + P.F_jcx, B[1] + P.F_jh)
         o = (float(P.D_o[0]), float(P.D_o[2]))
@@ -489,12 +473,10 @@ class ElementalMechanism(Mechanism):
             Pivot("pivot", "ground", B, "follower", (0.0, 0.0)),
             CamOnLine("window-tab", "driver", a_loc, 0.0, "follower", (P.F_jcx, t_lo), (P.F_jcx, t_hi)),
         ]
-        return [ground, drv, follower], joints, driver
+        return [ground, drv, follower], joints
 
-    def _build_9(self, rate, phase):
+    def _build_9(self):
         P = self.params
-        driver = self._driver(rate, phase)
-        self.driver = driver
         p0 = _xy(P.F_o)
         r = P.F_jr
         phi = P.phi
@@ -516,7 +498,7 @@ class ElementalMechanism(Mechanism):
             SkewContact("slot-pin", "driver", e_loc, _xy(d), "follower", float(P.F_o[0]), r,
                         plane_z=float(P.D_o[2])),
         ]
-        return [ground, drv, follower], joints, driver
+        return [ground, drv, follower], joints
 
     def _arc_driver(self, P, qs, st, p0, R) -> tuple[Part, ArcSlot]:
         """OzT driver plate with an arc slot of radius R about its origin, covering the pin's travel."""
@@ -530,10 +512,8 @@ class ElementalMechanism(Mechanism):
         part = Part("driver", ((0.0, 0.0, 2 * P.F_jr), *[(x, y, 1.6 * P.F_jr) for x, y in pts]), (arc,))
         return part, arc
 
-    def _build_10(self, rate, phase):
+    def _build_10(self):
         P = self.params
-        driver = self._driver(rate, phase)
-        self.driver = driver
         qs, st = self._sweep()
         fo = _xy(P.F_o)
         pin = _xy(P.F_jc)
@@ -548,12 +528,10 @@ class ElementalMechanism(Mechanism):
             PinInArcSlot("pin-arc", "follower", pin, "driver", arc.centre, R),
             slide,
         ]
-        return [ground, drv, follower], joints, driver
+        return [ground, drv, follower], joints
 
-    def _build_11(self, rate, phase):
+    def _build_11(self):
         P = self.params
-        driver = self._driver(rate, phase)
-        self.driver = driver
         qs, st = self._sweep()
         s = _xy(P.F_o)
         pin = _xy(P.F_jc)
@@ -567,7 +545,7 @@ class ElementalMechanism(Mechanism):
             Pivot("pivot", "ground", s, "follower", (0.0, 0.0)),
             PinInArcSlot("pin-arc", "follower", pin, "driver", arc.centre, R),
         ]
-        return [ground, drv, follower], joints, driver
+        return [ground, drv, follower], joints
 
 
 def elemental(number: int, **overrides: Any) -> ElementalMechanism:
