@@ -220,6 +220,8 @@ def test_no_duplicate_cut_entities_and_jansen_link_lengths(tmp_path):
         d = math.dist((cs[0].dxf.center.x, cs[0].dxf.center.y), (cs[1].dxf.center.x, cs[1].dxf.center.y))
         assert abs(d - length) < 1e-6, name
     tri = sorted(math.dist((a.dxf.center.x, a.dxf.center.y), (b.dxf.center.x, b.dxf.center.y))
-                 for i, a in enumerate(c for c in groups["lower"] if c.dxftype() == "CIRCLE")
-                 for j, b in enumerate(c for c in groups["lower"] if c.dxftype() == "CIRCLE") if i < j)
-    assert np.allclose(tri, sorted([36.7, 49.0, 65.7]), atol=1e-6)
+                 for i, a in enumerate(c for c in groups["upper"] if c.dxftype() == "CIRCLE")
+                 for j, b in enumerate(c for c in groups["upper"] if c.dxftype() == "CIRCLE") if i < j)
+    assert np.allclose(tri, sorted([41.5, 40.1, 55.8]), atol=1e-6)  # the ternary link Z-B-D
+    # the foot F is a point of the lower link, not a joint: no hole there
+    assert sum(c.dxftype() == "CIRCLE" for c in groups["lower"]) == 2
