@@ -114,31 +114,18 @@ def palette_colors(style: Style, n_parts: int) -> list[RGB]:
 
 
 @dataclass
-class _Sprite:
-    """A rigid layer (a part or a swept polygon) pre-drawn once in its own frame."""
-
-    part: Part
-    rings: list[Array]  # in the part's frame
-    fill: RGB
-    fill_mask: object  # PIL "L" coverage of the fill, drawn at ``k`` pixels per unit
-    line_mask: object  # PIL "L" coverage of the outline strokes
-    origin: tuple[float, float]  # part-frame (u_min, v_max) of the sprite's top-left
-    k: float
-    tint: RGB
-
-
-@dataclass
 class Renderer:
     """Renders ``motion`` of ``mech`` (and optionally an ``overlay`` motion) frame by frame.
 
     ``polygons`` maps a name to ``(part, points)`` in that part's frame: drawn
     swept with the part (the notes' foot).
 
-    How: every rigid part is drawn once, antialiased, as a sprite in its own
-    frame; a frame is the static layer (ground, other parts that do not move,
-    the trails) with each moving sprite resampled through one affine map
-    (rotation, translation, scale in a single bilinear pass).  Parts seen
-    edge-on (another plane than the view) are drawn as projected polygons.
+    How: every part's outline is transformed for all frames at once (numpy);
+    a frame is the static layer (ground, parts that do not move, the trails,
+    drawn once, supersampled) plus, for each moving part, a scanline fill
+    through a coverage mask (holes cleared) and its outline strokes drawn at
+    twice the size and box-reduced: the antialiasing.  The fill's aliased edge
+    lies under the antialiased outline.
     """
 
     mech: Mechanism
@@ -158,23 +145,17 @@ class Renderer:
         world = self._world_geometry(self.motion)
         self._fit(world)
         self.lw = max(1.0, s.line_width)
-        # classify parts: static (pose constant), rigid sprites (in the view plane), projected
+        # static parts (pose constant over the motion) go into the pre-drawn layer
         self.static: list[int] = []
-        self.sprites: list[tuple[int, _Sprite]] = []
-        self.projected: list[int] = []
+        self.moving: list[int] = []
         for i, p in enumerate(self.mech.parts):
             pose = self.motion.poses[p.name]
             if np.ptp(pose, axis=0).max() <= 1e-12 * max(1.0, float(np.abs(pose).max())):
                 self.static.append(i)
-            elif p.plane == self.view:
-                self.sprites.append((i, self._sprite(p, _rings(p), self._fill(i, p))))
             else:
-                self.projected.append(i)
+                self.moving.append(i)
         self.world_parts = [[self._px(r) for r in rings] for rings in world["parts"]]
-        self.sweep_sprites = []
-        for n, (pname, pts) in self.polygons.items():
-            part = self.mech.part(pname)
-            self.sweep_sprites.append((pname, self._sprite(part, [np.asarray(pts, float)], _rgb(s.sweep))))
+        self.sweep_rings = [[self._px(v)] for v in world["sweeps"].values()]
         self.trails = {k: self._px(v) for k, v in world["trails"].items()}
         self.pins = {k: self._px(v) for k, v in world["pins"].items()}
         self.overlay_parts = []
@@ -237,36 +218,6 @@ class Renderer:
         return _rgb(self.style.part_colors[(i - 1) % len(self.style.part_colors)])
 
     # -- pre-drawn layers ------------------------------------------------------------
-    def _sprite(self, part: Part, rings: list[Array], fill: RGB) -> _Sprite:
-        from PIL import Image, ImageDraw
-
-        k = self.S * self.scale
-        pad = 2.0 * self.S * self.lw + 2
-        lo = rings[0].min(0)
-        hi = rings[0].max(0)
-        w = int(np.ceil((hi[0] - lo[0]) * k + 2 * pad)) + 1
-        h = int(np.ceil((hi[1] - lo[1]) * k + 2 * pad)) + 1
-        origin = (float(lo[0] - pad / k), float(hi[1] + pad / k))
-
-        def to_px(r: Array) -> list[tuple[float, float]]:
-            return [((u - origin[0]) * k, (origin[1] - v) * k) for u, v in r]
-
-        fill_mask = Image.new("L", (w, h), 0)
-        md = ImageDraw.Draw(fill_mask)
-        md.polygon(to_px(rings[0]), fill=255)
-        for hole in rings[1:]:
-            md.polygon(to_px(hole), fill=0)
-        line_mask = Image.new("L", (w, h), 0)
-        ld = ImageDraw.Draw(line_mask)
-        lw = max(1, int(round(self.lw * self.S)))
-        for r in rings:
-            pts = to_px(r)
-            ld.line(pts + [pts[0]], fill=255, width=lw, joint="curve")
-        tint = tuple(int(0.5 * a + 0.5 * b) for a, b in zip(fill, _rgb(self.style.invalid)))
-        # two coverage masks, resampled per frame, through which solid colours are pasted: a
-        # one-channel resample is a quarter of an RGBA one
-        return _Sprite(part, rings, fill, fill_mask, line_mask, origin, k, tint)  # type: ignore[arg-type]
-
     def _dot(self, colour: RGB, radius: float):
         from PIL import Image, ImageDraw
 
@@ -310,61 +261,34 @@ class Renderer:
     def __len__(self) -> int:
         return len(self.motion)
 
-    def _blit(self, img, sp: _Sprite, pose: Array, tinted: bool, rings_px: list[Array] | None = None) -> None:
-        """Resample sprite ``sp`` at ``pose`` into ``img`` (one affine map, bilinear)."""
-        from PIL import Image
+    def _draw_rings(self, img, rings: list[Array], fill: RGB) -> None:
+        """Fill a polygon with holes and stroke its rings, antialiased, within its bounding box."""
+        from PIL import Image, ImageDraw
 
-        x, y, th = float(pose[0]), float(pose[1]), float(pose[2])
-        c, s_ = np.cos(th), np.sin(th)
-        # output bbox: transform the sprite's corners
-        sw, sh = sp.fill_mask.size
-        corners = np.array([[0, 0], [sw, 0], [0, sh], [sw, sh]], float)
-        u = sp.origin[0] + corners[:, 0] / sp.k
-        v = sp.origin[1] - corners[:, 1] / sp.k
-        wx = x + c * u - s_ * v
-        wy = y + s_ * u + c * v
-        X = self.origin[0] + self.scale * wx
-        Y = self.origin[1] - self.scale * wy
-        x0, y0 = int(np.floor(X.min())), int(np.floor(Y.min()))
-        x1, y1 = int(np.ceil(X.max())), int(np.ceil(Y.max()))
-        x0c, y0c = max(x0, 0), max(y0, 0)
-        x1c, y1c = min(x1, self.W), min(y1, self.H)
-        if x1c <= x0c or y1c <= y0c:
+        ext = rings[0]
+        x0, y0 = np.floor(ext.min(0)).astype(int) - 2
+        x1, y1 = np.ceil(ext.max(0)).astype(int) + 3
+        x0, y0 = max(int(x0), 0), max(int(y0), 0)
+        x1, y1 = min(int(x1), self.W), min(int(y1), self.H)
+        if x1 <= x0 or y1 <= y0:
             return
-        # output pixel (X, Y) -> world -> part frame -> sprite pixel
-        inv = 1.0 / self.scale
-        # world: wx = (X - ox)/s ; wy = (oy - Y)/s ; part: u = c(wx - x) + s(wy - y) ; v = -s(wx - x) + c(wy - y)
-        # sprite: sx = (u - u0) k ; sy = (v0 - v) k
-        k = sp.k
-        ox, oy = self.origin
-        a = k * c * inv
-        b = -k * s_ * inv
-        cc = k * (c * (-ox * inv - x) + s_ * (oy * inv - y) - sp.origin[0])
-        d = k * s_ * inv
-        e = k * c * inv
-        f = k * (sp.origin[1] - (-s_ * (-ox * inv - x) + c * (oy * inv - y)))
-        # shift for the bbox origin
-        cc += a * x0c + b * y0c
-        f += d * x0c + e * y0c
-        size = (x1c - x0c, y1c - y0c)
-        box = (x0c, y0c, x1c, y1c)
-        coeffs = (a, b, cc, d, e, f)
-        if rings_px is None:
-            fm = sp.fill_mask.transform(size, Image.Transform.AFFINE, coeffs, resample=Image.Resampling.BILINEAR)
-        else:
-            # the fill's edge lies under the antialiased outline, so a plain scanline fill of the
-            # projected polygon (holes cleared) looks the same and costs a fraction of a resample
-            from PIL import ImageDraw
-
-            fm = Image.new("L", size, 0)
-            md = ImageDraw.Draw(fm)
-            off = np.array([x0c, y0c], float)
-            md.polygon((rings_px[0] - off).ravel().tolist(), fill=255)  # a flat list: no per-point tuples
-            for hole in rings_px[1:]:
-                md.polygon((hole - off).ravel().tolist(), fill=0)
-        img.paste(sp.tint if tinted else sp.fill, box, fm)
-        lm = sp.line_mask.transform(size, Image.Transform.AFFINE, coeffs, resample=Image.Resampling.BILINEAR)
-        img.paste(_rgb(self.style.outline), box, lm)
+        box = (x0, y0, x1, y1)
+        size = (x1 - x0, y1 - y0)
+        off = np.array([x0, y0], float)
+        fm = Image.new("L", size, 0)
+        md = ImageDraw.Draw(fm)
+        md.polygon((ext - off).ravel().tolist(), fill=255)  # flat lists: no per-point tuples
+        for hole in rings[1:]:
+            md.polygon((hole - off).ravel().tolist(), fill=0)
+        img.paste(fill, box, fm)
+        S = 2
+        lm = Image.new("L", (size[0] * S, size[1] * S), 0)
+        ld = ImageDraw.Draw(lm)
+        width = max(1, int(round(self.lw * S)))
+        for ring in rings:
+            pts = (np.vstack([ring, ring[:1]]) - off) * S
+            ld.line(pts.ravel().tolist(), fill=255, width=width, joint="curve")
+        img.paste(_rgb(self.style.outline), box, lm.reduce(S))
 
     def frame(self, i: int):
         """Frame ``i`` as a PIL RGB image of the style's size."""
@@ -374,15 +298,14 @@ class Renderer:
         img = self.base.copy()
         valid = bool(self.motion.valid[i])
         draw = ImageDraw.Draw(img)
-        for idx in self.projected:
-            rings = self.world_parts[idx]
-            p = self.mech.parts[idx]
-            draw.polygon(rings[0][i].ravel().tolist(), fill=self._fill(idx, p), outline=_rgb(s.outline))
-        for idx, sp in self.sprites:
-            rings = [r[i] for r in self.world_parts[idx]]
-            self._blit(img, sp, self.motion.poses[self.mech.parts[idx].name][i], not valid, rings)
-        for pname, sp in self.sweep_sprites:
-            self._blit(img, sp, self.motion.poses[pname][i], False)
+        tint = _rgb(s.invalid)
+        for idx in self.moving:
+            fill = self._fill(idx, self.mech.parts[idx])
+            if not valid:
+                fill = tuple(int(0.5 * a + 0.5 * b) for a, b in zip(fill, tint))  # type: ignore[assignment]
+            self._draw_rings(img, [r[i] for r in self.world_parts[idx]], fill)
+        for rings in self.sweep_rings:
+            self._draw_rings(img, [r[i] for r in rings], _rgb(s.sweep))
         for rings in self.overlay_parts:
             for r in rings:
                 pts = np.vstack([r[i], r[i][:1]]).ravel().tolist()
