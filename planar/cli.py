@@ -151,9 +151,13 @@ def _cmd_render(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
     overlay = None
     if args.overlay:
-        from .simulate import simulate_scene
+        from .simulate import SimulationError, simulate_scene
 
-        overlay = simulate_scene(scene).motion
+        sim = simulate_scene(scene)
+        if sim.blowup is not None:
+            raise SimulationError(f"{args.scene}: the simulation {sim.motion.reason(sim.blowup[0])}; "
+                                  "no animation written (try more substeps: planar compare --substeps)")
+        overlay = sim.motion
     n = render_scene(scene, args.output, overlay=overlay)
     print(f"wrote {args.output}: {n} frames")
     return 0

@@ -247,3 +247,34 @@ def test_scaled_mechanisms_keep_their_relative_accuracy(scale):
     sim = simulate(fb, t)
     c = compare(fb, analytic, sim.motion)
     assert c.max_rel_error < 1e-3, (scale, c.max_rel_error)
+
+
+def test_accuracy_benchmark_quick_run(tmp_path):
+    pytest.importorskip("matplotlib")
+    from planar.bench import bench_accuracy
+
+    r = bench_accuracy(out_dir=str(tmp_path), quick=True, repeats=1, progress=False)
+    assert (tmp_path / "accuracy.csv").exists() and (tmp_path / "accuracy.png").stat().st_size > 1000
+    assert r["default_on_frontier"]
+    assert r["default"]["max_error"] < 1e-3
+    assert r["frontier"] and all(a["frontier"] for a in r["frontier"])
+    assert abs(r["effects_cost"]["unused"] / r["effects_cost"]["none"] - 1.0) < 0.5
+    import csv
+
+    rows = list(csv.DictReader(open(tmp_path / "accuracy.csv")))
+    assert {"mechanism", "substeps", "iterations", "error_bias", "error", "seconds_per_sim_second"} <= set(rows[0])
+
+
+def test_pareto_frontier():
+    from planar.bench import _pareto
+
+    pts = [(1.0, 1.0), (2.0, 0.5), (3.0, 0.6), (0.5, 2.0), (2.0, 0.5)]
+    assert _pareto(pts) == [True, True, False, True, True]
+
+
+def test_overlay_render(tmp_path):
+    from planar.cli import main
+
+    out = tmp_path / "o.gif"
+    assert main(["render", str(GALLERY / "slider-crank.toml"), "--overlay", "-o", str(out)]) == 0
+    assert out.stat().st_size > 1000
