@@ -72,7 +72,7 @@ def test_only_the_named_effects_are_built():
     assert b["damping"] == 0.9 and b["loads"] == 1
 
 
-def test_purely_kinematic_render_builds_no_space(monkeypatch):
+def test_purely_kinematic_render_builds_no_space(monkeypatch, tmp_path):
     import planar.simulate as sim_mod
     from planar.cli import render_scene
 
@@ -80,7 +80,7 @@ def test_purely_kinematic_render_builds_no_space(monkeypatch):
         raise AssertionError("a space was built")
 
     monkeypatch.setattr(sim_mod, "_Rebuild", boom)
-    render_scene(scene_of(LEG), Path("/tmp/planar-test-kinematic.gif"), progress=False)
+    assert render_scene(scene_of(LEG), tmp_path / "k.gif", progress=False) == 36
 
 
 def test_spatial_mechanisms_are_refused_with_a_clear_message():
