@@ -271,7 +271,7 @@ class ElementalMechanism(Mechanism):
         follower = Part("follower", ((wc[0], wc[1] - d, P.D_jr + m), (wc[0], wc[1] + d, P.D_jr + m),
                                      (pins[0][0], pins[0][1], 2 * P.F_sr), (pins[1][0], pins[1][1], 2 * P.F_sr)),
                         (window, Hole(pins[0], 2 * P.F_sr), Hole(pins[1], 2 * P.F_sr)))
-        drv = Part("driver", ((*_sub(P.D_jc, P.D_o), P.D_jr), (0.0, 0.0, 2 * P.D_ar)), (Hole((0.0, 0.0), 2 * P.D_ar),))
+        drv = self._cam_driver()
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*slot.start, 2 * P.F_sr), (*slot.end, 2 * P.F_sr)),
                       (Hole(_xy(P.D_o), 2 * P.D_ar), slot), ground=True)
         joints = [
@@ -297,7 +297,7 @@ class ElementalMechanism(Mechanism):
         mg = P.D_jr * 0.35
         follower = Part("follower", ((0.0, 0.0, 2 * P.F_sr), (x0, y0, P.D_jr + mg), (x1, y0, P.D_jr + mg)),
                         (Hole((0.0, 0.0), 2 * P.F_sr), window))
-        drv = Part("driver", ((*_sub(P.D_jc, P.D_o), P.D_jr), (0.0, 0.0, 2 * P.D_ar)), (Hole((0.0, 0.0), 2 * P.D_ar),))
+        drv = self._cam_driver()
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*s, 3 * P.F_sr)),
                       (Hole(_xy(P.D_o), 2 * P.D_ar), Hole(s, 2 * P.F_sr)), ground=True)
         joints = [
@@ -321,7 +321,7 @@ class ElementalMechanism(Mechanism):
         track = ArcSlot(s, r, float(ang.min() - pad), float(ang.max() + pad), 2 * P.F_jr)
         follower = Part("follower", ((0.0, 0.0, 2 * P.F_jr), (*hole, P.D_jr * 1.35)),
                         (Hole((0.0, 0.0), 2 * P.F_jr), Hole(hole, 2 * P.D_jr)))
-        drv = Part("driver", ((*_sub(P.D_jc, P.D_o), P.D_jr), (0.0, 0.0, 2 * P.D_ar)), (Hole((0.0, 0.0), 2 * P.D_ar),))
+        drv = self._cam_driver()
         ends = [(s[0] + r * np.cos(a), s[1] + r * np.sin(a)) for a in (track.angle0, track.angle1, 0.5 * (track.angle0 + track.angle1))]
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), *[(x, y, 2 * P.F_jr) for x, y in ends]),
                       (Hole(_xy(P.D_o), 2 * P.D_ar), track), ground=True)
@@ -344,8 +344,7 @@ class ElementalMechanism(Mechanism):
         gslot, pins, slide = self._ground_slide(fo, (0.0, 1.0), (st.out.min(), st.out.max()), P.F_sr)
         follower = Part("follower", ((*pin, 2 * P.F_jr), (*pins[0], 2 * P.F_sr), (*pins[1], 2 * P.F_sr)),
                         (Hole(pin, 2 * P.F_jr), Hole(pins[0], 2 * P.F_sr), Hole(pins[1], 2 * P.F_sr)))
-        drv = Part("driver", ((0.0, 0.0, 3 * P.D_ar), (slot.start[0], Y0, 2 * P.F_jr), (slot.end[0], Y0, 2 * P.F_jr)),
-                   (Hole((0.0, 0.0), 2 * P.D_ar), slot))
+        drv = self._slotted_driver(slot)
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*gslot.start, 2 * P.F_sr), (*gslot.end, 2 * P.F_sr)),
                       (Hole(_xy(P.D_o), 2 * P.D_ar), gslot), ground=True)
         joints = [
@@ -365,8 +364,7 @@ class ElementalMechanism(Mechanism):
         slot = self._driver_slot(q, st.aux["p"], d, 2 * P.F_jr)
         follower = Part("follower", ((0.0, 0.0, 2 * P.F_ar), (*pin, 2 * P.F_jr)),
                         (Hole((0.0, 0.0), 2 * P.F_ar), Hole(pin, 2 * P.F_jr)))
-        drv = Part("driver", ((0.0, 0.0, 3 * P.D_ar), (slot.start[0], d, 2 * P.F_jr), (slot.end[0], d, 2 * P.F_jr)),
-                   (Hole((0.0, 0.0), 2 * P.D_ar), slot))
+        drv = self._slotted_driver(slot)
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*s, 3 * P.F_ar)),
                       (Hole(_xy(P.D_o), 2 * P.D_ar), Hole(s, 2 * P.F_ar)), ground=True)
         joints = [
@@ -375,6 +373,18 @@ class ElementalMechanism(Mechanism):
             PinInSlot("pin-slot", "follower", pin, "driver", slot.start, slot.end),
         ]
         return [ground, drv, follower], joints
+
+    def _cam_driver(self) -> Part:
+        """The round cam of #1-#3: a disc of radius D_jr about D_jc, turning on an axle at D_o."""
+        P = self.params
+        return Part("driver", ((*_sub(P.D_jc, P.D_o), P.D_jr), (0.0, 0.0, 2 * P.D_ar)), (Hole((0.0, 0.0), 2 * P.D_ar),))
+
+    def _slotted_driver(self, slot: Slot) -> Part:
+        """The oscillating arm of #4/#5: an axle at its origin and ``slot`` (parallel to x) for the follower's pin."""
+        P = self.params
+        y = slot.start[1]
+        return Part("driver", ((0.0, 0.0, 3 * P.D_ar), (slot.start[0], y, slot.width), (slot.end[0], y, slot.width)),
+                    (Hole((0.0, 0.0), 2 * P.D_ar), slot))
 
     def _driver_slot(self, theta: Array, pins: Array, y: float, width: float) -> Slot:
         """The slot, parallel to x at height ``y`` in the (turning) driver's frame, covering the pin's travel."""
