@@ -96,6 +96,8 @@ class SimResult:
     steps: int
     torque: Array | None = None
     blowup: tuple[int, str] | None = None
+    #: the rebuild's pin bodies: (part, point in its frame, mass)
+    pins: list[tuple[str, tuple[float, float], float]] = field(default_factory=list)
     residuals: dict[str, Array] = field(default_factory=dict)
 
 
@@ -531,7 +533,8 @@ def simulate(mech: Mechanism, t: Array, effects: "EffectsSpec | None" = None,
                     points=pts, t=t)
     res = joint_residuals(mech, motion)
     built = dict(rb.built, mode=mode)
-    return SimResult(motion, settings, mode, built, wall, steps, torque, blowup, res)
+    pins = [(part, xy, body.mass) for body, part, xy in rb.pins]
+    return SimResult(motion, settings, mode, built, wall, steps, torque, blowup, residuals=res, pins=pins)
 
 
 def simulate_scene(scene: "Scene", settings: SimSettings = DEFAULT_SETTINGS, mode: str | None = None) -> SimResult:
@@ -606,17 +609,18 @@ def torque_comparison(mech: Mechanism, t: Array, effects: "EffectsSpec | None",
     ``t`` must cover exactly one cycle, evenly (the analytic side uses
     periodic differences).
     """
-    probe = _Rebuild(mech, mech.solve(mech.driver.value(t[:1]), t=t[:1]), effects, settings, "motor")
-    pins = [(part, xy, body.mass) for body, part, xy in probe.pins]
     # pymunk's torque over an output interval is the mean of its substep impulses: compare it with
     # the mean of the analytic torque over the same interval (sampled at the substeps' midpoints)
     K = settings.substeps
     dt = float(t[1] - t[0])
     t_fine = t[0] + (np.arange(t.size * K) + 0.5) * (dt / K)
-    fine = inverse_dynamics_torque(mech, t_fine, effects, pins)
-    analytic = np.roll(fine.reshape(t.size, K).mean(axis=1), 1)  # interval ending at sample i
-    peak = float(np.abs(analytic).max()) or 1.0
-    bias = 3.0 * peak + 1e-9
+
+    def interval_means(pins) -> Array:
+        fine = inverse_dynamics_torque(mech, t_fine, effects, pins)
+        return np.roll(fine.reshape(t.size, K).mean(axis=1), 1)  # interval ending at sample i
+
+    # the bias only has to exceed the torque; the pins (a tenth of their parts) are added once known
+    bias = 3.0 * float(np.abs(interval_means(None)).max()) + 1e-9
     for _ in range(4):
         sim = simulate(mech, t, effects, settings, mode="motor", torque_bias=bias)
         if sim.blowup is not None:
@@ -625,6 +629,8 @@ def torque_comparison(mech: Mechanism, t: Array, effects: "EffectsSpec | None",
         if np.all(tau[1:] < bias * 0.999):
             break
         bias *= 4.0  # the motor must always oppose the bias; give it more room
+    analytic = interval_means(sim.pins)
+    peak = float(np.abs(analytic).max()) or 1.0
     diff = np.abs(tau[1:] - analytic[1:])
     return {
         "analytic": analytic.tolist(),
