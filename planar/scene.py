@@ -20,6 +20,7 @@ from typing import Annotated, Any, Literal, Union
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from .effects import Effects, Load, Spring
 from .errors import PlanarError, SceneError
 from .model import Mechanism, Motion
 
@@ -299,6 +300,19 @@ class Scene:
     @property
     def name(self) -> str:
         return self.spec.name or Path(self.path).stem
+
+    @property
+    def effects(self) -> Effects:
+        """The scene's ``[effects]`` as the model's plain record (what ``simulate`` takes)."""
+        e = self.spec.effects
+        return Effects(
+            gravity=None if e.gravity is None else (float(e.gravity[0]), float(e.gravity[1])),
+            contact=e.contact, friction=e.friction, damping=e.damping, density=e.density,
+            springs=tuple(Spring(s.a, s.b, s.stiffness, tuple(s.anchor_a), tuple(s.anchor_b), s.rest_length,
+                                 s.damping) for s in e.springs),
+            loads=tuple(Load(ld.point, (float(ld.force[0]), float(ld.force[1]))) for ld in e.loads),
+            motor_force_limit=e.motor_force_limit,
+        )
 
 
 def load_scene(path: str | Path) -> Scene:

@@ -398,7 +398,7 @@ class Linkage(Mechanism):
             first = links[0]
             for other in links[1:]:
                 jname = nd if len(links) == 2 else f"{nd}:{other}"
-                joints.append(Pivot(jname, first, self._anchors[first][nd], other, self._anchors[other][nd]))
+                joints.append(Pivot(jname, first, other, anchor_a=self._anchors[first][nd], anchor_b=self._anchors[other][nd]))
             if isinstance(node, RRP):
                 self._slot_joint(node, links, hulls, feats, joints)
         parts = []
@@ -439,9 +439,9 @@ class Linkage(Mechanism):
                 for px, py in pins:
                     hulls[lk].append((px, py, self.width / 2))
                     feats[lk].append(Hole((px, py), self.pin_diameter, role="pin"))
-                joints.append(Slide(f"{lk}-slide", lk, pins[0], (2 * self.width, 0.0), owner, start_t, end_t))
+                joints.append(Slide(f"{lk}-slide", owner, lk, start=start_t, end=end_t, anchor=pins[0], axis=(2 * self.width, 0.0)))
             else:
-                joints.append(PinInSlot(f"{node.name}-slot", lk, self._anchors[lk][node.name], owner, start_t, end_t))
+                joints.append(PinInSlot(f"{node.name}-slot", owner, lk, start=start_t, end=end_t, pin=self._anchors[lk][node.name]))
 
     def node_positions(self, q) -> dict[str, Array]:
         """World positions ``(N, 2)`` of every node, placement applied."""

@@ -21,7 +21,7 @@ is its x); drawings project orthographically onto xy.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -31,6 +31,7 @@ from ..geometry import poses_apply
 from ..model import (
     ArcSlot,
     CamOnLine,
+    Feature,
     Driver,
     Hole,
     Mechanism,
@@ -40,6 +41,7 @@ from ..model import (
     Pivot,
     Slide,
     Slot,
+    joint_kind,
 )
 from . import params as P_
 from .kinematics import FORWARD, Stage
@@ -69,30 +71,38 @@ def _sub(a, b) -> tuple[float, float]:
     return (float(a[0] - b[0]), float(a[1] - b[1]))
 
 
+@joint_kind
 @dataclass(frozen=True)
 class SkewContact:
-    """A driver edge (in the xy plane) touching a follower's tilting pin (spatial #6, #9).
+    """A driver edge (part ``a``, in the xy plane) touching a follower's tilting pin (part ``b``; spatial #6, #9).
 
     Residual: ``| distance(edge line, pin axis) - r |`` in 3D, from the
     driver's pose (xy) and the follower's pose in its ``"yz"`` plane.
     """
 
+    kind: ClassVar[str] = "skew-contact"
     name: str
-    driver: str
+    a: str  # the driver, carrying the edge
+    b: str  # the follower, carrying the pin
     edge_point: tuple[float, float]  # on the edge, driver frame
     edge_dir: tuple[float, float]  # driver frame
-    follower: str
     pin_x: float  # the pin's x (the follower's offset)
     radius: float
     plane_z: float = 0.0
 
+    def features(self) -> tuple[tuple[str, Feature], ...]:
+        return ()
+
+    def pins(self) -> tuple[tuple[str, tuple[float, float]], ...]:
+        return ()  # the pin tilts out of the driver's plane; drawn with the follower's outline
+
     def residual(self, poses) -> Array:
-        dp = poses[self.driver]
+        dp = poses[self.a]
         e0 = poses_apply(dp, self.edge_point)
         c, s = np.cos(dp[:, 2]), np.sin(dp[:, 2])
         ex = c * self.edge_dir[0] - s * self.edge_dir[1]
         ey = s * self.edge_dir[0] + c * self.edge_dir[1]
-        fp = poses[self.follower]  # (y, z, alpha) of the pivot axis point
+        fp = poses[self.b]  # (y, z, alpha) of the pivot axis point
         a = fp[:, 2]
         P0 = np.column_stack([np.full_like(a, self.pin_x), fp[:, 0], fp[:, 1]])
         d1 = np.column_stack([np.zeros_like(a), -np.sin(a), np.cos(a)])
@@ -211,16 +221,6 @@ class ElementalMechanism(Mechanism):
         """Forward kinematics for driver values ``q`` (the standalone law applied)."""
         return self.forward(self.driver_motion(np.asarray(q, float)))
 
-    @property
-    def size(self) -> float:
-        """Characteristic length: the extent of all joint centres and outlines."""
-        pts = []
-        for p in self.parts:
-            for x, y, r in p.hull:
-                pts.append((x, y))
-        pts_a = np.asarray(pts)
-        return float(np.max(np.ptp(pts_a, axis=0))) if len(pts_a) > 1 else 1.0
-
     # -- travel helper --------------------------------------------------------
     def _sweep(self, n: int = 721) -> tuple[Array, Stage]:
         """Driver motions and follower stage of the valid samples of one cycle (to size slots, tracks)."""
@@ -256,7 +256,7 @@ class ElementalMechanism(Mechanism):
         g1 = np.asarray(fo) + (hi + 2 * L) * ax
         slot = Slot(_xy(g0), _xy(g1), 2 * pin_r)
         pins = [(0.0, 0.0), _xy(L * ax)]
-        joint = Slide(f"{label}-slide", "follower", pins[0], _xy(L * ax), "ground", slot.start, slot.end)
+        joint = Slide(f"{label}-slide", "ground", "follower", start=slot.start, end=slot.end, anchor=pins[0], axis=_xy(L * ax))
         return slot, pins, joint
 
     def _build_1(self):
@@ -275,8 +275,8 @@ class ElementalMechanism(Mechanism):
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*slot.start, 2 * P.F_sr), (*slot.end, 2 * P.F_sr)),
                       (Hole(_xy(P.D_o), 2 * P.D_ar), slot), ground=True)
         joints = [
-            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
-            PinInSlot("cam-window", "driver", _sub(P.D_jc, P.D_o), "follower", window.start, window.end),
+            Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
+            PinInSlot("cam-window", "follower", "driver", start=window.start, end=window.end, pin=_sub(P.D_jc, P.D_o)),
             slide,
         ]
         return [ground, drv, follower], joints
@@ -301,9 +301,9 @@ class ElementalMechanism(Mechanism):
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*s, 3 * P.F_sr)),
                       (Hole(_xy(P.D_o), 2 * P.D_ar), Hole(s, 2 * P.F_sr)), ground=True)
         joints = [
-            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
-            Pivot("pivot", "ground", s, "follower", (0.0, 0.0)),
-            PinInSlot("cam-window", "driver", _sub(P.D_jc, P.D_o), "follower", window.start, window.end),
+            Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
+            Pivot("pivot", "ground", "follower", anchor_a=s, anchor_b=(0.0, 0.0)),
+            PinInSlot("cam-window", "follower", "driver", start=window.start, end=window.end, pin=_sub(P.D_jc, P.D_o)),
         ]
         return [ground, drv, follower], joints
 
@@ -326,9 +326,9 @@ class ElementalMechanism(Mechanism):
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), *[(x, y, 2 * P.F_jr) for x, y in ends]),
                       (Hole(_xy(P.D_o), 2 * P.D_ar), track), ground=True)
         joints = [
-            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
-            Pivot("cam-hole", "driver", _sub(P.D_jc, P.D_o), "follower", hole),
-            PinInArcSlot("track", "follower", (0.0, 0.0), "ground", s, r),
+            Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
+            Pivot("cam-hole", "driver", "follower", anchor_a=_sub(P.D_jc, P.D_o), anchor_b=hole),
+            PinInArcSlot("track", "ground", "follower", centre=s, radius=r, pin=(0.0, 0.0)),
         ]
         return [ground, drv, follower], joints
 
@@ -348,8 +348,8 @@ class ElementalMechanism(Mechanism):
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*gslot.start, 2 * P.F_sr), (*gslot.end, 2 * P.F_sr)),
                       (Hole(_xy(P.D_o), 2 * P.D_ar), gslot), ground=True)
         joints = [
-            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
-            PinInSlot("pin-slot", "follower", pin, "driver", slot.start, slot.end),
+            Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
+            PinInSlot("pin-slot", "driver", "follower", start=slot.start, end=slot.end, pin=pin),
             slide,
         ]
         return [ground, drv, follower], joints
@@ -368,9 +368,9 @@ class ElementalMechanism(Mechanism):
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*s, 3 * P.F_ar)),
                       (Hole(_xy(P.D_o), 2 * P.D_ar), Hole(s, 2 * P.F_ar)), ground=True)
         joints = [
-            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
-            Pivot("pivot", "ground", s, "follower", (0.0, 0.0)),
-            PinInSlot("pin-slot", "follower", pin, "driver", slot.start, slot.end),
+            Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
+            Pivot("pivot", "ground", "follower", anchor_a=s, anchor_b=(0.0, 0.0)),
+            PinInSlot("pin-slot", "driver", "follower", start=slot.start, end=slot.end, pin=pin),
         ]
         return [ground, drv, follower], joints
 
@@ -411,9 +411,8 @@ class ElementalMechanism(Mechanism):
         follower = self._spatial_follower(P, N, r, abs(N))
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar),), (Hole(_xy(P.D_o), 2 * P.D_ar),), ground=True)
         joints = [
-            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
-            SkewContact("edge-pin", "driver", (0.0, h), (1.0, 0.0), "follower", float(P.F_o[0]), r,
-                        plane_z=float(P.D_o[2])),
+            Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
+            SkewContact("edge-pin", "driver", "follower", edge_point=(0.0, h), edge_dir=(1.0, 0.0), pin_x=float(P.F_o[0]), radius=r, plane_z=float(P.D_o[2])),
         ]
         return [ground, drv, follower], joints
 
@@ -439,9 +438,9 @@ class ElementalMechanism(Mechanism):
         ground = Part("ground", ((*g0, 2 * P.D_sr), (*g1, 2 * P.D_sr), (*s, 3 * P.F_ar)),
                       (gslot, Hole(s, 2 * P.F_ar)), ground=True)
         joints = [
-            Slide("driver-slide", "driver", (0.0, 0.0), (L, 0.0), "ground", g0, g1),
-            Pivot("pivot", "ground", s, "follower", (0.0, 0.0)),
-            PinInSlot("pin-slot", "driver", pin, "follower", slot.start, slot.end),
+            Slide("driver-slide", "ground", "driver", start=g0, end=g1, anchor=(0.0, 0.0), axis=(L, 0.0)),
+            Pivot("pivot", "ground", "follower", anchor_a=s, anchor_b=(0.0, 0.0)),
+            PinInSlot("pin-slot", "follower", "driver", start=slot.start, end=slot.end, pin=pin),
         ]
         return [ground, drv, follower], joints
 
@@ -479,9 +478,9 @@ class ElementalMechanism(Mechanism):
         # pose angle is psi - psi0 with psi0 the rest direction (+z); in the follower frame the tab runs
         # along +y (z) and the face is the line x = F_jcx
         joints = [
-            Slide("driver-slide", "driver", (0.0, 0.0), (L, 0.0), "ground", g0, g1),
-            Pivot("pivot", "ground", B, "follower", (0.0, 0.0)),
-            CamOnLine("window-tab", "driver", a_loc, 0.0, "follower", (P.F_jcx, t_lo), (P.F_jcx, t_hi)),
+            Slide("driver-slide", "ground", "driver", start=g0, end=g1, anchor=(0.0, 0.0), axis=(L, 0.0)),
+            Pivot("pivot", "ground", "follower", anchor_a=B, anchor_b=(0.0, 0.0)),
+            CamOnLine("window-tab", "follower", "driver", start=(P.F_jcx, t_lo), end=(P.F_jcx, t_hi), centre=a_loc, radius=0.0),
         ]
         return [ground, drv, follower], joints
 
@@ -504,9 +503,8 @@ class ElementalMechanism(Mechanism):
         follower = self._spatial_follower(P, N, r, abs(N))
         ground = Part("ground", ((*g0, 2 * P.D_ar), (*g1, 2 * P.D_ar)), (gslot,), ground=True)
         joints = [
-            Slide("driver-slide", "driver", (0.0, 0.0), (L, 0.0), "ground", g0, g1),
-            SkewContact("slot-pin", "driver", e_loc, _xy(d), "follower", float(P.F_o[0]), r,
-                        plane_z=float(P.D_o[2])),
+            Slide("driver-slide", "ground", "driver", start=g0, end=g1, anchor=(0.0, 0.0), axis=(L, 0.0)),
+            SkewContact("slot-pin", "driver", "follower", edge_point=e_loc, edge_dir=_xy(d), pin_x=float(P.F_o[0]), radius=r, plane_z=float(P.D_o[2])),
         ]
         return [ground, drv, follower], joints
 
@@ -535,7 +533,7 @@ class ElementalMechanism(Mechanism):
                         (Hole(pin, 2 * P.F_jr), Hole(pins[0], 2 * P.F_sr), Hole(pins[1], 2 * P.F_sr)))
         ground = Part("ground", ((*gslot.start, 2 * P.F_sr), (*gslot.end, 2 * P.F_sr)), (gslot,), ground=True)
         joints = [
-            PinInArcSlot("pin-arc", "follower", pin, "driver", arc.centre, R),
+            PinInArcSlot("pin-arc", "driver", "follower", centre=arc.centre, radius=R, pin=pin),
             slide,
         ]
         return [ground, drv, follower], joints
@@ -552,8 +550,8 @@ class ElementalMechanism(Mechanism):
                         (Hole((0.0, 0.0), 2 * P.F_ar), Hole(pin, 2 * P.F_jr)))
         ground = Part("ground", ((*s, 3 * P.F_ar),), (Hole(s, 2 * P.F_ar),), ground=True)
         joints = [
-            Pivot("pivot", "ground", s, "follower", (0.0, 0.0)),
-            PinInArcSlot("pin-arc", "follower", pin, "driver", arc.centre, R),
+            Pivot("pivot", "ground", "follower", anchor_a=s, anchor_b=(0.0, 0.0)),
+            PinInArcSlot("pin-arc", "driver", "follower", centre=arc.centre, radius=R, pin=pin),
         ]
         return [ground, drv, follower], joints
 
