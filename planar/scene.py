@@ -388,22 +388,14 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float) -> Mechanism:
         return SliderCrank(m.crank, m.rod, offset=m.offset, branch=m.branch, placement=placement,
                            rate=rate, phase=phase, name=spec.name or "slidercrank")
     if isinstance(m, LinkageSpec):
-        from .linkages import RRP, RRR, Actuator, Crank, Fixed, Link, Linkage, Rigid
+        from .linkages import NODE_KINDS, Link, Linkage
 
         nodes = []
         for n in m.nodes:
-            if n.kind == "fixed":
-                nodes.append(Fixed(n.name, n.at))
-            elif n.kind == "crank":
-                nodes.append(Crank(n.name, n.centre, n.radius, _angle(spec, n.phase)))
-            elif n.kind == "actuator":
-                nodes.append(Actuator(n.name, n.origin, n.axis, n.offset))
-            elif n.kind == "rrr":
-                nodes.append(RRR(n.name, n.a, n.ra, n.b, n.rb, n.branch))
-            elif n.kind == "rrp":
-                nodes.append(RRP(n.name, n.a, n.ra, n.p, n.q, n.branch, n.offset))
-            else:
-                nodes.append(Rigid(n.name, n.a, n.b, n.local))
+            cls = NODE_KINDS[n.kind]  # each node kind declares the scene keys it is built from
+            args = [_angle(spec, getattr(n, f)) if f in cls.angle_fields else getattr(n, f)
+                    for f in cls.scene_fields]
+            nodes.append(cls(n.name, *args))
         links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
         return Linkage(spec.name or "linkage", nodes, links, points=m.points, placement=placement,
                        rate=rate, phase=phase)
