@@ -400,13 +400,14 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float) -> Mechanism:
         return Linkage(spec.name or "linkage", nodes, links, points=m.points, placement=placement,
                        rate=rate, phase=phase)
     if isinstance(m, ElementalSpec):
-        from .windup import ElementalMechanism, params_for
+        from .windup import ELEMENTAL, ElementalMechanism, params_for
 
         base = params_for(m.number)
+        angle_params = ELEMENTAL[m.number].angle_params
         kw: dict[str, Any] = {}
         for k, v in m.params.items():
             val = tuple(v) if isinstance(v, list) else v
-            if k in ("phi", "D_theta") or (k == "amplitude" and m.number in (4, 5, 6)):
+            if k in angle_params:
                 val = tuple(_angle(spec, x) for x in val) if isinstance(val, tuple) else _angle(spec, val)
             kw[k] = val
         return ElementalMechanism(m.number, base.replace(**kw), rate=rate, phase=phase)

@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from ..model import CamOnLine, Driver, Mechanism, Part, PinInArcSlot, PinInSlot, Pivot, Slide
 from ..registry import Registry
-from .mechanisms import CONTACT_JOINT, ElementalMechanism, SkewContact
+from .mechanisms import ELEMENTAL, ElementalMechanism, SkewContact
 from .table import MOTION_TYPES, Realisation, enumerate_chains, realise
 
 __all__ = ["ToyMechanism", "chain_mechanism", "tree_cost", "rank_trees", "horse", "bunny", "Chain"]
@@ -154,7 +154,7 @@ class ToyMechanism(Mechanism):
         try:
             if u.ndim == 2:
                 return ElementalMechanism(k, sizing_input=u, **kw)
-            if k in (1, 2, 3):  # Rz driven: full turns
+            if ELEMENTAL[k].motions[0] == "Rz":  # turning drivers: full turns
                 return ElementalMechanism(k, **kw)
             amp = float(np.max(np.abs(u)))
             if amp > 0 and "amplitude" not in kw:
@@ -231,7 +231,7 @@ class ToyMechanism(Mechanism):
             outs[st.index] = _to_world(r, res.out)
             valid_in[st.index] = ok_in & res.valid
             bases[st.index] = (u, res)
-            checks.append((res.valid, f"{st.label}.{CONTACT_JOINT[r.number]}",
+            checks.append((res.valid, f"{st.label}.{ELEMENTAL[r.number].contact_joint}",
                            f"stage {st.label} ({r.pattern}, mechanism #{r.number}): {res.why}"))
         self._last_bases = bases
         return outs, checks
