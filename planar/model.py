@@ -458,7 +458,7 @@ class Driver:
         n = int(round(samples_per_cycle * cycles))
         if n < 1:
             raise InputError("samples_per_cycle", samples_per_cycle, "at least one sample")
-        return np.arange(n) * (self.period / samples_per_cycle)
+        return np.arange(n, dtype=np.float64) * (self.period / samples_per_cycle)
 
 
 # --------------------------------------------------------------------------
