@@ -11,7 +11,8 @@ import pytest
 from PIL import Image
 
 from planar import SceneError
-from planar.cli import gallery_scenes, main, render_scene
+from planar.cli import main
+from planar.pipeline import gallery_scenes, render_scene
 from planar.scene import load_scene, parse_scene, scene_schema
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -207,3 +208,14 @@ def test_gallery_command_renders_every_scene(tmp_path):
     (src / "b.toml").write_text(FOURBAR.replace("speed = 2.0", "speed = 1.0"))
     assert main(["gallery", "--source", str(src), "-o", str(tmp_path / "out")]) == 0
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["a.gif", "b.gif"]
+
+
+def test_gallery_command_away_from_the_repository_is_a_user_error(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)  # no gallery/ here, and none is looked for beside the code
+    assert main(["gallery"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "scenes folder" in err and "'gallery'" in err
+    assert list(tmp_path.iterdir()) == []
+    (tmp_path / "empty").mkdir()
+    assert main(["gallery", "--source", "empty"]) == 2
+    assert "it has none" in capsys.readouterr().err

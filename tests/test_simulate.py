@@ -74,7 +74,7 @@ def test_only_the_named_effects_are_built():
 
 def test_purely_kinematic_render_builds_no_space(monkeypatch, tmp_path):
     import planar.simulate as sim_mod
-    from planar.cli import render_scene
+    from planar.pipeline import render_scene
 
     def boom(*a, **k):
         raise AssertionError("a space was built")
@@ -249,20 +249,36 @@ def test_scaled_mechanisms_keep_their_relative_accuracy(scale):
     assert c.max_rel_error < 1e-3, (scale, c.max_rel_error)
 
 
-def test_accuracy_benchmark_quick_run(tmp_path):
+def test_accuracy_benchmark_quick_run(tmp_path, monkeypatch):
     pytest.importorskip("matplotlib")
     from planar.bench import bench_accuracy
 
-    r = bench_accuracy(out_dir=str(tmp_path), quick=True, repeats=1, progress=False)
-    assert (tmp_path / "accuracy.csv").exists() and (tmp_path / "accuracy.png").stat().st_size > 1000
+    # run away from the repository: the scenes folder is the one given, never looked up beside the code
+    monkeypatch.chdir(tmp_path)
+    r = bench_accuracy(GALLERY, out_dir="out", quick=True, repeats=1, progress=False, effects_fraction=0.2)
+    out = tmp_path / "out"
+    assert (out / "accuracy.csv").exists() and (out / "accuracy.png").stat().st_size > 1000
+    assert len(r["mechanisms"]) == 3 and r["settings"] == 9
     assert r["default_on_frontier"]
     assert r["default"]["max_error"] < 1e-3
     assert r["frontier"] and all(a["frontier"] for a in r["frontier"])
     assert abs(r["effects_cost"]["unused"] / r["effects_cost"]["none"] - 1.0) < 0.5
     import csv
 
-    rows = list(csv.DictReader(open(tmp_path / "accuracy.csv")))
+    rows = list(csv.DictReader(open(out / "accuracy.csv")))
     assert {"mechanism", "substeps", "iterations", "error_bias", "error", "seconds_per_sim_second"} <= set(rows[0])
+
+
+@pytest.mark.parametrize("args", [[], ["--scenes", "no-such-folder"]])
+def test_accuracy_benchmark_needs_a_scenes_folder(tmp_path, args):
+    # from a folder without gallery/: one line naming the folder, exit 2, no traceback, nothing written
+    root = str(Path(__file__).resolve().parents[1])
+    r = subprocess.run([sys.executable, "-m", "planar", "bench", "accuracy", "--quick", "-o", "out", *args],
+                       capture_output=True, text=True, cwd=tmp_path, env={"PYTHONPATH": root, "PATH": ""})
+    assert r.returncode == 2, r.stderr
+    assert "Traceback" not in r.stderr and len(r.stderr.strip().splitlines()) == 1
+    assert "scenes folder" in r.stderr and (args[-1] if args else "gallery") in r.stderr
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_pareto_frontier():
