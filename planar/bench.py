@@ -11,7 +11,8 @@ from __future__ import annotations
 import math
 import os
 import time
-from typing import Any, Callable
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -242,6 +243,9 @@ ACCURACY_GRID = {
     "error_bias": (1e-3, 1e-6, 1e-9),
 }
 
+#: ``planar bench accuracy --quick``
+ACCURACY_QUICK_GRID = {"substeps": (8, 48), "iterations": (10, 20), "error_bias": (1e-6, 1e-9)}
+
 
 def _pareto(points: list[tuple[float, float]]) -> list[bool]:
     """Which (time, error) points no other point beats in both (ties count as not beaten)."""
@@ -252,63 +256,71 @@ def _pareto(points: list[tuple[float, float]]) -> list[bool]:
     return out
 
 
-def bench_accuracy(out_dir: str = "planar-bench-accuracy", quick: bool = False, repeats: int = 2,
-                   progress: bool = True) -> dict[str, Any]:
+def bench_accuracy(scenes: str | os.PathLike, out_dir: str = "planar-bench-accuracy", quick: bool = False,
+                   repeats: int = 2, progress: bool = True,
+                   grid: Mapping[str, Sequence[float]] | None = None,
+                   effects_fraction: float = 1.0) -> dict[str, Any]:
     """Simulation error against the analytic motion vs wall time, over the settings that trade them.
 
-    For every gallery scene pymunk can rebuild, every combination of
+    ``scenes`` is the folder of scene files to measure (``planar bench
+    accuracy --scenes``; the repository's ``gallery/``); nothing is looked up
+    beside the code.  For every scene there that pymunk can rebuild, every combination of
     substeps per frame (i.e. the time step), solver iterations and error bias
     runs one full cycle; the error is the largest distance between simulated
     and analytic part points over the cycle, as a fraction of the mechanism's
     size; the cost is wall seconds per simulated second (best of
     ``repeats``).  Settings are ranked on the aggregate (worst error over the
     mechanisms, total time); the Pareto frontier is marked.  Writes
-    ``accuracy.csv`` and ``accuracy.png`` in ``out_dir``.
+    ``accuracy.csv`` and ``accuracy.png`` in ``out_dir``.  ``quick``: the
+    grid :data:`ACCURACY_QUICK_GRID` on the first three scenes; ``grid``
+    replaces the grid (keys as :data:`ACCURACY_GRID`).  The default settings
+    are always measured.  The cost of effects (``effects_cost``) is measured
+    over the first ``effects_fraction`` of a four-bar's cycle.
     """
     import csv
     import sys
     from pathlib import Path
 
-    from .cli import gallery_scenes
     from .compare import compare
+    from .pipeline import gallery_scenes
     from .scene import load_scene
     from .simulate import DEFAULT_SETTINGS, SimSettings, SimulationError, simulate
 
-    grid = ACCURACY_GRID
-    if quick:
-        grid = {"substeps": (8, 48), "iterations": (10, 20), "error_bias": (1e-6, 1e-9)}
-    settings = [SimSettings(substeps=s, iterations=i, error_bias=b)
+    scene_files = gallery_scenes(scenes)  # checks the folder before any work
+    if grid is None:
+        grid = ACCURACY_QUICK_GRID if quick else ACCURACY_GRID
+    settings = [SimSettings(substeps=int(s), iterations=int(i), error_bias=float(b))
                 for s in grid["substeps"] for i in grid["iterations"] for b in grid["error_bias"]]
     d = DEFAULT_SETTINGS
     if all((x.substeps, x.iterations, x.error_bias) != (d.substeps, d.iterations, d.error_bias) for x in settings):
         settings.append(d)
-    scenes = []
+    measured = []
     skipped = {}
-    for path in gallery_scenes():
+    for path in scene_files:
+        if quick and len(measured) == 3:
+            break
         sc = load_scene(path)
         try:
-            simulate(sc.mechanism, sc.motion().t[:3], sc.spec.effects, SimSettings(substeps=1))
+            simulate(sc.mechanism, sc.motion().t[:3], sc.effects, SimSettings(substeps=1))
         except SimulationError as e:
             skipped[sc.name] = str(e)
             continue
-        scenes.append(sc)
-    if quick:
-        scenes = scenes[:3]
+        measured.append(sc)
     rows = []
-    total = len(scenes) * len(settings)
+    total = len(measured) * len(settings)
     bar = None
     if progress:
         from tqdm import tqdm
 
         bar = tqdm(total=total, desc="accuracy", unit="run", disable=not sys.stderr.isatty(), leave=False)
-    for sc in scenes:
+    for sc in measured:
         ref = sc.motion()
         sim_seconds = float(ref.t[-1] - ref.t[0])
         for st in settings:
             best = math.inf
             err = math.nan
             for _ in range(repeats):
-                r = simulate(sc.mechanism, ref.t, sc.spec.effects, st)
+                r = simulate(sc.mechanism, ref.t, sc.effects, st)
                 best = min(best, r.wall_time)
                 err = compare(sc.mechanism, ref, r.motion).max_rel_error if r.blowup is None else math.inf
             rows.append({"mechanism": sc.name, "substeps": st.substeps, "iterations": st.iterations,
@@ -335,7 +347,7 @@ def bench_accuracy(out_dir: str = "planar-bench-accuracy", quick: bool = False, 
         for r, f in zip(rs, _pareto([(r["seconds_per_sim_second"], r["error"]) for r in rs])):
             r["frontier"] = f
     default = next(a for a in agg if a["default"])
-    effects_cost = _effects_cost(repeats=max(3, repeats))
+    effects_cost = _effects_cost(repeats=max(3, repeats), fraction=effects_fraction)
     per_mech_default = {r["mechanism"]: r["error"] for r in rows
                         if (r["substeps"], r["iterations"], r["error_bias"]) == (d.substeps, d.iterations, d.error_bias)}
     out = Path(out_dir)
@@ -356,7 +368,7 @@ def bench_accuracy(out_dir: str = "planar-bench-accuracy", quick: bool = False, 
     _accuracy_chart(out / "accuracy.png", agg)
     return {
         "benchmark": "accuracy",
-        "mechanisms": [s.name for s in scenes],
+        "mechanisms": [s.name for s in measured],
         "skipped": skipped,
         "settings": len(settings),
         "default": default,
@@ -371,8 +383,11 @@ def bench_accuracy(out_dir: str = "planar-bench-accuracy", quick: bool = False, 
     }
 
 
-def _effects_cost(repeats: int = 3) -> dict[str, float]:
+def _effects_cost(repeats: int = 3, fraction: float = 1.0) -> dict[str, float]:
     """Seconds per simulated second of one four-bar leg with different effects named.
+
+    Each variant simulates the first ``fraction`` of one cycle (at least two
+    samples), best of ``repeats``.
 
     ``none``: no [effects]; ``unused``: an [effects] table naming every effect
     switched off (the same space is built, so it costs the same); then gravity,
@@ -395,9 +410,10 @@ def _effects_cost(repeats: int = 3) -> dict[str, float]:
         if eff is not None:
             data["effects"] = eff
         sc = build_scene(parse_scene(data))
-        ref = sc.motion()
-        span = float(ref.t[-1] - ref.t[0])
-        best = min(simulate(sc.mechanism, ref.t, sc.spec.effects).wall_time for _ in range(repeats))
+        t = sc.motion().t
+        t = t[: max(2, round(fraction * t.size))]
+        span = float(t[-1] - t[0])
+        best = min(simulate(sc.mechanism, t, sc.effects).wall_time for _ in range(repeats))
         out[name] = best / span
     return out
 

@@ -9,72 +9,20 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from pathlib import Path
-from typing import Callable, Sequence
+from collections.abc import Sequence
 
 from .errors import PlanarError
 
 __all__ = ["main"]
 
 
-#: the embedded default: a wind-up toy and a four-bar walking leg
-DEMO_SCENES: dict[str, dict] = {
-    "horse": {
-        "name": "horse", "angle_unit": "deg",
-        "mechanism": {"type": "toy", "left": [["Rz->OzT", "OzT->Oz"]],
-                      "right": [["Rz->OzT", "OzT->Ty"], ["Rz->OzT", "OzT->Oz"]], "phase": 180},
-        "driver": {"speed": 0.5, "samples_per_cycle": 48},
-        "render": {"width": 480, "height": 360},
-        "fabrication": {"unit_mm": 100.0},
-    },
-    "kangaroo-leg": {
-        "name": "kangaroo-leg",
-        "mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0,
-                      "coupler_point": [5.5, -2.0],
-                      "polygons": [{"name": "foot", "part": "coupler",
-                                    "points": [[5.1, -2.25], [6.6, -2.25], [6.6, -1.95], [5.1, -1.95]]}]},
-        "driver": {"speed": 1.0, "samples_per_cycle": 48},
-        "effects": {"loads": [{"point": "coupler_point", "force": [0.0, 10.0]}]},
-        "render": {"width": 480, "height": 360, "sweep": ["foot"]},
-        "fabrication": {"unit_mm": 15.0},
-    },
-}
-
-
 def _cmd_demo(args: argparse.Namespace) -> int:
     """The embedded default: a wind-up toy and a four-bar walking leg, animated (and cut)."""
-    import numpy as np
+    from .pipeline import run_demo
 
-    from . import analysis
-    from .fileio import write_motion_csv
-    from .scene import build_scene, parse_scene
-
-    out = Path(args.output)
-    out.mkdir(parents=True, exist_ok=True)
-    for name, data in DEMO_SCENES.items():
-        scene = build_scene(parse_scene(data, f"<demo {name}>"), f"<demo {name}>")
-        motion = scene.motion()
-        gif = out / f"{name}.gif"
-        n = render_scene(scene, gif)
-        csv = out / f"{name}.csv"
-        write_motion_csv(csv, scene.mechanism, motion)
-        line = f"{name}: {n} frames, all valid: {bool(motion.valid.all())} -> {gif}, {csv}"
-        if name == "kangaroo-leg":
-            leg = scene.mechanism
-            loads = {l.point: np.array(l.force) for l in scene.spec.effects.loads}
-            tau, _ = analysis.motor_torque(leg, motion.driver, loads)
-            line += f"; peak motor torque {np.abs(tau).max():.3f} (force x unit) for a 10 N foot push"
-        dxf = out / f"{name}.dxf"
-        layout = export_scene(scene, dxf=dxf)
-        line += f"; {len(layout.parts)} parts -> {dxf}"
+    for line in run_demo(args.output):
         print(line)
-        for extra in _DEMO_EXTRAS:
-            extra(scene, out)
     return 0
-
-
-#: later features append writers here (scene, output dir) so the demo grows with the package
-_DEMO_EXTRAS: list[Callable[..., None]] = []
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
@@ -86,11 +34,12 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         if args.name == "accuracy":
             from .errors import InputError
 
-            raise InputError("-n", args.n, "no problem size for the accuracy benchmark (it runs the gallery)")
+            raise InputError("-n", args.n, "no problem size for the accuracy benchmark (it runs the scenes of --scenes)")
         kwargs["n"] = args.n
     if args.repeats is not None:
         kwargs["repeats"] = args.repeats
     if args.name == "accuracy":
+        kwargs["scenes"] = args.scenes
         kwargs["out_dir"] = args.output
         kwargs["quick"] = args.quick
     result = fn(**kwargs)
@@ -99,12 +48,9 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
 
 def _cmd_motion_catalog(args: argparse.Namespace) -> int:
-    from .catalog import get
-    from .fileio import write_motion_csv
+    from .pipeline import write_catalog_motion
 
-    mech = get(args.mechanism)
-    motion = mech.run(samples_per_cycle=args.samples)
-    write_motion_csv(args.output, mech, motion)
+    motion = write_catalog_motion(args.mechanism, args.output, args.samples)
     print(f"wrote {args.output}: {len(motion)} samples, {int(motion.valid.sum())} valid")
     return 0
 
@@ -123,80 +69,30 @@ def _cmd_chains(args: argparse.Namespace) -> int:
     return 0
 
 
-def _style(scene):
-    from .render import Style
-
-    r = scene.spec.render
-    return Style(width=r.width, height=r.height, supersample=r.supersample, background=r.background,
-                 trails=r.trails, show_pins=r.show_pins)
-
-
-def render_scene(scene, out: str | Path, overlay=None, progress: bool = True) -> int:
-    """Render a scene's analytic motion (and optionally an overlay motion) to a GIF; returns frames."""
-    from exporters.gif import frame_delay_ms, indexer, write_gif
-
-    from .render import Renderer, palette_colors
-
-    motion = scene.motion()
-    polys = {n: scene.polygons[n] for n in scene.spec.render.sweep}
-    r = Renderer(scene.mechanism, motion, _style(scene), overlay=overlay, polygons=polys)
-    pal = palette_colors(r.style, len(scene.mechanism.parts))
-    delay = frame_delay_ms(scene.mechanism.driver.period, scene.spec.driver.samples_per_cycle)
-    return write_gif(out, r.frames(progress=progress, post=indexer(pal)), delay, pal)
-
-
 def _cmd_render(args: argparse.Namespace) -> int:
+    from .pipeline import overlay_motion, render_scene
     from .scene import load_scene
 
     scene = load_scene(args.scene)
-    overlay = None
-    if args.overlay:
-        from .simulate import SimulationError, simulate_scene
-
-        sim = simulate_scene(scene)
-        if sim.blowup is not None:
-            raise SimulationError(f"{args.scene}: the simulation {sim.motion.reason(sim.blowup[0])}; "
-                                  "no animation written (try more substeps: planar compare --substeps)")
-        overlay = sim.motion
+    overlay = overlay_motion(scene) if args.overlay else None
     n = render_scene(scene, args.output, overlay=overlay)
     print(f"wrote {args.output}: {n} frames")
     return 0
 
 
 def _cmd_motion(args: argparse.Namespace) -> int:
-    from .fileio import write_motion_csv
+    from .pipeline import write_scene_motion
     from .scene import load_scene
 
-    scene = load_scene(args.scene)
-    motion = scene.motion()
-    write_motion_csv(args.output, scene.mechanism, motion)
+    motion = write_scene_motion(load_scene(args.scene), args.output)
     print(f"wrote {args.output}: {len(motion)} samples, {int(motion.valid.sum())} valid")
     return 0
 
 
-def gallery_scenes(folder: Path | None = None) -> list[Path]:
-    """The gallery's scene files, sorted by name."""
-    if folder is None:
-        here = Path.cwd() / "gallery"
-        folder = here if here.is_dir() else Path(__file__).resolve().parents[1] / "gallery"
-    return sorted(folder.glob("*.toml"))
-
-
 def _cmd_gallery(args: argparse.Namespace) -> int:
-    from .scene import load_scene
+    from .pipeline import build_gallery
 
-    src = Path(args.source) if args.source else None
-    scenes = gallery_scenes(src)
-    if not scenes:
-        from .errors import InputError
-
-        raise InputError("gallery", str(src or "gallery/"), "a folder with .toml scene files")
-    out = Path(args.output) if args.output else scenes[0].parent
-    out.mkdir(parents=True, exist_ok=True)
-    for path in scenes:
-        scene = load_scene(path)
-        target = out / (path.stem + ".gif")
-        n = render_scene(scene, target, progress=False)
+    for path, target, n in build_gallery(args.source, args.output):
         print(f"{path.name}: {n} frames -> {target}")
     return 0
 
@@ -216,39 +112,19 @@ def _cmd_schema(args: argparse.Namespace) -> int:
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
-    from .compare import compare, format_comparison
+    from .compare import format_comparison
+    from .pipeline import compare_scene
     from .scene import load_scene
-    from .simulate import SimSettings, simulate_scene, torque_comparison
 
-    scene = load_scene(args.scene)
-    settings = SimSettings(**{k: v for k, v in (("substeps", args.substeps), ("iterations", args.iterations),
-                                                 ("error_bias", args.error_bias)) if v is not None})
-    sim = simulate_scene(scene, settings)
-    result = compare(scene.mechanism, scene.motion(), sim.motion, threshold=args.threshold)
-    e = scene.spec.effects
-    mech = scene.mechanism
-    if (e.loads or e.gravity is not None) and mech.driver.kind == "rotation" and mech.driver.amplitude is None:
-        from .errors import PlanarError
-
-        try:
-            period_t = mech.driver.times(scene.spec.driver.samples_per_cycle, 1.0)
-            tc = torque_comparison(mech, period_t, e, settings)
-            result.torque = {k: tc[k] for k in ("peak", "max_abs_diff", "max_rel_diff", "note")}
-            if args.json:
-                result.torque.update(analytic=tc["analytic"], simulated=tc["simulated"])
-        except PlanarError as err:
-            result.notes.append(f"torque not compared: {err}")
+    c = compare_scene(load_scene(args.scene), threshold=args.threshold, substeps=args.substeps,
+                      iterations=args.iterations, error_bias=args.error_bias)
     if args.json:
-        d = result.to_dict()
-        d["settings"] = {"substeps": settings.substeps, "iterations": settings.iterations,
-                         "error_bias": settings.error_bias}
-        d["wall_time_s"] = sim.wall_time
-        d["built"] = {k: v for k, v in sim.built.items()}
-        print(json.dumps(d, indent=2, default=str))
+        print(json.dumps(c.to_dict(), indent=2, default=str))
     else:
-        print(format_comparison(result))
-        print(f"  simulated in {sim.wall_time:.3f} s ({sim.steps} steps; substeps {settings.substeps}, "
-              f"iterations {settings.iterations}, error bias {settings.error_bias:g})")
+        s = c.settings
+        print(format_comparison(c.result))
+        print(f"  simulated in {c.sim.wall_time:.3f} s ({c.sim.steps} steps; substeps {s.substeps}, "
+              f"iterations {s.iterations}, error bias {s.error_bias:g})")
     return 0
 
 
@@ -264,31 +140,9 @@ def _sheet(text: str) -> tuple[float, float]:
     return w, h
 
 
-def export_scene(scene, dxf: str | Path | None = None, svg: str | Path | None = None, kerf: float | None = None,
-                 sheet: tuple[float, float] | None = None, preview: str | Path | None = None):
-    """Lay a scene's parts on sheets and write DXF and/or SVG (and a PNG preview of the DXF)."""
-    from .fabrication import layout_parts
-
-    fab = scene.spec.fabrication
-    layout = layout_parts(scene.mechanism, unit_mm=fab.unit_mm, kerf=fab.kerf_mm if kerf is None else kerf,
-                          pin_mm=fab.pin_diameter_mm, clearance=fab.clearance_mm, sheet=sheet or fab.sheet_mm)
-    if dxf is not None:
-        from exporters.dxf import write_dxf
-
-        write_dxf(dxf, layout)
-        if preview is not None:
-            from exporters.dxf import preview_png
-
-            preview_png(dxf, preview)
-    if svg is not None:
-        from exporters.svg import write_svg
-
-        write_svg(svg, layout)
-    return layout
-
-
 def _cmd_export(args: argparse.Namespace) -> int:
     from .errors import InputError
+    from .pipeline import export_scene
     from .scene import load_scene
 
     if args.kerf is not None and not (0 <= args.kerf <= 2):
@@ -321,6 +175,8 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--repeats", type=int, default=None, help="timing repeats (best is kept)")
     b.add_argument("-o", "--output", default="planar-bench-accuracy", help="accuracy: folder for the CSV and chart")
     b.add_argument("--quick", action="store_true", help="accuracy: a small grid on three mechanisms")
+    b.add_argument("--scenes", default="gallery",
+                   help="accuracy: folder of scene files to measure (default: ./gallery, the repository's)")
     b.set_defaults(func=_cmd_bench)
 
     ch = sub.add_parser("chains", help="motion transfer chains from the motor (Rz) to an end effector")
@@ -341,9 +197,9 @@ def build_parser() -> argparse.ArgumentParser:
     mo.add_argument("-o", "--output", required=True, help="CSV file to write")
     mo.set_defaults(func=_cmd_motion)
 
-    g = sub.add_parser("gallery", help="render every scene in gallery/ to a GIF")
+    g = sub.add_parser("gallery", help="render every scene of a folder to a GIF")
     g.add_argument("-o", "--output", default=None, help="output directory (default: beside the scenes)")
-    g.add_argument("--source", default=None, help="folder of scenes (default: the repository's gallery/)")
+    g.add_argument("--source", default="gallery", help="folder of scenes (default: ./gallery, the repository's)")
     g.set_defaults(func=_cmd_gallery)
 
     sc = sub.add_parser("schema", help="print (or write) the JSON schema of scene files")

@@ -81,41 +81,7 @@ def _vec(v: ArrayLike) -> Vec:
 # --------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class Hole:
-    """A round hole centred at ``centre``; ``diameter`` nominal.
-
-    ``role="pin"``: a pivot hole whose size fabrication takes from the pin
-    (the scene's pin diameter); ``"sized"``: the mechanism's own size (an
-    axle, a cam's round hole).
-    """
-
-    centre: Vec
-    diameter: float
-    role: str = "sized"
-
-
-@dataclass(frozen=True)
-class Slot:
-    """A straight slot (stadium): the pin's centre travels from ``start`` to ``end``."""
-
-    start: Vec
-    end: Vec
-    width: float
-    role: str = "sized"
-
-
-@dataclass(frozen=True)
-class ArcSlot:
-    """An arc slot about ``centre`` of mid-radius ``radius`` from ``angle0`` to ``angle1`` (CCW)."""
-
-    centre: Vec
-    radius: float
-    angle0: float
-    angle1: float
-    width: float
-    role: str = "sized"
-
+from .features import ArcSlot, Hole, Slot
 
 Feature = Hole | Slot | ArcSlot
 

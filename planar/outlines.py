@@ -10,11 +10,16 @@ primitives instead.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import shapely
 from shapely.geometry import LineString, Point, Polygon
 
-from .model import ArcSlot, Hole, Part, Slot
+from .features import ArcSlot, Hole, Slot
+
+if TYPE_CHECKING:  # planar.model imports this module lazily (Part.outline): no runtime import back
+    from .model import Part
 
 __all__ = ["part_outline", "feature_shape", "QUAD_SEGS"]
 

@@ -191,11 +191,21 @@ class Renderer:
         return {"parts": parts, "trails": trails, "sweeps": sweeps, "pins": pins}
 
     def _fit(self, world: dict) -> None:
-        pts = [r.reshape(-1, 2) for rings in world["parts"] for r in rings]
-        pts += [v.reshape(-1, 2) for v in world["trails"].values()]
-        pts += [v.reshape(-1, 2) for v in world["sweeps"].values()]
-        allp = np.concatenate(pts)
+        """Scale and origin that frame the geometry of the motion's valid samples.
+
+        Invalid samples (a linkage that cannot close there) may hold any
+        numbers, so they never move the camera; with no valid sample at all,
+        every finite point is framed.
+        """
+        valid = np.asarray(self.motion.valid, bool)
+        keep = valid if valid.any() else np.ones_like(valid)
+        tracks = [r for rings in world["parts"] for r in rings]  # (N, M, 2) each
+        tracks += list(world["trails"].values())  # (N, 2)
+        tracks += list(world["sweeps"].values())  # (N, M, 2)
+        allp = np.concatenate([np.asarray(v)[keep].reshape(-1, 2) for v in tracks])
         allp = allp[np.all(np.isfinite(allp), axis=1)]
+        if allp.size == 0:
+            allp = np.zeros((1, 2))
         lo, hi = allp.min(0), allp.max(0)
         span = np.maximum(hi - lo, 1e-12)
         m = self.style.margin

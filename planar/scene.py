@@ -21,7 +21,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from .effects import Effects, Load, Spring
-from .errors import PlanarError, SceneError
+from .errors import InputError, PlanarError, SceneError
 from .model import Mechanism, Motion
 
 __all__ = ["SceneSpec", "Scene", "load_scene", "parse_scene", "scene_schema"]
@@ -155,18 +155,33 @@ MechanismSpec = Annotated[
 
 
 class DriverSpec(_Strict):
-    """The input's law: ``speed`` cycles per second, for ``cycles`` or ``duration`` seconds."""
+    """The input's law: ``speed`` cycles per second, for ``cycles`` or ``duration`` seconds.
+
+    Without ``amplitude`` the input turns fully: ``phase + 2 pi speed t``.
+    With ``amplitude`` it rocks: ``centre + amplitude sin(2 pi speed t + phase)``,
+    for a limited input (double-rockers, straight-line linkages).  For a
+    rotary input (a four-bar's or slider-crank's crank, a linkage's crank node)
+    ``amplitude``, ``centre`` and ``phase`` are in the scene's angle unit, the
+    input angle counter-clockwise from the linkage's own x axis (a four-bar's
+    ground line, before ``placement``; a crank node adds its own ``phase``);
+    for a linkage driven by an actuator node, ``amplitude`` and ``centre`` are
+    model units along its axis.
+    """
 
     speed: Pos = 1.0
     cycles: Pos | None = None
     duration: Pos | None = None
     samples_per_cycle: Annotated[int, Field(ge=4, le=100_000)] = 72
     phase: Real = 0.0
+    amplitude: Pos | None = None
+    centre: Real = 0.0
 
     @model_validator(mode="after")
     def _one(self) -> "DriverSpec":
         if self.cycles is not None and self.duration is not None:
             raise ValueError("give cycles or duration, not both")
+        if self.amplitude is None and "centre" in self.model_fields_set:
+            raise ValueError("centre is the middle of a rocking input: give amplitude too")
         return self
 
 
@@ -340,7 +355,11 @@ def build_scene(spec: SceneSpec, path: str = "<scene>") -> Scene:
     rate = 2 * math.pi * spec.driver.speed
     phase = _angle(spec, spec.driver.phase)
     try:
-        mech = _build(spec, m, rate, phase)
+        rock = _rocking(spec, m)
+    except InputError as e:
+        raise SceneError(f"{path}: {e}") from None
+    try:
+        mech = _build(spec, m, rate, phase, rock)
     except PlanarError as e:
         raise SceneError(f"{path}: mechanism: {e}") from None
     polygons: dict[str, tuple[str, np.ndarray]] = {}
@@ -370,7 +389,26 @@ def build_scene(spec: SceneSpec, path: str = "<scene>") -> Scene:
     return Scene(spec, mech, path, polygons)
 
 
-def _build(spec: SceneSpec, m: Any, rate: float, phase: float) -> Mechanism:
+#: mechanism types whose driver can rock (``[driver] amplitude``)
+_ROCKING = ("fourbar", "slidercrank", "linkage")
+
+
+def _rocking(spec: SceneSpec, m: Any) -> dict[str, Any]:
+    """Keyword arguments ``amplitude``/``centre`` for a rocking input (radians or model units), or none."""
+    d = spec.driver
+    if d.amplitude is None:
+        return {}
+    if m.type not in _ROCKING:
+        raise InputError("driver.amplitude", d.amplitude,
+                         f"no amplitude for a {m.type!r} mechanism (a rocking input is for {', '.join(_ROCKING)})")
+    if isinstance(m, LinkageSpec):
+        first = next((n for n in m.nodes if n.kind in ("crank", "actuator")), None)
+        if first is not None and first.kind == "actuator":
+            return {"amplitude": float(d.amplitude), "centre": float(d.centre)}
+    return {"amplitude": _angle(spec, d.amplitude), "centre": _angle(spec, d.centre)}
+
+
+def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, Any]) -> Mechanism:
     from .catalog import get
 
     placement = None
@@ -381,12 +419,12 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float) -> Mechanism:
 
         return FourBar(m.ground, m.crank, m.coupler, m.rocker, coupler_point=m.coupler_point,
                        circuit=m.circuit, placement=placement, rate=rate, phase=phase,
-                       name=spec.name or "fourbar")
+                       name=spec.name or "fourbar", **rock)
     if isinstance(m, SliderCrankSpec):
         from .linkages import SliderCrank
 
         return SliderCrank(m.crank, m.rod, offset=m.offset, branch=m.branch, placement=placement,
-                           rate=rate, phase=phase, name=spec.name or "slidercrank")
+                           rate=rate, phase=phase, name=spec.name or "slidercrank", **rock)
     if isinstance(m, LinkageSpec):
         from .linkages import NODE_KINDS, Link, Linkage
 
@@ -398,7 +436,7 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float) -> Mechanism:
             nodes.append(cls(n.name, *args))
         links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
         return Linkage(spec.name or "linkage", nodes, links, points=m.points, placement=placement,
-                       rate=rate, phase=phase)
+                       rate=rate, phase=phase, **rock)
     if isinstance(m, ElementalSpec):
         from .windup import ELEMENTAL, ElementalMechanism, params_for
 

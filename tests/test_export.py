@@ -16,7 +16,8 @@ from hypothesis import strategies as st
 from shapely.geometry import Point, Polygon
 
 from planar.catalog import CATALOG
-from planar.cli import export_scene, gallery_scenes, main
+from planar.cli import main
+from planar.pipeline import export_scene, gallery_scenes
 from planar.fabrication import Circle, Contour, bulge_points, hull_of_circles, layout_parts
 from planar.linkages import FourBar
 from planar.model import ArcSlot, Hole, Pivot, Slot

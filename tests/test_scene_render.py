@@ -11,7 +11,8 @@ import pytest
 from PIL import Image
 
 from planar import SceneError
-from planar.cli import gallery_scenes, main, render_scene
+from planar.cli import main
+from planar.pipeline import gallery_scenes, render_scene
 from planar.scene import load_scene, parse_scene, scene_schema
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -207,3 +208,41 @@ def test_gallery_command_renders_every_scene(tmp_path):
     (src / "b.toml").write_text(FOURBAR.replace("speed = 2.0", "speed = 1.0"))
     assert main(["gallery", "--source", str(src), "-o", str(tmp_path / "out")]) == 0
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["a.gif", "b.gif"]
+
+
+def test_gallery_command_away_from_the_repository_is_a_user_error(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)  # no gallery/ here, and none is looked for beside the code
+    assert main(["gallery"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "scenes folder" in err and "'gallery'" in err
+    assert list(tmp_path.iterdir()) == []
+    (tmp_path / "empty").mkdir()
+    assert main(["gallery", "--source", "empty"]) == 2
+    assert "it has none" in capsys.readouterr().err
+
+
+def test_camera_fits_valid_samples_only():
+    # one invalid sample holding huge numbers must not shrink every frame to a dot
+    from dataclasses import replace
+
+    from planar.linkages import FourBar
+    from planar.render import Renderer, Style, _rgb
+
+    fb = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0))
+    clean = fb.run(24)
+    poses = {k: v.copy() for k, v in clean.poses.items()}
+    points = {k: v.copy() for k, v in clean.points.items()}
+    for v in (*poses.values(), *points.values()):
+        v[5, :2] = 3e16
+    valid = clean.valid.copy()
+    valid[5] = False
+    code = clean.fail_code.copy()
+    code[5] = 0
+    bad = replace(clean, poses=poses, points=points, valid=valid, fail_code=code, fail_table=[("C", "test")])
+    style = Style(width=160, height=120)
+    ref, r = Renderer(fb, clean, style), Renderer(fb, bad, style)
+    assert r.scale == pytest.approx(ref.scale, rel=1e-12)
+    assert r.origin == pytest.approx(ref.origin, rel=1e-12)
+    bg = np.array(_rgb(style.background))
+    drawn = [int(np.any(np.asarray(x.frame(0).convert("RGB")) != bg, axis=-1).sum()) for x in (ref, r)]
+    assert drawn[0] > 500 and drawn[1] > 0.9 * drawn[0]

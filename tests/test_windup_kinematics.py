@@ -97,17 +97,18 @@ def _cylinder_clearance(k, P, u, a):
     base = np.array([p0[0], p0[1], zs])
 
     def dist(phi):
-        rim = base + r * (np.cos(phi) * e1 + np.sin(phi) * e2)
-        lam = (zp - rim[2]) / d[2]
-        pt = (rim + lam * d)[:2]  # the surface line through the rim point, met with the driver's plane
-        w = pt - e0
-        return e[0] * w[1] - e[1] * w[0]  # signed distance from the edge (pin side positive)
+        """Signed distance from the edge (pin side positive) of rim points at angles ``phi`` (array or scalar)."""
+        c, s_ = np.cos(phi)[..., None], np.sin(phi)[..., None]
+        rim = base + r * (c * e1 + s_ * e2)
+        lam = (zp - rim[..., 2:3]) / d[2]
+        w = (rim + lam * d)[..., :2] - e0  # the surface line through the rim point, met with the driver's plane
+        return e[0] * w[..., 1] - e[1] * w[..., 0]
 
     phis = np.linspace(0, 2 * np.pi, 721)
-    vals = np.array([dist(p) for p in phis])
+    vals = dist(phis)
     sign = 1.0 if np.median(vals) > 0 else -1.0
     i = int(np.argmin(sign * vals))
-    res = minimize_scalar(lambda p: sign * dist(p), bounds=(phis[i] - 0.01, phis[i] + 0.01),
+    res = minimize_scalar(lambda p: float(sign * dist(np.asarray(p, float))), bounds=(phis[i] - 0.01, phis[i] + 0.01),
                           method="bounded", options={"xatol": 1e-14})
     return res.fun
 

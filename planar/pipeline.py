@@ -1,0 +1,280 @@
+"""What the CLI, the benchmarks and the tests run: a scene in, files and records out.
+
+Each function takes a built :class:`planar.scene.Scene` (or a folder given
+explicitly) and returns what it made; printing is the caller's business.
+Heavy libraries (imageio, pymunk, ezdxf, shapely) are imported inside the
+functions that need them, so ``import planar.pipeline`` stays light.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from .errors import InputError, PlanarError
+
+if TYPE_CHECKING:
+    from .compare import Comparison
+    from .fabrication import Layout
+    from .model import Motion
+    from .render import Style
+    from .scene import Scene
+    from .simulate import SimResult, SimSettings
+
+__all__ = [
+    "DEMO_EXTRAS", "DEMO_SCENES", "SceneComparison", "build_gallery", "compare_scene", "export_scene",
+    "gallery_scenes", "overlay_motion", "render_scene", "run_demo", "scene_style", "write_catalog_motion",
+    "write_scene_motion",
+]
+
+
+# --------------------------------------------------------------------------- scenes of a folder
+
+
+def gallery_scenes(folder: str | Path) -> list[Path]:
+    """The scene files (``*.toml``) directly in ``folder``, sorted by name.
+
+    The folder is always given by the caller (``planar gallery --source``,
+    ``planar bench accuracy --scenes``): nothing is looked up beside the
+    code.  Raises :class:`InputError` if ``folder`` is not a directory or holds
+    no scene file.
+    """
+    p = Path(folder)
+    if not p.is_dir():
+        raise InputError("scenes folder", str(p), "an existing folder of .toml scene files")
+    scenes = sorted(p.glob("*.toml"))
+    if not scenes:
+        raise InputError("scenes folder", str(p), "a folder with .toml scene files (it has none)")
+    return scenes
+
+
+# --------------------------------------------------------------------------- render
+
+
+def scene_style(scene: Scene) -> Style:
+    """The renderer's :class:`~planar.render.Style` from a scene's ``[render]`` table."""
+    from .render import Style
+
+    r = scene.spec.render
+    return Style(width=r.width, height=r.height, supersample=r.supersample, background=r.background,
+                 trails=r.trails, show_pins=r.show_pins)
+
+
+def overlay_motion(scene: Scene) -> Motion:
+    """The pymunk rebuild's motion of ``scene``, for drawing over the analytic one.
+
+    Raises :class:`~planar.simulate.SimulationError` if the simulation blew up.
+    """
+    from .simulate import SimulationError, simulate_scene
+
+    sim = simulate_scene(scene)
+    if sim.blowup is not None:
+        raise SimulationError(f"{scene.path}: the simulation {sim.motion.reason(sim.blowup[0])}; "
+                              "no animation written (try more substeps: planar compare --substeps)")
+    return sim.motion
+
+
+def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, progress: bool = True) -> int:
+    """Render a scene's analytic motion (and optionally an overlay motion) to a GIF; returns frames."""
+    from exporters.gif import frame_delay_ms, indexer, write_gif
+
+    from .render import Renderer, palette_colors
+
+    motion = scene.motion()
+    polys = {n: scene.polygons[n] for n in scene.spec.render.sweep}
+    r = Renderer(scene.mechanism, motion, scene_style(scene), overlay=overlay, polygons=polys)
+    pal = palette_colors(r.style, len(scene.mechanism.parts))
+    delay = frame_delay_ms(scene.mechanism.driver.period, scene.spec.driver.samples_per_cycle)
+    return write_gif(out, r.frames(progress=progress, post=indexer(pal)), delay, pal)
+
+
+def build_gallery(source: str | Path, output: str | Path | None = None,
+                  progress: bool = False) -> Iterator[tuple[Path, Path, int]]:
+    """Render every scene of the folder ``source`` to ``output`` (default: beside the scenes).
+
+    Yields ``(scene file, GIF written, frames)`` as each GIF is finished.
+    """
+    from .scene import load_scene
+
+    scenes = gallery_scenes(source)
+    out = Path(output) if output is not None else Path(source)
+    out.mkdir(parents=True, exist_ok=True)
+    for path in scenes:
+        target = out / (path.stem + ".gif")
+        yield path, target, render_scene(load_scene(path), target, progress=progress)
+
+
+# --------------------------------------------------------------------------- motion tables
+
+
+def write_scene_motion(scene: Scene, out: str | Path) -> Motion:
+    """Write the scene's analytic motion table (CSV) to ``out``; returns the motion."""
+    from .fileio import write_motion_csv
+
+    motion = scene.motion()
+    write_motion_csv(out, scene.mechanism, motion)
+    return motion
+
+
+def write_catalog_motion(name: str, out: str | Path, samples: int = 360) -> Motion:
+    """Write one cycle (``samples`` samples) of the built-in mechanism ``name`` to ``out`` (CSV)."""
+    from .catalog import get
+    from .fileio import write_motion_csv
+
+    mech = get(name)
+    motion = mech.run(samples_per_cycle=samples)
+    write_motion_csv(out, mech, motion)
+    return motion
+
+
+# --------------------------------------------------------------------------- fabrication
+
+
+def export_scene(scene: Scene, dxf: str | Path | None = None, svg: str | Path | None = None,
+                 kerf: float | None = None, sheet: tuple[float, float] | None = None,
+                 preview: str | Path | None = None) -> Layout:
+    """Lay a scene's parts on sheets and write DXF and/or SVG (and a PNG preview of the DXF).
+
+    ``kerf`` (mm) and ``sheet`` (width, height in mm) default to the scene's
+    ``[fabrication]`` table.
+    """
+    from .fabrication import layout_parts
+
+    fab = scene.spec.fabrication
+    layout = layout_parts(scene.mechanism, unit_mm=fab.unit_mm, kerf=fab.kerf_mm if kerf is None else kerf,
+                          pin_mm=fab.pin_diameter_mm, clearance=fab.clearance_mm, sheet=sheet or fab.sheet_mm)
+    if dxf is not None:
+        from exporters.dxf import write_dxf
+
+        write_dxf(dxf, layout)
+        if preview is not None:
+            from exporters.dxf import preview_png
+
+            preview_png(dxf, preview)
+    if svg is not None:
+        from exporters.svg import write_svg
+
+        write_svg(svg, layout)
+    return layout
+
+
+# --------------------------------------------------------------------------- physics comparison
+
+
+@dataclass
+class SceneComparison:
+    """A scene's analytic motion against its pymunk rebuild (see :func:`compare_scene`)."""
+
+    result: Comparison
+    sim: SimResult
+    settings: SimSettings
+    torque_series: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: the comparison, the settings, wall time and what was built."""
+        d = self.result.to_dict()
+        if d.get("torque") is not None and self.torque_series:
+            d["torque"] = {**d["torque"], **self.torque_series}
+        s = self.settings
+        d["settings"] = {"substeps": s.substeps, "iterations": s.iterations, "error_bias": s.error_bias}
+        d["wall_time_s"] = self.sim.wall_time
+        d["built"] = dict(self.sim.built)
+        return d
+
+
+def compare_scene(scene: Scene, threshold: float = 1e-3, substeps: int | None = None,
+                  iterations: int | None = None, error_bias: float | None = None) -> SceneComparison:
+    """Simulate ``scene`` in pymunk and compare with its analytic motion.
+
+    Settings left ``None`` take :data:`planar.simulate.DEFAULT_SETTINGS`.
+    ``threshold`` is a fraction of the mechanism's size.  With loads or
+    gravity on a constant-rate rotary input, the motor torque is compared too
+    (``result.torque``; a reason in ``result.notes`` when it cannot be).
+    """
+    from dataclasses import replace
+
+    from .compare import compare
+    from .simulate import DEFAULT_SETTINGS, simulate_scene, torque_comparison
+
+    settings = DEFAULT_SETTINGS
+    if substeps is not None:
+        settings = replace(settings, substeps=substeps)
+    if iterations is not None:
+        settings = replace(settings, iterations=iterations)
+    if error_bias is not None:
+        settings = replace(settings, error_bias=error_bias)
+    sim = simulate_scene(scene, settings)
+    result = compare(scene.mechanism, scene.motion(), sim.motion, threshold=threshold)
+    out = SceneComparison(result, sim, settings)
+    e = scene.effects
+    mech = scene.mechanism
+    if (e.loads or e.gravity is not None) and mech.driver.kind == "rotation" and mech.driver.amplitude is None:
+        try:
+            period_t = mech.driver.times(scene.spec.driver.samples_per_cycle, 1.0)
+            tc = torque_comparison(mech, period_t, e, settings)
+            result.torque = {k: tc[k] for k in ("peak", "max_abs_diff", "max_rel_diff", "note")}
+            out.torque_series = {"analytic": tc["analytic"], "simulated": tc["simulated"]}
+        except PlanarError as err:
+            result.notes.append(f"torque not compared: {err}")
+    return out
+
+
+# --------------------------------------------------------------------------- the demo
+
+
+#: the embedded default: a wind-up toy and a four-bar walking leg
+DEMO_SCENES: dict[str, dict] = {
+    "horse": {
+        "name": "horse", "angle_unit": "deg",
+        "mechanism": {"type": "toy", "left": [["Rz->OzT", "OzT->Oz"]],
+                      "right": [["Rz->OzT", "OzT->Ty"], ["Rz->OzT", "OzT->Oz"]], "phase": 180},
+        "driver": {"speed": 0.5, "samples_per_cycle": 48},
+        "render": {"width": 480, "height": 360},
+        "fabrication": {"unit_mm": 100.0},
+    },
+    "kangaroo-leg": {
+        "name": "kangaroo-leg",
+        "mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0,
+                      "coupler_point": [5.5, -2.0],
+                      "polygons": [{"name": "foot", "part": "coupler",
+                                    "points": [[5.1, -2.25], [6.6, -2.25], [6.6, -1.95], [5.1, -1.95]]}]},
+        "driver": {"speed": 1.0, "samples_per_cycle": 48},
+        "effects": {"loads": [{"point": "coupler_point", "force": [0.0, 10.0]}]},
+        "render": {"width": 480, "height": 360, "sweep": ["foot"]},
+        "fabrication": {"unit_mm": 15.0},
+    },
+}
+
+#: later features append writers here ``(scene, output dir)`` so the demo grows with the package
+DEMO_EXTRAS: list[Callable[..., None]] = []
+
+
+def run_demo(output: str | Path) -> Iterator[str]:
+    """Animate, tabulate and cut the embedded demo scenes into ``output``; yields one line per scene."""
+    import numpy as np
+
+    from . import analysis
+    from .linkages import Linkage
+    from .scene import build_scene, parse_scene
+
+    out = Path(output)
+    out.mkdir(parents=True, exist_ok=True)
+    for name, data in DEMO_SCENES.items():
+        scene = build_scene(parse_scene(data, f"<demo {name}>"), f"<demo {name}>")
+        gif = out / f"{name}.gif"
+        n = render_scene(scene, gif)
+        csv = out / f"{name}.csv"
+        motion = write_scene_motion(scene, csv)
+        line = f"{name}: {n} frames, all valid: {bool(motion.valid.all())} -> {gif}, {csv}"
+        if name == "kangaroo-leg" and isinstance(scene.mechanism, Linkage):
+            loads = {ld.point: np.array(ld.force) for ld in scene.spec.effects.loads}
+            tau, _ = analysis.motor_torque(scene.mechanism, motion.driver, loads)
+            line += f"; peak motor torque {np.abs(tau).max():.3f} (force x unit) for a 10 N foot push"
+        dxf = out / f"{name}.dxf"
+        layout = export_scene(scene, dxf=dxf)
+        line += f"; {len(layout.parts)} parts -> {dxf}"
+        yield line
+        for extra in DEMO_EXTRAS:
+            extra(scene, out)
