@@ -5,7 +5,7 @@ from pathlib import Path
 import pytest
 
 from fabcheck import dxf_cut_polygons, match_contours, svg_closed_polygons
-from planar.cli import export_scene, gallery_scenes
+from planar.pipeline import export_scene, gallery_scenes
 from planar.scene import load_scene
 
 GALLERY = Path(__file__).resolve().parents[1] / "gallery"
