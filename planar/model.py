@@ -533,6 +533,8 @@ class Mechanism:
         for pname, (part, _) in self.points.items():
             if part not in names:
                 raise InputError(f"{name}.points.{pname}", part, f"one of the parts {names}")
+            if pname in names:
+                raise InputError(f"{name}.points", pname, "a point name that no part has (tables name columns by both)")
         self._check_joints(names)
         self.parts = _with_joint_features(self.parts, self.joints)
 

@@ -48,7 +48,7 @@ Where a dyad cannot close the sample is invalid with the node named.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import ClassVar, Mapping, Sequence
 
 import numpy as np
@@ -194,6 +194,14 @@ class NodeKind:
         """
         raise NotImplementedError
 
+    def held_by(self) -> tuple[tuple[str, ...], ...]:
+        """Groups of nodes (this one included) that one link must carry to hold this node's constraint."""
+        return ()
+
+    def branch_of(self, pos: Mapping[str, Array]) -> int | None:
+        """Which branch (+1 or -1) the node's last position in ``pos`` is on; ``None`` for kinds without one."""
+        return None
+
 
 @node_kind
 @dataclass(frozen=True)
@@ -231,6 +239,9 @@ class Crank(NodeKind):
 
     def refs(self) -> tuple[str, ...]:
         return (self.centre,)
+
+    def held_by(self) -> tuple[tuple[str, ...], ...]:
+        return ((self.name, self.centre),)
 
     def validate(self, where: str) -> None:
         check_positive(f"{where}.radius", self.radius)
@@ -313,6 +324,13 @@ class RRR(NodeKind):
         return p, (ok, f"links of length {self.ra:g} (from {self.a!r}) and {self.rb:g} (from {self.b!r}) "
                        "cannot span the distance between them")
 
+    def held_by(self) -> tuple[tuple[str, ...], ...]:
+        return ((self.name, self.a), (self.name, self.b))
+
+    def branch_of(self, pos: Mapping[str, Array]) -> int | None:
+        a, b, p = pos[self.a][-1], pos[self.b][-1], pos[self.name][-1]
+        return 1 if (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) >= 0 else -1
+
     def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
         # (P - A) . (vP - vA) = 0 and (P - B) . (vP - vB) = 0
         P = pos[self.name]
@@ -354,6 +372,14 @@ class RRP(NodeKind):
         p = np.where(flip[:, None], other, keep) if flip.any() else keep
         return p, (ok, f"a link of length {self.ra:g} from {self.a!r} cannot reach the line {self.p!r}-{self.q!r}")
 
+    def held_by(self) -> tuple[tuple[str, ...], ...]:
+        return ((self.name, self.a),)
+
+    def branch_of(self, pos: Mapping[str, Array]) -> int | None:
+        u = pos[self.q][-1] - pos[self.p][-1]
+        # further along p -> q than the foot of the perpendicular from a: +1
+        return 1 if float(np.dot(pos[self.name][-1] - pos[self.a][-1], u)) >= 0 else -1
+
     def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
         # |P - A| = ra and cross(w, P - p) = e |w|, differentiated:
         # cross(w, vP) = e (w . vw)/|w| - cross(vw, P - p) + cross(w, vp)
@@ -384,6 +410,10 @@ class Rigid(NodeKind):
 
     def validate(self, where: str) -> None:
         check_finite(f"{where}.local", self.local)
+
+    def held_by(self) -> tuple[tuple[str, ...], ...]:
+        # its distance from ``a``; the direction ``a -> b`` may be held by a guide (a cylinder along its rod)
+        return ((self.name, self.a),)
 
     def position(self, pos: Mapping[str, Array], q: Array, path: Mask) -> tuple[Array, Check | None]:
         a, b = pos[self.a], pos[self.b]
@@ -460,6 +490,7 @@ class Linkage(Mechanism):
         self.ground_name = ground
         self.links = self._with_ground(tuple(links), ground)
         self._validate_links(name)
+        self._check_held(name)
         inputs = [n for n in self.nodes if n.is_input]
         if not inputs:
             raise InputError(f"{name}.nodes", [n.name for n in self.nodes], "one crank or actuator node as the input")
@@ -550,6 +581,16 @@ class Linkage(Mechanism):
                     raise InputError(f"{where}.guide", lk.guide, "two different nodes")
                 self._guide_owner(lk)  # raises if no other link carries the guide line
 
+    def _check_held(self, name: str) -> None:
+        """Every node's constraint is held by a part: the nodes it is placed from share a link with it."""
+        for n in self.nodes:
+            for group in n.held_by():
+                if not any(all(g in lk.nodes for g in group) for lk in self.links):
+                    others = ", ".join(repr(g) for g in group if g != n.name)
+                    raise InputError(f"{name}.nodes.{n.name}", n.name,
+                                     f"a link carrying {n.name!r} with {others} (the {n.kind} node is placed "
+                                     "from them; without that link no part holds it there)")
+
     def _guide_owner(self, lk: Link) -> str:
         """The link (not ``lk``) that carries both nodes of ``lk``'s guide line."""
         assert lk.guide is not None
@@ -609,16 +650,59 @@ class Linkage(Mechanism):
                         f"{dev:.4g} rad against the guide {lk.guide[0]!r}-{lk.guide[1]!r}")
 
     # -- solving ------------------------------------------------------------
+    #: driver value at which the declared branches hold (``None``: at the first sample); see
+    #: :meth:`_lead_in` (a :class:`FourBar` declares its circuit with the crank at pi/2)
+    branch_reference: float | None = None
+
+    def _lead_in(self, q: Array) -> Array:
+        """Driver values leading from :attr:`branch_reference` into the path ``q`` (empty if none applies).
+
+        The lead-in runs toward ``q[0]`` in the path's direction (for a
+        turning crank from the reference a whole number of turns away, less
+        than one turn before ``q[0]``), with steps that shrink by at most 1.4x
+        per sample down to the path's first step, so continuity carries the
+        declared branch from the reference through every sample, ``q[0]``
+        included even where it is singular.
+        """
+        ref = self.branch_reference
+        if ref is None or q.shape[0] < 4 or not path_mask(q[:4])[3]:
+            return q[:0]
+        q0, h = float(q[0]), float(q[1] - q[0])
+        direction = 1.0 if h > 0 else -1.0
+        if self.driver.kind == "rotation":
+            turns = np.floor((q0 - ref) / (2 * np.pi)) if direction > 0 else np.ceil((q0 - ref) / (2 * np.pi))
+            ref = ref + 2 * np.pi * turns
+        span = (q0 - ref) * direction
+        if span <= 0:
+            return q[:0]
+        h_max = max(abs(h), 2 * np.pi / 360 if self.driver.kind == "rotation" else abs(h))
+        steps: list[float] = []
+        step, total = abs(h), 0.0
+        while total < span and len(steps) < 4096:
+            step = min(step * 1.4, h_max) if steps else abs(h)
+            steps.append(step)
+            total += step
+        back = np.cumsum(steps)  # distances before q[0], nearest first
+        return q0 - direction * back[::-1]
+
     def solve_nodes(self, q: Array) -> tuple[dict[str, Array], list[tuple[Mask, str, str]]]:
         """World positions ``(N, 2)`` of every node (before placement) and validity checks.
 
         The samples are a path in their order (see the module's note on branches).
         """
         q = np.asarray(q, dtype=float)
+        lead = self._lead_in(q)
+        if lead.size == 0:
+            return self._solve_nodes(q, self.nodes)
+        k = lead.shape[0]
+        pos, checks = self._solve_nodes(np.concatenate([lead, q]), self.nodes)
+        return {n: v[k:] for n, v in pos.items()}, [(m[k:], j, w) for m, j, w in checks]
+
+    def _solve_nodes(self, q: Array, nodes: Sequence[NodeKind]) -> tuple[dict[str, Array], list[tuple[Mask, str, str]]]:
         path = path_mask(q)
         pos: dict[str, Array] = {}
         checks: list[tuple[Mask, str, str]] = []
-        for node in self.nodes:
+        for node in nodes:
             p, check = node.position(pos, q, path)
             pos[node.name] = p
             if check is not None:
@@ -669,7 +753,9 @@ class Linkage(Mechanism):
 
     # -- parts and joints -----------------------------------------------------
     def _span(self) -> float:
-        pts = np.array(list(self._ref_nodes.values()))
+        """The larger side of the box every node stays in over the driver's cycle (independent of the phase)."""
+        ok = self._sweep_ok
+        pts = np.concatenate([v[ok] for v in self._sweep_pos.values()])
         ext = float(np.max(np.ptp(pts, axis=0))) if len(pts) > 1 else 1.0
         return ext if ext > 0 else 1.0
 

@@ -238,6 +238,9 @@ class FourBar(Linkage):
             Rigid("P", "B", "C", self.coupler_point),
         ]
         links = [Link("crank", ("O2", "B")), Link("coupler", ("B", "C", "P")), Link("rocker", ("O4", "C"))]
+        # the circuit is declared with the crank at pi/2 and carried from there by continuity, so a
+        # change-point linkage is the same assembly whatever sample its motion starts from
+        self.branch_reference = np.pi / 2
         super().__init__(name, nodes, links, points={"coupler_point": "P"}, placement=placement, **kw)
 
     # -- classification and limits -----------------------------------------
