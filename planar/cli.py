@@ -65,8 +65,8 @@ def _cmd_demo(args: argparse.Namespace) -> int:
             tau, _ = analysis.motor_torque(leg, motion.driver, loads)
             line += f"; peak motor torque {np.abs(tau).max():.3f} (force x unit) for a 10 N foot push"
         dxf = out / f"{name}.dxf"
-        layout = export_scene(scene, dxf=dxf)
-        line += f"; {len(layout.parts)} parts -> {dxf}"
+        fab = export_scene(scene, dxf=dxf)
+        line += f"; {len(fab.layout.parts)} parts -> {', '.join(map(str, fab.written))}"
         print(line)
         for extra in _DEMO_EXTRAS:
             extra(scene, out)
@@ -265,42 +265,32 @@ def _sheet(text: str) -> tuple[float, float]:
 
 
 def export_scene(scene, dxf: str | Path | None = None, svg: str | Path | None = None, kerf: float | None = None,
-                 sheet: tuple[float, float] | None = None, preview: str | Path | None = None):
-    """Lay a scene's parts on sheets and write DXF and/or SVG (and a PNG preview of the DXF)."""
-    from .fabrication import layout_parts
+                 sheet: tuple[float, float] | None = None, preview: str | Path | None = None,
+                 bom: str | Path | None = None, assembly: str | Path | None = None,
+                 kerf_test: str | Path | None = None):
+    """Check, layer and nest a scene's parts and write the requested files (see planar.fabexport)."""
+    from .fabexport import build, write_outputs
+    from .fabparts import FabSettings
 
-    fab = scene.spec.fabrication
-    layout = layout_parts(scene.mechanism, unit_mm=fab.unit_mm, kerf=fab.kerf_mm if kerf is None else kerf,
-                          pin_mm=fab.pin_diameter_mm, clearance=fab.clearance_mm, sheet=sheet or fab.sheet_mm)
-    if dxf is not None:
-        from exporters.dxf import write_dxf
-
-        write_dxf(dxf, layout)
-        if preview is not None:
-            from exporters.dxf import preview_png
-
-            preview_png(dxf, preview)
-    if svg is not None:
-        from exporters.svg import write_svg
-
-        write_svg(svg, layout)
-    return layout
+    fab = build(scene, FabSettings.from_spec(scene.spec.fabrication, kerf, sheet))
+    fab.written = write_outputs(fab, dxf, svg, preview, bom, assembly, kerf_test)
+    return fab
 
 
 def _cmd_export(args: argparse.Namespace) -> int:
     from .errors import InputError
+    from .fabexport import summary
     from .scene import load_scene
 
     if args.kerf is not None and not (0 <= args.kerf <= 2):
         raise InputError("--kerf", args.kerf, "a kerf between 0 and 2 mm")
-    if args.preview and not args.output:
-        raise InputError("--preview", args.preview, "a DXF output (-o) to preview")
     scene = load_scene(args.scene)
     sheet = _sheet(args.sheet) if args.sheet else None
-    layout = export_scene(scene, args.output, args.svg, args.kerf, sheet, args.preview)
-    outs = [p for p in (args.output, args.svg, args.preview) if p]
-    print(f"{len(layout.parts)} parts on {layout.sheets} sheet(s) of {layout.sheet_size[0]:g} x "
-          f"{layout.sheet_size[1]:g} mm, kerf {layout.kerf:g} mm -> {', '.join(outs)}")
+    fab = export_scene(scene, args.output, args.svg, args.kerf, sheet, args.preview, args.bom, args.assembly,
+                       args.kerf_test)
+    for note in fab.notes:
+        print(f"note: {note}")
+    print(f"{summary(fab)} -> {', '.join(map(str, fab.written)) or 'nothing written'}")
     return 0
 
 
@@ -365,7 +355,10 @@ def build_parser() -> argparse.ArgumentParser:
     ex.add_argument("--svg", default=None, help="SVG file to write")
     ex.add_argument("--kerf", type=float, default=None, help="beam width in mm (default: the scene's kerf_mm)")
     ex.add_argument("--sheet", default=None, help="sheet size WIDTHxHEIGHT in mm (default: the scene's)")
-    ex.add_argument("--preview", default=None, help="PNG preview of the DXF (ezdxf's drawing add-on)")
+    ex.add_argument("--preview", default=None, help="PNG preview of each sheet (photo-like)")
+    ex.add_argument("--bom", default=None, help="bill of materials (CSV): parts, layers, pins, spacers")
+    ex.add_argument("--assembly", default=None, help="assembly drawing (SVG): parts in place, layers, letters")
+    ex.add_argument("--kerf-test", default=None, help="a kerf calibration piece (.dxf or .svg)")
     ex.set_defaults(func=_cmd_export)
 
     c = sub.add_parser("catalog", help="write the motion table of a built-in mechanism")

@@ -3,8 +3,8 @@
 from pathlib import Path
 
 import pytest
-
 from fabcheck import dxf_cut_polygons, match_contours, svg_closed_polygons
+
 from planar.cli import export_scene, gallery_scenes
 from planar.scene import load_scene
 
