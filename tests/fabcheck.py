@@ -65,7 +65,7 @@ def svg_closed_polygons(path) -> list[Polygon]:
         for s in segs:
             if isinstance(s, Move):
                 continue
-            n = 2000 if isinstance(s, Arc) else 2
+            n = 400 if isinstance(s, Arc) else 2
             pts.extend(s.npoint(np.linspace(0.0, 1.0, n))[:-1].tolist())
         xy = np.asarray(pts, float) / scale
         xy[:, 1] = H - xy[:, 1]
