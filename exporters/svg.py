@@ -115,7 +115,7 @@ def assembly_svg_text(fab: Any) -> str:
         x, y, a = asm.pose[name]
         poly = fab.own[name]
         c, s = math.cos(a), math.sin(a)
-        shapes.append((layer, name, affinity.affine_transform(poly, [c, -s, s, c, x, y])))
+        shapes.append((layer, name, affinity.affine_transform(poly, [c, -s, s, c, x, y]).simplify(0.01)))
     shapes.sort(key=lambda t: (t[0], list(asm.layers).index(t[1])))
     pts = []
     for *_, g in shapes:
@@ -151,7 +151,7 @@ def assembly_svg_text(fab: Any) -> str:
         for poly in geoms:
             for ring in [poly.exterior, *poly.interiors]:
                 xy = list(ring.coords)
-                d.append("M " + " L ".join(f"{_f(X(a))} {_f(Y(b))}" for a, b in xy) + " Z")
+                d.append("M " + " L ".join(f"{X(a):.3f} {Y(b):.3f}" for a, b in xy) + " Z")
         out.append(f'<path d="{" ".join(d)}" fill="{LAYER_FILLS[layer % len(LAYER_FILLS)]}" fill-opacity="0.75" '
                    f'fill-rule="evenodd" stroke="#333333" stroke-width="{_f(fs * 0.08)}"><title>{escape(name)} '
                    f'(layer {layer + 1})</title></path>')
