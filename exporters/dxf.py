@@ -1,13 +1,17 @@
 """DXF R2010 in millimetres for laser cutters: true arcs, closed contours, layers per operation.
 
-Layers: ``CUT_INNER`` (blue, holes and slots: cut first), ``CUT_OUTER`` (red,
-part outlines), ``ENGRAVE`` (green, part names), ``SHEET`` (grey, the sheet's
-edge, for reference only: do not cut).  Contours are closed LWPOLYLINEs with
-bulges (arcs as arcs), round holes are CIRCLEs.  Each part's entities form a
-DXF group named after the part.  ``$INSUNITS`` = 4 (mm), ``$MEASUREMENT`` = 1.
+Layers: ``CUT_INNER`` (holes and slots: cut first) and ``CUT_OUTER`` (part
+outlines) in the cut colour (red by default), ``ENGRAVE`` (labels and hole
+letters as single-line polylines, not live text) in the engrave colour (blue),
+``SHEET`` (grey, not plotted: the sheet's edge, reference only).  The material
+and kerf are noted in a custom drawing property (``planar``).  Contours are closed LWPOLYLINEs with bulges (arcs as arcs),
+round holes are CIRCLEs.  Each part's entities form a DXF group named after the
+part.  ``$INSUNITS`` = 4 (mm), ``$MEASUREMENT`` = 1, ``$EXTMIN``/``$EXTMAX``
+the sheet.  One file per sheet.
 
-Reproducible byte for byte: ezdxf's fixed metadata (no timestamps, constant
-GUIDs) and a deterministic entity order.
+Reproducible byte for byte in any process: ezdxf's fixed metadata (no
+timestamps, constant GUIDs), a deterministic entity order and CLASSES
+registered in sorted order.
 """
 
 from __future__ import annotations
@@ -15,15 +19,25 @@ from __future__ import annotations
 import contextlib
 import io
 import os
-from typing import Iterator
+from collections.abc import Iterator
+from typing import Any
 
-from planar.fabrication import Circle, Contour, Layout
+from planar.fabrication import Circle, Layout
 from planar.fileio import atomic_write
 
-__all__ = ["write_dxf", "LAYERS", "preview_png"]
+__all__ = ["LAYERS", "aci", "dxf_bytes", "preview_png", "write_dxf"]
 
-#: layer -> ACI colour
-LAYERS = {"CUT_INNER": 5, "CUT_OUTER": 1, "ENGRAVE": 3, "SHEET": 8}
+#: layer -> default ACI colour
+LAYERS = {"CUT_INNER": 1, "CUT_OUTER": 1, "ENGRAVE": 5, "SHEET": 8}
+
+_ACI = {1: (255, 0, 0), 2: (255, 255, 0), 3: (0, 255, 0), 4: (0, 255, 255), 5: (0, 0, 255), 6: (255, 0, 255),
+        7: (255, 255, 255), 8: (128, 128, 128)}
+
+
+def aci(colour: str) -> int:
+    """The nearest of AutoCAD's first eight colour indices to ``#rrggbb``."""
+    rgb = tuple(int(colour[i:i + 2], 16) for i in (1, 3, 5))
+    return min(_ACI, key=lambda k: sum((a - b) ** 2 for a, b in zip(_ACI[k], rgb)))
 
 
 @contextlib.contextmanager
@@ -38,35 +52,46 @@ def _fixed_metadata() -> Iterator[None]:
         ezdxf.options.write_fixed_meta_data_for_testing = old
 
 
-def build_document(layout: Layout):
-    """The ezdxf document for a layout."""
+def build_document(layout: Layout, sheet: int = 0, settings: Any = None, note: str = ""):
+    """The ezdxf document for one sheet of a layout."""
     import ezdxf
 
+    cut = getattr(settings, "cut_colour", "#ff0000")
+    eng = getattr(settings, "engrave_colour", "#0000ff")
     doc = ezdxf.new("R2010", setup=False)
     doc.header["$INSUNITS"] = 4
     doc.header["$MEASUREMENT"] = 1
     doc.header["$LUNITS"] = 2
-    for name, colour in LAYERS.items():
-        doc.layers.add(name, color=colour)
-    msp = doc.modelspace()
     W, H = layout.sheet_size
-    for k in range(layout.sheets):
-        x0, y0 = layout.sheet_origin(k)
-        msp.add_lwpolyline([(x0, y0), (x0 + W, y0), (x0 + W, y0 + H), (x0, y0 + H)], close=True,
-                           dxfattribs={"layer": "SHEET"})
+    msp = doc.modelspace()
+    # ezdxf copies the modelspace's extents and limits into the header at write time
+    msp.dxf.extmin = (0.0, 0.0, 0.0)
+    msp.dxf.extmax = (W, H, 0.0)
+    msp.dxf.limmin = (0.0, 0.0)
+    msp.dxf.limmax = (W, H)
+    doc.header["$EXTMIN"] = (0.0, 0.0, 0.0)  # (ezdxf keeps these when the layout's minimum is the origin)
+    doc.header["$EXTMAX"] = (W, H, 0.0)
+    colours = {"CUT_INNER": cut, "CUT_OUTER": cut, "ENGRAVE": eng, "SHEET": "#808080"}
+    for name, hexcol in colours.items():
+        layer = doc.layers.add(name, color=aci(hexcol))
+        layer.rgb = tuple(int(hexcol[i:i + 2], 16) for i in (1, 3, 5))
+        if name == "SHEET":
+            layer.dxf.plot = 0
+    msp.add_lwpolyline([(0, 0), (W, 0), (W, H), (0, H)], close=True, dxfattribs={"layer": "SHEET"})
+    if note:  # a drawing property, not an entity: nothing for the cutter to import
+        doc.header.custom_vars.append("planar", note)
 
-    def add(cut, layer: str):
-        if isinstance(cut, Circle):
-            return msp.add_circle(cut.centre, cut.radius, dxfattribs={"layer": layer})
-        return msp.add_lwpolyline([(x, y, 0.0, 0.0, b) for x, y, b in cut.vertices], format="xyseb", close=True,
+    def add(c, layer: str):
+        if isinstance(c, Circle):
+            return msp.add_circle(c.centre, c.radius, dxfattribs={"layer": layer})
+        return msp.add_lwpolyline([(x, y, 0.0, 0.0, b) for x, y, b in c.vertices], format="xyseb", close=True,
                                   dxfattribs={"layer": layer})
 
-    for part in layout.parts:
+    for part in layout.on_sheet(sheet):
         ents = [add(c, "CUT_INNER") for c in part.inner]
         ents.append(add(part.outer, "CUT_OUTER"))
-        text = msp.add_text(part.name, height=part.label_height, dxfattribs={"layer": "ENGRAVE"})
-        text.set_placement(part.label_at, align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
-        ents.append(text)
+        for stroke in part.engrave:
+            ents.append(msp.add_lwpolyline([(float(x), float(y)) for x, y in stroke], dxfattribs={"layer": "ENGRAVE"}))
         group = doc.groups.new(part.name.replace(" ", "_"))
         group.extend(ents)
     return doc
@@ -83,15 +108,21 @@ def _register_classes_in_order(doc) -> None:
         doc.classes.add_class(name)
 
 
-def write_dxf(path: str | os.PathLike, layout: Layout) -> None:
-    """Write the layout as DXF (atomically)."""
+def dxf_bytes(layout: Layout, sheet: int = 0, settings: Any = None, note: str = "") -> bytes:
+    """One sheet of the layout as DXF bytes."""
     with _fixed_metadata():
-        doc = build_document(layout)
+        doc = build_document(layout, sheet, settings, note)
         _register_classes_in_order(doc)
         buf = io.StringIO()
         doc.write(buf)
-    with atomic_write(path, "w") as fh:
-        fh.write(buf.getvalue())
+    return buf.getvalue().encode("utf-8")
+
+
+def write_dxf(path: str | os.PathLike, layout: Layout, sheet: int = 0, settings: Any = None) -> None:
+    """Write one sheet of the layout as DXF (atomically)."""
+    data = dxf_bytes(layout, sheet, settings)
+    with atomic_write(path, "wb") as fh:
+        fh.write(data)
 
 
 def preview_png(dxf_path: str | os.PathLike, png_path: str | os.PathLike, dpi: int = 100) -> None:

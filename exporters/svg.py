@@ -1,24 +1,32 @@
-"""SVG in millimetres with the same geometry as the DXF, for cutters whose software takes no DXF.
+"""SVG in millimetres with the same geometry as the DXF, and the assembly drawing.
 
-One ``<g>`` per layer (``CUT_INNER`` blue, ``CUT_OUTER`` red, ``ENGRAVE``
-green, ``SHEET`` grey), strokes only.  Arcs are SVG elliptical-arc commands
-(circles), holes are ``<circle>``.  The drawing's y axis points up like the
-DXF's; SVG's points down, so y is flipped once here.  Reproducible: no ids
-or timestamps, fixed number formatting.
+Cut files (:func:`svg_text`, one per sheet): the document is the sheet
+(``width``/``height`` in mm, no outline drawn), one ``<g>`` per layer —
+``CUT_INNER`` and ``CUT_OUTER`` stroked in the cut colour (red by default),
+``ENGRAVE`` in the engrave colour (blue), the colours laser software such as
+LightBurn, xTool Creative Space or Glowforge maps to operations — strokes only,
+hairline width (``svg_stroke_mm``, 0.025 mm = 0.001 in by default).  Arcs are
+SVG elliptical-arc commands, holes ``<circle>``; engraving is open paths (a
+stroke font, not text).  The drawing's y axis points up like the DXF's; SVG's
+points down, so y is flipped once here.  Reproducible: no ids beyond the layer
+names, no timestamps, fixed number formatting.
+
+Assembly drawing (:func:`assembly_svg_text`): every part in place at the first
+valid pose, filled by layer (bottom first), pins lettered, and a legend of the
+layers from the bottom up and of the pins with their lengths and spacers.
 """
 
 from __future__ import annotations
 
 import math
 import os
+from typing import Any
 from xml.sax.saxutils import escape
 
-from planar.fabrication import SHEET_GAP, Circle, Contour, Layout
+from planar.fabrication import Circle, Contour, Layout
 from planar.fileio import atomic_write
 
-__all__ = ["write_svg", "svg_text"]
-
-COLOURS = {"CUT_INNER": "#0000ff", "CUT_OUTER": "#ff0000", "ENGRAVE": "#00a000", "SHEET": "#999999"}
+__all__ = ["assembly_svg_text", "svg_text", "write_svg"]
 
 
 def _f(v: float) -> str:
@@ -26,63 +34,167 @@ def _f(v: float) -> str:
     return "0" if s in ("-0", "") else s
 
 
-def svg_text(layout: Layout) -> str:
+def _path(c: Contour, y) -> str:
+    v = c.vertices
+    parts = [f"M {_f(v[0][0])} {_f(y(v[0][1]))}"]
+    for k in range(len(v)):
+        x0, y0, b = v[k]
+        x1, y1, _ = v[(k + 1) % len(v)]
+        if abs(b) < 1e-15:
+            parts.append(f"L {_f(x1)} {_f(y(y1))}")
+        else:
+            theta = 4 * math.atan(b)
+            chord = math.hypot(x1 - x0, y1 - y0)
+            r = chord / (2 * math.sin(abs(theta) / 2))
+            large = 1 if abs(theta) > math.pi else 0
+            # counter-clockwise with y up (b > 0) is counter-clockwise on screen too, which in SVG's
+            # y-down frame is the negative-angle direction: sweep-flag 0
+            sweep = 0 if b > 0 else 1
+            parts.append(f"A {_f(r)} {_f(r)} 0 {large} {sweep} {_f(x1)} {_f(y(y1))}")
+    parts.append("Z")
+    return " ".join(parts)
+
+
+def _element(c, y) -> str:
+    if isinstance(c, Circle):
+        return f'<circle cx="{_f(c.centre[0])}" cy="{_f(y(c.centre[1]))}" r="{_f(c.radius)}"/>'
+    return f'<path d="{_path(c, y)}"/>'
+
+
+def svg_text(layout: Layout, sheet: int = 0, settings: Any = None) -> str:
+    """One sheet of the layout as an SVG document."""
     W, H = layout.sheet_size
-    total_w = layout.sheets * W + (layout.sheets - 1) * SHEET_GAP
+    cut = getattr(settings, "cut_colour", "#ff0000")
+    eng = getattr(settings, "engrave_colour", "#0000ff")
+    stroke = getattr(settings, "svg_stroke_mm", 0.025)
 
     def y(v: float) -> float:
         return H - v
 
-    def path(c: Contour) -> str:
-        v = c.vertices
-        parts = [f"M {_f(v[0][0])} {_f(y(v[0][1]))}"]
-        for k in range(len(v)):
-            x0, y0, b = v[k]
-            x1, y1, _ = v[(k + 1) % len(v)]
-            if abs(b) < 1e-15:
-                parts.append(f"L {_f(x1)} {_f(y(y1))}")
-            else:
-                theta = 4 * math.atan(b)
-                chord = math.hypot(x1 - x0, y1 - y0)
-                r = chord / (2 * math.sin(abs(theta) / 2))
-                large = 1 if abs(theta) > math.pi else 0
-                # counter-clockwise with y up (b > 0) is counter-clockwise on screen too, which in SVG's
-                # y-down frame is the negative-angle direction: sweep-flag 0
-                sweep = 0 if b > 0 else 1
-                parts.append(f"A {_f(r)} {_f(r)} 0 {large} {sweep} {_f(x1)} {_f(y(y1))}")
-        parts.append("Z")
-        return " ".join(parts)
-
-    def element(c) -> str:
-        if isinstance(c, Circle):
-            return f'<circle cx="{_f(c.centre[0])}" cy="{_f(y(c.centre[1]))}" r="{_f(c.radius)}"/>'
-        return f'<path d="{path(c)}"/>'
-
-    layers: dict[str, list[str]] = {k: [] for k in COLOURS}
-    for k in range(layout.sheets):
-        x0, y0 = layout.sheet_origin(k)
-        layers["SHEET"].append(f'<rect x="{_f(x0)}" y="{_f(y(y0 + H))}" width="{_f(W)}" height="{_f(H)}"/>')
-    for p in layout.parts:
+    layers: dict[str, list[str]] = {"CUT_INNER": [], "CUT_OUTER": [], "ENGRAVE": []}
+    for p in layout.on_sheet(sheet):
         for c in p.inner:
-            layers["CUT_INNER"].append(element(c))
-        layers["CUT_OUTER"].append(element(p.outer))
-        lx, ly = p.label_at
-        layers["ENGRAVE"].append(
-            f'<text x="{_f(lx)}" y="{_f(y(ly))}" font-size="{_f(p.label_height)}" text-anchor="middle" '
-            f'dominant-baseline="middle" stroke="none" fill="{COLOURS["ENGRAVE"]}">{escape(p.name)}</text>')
+            layers["CUT_INNER"].append(_element(c, y))
+        layers["CUT_OUTER"].append(_element(p.outer, y))
+        for st in p.engrave:
+            d = " ".join(("M" if i == 0 else "L") + f" {_f(float(a))} {_f(y(float(b)))}" for i, (a, b) in enumerate(st))
+            layers["ENGRAVE"].append(f'<path d="{d}"/>')
     out = ['<?xml version="1.0" encoding="UTF-8"?>',
-           f'<svg xmlns="http://www.w3.org/2000/svg" width="{_f(total_w)}mm" height="{_f(H)}mm" '
-           f'viewBox="0 0 {_f(total_w)} {_f(H)}">']
-    for name in ("SHEET", "CUT_INNER", "CUT_OUTER", "ENGRAVE"):
-        out.append(f'<g id="{name}" fill="none" stroke="{COLOURS[name]}" stroke-width="0.1">')
+           f'<svg xmlns="http://www.w3.org/2000/svg" width="{_f(W)}mm" height="{_f(H)}mm" '
+           f'viewBox="0 0 {_f(W)} {_f(H)}">']
+    colour = {"CUT_INNER": cut, "CUT_OUTER": cut, "ENGRAVE": eng}
+    for name in ("CUT_INNER", "CUT_OUTER", "ENGRAVE"):
+        out.append(f'<g id="{name}" fill="none" stroke="{colour[name]}" stroke-width="{_f(stroke)}" '
+                   f'stroke-linecap="round" stroke-linejoin="round">')
         out.extend("  " + e for e in layers[name])
         out.append("</g>")
     out.append("</svg>")
     return "\n".join(out) + "\n"
 
 
-def write_svg(path: str | os.PathLike, layout: Layout) -> None:
-    """Write the layout as SVG (atomically)."""
-    text = svg_text(layout)
+def write_svg(path: str | os.PathLike, layout: Layout, sheet: int = 0, settings: Any = None) -> None:
+    """Write one sheet of the layout as SVG (atomically)."""
+    text = svg_text(layout, sheet, settings)
     with atomic_write(path, "w") as fh:
         fh.write(text)
+
+
+#: fill colours of layers 0, 1, ... (bottom up)
+LAYER_FILLS = ("#c8a064", "#6aa0d8", "#e07a5f", "#81b29a", "#f2cc8f", "#9c89b8", "#5fa8d3", "#d4a5a5")
+
+
+def assembly_svg_text(fab: Any) -> str:
+    """The assembly drawing of a :class:`planar.fabexport.Fabrication` (see the module docstring)."""
+    from shapely import affinity
+
+    asm = fab.assembly
+    shapes = []
+    for name, layer in asm.layers.items():
+        if layer is None or name not in fab.own:
+            continue
+        x, y, a = asm.pose[name]
+        poly = fab.own[name]
+        c, s = math.cos(a), math.sin(a)
+        shapes.append((layer, name, affinity.affine_transform(poly, [c, -s, s, c, x, y]).simplify(0.01)))
+    shapes.sort(key=lambda t: (t[0], list(asm.layers).index(t[1])))
+    pts = []
+    for *_, g in shapes:
+        b = g.bounds
+        pts += [(b[0], b[1]), (b[2], b[3])]
+    for pp in asm.pins:
+        pts.append(_pin_xy(asm, pp))
+    if not pts:
+        pts = [(0.0, 0.0), (10.0, 10.0)]
+    x0 = min(p[0] for p in pts) - 10
+    y0 = min(p[1] for p in pts) - 10
+    x1 = max(p[0] for p in pts) + 10
+    y1 = max(p[1] for p in pts) + 10
+    legend = _legend(fab)
+    fs = max(2.5, 0.025 * max(x1 - x0, y1 - y0))
+    lw = fs * 0.6 * max(len(t) for t in legend) + 10
+    W = (x1 - x0) + lw
+    H = max(y1 - y0, fs * 1.5 * (len(legend) + 1))
+
+    def X(v: float) -> float:
+        return v - x0
+
+    def Y(v: float) -> float:
+        return y1 - v
+
+    out = ['<?xml version="1.0" encoding="UTF-8"?>',
+           f'<svg xmlns="http://www.w3.org/2000/svg" width="{_f(W)}mm" height="{_f(H)}mm" viewBox="0 0 {_f(W)} {_f(H)}" '
+           f'font-family="sans-serif">',
+           f'<rect x="0" y="0" width="{_f(W)}" height="{_f(H)}" fill="#ffffff"/>']
+    for layer, name, g in shapes:
+        geoms = getattr(g, "geoms", [g])
+        d = []
+        for poly in geoms:
+            for ring in [poly.exterior, *poly.interiors]:
+                xy = list(ring.coords)
+                d.append("M " + " L ".join(f"{X(a):.3f} {Y(b):.3f}" for a, b in xy) + " Z")
+        out.append(f'<path d="{" ".join(d)}" fill="{LAYER_FILLS[layer % len(LAYER_FILLS)]}" fill-opacity="0.75" '
+                   f'fill-rule="evenodd" stroke="#333333" stroke-width="{_f(fs * 0.08)}"><title>{escape(name)} '
+                   f'(layer {layer + 1})</title></path>')
+    for pp in asm.pins:
+        px, py = _pin_xy(asm, pp)
+        out.append(f'<circle cx="{_f(X(px))}" cy="{_f(Y(py))}" r="{_f(fs * 0.7)}" fill="#ffffff" stroke="#000000" '
+                   f'stroke-width="{_f(fs * 0.06)}"/>')
+        out.append(f'<text x="{_f(X(px))}" y="{_f(Y(py) + fs * 0.35)}" font-size="{_f(fs)}" text-anchor="middle">'
+                   f'{escape(pp.letter)}</text>')
+    lx = x1 - x0 + 5
+    for i, t in enumerate(legend):
+        out.append(f'<text x="{_f(lx)}" y="{_f(fs * 1.5 * (i + 1))}" font-size="{_f(fs)}">{escape(t)}</text>')
+    out.append("</svg>")
+    return "\n".join(out) + "\n"
+
+
+def _pin_xy(asm, pp) -> tuple[float, float]:
+    a = pp.spec.parts[0]
+    x, y, ang = asm.pose[a]
+    u = asm.unit_mm
+    lx, ly = pp.spec.at[0][0] * u, pp.spec.at[0][1] * u
+    c, s = math.cos(ang), math.sin(ang)
+    return (x + c * lx - s * ly, y + s * lx + c * ly)
+
+
+def _legend(fab: Any) -> list[str]:
+    asm = fab.assembly
+    t = fab.settings.thickness_mm
+    lines = [f"{fab.name}: layers from the bottom, {t:g} mm each"]
+    by_plane: dict[str, list[str]] = {}
+    for name, layer in asm.layers.items():
+        if layer is not None:
+            by_plane.setdefault(asm.plane.get(name, "xy"), []).append(name)
+    for pl in sorted(by_plane, key=lambda v: (v != "xy", v)):
+        names = by_plane[pl]
+        if pl != "xy":
+            lines.append(f"standing in the {pl} plane:")
+        for k in range(max(asm.layers[n] for n in names) + 1):  # type: ignore[type-var]
+            lines.append(f"  layer {k + 1}: " + ", ".join(n for n in names if asm.layers[n] == k))
+    for pp in asm.pins:
+        lo, hi = pp.layers or (0, 0)
+        what = "motor shaft" if pp.shaft else f"pin d{pp.diameter_mm:g} x {pp.length_mm:g} mm"
+        sp = f", {pp.spacers} spacer(s)" if pp.spacers else ""
+        joins = " + ".join(pp.parts)
+        lines.append(f"{pp.letter}: {what}, {joins}, layers {lo + 1}-{hi + 1}{sp}")
+    return lines

@@ -142,19 +142,19 @@ def _sheet(text: str) -> tuple[float, float]:
 
 def _cmd_export(args: argparse.Namespace) -> int:
     from .errors import InputError
+    from .fabexport import summary
     from .pipeline import export_scene
     from .scene import load_scene
 
     if args.kerf is not None and not (0 <= args.kerf <= 2):
         raise InputError("--kerf", args.kerf, "a kerf between 0 and 2 mm")
-    if args.preview and not args.output:
-        raise InputError("--preview", args.preview, "a DXF output (-o) to preview")
     scene = load_scene(args.scene)
     sheet = _sheet(args.sheet) if args.sheet else None
-    layout = export_scene(scene, args.output, args.svg, args.kerf, sheet, args.preview)
-    outs = [p for p in (args.output, args.svg, args.preview) if p]
-    print(f"{len(layout.parts)} parts on {layout.sheets} sheet(s) of {layout.sheet_size[0]:g} x "
-          f"{layout.sheet_size[1]:g} mm, kerf {layout.kerf:g} mm -> {', '.join(outs)}")
+    fab = export_scene(scene, args.output, args.svg, args.kerf, sheet, args.preview, args.bom, args.assembly,
+                       args.kerf_test)
+    for note in fab.notes:
+        print(f"note: {note}")
+    print(f"{summary(fab)} -> {', '.join(map(str, fab.written)) or 'nothing written'}")
     return 0
 
 
@@ -221,7 +221,10 @@ def build_parser() -> argparse.ArgumentParser:
     ex.add_argument("--svg", default=None, help="SVG file to write")
     ex.add_argument("--kerf", type=float, default=None, help="beam width in mm (default: the scene's kerf_mm)")
     ex.add_argument("--sheet", default=None, help="sheet size WIDTHxHEIGHT in mm (default: the scene's)")
-    ex.add_argument("--preview", default=None, help="PNG preview of the DXF (ezdxf's drawing add-on)")
+    ex.add_argument("--preview", default=None, help="PNG preview of each sheet (photo-like)")
+    ex.add_argument("--bom", default=None, help="bill of materials (CSV): parts, layers, pins, spacers")
+    ex.add_argument("--assembly", default=None, help="assembly drawing (SVG): parts in place, layers, letters")
+    ex.add_argument("--kerf-test", default=None, help="a kerf calibration piece (.dxf or .svg)")
     ex.set_defaults(func=_cmd_export)
 
     c = sub.add_parser("catalog", help="write the motion table of a built-in mechanism")

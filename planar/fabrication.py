@@ -8,39 +8,39 @@ straight segment, positive counter-clockwise).  Round holes are circles.
 * Outer profile: the convex hull of the part's hull circles (the paper's
   "convex hull around the joints, rounded"): arcs on the circles joined by
   their outer common tangents, computed exactly.
-* Holes: pivot holes are the scene's pin diameter plus a running clearance;
-  holes the mechanism sizes itself (axles, cams in round holes) keep their
-  size, plus the clearance.  Slots are stadiums (straight) or arc slots of the
-  pin's width plus clearance.
+* Inner cuts: holes, straight slots (stadiums), arc slots and D-shaped
+  shaft holes; which size each gets, and the checks, are in
+  :mod:`planar.fabparts`.
 * Kerf: the beam removes ``kerf / 2`` on each side of its path, so outer
   contours are offset outward by ``kerf / 2`` (hull circles grow: the offset
   of a hull of circles is exact) and holes and slots inward by ``kerf / 2``;
   the cut parts come out at nominal size.
-* Layout: parts are placed apart on sheets of the given size by shelf
-  packing (each turned by 0 or 90 degrees, whichever is lower), several sheets
-  when needed; a part larger than a sheet is an error naming it.
+* Nesting: :mod:`planar.nesting`; assembly: :mod:`planar.assembly`.
 
-Coordinates: millimetres, x right, y up, sheet ``k`` offset along x by
-``k * (sheet width + SHEET_GAP)``.
+Coordinates: millimetres, x right, y up.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from typing import Sequence
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .errors import InputError
-from .model import ArcSlot, Hole, Mechanism, Part, Slot
+__all__ = [
+    "Circle",
+    "Contour",
+    "Layout",
+    "PartCut",
+    "arc_slot",
+    "bulge_points",
+    "cut_polygon",
+    "d_hole",
+    "hull_of_circles",
+    "stadium",
+]
 
-__all__ = ["Contour", "Circle", "PartCut", "Layout", "hull_of_circles", "part_cuts", "layout_parts",
-           "SHEET_GAP", "bulge_points"]
-
-SHEET_GAP = 20.0  # mm between sheets in one drawing
-MARGIN = 5.0  # mm from the sheet's edge
-SPACING = 4.0  # mm between parts
 EPS = 1e-9
 
 
@@ -50,7 +50,7 @@ class Contour:
 
     vertices: list[tuple[float, float, float]]
 
-    def transformed(self, angle: float, dx: float, dy: float) -> "Contour":
+    def transformed(self, angle: float, dx: float, dy: float) -> Contour:
         c, s = math.cos(angle), math.sin(angle)
         return Contour([(c * x - s * y + dx, s * x + c * y + dy, b) for x, y, b in self.vertices])
 
@@ -60,7 +60,7 @@ class Circle:
     centre: tuple[float, float]
     radius: float
 
-    def transformed(self, angle: float, dx: float, dy: float) -> "Circle":
+    def transformed(self, angle: float, dx: float, dy: float) -> Circle:
         c, s = math.cos(angle), math.sin(angle)
         x, y = self.centre
         return Circle((c * x - s * y + dx, s * x + c * y + dy), self.radius)
@@ -71,36 +71,64 @@ Cut = Contour | Circle
 
 @dataclass
 class PartCut:
-    """One part ready to cut: outer profile, inner cuts, label; in its own frame until laid out."""
+    """One part ready to cut: outer profile, inner cuts, engraving; in its own frame until laid out.
+
+    ``engrave`` holds open polylines ``(n, 2)`` (mm): the label and hole
+    letters in a single-line stroke font.  ``sheet`` is the sheet index after
+    nesting; coordinates are then relative to that sheet's lower-left corner.
+    """
 
     name: str
     outer: Cut
     inner: list[Cut]
-    label_at: tuple[float, float]
-    label_height: float
+    engrave: list[np.ndarray] = field(default_factory=list)
+    label: str = ""
+    label_height: float = 0.0
     sheet: int = 0
-    #: nominal (zero-kerf) hole centres and radii, and which feature each inner cut comes from
+    #: nominal (zero-kerf) hole centres and radii
     nominal_holes: list[tuple[tuple[float, float], float]] = field(default_factory=list)
+    #: what the checks changed or found (widened, label shortened, ...), one line each
+    notes: list[str] = field(default_factory=list)
+    #: assembly layer (0 = bottom) or None for a part standing in another plane
+    layer: int | None = None
 
-    def transformed(self, angle: float, dx: float, dy: float) -> "PartCut":
+    def transformed(self, angle: float, dx: float, dy: float) -> PartCut:
         c, s = math.cos(angle), math.sin(angle)
-        lx, ly = self.label_at
-        return PartCut(self.name, self.outer.transformed(angle, dx, dy),
-                       [k.transformed(angle, dx, dy) for k in self.inner],
-                       (c * lx - s * ly + dx, s * lx + c * ly + dy), self.label_height, self.sheet,
-                       [((c * x - s * y + dx, s * x + c * y + dy), r) for (x, y), r in self.nominal_holes])
+        rot = np.array([[c, -s], [s, c]])
+        return replace(self, outer=self.outer.transformed(angle, dx, dy),
+                       inner=[k.transformed(angle, dx, dy) for k in self.inner],
+                       engrave=[np.asarray(e) @ rot.T + (dx, dy) for e in self.engrave],
+                       nominal_holes=[((c * x - s * y + dx, s * x + c * y + dy), r) for (x, y), r in self.nominal_holes],
+                       notes=list(self.notes))
 
 
 @dataclass
 class Layout:
+    """Parts nested on ``sheets`` sheets of ``sheet_size`` mm; each part's coordinates are on its own sheet."""
+
     parts: list[PartCut]
     sheets: int
     sheet_size: tuple[float, float]
     kerf: float
     unit_mm: float
+    #: fraction of each sheet's area covered by parts (outer contours)
+    utilisation: list[float] = field(default_factory=list)
 
     def sheet_origin(self, k: int) -> tuple[float, float]:
-        return (k * (self.sheet_size[0] + SHEET_GAP), 0.0)
+        """Every sheet is written in its own file with its corner at the origin."""
+        return (0.0, 0.0)
+
+    def on_sheet(self, k: int) -> list[PartCut]:
+        return [p for p in self.parts if p.sheet == k]
+
+
+def cut_polygon(cut: Cut, seg_angle: float = math.radians(1.0)):
+    """A cut as a shapely polygon (arcs sampled every ``seg_angle``)."""
+    from shapely.geometry import Point, Polygon
+
+    if isinstance(cut, Circle):
+        return Point(cut.centre).buffer(cut.radius, quad_segs=max(8, int(round(math.pi / 2 / seg_angle))))
+    return Polygon(bulge_points(cut, seg_angle))
 
 
 # --------------------------------------------------------------------------- geometry
@@ -231,7 +259,7 @@ def bulge_points(contour: Contour, seg_angle: float = math.radians(2.0)) -> np.n
     return np.asarray(out)
 
 
-def _stadium(p0, p1, h: float) -> Cut:
+def stadium(p0, p1, h: float) -> Cut:
     p0, p1 = np.asarray(p0, float), np.asarray(p1, float)
     d = p1 - p0
     L = float(np.hypot(*d))
@@ -244,7 +272,7 @@ def _stadium(p0, p1, h: float) -> Cut:
     return Contour([(a[0], a[1], 0.0), (b[0], b[1], 1.0), (c[0], c[1], 0.0), (dd[0], dd[1], 1.0)])
 
 
-def _arc_slot(centre, R: float, a0: float, a1: float, h: float) -> Cut:
+def arc_slot(centre, R: float, a0: float, a1: float, h: float) -> Cut:
     cx, cy = centre
     sweep = a1 - a0
     bo = math.tan(sweep / 4)
@@ -257,105 +285,16 @@ def _arc_slot(centre, R: float, a0: float, a1: float, h: float) -> Cut:
     return Contour([(o0[0], o0[1], bo), (o1[0], o1[1], 1.0), (i1[0], i1[1], -bo), (i0[0], i0[1], 1.0)])
 
 
-def _label_point(part: Part, u: float) -> tuple[tuple[float, float], float]:
-    from shapely.geometry import Point
-    from shapely.ops import polylabel
+def d_hole(centre, r: float, flat: float, angle: float) -> Contour:
+    """A D-shaped hole: the disc of radius ``r`` cut by the line ``flat`` from the centre along ``angle``.
 
-    poly = part.outline
-    p = polylabel(poly, tolerance=1e-3 * max(poly.length, 1e-9))
-    if not poly.contains(p):
-        p = poly.representative_point()
-    room = poly.exterior.distance(Point(p))
-    for hole in poly.interiors:
-        room = min(room, hole.distance(Point(p)))
-    # the name must fit across the room too: a character is about 0.6 of the height wide
-    n = max(1, len(part.name))
-    height = float(min(5.0, 0.8 * room * u, 2 * 0.8 * room * u / (0.6 * n)))
-    return (float(p.x * u), float(p.y * u)), max(height, 0.5)
-
-
-def part_cuts(part: Part, unit_mm: float, kerf: float, pin_mm: float, clearance: float) -> PartCut:
-    """A part's cuts in millimetres in its own frame (kerf applied)."""
-    u = unit_mm
-    k2 = kerf / 2.0
-    if part.polygon is not None:
-        from shapely.geometry import Polygon
-
-        grown = Polygon([(x * u, y * u) for x, y in part.polygon]).buffer(k2, join_style="mitre")
-        outer: Cut = Contour([(float(x), float(y), 0.0) for x, y in list(grown.exterior.coords)[:-1]])
-    else:
-        outer = hull_of_circles([(x * u, y * u, r * u + k2) for x, y, r in part.hull])
-    inner: list[Cut] = []
-    nominal = []
-    for f in part.features:
-        if isinstance(f, Hole):
-            d = (pin_mm if f.role == "pin" else f.diameter * u) + clearance
-            r = d / 2 - k2
-            if r <= 0:
-                raise InputError(f"{part.name}.hole", d, f"a hole larger than the kerf {kerf:g} mm")
-            c = (f.centre[0] * u, f.centre[1] * u)
-            inner.append(Circle(c, r))
-            nominal.append((c, d / 2))
-        elif isinstance(f, Slot):
-            w = (pin_mm if f.role == "pin" else f.width * u) + clearance
-            h = w / 2 - k2
-            if h <= 0:
-                raise InputError(f"{part.name}.slot", w, f"a slot wider than the kerf {kerf:g} mm")
-            inner.append(_stadium((f.start[0] * u, f.start[1] * u), (f.end[0] * u, f.end[1] * u), h))
-        elif isinstance(f, ArcSlot):
-            w = (pin_mm if f.role == "pin" else f.width * u) + clearance
-            h = w / 2 - k2
-            inner.append(_arc_slot((f.centre[0] * u, f.centre[1] * u), f.radius * u, f.angle0, f.angle1, h))
-    at, height = _label_point(part, u)
-    return PartCut(part.name, outer, inner, at, height, nominal_holes=nominal)
-
-
-def _bbox(pc: PartCut) -> tuple[float, float, float, float]:
-    pts = bulge_points(pc.outer) if isinstance(pc.outer, Contour) else None
-    if pts is None:
-        (x, y), r = pc.outer.centre, pc.outer.radius
-        return x - r, y - r, x + r, y + r
-    return float(pts[:, 0].min()), float(pts[:, 1].min()), float(pts[:, 0].max()), float(pts[:, 1].max())
-
-
-def layout_parts(mech: Mechanism, unit_mm: float = 10.0, kerf: float = 0.0, pin_mm: float = 3.0,
-                 clearance: float = 0.1, sheet: tuple[float, float] = (300.0, 200.0)) -> Layout:
-    """Every part of ``mech``, cut-ready, placed apart on as many sheets as needed."""
-    W, H = sheet
-    if not (W > 2 * MARGIN and H > 2 * MARGIN):
-        raise InputError("sheet", sheet, f"a sheet larger than {2 * MARGIN:g} x {2 * MARGIN:g} mm")
-    if kerf < 0:
-        raise InputError("kerf", kerf, "a kerf >= 0 mm")
-    cuts = []
-    for p in mech.parts:
-        pc = part_cuts(p, unit_mm, kerf, pin_mm, clearance)
-        x0, y0, x1, y1 = _bbox(pc)
-        w, h = x1 - x0, y1 - y0
-        # lie flat: turn a quarter when that makes the part lower (shelves are filled left to right)
-        if h > w and h > H - 2 * MARGIN or (w > W - 2 * MARGIN and h <= W - 2 * MARGIN):
-            pc = pc.transformed(math.pi / 2, 0.0, 0.0)
-            x0, y0, x1, y1 = _bbox(pc)
-            w, h = x1 - x0, y1 - y0
-        if w > W - 2 * MARGIN or h > H - 2 * MARGIN:
-            raise InputError(f"part {p.name!r}", f"{w:.1f} x {h:.1f} mm",
-                             f"a part that fits the {W:g} x {H:g} mm sheet inside {MARGIN:g} mm margins "
-                             "(use a larger --sheet or a smaller unit_mm)")
-        cuts.append((pc, (x0, y0, w, h)))
-    # shelf packing, tallest first (stable: ties keep the mechanism's order)
-    order = sorted(range(len(cuts)), key=lambda i: -cuts[i][1][3])
-    placed: list[PartCut] = []
-    sheet_k, x, y, shelf_h = 0, MARGIN, MARGIN, 0.0
-    for i in order:
-        pc, (x0, y0, w, h) = cuts[i]
-        if x + w > W - MARGIN:  # next shelf
-            x, y, shelf_h = MARGIN, y + shelf_h + SPACING, 0.0
-        if y + h > H - MARGIN:  # next sheet
-            sheet_k, x, y, shelf_h = sheet_k + 1, MARGIN, MARGIN, 0.0
-        ox = sheet_k * (W + SHEET_GAP)
-        moved = pc.transformed(0.0, ox + x - x0, y - y0)
-        moved.sheet = sheet_k
-        placed.append(moved)
-        x += w + SPACING
-        shelf_h = max(shelf_h, h)
-    placed.sort(key=lambda p: [q.name for q in mech.parts].index(p.name))
-    return Layout(placed, sheet_k + 1, (W, H), kerf, unit_mm)
+    Counter-clockwise: the long arc from one end of the flat to the other, then the flat.
+    """
+    if not 0 < flat < r:
+        raise ValueError("flat must lie inside the circle")
+    cx, cy = centre
+    alpha = math.acos(flat / r)
+    p1 = (cx + r * math.cos(angle + alpha), cy + r * math.sin(angle + alpha))
+    p2 = (cx + r * math.cos(angle - alpha), cy + r * math.sin(angle - alpha))
+    sweep = 2 * math.pi - 2 * alpha
+    return Contour([(p1[0], p1[1], math.tan(sweep / 4)), (p2[0], p2[1], 0.0)])

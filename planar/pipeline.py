@@ -17,7 +17,7 @@ from .errors import InputError, PlanarError
 
 if TYPE_CHECKING:
     from .compare import Comparison
-    from .fabrication import Layout
+    from .fabexport import Fabrication
     from .model import Motion
     from .render import Style
     from .scene import Scene
@@ -134,30 +134,20 @@ def write_catalog_motion(name: str, out: str | Path, samples: int = 360) -> Moti
 
 def export_scene(scene: Scene, dxf: str | Path | None = None, svg: str | Path | None = None,
                  kerf: float | None = None, sheet: tuple[float, float] | None = None,
-                 preview: str | Path | None = None) -> Layout:
-    """Lay a scene's parts on sheets and write DXF and/or SVG (and a PNG preview of the DXF).
+                 preview: str | Path | None = None, bom: str | Path | None = None,
+                 assembly: str | Path | None = None, kerf_test: str | Path | None = None) -> "Fabrication":
+    """Check, layer and nest a scene's parts and write the requested files (see :mod:`planar.fabexport`).
 
     ``kerf`` (mm) and ``sheet`` (width, height in mm) default to the scene's
-    ``[fabrication]`` table.
+    ``[fabrication]`` table.  Every file is written to a temporary and
+    renamed only when all succeeded.
     """
-    from .fabrication import layout_parts
+    from .fabexport import build, write_outputs
+    from .fabparts import FabSettings
 
-    fab = scene.spec.fabrication
-    layout = layout_parts(scene.mechanism, unit_mm=fab.unit_mm, kerf=fab.kerf_mm if kerf is None else kerf,
-                          pin_mm=fab.pin_diameter_mm, clearance=fab.clearance_mm, sheet=sheet or fab.sheet_mm)
-    if dxf is not None:
-        from exporters.dxf import write_dxf
-
-        write_dxf(dxf, layout)
-        if preview is not None:
-            from exporters.dxf import preview_png
-
-            preview_png(dxf, preview)
-    if svg is not None:
-        from exporters.svg import write_svg
-
-        write_svg(svg, layout)
-    return layout
+    fab = build(scene, FabSettings.from_spec(scene.spec.fabrication, kerf, sheet))
+    fab.written = write_outputs(fab, dxf, svg, preview, bom, assembly, kerf_test)
+    return fab
 
 
 # --------------------------------------------------------------------------- physics comparison
@@ -273,8 +263,8 @@ def run_demo(output: str | Path) -> Iterator[str]:
             tau, _ = analysis.motor_torque(scene.mechanism, motion.driver, loads)
             line += f"; peak motor torque {np.abs(tau).max():.3f} (force x unit) for a 10 N foot push"
         dxf = out / f"{name}.dxf"
-        layout = export_scene(scene, dxf=dxf)
-        line += f"; {len(layout.parts)} parts -> {dxf}"
+        fab = export_scene(scene, dxf=dxf)
+        line += f"; {len(fab.layout.parts)} parts -> {', '.join(map(str, fab.written))}"
         yield line
         for extra in DEMO_EXTRAS:
             extra(scene, out)

@@ -234,6 +234,28 @@ class FabricationSpec(_Strict):
     pin_diameter_mm: Pos = 3.0
     clearance_mm: Annotated[float, Field(ge=0, le=2)] = 0.1
     sheet_mm: tuple[Pos, Pos] = (300.0, 200.0)
+    # manufacturability (planar.fabparts): thinnest material between a cut and the outline, smallest part,
+    # smallest engraved text, clearance past each end of a pin's travel in its slot; narrow parts are
+    # widened (widen = true) or refused
+    min_wall_mm: Pos = 1.5
+    min_part_mm: Pos = 5.0
+    min_label_mm: Pos = 1.5
+    slot_end_margin_mm: Annotated[float, Field(ge=0, le=50)] = 1.0
+    widen: bool = True
+    # assembly: pin head allowance per end; drive: D-shaft (diameter, distance across the flat), motor
+    # screws either side of the shaft, ground-plate mounting holes
+    pin_head_mm: Annotated[float, Field(ge=0, le=50)] = 1.5
+    shaft_diameter_mm: Pos = 3.0
+    shaft_flat_mm: Pos = 2.5
+    motor_screw_mm: Pos = 1.7
+    motor_screw_spacing_mm: Pos = 9.0
+    mounting_hole_mm: Pos = 3.2
+    # nesting and file conventions
+    spacing_mm: Annotated[float, Field(ge=0, le=100)] = 3.0
+    margin_mm: Annotated[float, Field(ge=0, le=100)] = 5.0
+    svg_stroke_mm: Pos = 0.025
+    cut_colour: Annotated[str, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#ff0000"
+    engrave_colour: Annotated[str, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#0000ff"
 
 
 class SceneSpec(_Strict):

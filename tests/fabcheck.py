@@ -15,16 +15,35 @@ CUT_LAYERS = ("CUT_INNER", "CUT_OUTER")
 def dxf_cut_polygons(path, layers=CUT_LAYERS) -> list[Polygon]:
     """Every closed cut contour of a DXF as a shapely polygon (ezdxf flattening, 1e-4 mm)."""
     import ezdxf
-    from ezdxf import path as ezpath
 
     doc = ezdxf.readfile(path)
     out = []
     for e in doc.modelspace():
         if e.dxf.layer not in layers or e.dxftype() not in ("CIRCLE", "LWPOLYLINE"):
             continue
-        pts = [(v.x, v.y) for v in ezpath.make_path(e).flattening(distance=1e-4)]
-        out.append(Polygon(pts))
+        out.append(_valid(Polygon(_dxf_points(e))))
     return out
+
+
+def _dxf_points(e) -> list[tuple[float, float]]:
+    """Points on a CIRCLE or closed LWPOLYLINE, exact on its arcs (ezdxf's ARC/CIRCLE flattening, 1e-5 mm).
+
+    (ezdxf's path module would first turn arcs into Bezier curves, a few micrometres off a circle.)
+    """
+    if e.dxftype() == "CIRCLE":
+        return [(v.x, v.y) for v in e.flattening(1e-5)]
+    x0, y0, *_ = e.get_points("xy")[0]
+    pts: list[tuple[float, float]] = []
+    for ve in e.virtual_entities():
+        if ve.dxftype() == "LINE":
+            seg = [(ve.dxf.start.x, ve.dxf.start.y), (ve.dxf.end.x, ve.dxf.end.y)]
+        else:  # ARC, always counter-clockwise in DXF: reverse when the polyline runs clockwise
+            seg = [(v.x, v.y) for v in ve.flattening(1e-5)]
+        here = pts[-1] if pts else (x0, y0)
+        if np.hypot(*np.subtract(seg[-1], here)) < np.hypot(*np.subtract(seg[0], here)):
+            seg = seg[::-1]
+        pts.extend(seg[:-1])
+    return pts
 
 
 def svg_closed_polygons(path) -> list[Polygon]:
@@ -46,12 +65,21 @@ def svg_closed_polygons(path) -> list[Polygon]:
         for s in segs:
             if isinstance(s, Move):
                 continue
-            n = 2000 if isinstance(s, Arc) else 2
+            n = 400 if isinstance(s, Arc) else 2
             pts.extend(s.npoint(np.linspace(0.0, 1.0, n))[:-1].tolist())
         xy = np.asarray(pts, float) / scale
         xy[:, 1] = H - xy[:, 1]
-        out.append(Polygon(xy))
+        out.append(_valid(Polygon(xy)))
     return out
+
+
+def _valid(p: Polygon) -> Polygon:
+    """Round-off at a tangent join (1e-14 mm) can make GEOS see a self-touch; buffer(0) mends only that."""
+    if p.is_valid:
+        return p
+    q = p.buffer(0)
+    assert abs(q.area - p.area) <= 1e-9 * max(p.area, 1.0), "a contour that really crosses itself"
+    return q
 
 
 def match_contours(a: list[Polygon], b: list[Polygon]) -> list[float]:

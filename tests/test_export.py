@@ -4,7 +4,6 @@ import hashlib
 import math
 import subprocess
 import sys
-import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import ezdxf
@@ -16,11 +15,14 @@ from hypothesis import strategies as st
 from shapely.geometry import Point, Polygon
 
 from planar.catalog import CATALOG
+from fabcheck import dxf_cut_polygons, match_contours, svg_closed_polygons
 from planar.cli import main
+from planar.fabexport import build
+from planar.fabparts import FabSettings, part_cuts
+from planar.fabrication import Circle, Contour, bulge_points, hull_of_circles
 from planar.pipeline import export_scene, gallery_scenes
-from planar.fabrication import Circle, Contour, bulge_points, hull_of_circles, layout_parts
 from planar.linkages import FourBar
-from planar.model import ArcSlot, Hole, Pivot, Slot
+from planar.model import ArcSlot, Part, Slot
 from planar.scene import load_scene
 
 GALLERY = Path(__file__).resolve().parents[1] / "gallery"
@@ -41,17 +43,6 @@ def test_hull_of_circles_is_the_convex_hull_of_the_discs(circles):
     assert poly.hausdorff_distance(ref) < 2e-3 * max(r for _, _, r in circles) + 1e-9
 
 
-def _entities_by_part(doc):
-    out = {}
-    for name, group in doc.groups:
-        out[name] = list(group)
-    return out
-
-
-def _closed_polys(doc):
-    return [e for e in doc.modelspace().query("LWPOLYLINE") if e.dxf.layer != "SHEET"]
-
-
 def _shape(e):
     if e.dxftype() == "CIRCLE":
         return Point(e.dxf.center.x, e.dxf.center.y).buffer(e.dxf.radius, quad_segs=64)
@@ -59,115 +50,158 @@ def _shape(e):
     return Polygon(bulge_points(Contour(pts), math.radians(1.0)))
 
 
-def check_dxf(path, mech, kerf, unit_mm, sheet):
+def check_dxf(path, n_parts, kerf, sheet, min_wall=1.5):
+    """Audit, units, extents, closed contours, inner cuts inside with the wall, parts apart and on the sheet."""
     doc = ezdxf.readfile(path)
     auditor = doc.audit()
     assert not auditor.has_errors, [str(e) for e in auditor.errors]
     assert doc.dxfversion == "AC1024"  # R2010
     assert doc.header["$INSUNITS"] == 4 and doc.header["$MEASUREMENT"] == 1
+    W, H = sheet
+    assert tuple(doc.header["$EXTMIN"])[:2] == (0, 0) and tuple(doc.header["$EXTMAX"])[:2] == (W, H)
     for layer in ("CUT_INNER", "CUT_OUTER", "ENGRAVE"):
         assert layer in doc.layers
-    for e in _closed_polys(doc):
-        assert e.closed
-        pts = np.array([(x, y) for x, y, *_ in e.get_points("xyseb")])
-        seg = np.hypot(*(np.roll(pts, -1, axis=0) - pts).T)
-        assert seg.min() > 1e-6, "zero-length segment"
-    groups = _entities_by_part(doc)
-    assert len(groups) == len(mech.parts)
-    W, H = sheet
+    assert not doc.layers.get("SHEET").dxf.plot  # the sheet's edge is reference only
+    assert not doc.modelspace().query("TEXT MTEXT")  # engraving is strokes, not live text
+    groups = dict(doc.groups)
+    assert len(groups) == n_parts
     outers = []
-    for part in mech.parts:
-        ents = groups[part.name.replace(" ", "_")]
+    k2 = kerf / 2
+    for name, ents in groups.items():
         outer = [e for e in ents if e.dxf.layer == "CUT_OUTER"]
         inner = [e for e in ents if e.dxf.layer == "CUT_INNER"]
-        text = [e for e in ents if e.dxf.layer == "ENGRAVE"]
-        assert len(outer) == 1 and len(text) == 1 and text[0].dxf.text == part.name
-        assert len(inner) == len(part.features)
-        assert sum(isinstance(f, Hole) for f in part.features) == sum(e.dxftype() == "CIRCLE" for e in inner)
+        assert len(outer) == 1
+        for e in outer + inner:
+            assert e.dxftype() == "CIRCLE" or e.closed
         o = _shape(outer[0])
+        nominal = o.buffer(-k2, quad_segs=64)
         for e in inner:
-            assert o.contains(_shape(e)), f"{part.name}: an inner cut leaves the part"
+            cut = _shape(e).buffer(k2, quad_segs=64)
+            assert o.contains(_shape(e)), f"{name}: an inner cut leaves the part"
+            wall = nominal.exterior.distance(cut)
+            assert wall >= min_wall - 0.01, f"{name}: {wall:.3f} mm wall"
         outers.append(o)
-    # apart and on their sheets
+    sheet_rect = Polygon([(0, 0), (W, 0), (W, H), (0, H)])
     for i in range(len(outers)):
+        assert sheet_rect.contains(outers[i])
         for j in range(i + 1, len(outers)):
             assert outers[i].intersection(outers[j]).area < 1e-9
-        k = int(outers[i].bounds[0] // (W + 20.0))
-        sheet_rect = Polygon([(k * (W + 20), 0), (k * (W + 20) + W, 0), (k * (W + 20) + W, H), (k * (W + 20), H)])
-        assert sheet_rect.contains(outers[i])
     return doc, groups
 
 
-def test_fourbar_holes_at_the_joint_distances_and_kerf(tmp_path):
+def _sheets(tmp_path, stem, ext):
+    one = tmp_path / f"{stem}.{ext}"
+    if one.exists():
+        return [one]
+    return sorted(tmp_path.glob(f"{stem}-*.{ext}"), key=lambda p: int(p.stem.rsplit("-", 1)[1]))
+
+
+def test_fourbar_holes_at_the_joint_distances_and_kerf():
     fb = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0))
-    unit = 20.0
-    lay0 = layout_parts(fb, unit_mm=unit, kerf=0.0, pin_mm=3.0, clearance=0.1, sheet=(300, 200))
-    from exporters.dxf import write_dxf
+    s0 = FabSettings(unit_mm=20.0, kerf=0.0)
+    s1 = FabSettings(unit_mm=20.0, kerf=0.3)
+    from planar.fabjoints import pin_features
 
-    write_dxf(tmp_path / "k0.dxf", lay0)
-    doc, groups = check_dxf(tmp_path / "k0.dxf", fb, 0.0, unit, (300, 200))
-    # hole centre distances equal the joint distances
-    expected = {"crank": 1.0, "coupler": 4.0, "rocker": 3.0, "ground": 4.0}
-    for name, length in expected.items():
-        cs = [e for e in groups[name] if e.dxftype() == "CIRCLE"]
-        assert len(cs) == 2
-        d = math.dist((cs[0].dxf.center.x, cs[0].dxf.center.y), (cs[1].dxf.center.x, cs[1].dxf.center.y))
-        assert abs(d - length * unit) < 1e-6, name
-        # pivot holes: pin diameter plus running clearance
-        assert all(abs(2 * c.dxf.radius - 3.1) < 1e-9 for c in cs)
-    # kerf: outlines grow by kerf/2, holes shrink by kerf/2; the centres stay
-    kerf = 0.3
-    lay1 = layout_parts(fb, unit_mm=unit, kerf=kerf, pin_mm=3.0, clearance=0.1, sheet=(300, 200))
-    for p0, p1 in zip(lay0.parts, lay1.parts):
-        dx = np.subtract(p1.nominal_holes[0][0], p0.nominal_holes[0][0])
-        for c0, c1 in zip(p0.inner, p1.inner):
-            assert abs(c0.radius - c1.radius - kerf / 2) < 1e-12
-            assert np.allclose(np.add(c0.centre, dx), c1.centre, atol=1e-9)
-        s0 = Polygon(bulge_points(p0.outer, math.radians(0.25))) if isinstance(p0.outer, Contour) else None
-        s1 = Polygon(bulge_points(p1.outer, math.radians(0.25))) if isinstance(p1.outer, Contour) else None
-        from shapely import affinity
-
-        s1 = affinity.translate(s1, -dx[0], -dx[1])
-        # the kerfed outline is the nominal one grown by kerf/2
-        assert s1.hausdorff_distance(s0.buffer(kerf / 2, quad_segs=64)) < 5e-3
-        assert abs(s1.area - s0.buffer(kerf / 2, quad_segs=64).area) < 1e-2 * s1.area
+    pinned = pin_features(fb)
+    for n, part in enumerate(fb.parts):
+        idx = {i for p, i in pinned if p == part.name}
+        a = part_cuts(part, s0, n + 1, idx)
+        b = part_cuts(part, s1, n + 1, idx)
+        holes = [c for c in a.inner if isinstance(c, Circle)]
+        assert len(holes) == 2
+        # pivot holes: pin diameter plus running clearance, at the joint distance
+        assert all(abs(2 * c.radius - 3.1) < 1e-9 for c in holes)
+        d = math.dist(holes[0].centre, holes[1].centre)
+        length = {"crank": 1.0, "coupler": 4.0, "rocker": 3.0, "ground": 4.0}[part.name]
+        assert abs(d - length * 20.0) < 1e-9
+        for c0, c1 in zip(a.inner, b.inner):
+            assert abs(c0.radius - c1.radius - 0.15) < 1e-12 and np.allclose(c0.centre, c1.centre)
+        if isinstance(a.outer, Contour):
+            s_0 = Polygon(bulge_points(a.outer, math.radians(0.25)))
+            s_1 = Polygon(bulge_points(b.outer, math.radians(0.25)))
+            assert s_1.hausdorff_distance(s_0.buffer(0.15, quad_segs=64)) < 5e-3
 
 
 def test_slot_kerf_and_arc_slots():
-    from planar.fabrication import part_cuts
-    from planar.model import Part
-
     part = Part("p", ((0, 0, 1.0), (4, 0, 1.0)), (Slot((0.5, 0), (3.5, 0), 0.4), ArcSlot((2, 0), 1.0, 0.2, 2.0, 0.3)))
-    a = part_cuts(part, 10.0, 0.0, 3.0, 0.0)
-    b = part_cuts(part, 10.0, 0.4, 3.0, 0.0)
+    a = part_cuts(part, FabSettings(unit_mm=10.0, kerf=0.0, clearance=0.0, slot_end=0.0), 1)
+    b = part_cuts(part, FabSettings(unit_mm=10.0, kerf=0.4, clearance=0.0, slot_end=0.0), 1)
     for c0, c1 in zip(a.inner, b.inner):
         p0 = Polygon(bulge_points(c0, math.radians(0.25)))
         p1 = Polygon(bulge_points(c1, math.radians(0.25)))
-        assert p0.is_valid and p1.is_valid
-        assert p0.contains(p1)
+        assert p0.is_valid and p1.is_valid and p0.contains(p1)
         assert p1.hausdorff_distance(p0.buffer(-0.2, quad_segs=64)) < 5e-3
-    # the straight slot's nominal width: 0.4 units at 10 mm/unit
     slot = Polygon(bulge_points(a.inner[0], math.radians(0.25)))
     assert abs(slot.area - (30 * 4 + math.pi * 2 ** 2)) < 0.05
+    # end margin: 1.5 mm past each end of the travel
+    c = part_cuts(part, FabSettings(unit_mm=10.0, kerf=0.0, clearance=0.0, slot_end=1.5), 1)
+    slot = Polygon(bulge_points(c.inner[0], math.radians(0.25)))
+    assert abs(slot.area - (33 * 4 + math.pi * 2 ** 2)) < 0.05
 
 
 @pytest.mark.parametrize("path", gallery_scenes(GALLERY), ids=lambda p: p.stem)
-def test_every_gallery_scene_exports_valid_dxf_and_svg(tmp_path, path):
+def test_every_gallery_scene_exports_checked_files(tmp_path, path):
     scene = load_scene(path)
-    fab = scene.spec.fabrication
-    layout = export_scene(scene, tmp_path / "p.dxf", tmp_path / "p.svg")
-    check_dxf(tmp_path / "p.dxf", scene.mechanism, fab.kerf_mm, fab.unit_mm, fab.sheet_mm)
-    root = ET.parse(tmp_path / "p.svg").getroot()
-    assert root.get("width").endswith("mm") and root.get("height").endswith("mm")
-    ns = "{http://www.w3.org/2000/svg}"
-    doc = ezdxf.readfile(tmp_path / "p.dxf")
-    n_circles = len(doc.modelspace().query("CIRCLE"))
-    n_paths = len([e for e in _closed_polys(doc)])
-    assert len(root.findall(f".//{ns}circle")) == n_circles
-    assert len(root.findall(f".//{ns}path")) == n_paths
-    assert len(root.findall(f".//{ns}text")) == len(scene.mechanism.parts)
-    for p in root.findall(f".//{ns}path"):
-        assert p.get("d").rstrip().endswith("Z")
+    fab = export_scene(scene, tmp_path / "p.dxf", tmp_path / "p.svg", bom=tmp_path / "b.csv",
+                       assembly=tmp_path / "a.svg")
+    s = fab.settings
+    dxfs = _sheets(tmp_path, "p", "dxf")
+    assert len(dxfs) == fab.layout.sheets == len(_sheets(tmp_path, "p", "svg"))
+    for k, d in enumerate(dxfs):
+        check_dxf(d, len(fab.layout.on_sheet(k)), s.kerf, s.sheet, s.min_wall)
+    # the SVG cuts what the DXF cuts: every contour read by svgelements vs ezdxf, within 0.1 % of its area
+    for d, v in zip(dxfs, _sheets(tmp_path, "p", "svg")):
+        a, b = svg_closed_polygons(v), dxf_cut_polygons(d)
+        assert all(p.area > 0 for p in a + b)
+        rel = match_contours(a, b)
+        assert rel and max(rel) <= 1e-3, f"{v.name}: worst contour differs by {max(rel):.3%} of its area"
+    # labels: single-line strokes at least min_label tall, or none (noted)
+    for p in fab.layout.parts:
+        assert p.label == "" or p.label_height >= s.min_label - 1e-9
+    # parts on one layer never overlap at any instant of the cycle (shapely, from the parts' own outlines)
+    motion = scene.mechanism.run(samples_per_cycle=24)
+    from shapely import affinity
+
+    asm = fab.assembly
+    for a_name, b_name in [(a, b) for a in asm.layers for b in asm.layers if a < b]:
+        if asm.layers[a_name] is None or asm.layers[a_name] != asm.layers[b_name]:
+            continue
+        if asm.plane[a_name] != asm.plane[b_name]:
+            continue
+        for i in np.flatnonzero(motion.valid):
+            ga, gb = [affinity.affine_transform(fab.own[n], [math.cos(q[2]), -math.sin(q[2]), math.sin(q[2]),
+                                                            math.cos(q[2]), q[0] * s.unit_mm, q[1] * s.unit_mm])
+                      for n, q in ((a_name, motion.poses[a_name][i]), (b_name, motion.poses[b_name][i]))]
+            assert ga.intersection(gb).area < 1.0, (a_name, b_name, i)
+    # BOM: pins as long as the layers they span plus heads
+    import csv
+
+    rows = list(csv.DictReader((tmp_path / "b.csv").open()))
+    parts = [r for r in rows if r["item"] == "part"]
+    assert {r["id"] for r in parts} == {p.name for p in scene.mechanism.parts}
+    for r in rows:
+        if r["item"] == "pin":
+            lo, hi = map(int, r["layer"].split("-"))
+            d, length = map(float, r["size_mm"].split(" x "))
+            assert d == s.pin_mm and abs(length - (s.thickness_mm * (hi - lo + 1) + 2 * s.pin_head)) < 1e-9
+    # the assembly drawing reads back with svgelements: one filled shape per layered part
+    from svgelements import SVG, Path as SPath
+
+    shapes = [e for e in SVG.parse(str(tmp_path / "a.svg")).elements() if isinstance(e, SPath)]
+    assert len(shapes) == sum(1 for v in asm.layers.values() if v is not None)
+
+
+def test_svg_conventions(tmp_path):
+    from svgelements import SVG, Circle as SCircle, Path as SPath, Rect, Text
+
+    export_scene(load_scene(GALLERY / "jansen-leg.toml"), svg=tmp_path / "j.svg")
+    svg = SVG.parse(str(tmp_path / "j.svg"))
+    els = [e for e in svg.elements() if isinstance(e, (SPath, SCircle, Rect, Text))]
+    assert not [e for e in els if isinstance(e, (Rect, Text))]  # no sheet outline, no live text
+    colours = {str(e.stroke) for e in els}
+    assert colours == {"#ff0000", "#0000ff"}
+    widths = {round(e.stroke_width / (svg.width / svg.viewbox.width), 6) for e in els}
+    assert widths == {0.025}
 
 
 def test_export_is_reproducible_and_cli(tmp_path):
@@ -183,13 +217,132 @@ def test_export_is_reproducible_and_cli(tmp_path):
     assert abs(w - 250) < 1e-9
 
 
-def test_export_errors_are_user_errors(tmp_path):
+def _scene_file(tmp_path, src, extra):
+    text = (GALLERY / src).read_text()
+    p = tmp_path / "s.toml"
+    p.write_text(text.replace("[fabrication]\n", "[fabrication]\n" + extra + "\n") if "[fabrication]" in text
+                 else text + "\n[fabrication]\n" + extra + "\n")
+    return p
+
+
+def test_export_errors_are_user_errors(tmp_path, capsys):
     scene = GALLERY / "jansen-leg.toml"
-    for args in (["--sheet", "30x20"], ["--sheet", "big"], ["--kerf", "-1"]):
-        r = subprocess.run([sys.executable, "-m", "planar", "export", str(scene), "-o", str(tmp_path / "x.dxf"), *args],
-                           capture_output=True, text=True)
-        assert r.returncode == 2 and "Traceback" not in r.stderr, (args, r.stderr)
-        assert not (tmp_path / "x.dxf").exists()
+    cases = [(scene, ["--sheet", "30x20"]), (scene, ["--sheet", "big"]), (scene, ["--kerf", "-1"]),
+             (scene, ["--sheet", "infx200"]),
+             (_scene_file(tmp_path, "paddle-boat.toml", "widen = false"), []),
+             (_scene_file(tmp_path, "jansen-leg.toml", "pin_diameter_mm = 0.3\nkerf_mm = 0.5"), [])]
+    for sc, args in cases:
+        assert main(["export", str(sc), "-o", str(tmp_path / "x.dxf"), "--bom", str(tmp_path / "x.csv"), *args]) == 2
+        err = capsys.readouterr().err
+        assert len(err.strip().splitlines()) == 1 and err.startswith("planar: error:"), (args, err)
+        assert not (tmp_path / "x.dxf").exists() and not (tmp_path / "x.csv").exists()
+    # no traceback from the command itself either
+    r = subprocess.run([sys.executable, "-m", "planar", "export", str(scene), "-o", str(tmp_path / "x.dxf"),
+                        "--sheet", "infx200"], capture_output=True, text=True)
+    assert r.returncode == 2 and "Traceback" not in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_narrow_links_are_widened_or_refused(tmp_path):
+    scene = load_scene(GALLERY / "paddle-boat.toml")
+    fab = build(scene, FabSettings.from_spec(scene.spec.fabrication))
+    assert any("crank: widened" in n for n in fab.notes)
+    r = subprocess.run([sys.executable, "-m", "planar", "export", str(_scene_file(tmp_path, "paddle-boat.toml",
+                        "widen = false")), "-o", str(tmp_path / "x.dxf")], capture_output=True, text=True)
+    assert r.returncode == 2 and "wall" in r.stderr and "min_wall_mm" in r.stderr
+
+
+def test_thickness_and_pin_diameter_have_effect(tmp_path):
+    import csv
+
+    out = {}
+    for t in (3, 6):
+        sc = load_scene(_scene_file(tmp_path, "jansen-leg.toml", f"thickness_mm = {t}"))
+        export_scene(sc, tmp_path / f"t{t}.dxf", bom=tmp_path / f"t{t}.csv")
+        out[t] = [r for r in csv.DictReader((tmp_path / f"t{t}.csv").open()) if r["item"] == "pin"]
+    assert (tmp_path / "t3.dxf").read_bytes() != (tmp_path / "t6.dxf").read_bytes()
+    for a, b in zip(out[3], out[6]):
+        lo, hi = map(int, a["layer"].split("-"))
+        la, lb = (float(r["size_mm"].split(" x ")[1]) for r in (a, b))
+        assert abs((lb - la) - 3 * (hi - lo + 1)) < 1e-9
+    # a wind-up toy's pins follow pin_diameter_mm: the follower's pin hole and the ground's slot
+    sc = load_scene(_scene_file(tmp_path, "windup-01.toml", "pin_diameter_mm = 4.0\nkerf_mm = 0.0"))
+    fab = export_scene(sc, tmp_path / "w.dxf")
+    follower = next(p for p in fab.layout.parts if p.name == "follower")
+    radii = sorted(round(c.radius, 9) for c in follower.inner if isinstance(c, Circle))
+    assert radii == [2.05, 2.05]
+
+
+def test_slots_leave_margin_past_the_pins_travel():
+    from planar.fabjoints import pin_features
+    from planar.fabparts import _features
+
+    for name in ("windup-01", "windup-04", "slider-crank", "windup-07"):
+        scene = load_scene(GALLERY / f"{name}.toml")
+        mech = scene.mechanism
+        s = FabSettings.from_spec(scene.spec.fabrication)
+        motion = mech.run(samples_per_cycle=90)
+        for j in mech.joints:
+            if type(j).__name__ not in ("PinInSlot", "Slide"):
+                continue
+            pin_part, slot_part = j.b, j.a  # the slot on a, the pin on b (the joint protocol)
+            pin = j.pin if hasattr(j, "pin") else j.anchor
+            part = mech.part(slot_part)
+            feats = _features(part, s, {i for p, i in pin_features(mech) if p == slot_part}, None, None)
+            slot = next(f for f in feats if f.kind == "slot")
+            # pin centre over the cycle, in the slot part's frame, mm
+            from planar.geometry import poses_apply
+
+            w = poses_apply(motion.poses[pin_part], pin)
+            q = motion.poses[slot_part]
+            c, sn = np.cos(q[:, 2]), np.sin(q[:, 2])
+            d = w - q[:, :2]
+            local = np.c_[c * d[:, 0] + sn * d[:, 1], -sn * d[:, 0] + c * d[:, 1]] * s.unit_mm
+            a, b = np.array(slot.a), np.array(slot.b)
+            e = (b - a) / np.hypot(*(b - a))
+            t = (local - a) @ e
+            L = float(np.hypot(*(b - a)))
+            assert t.min() >= s.slot_end - 1e-6 and t.max() <= L - s.slot_end + 1e-6, (name, j.name, t.min(), L - t.max())
+
+
+def test_nesting_horse_on_one_sheet_and_several_files(tmp_path):
+    scene = load_scene(GALLERY / "horse.toml")
+    fab = export_scene(scene, tmp_path / "h.dxf", sheet=(300, 200))
+    assert fab.layout.sheets == 1 and (tmp_path / "h.dxf").exists()
+    area = sum(Polygon(bulge_points(p.outer, math.radians(1))).area if isinstance(p.outer, Contour)
+               else math.pi * p.outer.radius ** 2 for p in fab.layout.parts)
+    assert abs(fab.layout.utilisation[0] - area / (300 * 200)) < 1e-3
+    fab = export_scene(scene, tmp_path / "s.dxf", tmp_path / "s.svg", sheet=(160, 120))
+    n = fab.layout.sheets
+    assert n >= 2
+    assert [p.name for p in _sheets(tmp_path, "s", "dxf")] == [f"s-{k + 1}.dxf" for k in range(n)]
+    assert not (tmp_path / "s.dxf").exists()
+    for k, p in enumerate(_sheets(tmp_path, "s", "dxf")):
+        check_dxf(p, len(fab.layout.on_sheet(k)), fab.settings.kerf, (160, 120))
+
+
+def test_drive_and_mounting_holes(tmp_path):
+    scene = load_scene(GALLERY / "jansen-leg.toml")
+    export_scene(scene, tmp_path / "j.dxf", kerf=0.0)
+    groups = dict(ezdxf.readfile(tmp_path / "j.dxf").groups)
+    d = [e for e in groups["crank"] if e.dxf.layer == "CUT_INNER" and e.dxftype() == "LWPOLYLINE"]
+    assert len(d) == 1  # the D-shaped shaft hole
+    poly = _shape(d[0])
+    r, f = 1.5, 1.0  # 3 mm shaft, 2.5 mm across the flat
+    alpha = math.acos(f / r)
+    assert abs(poly.area - (r * r * (math.pi - alpha) + f * math.sqrt(r * r - f * f))) < 1e-3
+    radii = sorted(round(e.dxf.radius, 6) for e in groups["ground"] if e.dxftype() == "CIRCLE")
+    assert radii.count(1.65) == 2 and radii.count(0.9) == 2  # M3 mounting holes, motor screws
+
+
+def test_kerf_test_piece(tmp_path):
+    assert main(["export", str(GALLERY / "jansen-leg.toml"), "--kerf", "0.2", "--kerf-test",
+                 str(tmp_path / "k.dxf")]) == 0
+    doc = ezdxf.readfile(tmp_path / "k.dxf")
+    outer = [e for e in doc.modelspace() if e.dxf.layer == "CUT_OUTER"]
+    x0, y0, x1, y1 = _shape(outer[0]).bounds
+    assert abs((x1 - x0) - 20.2) < 1e-9  # the square grows by half the kerf per side
+    assert doc.modelspace().query("CIRCLE")[0].dxf.radius == pytest.approx(4.9)
+    assert len([e for e in doc.modelspace() if e.dxf.layer == "ENGRAVE"]) > 3
 
 
 def test_preview_png(tmp_path):
@@ -215,14 +368,15 @@ def test_no_duplicate_cut_entities_and_jansen_link_lengths(tmp_path):
             assert key not in seen, "duplicate cut"
             seen.add(key)
     groups = dict(doc.groups)
+
+    def centres(name):
+        return [(e.dxf.center.x, e.dxf.center.y) for e in groups[name] if e.dxftype() == "CIRCLE"]
+
     # Jansen's holy numbers (unit_mm = 1): each two-hole link's hole centres are its length apart
-    for name, length in {"j": 50.0, "k": 61.9, "c": 39.3, "f": 39.4, "crank": 15.0}.items():
-        cs = [e for e in groups[name] if e.dxftype() == "CIRCLE"]
-        d = math.dist((cs[0].dxf.center.x, cs[0].dxf.center.y), (cs[1].dxf.center.x, cs[1].dxf.center.y))
-        assert abs(d - length) < 1e-6, name
-    tri = sorted(math.dist((a.dxf.center.x, a.dxf.center.y), (b.dxf.center.x, b.dxf.center.y))
-                 for i, a in enumerate(c for c in groups["upper"] if c.dxftype() == "CIRCLE")
-                 for j, b in enumerate(c for c in groups["upper"] if c.dxftype() == "CIRCLE") if i < j)
+    for name, length in {"j": 50.0, "k": 61.9, "c": 39.3, "f": 39.4}.items():
+        cs = centres(name)
+        assert len(cs) == 2
+        assert abs(math.dist(*cs) - length) < 1e-6, name
+    tri = sorted(math.dist(a, b) for i, a in enumerate(centres("upper")) for j, b in enumerate(centres("upper")) if i < j)
     assert np.allclose(tri, sorted([41.5, 40.1, 55.8]), atol=1e-6)  # the ternary link Z-B-D
-    # the foot F is a point of the lower link, not a joint: no hole there
-    assert sum(c.dxftype() == "CIRCLE" for c in groups["lower"]) == 2
+    assert len(centres("lower")) == 2  # the foot F is a point of the lower link, not a joint

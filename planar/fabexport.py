@@ -1,0 +1,220 @@
+"""``planar export``: parts checked, lettered, layered, nested, then every file written at once.
+
+:func:`build` turns a scene into a :class:`Fabrication` (layout, assembly,
+notes); :func:`write_outputs` renders every requested file in memory and only
+then writes them (each to a temporary beside its target, all renamed at the
+end), so bad input or a failed check leaves no file written or clobbered.
+With several sheets, ``parts.dxf`` becomes ``parts-1.dxf``, ``parts-2.dxf``
+(same for SVG and the preview PNG).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .assembly import Assembly, letter, pin_stacks, plan_assembly
+from .errors import InputError
+from .fabjoints import joint_pins, pin_features
+from .fabparts import FabSettings, nominal_material, part_cuts
+from .fabrication import Circle, Layout, PartCut
+from .nesting import nest
+
+__all__ = ["Fabrication", "build", "kerf_test_layout", "sheet_paths", "write_outputs"]
+
+
+@dataclass
+class Fabrication:
+    name: str
+    settings: FabSettings
+    layout: Layout
+    assembly: Assembly
+    notes: list[str] = field(default_factory=list)
+    #: the pin that is the motor shaft (joint name), if any
+    shaft: str | None = None
+    #: each part's material (outline minus cuts, mm) in its own frame
+    own: dict[str, Any] = field(default_factory=dict)
+    #: the ground plates (with mounting holes)
+    grounds: list[str] = field(default_factory=list)
+    #: files written by :func:`write_outputs`
+    written: list[Path] = field(default_factory=list)
+
+
+def _shaft_pin(mech: Any, pins) -> Any:
+    drv = mech.driver
+    if drv.kind != "rotation":
+        return None
+    ground = {p.name for p in mech.parts if p.ground}
+    for pin in pins:
+        if drv.part in pin.parts and (set(pin.parts) - {drv.part}) <= ground and pin.kinds == ("hole", "hole"):
+            return pin
+    return None
+
+
+def build(scene: Any, settings: FabSettings) -> Fabrication:
+    """Cut-ready, checked, layered and nested parts of ``scene`` (raises FabricationError/InputError)."""
+    s = settings
+    if not (0 <= s.kerf <= 2):
+        raise InputError("kerf", s.kerf, "a kerf between 0 and 2 mm")
+    mech = scene.mechanism
+    pins, contacts = joint_pins(mech)
+    pinned = pin_features(mech)
+    shaft = _shaft_pin(mech, pins)
+    notes: list[str] = []
+    if mech.driver.kind != "rotation":
+        notes.append(f"driver {mech.driver.part!r} is a {mech.driver.kind} drive: no motor shaft hole")
+    elif shaft is None:
+        notes.append(f"driver {mech.driver.part!r}: no pin to the ground on its axis, no motor shaft hole")
+    letters: dict[str, list[tuple[tuple[float, float], str]]] = {p.name: [] for p in mech.parts}
+    for k, stack in enumerate(pin_stacks(pins)):
+        marked: set[tuple[str, tuple[float, float]]] = set()
+        for i in stack:
+            pin = pins[i]
+            for side in (0, 1):
+                key = (pin.parts[side], pin.at[side])
+                if pin.kinds[side] == "hole" and pin is not shaft and key not in marked:
+                    marked.add(key)
+                    letters[pin.parts[side]].append((pin.at[side], letter(k)))
+    cuts: list[PartCut] = []
+    for n, part in enumerate(mech.parts, start=1):
+        drive_at = motor_at = None
+        if shaft is not None and part.name in shaft.parts:
+            k = shaft.parts.index(part.name)
+            if part.name == mech.driver.part:
+                drive_at = shaft.at[k]
+            else:
+                motor_at = shaft.at[k]
+        pc = part_cuts(part, s, n, {i for (pn, i) in pinned if pn == part.name}, drive_at, motor_at,
+                       mounting=part.ground and part.plane == "xy", letters=letters[part.name])
+        notes.extend(pc.notes)
+        cuts.append(pc)
+    material = {pc.name: nominal_material(pc.outer, pc.inner, s.kerf / 2) for pc in cuts}
+    asm = plan_assembly(mech, material, pins, contacts, s.unit_mm, s.thickness_mm, s.pin_mm, s.pin_head,
+                        shaft.joint if shaft is not None else None)
+    notes.extend(asm.notes)
+    for pc in cuts:
+        pc.layer = asm.layers.get(pc.name)
+    # spacer rings, cut from the same sheet
+    k2 = s.kerf / 2
+    ri = (s.pin_mm + s.clearance) / 2
+    ro = max(ri + s.min_wall, s.min_part / 2)
+    for pp in asm.pins:
+        for j in range(pp.spacers):
+            cuts.append(PartCut(f"spacer {pp.letter}{j + 1}", Circle((0.0, 0.0), ro + k2), [Circle((0.0, 0.0), ri - k2)],
+                                nominal_holes=[((0.0, 0.0), ri)]))
+    layout = nest(cuts, s.sheet, s.spacing, s.margin, s.kerf, s.unit_mm)
+    return Fabrication(scene.name, s, layout, asm, notes, shaft.joint if shaft is not None else None, material,
+                       [p.name for p in mech.parts if p.ground and p.plane == "xy"])
+
+
+def sheet_paths(path: str | os.PathLike, sheets: int) -> list[Path]:
+    """``parts.dxf`` for one sheet; ``parts-1.dxf``, ``parts-2.dxf``, ... for several."""
+    p = Path(path)
+    if sheets == 1:
+        return [p]
+    return [p.with_name(f"{p.stem}-{k + 1}{p.suffix}") for k in range(sheets)]
+
+
+def kerf_test_layout(settings: FabSettings) -> Layout:
+    """A kerf calibration piece: a 20 mm square with a 10 mm hole, both kerf-compensated, the kerf engraved.
+
+    Measure the square and the hole after cutting: too small a square (or too large a hole) means the
+    real kerf is wider than ``kerf_mm`` by the difference.
+    """
+    from .fabrication import Contour
+    from .strokefont import text_strokes
+
+    k2 = settings.kerf / 2
+    a = 10.0 + k2
+    outer = Contour([(-a, -a, 0.0), (a, -a, 0.0), (a, a, 0.0), (-a, a, 0.0)])
+    inner = [Circle((0.0, 3.0), 5.0 - k2)]
+    engrave = text_strokes(f"K {settings.kerf:.2f}", 2.0, (0.0, -5.5), 0.0)
+    engrave += text_strokes("20 / 10", 1.6, (0.0, -8.3), 0.0)
+    pc = PartCut("kerf test", outer, inner, engrave, f"K {settings.kerf:.2f}", 2.0, nominal_holes=[((0.0, 3.0), 5.0)])
+    return nest([pc], settings.sheet, settings.spacing, settings.margin, settings.kerf, settings.unit_mm)
+
+
+def _commit(files: dict[Path, bytes]) -> None:
+    """Write every file to a temporary beside it, then rename them all; on any failure remove the temporaries."""
+    for target in files:
+        parent = target.parent if str(target.parent) else Path(".")
+        if not parent.is_dir():
+            raise InputError("output", str(target), f"a path in an existing directory ({parent} does not exist)")
+    temps: list[tuple[str, Path]] = []
+    try:
+        umask = os.umask(0)
+        os.umask(umask)
+        for target, data in files.items():
+            fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent)
+            temps.append((tmp, target))
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(data)
+            os.chmod(tmp, 0o666 & ~umask)
+        for tmp, target in temps:
+            os.replace(tmp, target)
+    except BaseException:
+        for tmp, _ in temps:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(tmp)
+        raise
+
+
+def write_outputs(fab: Fabrication | None, dxf=None, svg=None, preview=None, bom=None, assembly=None,
+                  kerf_test=None, settings: FabSettings | None = None) -> list[Path]:
+    """Render every requested output in memory, then write them all (see the module docstring)."""
+    from exporters.dxf import dxf_bytes
+    from exporters.svg import svg_text
+
+    files: dict[Path, bytes] = {}
+    if fab is not None:
+        lay, s = fab.layout, fab.settings
+        meta = f"{fab.name}: {s.thickness_mm:g} mm sheet, kerf {s.kerf:g} mm"
+        if dxf is not None:
+            for k, p in enumerate(sheet_paths(dxf, lay.sheets)):
+                files[p] = dxf_bytes(lay, k, s, f"{meta}, sheet {k + 1} of {lay.sheets}")
+        if svg is not None:
+            for k, p in enumerate(sheet_paths(svg, lay.sheets)):
+                files[p] = svg_text(lay, k, s).encode()
+        if preview is not None:
+            from exporters.preview import sheet_png
+
+            for k, p in enumerate(sheet_paths(preview, lay.sheets)):
+                files[p] = sheet_png(lay, k, s)
+        if bom is not None:
+            from exporters.bom import bom_text
+
+            files[Path(bom)] = bom_text(fab).encode()
+        if assembly is not None:
+            from exporters.svg import assembly_svg_text
+
+            files[Path(assembly)] = assembly_svg_text(fab).encode()
+    if kerf_test is not None:
+        s = settings or (fab.settings if fab is not None else FabSettings())
+        lay = kerf_test_layout(s)
+        p = Path(kerf_test)
+        if p.suffix.lower() == ".svg":
+            files[p] = svg_text(lay, 0, s).encode()
+        elif p.suffix.lower() == ".dxf":
+            files[p] = dxf_bytes(lay, 0, s, f"kerf test, kerf {s.kerf:g} mm")
+        else:
+            raise InputError("--kerf-test", str(p), "a .dxf or .svg file name")
+    if len({str(p.resolve()) for p in files}) != len(files):
+        raise InputError("output", ", ".join(map(str, files)), "distinct output files")
+    _commit(files)
+    return list(files)
+
+
+def summary(fab: Fabrication) -> str:
+    """One line: parts, sheets, utilisation, layers, pins, spacers."""
+    lay, asm = fab.layout, fab.assembly
+    util = ", ".join(f"{u:.0%}" for u in lay.utilisation)
+    layers = max(asm.n_layers.values()) if asm.n_layers else 0
+    spacers = sum(p.spacers for p in asm.pins)
+    return (f"{len(lay.parts)} parts on {lay.sheets} sheet(s) of {lay.sheet_size[0]:g} x {lay.sheet_size[1]:g} mm "
+            f"(utilisation {util}), kerf {lay.kerf:g} mm, {layers} layer(s) of {fab.settings.thickness_mm:g} mm, "
+            f"{len(asm.pins)} pin(s), {spacers} spacer(s)")
+
