@@ -115,52 +115,7 @@ def node_velocities(
     position does not close.  Velocities are in the linkage's own frame
     before placement; rotate them by ``placement[2]`` for the world.
     """
-    from .linkages.dyads import RRP, RRR, Actuator, Crank, Fixed
-
-    qa = np.atleast_1d(np.asarray(q, float))
-    qd = np.broadcast_to(np.asarray(qdot, float), qa.shape)
-    pos, checks = link.solve_nodes(qa)
-    valid = np.ones(qa.shape, bool)
-    for m, _, _ in checks:
-        valid &= m
-    vel: dict[str, Array] = {}
-    for node in link.nodes:
-        if isinstance(node, Fixed):
-            vel[node.name] = np.zeros(qa.shape + (2,))
-        elif isinstance(node, Crank):
-            vel[node.name] = vel[node.centre] + qd[:, None] * _perp(pos[node.name] - pos[node.centre])
-        elif isinstance(node, Actuator):
-            ax = np.asarray(node.axis, float) / np.hypot(*node.axis)
-            vel[node.name] = vel[node.origin] + qd[:, None] * ax
-        elif isinstance(node, (RRR, RRP)):
-            P = pos[node.name]
-            r1 = P - pos[node.a]
-            b1 = (r1 * vel[node.a]).sum(-1)
-            if isinstance(node, RRR):
-                r2 = P - pos[node.b]
-                b2 = (r2 * vel[node.b]).sum(-1)
-            else:
-                p0, vp0 = pos[node.p], vel[node.p]
-                w = pos[node.q] - p0
-                vw = vel[node.q] - vp0
-                wn = np.hypot(w[:, 0], w[:, 1])
-                # cross(w, vP) = e (w . vw)/|w| - cross(vw, P - p0) + cross(w, vp0)
-                r2 = np.stack([-w[:, 1], w[:, 0]], -1)
-                b2 = node.offset * (w * vw).sum(-1) / wn - _cross(vw, P - p0) + _cross(w, vp0)
-            det = r1[:, 0] * r2[:, 1] - r1[:, 1] * r2[:, 0]
-            scale = np.hypot(*r1.T) * np.hypot(*r2.T)
-            sing = np.abs(det) <= 1e-12 * scale
-            valid &= ~sing
-            det = np.where(sing, 1.0, det)
-            vx = (b1 * r2[:, 1] - b2 * r1[:, 1]) / det
-            vy = (r1[:, 0] * b2 - r2[:, 0] * b1) / det
-            vel[node.name] = np.stack([vx, vy], -1)
-        else:  # Rigid
-            a, b = pos[node.a], pos[node.b]
-            d = b - a
-            omega = _cross(d, vel[node.b] - vel[node.a]) / (d * d).sum(-1)
-            vel[node.name] = vel[node.a] + omega[:, None] * _perp(pos[node.name] - a)
-    return vel, valid
+    return link.node_velocities(q, qdot)
 
 
 def point_velocities(

@@ -13,9 +13,9 @@ are radians, counter-clockwise positive.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import TYPE_CHECKING, Any, Literal, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, ClassVar, Literal, Mapping, Protocol, Sequence, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -37,6 +37,9 @@ __all__ = [
     "Slide",
     "CamOnLine",
     "Joint",
+    "JointProtocol",
+    "JOINT_KINDS",
+    "joint_kind",
     "Driver",
     "Motion",
     "Mechanism",
@@ -118,8 +121,58 @@ class Part:
 
 
 # --------------------------------------------------------------------------
-# Joints
+# Joints: every kind joins part ``a`` to part ``b`` and declares itself
 # --------------------------------------------------------------------------
+
+#: every joint kind, by name (filled by :func:`joint_kind`)
+JOINT_KINDS: dict[str, type] = {}
+
+J = TypeVar("J", bound=type)
+
+
+def joint_kind(cls: J) -> J:
+    """Class decorator: register ``cls`` as a joint kind (ezdxf's ``register_entity`` pattern).
+
+    A joint kind is a frozen dataclass with ``name``, the two parts it joins
+    ``a`` and ``b`` (part names; ``a`` carries the track, slot, face or edge,
+    ``b`` the pin, block or cam riding on it; for a pivot they are
+    symmetric), a class attribute ``kind``, and the methods of
+    :class:`JointProtocol`.  Registering a name twice is a :class:`TypeError`.
+    """
+    name = cls.__dict__.get("kind")
+    if not isinstance(name, str):
+        raise TypeError(f"joint kind {cls.__name__} needs a class attribute 'kind'")
+    if name in JOINT_KINDS:
+        raise TypeError(f"double registration for joint kind {name!r}")
+    for attr in ("residual", "features", "pins"):
+        if not callable(getattr(cls, attr, None)):
+            raise TypeError(f"joint kind {name!r} has no method {attr!r}")
+    JOINT_KINDS[name] = cls
+    return cls
+
+
+class JointProtocol(Protocol):
+    """What every joint kind states, one uniform way (pymunk's ``a`` and ``b``)."""
+
+    kind: ClassVar[str]
+    name: str
+    a: str
+    b: str
+
+    def residual(self, poses: Mapping[str, Array]) -> Array:
+        """How far the joint is from closing, per sample (model units, >= 0)."""
+        ...
+
+    def features(self) -> tuple[tuple[str, Feature], ...]:
+        """``(part, feature)``: the holes and slots this joint cuts into its parts (own frames)."""
+        ...
+
+    def pins(self) -> tuple[tuple[str, Vec], ...]:
+        """``(part, point)``: where the joint's pins sit (own frames), for drawing."""
+        ...
+
+
+Joint = JointProtocol
 
 
 def _pose(poses: Mapping[str, Array], part: str) -> Array:
@@ -134,15 +187,22 @@ def _point_line_distance(p: Array, a: Array, b: Array) -> Array:
     return (d[..., 0] * w[..., 1] - d[..., 1] * w[..., 0]) / n
 
 
+@joint_kind
 @dataclass(frozen=True)
 class Pivot:
-    """Revolute joint: point ``anchor_a`` of part ``a`` coincides with ``anchor_b`` of ``b``."""
+    """Revolute joint: point ``anchor_a`` of part ``a`` coincides with ``anchor_b`` of ``b``.
 
+    ``diameter`` (model units), when given, is the pin: the joint then puts a
+    pin hole on both parts; ``None`` leaves the holes to the part's builder.
+    """
+
+    kind: ClassVar[str] = "pivot"
     name: str
     a: str
-    anchor_a: Vec
     b: str
+    anchor_a: Vec
     anchor_b: Vec
+    diameter: float | None = None
 
     def residual(self, poses: Mapping[str, Array]) -> Array:
         """Distance between the two anchor points, per sample."""
@@ -150,106 +210,158 @@ class Pivot:
         pb = poses_apply(_pose(poses, self.b), self.anchor_b)
         return np.hypot(*(pa - pb).T)
 
+    def features(self) -> tuple[tuple[str, Feature], ...]:
+        if self.diameter is None:
+            return ()
+        return ((self.a, Hole(self.anchor_a, self.diameter, "pin")), (self.b, Hole(self.anchor_b, self.diameter, "pin")))
 
+    def pins(self) -> tuple[tuple[str, Vec], ...]:
+        return ((self.a, self.anchor_a),)
+
+
+@joint_kind
 @dataclass(frozen=True)
 class PinInSlot:
-    """A pin ``pin`` on ``pin_part`` runs in a straight slot ``start -> end`` of ``slot_part``.
+    """A pin at ``pin`` on part ``b`` runs in a straight slot ``start -> end`` of part ``a``.
 
     The residual is the pin's distance from the slot's centre line, plus how
     far it has left the slot's length (so a slot that is too short shows).
+    ``width``, when given, is the slot's width (the pin's diameter): the joint
+    then cuts the slot in ``a`` and the pin hole in ``b``.
     """
 
+    kind: ClassVar[str] = "pin-in-slot"
     name: str
-    pin_part: str
-    pin: Vec
-    slot_part: str
+    a: str
+    b: str
     start: Vec
     end: Vec
+    pin: Vec
+    width: float | None = None
 
     def residual(self, poses: Mapping[str, Array]) -> Array:
-        p = poses_apply(_pose(poses, self.pin_part), self.pin)
-        a = poses_apply(_pose(poses, self.slot_part), self.start)
-        b = poses_apply(_pose(poses, self.slot_part), self.end)
-        off = np.abs(_point_line_distance(p, a, b))
-        d = b - a
+        p = poses_apply(_pose(poses, self.b), self.pin)
+        s0 = poses_apply(_pose(poses, self.a), self.start)
+        s1 = poses_apply(_pose(poses, self.a), self.end)
+        off = np.abs(_point_line_distance(p, s0, s1))
+        d = s1 - s0
         L = np.hypot(d[..., 0], d[..., 1])
-        s = ((p - a) * d).sum(-1) / L
+        s = ((p - s0) * d).sum(-1) / L
         beyond = np.maximum(0.0, np.maximum(-s, s - L))
         return np.hypot(off, beyond)
 
+    def features(self) -> tuple[tuple[str, Feature], ...]:
+        if self.width is None:
+            return ()
+        return ((self.a, Slot(self.start, self.end, self.width, "pin")), (self.b, Hole(self.pin, self.width, "pin")))
 
+    def pins(self) -> tuple[tuple[str, Vec], ...]:
+        return ((self.b, self.pin),)
+
+
+@joint_kind
 @dataclass(frozen=True)
 class PinInArcSlot:
-    """A pin on ``pin_part`` in an arc slot of ``slot_part`` (centre, mid-radius).
+    """A pin at ``pin`` on part ``b`` in an arc slot of part ``a`` (``centre``, mid-radius ``radius``).
 
     Kinematically the same as a pivot on a link of length ``radius`` about
     ``centre`` (reference file); the residual is ``| |pin - centre| - radius |``.
+    The arc slot itself is cut by the part's builder (it knows the travel).
     """
 
+    kind: ClassVar[str] = "pin-in-arc-slot"
     name: str
-    pin_part: str
-    pin: Vec
-    slot_part: str
+    a: str
+    b: str
     centre: Vec
     radius: float
+    pin: Vec
 
     def residual(self, poses: Mapping[str, Array]) -> Array:
-        p = poses_apply(_pose(poses, self.pin_part), self.pin)
-        c = poses_apply(_pose(poses, self.slot_part), self.centre)
+        p = poses_apply(_pose(poses, self.b), self.pin)
+        c = poses_apply(_pose(poses, self.a), self.centre)
         return np.abs(np.hypot(*(p - c).T) - self.radius)
 
+    def features(self) -> tuple[tuple[str, Feature], ...]:
+        return ()
 
+    def pins(self) -> tuple[tuple[str, Vec], ...]:
+        return ((self.b, self.pin),)
+
+
+@joint_kind
 @dataclass(frozen=True)
 class Slide:
-    """Prismatic joint: ``part`` translates along ``guide``'s line without rotating.
+    """Prismatic joint: part ``b`` translates along the line ``start -> end`` of part ``a`` without turning.
 
-    Realised as two pins of ``part`` (``anchor`` and ``anchor + axis``, with
-    ``axis`` a vector in ``part``'s frame) sliding in one straight slot
-    ``start -> end`` of ``guide`` (the paper's support kind (h)).  The
-    residual is the larger of the two pins' distances from the slot line.
+    Realised as two pins of ``b`` (``anchor`` and ``anchor + axis``, with
+    ``axis`` a vector in ``b``'s frame) sliding in one straight slot
+    ``start -> end`` of ``a`` (the paper's support kind (h)).  The residual
+    is the larger of the two pins' distances from the slot line.  ``width``,
+    when given, is the slot's width: the joint then cuts the slot in ``a`` and
+    the two pin holes in ``b``.
     """
 
+    kind: ClassVar[str] = "slide"
     name: str
-    part: str
-    anchor: Vec
-    axis: Vec
-    guide: str
+    a: str
+    b: str
     start: Vec
     end: Vec
+    anchor: Vec
+    axis: Vec
+    width: float | None = None
+
+    def _pin_points(self) -> tuple[Vec, Vec]:
+        return self.anchor, (self.anchor[0] + self.axis[0], self.anchor[1] + self.axis[1])
 
     def residual(self, poses: Mapping[str, Array]) -> Array:
-        q = _pose(poses, self.part)
-        p1 = poses_apply(q, self.anchor)
-        p2 = poses_apply(q, (self.anchor[0] + self.axis[0], self.anchor[1] + self.axis[1]))
-        a = poses_apply(_pose(poses, self.guide), self.start)
-        b = poses_apply(_pose(poses, self.guide), self.end)
-        return np.maximum(np.abs(_point_line_distance(p1, a, b)), np.abs(_point_line_distance(p2, a, b)))
+        q = _pose(poses, self.b)
+        p1, p2 = (poses_apply(q, p) for p in self._pin_points())
+        s0 = poses_apply(_pose(poses, self.a), self.start)
+        s1 = poses_apply(_pose(poses, self.a), self.end)
+        return np.maximum(np.abs(_point_line_distance(p1, s0, s1)), np.abs(_point_line_distance(p2, s0, s1)))
+
+    def features(self) -> tuple[tuple[str, Feature], ...]:
+        if self.width is None:
+            return ()
+        p1, p2 = self._pin_points()
+        return ((self.a, Slot(self.start, self.end, self.width, "pin")),
+                (self.b, Hole(p1, self.width, "pin")), (self.b, Hole(p2, self.width, "pin")))
+
+    def pins(self) -> tuple[tuple[str, Vec], ...]:
+        return tuple((self.b, p) for p in self._pin_points())
 
 
+@joint_kind
 @dataclass(frozen=True)
 class CamOnLine:
-    """A round cam (``centre``, ``radius`` on ``cam_part``) touching a flat face.
+    """A round cam (``centre``, ``radius`` on part ``b``) touching a flat face of part ``a``.
 
-    The face is the line ``start -> end`` on ``face_part``; residual is
+    The face is the line ``start -> end`` on ``a``; the residual is
     ``| distance(centre, line) - radius |``.
     """
 
+    kind: ClassVar[str] = "cam-on-line"
     name: str
-    cam_part: str
-    centre: Vec
-    radius: float
-    face_part: str
+    a: str
+    b: str
     start: Vec
     end: Vec
+    centre: Vec
+    radius: float
 
     def residual(self, poses: Mapping[str, Array]) -> Array:
-        c = poses_apply(_pose(poses, self.cam_part), self.centre)
-        a = poses_apply(_pose(poses, self.face_part), self.start)
-        b = poses_apply(_pose(poses, self.face_part), self.end)
-        return np.abs(np.abs(_point_line_distance(c, a, b)) - self.radius)
+        c = poses_apply(_pose(poses, self.b), self.centre)
+        s0 = poses_apply(_pose(poses, self.a), self.start)
+        s1 = poses_apply(_pose(poses, self.a), self.end)
+        return np.abs(np.abs(_point_line_distance(c, s0, s1)) - self.radius)
 
+    def features(self) -> tuple[tuple[str, Feature], ...]:
+        return ()
 
-Joint = Pivot | PinInSlot | PinInArcSlot | Slide | CamOnLine
+    def pins(self) -> tuple[tuple[str, Vec], ...]:
+        return ((self.b, self.centre),)
 
 
 # --------------------------------------------------------------------------
@@ -398,7 +510,7 @@ class Mechanism:
 
     name: str
     parts: tuple[Part, ...]
-    joints: tuple[Any, ...]
+    joints: tuple[JointProtocol, ...]
     driver: Driver
     points: dict[str, tuple[str, Vec]]
 
@@ -421,6 +533,25 @@ class Mechanism:
         for pname, (part, _) in self.points.items():
             if part not in names:
                 raise InputError(f"{name}.points.{pname}", part, f"one of the parts {names}")
+        self._check_joints(names)
+        self.parts = _with_joint_features(self.parts, self.joints)
+
+    def _check_joints(self, names: list[str]) -> None:
+        """Every joint is of a registered kind and joins two existing parts."""
+        seen: set[str] = set()
+        for j in self.joints:
+            cls = type(j)
+            kname = cls.__dict__.get("kind")
+            if not isinstance(kname, str) or JOINT_KINDS.get(kname) is not cls:
+                raise InputError(f"{self.name}.joints.{getattr(j, 'name', '?')}", cls.__name__,
+                                 f"a registered joint kind, one of {sorted(JOINT_KINDS)}")
+            if j.name in seen:
+                raise InputError(f"{self.name}.joints", j.name, "unique joint names")
+            seen.add(j.name)
+            for side in ("a", "b"):
+                if getattr(j, side) not in names:
+                    raise InputError(f"{self.name}.joints.{j.name}.{side}", getattr(j, side),
+                                     f"one of the parts {names}")
 
     # -- to implement ------------------------------------------------------
     def _solve_poses(
@@ -458,19 +589,41 @@ class Mechanism:
         t = self.driver.times(samples_per_cycle, cycles)
         return self.solve(self.driver.value(t), t=t)
 
-    @property
+    @cached_property
     def size(self) -> float:
-        """Characteristic length: the largest extent of any part's hull."""
+        """The mechanism's characteristic length, the denominator of every "error / size" figure.
+
+        Defined once, here: the largest diameter of any part, i.e. the
+        largest distance between two points of one part's hull,
+        ``max |c_i - c_j| + r_i + r_j`` over the hull circles ``(c, r)`` of
+        each part (its own frame, so it does not depend on the pose).  Model
+        units; 1.0 for a mechanism with no hulls.
+        """
         best = 0.0
         for p in self.parts:
             if p.hull:
-                h = np.asarray(p.hull)
-                ext = np.ptp(h[:, 0]) + np.ptp(h[:, 1]) + 2 * h[:, 2].max()
-                best = max(best, float(ext))
+                h = np.asarray(p.hull, dtype=float)
+                d = np.hypot(h[:, None, 0] - h[None, :, 0], h[:, None, 1] - h[None, :, 1])
+                best = max(best, float((d + h[:, None, 2] + h[None, :, 2]).max()))
         return best or 1.0
 
     def __repr__(self) -> str:
         return f"<{type(self).__name__} {self.name!r}: {len(self.parts)} parts, {len(self.joints)} joints>"
+
+
+def _with_joint_features(parts: tuple[Part, ...], joints: Sequence[Any]) -> tuple[Part, ...]:
+    """``parts`` with every feature their joints declare added (once; a feature already there is kept)."""
+    extra: dict[str, list[Feature]] = {}
+    for j in joints:
+        for part, feat in j.features():
+            extra.setdefault(part, []).append(feat)
+    if not extra:
+        return parts
+    out = []
+    for p in parts:
+        add = [f for f in dict.fromkeys(extra.get(p.name, ())) if f not in p.features]
+        out.append(replace(p, features=p.features + tuple(add)) if add else p)
+    return tuple(out)
 
 
 def joint_residuals(mech: Mechanism, motion: Motion) -> dict[str, Array]:

@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .geometry import poses_apply
-from .model import Mechanism, Motion, Part, Pivot
+from .model import Mechanism, Motion, Part
 
 __all__ = ["Style", "Renderer", "project", "palette_colors"]
 
@@ -183,12 +183,11 @@ class Renderer:
             sweeps[n] = project(part, poses_apply(motion.poses[pname], np.asarray(pts, float)), self.view)
         pins = {}
         for j in self.mech.joints:
-            if isinstance(j, Pivot):
-                part = self.mech.part(j.a)
-                pins[j.name] = project(part, poses_apply(motion.poses[j.a], j.anchor_a), self.view)
-            elif hasattr(j, "pin_part"):
-                part = self.mech.part(j.pin_part)
-                pins[j.name] = project(part, poses_apply(motion.poses[j.pin_part], j.pin), self.view)
+            # every joint kind states where its pins are (model.JointProtocol.pins)
+            for k, (pname, xy) in enumerate(j.pins()):
+                part = self.mech.part(pname)
+                key = j.name if k == 0 else f"{j.name}#{k}"
+                pins[key] = project(part, poses_apply(motion.poses[pname], xy), self.view)
         return {"parts": parts, "trails": trails, "sweeps": sweeps, "pins": pins}
 
     def _fit(self, world: dict) -> None:

@@ -20,6 +20,7 @@ from typing import Annotated, Any, Literal, Union
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from .effects import Effects, Load, Spring
 from .errors import InputError, PlanarError, SceneError
 from .model import Mechanism, Motion
 
@@ -315,6 +316,19 @@ class Scene:
     def name(self) -> str:
         return self.spec.name or Path(self.path).stem
 
+    @property
+    def effects(self) -> Effects:
+        """The scene's ``[effects]`` as the model's plain record (what ``simulate`` takes)."""
+        e = self.spec.effects
+        return Effects(
+            gravity=None if e.gravity is None else (float(e.gravity[0]), float(e.gravity[1])),
+            contact=e.contact, friction=e.friction, damping=e.damping, density=e.density,
+            springs=tuple(Spring(s.a, s.b, s.stiffness, tuple(s.anchor_a), tuple(s.anchor_b), s.rest_length,
+                                 s.damping) for s in e.springs),
+            loads=tuple(Load(ld.point, (float(ld.force[0]), float(ld.force[1]))) for ld in e.loads),
+            motor_force_limit=e.motor_force_limit,
+        )
+
 
 def load_scene(path: str | Path) -> Scene:
     """Read, validate and build the scene in ``path``."""
@@ -388,8 +402,10 @@ def _rocking(spec: SceneSpec, m: Any) -> dict[str, Any]:
         raise InputError("driver.amplitude", d.amplitude,
                          f"no amplitude for a {m.type!r} mechanism (a rocking input is for {', '.join(_ROCKING)})")
     if isinstance(m, LinkageSpec):
-        first = next((n for n in m.nodes if n.kind in ("crank", "actuator")), None)
-        if first is not None and first.kind == "actuator":
+        from .linkages import NODE_KINDS
+
+        first = next((n for n in m.nodes if NODE_KINDS[n.kind].is_input), None)
+        if first is not None and first.kind == "actuator":  # a translating input: model units
             return {"amplitude": float(d.amplitude), "centre": float(d.centre)}
     return {"amplitude": _angle(spec, d.amplitude), "centre": _angle(spec, d.centre)}
 
@@ -412,33 +428,26 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, A
         return SliderCrank(m.crank, m.rod, offset=m.offset, branch=m.branch, placement=placement,
                            rate=rate, phase=phase, name=spec.name or "slidercrank", **rock)
     if isinstance(m, LinkageSpec):
-        from .linkages import RRP, RRR, Actuator, Crank, Fixed, Link, Linkage, Rigid
+        from .linkages import NODE_KINDS, Link, Linkage
 
         nodes = []
         for n in m.nodes:
-            if n.kind == "fixed":
-                nodes.append(Fixed(n.name, n.at))
-            elif n.kind == "crank":
-                nodes.append(Crank(n.name, n.centre, n.radius, _angle(spec, n.phase)))
-            elif n.kind == "actuator":
-                nodes.append(Actuator(n.name, n.origin, n.axis, n.offset))
-            elif n.kind == "rrr":
-                nodes.append(RRR(n.name, n.a, n.ra, n.b, n.rb, n.branch))
-            elif n.kind == "rrp":
-                nodes.append(RRP(n.name, n.a, n.ra, n.p, n.q, n.branch, n.offset))
-            else:
-                nodes.append(Rigid(n.name, n.a, n.b, n.local))
+            cls = NODE_KINDS[n.kind]  # each node kind declares the scene keys it is built from
+            args = [_angle(spec, getattr(n, f)) if f in cls.angle_fields else getattr(n, f)
+                    for f in cls.scene_fields]
+            nodes.append(cls(n.name, *args))
         links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
         return Linkage(spec.name or "linkage", nodes, links, points=m.points, placement=placement,
                        rate=rate, phase=phase, **rock)
     if isinstance(m, ElementalSpec):
-        from .windup import ElementalMechanism, params_for
+        from .windup import ELEMENTAL, ElementalMechanism, params_for
 
         base = params_for(m.number)
+        angle_params = ELEMENTAL[m.number].angle_params
         kw: dict[str, Any] = {}
         for k, v in m.params.items():
             val = tuple(v) if isinstance(v, list) else v
-            if k in ("phi", "D_theta") or (k == "amplitude" and m.number in (4, 5, 6)):
+            if k in angle_params:
                 val = tuple(_angle(spec, x) for x in val) if isinstance(val, tuple) else _angle(spec, val)
             kw[k] = val
         return ElementalMechanism(m.number, base.replace(**kw), rate=rate, phase=phase)

@@ -33,16 +33,18 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 from numpy.typing import NDArray
 
+from .effects import Effects
 from .errors import PlanarError
 from .model import CamOnLine, Mechanism, Motion, PinInArcSlot, PinInSlot, Pivot, Slide, joint_residuals
+from .registry import Registry
 
 if TYPE_CHECKING:
-    from .scene import EffectsSpec, Scene
+    from .scene import Scene
 
 __all__ = ["SimSettings", "SimResult", "SimulationError", "mass_properties", "simulate", "simulate_scene",
            "DEFAULT_SETTINGS"]
@@ -164,14 +166,14 @@ def _driven_parts(mech: Mechanism) -> list[str]:
     return out
 
 
-def _holding_effect(effects: "EffectsSpec | None") -> bool:
+def _holding_effect(effects: Effects | None) -> bool:
     return effects is not None and (effects.gravity is not None or len(effects.springs) > 0)
 
 
 class _Rebuild:
     """pymunk space, bodies and constraints for one mechanism."""
 
-    def __init__(self, mech: Mechanism, analytic: Motion, effects: "EffectsSpec | None", settings: SimSettings,
+    def __init__(self, mech: Mechanism, analytic: Motion, effects: Effects | None, settings: SimSettings,
                  mode: str, densities: dict[str, float] | None = None) -> None:
         import pymunk
 
@@ -226,13 +228,12 @@ class _Rebuild:
         self.space_pending: list[Any] = []
         built["imposed"] = []
         for j in mech.joints:
-            parts = [getattr(j, f) for f in ("a", "b", "pin_part", "slot_part", "part", "guide", "cam_part",
-                                             "face_part") if hasattr(j, f)]
-            if all(self.bodies[p].body_type != pymunk.Body.DYNAMIC for p in parts):
+            rebuild = REBUILDERS.get(j, f"joint {j.name!r} of {mech.name}")
+            if all(self.bodies[p].body_type != pymunk.Body.DYNAMIC for p in (j.a, j.b)):
                 # e.g. the driver's axle: both sides move as imposed (pymunk 7 allows no joint there)
                 built["imposed"].append(j.name)
                 continue
-            for c in self._joint(j, effects):
+            for c in rebuild(self, j, effects):
                 for body in self.space_pending:
                     space.add(body)
                 self.space_pending.clear()
@@ -280,33 +281,6 @@ class _Rebuild:
             return (float(w[0]), float(w[1]))
         cx, cy = self.cog[part]
         return (float(xy[0] - cx), float(xy[1] - cy))
-
-    def _joint(self, j, effects) -> list:
-        pm = self.pymunk
-        B = self.bodies
-        if isinstance(j, Pivot):
-            return [pm.PivotJoint(B[j.a], B[j.b], self._local(j.a, j.anchor_a), self._local(j.b, j.anchor_b))]
-        if isinstance(j, PinInSlot):
-            a, b = _padded(self._local(j.slot_part, j.start), self._local(j.slot_part, j.end))
-            return self._groove(B[j.slot_part], a, b, j.pin_part, j.pin)
-        if isinstance(j, Slide):
-            a, b = _padded(self._local(j.guide, j.start), self._local(j.guide, j.end))
-            phase = B[j.part].angle - B[j.guide].angle
-            return self._groove(B[j.guide], a, b, j.part, j.anchor) + \
-                [pm.GearJoint(B[j.guide], B[j.part], phase, 1.0)]
-        if isinstance(j, PinInArcSlot):
-            return [pm.PinJoint(B[j.slot_part], B[j.pin_part], self._local(j.slot_part, j.centre),
-                                self._local(j.pin_part, j.pin))]
-        if isinstance(j, CamOnLine):
-            if not _holding_effect(effects):
-                raise SimulationError(
-                    f"{self.mech.name}: joint {j.name!r} is a contact held by gravity or a spring; "
-                    "name one in the scene's [effects] (gravity = [...] or springs = [...])")
-            if j.radius != 0.0:
-                raise SimulationError(f"{self.mech.name}: joint {j.name!r}: a round cam on a face is not rebuilt")
-            a, b = _padded(self._local(j.face_part, j.start), self._local(j.face_part, j.end))
-            return self._groove(B[j.face_part], a, b, j.cam_part, j.centre)
-        raise SimulationError(f"{self.mech.name}: joint {j.name!r} ({type(j).__name__}) has no pymunk rebuild")
 
     def _groove(self, slot_body, a, b, part: str, xy) -> list:
         pm = self.pymunk
@@ -395,6 +369,52 @@ class _Rebuild:
         return out
 
 
+#: pymunk constraints for each joint kind: (rebuild, joint, effects) -> constraints
+REBUILDERS: Registry[Callable[[_Rebuild, Any, Effects | None], list[Any]]] = Registry("simulate")
+
+
+@REBUILDERS.register(Pivot)
+def _pivot(rb: _Rebuild, j: Pivot, effects: Effects | None) -> list[Any]:
+    B = rb.bodies
+    return [rb.pymunk.PivotJoint(B[j.a], B[j.b], rb._local(j.a, j.anchor_a), rb._local(j.b, j.anchor_b))]
+
+
+@REBUILDERS.register(PinInSlot)
+def _pin_in_slot(rb: _Rebuild, j: PinInSlot, effects: Effects | None) -> list[Any]:
+    """``GrooveJoint`` with the groove on the slot's part ``a``, the pin a body pivoted to ``b``."""
+    s0, s1 = _padded(rb._local(j.a, j.start), rb._local(j.a, j.end))
+    return rb._groove(rb.bodies[j.a], s0, s1, j.b, j.pin)
+
+
+@REBUILDERS.register(Slide)
+def _slide(rb: _Rebuild, j: Slide, effects: Effects | None) -> list[Any]:
+    """A groove plus a ``GearJoint`` (ratio 1) locking ``b``'s rotation to ``a``'s."""
+    B = rb.bodies
+    s0, s1 = _padded(rb._local(j.a, j.start), rb._local(j.a, j.end))
+    phase = B[j.b].angle - B[j.a].angle
+    return rb._groove(B[j.a], s0, s1, j.b, j.anchor) + [rb.pymunk.GearJoint(B[j.a], B[j.b], phase, 1.0)]
+
+
+@REBUILDERS.register(PinInArcSlot)
+def _pin_in_arc_slot(rb: _Rebuild, j: PinInArcSlot, effects: Effects | None) -> list[Any]:
+    """The equivalent link: a ``PinJoint`` holding the pin at the arc's radius from its centre."""
+    B = rb.bodies
+    return [rb.pymunk.PinJoint(B[j.a], B[j.b], rb._local(j.a, j.centre), rb._local(j.b, j.pin))]
+
+
+@REBUILDERS.register(CamOnLine)
+def _cam_on_line(rb: _Rebuild, j: CamOnLine, effects: Effects | None) -> list[Any]:
+    """The contact point held on the face by a groove; only where the scene names what holds it."""
+    if not _holding_effect(effects):
+        raise SimulationError(
+            f"{rb.mech.name}: joint {j.name!r} is a contact held by gravity or a spring; "
+            "name one in the scene's [effects] (gravity = [...] or springs = [...])")
+    if j.radius != 0.0:
+        raise SimulationError(f"{rb.mech.name}: joint {j.name!r}: a round cam on a face is not rebuilt")
+    s0, s1 = _padded(rb._local(j.a, j.start), rb._local(j.a, j.end))
+    return rb._groove(rb.bodies[j.a], s0, s1, j.b, j.centre)
+
+
 def _padded(a, b, frac: float = 0.1) -> tuple[tuple[float, float], tuple[float, float]]:
     """A groove ``frac`` of its length longer at each end.
 
@@ -424,7 +444,7 @@ def _analytic_pose_velocity(mech: Mechanism, t: Array) -> tuple[dict[str, Array]
     return m0.poses, vel, m0
 
 
-def simulate(mech: Mechanism, t: Array, effects: "EffectsSpec | None" = None,
+def simulate(mech: Mechanism, t: Array, effects: Effects | None = None,
              settings: SimSettings = DEFAULT_SETTINGS, mode: str = "kinematic",
              densities: dict[str, float] | None = None, torque_bias: float | None = None) -> SimResult:
     """Simulate ``mech`` at output times ``t`` (evenly spaced), driven by the analytic input.
@@ -539,7 +559,7 @@ def simulate(mech: Mechanism, t: Array, effects: "EffectsSpec | None" = None,
 
 def simulate_scene(scene: "Scene", settings: SimSettings = DEFAULT_SETTINGS, mode: str | None = None) -> SimResult:
     """Simulate a scene over its cycles with its effects (kinematic driver unless dynamics are asked for)."""
-    e = scene.spec.effects
+    e = scene.effects
     if mode is None:
         mode = "motor" if e.motor_force_limit is not None else "kinematic"
     motion = scene.motion()
@@ -549,7 +569,7 @@ def simulate_scene(scene: "Scene", settings: SimSettings = DEFAULT_SETTINGS, mod
 # --------------------------------------------------------------------------- torque
 
 
-def inverse_dynamics_torque(mech: Mechanism, t: Array, effects: "EffectsSpec | None",
+def inverse_dynamics_torque(mech: Mechanism, t: Array, effects: Effects | None,
                             point_masses: list[tuple[str, tuple[float, float], float]] | None = None) -> Array:
     """Motor torque by virtual work with inertia (d'Alembert), for a driver turning at a constant rate.
 
@@ -602,7 +622,7 @@ def inverse_dynamics_torque(mech: Mechanism, t: Array, effects: "EffectsSpec | N
     return tau
 
 
-def torque_comparison(mech: Mechanism, t: Array, effects: "EffectsSpec | None",
+def torque_comparison(mech: Mechanism, t: Array, effects: Effects | None,
                       settings: SimSettings = DEFAULT_SETTINGS) -> dict[str, Any]:
     """pymunk's motor torque (from the motor's constraint impulses) against inverse dynamics by virtual work.
 

@@ -33,16 +33,36 @@ def test_every_part_has_a_real_outline(name):
         assert len(poly.interiors) == len(holes), f"{name}.{part.name}: {len(poly.interiors)} vs {len(holes)}"
 
 
-def test_residual_detects_a_broken_joint():
-    # a ternary link whose triangle is not rigid must show a residual
+def test_a_link_whose_nodes_move_apart_is_refused_naming_link_nodes_and_change():
+    # a ternary link whose triangle is not rigid: D hangs from the crank pin, yet the link
+    # "upper" claims Z, B, D are one rigid body
+    from planar.errors import InputError
     from planar.linkages import RRR, Crank, Fixed, Link, Linkage
 
     nodes = [Fixed("O", (0, 0)), Fixed("Z", (-38, -7.8)), Crank("A", "O", 15),
              RRR("B", "A", 50, "Z", 41.5, -1), RRR("D", "A", 55.8, "Z", 40.1, -1)]
-    # D hangs from the crank pin, yet the link "upper" claims Z, B, D are one rigid body
     links = [Link("crank", ("O", "A")), Link("j", ("A", "B")), Link("upper", ("Z", "B", "D")),
              Link("e", ("A", "D"))]
-    lk = Linkage("bad", nodes, links)
-    m = lk.run(360)
-    worst = max(r.max() for r in joint_residuals(lk, m).values())
-    assert worst > 1e-3
+    with pytest.raises(InputError) as e:
+        Linkage("bad", nodes, links)
+    msg = str(e.value)
+    assert "bad.links.upper" in msg and "'B' and 'D'" in msg and "changes by" in msg
+    # the change it names is the true one (independent: the distance B-D over the cycle)
+    ok = Linkage("ok", nodes, links[:2] + [Link("upper", ("Z", "B")), Link("e", ("A", "D")),
+                                            Link("zd", ("Z", "D"))])
+    pos = ok.node_positions(np.linspace(0, 2 * np.pi, 721))
+    d = np.hypot(*(pos["B"] - pos["D"]).T)
+    assert f"{np.ptp(d):.4g}" in msg
+
+
+def test_residual_detects_a_broken_joint():
+    # a motion in which one part is moved off its pose shows a residual at its joints
+    from planar.catalog import jansen_leg
+
+    lk = jansen_leg()
+    m = lk.run(90)
+    m.poses["upper"] = m.poses["upper"] + np.array([0.0, 0.0, 0.01])
+    res = joint_residuals(lk, m)
+    worst = max(r.max() for r in res.values())
+    assert worst > 0.1  # 0.01 rad at about 40 units
+    assert max(res["B"].max(), res["D"].max()) == worst

@@ -13,7 +13,8 @@ from planar import InputError
 from planar.model import joint_residuals
 from planar.windup import elemental
 from planar.windup.chain import bunny, chain_mechanism, horse, rank_trees, tree_cost
-from planar.windup.kinematics import FORWARD, cam_centre
+from planar.windup.kinematics import cam_centre
+from planar.windup.mechanisms import ELEMENTAL
 from planar.windup.mechanisms import MOTIONS
 from planar.windup.sizing import motion_range, size_for_range
 from planar.windup.table import TABLE, chain_counts, enumerate_chains, patterns, realise
@@ -92,8 +93,8 @@ def test_chain_output_is_the_exact_composition():
     P1 = toy.stages[0].mech.params
     dx = cam_centre(P1.D_o, P1.D_jc, q)[:, 0] - P1.D_jc[0]
     np.testing.assert_allclose(outs[0], dx, atol=1e-15)
-    np.testing.assert_allclose(outs[1], FORWARD[9](toy.stages[1].mech.params, dx).out, atol=1e-15)
-    np.testing.assert_allclose(outs[2], FORWARD[8](toy.stages[2].mech.params, dx).out, atol=1e-15)
+    np.testing.assert_allclose(outs[1], ELEMENTAL[9].forward(toy.stages[1].mech.params, dx).out, atol=1e-15)
+    np.testing.assert_allclose(outs[2], ELEMENTAL[8].forward(toy.stages[2].mech.params, dx).out, atol=1e-15)
 
 
 def test_rotated_stage_carries_signs():

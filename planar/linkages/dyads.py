@@ -2,36 +2,54 @@
 
 A linkage is a list of *nodes* (joint centres), each placed in closed form from
 nodes declared before it, and a list of *links* (rigid parts) naming the nodes
-they carry.  Node kinds:
+they carry.  Every node kind is one class that declares itself (the
+:class:`NodeKind` contract, like pylinkage's ``Component``): the nodes it
+references, how its position and its velocity follow from theirs, and its
+name in scene files.  ``NODE_KINDS`` maps that name to the class.
 
-* :class:`Fixed` — a point on the ground.
-* :class:`Crank` — rotates about a node: ``centre + r (cos(q + phase), sin(q + phase))``
-  where ``q`` is the driver angle.
-* :class:`Actuator` — translates with the driver: ``origin + (q + offset) * axis``.
-* :class:`RRR` — distance ``ra`` from node ``a`` and ``rb`` from node ``b``
-  (circle-circle).  ``branch=+1`` places it to the left of ``a -> b``.
-* :class:`RRP` — distance ``ra`` from ``a`` and on the line through ``p -> q``
-  (shifted left by ``offset``), line-circle.  ``branch=+1`` takes the root
-  further along ``p -> q``.
-* :class:`Rigid` — fixed in the frame of nodes ``a, b``: ``a + u e + v e_perp``
-  with ``e`` the unit vector ``a -> b`` (coupler points, ternary links).
+* :class:`Fixed` (``"fixed"``) — a point on the ground.
+* :class:`Crank` (``"crank"``) — rotates about a node:
+  ``centre + r (cos(q + phase), sin(q + phase))`` with ``q`` the driver angle.
+* :class:`Actuator` (``"actuator"``) — translates with the driver:
+  ``origin + (q + offset) * axis``.
+* :class:`RRR` (``"rrr"``) — distance ``ra`` from node ``a`` and ``rb`` from
+  node ``b`` (circle-circle).  ``branch=+1`` starts it to the left of ``a -> b``.
+* :class:`RRP` (``"rrp"``) — distance ``ra`` from ``a`` and on the line
+  through ``p -> q`` (shifted left by ``offset``), line-circle.
+  ``branch=+1`` starts it at the root further along ``p -> q``.
+* :class:`Rigid` (``"rigid"``) — fixed in the frame of nodes ``a, b``:
+  ``a + u e + v e_perp`` with ``e`` the unit vector ``a -> b`` (coupler
+  points, ternary links, a lever's far end).
 
 A link's frame has its origin at its first node and its x axis toward its
-second; a link with one node and a ``guide`` keeps the guide line's direction
-(a slider block).  Joints follow from the declaration: a node shared by links
-is a pivot; an RRP node is a pin in a straight slot of the link that carries
-the line, or a slide when the carrying link is guided by that line.
+second; a link with one node and a ``guide`` ``(p, q)`` keeps the guide
+line's direction (a slider block).  Joints follow from the declaration: a
+node shared by links is a pivot; an RRP node is a pin in a straight slot of
+the link that carries the line; a guided link is a block sliding along the
+line of the link that carries ``p`` and ``q``, which may itself move (the
+inverted slider-crank family: a quick return's block in its slotted lever, an
+oscillating cylinder's piston).  Each link is checked to be rigid: nodes on
+one link that move relative to each other are refused when the linkage is
+built.
 
 Every node is solved for all driver values at once (numpy, no per-sample
-loop).  A branch is a fixed side of a fixed directed line, so it is continuous
-through a full input sweep wherever the dyad can close; where it cannot, the
-sample is invalid with the node named.
+loop).  **Branches.**  The samples are taken as a path, in their order: the
+declared branch holds at the first sample, and is carried by continuity of
+the motion through singular samples (two roots meeting, as a change-point
+four-bar's at its flat positions, or a dyad's two centres passing through
+each other, as a kite's): at each sample the root taken is the one that
+continues the quadratic extrapolation of the node's three previous valid
+samples, where that prediction prefers the other root by a factor of 4.
+Continuity is only applied where the driver steps of those samples have one
+sign and agree within a factor of 1.5 (a path, not a scattered batch), so a
+batch of unrelated driver values gets the declared branch throughout.
+Where a dyad cannot close the sample is invalid with the node named.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Mapping, Sequence
+from typing import ClassVar, Mapping, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -40,47 +58,238 @@ from ..errors import AssemblyError, InputError
 from ..geometry import circle_circle, line_circle, poses_apply, poses_compose, poses_invert
 from ..model import (
     Driver,
-    Hole,
     Mechanism,
     Part,
     PinInSlot,
     Pivot,
     Slide,
-    Slot,
     check_finite,
     check_positive,
 )
 
-__all__ = ["Fixed", "Crank", "Actuator", "RRR", "RRP", "Rigid", "Link", "Linkage", "Node"]
+__all__ = ["Fixed", "Crank", "Actuator", "RRR", "RRP", "Rigid", "Link", "Linkage", "Node", "NodeKind",
+           "NODE_KINDS", "node_kind", "carry_branch"]
 
 Vec = tuple[float, float]
 Array = NDArray[np.float64]
+Mask = NDArray[np.bool_]
+Check = tuple[Mask, str]
+
+#: every node kind, by its scene name (filled by :func:`node_kind`)
+NODE_KINDS: dict[str, type["NodeKind"]] = {}
 
 
+def node_kind(cls: type["NodeKind"]) -> type["NodeKind"]:
+    """Class decorator: register a node kind under its ``kind`` name (a double is a :class:`TypeError`)."""
+    name = cls.__dict__.get("kind")
+    if not isinstance(name, str):
+        raise TypeError(f"node kind {cls.__name__} needs a class attribute 'kind'")
+    if name in NODE_KINDS:
+        raise TypeError(f"double registration for node kind {name!r}")
+    NODE_KINDS[name] = cls
+    return cls
+
+
+def _perp(v: Array) -> Array:
+    return np.stack([-v[:, 1], v[:, 0]], -1)
+
+
+def _cross(a: Array, b: Array) -> Array:
+    return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+
+
+def _solve2(r1: Array, b1: Array, r2: Array, b2: Array) -> tuple[Array, Mask]:
+    """Solve ``r1 . v = b1, r2 . v = b2`` per sample (Cramer); ``ok`` false where singular."""
+    det = r1[:, 0] * r2[:, 1] - r1[:, 1] * r2[:, 0]
+    scale = np.hypot(r1[:, 0], r1[:, 1]) * np.hypot(r2[:, 0], r2[:, 1])
+    sing = np.abs(det) <= 1e-12 * scale
+    det = np.where(sing, 1.0, det)
+    vx = (b1 * r2[:, 1] - b2 * r1[:, 1]) / det
+    vy = (r1[:, 0] * b2 - r2[:, 0] * b1) / det
+    return np.stack([vx, vy], -1), ~sing
+
+
+def carry_branch(keep: Array, other: Array, valid: Mask, path: Mask) -> NDArray[np.bool_]:
+    """Where the motion continues on the ``other`` root rather than the declared one.
+
+    ``keep`` and ``other`` are the two roots ``(N, 2)`` of a dyad, ``valid``
+    where it closes, ``path[k]`` where samples ``k-3 .. k`` are a path (see the
+    module's note on branches).  Returns ``flip`` ``(N,)``: the samples where
+    the other root is taken.  Each switch is found with array operations over
+    the remaining samples; the loop runs once per switch plus once.
+    """
+    n = keep.shape[0]
+    flip = np.zeros(n, dtype=bool)
+    if n < 4:
+        return flip
+    idx = np.arange(n)
+    last = np.maximum.accumulate(np.where(valid, idx, -1))
+    prev = np.concatenate([[-1], last[:-1]])  # prev[k]: the last valid sample before k
+
+    def back(i: NDArray[np.int_]) -> NDArray[np.int_]:
+        return np.where(i >= 0, prev[np.maximum(i, 0)], -1)
+
+    p1 = prev
+    p2 = back(p1)
+    p3 = back(p2)
+    ok = valid & (p3 >= 0) & (idx - p3 <= 8) & path
+    ks = np.flatnonzero(ok)
+    if ks.size == 0:
+        return flip
+    i1, i2, i3 = p1[ks], p2[ks], p3[ks]
+    # quadratic (Lagrange) extrapolation in the sample index to k
+    t, t1, t2, t3 = ks.astype(float), i1.astype(float), i2.astype(float), i3.astype(float)
+    w1 = (t - t2) * (t - t3) / ((t1 - t2) * (t1 - t3))
+    w2 = (t - t1) * (t - t3) / ((t2 - t1) * (t2 - t3))
+    w3 = (t - t1) * (t - t2) / ((t3 - t1) * (t3 - t2))
+    cur = keep.copy()
+    alt = other.copy()
+    start = 0
+    while True:
+        sel = slice(start, None)
+        k, a1, a2, a3 = ks[sel], i1[sel], i2[sel], i3[sel]
+        pred = w1[sel, None] * cur[a1] + w2[sel, None] * cur[a2] + w3[sel, None] * cur[a3]
+        dk = np.hypot(*(cur[k] - pred).T)
+        da = np.hypot(*(alt[k] - pred).T)
+        hit = np.flatnonzero(4.0 * da < dk)
+        if hit.size == 0:
+            return flip
+        j = int(k[hit[0]])
+        flip[j:] ^= True
+        cur[j:], alt[j:] = alt[j:].copy(), cur[j:].copy()
+        start += int(hit[0]) + 1
+
+
+class NodeKind:
+    """What a node kind declares (subclasses are frozen dataclasses with a ``name``).
+
+    ``kind`` is its name in scene files, ``scene_fields`` the scene keys
+    passed to its constructor after ``name`` (``angle_fields`` among them are
+    angles, converted from the scene's angle unit).  ``is_input``: the node
+    moves with the driver value.
+    """
+
+    kind: ClassVar[str]
+    scene_fields: ClassVar[tuple[str, ...]] = ()
+    angle_fields: ClassVar[tuple[str, ...]] = ()
+    is_input: ClassVar[bool] = False
+    name: str
+
+    def refs(self) -> tuple[str, ...]:
+        """The nodes this one is placed from (declared before it)."""
+        return ()
+
+    def validate(self, where: str) -> None:
+        """Raise :class:`InputError` (naming ``where``) for unusable values."""
+
+    def position(self, pos: Mapping[str, Array], q: Array, path: Mask) -> tuple[Array, Check | None]:
+        """World position ``(N, 2)`` and, for a node that can fail to close, ``(valid, why)``."""
+        raise NotImplementedError
+
+    def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
+        """Velocity ``(N, 2)`` from the positions and the velocities of the nodes before it.
+
+        ``qd`` is the driver's rate (rad/s or units/s) per sample; ``ok``
+        false where the differentiated closure is singular (a toggle).
+        """
+        raise NotImplementedError
+
+
+@node_kind
 @dataclass(frozen=True)
-class Fixed:
+class Fixed(NodeKind):
+    """A point ``xy`` on the ground."""
+
+    kind: ClassVar[str] = "fixed"
+    scene_fields: ClassVar[tuple[str, ...]] = ("at",)
     name: str
     xy: Vec
 
+    def validate(self, where: str) -> None:
+        check_finite(f"{where}.xy", self.xy)
 
+    def position(self, pos: Mapping[str, Array], q: Array, path: Mask) -> tuple[Array, Check | None]:
+        return np.broadcast_to(np.asarray(self.xy, float), (q.shape[0], 2)), None
+
+    def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
+        return np.zeros((qd.shape[0], 2)), None
+
+
+@node_kind
 @dataclass(frozen=True)
-class Crank:
+class Crank(NodeKind):
+    """Turns about node ``centre`` at ``radius``: angle ``q + phase`` (rad, counter-clockwise)."""
+
+    kind: ClassVar[str] = "crank"
+    scene_fields: ClassVar[tuple[str, ...]] = ("centre", "radius", "phase")
+    angle_fields: ClassVar[tuple[str, ...]] = ("phase",)
+    is_input: ClassVar[bool] = True
     name: str
     centre: str
     radius: float
     phase: float = 0.0
 
+    def refs(self) -> tuple[str, ...]:
+        return (self.centre,)
 
+    def validate(self, where: str) -> None:
+        check_positive(f"{where}.radius", self.radius)
+        check_finite(f"{where}.phase", self.phase)
+
+    def position(self, pos: Mapping[str, Array], q: Array, path: Mask) -> tuple[Array, Check | None]:
+        a = q + self.phase
+        return pos[self.centre] + self.radius * np.stack([np.cos(a), np.sin(a)], -1), None
+
+    def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
+        return vel[self.centre] + qd[:, None] * _perp(pos[self.name] - pos[self.centre]), None
+
+
+@node_kind
 @dataclass(frozen=True)
-class Actuator:
+class Actuator(NodeKind):
+    """Translates with the driver: ``origin + (q + offset) * axis / |axis|`` (model units)."""
+
+    kind: ClassVar[str] = "actuator"
+    scene_fields: ClassVar[tuple[str, ...]] = ("origin", "axis", "offset")
+    is_input: ClassVar[bool] = True
     name: str
     origin: str
     axis: Vec = (1.0, 0.0)
     offset: float = 0.0
 
+    def refs(self) -> tuple[str, ...]:
+        return (self.origin,)
 
+    def validate(self, where: str) -> None:
+        ax = check_finite(f"{where}.axis", self.axis)
+        if np.hypot(*ax) == 0:
+            raise InputError(f"{where}.axis", self.axis, "a non-zero direction")
+        check_finite(f"{where}.offset", self.offset)
+
+    @property
+    def unit_axis(self) -> Array:
+        ax = np.asarray(self.axis, float)
+        return ax / np.hypot(*ax)
+
+    def position(self, pos: Mapping[str, Array], q: Array, path: Mask) -> tuple[Array, Check | None]:
+        return pos[self.origin] + (q + self.offset)[:, None] * self.unit_axis, None
+
+    def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
+        return vel[self.origin] + qd[:, None] * self.unit_axis, None
+
+
+def _check_branch(where: str, branch: int) -> None:
+    if branch not in (1, -1):
+        raise InputError(f"{where}.branch", branch, "+1 or -1")
+
+
+@node_kind
 @dataclass(frozen=True)
-class RRR:
+class RRR(NodeKind):
+    """At ``ra`` from node ``a`` and ``rb`` from node ``b`` (circle-circle); ``branch`` +1: left of ``a -> b``."""
+
+    kind: ClassVar[str] = "rrr"
+    scene_fields: ClassVar[tuple[str, ...]] = ("a", "ra", "b", "rb", "branch")
     name: str
     a: str
     ra: float
@@ -88,9 +297,36 @@ class RRR:
     rb: float
     branch: int = 1
 
+    def refs(self) -> tuple[str, ...]:
+        return (self.a, self.b)
 
+    def validate(self, where: str) -> None:
+        check_positive(f"{where}.ra", self.ra)
+        check_positive(f"{where}.rb", self.rb)
+        _check_branch(where, self.branch)
+
+    def position(self, pos: Mapping[str, Array], q: Array, path: Mask) -> tuple[Array, Check | None]:
+        keep, ok = circle_circle(pos[self.a], self.ra, pos[self.b], self.rb, self.branch)
+        other, _ = circle_circle(pos[self.a], self.ra, pos[self.b], self.rb, -self.branch)
+        flip = carry_branch(keep, other, ok, path)
+        p = np.where(flip[:, None], other, keep) if flip.any() else keep
+        return p, (ok, f"links of length {self.ra:g} (from {self.a!r}) and {self.rb:g} (from {self.b!r}) "
+                       "cannot span the distance between them")
+
+    def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
+        # (P - A) . (vP - vA) = 0 and (P - B) . (vP - vB) = 0
+        P = pos[self.name]
+        r1, r2 = P - pos[self.a], P - pos[self.b]
+        return _solve2(r1, (r1 * vel[self.a]).sum(-1), r2, (r2 * vel[self.b]).sum(-1))
+
+
+@node_kind
 @dataclass(frozen=True)
-class RRP:
+class RRP(NodeKind):
+    """At ``ra`` from node ``a`` on the line ``p -> q`` shifted left by ``offset``; ``branch`` +1: further along."""
+
+    kind: ClassVar[str] = "rrp"
+    scene_fields: ClassVar[tuple[str, ...]] = ("a", "ra", "p", "q", "branch", "offset")
     name: str
     a: str
     ra: float
@@ -99,13 +335,70 @@ class RRP:
     branch: int = 1
     offset: float = 0.0
 
+    def refs(self) -> tuple[str, ...]:
+        return (self.a, self.p, self.q)
 
+    def validate(self, where: str) -> None:
+        check_positive(f"{where}.ra", self.ra)
+        check_finite(f"{where}.offset", self.offset)
+        _check_branch(where, self.branch)
+
+    def position(self, pos: Mapping[str, Array], q: Array, path: Mask) -> tuple[Array, Check | None]:
+        p0, p1 = pos[self.p], pos[self.q]
+        u = p1 - p0
+        un = np.hypot(u[:, 0], u[:, 1])[:, None]
+        base = p0 + self.offset * _perp(u) / np.where(un > 0, un, 1.0)
+        keep, ok, _ = line_circle(base, u, pos[self.a], self.ra, self.branch)
+        other, _, _ = line_circle(base, u, pos[self.a], self.ra, -self.branch)
+        flip = carry_branch(keep, other, ok, path)
+        p = np.where(flip[:, None], other, keep) if flip.any() else keep
+        return p, (ok, f"a link of length {self.ra:g} from {self.a!r} cannot reach the line {self.p!r}-{self.q!r}")
+
+    def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
+        # |P - A| = ra and cross(w, P - p) = e |w|, differentiated:
+        # cross(w, vP) = e (w . vw)/|w| - cross(vw, P - p) + cross(w, vp)
+        P = pos[self.name]
+        r1 = P - pos[self.a]
+        p0, vp0 = pos[self.p], vel[self.p]
+        w = pos[self.q] - p0
+        vw = vel[self.q] - vp0
+        wn = np.hypot(w[:, 0], w[:, 1])
+        b2 = self.offset * (w * vw).sum(-1) / wn - _cross(vw, P - p0) + _cross(w, vp0)
+        return _solve2(r1, (r1 * vel[self.a]).sum(-1), _perp(w), b2)
+
+
+@node_kind
 @dataclass(frozen=True)
-class Rigid:
+class Rigid(NodeKind):
+    """Fixed in the frame of nodes ``a, b``: ``a + u e + v e_perp``, ``e`` the unit vector ``a -> b``."""
+
+    kind: ClassVar[str] = "rigid"
+    scene_fields: ClassVar[tuple[str, ...]] = ("a", "b", "local")
     name: str
     a: str
     b: str
     local: Vec
+
+    def refs(self) -> tuple[str, ...]:
+        return (self.a, self.b)
+
+    def validate(self, where: str) -> None:
+        check_finite(f"{where}.local", self.local)
+
+    def position(self, pos: Mapping[str, Array], q: Array, path: Mask) -> tuple[Array, Check | None]:
+        a, b = pos[self.a], pos[self.b]
+        e = b - a
+        en = np.hypot(e[:, 0], e[:, 1])
+        ok = en > 0
+        e = e / np.where(ok, en, 1.0)[:, None]
+        u, v = self.local
+        return a + u * e + v * _perp(e), (ok, f"nodes {self.a!r} and {self.b!r} coincide")
+
+    def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
+        a = pos[self.a]
+        d = pos[self.b] - a
+        omega = _cross(d, vel[self.b] - vel[self.a]) / (d * d).sum(-1)
+        return vel[self.a] + omega[:, None] * _perp(pos[self.name] - a), None
 
 
 Node = Fixed | Crank | Actuator | RRR | RRP | Rigid
@@ -113,25 +406,25 @@ Node = Fixed | Crank | Actuator | RRR | RRP | Rigid
 
 @dataclass(frozen=True)
 class Link:
-    """A rigid part carrying ``nodes``; ``guide`` makes a one-node slider block."""
+    """A rigid part carrying ``nodes``; ``guide`` ``(p, q)`` makes it a block sliding along that line."""
 
     name: str
     nodes: tuple[str, ...]
     guide: tuple[str, str] | None = None
 
 
-def _refs(n: Node) -> tuple[str, ...]:
-    if isinstance(n, Fixed):
-        return ()
-    if isinstance(n, Crank):
-        return (n.centre,)
-    if isinstance(n, Actuator):
-        return (n.origin,)
-    if isinstance(n, RRR):
-        return (n.a, n.b)
-    if isinstance(n, RRP):
-        return (n.a, n.p, n.q)
-    return (n.a, n.b)
+def path_mask(q: Array) -> Mask:
+    """``path[k]``: the driver steps into samples ``k-3 .. k`` share one sign and agree within 1.5x."""
+    n = q.shape[0]
+    out = np.zeros(n, dtype=bool)
+    if n < 4:
+        return out
+    dq = np.diff(q)
+    a, b, c = dq[:-2], dq[1:-1], dq[2:]
+    same = ((a > 0) & (b > 0) & (c > 0)) | ((a < 0) & (b < 0) & (c < 0))
+    mag = np.abs(np.stack([a, b, c]))
+    out[3:] = same & (mag.max(0) <= 1.5 * mag.min(0))
+    return out
 
 
 class Linkage(Mechanism):
@@ -140,13 +433,15 @@ class Linkage(Mechanism):
     ``placement`` ``(x, y, angle)`` places the whole linkage in the world
     (the linkage is solved in its own frame, then transformed).  ``width``
     and ``pin_diameter`` size the parts' outlines (default: 8 % and 3 % of
-    the linkage's span).  ``points`` maps names to node names.
+    the linkage's span).  ``points`` maps names to node names.  A driver that
+    rocks instead of turning: ``amplitude`` and ``centre`` (rad or units), so
+    the input is ``centre + amplitude sin(rate t + phase)``.
     """
 
     def __init__(
         self,
         name: str,
-        nodes: Sequence[Node],
+        nodes: Sequence[NodeKind],
         links: Sequence[Link],
         points: Mapping[str, str] | None = None,
         placement: Sequence[float] = (0.0, 0.0, 0.0),
@@ -158,16 +453,17 @@ class Linkage(Mechanism):
         pin_diameter: float | None = None,
         ground: str = "ground",
     ) -> None:
-        self.nodes: tuple[Node, ...] = tuple(nodes)
+        self.name = name
+        self.nodes: tuple[NodeKind, ...] = tuple(nodes)
         self.placement = tuple(float(v) for v in check_finite(f"{name}.placement", placement))
         self._validate_nodes(name)
-        self.links = self._with_ground(tuple(links), ground)
         self.ground_name = ground
+        self.links = self._with_ground(tuple(links), ground)
         self._validate_links(name)
-        drivers = [n for n in self.nodes if isinstance(n, (Crank, Actuator))]
-        if not drivers:
-            raise InputError(f"{name}.nodes", [n.name for n in self.nodes], "one Crank or Actuator node as the input")
-        self._driver_node = drivers[0]
+        inputs = [n for n in self.nodes if n.is_input]
+        if not inputs:
+            raise InputError(f"{name}.nodes", [n.name for n in self.nodes], "one crank or actuator node as the input")
+        self._driver_node = inputs[0]
         driver_link = self._link_of(self._driver_node.name, exclude_ground=True)
         byname = {n.name: n for n in self.nodes}
         if isinstance(self._driver_node, Crank):
@@ -176,20 +472,28 @@ class Linkage(Mechanism):
             driver = Driver(driver_link, "rotation", origin=origin, rate=rate, phase=phase,
                             amplitude=amplitude, centre=centre)
         else:
-            ax = np.asarray(self._driver_node.axis, float)
-            driver = Driver(driver_link, "translation", axis=tuple(ax / np.hypot(*ax)), rate=rate,
-                            phase=phase, amplitude=amplitude if amplitude is not None else 1.0, centre=centre)
-        # reference configuration: the first assemblable sample of a sweep
-        q_ref = self._reference_input(name, driver)
-        ref = self.solve_nodes(np.array([q_ref]))[0]
-        self._ref_nodes = {k: v[0] for k, v in ref.items()}
+            ax = np.asarray(getattr(self._driver_node, "axis", (1.0, 0.0)), float)
+            driver = Driver(driver_link, "translation", axis=(float(ax[0] / np.hypot(*ax)), float(ax[1] / np.hypot(*ax))),
+                            rate=rate, phase=phase, amplitude=amplitude if amplitude is not None else 1.0, centre=centre)
+        self.driver = driver
+        # one sweep of the driver's cycle: the reference configuration, rigidity, slot travel
+        self._sweep_q = self._cycle_inputs(driver)
+        self._sweep_pos, sweep_ok = self._solve_valid(self._sweep_q)
+        if not sweep_ok.any():
+            _, checks = self.solve_nodes(self._sweep_q)
+            joint, why = next(((j, w) for m, j, w in checks if not m.any()), (checks[0][1], checks[0][2]))
+            raise AssemblyError(f"{name}: cannot be assembled at any driver value: joint {joint!r}: {why}")
+        self._sweep_ok = sweep_ok
+        k_ref = int(np.argmax(sweep_ok))
+        self._ref_nodes = {k: v[k_ref] for k, v in self._sweep_pos.items()}
+        self._check_rigid(name)
         span = self._span()
         self.width = check_positive(f"{name}.width", width) if width is not None else 0.08 * span
         self.pin_diameter = (
             check_positive(f"{name}.pin_diameter", pin_diameter) if pin_diameter is not None else 0.03 * span
         )
         self._anchors = self._local_anchors()
-        parts, joints = self._build_parts_and_joints(driver)
+        parts, joints = self._build_parts_and_joints()
         pts = {}
         #: named point -> the node that defines it
         self.point_nodes: dict[str, str] = dict(points or {})
@@ -204,33 +508,17 @@ class Linkage(Mechanism):
     def _validate_nodes(self, name: str) -> None:
         seen: set[str] = set()
         for n in self.nodes:
-            where = f"{name}.nodes.{n.name}"
+            where = f"{name}.nodes.{getattr(n, 'name', '?')}"
+            cls = type(n)
+            kname = cls.__dict__.get("kind")
+            if not isinstance(kname, str) or NODE_KINDS.get(kname) is not cls:
+                raise InputError(where, cls.__name__, f"a registered node kind, one of {sorted(NODE_KINDS)}")
             if n.name in seen:
                 raise InputError(where, n.name, "a node name used once")
-            for r in _refs(n):
+            for r in n.refs():
                 if r not in seen:
                     raise InputError(where, r, "a node declared before it")
-            if isinstance(n, Fixed):
-                check_finite(f"{where}.xy", n.xy)
-            elif isinstance(n, Crank):
-                check_positive(f"{where}.radius", n.radius)
-                check_finite(f"{where}.phase", n.phase)
-            elif isinstance(n, Actuator):
-                ax = check_finite(f"{where}.axis", n.axis)
-                if np.hypot(*ax) == 0:
-                    raise InputError(f"{where}.axis", n.axis, "a non-zero direction")
-            elif isinstance(n, RRR):
-                check_positive(f"{where}.ra", n.ra)
-                check_positive(f"{where}.rb", n.rb)
-                if n.branch not in (1, -1):
-                    raise InputError(f"{where}.branch", n.branch, "+1 or -1")
-            elif isinstance(n, RRP):
-                check_positive(f"{where}.ra", n.ra)
-                check_finite(f"{where}.offset", n.offset)
-                if n.branch not in (1, -1):
-                    raise InputError(f"{where}.branch", n.branch, "+1 or -1")
-            elif isinstance(n, Rigid):
-                check_finite(f"{where}.local", n.local)
+            n.validate(where)
             seen.add(n.name)
 
     def _with_ground(self, links: tuple[Link, ...], ground: str) -> tuple[Link, ...]:
@@ -250,8 +538,27 @@ class Linkage(Mechanism):
             for n in lk.nodes:
                 if n not in names:
                     raise InputError(f"{where}.nodes", n, f"a node name, one of {sorted(names)}")
+            if len(set(lk.nodes)) != len(lk.nodes):
+                raise InputError(f"{where}.nodes", lk.nodes, "each node once")
             if lk.name != self.ground_name and len(lk.nodes) < 2 and lk.guide is None:
                 raise InputError(f"{where}.nodes", lk.nodes, "two or more nodes (or one node and a guide)")
+            if lk.guide is not None:
+                for g in lk.guide:
+                    if g not in names:
+                        raise InputError(f"{where}.guide", g, f"a node name, one of {sorted(names)}")
+                if lk.guide[0] == lk.guide[1]:
+                    raise InputError(f"{where}.guide", lk.guide, "two different nodes")
+                self._guide_owner(lk)  # raises if no other link carries the guide line
+
+    def _guide_owner(self, lk: Link) -> str:
+        """The link (not ``lk``) that carries both nodes of ``lk``'s guide line."""
+        assert lk.guide is not None
+        p, q = lk.guide
+        for other in self.links:
+            if other.name != lk.name and p in other.nodes and q in other.nodes:
+                return other.name
+        raise InputError(f"{self.name}.links.{lk.name}.guide", list(lk.guide),
+                         "two nodes carried by one other link (the link the block slides along)")
 
     def _link_of(self, node: str, exclude_ground: bool) -> str:
         for lk in self.links:
@@ -259,66 +566,63 @@ class Linkage(Mechanism):
                 continue
             if node in lk.nodes:
                 return lk.name
-        raise InputError(f"{self.name if hasattr(self, 'name') else 'linkage'}.links", node,
-                         "a link that carries this node")
+        raise InputError(f"{self.name}.links", node, "a link that carries this node")
 
-    def _reference_input(self, name: str, driver: Driver) -> float:
+    def _cycle_inputs(self, driver: Driver, n: int = 721) -> Array:
+        """Driver values over one cycle of its law (a full turn for a turning crank)."""
         if driver.amplitude is None:
-            q = driver.phase + np.linspace(0.0, 2 * np.pi, 721)
-        else:
-            q = driver.value(np.linspace(0.0, driver.period, 721))
-        nodes, checks = self.solve_nodes(q)
+            return driver.phase + np.linspace(0.0, 2 * np.pi, n)
+        return driver.value(np.linspace(0.0, driver.period, n))
+
+    def _solve_valid(self, q: Array) -> tuple[dict[str, Array], Mask]:
+        pos, checks = self.solve_nodes(q)
         ok = np.ones(q.shape, bool)
         for m, _, _ in checks:
             ok &= m
-        if not ok.any():
-            joint, why = checks[0][1], checks[0][2]
-            for m, j, w in checks:
-                if not m.any():
-                    joint, why = j, w
-                    break
-            raise AssemblyError(f"{name}: cannot be assembled at any driver value: joint {joint!r}: {why}")
-        return float(q[np.argmax(ok)])
+        return pos, ok
+
+    def _check_rigid(self, name: str) -> None:
+        """Refuse a link whose nodes move relative to each other over the driver's cycle."""
+        ok = self._sweep_ok
+        P = {k: v[ok] for k, v in self._sweep_pos.items()}
+        tol = 1e-9 * self._span()
+        for lk in self.links:
+            nodes = list(lk.nodes)
+            for i, a in enumerate(nodes):
+                for b in nodes[i + 1:]:
+                    d = np.hypot(*(P[a] - P[b]).T)
+                    change = float(d.max() - d.min())
+                    if change > tol:
+                        raise InputError(
+                            f"{name}.links.{lk.name}", nodes,
+                            f"a rigid link: nodes {a!r} and {b!r} move relative to each other "
+                            f"(their distance changes by {change:.4g}, from {d.min():.6g} to {d.max():.6g})")
+            if lk.guide is not None and len(nodes) >= 2:
+                g = P[lk.guide[1]] - P[lk.guide[0]]
+                e = P[nodes[1]] - P[nodes[0]]
+                turn = np.arctan2(_cross(g, e), (g * e).sum(-1))
+                dev = float(np.ptp(np.unwrap(turn)))
+                if dev > 1e-9:
+                    raise InputError(
+                        f"{name}.links.{lk.name}", nodes,
+                        f"a block that keeps its guide's direction: nodes {nodes[0]!r}-{nodes[1]!r} turn by "
+                        f"{dev:.4g} rad against the guide {lk.guide[0]!r}-{lk.guide[1]!r}")
 
     # -- solving ------------------------------------------------------------
-    def solve_nodes(self, q: Array) -> tuple[dict[str, Array], list[tuple[NDArray[np.bool_], str, str]]]:
-        """World positions ``(N, 2)`` of every node (before placement) and validity checks."""
-        n = q.shape[0]
+    def solve_nodes(self, q: Array) -> tuple[dict[str, Array], list[tuple[Mask, str, str]]]:
+        """World positions ``(N, 2)`` of every node (before placement) and validity checks.
+
+        The samples are a path in their order (see the module's note on branches).
+        """
+        q = np.asarray(q, dtype=float)
+        path = path_mask(q)
         pos: dict[str, Array] = {}
-        checks: list[tuple[NDArray[np.bool_], str, str]] = []
+        checks: list[tuple[Mask, str, str]] = []
         for node in self.nodes:
-            if isinstance(node, Fixed):
-                pos[node.name] = np.broadcast_to(np.asarray(node.xy, float), (n, 2))
-            elif isinstance(node, Crank):
-                a = q + node.phase
-                pos[node.name] = pos[node.centre] + node.radius * np.stack([np.cos(a), np.sin(a)], -1)
-            elif isinstance(node, Actuator):
-                ax = np.asarray(node.axis, float)
-                ax = ax / np.hypot(*ax)
-                pos[node.name] = pos[node.origin] + (q + node.offset)[:, None] * ax
-            elif isinstance(node, RRR):
-                p, ok = circle_circle(pos[node.a], node.ra, pos[node.b], node.rb, node.branch)
-                pos[node.name] = p
-                checks.append((ok, node.name, f"links of length {node.ra:g} (from {node.a!r}) and "
-                               f"{node.rb:g} (from {node.b!r}) cannot span the distance between them"))
-            elif isinstance(node, RRP):
-                p0, p1 = pos[node.p], pos[node.q]
-                u = p1 - p0
-                un = np.hypot(u[:, 0], u[:, 1])[:, None]
-                base = p0 + node.offset * np.stack([-u[:, 1], u[:, 0]], -1) / un
-                p, ok, _ = line_circle(base, u, pos[node.a], node.ra, node.branch)
-                pos[node.name] = p
-                checks.append((ok, node.name, f"a link of length {node.ra:g} from {node.a!r} cannot "
-                               f"reach the line {node.p!r}-{node.q!r}"))
-            else:  # Rigid
-                a, b = pos[node.a], pos[node.b]
-                e = b - a
-                en = np.hypot(e[:, 0], e[:, 1])
-                ok = en > 0
-                e = e / np.where(ok, en, 1.0)[:, None]
-                u, v = node.local
-                pos[node.name] = a + u * e + v * np.stack([-e[:, 1], e[:, 0]], -1)
-                checks.append((ok, node.name, f"nodes {node.a!r} and {node.b!r} coincide"))
+            p, check = node.position(pos, q, path)
+            pos[node.name] = p
+            if check is not None:
+                checks.append((check[0], node.name, check[1]))
         return pos, checks
 
     def _link_poses(self, pos: Mapping[str, Array], n: int) -> dict[str, Array]:
@@ -343,6 +647,26 @@ class Linkage(Mechanism):
             poses = {k: poses_compose(pl, v) for k, v in poses.items()}
         return poses, checks
 
+    def node_velocities(self, q: Array, qdot: Array | float = 1.0) -> tuple[dict[str, Array], Mask]:
+        """Velocity ``(N, 2)`` of every node (own frame, before placement) and where it is defined.
+
+        Each node kind differentiates its own closure (:meth:`NodeKind.velocity`);
+        ``qdot = 1`` gives velocity coefficients ``dX/dq``.
+        """
+        qa = np.atleast_1d(np.asarray(q, float))
+        qd = np.broadcast_to(np.asarray(qdot, float), qa.shape)
+        pos, checks = self.solve_nodes(qa)
+        valid = np.ones(qa.shape, bool)
+        for m, _, _ in checks:
+            valid &= m
+        vel: dict[str, Array] = {}
+        for node in self.nodes:
+            v, ok = node.velocity(pos, vel, qd)
+            vel[node.name] = v
+            if ok is not None:
+                valid &= ok
+        return vel, valid
+
     # -- parts and joints -----------------------------------------------------
     def _span(self) -> float:
         pts = np.array(list(self._ref_nodes.values()))
@@ -356,92 +680,96 @@ class Linkage(Mechanism):
         for lk in self.links:
             inv = poses_invert(poses[lk.name][0])
             names = list(lk.nodes) + [g for g in (lk.guide or ()) if g not in lk.nodes and lk.name != self.ground_name]
-            out[lk.name] = {
-                nd: tuple(float(c) for c in poses_apply(inv, self._ref_nodes[nd])) for nd in names  # type: ignore[misc]
-            }
+            out[lk.name] = {}
+            for nd in names:
+                x, y = poses_apply(inv, self._ref_nodes[nd])
+                out[lk.name][nd] = (float(x), float(y))
         return out
 
     def _travel(self, node: str, p: str, q: str) -> tuple[float, float]:
-        """Range of ``node``'s position along the line ``p -> q`` over a full sweep."""
-        drv = self.driver if hasattr(self, "driver") else None
-        qs = np.linspace(0, 2 * np.pi, 721) if drv is None or drv.amplitude is None else \
-            drv.value(np.linspace(0, drv.period, 721))
-        pos, checks = self.solve_nodes(qs)
-        ok = np.ones(qs.shape, bool)
-        for m, _, _ in checks:
-            ok &= m
-        a, b = pos[p][ok], pos[q][ok]
+        """Range of ``node``'s position along the line ``p -> q`` over the driver's cycle."""
+        ok = self._sweep_ok
+        P = self._sweep_pos
+        a, b = P[p][ok], P[q][ok]
         d = b - a
-        s = ((pos[node][ok] - a) * d).sum(-1) / np.hypot(d[:, 0], d[:, 1])
+        s = ((P[node][ok] - a) * d).sum(-1) / np.hypot(d[:, 0], d[:, 1])
         return float(s.min()), float(s.max())
 
-    def _build_parts_and_joints(self, driver: Driver) -> tuple[list[Part], list]:
-        self.driver = driver  # needed by _travel
+    def _build_parts_and_joints(self) -> tuple[list[Part], list[Pivot | PinInSlot | Slide]]:
+        """Parts (hulls) and the joints the declaration implies; the joints cut the holes and slots."""
         r = self.width / 2
         hulls: dict[str, list[tuple[float, float, float]]] = {lk.name: [] for lk in self.links}
-        feats: dict[str, list] = {lk.name: [] for lk in self.links}
-        joints: list = []
-        byname = {n.name: n for n in self.nodes}
+        joints: list[Pivot | PinInSlot | Slide] = []
         owners: dict[str, list[str]] = {}
         for lk in self.links:
             for nd in lk.nodes:
                 owners.setdefault(nd, []).append(lk.name)
-        for lk in self.links:
-            for nd in lk.nodes:
                 x, y = self._anchors[lk.name][nd]
                 hulls[lk.name].append((x, y, r))
-                # a hole only where a pin goes: a shared node or a pin running in a slot
-                if len(owners[nd]) > 1 or isinstance(byname[nd], RRP):
-                    feats[lk.name].append(Hole((x, y), self.pin_diameter, role="pin"))
         for nd, links in owners.items():
-            node = byname[nd]
             first = links[0]
             for other in links[1:]:
                 jname = nd if len(links) == 2 else f"{nd}:{other}"
-                joints.append(Pivot(jname, first, self._anchors[first][nd], other, self._anchors[other][nd]))
-            if isinstance(node, RRP):
-                self._slot_joint(node, links, hulls, feats, joints)
+                joints.append(Pivot(jname, first, other, self._anchors[first][nd], self._anchors[other][nd],
+                                    diameter=self.pin_diameter))
+        guided = {(lk.guide, nd): lk for lk in self.links if lk.guide is not None for nd in lk.nodes[:1]}
+        for node in self.nodes:
+            if isinstance(node, RRP) and ((node.p, node.q), node.name) not in guided:
+                self._pin_slot(node, owners.get(node.name, []), hulls, joints)
+        for (guide, nd), lk in guided.items():
+            assert guide is not None
+            self._block_slide(lk, nd, guide, hulls, joints)
         parts = []
         for lk in self.links:
-            is_ground = lk.name == self.ground_name
             hull = hulls[lk.name] or [(0.0, 0.0, r)]
-            parts.append(Part(lk.name, tuple(hull), tuple(feats[lk.name]), ground=is_ground))
+            parts.append(Part(lk.name, tuple(hull), (), ground=lk.name == self.ground_name))
         return parts, joints
 
-    def _slot_joint(self, node: RRP, links: list[str], hulls, feats, joints) -> None:
-        owner = None
-        for lk in self.links:
-            if node.p in lk.nodes and node.q in lk.nodes:
-                owner = lk.name
-                break
+    def _slot_on(self, owner: str, node: str, p: str, q: str, offset: float, pad: float,
+                 hulls: dict[str, list[tuple[float, float, float]]]) -> tuple[Vec, Vec]:
+        """Ends of a slot on ``owner`` along ``p -> q`` covering ``node``'s travel plus ``pad``; widens the hull."""
+        ap = np.asarray(self._anchors[owner][p])
+        aq = np.asarray(self._anchors[owner][q])
+        e = (aq - ap) / np.hypot(*(aq - ap))
+        base = ap + offset * np.array([-e[1], e[0]])
+        s0, s1 = self._travel(node, p, q)
+        start = base + (s0 - pad) * e
+        end = base + (s1 + pad) * e
+        start_t, end_t = (float(start[0]), float(start[1])), (float(end[0]), float(end[1]))
+        hulls[owner].extend([(start_t[0], start_t[1], self.width / 2), (end_t[0], end_t[1], self.width / 2)])
+        return start_t, end_t
+
+    def _pin_slot(self, node: RRP, links: list[str], hulls: dict[str, list[tuple[float, float, float]]],
+                  joints: list[Pivot | PinInSlot | Slide]) -> None:
+        owner = next((lk.name for lk in self.links if node.p in lk.nodes and node.q in lk.nodes), None)
         if owner is None:
             raise InputError(f"{self.name}.nodes.{node.name}", (node.p, node.q),
                              "line nodes carried by one link (the slot's part)")
-        ap = np.asarray(self._anchors[owner][node.p])
-        aq = np.asarray(self._anchors[owner][node.q])
+        start, end = self._slot_on(owner, node.name, node.p, node.q, node.offset, 0.0, hulls)
+        riders = [lk for lk in links if lk != owner]
+        if not riders:
+            raise InputError(f"{self.name}.nodes.{node.name}", node.name,
+                             "a link that carries the pin running in the slot")
+        pin_link = riders[0]
+        joints.append(PinInSlot(f"{node.name}-slot", owner, pin_link, start, end,
+                                self._anchors[pin_link][node.name], width=self.pin_diameter))
+
+    def _block_slide(self, lk: Link, node: str, guide: tuple[str, str],
+                     hulls: dict[str, list[tuple[float, float, float]]], joints: list[Pivot | PinInSlot | Slide]) -> None:
+        """A block ``lk`` on ``node`` sliding along the line ``guide`` of the link that carries it."""
+        owner = self._guide_owner(lk)
+        p, q = guide
+        # the block's node lies on the guide line (an RRP node's offset, or measured here)
+        ap, aq = np.asarray(self._ref_nodes[p]), np.asarray(self._ref_nodes[q])
         e = (aq - ap) / np.hypot(*(aq - ap))
-        base = ap + node.offset * np.array([-e[1], e[0]])
-        s0, s1 = self._travel(node.name, node.p, node.q)
-        guided = [lk for lk in self.links if lk.guide == (node.p, node.q) and node.name in lk.nodes]
-        pad = self.width if guided else 0.0
-        start = base + (s0 - pad) * e
-        end = base + (s1 + pad) * e
-        start_t, end_t = tuple(map(float, start)), tuple(map(float, end))
-        feats[owner].append(Slot(start_t, end_t, self.pin_diameter, role="pin"))
-        hulls[owner].extend([(start_t[0], start_t[1], self.width / 2), (end_t[0], end_t[1], self.width / 2)])
-        for lk in links:
-            if lk == owner or (guided and not any(g.name == lk for g in guided)):
-                continue  # links pinned to a slider block ride on it, not in the slot
-            if any(g.name == lk for g in guided):
-                # slider block: two guide pins a width apart along the slot
-                anchor = self._anchors[lk][node.name]
-                pins = [(anchor[0] - self.width, anchor[1]), (anchor[0] + self.width, anchor[1])]
-                for px, py in pins:
-                    hulls[lk].append((px, py, self.width / 2))
-                    feats[lk].append(Hole((px, py), self.pin_diameter, role="pin"))
-                joints.append(Slide(f"{lk}-slide", lk, pins[0], (2 * self.width, 0.0), owner, start_t, end_t))
-            else:
-                joints.append(PinInSlot(f"{node.name}-slot", lk, self._anchors[lk][node.name], owner, start_t, end_t))
+        offset = float(_cross(e[None], (np.asarray(self._ref_nodes[node]) - ap)[None])[0])
+        start, end = self._slot_on(owner, node, p, q, offset, self.width, hulls)
+        anchor = self._anchors[lk.name][node]
+        pins = [(anchor[0] - self.width, anchor[1]), (anchor[0] + self.width, anchor[1])]
+        for px, py in pins:
+            hulls[lk.name].append((px, py, self.width / 2))
+        joints.append(Slide(f"{lk.name}-slide", owner, lk.name, start, end, pins[0], (2 * self.width, 0.0),
+                            width=self.pin_diameter))
 
     def node_positions(self, q) -> dict[str, Array]:
         """World positions ``(N, 2)`` of every node, placement applied."""

@@ -5,7 +5,6 @@ See ``ERRATA.md`` beside this file for every correction to the supplement's
 equations and how it was verified.
 """
 
-from .mechanisms import MOTIONS, ElementalMechanism, elemental
-from .params import PARAMS, params_for
+from .mechanisms import ELEMENTAL, MOTIONS, ElementalMechanism, ElementalRecord, elemental, params_for
 
-__all__ = ["MOTIONS", "ElementalMechanism", "elemental", "PARAMS", "params_for"]
+__all__ = ["ELEMENTAL", "MOTIONS", "ElementalMechanism", "ElementalRecord", "elemental", "params_for"]

@@ -19,14 +19,15 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass, replace
-from typing import Any, Iterable, Mapping, Sequence
+from typing import Any, Callable, Iterable, Mapping, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from ..model import Driver, Mechanism, Part
-from .mechanisms import CONTACT_JOINT, ElementalMechanism, SkewContact
+from ..model import CamOnLine, Driver, Mechanism, Part, PinInArcSlot, PinInSlot, Pivot, Slide
+from ..registry import Registry
+from .mechanisms import ELEMENTAL, ElementalMechanism, SkewContact
 from .table import MOTION_TYPES, Realisation, enumerate_chains, realise
 
 __all__ = ["ToyMechanism", "chain_mechanism", "tree_cost", "rank_trees", "horse", "bunny", "Chain"]
@@ -153,7 +154,7 @@ class ToyMechanism(Mechanism):
         try:
             if u.ndim == 2:
                 return ElementalMechanism(k, sizing_input=u, **kw)
-            if k in (1, 2, 3):  # Rz driven: full turns
+            if ELEMENTAL[k].motions[0] == "Rz":  # turning drivers: full turns
                 return ElementalMechanism(k, **kw)
             amp = float(np.max(np.abs(u)))
             if amp > 0 and "amplitude" not in kw:
@@ -230,7 +231,7 @@ class ToyMechanism(Mechanism):
             outs[st.index] = _to_world(r, res.out)
             valid_in[st.index] = ok_in & res.valid
             bases[st.index] = (u, res)
-            checks.append((res.valid, f"{st.label}.{CONTACT_JOINT[r.number]}",
+            checks.append((res.valid, f"{st.label}.{ELEMENTAL[r.number].contact_joint}",
                            f"stage {st.label} ({r.pattern}, mechanism #{r.number}): {res.why}"))
         self._last_bases = bases
         return outs, checks
@@ -256,10 +257,6 @@ class ToyMechanism(Mechanism):
         return poses, checks
 
     @property
-    def size(self) -> float:
-        return max(st.mech.size for st in self.stages)
-
-    @property
     def mechanism_count(self) -> int:
         """Number of elemental mechanisms (distinct stages)."""
         return len(self.stages)
@@ -270,14 +267,24 @@ class ToyMechanism(Mechanism):
         return tree_cost(self.cams)
 
 
-def _rename_joint(j, label: str, ox: float):
-    kw = {}
-    for f in ("a", "b", "pin_part", "slot_part", "part", "guide", "cam_part", "face_part", "driver", "follower"):
-        if hasattr(j, f):
-            kw[f] = f"{label}.{getattr(j, f)}"
-    if isinstance(j, SkewContact):
-        kw["pin_x"] = j.pin_x + ox
-    return replace(j, name=f"{label}.{j.name}", **kw)
+#: how chain composition places a stage's joint in the toy: (joint, stage label, stage x offset) -> joint
+COMPOSERS: Registry[Callable[[Any, str, float], Any]] = Registry("chain composition")
+
+
+@COMPOSERS.register(Pivot, PinInSlot, PinInArcSlot, Slide, CamOnLine)
+def _renamed(j: Any, label: str, ox: float) -> Any:
+    """A planar joint: its parts and name take the stage's label (part frames move with the parts)."""
+    return replace(j, name=f"{label}.{j.name}", a=f"{label}.{j.a}", b=f"{label}.{j.b}")
+
+
+@COMPOSERS.register(SkewContact)
+def _renamed_skew(j: SkewContact, label: str, ox: float) -> SkewContact:
+    """The spatial contact also carries the pin's world x, which the stage's offset moves."""
+    return replace(_renamed(j, label, ox), pin_x=j.pin_x + ox)
+
+
+def _rename_joint(j: Any, label: str, ox: float) -> Any:
+    return COMPOSERS.get(j, f"joint {j.name!r}")(j, label, ox)
 
 
 def chain_mechanism(chain: Sequence[str], **kw: Any) -> ToyMechanism:

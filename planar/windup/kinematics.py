@@ -30,7 +30,7 @@ from numpy.typing import NDArray
 from ..geometry import circle_circle, line_circle, wrap_angle
 from . import params as P_
 
-__all__ = ["Stage", "FORWARD", "rot", "cam_centre"]
+__all__ = ["Stage", "rot", "cam_centre"] + [f"forward_{k}" for k in range(1, 12)]
 
 Array = NDArray[np.float64]
 
@@ -358,7 +358,3 @@ def forward_11(P: P_.P11, u: Array) -> Stage:
     alpha = wrap_angle(np.arctan2(p[:, 1] - s[1], p[:, 0] - s[0]) - a0)
     return Stage(alpha, ok, f"the arc slot (R={R:.4g}) and the pin's circle (r={r:.4g}) do not meet",
                  aux={"m": m, "p": p})
-
-
-FORWARD = {1: forward_1, 2: forward_2, 3: forward_3, 4: forward_4, 5: forward_5, 6: forward_6,
-           7: forward_7, 8: forward_8, 9: forward_9, 10: forward_10, 11: forward_11}

@@ -21,7 +21,7 @@ is its x); drawings project orthographically onto xy.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -31,6 +31,7 @@ from ..geometry import poses_apply
 from ..model import (
     ArcSlot,
     CamOnLine,
+    Feature,
     Driver,
     Hole,
     Mechanism,
@@ -40,26 +41,16 @@ from ..model import (
     Pivot,
     Slide,
     Slot,
+    joint_kind,
 )
 from . import params as P_
-from .kinematics import FORWARD, Stage
+from . import kinematics as K
+from .kinematics import Stage
 
-__all__ = ["ElementalMechanism", "MOTIONS", "SkewContact", "elemental"]
+__all__ = ["ElementalMechanism", "ElementalRecord", "ELEMENTAL", "MOTIONS", "CONTACT_JOINT", "SkewContact",
+           "elemental", "params_for", "register_elemental"]
 
 Array = NDArray[np.float64]
-
-#: (driver motion, follower motion) of each elemental mechanism
-MOTIONS: dict[int, tuple[str, str]] = {
-    1: ("Rz", "Tx"), 2: ("Rz", "Oz"), 3: ("Rz", "OzT"), 4: ("Oz", "Ty"), 5: ("Oz", "Oz"),
-    6: ("Oz", "Ox"), 7: ("Tx", "Oz"), 8: ("Tx", "Oy"), 9: ("Tx", "Ox"), 10: ("OzT", "Tx"),
-    11: ("OzT", "Oz"),
-}
-
-
-#: the joint whose closure the forward kinematics solves (named in failure reports)
-CONTACT_JOINT = {1: "cam-window", 2: "cam-window", 3: "track", 4: "pin-slot", 5: "pin-slot", 6: "edge-pin",
-                 7: "pin-slot", 8: "window-tab", 9: "slot-pin", 10: "pin-arc", 11: "pin-arc"}
-
 
 def _xy(v) -> tuple[float, float]:
     return (float(v[0]), float(v[1]))
@@ -69,30 +60,38 @@ def _sub(a, b) -> tuple[float, float]:
     return (float(a[0] - b[0]), float(a[1] - b[1]))
 
 
+@joint_kind
 @dataclass(frozen=True)
 class SkewContact:
-    """A driver edge (in the xy plane) touching a follower's tilting pin (spatial #6, #9).
+    """A driver edge (part ``a``, in the xy plane) touching a follower's tilting pin (part ``b``; spatial #6, #9).
 
     Residual: ``| distance(edge line, pin axis) - r |`` in 3D, from the
     driver's pose (xy) and the follower's pose in its ``"yz"`` plane.
     """
 
+    kind: ClassVar[str] = "skew-contact"
     name: str
-    driver: str
+    a: str  # the driver, carrying the edge
+    b: str  # the follower, carrying the pin
     edge_point: tuple[float, float]  # on the edge, driver frame
     edge_dir: tuple[float, float]  # driver frame
-    follower: str
     pin_x: float  # the pin's x (the follower's offset)
     radius: float
     plane_z: float = 0.0
 
+    def features(self) -> tuple[tuple[str, Feature], ...]:
+        return ()
+
+    def pins(self) -> tuple[tuple[str, tuple[float, float]], ...]:
+        return ()  # the pin tilts out of the driver's plane; drawn with the follower's outline
+
     def residual(self, poses) -> Array:
-        dp = poses[self.driver]
+        dp = poses[self.a]
         e0 = poses_apply(dp, self.edge_point)
         c, s = np.cos(dp[:, 2]), np.sin(dp[:, 2])
         ex = c * self.edge_dir[0] - s * self.edge_dir[1]
         ey = s * self.edge_dir[0] + c * self.edge_dir[1]
-        fp = poses[self.follower]  # (y, z, alpha) of the pivot axis point
+        fp = poses[self.b]  # (y, z, alpha) of the pivot axis point
         a = fp[:, 2]
         P0 = np.column_stack([np.full_like(a, self.pin_x), fp[:, 0], fp[:, 1]])
         d1 = np.column_stack([np.zeros_like(a), -np.sin(a), np.cos(a)])
@@ -110,15 +109,16 @@ class ElementalMechanism(Mechanism):
                  phase: float = 0.0, sizing_input: Array | None = None, **overrides: Any) -> None:
         """``sizing_input``: the driver motions the parts must serve (slot and track lengths);
         by default one cycle of the standalone driver law."""
-        if number not in FORWARD:
-            raise InputError("mechanism", number, "an elemental mechanism number 1-11")
-        self.number = number
+        if not isinstance(number, (int, np.integer)) or isinstance(number, bool) or number not in ELEMENTAL:
+            raise InputError("mechanism", number, f"an elemental mechanism number, one of {sorted(ELEMENTAL)}")
+        self.number = int(number)
+        self.record = rec = ELEMENTAL[self.number]
         self._sizing_input = None if sizing_input is None else np.asarray(sizing_input, float)
-        self.params = params.replace(**overrides) if params is not None else P_.params_for(number, **overrides)
+        self.params = params.replace(**overrides) if params is not None else params_for(self.number, **overrides)
         self._validate()
-        self.motion_in, self.motion_out = MOTIONS[number]
-        self.view = "xz" if number == 8 else "xy"
-        self.spatial = number in (6, 9)
+        self.motion_in, self.motion_out = rec.motions
+        self.view = rec.view
+        self.spatial = rec.spatial
         for fld, label, length in self._derived_lengths():
             if not length > 1e-12:
                 raise InputError(f"#{number}.{fld}", getattr(self.params, fld), f"a positive {label} (got {length:g})")
@@ -126,24 +126,12 @@ class ElementalMechanism(Mechanism):
         if not ref.valid[0]:
             raise InputError(f"#{number}.params", self.params, f"a mechanism that assembles at rest ({ref.why})")
         self.driver = self._driver(rate, phase)
-        parts, joints = getattr(self, f"_build_{number}")()
+        parts, joints = rec.build(self)
         super().__init__(f"#{number} {self.motion_in}->{self.motion_out}", parts, joints, self.driver)
 
     def _derived_lengths(self) -> list[tuple[str, str, float]]:
         """(field, meaning, value) of radii and distances the geometry needs to be non-zero."""
-        P = self.params
-        k = self.number
-        out = []
-        if k in (1, 2, 3):
-            out.append(("D_jc", "cam eccentricity |D_jc - D_o|", float(np.hypot(*_sub(P.D_jc, P.D_o)))))
-        if k == 3:
-            out.append(("S_c", "track radius |S_c|", float(np.hypot(P.S_c[0], P.S_c[1]))))
-            out.append(("F_o", "cam-to-pin distance |F_o - D_jc|", float(np.hypot(*_sub(P.F_o, P.D_jc)))))
-        if k in (5, 11):
-            out.append(("F_jc", "pin radius |F_jc|", float(np.hypot(*P.F_jc))))
-        if k == 7:
-            out.append(("F_o", "pin-to-pivot distance |F_o - D_jc|", float(np.hypot(*_sub(P.F_o, P.D_jc)))))
-        return out
+        return [(f, meaning, float(fn(self.params))) for f, meaning, fn in self.record.lengths]
 
     def _validate(self) -> None:
         from dataclasses import fields
@@ -167,7 +155,7 @@ class ElementalMechanism(Mechanism):
 
     def forward(self, u: Array) -> Stage:
         """Follower motion for driver motion ``u`` (see :mod:`planar.windup.kinematics`)."""
-        return FORWARD[self.number](self.params, np.asarray(u, float))
+        return self.record.forward(self.params, np.asarray(u, float))
 
     def _solve_poses(self, q: Array):  # type: ignore[override]
         u = self.driver_motion(q)
@@ -175,7 +163,7 @@ class ElementalMechanism(Mechanism):
         poses = {"ground": np.zeros((q.size, 3))}
         poses["driver"] = self._driver_pose(u)
         poses["follower"] = self._follower_pose(st.out)
-        return poses, [(st.valid, CONTACT_JOINT[self.number], st.why)]
+        return poses, [(st.valid, self.record.contact_joint, st.why)]
 
     def _driver_pose(self, u: Array) -> Array:
         P = self.params
@@ -188,38 +176,12 @@ class ElementalMechanism(Mechanism):
         return np.column_stack([o[0] + u[:, 0], o[1] + u[:, 1], u[:, 2]])  # OzT
 
     def _follower_pose(self, out: Array) -> Array:
-        P = self.params
-        n = out.shape[0]
-        k = self.number
-        if k in (1, 10):
-            fo = _xy(P.F_o)
-            return np.column_stack([fo[0] + out, np.full(n, fo[1]), np.zeros(n)])
-        if k == 4:
-            fo = _xy(P.F_o)
-            return np.column_stack([np.full(n, fo[0]), fo[1] + out, np.zeros(n)])
-        if k == 3:
-            fo = _xy(P.F_o)
-            return np.column_stack([fo[0] + out[:, 0], fo[1] + out[:, 1], out[:, 2]])
-        if k in (6, 9):
-            return np.column_stack([np.full(n, P.F_o[1]), np.full(n, P.F_o[2]), out])
-        if k == 8:
-            return np.column_stack([np.full(n, P.F_o[0]), np.full(n, P.F_o[2]), -out])
-        fo = _xy(P.F_o)  # 2, 5, 7, 11: pivot at F_o
-        return np.column_stack([np.full(n, fo[0]), np.full(n, fo[1]), out])
+        """The follower's pose track for follower motions ``out`` (the record's ``follower_pose``)."""
+        return self.record.follower_pose(self.params, out)
 
     def stage(self, q: Array) -> Stage:
         """Forward kinematics for driver values ``q`` (the standalone law applied)."""
         return self.forward(self.driver_motion(np.asarray(q, float)))
-
-    @property
-    def size(self) -> float:
-        """Characteristic length: the extent of all joint centres and outlines."""
-        pts = []
-        for p in self.parts:
-            for x, y, r in p.hull:
-                pts.append((x, y))
-        pts_a = np.asarray(pts)
-        return float(np.max(np.ptp(pts_a, axis=0))) if len(pts_a) > 1 else 1.0
 
     # -- travel helper --------------------------------------------------------
     def _sweep(self, n: int = 721) -> tuple[Array, Stage]:
@@ -256,7 +218,7 @@ class ElementalMechanism(Mechanism):
         g1 = np.asarray(fo) + (hi + 2 * L) * ax
         slot = Slot(_xy(g0), _xy(g1), 2 * pin_r)
         pins = [(0.0, 0.0), _xy(L * ax)]
-        joint = Slide(f"{label}-slide", "follower", pins[0], _xy(L * ax), "ground", slot.start, slot.end)
+        joint = Slide(f"{label}-slide", "ground", "follower", start=slot.start, end=slot.end, anchor=pins[0], axis=_xy(L * ax))
         return slot, pins, joint
 
     def _build_1(self):
@@ -275,8 +237,8 @@ class ElementalMechanism(Mechanism):
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*slot.start, 2 * P.F_sr), (*slot.end, 2 * P.F_sr)),
                       (Hole(_xy(P.D_o), 2 * P.D_ar), slot), ground=True)
         joints = [
-            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
-            PinInSlot("cam-window", "driver", _sub(P.D_jc, P.D_o), "follower", window.start, window.end),
+            Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
+            PinInSlot("cam-window", "follower", "driver", start=window.start, end=window.end, pin=_sub(P.D_jc, P.D_o)),
             slide,
         ]
         return [ground, drv, follower], joints
@@ -301,9 +263,9 @@ class ElementalMechanism(Mechanism):
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*s, 3 * P.F_sr)),
                       (Hole(_xy(P.D_o), 2 * P.D_ar), Hole(s, 2 * P.F_sr)), ground=True)
         joints = [
-            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
-            Pivot("pivot", "ground", s, "follower", (0.0, 0.0)),
-            PinInSlot("cam-window", "driver", _sub(P.D_jc, P.D_o), "follower", window.start, window.end),
+            Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
+            Pivot("pivot", "ground", "follower", anchor_a=s, anchor_b=(0.0, 0.0)),
+            PinInSlot("cam-window", "follower", "driver", start=window.start, end=window.end, pin=_sub(P.D_jc, P.D_o)),
         ]
         return [ground, drv, follower], joints
 
@@ -326,9 +288,9 @@ class ElementalMechanism(Mechanism):
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), *[(x, y, 2 * P.F_jr) for x, y in ends]),
                       (Hole(_xy(P.D_o), 2 * P.D_ar), track), ground=True)
         joints = [
-            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
-            Pivot("cam-hole", "driver", _sub(P.D_jc, P.D_o), "follower", hole),
-            PinInArcSlot("track", "follower", (0.0, 0.0), "ground", s, r),
+            Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
+            Pivot("cam-hole", "driver", "follower", anchor_a=_sub(P.D_jc, P.D_o), anchor_b=hole),
+            PinInArcSlot("track", "ground", "follower", centre=s, radius=r, pin=(0.0, 0.0)),
         ]
         return [ground, drv, follower], joints
 
@@ -348,8 +310,8 @@ class ElementalMechanism(Mechanism):
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*gslot.start, 2 * P.F_sr), (*gslot.end, 2 * P.F_sr)),
                       (Hole(_xy(P.D_o), 2 * P.D_ar), gslot), ground=True)
         joints = [
-            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
-            PinInSlot("pin-slot", "follower", pin, "driver", slot.start, slot.end),
+            Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
+            PinInSlot("pin-slot", "driver", "follower", start=slot.start, end=slot.end, pin=pin),
             slide,
         ]
         return [ground, drv, follower], joints
@@ -368,9 +330,9 @@ class ElementalMechanism(Mechanism):
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*s, 3 * P.F_ar)),
                       (Hole(_xy(P.D_o), 2 * P.D_ar), Hole(s, 2 * P.F_ar)), ground=True)
         joints = [
-            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
-            Pivot("pivot", "ground", s, "follower", (0.0, 0.0)),
-            PinInSlot("pin-slot", "follower", pin, "driver", slot.start, slot.end),
+            Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
+            Pivot("pivot", "ground", "follower", anchor_a=s, anchor_b=(0.0, 0.0)),
+            PinInSlot("pin-slot", "driver", "follower", start=slot.start, end=slot.end, pin=pin),
         ]
         return [ground, drv, follower], joints
 
@@ -411,9 +373,8 @@ class ElementalMechanism(Mechanism):
         follower = self._spatial_follower(P, N, r, abs(N))
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar),), (Hole(_xy(P.D_o), 2 * P.D_ar),), ground=True)
         joints = [
-            Pivot("axle", "ground", _xy(P.D_o), "driver", (0.0, 0.0)),
-            SkewContact("edge-pin", "driver", (0.0, h), (1.0, 0.0), "follower", float(P.F_o[0]), r,
-                        plane_z=float(P.D_o[2])),
+            Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
+            SkewContact("edge-pin", "driver", "follower", edge_point=(0.0, h), edge_dir=(1.0, 0.0), pin_x=float(P.F_o[0]), radius=r, plane_z=float(P.D_o[2])),
         ]
         return [ground, drv, follower], joints
 
@@ -439,9 +400,9 @@ class ElementalMechanism(Mechanism):
         ground = Part("ground", ((*g0, 2 * P.D_sr), (*g1, 2 * P.D_sr), (*s, 3 * P.F_ar)),
                       (gslot, Hole(s, 2 * P.F_ar)), ground=True)
         joints = [
-            Slide("driver-slide", "driver", (0.0, 0.0), (L, 0.0), "ground", g0, g1),
-            Pivot("pivot", "ground", s, "follower", (0.0, 0.0)),
-            PinInSlot("pin-slot", "driver", pin, "follower", slot.start, slot.end),
+            Slide("driver-slide", "ground", "driver", start=g0, end=g1, anchor=(0.0, 0.0), axis=(L, 0.0)),
+            Pivot("pivot", "ground", "follower", anchor_a=s, anchor_b=(0.0, 0.0)),
+            PinInSlot("pin-slot", "follower", "driver", start=slot.start, end=slot.end, pin=pin),
         ]
         return [ground, drv, follower], joints
 
@@ -479,9 +440,9 @@ class ElementalMechanism(Mechanism):
         # pose angle is psi - psi0 with psi0 the rest direction (+z); in the follower frame the tab runs
         # along +y (z) and the face is the line x = F_jcx
         joints = [
-            Slide("driver-slide", "driver", (0.0, 0.0), (L, 0.0), "ground", g0, g1),
-            Pivot("pivot", "ground", B, "follower", (0.0, 0.0)),
-            CamOnLine("window-tab", "driver", a_loc, 0.0, "follower", (P.F_jcx, t_lo), (P.F_jcx, t_hi)),
+            Slide("driver-slide", "ground", "driver", start=g0, end=g1, anchor=(0.0, 0.0), axis=(L, 0.0)),
+            Pivot("pivot", "ground", "follower", anchor_a=B, anchor_b=(0.0, 0.0)),
+            CamOnLine("window-tab", "follower", "driver", start=(P.F_jcx, t_lo), end=(P.F_jcx, t_hi), centre=a_loc, radius=0.0),
         ]
         return [ground, drv, follower], joints
 
@@ -504,9 +465,8 @@ class ElementalMechanism(Mechanism):
         follower = self._spatial_follower(P, N, r, abs(N))
         ground = Part("ground", ((*g0, 2 * P.D_ar), (*g1, 2 * P.D_ar)), (gslot,), ground=True)
         joints = [
-            Slide("driver-slide", "driver", (0.0, 0.0), (L, 0.0), "ground", g0, g1),
-            SkewContact("slot-pin", "driver", e_loc, _xy(d), "follower", float(P.F_o[0]), r,
-                        plane_z=float(P.D_o[2])),
+            Slide("driver-slide", "ground", "driver", start=g0, end=g1, anchor=(0.0, 0.0), axis=(L, 0.0)),
+            SkewContact("slot-pin", "driver", "follower", edge_point=e_loc, edge_dir=_xy(d), pin_x=float(P.F_o[0]), radius=r, plane_z=float(P.D_o[2])),
         ]
         return [ground, drv, follower], joints
 
@@ -535,7 +495,7 @@ class ElementalMechanism(Mechanism):
                         (Hole(pin, 2 * P.F_jr), Hole(pins[0], 2 * P.F_sr), Hole(pins[1], 2 * P.F_sr)))
         ground = Part("ground", ((*gslot.start, 2 * P.F_sr), (*gslot.end, 2 * P.F_sr)), (gslot,), ground=True)
         joints = [
-            PinInArcSlot("pin-arc", "follower", pin, "driver", arc.centre, R),
+            PinInArcSlot("pin-arc", "driver", "follower", centre=arc.centre, radius=R, pin=pin),
             slide,
         ]
         return [ground, drv, follower], joints
@@ -552,8 +512,8 @@ class ElementalMechanism(Mechanism):
                         (Hole((0.0, 0.0), 2 * P.F_ar), Hole(pin, 2 * P.F_jr)))
         ground = Part("ground", ((*s, 3 * P.F_ar),), (Hole(s, 2 * P.F_ar),), ground=True)
         joints = [
-            Pivot("pivot", "ground", s, "follower", (0.0, 0.0)),
-            PinInArcSlot("pin-arc", "follower", pin, "driver", arc.centre, R),
+            Pivot("pivot", "ground", "follower", anchor_a=s, anchor_b=(0.0, 0.0)),
+            PinInArcSlot("pin-arc", "driver", "follower", centre=arc.centre, radius=R, pin=pin),
         ]
         return [ground, drv, follower], joints
 
@@ -561,3 +521,135 @@ class ElementalMechanism(Mechanism):
 def elemental(number: int, **overrides: Any) -> ElementalMechanism:
     """Elemental mechanism ``number`` at the supplement's defaults, with ``overrides``."""
     return ElementalMechanism(number, **overrides)
+
+
+# --------------------------------------------------------------------------
+# One record per elemental mechanism
+# --------------------------------------------------------------------------
+
+
+def _fo(P: Any) -> tuple[float, float]:
+    return _xy(P.F_o)
+
+
+def _slide_x(P: Any, out: Array) -> Array:
+    """Follower translating along x from ``F_o``."""
+    fo = _fo(P)
+    n = out.shape[0]
+    return np.column_stack([fo[0] + out, np.full(n, fo[1]), np.zeros(n)])
+
+
+def _slide_y(P: Any, out: Array) -> Array:
+    """Follower translating along y from ``F_o``."""
+    fo = _fo(P)
+    n = out.shape[0]
+    return np.column_stack([np.full(n, fo[0]), fo[1] + out, np.zeros(n)])
+
+
+def _free(P: Any, out: Array) -> Array:
+    """Follower moving in the plane: ``out`` is ``(dx, dy, angle)`` from ``F_o``."""
+    fo = _fo(P)
+    return np.column_stack([fo[0] + out[:, 0], fo[1] + out[:, 1], out[:, 2]])
+
+
+def _pivot(P: Any, out: Array) -> Array:
+    """Follower turning by ``out`` about its pivot ``F_o``."""
+    fo = _fo(P)
+    n = out.shape[0]
+    return np.column_stack([np.full(n, fo[0]), np.full(n, fo[1]), out])
+
+
+def _tilt_yz(P: Any, out: Array) -> Array:
+    """Spatial follower turning about an x-parallel axis: pose in its ``"yz"`` plane."""
+    n = out.shape[0]
+    return np.column_stack([np.full(n, P.F_o[1]), np.full(n, P.F_o[2]), out])
+
+
+def _pivot_xz(P: Any, out: Array) -> Array:
+    """Follower turning about a y-parallel axis at ``F_o``, in ``(x, z)`` coordinates (+Oy is -angle in xz)."""
+    n = out.shape[0]
+    return np.column_stack([np.full(n, P.F_o[0]), np.full(n, P.F_o[2]), -out])
+
+
+def _norm2(v: Any) -> float:
+    return float(np.hypot(v[0], v[1]))
+
+
+_CAM_ECC = ("D_jc", "cam eccentricity |D_jc - D_o|", lambda P: _norm2(_sub(P.D_jc, P.D_o)))
+
+
+@dataclass(frozen=True)
+class ElementalRecord:
+    """Everything that makes elemental mechanism ``number`` what it is, in one place.
+
+    ``motions``: (driver, follower) motion types; ``params``: its parameter
+    class (the supplement's defaults and frames); ``forward``: closed-form
+    follower motion from driver motion (:mod:`planar.windup.kinematics`);
+    ``build``: parts and joints; ``contact_joint``: the joint the forward
+    kinematics closes (named in failures); ``view``: the plane it moves in;
+    ``spatial``: its follower turns out of the driver's plane;
+    ``follower_pose``: pose track from follower motion; ``lengths``: derived
+    lengths that must be positive; ``angle_params``: parameters a scene gives
+    in its angle unit.
+    """
+
+    number: int
+    motions: tuple[str, str]
+    params: type[P_.Params]
+    forward: Callable[[Any, Array], Stage]
+    build: Callable[[ElementalMechanism], tuple[list[Part], list[Any]]]
+    contact_joint: str
+    follower_pose: Callable[[Any, Array], Array]
+    view: str = "xy"
+    spatial: bool = False
+    lengths: tuple[tuple[str, str, Callable[[Any], float]], ...] = ()
+    angle_params: tuple[str, ...] = ("phi", "D_theta")
+
+
+#: every elemental mechanism, by number (filled by :func:`register_elemental`)
+ELEMENTAL: dict[int, ElementalRecord] = {}
+
+
+def register_elemental(rec: ElementalRecord) -> ElementalRecord:
+    """Add ``rec`` to :data:`ELEMENTAL` (a number registered twice is a :class:`TypeError`)."""
+    if rec.number in ELEMENTAL:
+        raise TypeError(f"double registration for elemental mechanism #{rec.number}")
+    ELEMENTAL[rec.number] = rec
+    return rec
+
+
+EM = ElementalMechanism
+for _rec in (
+    ElementalRecord(1, ("Rz", "Tx"), P_.P1, K.forward_1, EM._build_1, "cam-window", _slide_x, lengths=(_CAM_ECC,)),
+    ElementalRecord(2, ("Rz", "Oz"), P_.P2, K.forward_2, EM._build_2, "cam-window", _pivot, lengths=(_CAM_ECC,)),
+    ElementalRecord(3, ("Rz", "OzT"), P_.P3, K.forward_3, EM._build_3, "track", _free, lengths=(
+        _CAM_ECC, ("S_c", "track radius |S_c|", lambda P: _norm2(P.S_c)),
+        ("F_o", "cam-to-pin distance |F_o - D_jc|", lambda P: _norm2(_sub(P.F_o, P.D_jc))))),
+    ElementalRecord(4, ("Oz", "Ty"), P_.P4, K.forward_4, EM._build_4, "pin-slot", _slide_y,
+                    angle_params=("phi", "D_theta", "amplitude")),
+    ElementalRecord(5, ("Oz", "Oz"), P_.P5, K.forward_5, EM._build_5, "pin-slot", _pivot,
+                    lengths=(("F_jc", "pin radius |F_jc|", lambda P: _norm2(P.F_jc)),),
+                    angle_params=("phi", "D_theta", "amplitude")),
+    ElementalRecord(6, ("Oz", "Ox"), P_.P6, K.forward_6, EM._build_6, "edge-pin", _tilt_yz, spatial=True,
+                    angle_params=("phi", "D_theta", "amplitude")),
+    ElementalRecord(7, ("Tx", "Oz"), P_.P7, K.forward_7, EM._build_7, "pin-slot", _pivot, lengths=(
+        ("F_o", "pin-to-pivot distance |F_o - D_jc|", lambda P: _norm2(_sub(P.F_o, P.D_jc))),)),
+    ElementalRecord(8, ("Tx", "Oy"), P_.P8, K.forward_8, EM._build_8, "window-tab", _pivot_xz, view="xz"),
+    ElementalRecord(9, ("Tx", "Ox"), P_.P9, K.forward_9, EM._build_9, "slot-pin", _tilt_yz, spatial=True),
+    ElementalRecord(10, ("OzT", "Tx"), P_.P10, K.forward_10, EM._build_10, "pin-arc", _slide_x),
+    ElementalRecord(11, ("OzT", "Oz"), P_.P11, K.forward_11, EM._build_11, "pin-arc", _pivot,
+                    lengths=(("F_jc", "pin radius |F_jc|", lambda P: _norm2(P.F_jc)),)),
+):
+    register_elemental(_rec)
+
+#: (driver motion, follower motion) of each elemental mechanism (from the records)
+MOTIONS: dict[int, tuple[str, str]] = {k: r.motions for k, r in ELEMENTAL.items()}
+#: the joint whose closure the forward kinematics solves, per mechanism (from the records)
+CONTACT_JOINT: dict[int, str] = {k: r.contact_joint for k, r in ELEMENTAL.items()}
+
+
+def params_for(number: int, **overrides: Any) -> P_.Params:
+    """Parameters of elemental mechanism ``number``: the supplement's defaults with ``overrides``."""
+    if not isinstance(number, (int, np.integer)) or isinstance(number, bool) or number not in ELEMENTAL:
+        raise InputError("mechanism", number, f"an elemental mechanism number, one of {sorted(ELEMENTAL)}")
+    return ELEMENTAL[int(number)].params().replace(**overrides)

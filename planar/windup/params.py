@@ -18,7 +18,7 @@ from typing import Any
 
 from ..errors import InputError
 
-__all__ = ["PARAMS", "params_for", "Params"]
+__all__ = ["Params", "P1", "P2", "P3", "P4", "P5", "P6", "P7", "P8", "P9", "P10", "P11"]
 
 V2 = tuple[float, float]
 V3 = tuple[float, float, float]
@@ -157,13 +157,3 @@ class P11(Params):  # OzT -> Oz
     F_jr: float = 0.075
     F_ar: float = 0.03
     path: V2 = (0.04, 0.03)  # planar: smaller than #10's: at (0.10, 0.05) the arc slot leaves the pin's circle
-
-
-PARAMS: dict[int, type[Params]] = {1: P1, 2: P2, 3: P3, 4: P4, 5: P5, 6: P6, 7: P7, 8: P8, 9: P9, 10: P10, 11: P11}
-
-
-def params_for(number: int, **overrides: Any) -> Params:
-    """Default parameters of mechanism ``number`` (1-11), with ``overrides`` applied."""
-    if number not in PARAMS:
-        raise InputError("mechanism", number, "an elemental mechanism number 1-11")
-    return PARAMS[number]().replace(**overrides)

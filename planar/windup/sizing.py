@@ -17,8 +17,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from .mechanisms import ElementalMechanism
-from .params import params_for
+from .mechanisms import ElementalMechanism, params_for
 
 __all__ = ["DESIGN_PARAMETER", "motion_range", "size_for_range", "Sizing"]
 

@@ -1,0 +1,236 @@
+"""The joint protocol, sliders on moving links, rigid links and branch continuity (issue 9)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import ClassVar
+
+import numpy as np
+import pytest
+
+from planar.catalog import CATALOG
+from planar.errors import InputError
+from planar.geometry import poses_apply, wrap_angle
+from planar.linkages import RRR, Crank, Fixed, FourBar, Link, Linkage, Rigid
+from planar.model import JOINT_KINDS, Hole, Mechanism, Part, Pivot, Slot, joint_kind, joint_residuals
+from planar.registry import UnsupportedError
+from planar.scene import load_scene
+
+GALLERY = Path(__file__).resolve().parents[1] / "gallery"
+
+
+def _quick_return(r: float = 1.0, d: float = 2.0, lever: float = 4.0) -> Linkage:
+    nodes = [Fixed("O", (0, 0)), Fixed("Q", (0, -d)), Crank("A", "O", r), Rigid("T", "Q", "A", (lever, 0.0))]
+    links = [Link("crank", ("O", "A")), Link("lever", ("Q", "T")), Link("block", ("A",), guide=("Q", "T"))]
+    return Linkage("qr", nodes, links, points={"tip": "T"})
+
+
+@pytest.mark.parametrize("name", sorted(CATALOG))
+def test_every_joint_states_its_parts_and_its_pins_sit_in_holes_or_slots(name):
+    mech = CATALOG[name]()
+    parts = {p.name: p for p in mech.parts}
+    for j in mech.joints:
+        assert type(j) is JOINT_KINDS[j.kind]
+        assert j.a in parts and j.b in parts and j.a != j.b
+        # every feature a joint declares is cut in the part it names
+        for part, feat in j.features():
+            assert feat in parts[part].features, (name, j.name, part, feat)
+
+
+def test_quick_return_block_slides_in_a_slot_of_the_moving_lever():
+    qr = _quick_return()
+    slide = [j for j in qr.joints if j.kind == "slide"]
+    assert len(slide) == 1 and (slide[0].a, slide[0].b) == ("lever", "block")
+    lever = qr.part("lever")
+    slots = [f for f in lever.features if isinstance(f, Slot)]
+    assert len(slots) == 1
+    # drawn and cut: the slot is a hole in the lever's outline
+    assert len(lever.outline.interiors) == len(lever.features)
+    m = qr.run(720)
+    assert m.valid.all()
+    assert max(r.max() for r in joint_residuals(qr, m).values()) < 1e-12 * qr.size
+    # the crank pin stays on the lever's line, inside the slot's length (independent geometry)
+    A = poses_apply(m.poses["crank"], (1.0, 0.0))
+    s0 = poses_apply(m.poses["lever"], slots[0].start)
+    s1 = poses_apply(m.poses["lever"], slots[0].end)
+    d = s1 - s0
+    t = ((A - s0) * d).sum(-1) / (d * d).sum(-1)
+    assert t.min() > 0.0 and t.max() < 1.0
+
+
+def test_quick_return_time_ratio_from_its_geometry():
+    r, d = 1.0, 2.5
+    qr = _quick_return(r, d)
+    th = np.linspace(0.0, 2 * np.pi, 200_001)
+    m = qr.solve(th)
+    phi = np.unwrap(m.poses["lever"][:, 2])
+    i_max, i_min = int(np.argmax(phi)), int(np.argmin(phi))
+    # crank angle spent going from one extreme to the other, and back
+    one = (th[i_min] - th[i_max]) % (2 * np.pi)
+    ratio = max(one, 2 * np.pi - one) / min(one, 2 * np.pi - one)
+    alpha = np.arccos(r / d)
+    assert ratio == pytest.approx((2 * np.pi - 2 * alpha) / (2 * alpha), rel=1e-4)
+
+
+def test_oscillating_cylinder_swings_by_asin_r_over_d():
+    scene = load_scene(GALLERY / "oscillating-cylinder.toml")
+    mech = scene.mechanism
+    m = mech.solve(np.linspace(0.0, 2 * np.pi, 100_001))
+    ang = np.unwrap(m.poses["cylinder"][:, 2])
+    assert 0.5 * np.ptp(ang) == pytest.approx(np.arcsin(0.6 / 2.4), rel=1e-8)
+    assert [j.kind for j in mech.joints].count("slide") == 1
+
+
+@pytest.mark.parametrize("scene", ["quick-return", "oscillating-cylinder"])
+def test_inverted_slider_crank_scenes_simulate_close_to_the_analytic_motion(scene):
+    from planar.compare import compare
+    from planar.simulate import simulate
+
+    sc = load_scene(GALLERY / f"{scene}.toml")
+    ref = sc.motion()
+    sim = simulate(sc.mechanism, ref.t, sc.effects)
+    assert sim.blowup is None
+    c = compare(sc.mechanism, ref, sim.motion)
+    assert c.max_rel_error < 1e-3
+
+
+def test_a_guide_no_other_link_carries_is_refused():
+    nodes = [Fixed("O", (0, 0)), Fixed("Q", (0, -2)), Crank("A", "O", 1.0), Rigid("T", "Q", "A", (4.0, 0.0))]
+    links = [Link("crank", ("O", "A")), Link("lever", ("Q",)), Link("block", ("A",), guide=("Q", "T"))]
+    with pytest.raises(InputError, match=r"qr.links.lever .*'Q' and 'A' move relative.*changes by 2\b"):
+        Linkage("qr", nodes, links[:1] + [Link("lever", ("Q", "A", "T"))] + links[2:])  # A slides: not rigid
+    with pytest.raises(InputError, match="qr.links.block.guide"):
+        Linkage("qr", nodes, [links[0], Link("lever2", ("O", "Q")), links[2]])
+
+
+def test_an_unregistered_joint_kind_is_refused_by_the_mechanism():
+    @dataclass(frozen=True)
+    class MyPivot:  # a look-alike copy of Pivot with other field names
+        kind: ClassVar[str] = "pivot"
+        name: str
+        first: str
+        second: str
+
+        def residual(self, poses):
+            return np.zeros(len(next(iter(poses.values()))))
+
+    parts = [Part("ground", ((0, 0, 1),), ground=True), Part("p", ((0, 0, 1),))]
+    with pytest.raises(InputError, match="registered joint kind"):
+        Mechanism("m", parts, [MyPivot("j", "ground", "p")], CATALOG["slider-crank"]().driver)
+
+
+def test_a_registered_kind_a_consumer_lacks_is_an_error_naming_it():
+    from planar.simulate import simulate
+
+    @joint_kind
+    @dataclass(frozen=True)
+    class Weld:
+        kind: ClassVar[str] = "test-weld"
+        name: str
+        a: str
+        b: str
+
+        def residual(self, poses):
+            return np.zeros(len(poses[self.a]))
+
+        def features(self):
+            return ()
+
+        def pins(self):
+            return ()
+
+    try:
+        fb = FourBar(4.0, 1.0, 4.0, 3.0)
+        mech = Mechanism("welded", fb.parts, list(fb.joints) + [Weld("w", "coupler", "rocker")], fb.driver)
+        mech._solve_poses = fb._solve_poses  # type: ignore[method-assign]
+        with pytest.raises(UnsupportedError, match="simulate has no handler for joint kind 'test-weld'"):
+            simulate(mech, np.linspace(0, 1, 5))
+        from planar.windup.chain import _rename_joint
+
+        with pytest.raises(UnsupportedError, match="chain composition.*'test-weld'"):
+            _rename_joint(Weld("w", "a", "b"), "s0", 0.0)
+        with pytest.raises(TypeError, match="double registration"):
+            joint_kind(Weld)
+    finally:
+        JOINT_KINDS.pop("test-weld", None)
+
+
+def test_joint_features_are_cut_once():
+    parts = [Part("ground", ((0, 0, 1),), ground=True), Part("p", ((0, 0, 1), (2, 0, 1)), (Hole((0, 0), 0.2, "pin"),))]
+    j = Pivot("o", "ground", "p", (0, 0), (0, 0), diameter=0.2)
+    mech = Mechanism("m", parts, [j], CATALOG["slider-crank"]().driver)
+    assert mech.part("p").features == (Hole((0, 0), 0.2, "pin"),)
+    assert mech.part("ground").features == (Hole((0, 0), 0.2, "pin"),)
+
+
+# ---------------------------------------------------------------------------------------- branches
+
+
+def test_parallelogram_runs_its_whole_turn_as_a_parallelogram():
+    fb = FourBar(2.0, 1.0, 2.0, 1.0, circuit="open")  # change point: ground 2, crank 1, coupler 2, rocker 1
+    th = np.linspace(0.0, 4 * np.pi, 721)
+    pos = fb.node_positions(th)
+    # a parallelogram keeps its coupler parallel to the ground: C - B = (2, 0) at every sample
+    err = np.hypot(*(pos["C"] - pos["B"] - np.array([2.0, 0.0])).T)
+    assert err.max() < 1e-9
+    m = fb.solve(th)
+    assert m.valid.all()
+    # the rocker turns with the crank (same angle), no jump in speed
+    assert np.abs(wrap_angle(m.poses["rocker"][:, 2] - th)).max() < 1e-9
+
+
+def test_parallelogram_branch_is_kept_at_any_sampling_phase():
+    fb = FourBar(2.0, 1.0, 2.0, 1.0)
+    for n, off in [(37, 0.0), (100, 0.013), (360, 0.5)]:
+        th = off + np.linspace(0.0, 2 * np.pi, n)
+        pos = fb.node_positions(th)
+        assert np.hypot(*(pos["C"] - pos["B"] - np.array([2.0, 0.0])).T).max() < 1e-9, (n, off)
+
+
+def test_kite_does_not_flip_its_rocker():
+    # ground = crank, coupler = rocker (a kite / deltoid): the crank pin passes over the rocker pivot
+    fb = FourBar(1.0, 1.0, 2.0, 2.0)
+    th = np.linspace(0.0, 2 * np.pi, 361)
+    m = fb.solve(th)
+    rocker = m.poses["rocker"][:, 2]
+    steps = np.abs(wrap_angle(np.diff(rocker)))[m.valid[1:] & m.valid[:-1]]
+    assert steps.max() < 0.1  # was a 3.1 rad flip between two valid samples
+    # the continued motion still closes every joint (an independent check: link lengths)
+    pos = fb.node_positions(th)
+    ok = m.valid
+    assert np.allclose(np.hypot(*(pos["C"] - pos["B"]).T)[ok], 2.0, atol=1e-9)
+    assert np.allclose(np.hypot(*(pos["C"] - np.array([1.0, 0.0])).T)[ok], 2.0, atol=1e-9)
+
+
+def test_scattered_samples_keep_the_declared_branch():
+    fb = FourBar(2.0, 1.0, 2.0, 1.0)
+    th = np.random.default_rng(1).uniform(0, 2 * np.pi, 500)
+    pos = fb.node_positions(th)
+    # declared "open" circuit: C to the left of B -> O4 at every sample
+    B, C = pos["B"], pos["C"]
+    side = (np.array([2.0, 0.0]) - B)[:, 0] * (C - B)[:, 1] - (np.array([2.0, 0.0]) - B)[:, 1] * (C - B)[:, 0]
+    assert np.all(side >= -1e-9)
+
+
+def test_crank_rocker_is_unchanged_by_continuity():
+    fb = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0))
+    th = np.linspace(0.0, 2 * np.pi, 361)
+    ordered = fb.solve(th)
+    single = [fb.solve(np.array([t])).poses["rocker"][0, 2] for t in th[::30]]
+    assert np.allclose(ordered.poses["rocker"][::30, 2], single, atol=1e-14)
+
+
+# ---------------------------------------------------------------------------------------- size
+
+
+@pytest.mark.parametrize("name", ["kangaroo", "jansen", "windup-4", "horse"])
+def test_size_is_the_largest_part_diameter(name):
+    mech = CATALOG[name]()
+    # independent: the largest distance between two points of any part's outline (shapely geometry)
+    best = 0.0
+    for p in mech.parts:
+        xy = np.asarray(p.outline.exterior.coords)
+        d = np.hypot(xy[:, None, 0] - xy[None, :, 0], xy[:, None, 1] - xy[None, :, 1])
+        best = max(best, float(d.max()))
+    assert mech.size == pytest.approx(best, rel=2e-3)
