@@ -72,10 +72,22 @@ def build_document(layout: Layout):
     return doc
 
 
+def _register_classes_in_order(doc) -> None:
+    """Register the CLASSES of the entity types in use in sorted order.
+
+    ezdxf adds them at write time by iterating a ``set`` of type names, so
+    their order (and the file's bytes) would follow ``PYTHONHASHSEED``;
+    classes already registered keep their place.
+    """
+    for name in sorted(doc.entitydb.dxf_types_in_use()):
+        doc.classes.add_class(name)
+
+
 def write_dxf(path: str | os.PathLike, layout: Layout) -> None:
     """Write the layout as DXF (atomically)."""
     with _fixed_metadata():
         doc = build_document(layout)
+        _register_classes_in_order(doc)
         buf = io.StringIO()
         doc.write(buf)
     with atomic_write(path, "w") as fh:

@@ -46,7 +46,9 @@ def svg_text(layout: Layout) -> str:
                 chord = math.hypot(x1 - x0, y1 - y0)
                 r = chord / (2 * math.sin(abs(theta) / 2))
                 large = 1 if abs(theta) > math.pi else 0
-                sweep = 1 if b > 0 else 0  # counter-clockwise with y up is clockwise with y down
+                # counter-clockwise with y up (b > 0) is counter-clockwise on screen too, which in SVG's
+                # y-down frame is the negative-angle direction: sweep-flag 0
+                sweep = 0 if b > 0 else 1
                 parts.append(f"A {_f(r)} {_f(r)} 0 {large} {sweep} {_f(x1)} {_f(y(y1))}")
         parts.append("Z")
         return " ".join(parts)

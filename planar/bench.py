@@ -301,7 +301,7 @@ def bench_accuracy(scenes: str | os.PathLike, out_dir: str = "planar-bench-accur
             break
         sc = load_scene(path)
         try:
-            simulate(sc.mechanism, sc.motion().t[:3], sc.spec.effects, SimSettings(substeps=1))
+            simulate(sc.mechanism, sc.motion().t[:3], sc.effects, SimSettings(substeps=1))
         except SimulationError as e:
             skipped[sc.name] = str(e)
             continue
@@ -320,7 +320,7 @@ def bench_accuracy(scenes: str | os.PathLike, out_dir: str = "planar-bench-accur
             best = math.inf
             err = math.nan
             for _ in range(repeats):
-                r = simulate(sc.mechanism, ref.t, sc.spec.effects, st)
+                r = simulate(sc.mechanism, ref.t, sc.effects, st)
                 best = min(best, r.wall_time)
                 err = compare(sc.mechanism, ref, r.motion).max_rel_error if r.blowup is None else math.inf
             rows.append({"mechanism": sc.name, "substeps": st.substeps, "iterations": st.iterations,
@@ -421,7 +421,7 @@ def _effects_cost(repeats: int = 3, fraction: float = 1.0) -> dict[str, float]:
         # take milliseconds: a best of three would be noise)
         times: list[float] = []
         while len(times) < repeats or (sum(times) < MIN_TIMING_S and len(times) < 1000):
-            times.append(simulate(sc.mechanism, t, sc.spec.effects).wall_time)
+            times.append(simulate(sc.mechanism, t, sc.effects).wall_time)
         best = min(times)
         out[name] = best / span
     return out

@@ -81,7 +81,7 @@ def _vec(v: ArrayLike) -> Vec:
 # --------------------------------------------------------------------------
 
 
-from .features import ArcSlot, Hole, Slot
+from .features import ArcSlot, Hole, Slot  # noqa: E402  (re-exported: defined in planar.features)
 
 Feature = Hole | Slot | ArcSlot
 
@@ -424,7 +424,7 @@ class Driver:
         n = int(round(samples_per_cycle * cycles))
         if n < 1:
             raise InputError("samples_per_cycle", samples_per_cycle, "at least one sample")
-        return np.arange(n) * (self.period / samples_per_cycle)
+        return np.arange(n, dtype=np.float64) * (self.period / samples_per_cycle)
 
 
 # --------------------------------------------------------------------------

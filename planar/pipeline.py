@@ -208,7 +208,7 @@ def compare_scene(scene: Scene, threshold: float = 1e-3, substeps: int | None = 
     sim = simulate_scene(scene, settings)
     result = compare(scene.mechanism, scene.motion(), sim.motion, threshold=threshold)
     out = SceneComparison(result, sim, settings)
-    e = scene.spec.effects
+    e = scene.effects
     mech = scene.mechanism
     if (e.loads or e.gravity is not None) and mech.driver.kind == "rotation" and mech.driver.amplitude is None:
         try:

@@ -52,7 +52,7 @@ from dataclasses import dataclass
 from typing import ClassVar, Mapping, Sequence
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ..errors import AssemblyError, InputError
 from ..geometry import circle_circle, line_circle, poses_apply, poses_compose, poses_invert
@@ -647,7 +647,7 @@ class Linkage(Mechanism):
             poses = {k: poses_compose(pl, v) for k, v in poses.items()}
         return poses, checks
 
-    def node_velocities(self, q: Array, qdot: Array | float = 1.0) -> tuple[dict[str, Array], Mask]:
+    def node_velocities(self, q: ArrayLike, qdot: ArrayLike = 1.0) -> tuple[dict[str, Array], Mask]:
         """Velocity ``(N, 2)`` of every node (own frame, before placement) and where it is defined.
 
         Each node kind differentiates its own closure (:meth:`NodeKind.velocity`);

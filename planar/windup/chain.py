@@ -142,8 +142,8 @@ class ToyMechanism(Mechanism):
         points = {}
         for cam, chains in self.cams.items():
             for chain in chains:
-                st = self.stages[index[(cam, chain)]]
-                points[f"{cam}:{chain[-1].split('->')[1]}@{st.label}"] = (f"{st.label}.follower", (0.0, 0.0))
+                leaf = self.stages[index[(cam, chain)]]
+                points[f"{cam}:{chain[-1].split('->')[1]}@{leaf.label}"] = (f"{leaf.label}.follower", (0.0, 0.0))
         self.end_effectors = {cam: [index[(cam, c)] for c in chains] for cam, chains in self.cams.items()}
         super().__init__(name, parts, joints, driver, points)
 

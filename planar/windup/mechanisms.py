@@ -114,7 +114,8 @@ class ElementalMechanism(Mechanism):
         self.number = int(number)
         self.record = rec = ELEMENTAL[self.number]
         self._sizing_input = None if sizing_input is None else np.asarray(sizing_input, float)
-        self.params = params.replace(**overrides) if params is not None else params_for(self.number, **overrides)
+        #: the mechanism's parameter record (its ``ElementalRecord.params`` class; fields vary by mechanism)
+        self.params: Any = params.replace(**overrides) if params is not None else params_for(self.number, **overrides)
         self._validate()
         self.motion_in, self.motion_out = rec.motions
         self.view = rec.view

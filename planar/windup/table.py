@@ -118,7 +118,8 @@ def realise(pattern: str) -> Realisation:
             if si and so:
                 if a in ("Rz", "OzT") and R[2, 2] != 1:
                     continue  # the motor turns one way: keep z up
-                return Realisation(pattern, k, tuple(tuple(int(x) for x in row) for row in R), si, so)
+                rows = tuple((int(row[0]), int(row[1]), int(row[2])) for row in R)
+                return Realisation(pattern, k, rows, si, so)
     raise InputError("pattern", pattern, "a motion transfer no elemental mechanism can realise")
 
 
