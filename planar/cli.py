@@ -34,7 +34,8 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         if args.name == "accuracy":
             from .errors import InputError
 
-            raise InputError("-n", args.n, "no problem size for the accuracy benchmark (it runs the scenes of --scenes)")
+            raise InputError("-n", args.n,
+                             "no problem size for the accuracy benchmark (it runs the scenes of --scenes)")
         kwargs["n"] = args.n
     if args.repeats is not None:
         kwargs["repeats"] = args.repeats

@@ -81,7 +81,7 @@ def _vec(v: ArrayLike) -> Vec:
 # --------------------------------------------------------------------------
 
 
-from .features import ArcSlot, Hole, Slot
+from .features import ArcSlot, Hole, Slot  # noqa: E402  (re-exported: defined in planar.features)
 
 Feature = Hole | Slot | ArcSlot
 

@@ -424,8 +424,10 @@ def _rocking(spec: SceneSpec, m: Any) -> dict[str, Any]:
         raise InputError("driver.amplitude", d.amplitude,
                          f"no amplitude for a {m.type!r} mechanism (a rocking input is for {', '.join(_ROCKING)})")
     if isinstance(m, LinkageSpec):
-        first = next((n for n in m.nodes if n.kind in ("crank", "actuator")), None)
-        if first is not None and first.kind == "actuator":
+        from .linkages import NODE_KINDS
+
+        first = next((n for n in m.nodes if NODE_KINDS[n.kind].is_input), None)
+        if first is not None and first.kind == "actuator":  # a translating input: model units
             return {"amplitude": float(d.amplitude), "centre": float(d.centre)}
     return {"amplitude": _angle(spec, d.amplitude), "centre": _angle(spec, d.centre)}
 

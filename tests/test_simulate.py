@@ -315,7 +315,7 @@ def test_accuracy_benchmark_quick_run(tmp_path, monkeypatch):
 
     # run away from the repository: the scenes folder is the one given, never looked up beside the code
     monkeypatch.chdir(tmp_path)
-    r = bench_accuracy(GALLERY, out_dir="out", quick=True, repeats=1, progress=False, effects_fraction=0.2)
+    r = bench_accuracy(GALLERY, out_dir="out", quick=True, repeats=1, progress=False, effects_fraction=0.1)
     out = tmp_path / "out"
     assert (out / "accuracy.csv").exists() and (out / "accuracy.png").stat().st_size > 1000
     assert len(r["mechanisms"]) == 3 and r["settings"] == 9
