@@ -117,6 +117,8 @@ class ElementalMechanism(Mechanism):
         #: the mechanism's parameter record (its ``ElementalRecord.params`` class; fields vary by mechanism)
         self.params: Any = params.replace(**overrides) if params is not None else params_for(self.number, **overrides)
         self._validate()
+        #: ``params`` with ``D_jc`` and ``F_o`` resolved to world (``params.in_world``); the builders use it
+        self.world: Any = P_.in_world(self.params)
         self.motion_in, self.motion_out = rec.motions
         self.view = rec.view
         self.spatial = rec.spatial
@@ -167,7 +169,7 @@ class ElementalMechanism(Mechanism):
         return poses, [(st.valid, self.record.contact_joint, st.why)]
 
     def _driver_pose(self, u: Array) -> Array:
-        P = self.params
+        P = self.world
         o = (P.D_o[0], P.D_o[2]) if self.view == "xz" else _xy(P.D_o)
         n = u.shape[0]
         if self.motion_in in ("Rz", "Oz"):
@@ -177,7 +179,7 @@ class ElementalMechanism(Mechanism):
         return np.column_stack([o[0] + u[:, 0], o[1] + u[:, 1], u[:, 2]])  # OzT
 
     def _follower_pose(self, out: Array) -> Array:
-        """The follower's pose track for follower motions ``out`` (the record's ``follower_pose``)."""
+        """The follower's pose track for follower motions ``out`` (the record's ``follower_pose``, world)."""
         return self.record.follower_pose(self.params, out)
 
     def stage(self, q: Array) -> Stage:
@@ -199,7 +201,7 @@ class ElementalMechanism(Mechanism):
         return q[ok], Stage(st.out[ok], ok[ok], st.why, {k: v[ok] for k, v in st.aux.items()})
 
     def _driver(self, rate: float, phase: float) -> Driver:
-        P = self.params
+        P = self.world
         kind = self.motion_in
         if kind == "Rz":
             return Driver("driver", "rotation", origin=_xy(P.D_o), rate=rate, phase=phase)
@@ -223,7 +225,7 @@ class ElementalMechanism(Mechanism):
         return slot, pins, joint
 
     def _build_1(self):
-        P = self.params
+        P = self.world
         d = float(np.hypot(*_sub(P.D_jc, P.D_o)))
         _, st = self._sweep()
         fo = _xy(P.F_o)
@@ -245,7 +247,7 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _build_2(self):
-        P = self.params
+        P = self.world
         _, st = self._sweep()
         s = _xy(P.F_o)
         m = st.aux["m"]
@@ -271,7 +273,7 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _build_3(self):
-        P = self.params
+        P = self.world
         _, st = self._sweep()
         p0 = _xy(P.F_o)
         s = (p0[0] + P.S_c[0], p0[1] + P.S_c[1])
@@ -296,7 +298,7 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _build_4(self):
-        P = self.params
+        P = self.world
         q, st = self._sweep()
         fo = _xy(P.F_o)
         pin = _xy(P.F_jc)
@@ -318,7 +320,7 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _build_5(self):
-        P = self.params
+        P = self.world
         q, st = self._sweep()
         s = _xy(P.F_o)
         pin = _xy(P.F_jc)
@@ -339,19 +341,19 @@ class ElementalMechanism(Mechanism):
 
     def _cam_driver(self) -> Part:
         """The round cam of #1-#3: a disc of radius D_jr about D_jc, turning on an axle at D_o."""
-        P = self.params
+        P = self.world
         return Part("driver", ((*_sub(P.D_jc, P.D_o), P.D_jr), (0.0, 0.0, 2 * P.D_ar)), (Hole((0.0, 0.0), 2 * P.D_ar),))
 
     def _slotted_driver(self, slot: Slot) -> Part:
         """The oscillating arm of #4/#5: an axle at its origin and ``slot`` (parallel to x) for the follower's pin."""
-        P = self.params
+        P = self.world
         y = slot.start[1]
         return Part("driver", ((0.0, 0.0, 3 * P.D_ar), (slot.start[0], y, slot.width), (slot.end[0], y, slot.width)),
                     (Hole((0.0, 0.0), 2 * P.D_ar), slot))
 
     def _driver_slot(self, theta: Array, pins: Array, y: float, width: float) -> Slot:
         """The slot, parallel to x at height ``y`` in the (turning) driver's frame, covering the pin's travel."""
-        rel = pins - np.asarray(_xy(self.params.D_o))
+        rel = pins - np.asarray(_xy(self.world.D_o))
         c, s = np.cos(-theta), np.sin(-theta)
         xs = c * rel[:, 0] - s * rel[:, 1]
         return Slot((float(xs.min()), y), (float(xs.max()), y), width)
@@ -363,7 +365,7 @@ class ElementalMechanism(Mechanism):
                     plane="yz", offset=float(P.F_o[0]))
 
     def _build_6(self):
-        P = self.params
+        P = self.world
         p0 = _xy(P.F_o)
         r = P.F_jr
         h = p0[1] - P.D_o[1] - r
@@ -380,7 +382,7 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _build_7(self):
-        P = self.params
+        P = self.world
         _, st = self._sweep()
         s = _xy(P.F_o)
         pin = _sub(P.D_jc, P.D_o)
@@ -408,7 +410,7 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _build_8(self):
-        P = self.params
+        P = self.world
         B = (float(P.F_o[0]), float(P.F_o[2]))
         A0 = (B[0] + P.F_jcx, B[1] + P.F_jh)
         o = (float(P.D_o[0]), float(P.D_o[2]))
@@ -448,7 +450,7 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _build_9(self):
-        P = self.params
+        P = self.world
         p0 = _xy(P.F_o)
         r = P.F_jr
         phi = P.phi
@@ -484,7 +486,7 @@ class ElementalMechanism(Mechanism):
         return part, arc
 
     def _build_10(self):
-        P = self.params
+        P = self.world
         qs, st = self._sweep()
         fo = _xy(P.F_o)
         pin = _xy(P.F_jc)
@@ -502,7 +504,7 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _build_11(self):
-        P = self.params
+        P = self.world
         qs, st = self._sweep()
         s = _xy(P.F_o)
         pin = _xy(P.F_jc)
@@ -530,7 +532,8 @@ def elemental(number: int, **overrides: Any) -> ElementalMechanism:
 
 
 def _fo(P: Any) -> tuple[float, float]:
-    return _xy(P.F_o)
+    """The follower's origin ``F_o`` in world (xy)."""
+    return _xy(P_.in_world(P).F_o)
 
 
 def _slide_x(P: Any, out: Array) -> Array:
@@ -563,20 +566,22 @@ def _pivot(P: Any, out: Array) -> Array:
 def _tilt_yz(P: Any, out: Array) -> Array:
     """Spatial follower turning about an x-parallel axis: pose in its ``"yz"`` plane."""
     n = out.shape[0]
-    return np.column_stack([np.full(n, P.F_o[1]), np.full(n, P.F_o[2]), out])
+    fo = P_.in_world(P).F_o
+    return np.column_stack([np.full(n, fo[1]), np.full(n, fo[2]), out])
 
 
 def _pivot_xz(P: Any, out: Array) -> Array:
     """Follower turning about a y-parallel axis at ``F_o``, in ``(x, z)`` coordinates (+Oy is -angle in xz)."""
     n = out.shape[0]
-    return np.column_stack([np.full(n, P.F_o[0]), np.full(n, P.F_o[2]), -out])
+    fo = P_.in_world(P).F_o
+    return np.column_stack([np.full(n, fo[0]), np.full(n, fo[2]), -out])
 
 
 def _norm2(v: Any) -> float:
     return float(np.hypot(v[0], v[1]))
 
 
-_CAM_ECC = ("D_jc", "cam eccentricity |D_jc - D_o|", lambda P: _norm2(_sub(P.D_jc, P.D_o)))
+_CAM_ECC = ("D_jc", "cam eccentricity |D_jc| (driver frame)", lambda P: _norm2(P.D_jc))
 
 
 @dataclass(frozen=True)
@@ -589,7 +594,9 @@ class ElementalRecord:
     ``build``: parts and joints; ``contact_joint``: the joint the forward
     kinematics closes (named in failures); ``view``: the plane it moves in;
     ``spatial``: its follower turns out of the driver's plane;
-    ``follower_pose``: pose track from follower motion; ``lengths``: derived
+    ``follower_pose``: pose track from follower motion (``forward`` and
+    ``follower_pose`` take the parameters in the supplement's frames, see
+    :mod:`planar.windup.params`, and resolve them to world themselves); ``lengths``: derived
     lengths that must be positive; ``angle_params``: parameters a scene gives
     in its angle unit.
     """
