@@ -48,7 +48,8 @@ from . import kinematics as K
 from .kinematics import Stage
 
 __all__ = ["ElementalMechanism", "ElementalRecord", "ELEMENTAL", "MOTIONS", "CONTACT_JOINT", "SkewContact",
-           "elemental", "params_for", "register_elemental"]
+           "elemental", "params_for", "register_elemental", "check_params", "standalone_driver",
+           "standalone_motion"]
 
 Array = NDArray[np.float64]
 
@@ -116,45 +117,20 @@ class ElementalMechanism(Mechanism):
         self._sizing_input = None if sizing_input is None else np.asarray(sizing_input, float)
         #: the mechanism's parameter record (its ``ElementalRecord.params`` class; fields vary by mechanism)
         self.params: Any = params.replace(**overrides) if params is not None else params_for(self.number, **overrides)
-        self._validate()
+        check_params(self.number, self.params)
         #: ``params`` with ``D_jc`` and ``F_o`` resolved to world (``params.in_world``); the builders use it
         self.world: Any = P_.in_world(self.params)
         self.motion_in, self.motion_out = rec.motions
         self.view = rec.view
         self.spatial = rec.spatial
-        for fld, label, length in self._derived_lengths():
-            if not length > 1e-12:
-                raise InputError(f"#{number}.{fld}", getattr(self.params, fld), f"a positive {label} (got {length:g})")
-        ref = self.forward(np.zeros(1) if self.motion_in != "OzT" else np.zeros((1, 3)))
-        if not ref.valid[0]:
-            raise InputError(f"#{number}.params", self.params, f"a mechanism that assembles at rest ({ref.why})")
-        self.driver = self._driver(rate, phase)
+        self.driver = standalone_driver(self.number, self.params, rate, phase)
         parts, joints = rec.build(self)
         super().__init__(f"#{number} {self.motion_in}->{self.motion_out}", parts, joints, self.driver)
-
-    def _derived_lengths(self) -> list[tuple[str, str, float]]:
-        """(field, meaning, value) of radii and distances the geometry needs to be non-zero."""
-        return [(f, meaning, float(fn(self.params))) for f, meaning, fn in self.record.lengths]
-
-    def _validate(self) -> None:
-        from dataclasses import fields
-
-        for f in fields(self.params):
-            v = getattr(self.params, f.name)
-            arr = np.asarray(v, dtype=float)
-            if not np.all(np.isfinite(arr)):
-                raise InputError(f"#{self.number}.{f.name}", v, "finite numbers")
-            if f.name.endswith(("r", "h", "w1", "w2", "amplitude")) and arr.ndim == 0 and arr <= 0:
-                raise InputError(f"#{self.number}.{f.name}", v, "a positive length")
 
     # -- kinematics ---------------------------------------------------------
     def driver_motion(self, q: Array) -> Array:
         """The driver's motion value for driver values ``q`` (identity except for OzT paths)."""
-        if self.motion_in != "OzT":
-            return q
-        ax, ay = self.params.path
-        th = self.params.D_theta[1]
-        return np.column_stack([ax * np.sin(q), ay * (np.cos(q) - 1.0), th * np.sin(q)])
+        return standalone_motion(self.number, self.params, q)
 
     def forward(self, u: Array) -> Stage:
         """Follower motion for driver motion ``u`` (see :mod:`planar.windup.kinematics`)."""
@@ -199,17 +175,6 @@ class ElementalMechanism(Mechanism):
         if not ok.any():
             raise InputError(f"#{self.number}.params", self.params, f"a mechanism that moves ({st.why} everywhere)")
         return q[ok], Stage(st.out[ok], ok[ok], st.why, {k: v[ok] for k, v in st.aux.items()})
-
-    def _driver(self, rate: float, phase: float) -> Driver:
-        P = self.world
-        kind = self.motion_in
-        if kind == "Rz":
-            return Driver("driver", "rotation", origin=_xy(P.D_o), rate=rate, phase=phase)
-        if kind == "Oz":
-            return Driver("driver", "rotation", origin=_xy(P.D_o), rate=rate, phase=phase, amplitude=P.amplitude)
-        if kind == "Tx":
-            return Driver("driver", "translation", origin=_xy(P.D_o), rate=rate, phase=phase, amplitude=P.amplitude)
-        return Driver("driver", "path", origin=_xy(P.D_o), rate=rate, phase=phase)
 
     # -- builders: parts and joints -------------------------------------------
     def _ground_slide(self, fo, axis, travel, pin_r, label="support"):
@@ -519,6 +484,53 @@ class ElementalMechanism(Mechanism):
             PinInArcSlot("pin-arc", "driver", "follower", centre=arc.centre, radius=R, pin=pin),
         ]
         return [ground, drv, follower], joints
+
+
+def check_params(number: int, P: Any) -> None:
+    """Raise :class:`InputError` unless ``P`` can make mechanism ``number``: finite values, positive
+    sizes, positive derived lengths (the record's ``lengths``), assembled at rest."""
+    from dataclasses import fields
+
+    rec = ELEMENTAL[number]
+    for f in fields(P):
+        v = getattr(P, f.name)
+        arr = np.asarray(v, dtype=float)
+        if not np.all(np.isfinite(arr)):
+            raise InputError(f"#{number}.{f.name}", v, "finite numbers")
+        if f.name.endswith(("r", "h", "w1", "w2", "amplitude")) and arr.ndim == 0 and arr <= 0:
+            raise InputError(f"#{number}.{f.name}", v, "a positive length")
+    for fld, label, fn in rec.lengths:
+        length = float(fn(P))
+        if not length > 1e-12:
+            raise InputError(f"#{number}.{fld}", getattr(P, fld), f"a positive {label} (got {length:g})")
+    ref = rec.forward(P, np.zeros(1) if rec.motions[0] != "OzT" else np.zeros((1, 3)))
+    if not ref.valid[0]:
+        raise InputError(f"#{number}.params", P, f"a mechanism that assembles at rest ({ref.why})")
+
+
+def standalone_driver(number: int, P: Any, rate: float = 2 * np.pi, phase: float = 0.0) -> Driver:
+    """The standalone driver law of mechanism ``number``: ``Rz`` turns, ``Oz``/``Tx`` oscillate by
+    ``P.amplitude``, ``OzT`` runs its path parameter (see :func:`standalone_motion`)."""
+    kind = ELEMENTAL[number].motions[0]
+    o = _xy(P.D_o)
+    if kind == "Rz":
+        return Driver("driver", "rotation", origin=o, rate=rate, phase=phase)
+    if kind == "Oz":
+        return Driver("driver", "rotation", origin=o, rate=rate, phase=phase, amplitude=P.amplitude)
+    if kind == "Tx":
+        return Driver("driver", "translation", origin=o, rate=rate, phase=phase, amplitude=P.amplitude)
+    return Driver("driver", "path", origin=o, rate=rate, phase=phase)
+
+
+def standalone_motion(number: int, P: Any, q: Array) -> Array:
+    """The driver's motion for driver values ``q``: ``q`` itself, except for ``OzT`` drivers, whose
+    reference point moves ``(a_x sin q, a_y (cos q - 1))`` while turning ``theta_max sin q``."""
+    q = np.asarray(q, float)
+    if ELEMENTAL[number].motions[0] != "OzT":
+        return q
+    ax, ay = P.path
+    th = P.D_theta[1]
+    return np.column_stack([ax * np.sin(q), ay * (np.cos(q) - 1.0), th * np.sin(q)])
 
 
 def elemental(number: int, **overrides: Any) -> ElementalMechanism:
