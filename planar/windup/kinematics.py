@@ -4,6 +4,12 @@ Each ``forward_N(P, u)`` maps the driver's motion ``u`` (all samples at once)
 to the follower's motion, and returns a :class:`Stage` with the validity mask,
 the reason for invalid samples and the contact points the joints need.
 
+Parameters are given in the supplement's frames (``D_o`` world, ``D_jc`` and
+``F_o`` in the driver's frame, the rest in the follower's; see
+:mod:`planar.windup.params`); each ``forward_N`` resolves them with
+:func:`~planar.windup.params.in_world` first, so moving ``D_o`` moves the
+mechanism and leaves the motion unchanged.
+
 Motion values (radians, model units; counter-clockwise positive about the
 named axis, right-handed):
 
@@ -54,7 +60,7 @@ def rot(v, theta: Array) -> Array:
 
 
 def cam_centre(D_o, D_jc, theta: Array) -> Array:
-    """Cam centre ``m = D_o + R(theta) (D_jc - D_o)`` (#2 defines ``m = (q_x - d sin, q_y + d cos)``)."""
+    """Cam centre ``m = D_o + R(theta) (D_jc - D_o)``, ``D_jc`` in world (#2: ``m = (q_x - d sin, q_y + d cos)``)."""
     o = np.asarray(D_o, float)[:2]
     return o + rot(np.asarray(D_jc, float) - o, theta)
 
@@ -75,6 +81,7 @@ def forward_1(P: P_.P1, theta: Array) -> Stage:
     theta; with counter-clockwise theta and the cam at ``(0, d)`` at rest,
     ``dx = m_x - m0_x = -d sin(theta)`` (computed here for any ``D_jc``).
     """
+    P = P_.in_world(P)  # D_jc, F_o: driver frame -> world
     m = cam_centre(P.D_o, P.D_jc, theta)
     m0 = _xy(P.D_jc)
     return Stage(m[:, 0] - m0[0], _ones(theta.size), aux={"m": m})
@@ -111,6 +118,7 @@ def forward_2(P: P_.P2, theta: Array) -> Stage:
     (-78.6 deg at the defaults) and does not follow the window.  Corrected:
     ``alpha = phi - atan2(h0, l)`` (see :func:`_window_angle`).
     """
+    P = P_.in_world(P)  # D_jc, F_o: driver frame -> world
     m = cam_centre(P.D_o, P.D_jc, theta)
     alpha, ok = _window_angle(m, P.D_jc, P.F_o)
     return Stage(alpha, ok, "the cam centre comes closer to the pivot than the window line", aux={"m": m})
@@ -133,6 +141,7 @@ def forward_3(P: P_.P3, theta: Array) -> Stage:
     angles use ``atan`` of quotients.  Here: the stable circle-circle of
     :func:`planar.geometry.circle_circle`, branch fixed at rest, ``atan2``.
     """
+    P = P_.in_world(P)  # D_jc, F_o: driver frame -> world
     m0 = _xy(P.D_jc)
     p0 = _xy(P.F_o)
     s = p0 + _xy(P.S_c)
@@ -157,6 +166,7 @@ def forward_4(P: P_.P4, theta: Array) -> Stage:
     cancellation near rest.  Invalid where the slot turns parallel to the
     follower's path (``cos(theta) = 0``).
     """
+    P = P_.in_world(P)  # D_jc, F_o: driver frame -> world
     q = _xy(P.D_o)
     p0 = _xy(P.F_o) + _xy(P.F_jc)
     Dx, Y0 = p0 - q
@@ -177,6 +187,7 @@ def forward_5(P: P_.P5, theta: Array) -> Stage:
     lacks ``- R^2``; ``tan(theta)`` is unbounded at 90 deg.  Here: line-circle
     with the direction ``(cos, sin)``, branch fixed at rest, ``atan2`` angles.
     """
+    P = P_.in_world(P)  # D_jc, F_o: driver frame -> world
     q = _xy(P.D_o)
     s = _xy(P.F_o)
     p0 = s + _xy(P.F_jc)
@@ -242,6 +253,7 @@ def _oval_tangent(e0: Array, e: Array, p0, N: float, r: float, side: float) -> t
 
 def forward_6(P: P_.P6, theta: Array) -> Stage:
     """Driver edge (rotating about z) pushing the follower's pin, tilting it about x (spatial)."""
+    P = P_.in_world(P)  # D_jc, F_o: driver frame -> world
     q = _xy(P.D_o)
     p0 = _xy(P.F_o)
     r = P.F_jr
@@ -260,6 +272,7 @@ def forward_9(P: P_.P9, dx: Array) -> Stage:
     At rest the slot's edge ``y = -tan(phi) x - r / cos(phi)`` (frame at p0)
     touches the pin, as in the supplement; it translates by ``dx``.
     """
+    P = P_.in_world(P)  # D_jc, F_o: driver frame -> world
     p0 = _xy(P.F_o)
     r = P.F_jr
     phi = P.phi
@@ -280,6 +293,7 @@ def forward_7(P: P_.P7, dx: Array) -> Stage:
     ``alpha2 = atan(D_y / (D_x - dx))`` divides by ``D_x - dx``, zero when the
     pin passes under the pivot, and jumps by pi there; atan2 does not.
     """
+    P = P_.in_world(P)  # D_jc, F_o: driver frame -> world
     s = _xy(P.F_o)
     p0 = _xy(P.D_jc)
     p = p0 + np.column_stack([dx, np.zeros_like(dx)])
@@ -302,6 +316,7 @@ def forward_8(P: P_.P8, dx: Array) -> Stage:
     ``alpha = asin(D_x/|BA|) - acos(D_z/|BA|)`` is the face's absolute angle
     from z with unsigned parts; it folds where ``BA`` crosses the z axis.
     """
+    P = P_.in_world(P)  # D_jc, F_o: driver frame -> world
     B = np.array([P.F_o[0], P.F_o[2]])
     A0 = B + np.array([P.F_jcx, P.F_jh])
     A = A0 + np.column_stack([dx, np.zeros_like(dx)])
@@ -329,6 +344,7 @@ def forward_10(P: P_.P10, u: Array) -> Stage:
     ``p_x = sqrt(R^2 - (p0y - m_y)^2)`` is missing the centre ``m_x`` and the
     branch sign.  Computed as a line-circle intersection.
     """
+    P = P_.in_world(P)  # D_jc, F_o: driver frame -> world
     m = _ozt_centre(P.D_o, u)
     p0 = _xy(P.F_o) + _xy(P.F_jc)
     R = float(np.hypot(*(p0 - _xy(P.D_o))))
@@ -346,6 +362,7 @@ def forward_11(P: P_.P11, u: Array) -> Stage:
     ERRATA: as #3 (``c`` must use ``r``; division by ``m'_x``); the angles
     ``atan((s_y - p_y) / (s_x - p_x))`` lose the quadrant; atan2 here.
     """
+    P = P_.in_world(P)  # D_jc, F_o: driver frame -> world
     m0 = _xy(P.D_o)
     s = _xy(P.F_o)
     p0 = s + _xy(P.F_jc)

@@ -48,7 +48,8 @@ from . import kinematics as K
 from .kinematics import Stage
 
 __all__ = ["ElementalMechanism", "ElementalRecord", "ELEMENTAL", "MOTIONS", "CONTACT_JOINT", "SkewContact",
-           "elemental", "params_for", "register_elemental"]
+           "elemental", "params_for", "register_elemental", "check_params", "standalone_driver",
+           "standalone_motion"]
 
 Array = NDArray[np.float64]
 
@@ -116,43 +117,20 @@ class ElementalMechanism(Mechanism):
         self._sizing_input = None if sizing_input is None else np.asarray(sizing_input, float)
         #: the mechanism's parameter record (its ``ElementalRecord.params`` class; fields vary by mechanism)
         self.params: Any = params.replace(**overrides) if params is not None else params_for(self.number, **overrides)
-        self._validate()
+        check_params(self.number, self.params)
+        #: ``params`` with ``D_jc`` and ``F_o`` resolved to world (``params.in_world``); the builders use it
+        self.world: Any = P_.in_world(self.params)
         self.motion_in, self.motion_out = rec.motions
         self.view = rec.view
         self.spatial = rec.spatial
-        for fld, label, length in self._derived_lengths():
-            if not length > 1e-12:
-                raise InputError(f"#{number}.{fld}", getattr(self.params, fld), f"a positive {label} (got {length:g})")
-        ref = self.forward(np.zeros(1) if self.motion_in != "OzT" else np.zeros((1, 3)))
-        if not ref.valid[0]:
-            raise InputError(f"#{number}.params", self.params, f"a mechanism that assembles at rest ({ref.why})")
-        self.driver = self._driver(rate, phase)
+        self.driver = standalone_driver(self.number, self.params, rate, phase)
         parts, joints = rec.build(self)
         super().__init__(f"#{number} {self.motion_in}->{self.motion_out}", parts, joints, self.driver)
-
-    def _derived_lengths(self) -> list[tuple[str, str, float]]:
-        """(field, meaning, value) of radii and distances the geometry needs to be non-zero."""
-        return [(f, meaning, float(fn(self.params))) for f, meaning, fn in self.record.lengths]
-
-    def _validate(self) -> None:
-        from dataclasses import fields
-
-        for f in fields(self.params):
-            v = getattr(self.params, f.name)
-            arr = np.asarray(v, dtype=float)
-            if not np.all(np.isfinite(arr)):
-                raise InputError(f"#{self.number}.{f.name}", v, "finite numbers")
-            if f.name.endswith(("r", "h", "w1", "w2", "amplitude")) and arr.ndim == 0 and arr <= 0:
-                raise InputError(f"#{self.number}.{f.name}", v, "a positive length")
 
     # -- kinematics ---------------------------------------------------------
     def driver_motion(self, q: Array) -> Array:
         """The driver's motion value for driver values ``q`` (identity except for OzT paths)."""
-        if self.motion_in != "OzT":
-            return q
-        ax, ay = self.params.path
-        th = self.params.D_theta[1]
-        return np.column_stack([ax * np.sin(q), ay * (np.cos(q) - 1.0), th * np.sin(q)])
+        return standalone_motion(self.number, self.params, q)
 
     def forward(self, u: Array) -> Stage:
         """Follower motion for driver motion ``u`` (see :mod:`planar.windup.kinematics`)."""
@@ -167,7 +145,7 @@ class ElementalMechanism(Mechanism):
         return poses, [(st.valid, self.record.contact_joint, st.why)]
 
     def _driver_pose(self, u: Array) -> Array:
-        P = self.params
+        P = self.world
         o = (P.D_o[0], P.D_o[2]) if self.view == "xz" else _xy(P.D_o)
         n = u.shape[0]
         if self.motion_in in ("Rz", "Oz"):
@@ -177,7 +155,7 @@ class ElementalMechanism(Mechanism):
         return np.column_stack([o[0] + u[:, 0], o[1] + u[:, 1], u[:, 2]])  # OzT
 
     def _follower_pose(self, out: Array) -> Array:
-        """The follower's pose track for follower motions ``out`` (the record's ``follower_pose``)."""
+        """The follower's pose track for follower motions ``out`` (the record's ``follower_pose``, world)."""
         return self.record.follower_pose(self.params, out)
 
     def stage(self, q: Array) -> Stage:
@@ -198,17 +176,6 @@ class ElementalMechanism(Mechanism):
             raise InputError(f"#{self.number}.params", self.params, f"a mechanism that moves ({st.why} everywhere)")
         return q[ok], Stage(st.out[ok], ok[ok], st.why, {k: v[ok] for k, v in st.aux.items()})
 
-    def _driver(self, rate: float, phase: float) -> Driver:
-        P = self.params
-        kind = self.motion_in
-        if kind == "Rz":
-            return Driver("driver", "rotation", origin=_xy(P.D_o), rate=rate, phase=phase)
-        if kind == "Oz":
-            return Driver("driver", "rotation", origin=_xy(P.D_o), rate=rate, phase=phase, amplitude=P.amplitude)
-        if kind == "Tx":
-            return Driver("driver", "translation", origin=_xy(P.D_o), rate=rate, phase=phase, amplitude=P.amplitude)
-        return Driver("driver", "path", origin=_xy(P.D_o), rate=rate, phase=phase)
-
     # -- builders: parts and joints -------------------------------------------
     def _ground_slide(self, fo, axis, travel, pin_r, label="support"):
         """Ground slot + follower pins for a pure translation along ``axis`` (kind (h))."""
@@ -223,7 +190,7 @@ class ElementalMechanism(Mechanism):
         return slot, pins, joint
 
     def _build_1(self):
-        P = self.params
+        P = self.world
         d = float(np.hypot(*_sub(P.D_jc, P.D_o)))
         _, st = self._sweep()
         fo = _xy(P.F_o)
@@ -245,7 +212,7 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _build_2(self):
-        P = self.params
+        P = self.world
         _, st = self._sweep()
         s = _xy(P.F_o)
         m = st.aux["m"]
@@ -271,7 +238,7 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _build_3(self):
-        P = self.params
+        P = self.world
         _, st = self._sweep()
         p0 = _xy(P.F_o)
         s = (p0[0] + P.S_c[0], p0[1] + P.S_c[1])
@@ -296,7 +263,7 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _build_4(self):
-        P = self.params
+        P = self.world
         q, st = self._sweep()
         fo = _xy(P.F_o)
         pin = _xy(P.F_jc)
@@ -318,7 +285,7 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _build_5(self):
-        P = self.params
+        P = self.world
         q, st = self._sweep()
         s = _xy(P.F_o)
         pin = _xy(P.F_jc)
@@ -339,19 +306,19 @@ class ElementalMechanism(Mechanism):
 
     def _cam_driver(self) -> Part:
         """The round cam of #1-#3: a disc of radius D_jr about D_jc, turning on an axle at D_o."""
-        P = self.params
+        P = self.world
         return Part("driver", ((*_sub(P.D_jc, P.D_o), P.D_jr), (0.0, 0.0, 2 * P.D_ar)), (Hole((0.0, 0.0), 2 * P.D_ar),))
 
     def _slotted_driver(self, slot: Slot) -> Part:
         """The oscillating arm of #4/#5: an axle at its origin and ``slot`` (parallel to x) for the follower's pin."""
-        P = self.params
+        P = self.world
         y = slot.start[1]
         return Part("driver", ((0.0, 0.0, 3 * P.D_ar), (slot.start[0], y, slot.width), (slot.end[0], y, slot.width)),
                     (Hole((0.0, 0.0), 2 * P.D_ar), slot))
 
     def _driver_slot(self, theta: Array, pins: Array, y: float, width: float) -> Slot:
         """The slot, parallel to x at height ``y`` in the (turning) driver's frame, covering the pin's travel."""
-        rel = pins - np.asarray(_xy(self.params.D_o))
+        rel = pins - np.asarray(_xy(self.world.D_o))
         c, s = np.cos(-theta), np.sin(-theta)
         xs = c * rel[:, 0] - s * rel[:, 1]
         return Slot((float(xs.min()), y), (float(xs.max()), y), width)
@@ -363,7 +330,7 @@ class ElementalMechanism(Mechanism):
                     plane="yz", offset=float(P.F_o[0]))
 
     def _build_6(self):
-        P = self.params
+        P = self.world
         p0 = _xy(P.F_o)
         r = P.F_jr
         h = p0[1] - P.D_o[1] - r
@@ -380,7 +347,7 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _build_7(self):
-        P = self.params
+        P = self.world
         _, st = self._sweep()
         s = _xy(P.F_o)
         pin = _sub(P.D_jc, P.D_o)
@@ -408,7 +375,7 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _build_8(self):
-        P = self.params
+        P = self.world
         B = (float(P.F_o[0]), float(P.F_o[2]))
         A0 = (B[0] + P.F_jcx, B[1] + P.F_jh)
         o = (float(P.D_o[0]), float(P.D_o[2]))
@@ -448,7 +415,7 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _build_9(self):
-        P = self.params
+        P = self.world
         p0 = _xy(P.F_o)
         r = P.F_jr
         phi = P.phi
@@ -484,7 +451,7 @@ class ElementalMechanism(Mechanism):
         return part, arc
 
     def _build_10(self):
-        P = self.params
+        P = self.world
         qs, st = self._sweep()
         fo = _xy(P.F_o)
         pin = _xy(P.F_jc)
@@ -502,7 +469,7 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _build_11(self):
-        P = self.params
+        P = self.world
         qs, st = self._sweep()
         s = _xy(P.F_o)
         pin = _xy(P.F_jc)
@@ -519,6 +486,53 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
 
+def check_params(number: int, P: Any) -> None:
+    """Raise :class:`InputError` unless ``P`` can make mechanism ``number``: finite values, positive
+    sizes, positive derived lengths (the record's ``lengths``), assembled at rest."""
+    from dataclasses import fields
+
+    rec = ELEMENTAL[number]
+    for f in fields(P):
+        v = getattr(P, f.name)
+        arr = np.asarray(v, dtype=float)
+        if not np.all(np.isfinite(arr)):
+            raise InputError(f"#{number}.{f.name}", v, "finite numbers")
+        if f.name.endswith(("r", "h", "w1", "w2", "amplitude")) and arr.ndim == 0 and arr <= 0:
+            raise InputError(f"#{number}.{f.name}", v, "a positive length")
+    for fld, label, fn in rec.lengths:
+        length = float(fn(P))
+        if not length > 1e-12:
+            raise InputError(f"#{number}.{fld}", getattr(P, fld), f"a positive {label} (got {length:g})")
+    ref = rec.forward(P, np.zeros(1) if rec.motions[0] != "OzT" else np.zeros((1, 3)))
+    if not ref.valid[0]:
+        raise InputError(f"#{number}.params", P, f"a mechanism that assembles at rest ({ref.why})")
+
+
+def standalone_driver(number: int, P: Any, rate: float = 2 * np.pi, phase: float = 0.0) -> Driver:
+    """The standalone driver law of mechanism ``number``: ``Rz`` turns, ``Oz``/``Tx`` oscillate by
+    ``P.amplitude``, ``OzT`` runs its path parameter (see :func:`standalone_motion`)."""
+    kind = ELEMENTAL[number].motions[0]
+    o = _xy(P.D_o)
+    if kind == "Rz":
+        return Driver("driver", "rotation", origin=o, rate=rate, phase=phase)
+    if kind == "Oz":
+        return Driver("driver", "rotation", origin=o, rate=rate, phase=phase, amplitude=P.amplitude)
+    if kind == "Tx":
+        return Driver("driver", "translation", origin=o, rate=rate, phase=phase, amplitude=P.amplitude)
+    return Driver("driver", "path", origin=o, rate=rate, phase=phase)
+
+
+def standalone_motion(number: int, P: Any, q: Array) -> Array:
+    """The driver's motion for driver values ``q``: ``q`` itself, except for ``OzT`` drivers, whose
+    reference point moves ``(a_x sin q, a_y (cos q - 1))`` while turning ``theta_max sin q``."""
+    q = np.asarray(q, float)
+    if ELEMENTAL[number].motions[0] != "OzT":
+        return q
+    ax, ay = P.path
+    th = P.D_theta[1]
+    return np.column_stack([ax * np.sin(q), ay * (np.cos(q) - 1.0), th * np.sin(q)])
+
+
 def elemental(number: int, **overrides: Any) -> ElementalMechanism:
     """Elemental mechanism ``number`` at the supplement's defaults, with ``overrides``."""
     return ElementalMechanism(number, **overrides)
@@ -530,7 +544,8 @@ def elemental(number: int, **overrides: Any) -> ElementalMechanism:
 
 
 def _fo(P: Any) -> tuple[float, float]:
-    return _xy(P.F_o)
+    """The follower's origin ``F_o`` in world (xy)."""
+    return _xy(P_.in_world(P).F_o)
 
 
 def _slide_x(P: Any, out: Array) -> Array:
@@ -563,20 +578,22 @@ def _pivot(P: Any, out: Array) -> Array:
 def _tilt_yz(P: Any, out: Array) -> Array:
     """Spatial follower turning about an x-parallel axis: pose in its ``"yz"`` plane."""
     n = out.shape[0]
-    return np.column_stack([np.full(n, P.F_o[1]), np.full(n, P.F_o[2]), out])
+    fo = P_.in_world(P).F_o
+    return np.column_stack([np.full(n, fo[1]), np.full(n, fo[2]), out])
 
 
 def _pivot_xz(P: Any, out: Array) -> Array:
     """Follower turning about a y-parallel axis at ``F_o``, in ``(x, z)`` coordinates (+Oy is -angle in xz)."""
     n = out.shape[0]
-    return np.column_stack([np.full(n, P.F_o[0]), np.full(n, P.F_o[2]), -out])
+    fo = P_.in_world(P).F_o
+    return np.column_stack([np.full(n, fo[0]), np.full(n, fo[2]), -out])
 
 
 def _norm2(v: Any) -> float:
     return float(np.hypot(v[0], v[1]))
 
 
-_CAM_ECC = ("D_jc", "cam eccentricity |D_jc - D_o|", lambda P: _norm2(_sub(P.D_jc, P.D_o)))
+_CAM_ECC = ("D_jc", "cam eccentricity |D_jc| (driver frame)", lambda P: _norm2(P.D_jc))
 
 
 @dataclass(frozen=True)
@@ -589,7 +606,9 @@ class ElementalRecord:
     ``build``: parts and joints; ``contact_joint``: the joint the forward
     kinematics closes (named in failures); ``view``: the plane it moves in;
     ``spatial``: its follower turns out of the driver's plane;
-    ``follower_pose``: pose track from follower motion; ``lengths``: derived
+    ``follower_pose``: pose track from follower motion (``forward`` and
+    ``follower_pose`` take the parameters in the supplement's frames, see
+    :mod:`planar.windup.params`, and resolve them to world themselves); ``lengths``: derived
     lengths that must be positive; ``angle_params``: parameters a scene gives
     in its angle unit.
     """

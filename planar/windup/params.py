@@ -1,9 +1,25 @@
 """Default geometric parameters of the 11 elemental mechanisms (supplement, Part 2).
 
-Positions of the follower's origin ``F_o`` are in the driver's frame (whose
-origin is the driver's rotation centre ``D_o``); every other follower
-parameter is relative to ``F_o`` (supplement note to #1).  Units are the
-supplement's (the toys were about 9 cm across; read one unit as 100 mm).
+Frames (supplement, note to #1: "Coordinate of F_o is relative to the
+driver's local coordinate; coordinates of follower's all other positional
+parameters are relative to the follower's local coordinate"; the same rule
+read for the driver's own parameters):
+
+* ``D_o`` — world (the toy's motor frame): the driver's origin, its rotation
+  centre (#1-#6), its rest position (#7-#9) or its arc slot's centre ``m0``
+  (#10, #11);
+* ``D_jc`` — the driver's frame (origin ``D_o``, axes parallel to world at
+  rest): the cam centre (#1-#3) or the driver's pin (#7);
+* ``F_o`` — the driver's frame: the follower's origin (its support or pivot);
+* ``F_jc``, ``S_c``, ``F_jcx``, ``F_jh`` — the follower's frame (origin
+  ``F_o``, axes parallel to world at rest);
+* radii, widths, ``phi``, ``D_theta``, ``amplitude``, ``path`` — sizes,
+  angles and motions, frame-free.
+
+So moving ``D_o`` moves the whole mechanism and leaves its motion unchanged.
+:func:`in_world` resolves a parameter record to world positions (what the
+kinematics and the builders compute with).  Units are the supplement's (the
+toys were about 9 cm across; read one unit as 100 mm).
 
 Where the supplement leaves a quantity implicit, the choice is stated on the
 field (``# planar:``).  Every field can be overridden:
@@ -14,11 +30,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields, replace
-from typing import Any
+from typing import Any, TypeVar
 
 from ..errors import InputError
 
-__all__ = ["Params", "P1", "P2", "P3", "P4", "P5", "P6", "P7", "P8", "P9", "P10", "P11"]
+__all__ = ["in_world", "Params", "P1", "P2", "P3", "P4", "P5", "P6", "P7", "P8", "P9", "P10", "P11"]
 
 V2 = tuple[float, float]
 V3 = tuple[float, float, float]
@@ -34,6 +50,25 @@ class Params:
             if k not in names:
                 raise InputError(f"{type(self).__name__}.{k}", kw[k], f"one of the parameters {sorted(names)}")
         return replace(self, **kw)
+
+
+_P = TypeVar("_P", bound="Params")
+
+
+def in_world(P: _P) -> _P:
+    """``P`` with ``D_jc`` and ``F_o`` resolved from the driver's frame to world (``D_o +``).
+
+    The other positional parameters stay relative to ``F_o`` (the follower's
+    frame), which the code adds where it uses them.  Apply once: the result
+    is for computing, not for passing back to :func:`in_world`.
+    """
+    o = tuple(float(x) for x in P.D_o)  # type: ignore[attr-defined]
+    kw: dict[str, Any] = {}
+    for name in ("D_jc", "F_o"):
+        v = getattr(P, name, None)
+        if v is not None:
+            kw[name] = tuple(float(o[i]) + float(v[i]) if i < len(o) else float(v[i]) for i in range(len(v)))
+    return replace(P, **kw)
 
 
 @dataclass(frozen=True)
