@@ -9,8 +9,8 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Callable, Sequence
 
 from .errors import PlanarError
 
@@ -216,31 +216,18 @@ def _cmd_schema(args: argparse.Namespace) -> int:
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
-    from .compare import compare, format_comparison
+    from .compare import EXIT_MISMATCH, compare_scene, format_comparison
     from .scene import load_scene
-    from .simulate import SimSettings, simulate_scene, torque_comparison
+    from .simulate import SimSettings
 
     scene = load_scene(args.scene)
     settings = SimSettings(**{k: v for k, v in (("substeps", args.substeps), ("iterations", args.iterations),
                                                  ("error_bias", args.error_bias)) if v is not None})
-    sim = simulate_scene(scene, settings)
-    result = compare(scene.mechanism, scene.motion(), sim.motion, threshold=args.threshold)
-    e = scene.spec.effects
-    mech = scene.mechanism
-    if (e.loads or e.gravity is not None) and mech.driver.kind == "rotation" and mech.driver.amplitude is None:
-        from .errors import PlanarError
-
-        try:
-            period_t = mech.driver.times(scene.spec.driver.samples_per_cycle, 1.0)
-            tc = torque_comparison(mech, period_t, e, settings)
-            result.torque = {k: tc[k] for k in ("peak", "max_abs_diff", "max_rel_diff", "note")}
-            if args.json:
-                result.torque.update(analytic=tc["analytic"], simulated=tc["simulated"])
-        except PlanarError as err:
-            result.notes.append(f"torque not compared: {err}")
+    result, sim = compare_scene(scene, settings, args.threshold, args.torque_threshold, with_series=args.json)
     if args.json:
         d = result.to_dict()
-        d["settings"] = {"substeps": settings.substeps, "iterations": settings.iterations,
+        d["settings"] = {"substeps": settings.substeps, "iterations": sim.built.get("iterations"),
+                         "correction": settings.step_correction(sim.motion.t[1] - sim.motion.t[0]),
                          "error_bias": settings.error_bias}
         d["wall_time_s"] = sim.wall_time
         d["built"] = {k: v for k, v in sim.built.items()}
@@ -248,8 +235,9 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     else:
         print(format_comparison(result))
         print(f"  simulated in {sim.wall_time:.3f} s ({sim.steps} steps; substeps {settings.substeps}, "
-              f"iterations {settings.iterations}, error bias {settings.error_bias:g})")
-    return 0
+              f"iterations {sim.built.get('iterations')}, correction per step "
+              f"{settings.step_correction((sim.motion.t[1] - sim.motion.t[0]) / settings.substeps):.3g})")
+    return 0 if result.passed else EXIT_MISMATCH
 
 
 def _sheet(text: str) -> tuple[float, float]:
@@ -353,7 +341,10 @@ def build_parser() -> argparse.ArgumentParser:
     cp = sub.add_parser("compare", help="simulate a scene in pymunk and compare with the analytic motion")
     cp.add_argument("scene", help="scene file (TOML)")
     cp.add_argument("--json", action="store_true", help="print JSON (each part carries max_rel_error)")
-    cp.add_argument("--threshold", type=float, default=1e-3, help="error threshold, fraction of size (1e-3)")
+    cp.add_argument("--threshold", type=float, default=1e-3,
+                    help="error threshold, fraction of size (1e-3); exit status 3 when a check fails")
+    cp.add_argument("--torque-threshold", type=float, default=0.01,
+                    help="motor torque vs inverse dynamics, fraction of its peak (0.01)")
     cp.add_argument("--substeps", type=int, default=None)
     cp.add_argument("--iterations", type=int, default=None)
     cp.add_argument("--error-bias", type=float, default=None)

@@ -64,11 +64,11 @@ def test_only_the_named_effects_are_built():
     explicit_none = simulate_scene(scene_of(dict(LEG, effects={"contact": False})))
     assert {k: v for k, v in explicit_none.built.items()} == {k: v for k, v in bare.built.items()}
     full = simulate_scene(scene_of(dict(LEG, effects={
-        "gravity": [0.0, -9.81], "contact": True, "friction": 0.5, "damping": 0.9,
+        "gravity": [0.0, -9.81], "damping": 0.9,
         "springs": [{"a": "crank", "b": "rocker", "stiffness": 10.0}],
         "loads": [{"point": "coupler_point", "force": [0.0, 1.0]}]})))
     b = full.built
-    assert b["gravity"] == (0.0, -9.81) and b["shapes"] > 0 and b["springs"] == 1
+    assert b["gravity"] == (0.0, -9.81) and b["shapes"] == 0 and b["springs"] == 1
     assert b["damping"] == 0.9 and b["loads"] == 1
 
 
@@ -216,7 +216,7 @@ def test_ten_thousand_revolutions_analytic_has_no_drift():
 def test_ten_thousand_revolutions_simulated_stay_bounded():
     fb = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0), rate=2 * np.pi * 10)
     t = fb.driver.times(8, 10_000)
-    sim = simulate(fb, t, settings=SimSettings(substeps=4, iterations=10, error_bias=1e-9))
+    sim = simulate(fb, t, settings=SimSettings(substeps=4, iterations=10, error_bias=1e-9, tolerance=0.05))
     assert sim.blowup is None
     analytic = fb.solve(fb.driver.value(t), t=t)
     err = np.hypot(*(sim.motion.poses["rocker"][:, :2] - analytic.poses["rocker"][:, :2]).T)
