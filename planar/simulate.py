@@ -109,7 +109,7 @@ class SimSettings:
     """
 
     substeps: int = 32
-    iterations: int = 20
+    iterations: int = 40
     correction: float = 0.2
     error_bias: float | None = None
     tolerance: float = 1e-3
@@ -832,19 +832,22 @@ def torque_comparison(mech: Mechanism, t: Array, effects: Effects | None,
     pymunk's torque over an output interval is the mean of its step
     impulses; it is compared with the mean of the analytic torque
     (:func:`planar.dynamics.inverse_dynamics_torque`) over the same interval,
-    sampled at the steps' midpoints.  Only samples before a simulation
+    sampled at the steps' ends, after one sample of lead-in.  Only samples before a simulation
     failure are compared.  ``saturated`` lists the samples where the motor
     reached ``effects.motor_force_limit``.
     """
     t = np.asarray(t, float)
-    sim = simulate(mech, t, effects, settings, mode="motor", densities=densities)
     K = settings.substeps
     dt = float(t[1] - t[0])
-    t_fine = t[0] - dt + (np.arange(t.size * K) + 0.5) * (dt / K)  # steps of the interval ending at each sample
-    fine = inverse_dynamics_torque(mech, t_fine, effects, densities, t_rest=float(t[0]))
+    # one sample of lead-in, so that the first compared interval starts with settled joint forces
+    sim = simulate(mech, np.concatenate([[t[0] - dt], t]), effects, settings, mode="motor", densities=densities)
+    # a step's impulse is what holds the motion at the step's end (symplectic Euler): compare with the
+    # analytic torque at the ends of the steps of the interval ending at each sample, averaged
+    t_fine = t[0] - dt + (np.arange(t.size * K) + 1.0) * (dt / K)
+    fine = inverse_dynamics_torque(mech, t_fine, effects, densities, t_rest=float(t[0] - dt))
     analytic = fine.reshape(t.size, K).mean(axis=1)
-    tau = np.asarray(sim.torque, float)
-    upto = t.size if sim.failure is None else sim.failure.sample
+    tau = np.asarray(sim.torque, float)[1:]
+    upto = t.size if sim.failure is None else sim.failure.sample - 1
     peak = float(np.abs(analytic[1:]).max()) or 1.0
     diff = np.abs(tau[1:upto] - analytic[1:upto]) if upto > 1 else np.zeros(1)
     limit = effects.motor_force_limit if effects is not None else None
@@ -856,7 +859,7 @@ def torque_comparison(mech: Mechanism, t: Array, effects: Effects | None,
         "max_rel_diff": float(diff.max() / peak),
         "samples_compared": max(upto - 1, 0),
         "motor_force_limit": limit,
-        "saturated": sim.saturated.tolist(),
+        "saturated": (sim.saturated[sim.saturated > 0] - 1).tolist(),
         "failure": None if sim.failure is None else sim.failure.message,
         "pose_error": max(sim.pose_error.values(), default=0.0),
         "pins": "each groove's pin is a body of its own whose mass is taken out of its part "
@@ -865,3 +868,5 @@ def torque_comparison(mech: Mechanism, t: Array, effects: Effects | None,
         "wall_time": sim.wall_time,
     }
     return out
+
+
