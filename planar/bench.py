@@ -404,7 +404,7 @@ def _effects_cost(repeats: int = 3) -> dict[str, float]:
     from .simulate import simulate
 
     base = {"mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0,
-                          "coupler_point": [2.0, 1.0]}, "driver": {"samples_per_cycle": 36}}
+                          "coupler_point": [2.0, 1.0]}, "driver": {"samples_per_cycle": 360}}
     variants = {
         "none": None,
         "unused": {"contact": False, "springs": [], "loads": []},

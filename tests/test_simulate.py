@@ -262,7 +262,7 @@ def test_accuracy_benchmark_quick_run(tmp_path):
     import csv
 
     rows = list(csv.DictReader(open(tmp_path / "accuracy.csv")))
-    assert {"mechanism", "substeps", "iterations", "error_bias", "error", "seconds_per_sim_second"} <= set(rows[0])
+    assert {"mechanism", "substeps", "iterations", "correction", "error", "seconds_per_sim_second"} <= set(rows[0])
 
 
 def test_pareto_frontier():
