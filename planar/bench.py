@@ -238,13 +238,13 @@ BENCHMARKS["render"] = (bench_render, format_render)
 # --------------------------------------------------------------------------- accuracy
 
 ACCURACY_GRID = {
-    "substeps": (4, 8, 16, 32, 48, 64, 96),
-    "iterations": (5, 10, 20, 40),
-    "error_bias": (1e-3, 1e-6, 1e-9),
+    "substeps": (8, 16, 32, 64, 96),
+    "iterations": (10, 20, 40, 80),
+    "correction": (0.02, 0.05, 0.1, 0.2, 0.4),
 }
 
 #: ``planar bench accuracy --quick``
-ACCURACY_QUICK_GRID = {"substeps": (8, 48), "iterations": (10, 20), "error_bias": (1e-6, 1e-9)}
+ACCURACY_QUICK_GRID = {"substeps": (8, 32), "iterations": (10, 40), "correction": (0.05, 0.2)}
 
 
 def _pareto(points: list[tuple[float, float]]) -> list[bool]:
@@ -281,18 +281,21 @@ def bench_accuracy(scenes: str | os.PathLike, out_dir: str = "planar-bench-accur
     import sys
     from pathlib import Path
 
+    from dataclasses import replace
+
     from .compare import compare
+    from .errors import PlanarError
     from .pipeline import gallery_scenes
     from .scene import load_scene
-    from .simulate import DEFAULT_SETTINGS, SimSettings, SimulationError, simulate
+    from .simulate import DEFAULT_SETTINGS, SimSettings, SimulationError, simulate, torque_comparison
 
     scene_files = gallery_scenes(scenes)  # checks the folder before any work
     if grid is None:
         grid = ACCURACY_QUICK_GRID if quick else ACCURACY_GRID
-    settings = [SimSettings(substeps=int(s), iterations=int(i), error_bias=float(b))
-                for s in grid["substeps"] for i in grid["iterations"] for b in grid["error_bias"]]
-    d = DEFAULT_SETTINGS
-    if all((x.substeps, x.iterations, x.error_bias) != (d.substeps, d.iterations, d.error_bias) for x in settings):
+    settings = [SimSettings(substeps=int(s), iterations=int(i), correction=float(b), tolerance=1.0)
+                for s in grid["substeps"] for i in grid["iterations"] for b in grid["correction"]]
+    d = replace(DEFAULT_SETTINGS, tolerance=1.0)
+    if all((x.substeps, x.iterations, x.correction) != (d.substeps, d.iterations, d.correction) for x in settings):
         settings.append(d)
     measured = []
     skipped = {}
@@ -316,54 +319,73 @@ def bench_accuracy(scenes: str | os.PathLike, out_dir: str = "planar-bench-accur
     for sc in measured:
         ref = sc.motion()
         sim_seconds = float(ref.t[-1] - ref.t[0])
+        drv = sc.mechanism.driver
+        motor_ok = drv.kind == "rotation" and drv.amplitude is None
         for st in settings:
             best = math.inf
             err = math.nan
             for _ in range(repeats):
                 r = simulate(sc.mechanism, ref.t, sc.effects, st)
                 best = min(best, r.wall_time)
-                err = compare(sc.mechanism, ref, r.motion).max_rel_error if r.blowup is None else math.inf
+                err = compare(sc.mechanism, ref, r.motion).max_rel_error if r.failure is None else math.inf
+            motor_err = torque_err = math.nan
+            if motor_ok:
+                try:
+                    tc = torque_comparison(sc.mechanism, ref.t, sc.effects, st)
+                    motor_err = tc["pose_error"] if tc["failure"] is None else math.inf
+                    torque_err = tc["max_rel_diff"] if tc["failure"] is None else math.inf
+                except PlanarError:
+                    motor_ok = False
             rows.append({"mechanism": sc.name, "substeps": st.substeps, "iterations": st.iterations,
-                         "error_bias": st.error_bias, "dt_s": sim_seconds / (len(ref) - 1) / st.substeps,
-                         "error": err, "seconds_per_sim_second": best / sim_seconds})
+                         "correction": st.correction, "dt_s": sim_seconds / (len(ref) - 1) / st.substeps,
+                         "error": err, "motor_error": motor_err, "torque_error": torque_err,
+                         "seconds_per_sim_second": best / sim_seconds})
             if bar is not None:
                 bar.update()
     if bar is not None:
         bar.close()
     # aggregate per setting
+    def worst(rs, key):
+        v = [r[key] for r in rs if not math.isnan(r[key])]
+        return max(v) if v else math.nan
+
     agg = []
     for st in settings:
-        rs = [r for r in rows if (r["substeps"], r["iterations"], r["error_bias"]) ==
-              (st.substeps, st.iterations, st.error_bias)]
-        agg.append({"substeps": st.substeps, "iterations": st.iterations, "error_bias": st.error_bias,
-                    "max_error": max(r["error"] for r in rs),
+        rs = [r for r in rows if (r["substeps"], r["iterations"], r["correction"]) ==
+              (st.substeps, st.iterations, st.correction)]
+        agg.append({"substeps": st.substeps, "iterations": st.iterations, "correction": st.correction,
+                    "max_error": max(worst(rs, "error"), worst(rs, "motor_error")),
+                    "kinematic_error": worst(rs, "error"), "motor_error": worst(rs, "motor_error"),
+                    "torque_error": worst(rs, "torque_error"),
                     "seconds_per_sim_second": sum(r["seconds_per_sim_second"] for r in rs)})
     front = _pareto([(a["seconds_per_sim_second"], a["max_error"]) for a in agg])
     for a, f in zip(agg, front):
         a["frontier"] = f
-        a["default"] = (a["substeps"], a["iterations"], a["error_bias"]) == (d.substeps, d.iterations, d.error_bias)
+        a["default"] = (a["substeps"], a["iterations"], a["correction"]) == (d.substeps, d.iterations, d.correction)
     for sc_name in {r["mechanism"] for r in rows}:
         rs = [r for r in rows if r["mechanism"] == sc_name]
         for r, f in zip(rs, _pareto([(r["seconds_per_sim_second"], r["error"]) for r in rs])):
             r["frontier"] = f
     default = next(a for a in agg if a["default"])
     effects_cost = _effects_cost(repeats=max(3, repeats), fraction=effects_fraction)
-    per_mech_default = {r["mechanism"]: r["error"] for r in rows
-                        if (r["substeps"], r["iterations"], r["error_bias"]) == (d.substeps, d.iterations, d.error_bias)}
+    per_mech_default = {r["mechanism"]: {"kinematic": r["error"], "motor": r["motor_error"], "torque": r["torque_error"]}
+                        for r in rows
+                        if (r["substeps"], r["iterations"], r["correction"]) == (d.substeps, d.iterations, d.correction)}
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     from .fileio import atomic_write
 
     with atomic_write(out / "accuracy.csv", "w") as fh:
-        w = csv.DictWriter(fh, fieldnames=["mechanism", "substeps", "iterations", "error_bias", "dt_s", "error",
-                                           "seconds_per_sim_second", "frontier"])
+        w = csv.DictWriter(fh, fieldnames=["mechanism", "substeps", "iterations", "correction", "dt_s", "error",
+                                           "motor_error", "torque_error", "seconds_per_sim_second", "frontier"])
         w.writeheader()
         for r in rows:
             w.writerow(r)
         for a in agg:
             w.writerow({"mechanism": "ALL (worst error, total time)", "substeps": a["substeps"],
-                        "iterations": a["iterations"], "error_bias": a["error_bias"], "dt_s": "",
-                        "error": a["max_error"], "seconds_per_sim_second": a["seconds_per_sim_second"],
+                        "iterations": a["iterations"], "correction": a["correction"], "dt_s": "",
+                        "error": a["kinematic_error"], "motor_error": a["motor_error"],
+                        "torque_error": a["torque_error"], "seconds_per_sim_second": a["seconds_per_sim_second"],
                         "frontier": a["frontier"]})
     _accuracy_chart(out / "accuracy.png", agg)
     return {
@@ -394,19 +416,19 @@ def _effects_cost(repeats: int = 3, fraction: float = 1.0) -> dict[str, float]:
     samples), best of ``repeats`` runs or of as many as fill :data:`MIN_TIMING_S`.
 
     ``none``: no [effects]; ``unused``: an [effects] table naming every effect
-    switched off (the same space is built, so it costs the same); then gravity,
-    and contact shapes with friction, which do cost.
+    switched off (the same space is built, so it costs the same); then gravity
+    and damping.
     """
     from .scene import build_scene, parse_scene
     from .simulate import simulate
 
     base = {"mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0,
-                          "coupler_point": [2.0, 1.0]}, "driver": {"samples_per_cycle": 36}}
+                          "coupler_point": [2.0, 1.0]}, "driver": {"samples_per_cycle": 360}}
     variants = {
         "none": None,
         "unused": {"contact": False, "springs": [], "loads": []},
         "gravity": {"gravity": [0.0, -9.81]},
-        "contact+friction": {"contact": True, "friction": 0.6},
+        "damping": {"damping": 0.5},
     }
     out = {}
     for name, eff in variants.items():
@@ -435,24 +457,29 @@ def _accuracy_chart(path, agg: list[dict[str, Any]]) -> None:
 
     from .fileio import atomic_write
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.4), dpi=100)
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(10.4, 4.4), dpi=100)
     t = np.array([a["seconds_per_sim_second"] for a in agg])
     e = np.array([a["max_error"] for a in agg])
+    tq = np.array([a["torque_error"] for a in agg])
     f = np.array([a["frontier"] for a in agg])
-    ax.scatter(t[~f], e[~f], s=14, c="#9a9a9a", label="setting")
     order = np.argsort(t[f])
-    ax.plot(t[f][order], e[f][order], "-o", c="#4e79a7", ms=4, label="Pareto frontier")
     dflt = [i for i, a in enumerate(agg) if a["default"]]
-    if dflt:
-        i = dflt[0]
-        ax.scatter([t[i]], [e[i]], s=80, facecolors="none", edgecolors="#e15759", linewidths=2, label="default")
-    ax.axhline(1e-3, ls=":", c="#e15759", lw=1)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("wall seconds per simulated second (all gallery mechanisms)")
-    ax.set_ylabel("worst position error / mechanism size")
+    for axis, y, label, line in ((ax, e, "worst position error / size (kinematic and motor mode)", 1e-4),
+                                 (ax2, tq, "worst motor torque error / peak", 1e-2)):
+        y = np.where(np.isfinite(y), y, 1.0)
+        axis.scatter(t[~f], y[~f], s=14, c="#9a9a9a", label="setting")
+        axis.plot(t[f][order], y[f][order], "-o", c="#4e79a7", ms=4, label="Pareto frontier (positions)")
+        if dflt:
+            i = dflt[0]
+            axis.scatter([t[i]], [y[i]], s=80, facecolors="none", edgecolors="#e15759", linewidths=2, label="default")
+        axis.axhline(line, ls=":", c="#e15759", lw=1)
+        axis.set_xscale("log")
+        axis.set_yscale("log")
+        axis.set_xlabel("wall seconds per simulated second (all gallery mechanisms)")
+        axis.set_ylabel(label)
+        axis.legend(loc="upper right", fontsize=8)
     ax.set_title("pymunk rebuild vs analytic motion")
-    ax.legend(loc="upper right", fontsize=8)
+    ax2.set_title("motor torque vs inverse dynamics")
     fig.tight_layout()
     with atomic_write(path, "wb") as fh:
         fig.savefig(fh, format="png", metadata={"Software": None})
@@ -461,17 +488,18 @@ def _accuracy_chart(path, agg: list[dict[str, Any]]) -> None:
 
 def format_accuracy(r: dict[str, Any]) -> str:
     lines = [f"pymunk rebuild vs analytic, {len(r['mechanisms'])} mechanisms x {r['settings']} settings",
-             f"  {'substeps':>8}{'iters':>7}{'err bias':>10}{'worst err':>12}{'s/sim s':>10}"]
+             f"  {'substeps':>8}{'iters':>7}{'correct':>9}{'worst err':>12}{'torque':>10}{'s/sim s':>10}"]
     for a in sorted(r["frontier"], key=lambda a: a["seconds_per_sim_second"]):
         mark = "  <- default" if a["default"] else ""
-        lines.append(f"  {a['substeps']:>8}{a['iterations']:>7}{a['error_bias']:>10.0e}{a['max_error']:>12.2e}"
-                     f"{a['seconds_per_sim_second']:>10.3f}{mark}")
+        lines.append(f"  {a['substeps']:>8}{a['iterations']:>7}{a['correction']:>9.2f}{a['max_error']:>12.2e}"
+                     f"{a['torque_error']:>10.2e}{a['seconds_per_sim_second']:>10.3f}{mark}")
     d = r["default"]
-    lines.append(f"  default ({d['substeps']} substeps, {d['iterations']} iterations, error bias {d['error_bias']:g}): "
-                 f"worst error {d['max_error']:.2e}, {d['seconds_per_sim_second']:.3f} s per simulated second, "
+    lines.append(f"  default ({d['substeps']} substeps, {d['iterations']} iterations, correction {d['correction']:g}): "
+                 f"worst error {d['max_error']:.2e}, torque {d['torque_error']:.2e}, "
+                 f"{d['seconds_per_sim_second']:.3f} s per simulated second, "
                  f"{'on' if r['default_on_frontier'] else 'NOT on'} the frontier")
     for k, v in sorted(r["default_errors"].items()):
-        lines.append(f"    {k:<22} {v:.2e}")
+        lines.append(f"    {k:<22} kinematic {v['kinematic']:.2e}  motor {v['motor']:.2e}  torque {v['torque']:.2e}")
     for k, v in r["skipped"].items():
         lines.append(f"  skipped {k}: {v}")
     ec = r["effects_cost"]
@@ -483,3 +511,87 @@ def format_accuracy(r: dict[str, Any]) -> str:
 
 
 BENCHMARKS["accuracy"] = (bench_accuracy, format_accuracy)
+
+
+# --------------------------------------------------------------------------- sim
+
+
+def _bare_space(mech, t, settings):
+    """The same pymunk space planar builds (bodies, joints, pins), placed at the first sample, and its step count."""
+    from .simulate import _analytic_pose_velocity, _Rebuild
+
+    dt = float(t[1] - t[0]) / settings.substeps
+    poses, vel, analytic = _analytic_pose_velocity(mech, t)
+    rb = _Rebuild(mech, analytic, None, settings, "kinematic", dt)
+    comp = rb.compensation()
+    if comp:
+        rb = _Rebuild(mech, analytic, None, settings, "kinematic", dt, overrides=comp)
+    rb.set_state({k: v[0] for k, v in poses.items()}, {k: v[0] for k, v in vel.items()})
+    drv = rb.bodies[mech.driver.part]
+    drv.angular_velocity = mech.driver.rate * dt  # one time unit per step, as planar runs it
+    return rb.space, (t.size - 1) * settings.substeps
+
+
+def bench_sim(n: int = 360, repeats: int = 7) -> dict[str, Any]:
+    """Wall time per physics step: planar's ``simulate`` against a bare pymunk loop on the same space.
+
+    For the four-bar leg and the Jansen leg, ``n`` samples of one cycle at
+    the default settings: planar's run (driver, pose recording, failure
+    checks in blocks) and a bare ``space.step`` loop over the same bodies
+    and joints (the driver turned by a constant angular velocity), timed
+    alternately ``repeats`` times.  ``ratio`` is the median of the per-repeat
+    ratios planar / bare (worst mechanism), with their spread.
+    """
+    import platform
+
+    from .catalog import get
+    from .linkages import FourBar
+    from .simulate import DEFAULT_SETTINGS, simulate
+
+    st = DEFAULT_SETTINGS
+    mechs = {"four-bar": FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0)), "jansen": get("jansen")}
+    out: dict[str, Any] = {"benchmark": "sim", "samples": n, "substeps": st.substeps, "repeats": repeats,
+                           "machine": f"{platform.machine()} {platform.processor() or ''} "
+                                      f"{os.cpu_count()} cores, Python {platform.python_version()}".strip(),
+                           "mechanisms": {}}
+    for name, mech in mechs.items():
+        t = mech.driver.times(n)
+        ratios, ours, bare = [], [], []
+        for _ in range(repeats):
+            r = simulate(mech, t, None, st)
+            per_ours = r.wall_time / r.steps
+            space, steps = _bare_space(mech, t, st)
+            step = space.step
+            t0 = time.perf_counter()
+            for _ in range(steps):
+                step(1.0)
+            per_bare = (time.perf_counter() - t0) / steps
+            ours.append(per_ours)
+            bare.append(per_bare)
+            ratios.append(per_ours / per_bare)
+        out["mechanisms"][name] = {
+            "planar_us_per_step": float(np.median(ours)) * 1e6,
+            "bare_pymunk_us_per_step": float(np.median(bare)) * 1e6,
+            "ratio": float(np.median(ratios)),
+            "ratio_spread": [float(min(ratios)), float(max(ratios))],
+            "steps": int(r.steps),
+            "iterations": int(r.built["iterations"]),
+        }
+    worst = max(out["mechanisms"].values(), key=lambda m: m["ratio"])
+    out["ratio"] = worst["ratio"]
+    out["ratio_spread"] = worst["ratio_spread"]
+    return out
+
+
+def format_sim(r: dict[str, Any]) -> str:
+    head = (f"physics step cost, planar vs bare pymunk on the same space ({r['samples']} samples x "
+            f"{r['substeps']} substeps, {r['repeats']} interleaved repeats; {r['machine']})")
+    lines = [head]
+    for name, m in r["mechanisms"].items():
+        lines.append(f"  {name:<10} planar {m['planar_us_per_step']:8.2f} us/step   bare {m['bare_pymunk_us_per_step']:8.2f}"
+                     f" us/step   ratio {m['ratio']:.2f} (spread {m['ratio_spread'][0]:.2f}-{m['ratio_spread'][1]:.2f})")
+    lines.append(f"  ratio (worst mechanism, median): {r['ratio']:.2f}")
+    return "\n".join(lines)
+
+
+BENCHMARKS["sim"] = (bench_sim, format_sim)

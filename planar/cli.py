@@ -9,7 +9,8 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from pathlib import Path
 
 from .errors import PlanarError
 
@@ -113,20 +114,29 @@ def _cmd_schema(args: argparse.Namespace) -> int:
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
-    from .compare import format_comparison
+    from .compare import EXIT_MISMATCH, format_comparison
     from .pipeline import compare_scene
     from .scene import load_scene
+    from .simulate import SimSettings
 
-    c = compare_scene(load_scene(args.scene), threshold=args.threshold, substeps=args.substeps,
-                      iterations=args.iterations, error_bias=args.error_bias)
+    scene = load_scene(args.scene)
+    settings = SimSettings(**{k: v for k, v in (("substeps", args.substeps), ("iterations", args.iterations),
+                                                 ("error_bias", args.error_bias)) if v is not None})
+    result, sim = compare_scene(scene, settings, args.threshold, args.torque_threshold, with_series=args.json)
     if args.json:
-        print(json.dumps(c.to_dict(), indent=2, default=str))
+        d = result.to_dict()
+        d["settings"] = {"substeps": settings.substeps, "iterations": sim.built.get("iterations"),
+                         "correction": settings.step_correction(sim.motion.t[1] - sim.motion.t[0]),
+                         "error_bias": settings.error_bias}
+        d["wall_time_s"] = sim.wall_time
+        d["built"] = {k: v for k, v in sim.built.items()}
+        print(json.dumps(d, indent=2, default=str))
     else:
-        s = c.settings
-        print(format_comparison(c.result))
-        print(f"  simulated in {c.sim.wall_time:.3f} s ({c.sim.steps} steps; substeps {s.substeps}, "
-              f"iterations {s.iterations}, error bias {s.error_bias:g})")
-    return 0
+        print(format_comparison(result))
+        print(f"  simulated in {sim.wall_time:.3f} s ({sim.steps} steps; substeps {settings.substeps}, "
+              f"iterations {sim.built.get('iterations')}, correction per step "
+              f"{settings.step_correction((sim.motion.t[1] - sim.motion.t[0]) / settings.substeps):.3g})")
+    return 0 if result.passed else EXIT_MISMATCH
 
 
 def _sheet(text: str) -> tuple[float, float]:
@@ -210,7 +220,10 @@ def build_parser() -> argparse.ArgumentParser:
     cp = sub.add_parser("compare", help="simulate a scene in pymunk and compare with the analytic motion")
     cp.add_argument("scene", help="scene file (TOML)")
     cp.add_argument("--json", action="store_true", help="print JSON (each part carries max_rel_error)")
-    cp.add_argument("--threshold", type=float, default=1e-3, help="error threshold, fraction of size (1e-3)")
+    cp.add_argument("--threshold", type=float, default=1e-3,
+                    help="error threshold, fraction of size (1e-3); exit status 3 when a check fails")
+    cp.add_argument("--torque-threshold", type=float, default=0.01,
+                    help="motor torque vs inverse dynamics, fraction of its peak (0.01)")
     cp.add_argument("--substeps", type=int, default=None)
     cp.add_argument("--iterations", type=int, default=None)
     cp.add_argument("--error-bias", type=float, default=None)

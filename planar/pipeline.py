@@ -24,7 +24,7 @@ if TYPE_CHECKING:
     from .simulate import SimResult, SimSettings
 
 __all__ = [
-    "DEMO_EXTRAS", "DEMO_SCENES", "SceneComparison", "build_gallery", "compare_scene", "export_scene",
+    "DEMO_EXTRAS", "DEMO_SCENES", "build_gallery", "compare_scene", "export_scene",
     "gallery_scenes", "overlay_motion", "render_scene", "run_demo", "scene_style", "write_catalog_motion",
     "write_scene_motion",
 ]
@@ -153,62 +153,16 @@ def export_scene(scene: Scene, dxf: str | Path | None = None, svg: str | Path | 
 # --------------------------------------------------------------------------- physics comparison
 
 
-@dataclass
-class SceneComparison:
-    """A scene's analytic motion against its pymunk rebuild (see :func:`compare_scene`)."""
+def compare_scene(scene: Scene, settings: SimSettings | None = None, threshold: float = 1e-3,
+                  torque_threshold: float = 0.01, with_series: bool = False) -> tuple[Comparison, SimResult]:
+    """Simulate ``scene`` in pymunk and compare it with its analytic motion (and the motor torque).
 
-    result: Comparison
-    sim: SimResult
-    settings: SimSettings
-    torque_series: dict[str, Any] = field(default_factory=dict)
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready: the comparison, the settings, wall time and what was built."""
-        d = self.result.to_dict()
-        if d.get("torque") is not None and self.torque_series:
-            d["torque"] = {**d["torque"], **self.torque_series}
-        s = self.settings
-        d["settings"] = {"substeps": s.substeps, "iterations": s.iterations, "error_bias": s.error_bias}
-        d["wall_time_s"] = self.sim.wall_time
-        d["built"] = dict(self.sim.built)
-        return d
-
-
-def compare_scene(scene: Scene, threshold: float = 1e-3, substeps: int | None = None,
-                  iterations: int | None = None, error_bias: float | None = None) -> SceneComparison:
-    """Simulate ``scene`` in pymunk and compare with its analytic motion.
-
-    Settings left ``None`` take :data:`planar.simulate.DEFAULT_SETTINGS`.
-    ``threshold`` is a fraction of the mechanism's size.  With loads or
-    gravity on a constant-rate rotary input, the motor torque is compared too
-    (``result.torque``; a reason in ``result.notes`` when it cannot be).
+    See :func:`planar.compare.compare_scene`; ``result.passed`` is false when
+    a check fails (the CLI then exits with :data:`planar.compare.EXIT_MISMATCH`).
     """
-    from dataclasses import replace
+    from .compare import compare_scene as _compare_scene
 
-    from .compare import compare
-    from .simulate import DEFAULT_SETTINGS, simulate_scene, torque_comparison
-
-    settings = DEFAULT_SETTINGS
-    if substeps is not None:
-        settings = replace(settings, substeps=substeps)
-    if iterations is not None:
-        settings = replace(settings, iterations=iterations)
-    if error_bias is not None:
-        settings = replace(settings, error_bias=error_bias)
-    sim = simulate_scene(scene, settings)
-    result = compare(scene.mechanism, scene.motion(), sim.motion, threshold=threshold)
-    out = SceneComparison(result, sim, settings)
-    e = scene.effects
-    mech = scene.mechanism
-    if (e.loads or e.gravity is not None) and mech.driver.kind == "rotation" and mech.driver.amplitude is None:
-        try:
-            period_t = mech.driver.times(scene.spec.driver.samples_per_cycle, 1.0)
-            tc = torque_comparison(mech, period_t, e, settings)
-            result.torque = {k: tc[k] for k in ("peak", "max_abs_diff", "max_rel_diff", "note")}
-            out.torque_series = {"analytic": tc["analytic"], "simulated": tc["simulated"]}
-        except PlanarError as err:
-            result.notes.append(f"torque not compared: {err}")
-    return out
+    return _compare_scene(scene, settings, threshold, torque_threshold, with_series=with_series)
 
 
 # --------------------------------------------------------------------------- the demo

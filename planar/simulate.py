@@ -5,53 +5,87 @@ Rebuild:
 * every part becomes a body whose mass and moment come from its outline
   (area x density, second moment of the polygon with its holes); the ground
   is the space's static body;
-* :class:`~planar.model.Pivot` -> ``PivotJoint``; :class:`~planar.model.PinInSlot`
-  -> ``GrooveJoint`` (groove on the slot's part); :class:`~planar.model.Slide`
-  -> ``GrooveJoint`` plus a ``GearJoint`` (ratio 1) locking the rotation;
-  :class:`~planar.model.PinInArcSlot` -> the equivalent link: a ``PinJoint``
-  holding the pin at the arc's radius from its centre (a pin in an arc slot
-  moves exactly like a pin on a link pivoting at the centre);
-  :class:`~planar.model.CamOnLine` -> ``GrooveJoint`` (the contact point held
-  on the face), allowed only when the scene names what holds it there
-  (gravity or a spring), as wind-up #8 needs;
-* the driver follows the analytic input: a kinematic body whose velocity (not
-  position) is set before every step so that it reaches the analytic pose at
-  the end of the step (``mode="kinematic"``, the default); or, where the
-  scene asks for dynamics or the motor torque is wanted, a dynamic body
-  turned by a ``SimpleMotor`` at the driver's rate (``mode="motor"``).
+* each joint kind is rebuilt by the handler registered for it in
+  :data:`REBUILDERS`: :class:`~planar.model.Pivot` -> ``PivotJoint``;
+  :class:`~planar.model.PinInSlot` -> ``GrooveJoint`` (groove on the slot's
+  part); :class:`~planar.model.Slide` -> ``GrooveJoint`` plus a ``GearJoint``
+  (ratio 1) locking the rotation; :class:`~planar.model.PinInArcSlot` -> the
+  equivalent link (a ``PinJoint`` holding the pin at the arc's radius);
+  :class:`~planar.model.CamOnLine` -> ``GrooveJoint``, allowed only when the
+  scene names what holds it there (gravity or a spring);
+* grooves hold a pin that is a small body of its own; its mass is taken out
+  of the part it rides on (mass, centre of gravity and moment of the pair are
+  the part's), so the rebuilt mechanism has the model's inertia;
+* the driver follows the analytic input: a kinematic body whose velocity is
+  set so that it reaches the analytic pose at the end of each step
+  (``mode="kinematic"``, the default); or a dynamic body turned by a
+  ``SimpleMotor`` at the driver's rate (``mode="motor"``), whose signed
+  torque is read every step (and checked against the motor's force limit).
 
-Only the effects a scene names exist in the space: no gravity, collision
-shapes, friction, damping, springs or loads otherwise (``SimResult.built``
-lists what was built).  Wind-up #6 and #9 are spatial and are refused.
+Time is scaled so that one pymunk time unit is one step: the joint error
+correction is then a fraction per step (:attr:`SimSettings.correction`),
+the same at any rate and step, and never underflows (pymunk's per-second
+``error_bias`` cannot express more than ~3 % per step at 64 substeps of a
+1 s cycle).  Velocities, forces, stiffnesses and damping are scaled to match.
 
-Blow-ups are detected (non-finite state, or a joint residual above
-``blowup_tol`` of the mechanism's size) and reported with the sample.
+Only the effects a scene names exist in the space: no gravity, friction,
+damping, springs or loads otherwise (``SimResult.built`` lists what was
+built).  Wind-up #6 and #9 are spatial and are refused, as is
+``contact = true`` (parts of one mechanism sit in layers and never touch).
+
+Failures are found by comparing poses, in blocks of samples with arrays:
+a sample where any part leaves its analytic pose by more than
+``tolerance`` of the mechanism's size (worst hull point), or whose state is
+not finite, stops the run and is reported with its sample and part, and
+whether the joints came apart (a blow-up) or still hold (the mechanism took
+another assembly branch).
 """
 
 from __future__ import annotations
 
+import ctypes
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Callable
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from .dynamics import inverse_dynamics_torque, mass_properties
 from .effects import Effects
 from .errors import PlanarError
-from .model import CamOnLine, Mechanism, Motion, PinInArcSlot, PinInSlot, Pivot, Slide, joint_residuals
+from .geometry import poses_apply, wrap_angle
+from .model import (
+    CamOnLine,
+    Mechanism,
+    Motion,
+    PinInArcSlot,
+    PinInSlot,
+    Pivot,
+    Slide,
+    joint_residuals,
+)
 from .registry import Registry
 
 if TYPE_CHECKING:
     from .scene import Scene
 
-__all__ = ["SimSettings", "SimResult", "SimulationError", "mass_properties", "simulate", "simulate_scene",
-           "DEFAULT_SETTINGS"]
+__all__ = [
+    "DEFAULT_SETTINGS",
+    "SimFailure",
+    "SimResult",
+    "SimSettings",
+    "SimulationError",
+    "inverse_dynamics_torque",
+    "mass_properties",
+    "simulate",
+    "simulate_scene",
+    "torque_comparison",
+]
 
 Array = NDArray[np.float64]
-
-DEFAULT_ERROR_BIAS = (1.0 - 0.1) ** 60.0  # pymunk's default: 10 % of the error fixed per 1/60 s
 
 
 class SimulationError(PlanarError):
@@ -63,14 +97,24 @@ class SimSettings:
     """Settings that trade accuracy for time.
 
     ``substeps``: physics steps per output sample; ``iterations``: solver
-    iterations per step; ``error_bias``: fraction of joint error left
-    uncorrected after one second (pymunk's meaning; smaller corrects faster).
+    iterations per step (raised automatically where the moving parts'
+    masses differ a lot, see :func:`solver_iterations`, unless ``adaptive``
+    is off); ``correction``: fraction of a joint's position error corrected
+    per step (0 = none, 1 = all of it in one step); ``error_bias``: pymunk's
+    fraction of joint error left uncorrected after one second, if given it
+    replaces ``correction`` (``correction = 1 - error_bias ** dt``);
+    ``tolerance``: a part further than this fraction of the mechanism's size
+    from its analytic pose is a failure; ``blowup_tol``: a joint residual
+    above this fraction of the size marks the failure as a blow-up.
     """
 
-    substeps: int = 64
-    iterations: int = 20
-    error_bias: float = 1e-9
+    substeps: int = 32
+    iterations: int = 40
+    correction: float = 0.2
+    error_bias: float | None = None
+    tolerance: float = 1e-3
     blowup_tol: float = 0.05
+    adaptive: bool = True
 
     def __post_init__(self) -> None:
         from .errors import InputError
@@ -79,11 +123,40 @@ class SimSettings:
             raise InputError("substeps", self.substeps, "at least 1")
         if self.iterations < 1:
             raise InputError("iterations", self.iterations, "at least 1")
-        if not (0.0 <= self.error_bias < 1.0):
+        if not (0.0 <= self.correction <= 1.0):
+            raise InputError("correction", self.correction, "a fraction in [0, 1]")
+        if self.error_bias is not None and not (0.0 <= self.error_bias < 1.0):
             raise InputError("error_bias", self.error_bias, "a fraction in [0, 1)")
+        if not (self.tolerance > 0.0):
+            raise InputError("tolerance", self.tolerance, "a positive fraction of the size")
+
+    def step_correction(self, dt: float) -> float:
+        """Fraction of joint error corrected per step of ``dt`` seconds."""
+        if self.error_bias is None:
+            return self.correction
+        return 1.0 - self.error_bias ** dt
 
 
 DEFAULT_SETTINGS = SimSettings()
+
+
+@dataclass(frozen=True)
+class SimFailure:
+    """Where and how a simulation left its analytic motion.
+
+    ``kind``: ``"blow-up"`` (non-finite state or a joint came apart),
+    ``"branch"`` (every joint holds but a part is elsewhere: another assembly
+    branch) or ``"drift"`` (the joints are off by more than ``tolerance`` but
+    less than ``blowup_tol``).  ``error``: the part's distance from its
+    analytic pose as a fraction of the size.
+    """
+
+    sample: int
+    time: float
+    part: str
+    kind: str
+    error: float
+    message: str
 
 
 @dataclass
@@ -97,48 +170,19 @@ class SimResult:
     wall_time: float
     steps: int
     torque: Array | None = None
-    blowup: tuple[int, str] | None = None
+    failure: SimFailure | None = None
     #: the rebuild's pin bodies: (part, point in its frame, mass)
     pins: list[tuple[str, tuple[float, float], float]] = field(default_factory=list)
     residuals: dict[str, Array] = field(default_factory=dict)
+    #: samples whose interval had a step with the motor at its force limit (motor mode)
+    saturated: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, dtype=np.intp))
+    #: largest deviation of every part from its analytic pose over the simulated samples, / size
+    pose_error: dict[str, float] = field(default_factory=dict)
 
-
-# --------------------------------------------------------------------------- mass
-
-
-def _ring_moments(xy: Array) -> tuple[float, float, float, float]:
-    """Signed area, first moments and polar second moment (about the origin) of a closed ring."""
-    x, y = xy[:, 0], xy[:, 1]
-    x1, y1 = np.roll(x, -1), np.roll(y, -1)
-    cross = x * y1 - x1 * y
-    a = 0.5 * cross.sum()
-    sx = (cross * (x + x1)).sum() / 6.0
-    sy = (cross * (y + y1)).sum() / 6.0
-    jz = (cross * (x * x + x * x1 + x1 * x1 + y * y + y * y1 + y1 * y1)).sum() / 12.0
-    return a, sx, sy, jz
-
-
-def mass_properties(part, density: float) -> tuple[float, tuple[float, float], float]:
-    """``(mass, centre of gravity, moment about it)`` of a part's outline (holes removed).
-
-    Polygon formulas (Green's theorem) over the exterior (counter-clockwise)
-    and the holes (clockwise), so the holes subtract.
-    """
-    from shapely.geometry.polygon import orient
-
-    poly = orient(part.outline, sign=1.0)  # exterior counter-clockwise, holes clockwise: signed sums
-    rings = [np.asarray(poly.exterior.coords)[:-1]] + [np.asarray(r.coords)[:-1] for r in poly.interiors]
-    A = Sx = Sy = J = 0.0
-    for r in rings:
-        a, sx, sy, jz = _ring_moments(r)
-        A += a
-        Sx += sx
-        Sy += sy
-        J += jz
-    cx, cy = Sx / A, Sy / A
-    mass = density * A
-    moment = density * (J - A * (cx * cx + cy * cy))
-    return mass, (cx, cy), moment
+    @property
+    def blowup(self) -> tuple[int, str] | None:
+        """``(sample, message)`` of the failure, if any (any kind, not only blow-ups)."""
+        return None if self.failure is None else (self.failure.sample, self.failure.message)
 
 
 # --------------------------------------------------------------------------- building
@@ -170,50 +214,137 @@ def _holding_effect(effects: Effects | None) -> bool:
     return effects is not None and (effects.gravity is not None or len(effects.springs) > 0)
 
 
+def solver_iterations(settings: SimSettings, masses: list[float]) -> int:
+    """Solver iterations for bodies of these masses: ``settings.iterations``, times
+    ``1 + log10`` of the largest mass ratio above 10 when ``settings.adaptive``.
+
+    An iterative (Gauss-Seidel) solver converges more slowly the more the
+    masses it couples differ: a four-bar with a 1:1000 coupler/rocker mass
+    ratio blew up in motor mode at 20 iterations and holds at 80.
+    """
+    m = [x for x in masses if x > 0 and math.isfinite(x)]
+    if not settings.adaptive or len(m) < 2:
+        return settings.iterations
+    ratio = max(m) / min(m)
+    if ratio <= 10.0:
+        return settings.iterations
+    return math.ceil(settings.iterations * (1.0 + math.log10(ratio)))
+
+
+_MASS_RATIO_CORRECTION = 0.05
+_PIN_FRACTION = 0.1  # pin mass / its part's mass (see _Rebuild._pin)
+
+
+def _compensated(mass: float, cog: tuple[float, float], moment: float,
+                 pins: list[tuple[tuple[float, float], float]]) -> tuple[float, tuple[float, float], float, float]:
+    """The part without its pins, so that part + pins has the part's mass, centre and moment.
+
+    Returns ``(mass, cog, moment, scale)`` with ``scale`` the factor applied
+    to every pin mass (1, or less where the pins would take too much of the
+    part: at most half its mass and half its moment).
+    """
+    scale = 1.0
+    c = np.asarray(cog, float)
+    for _ in range(60):
+        mp = np.array([m * scale for _, m in pins])
+        xy = np.array([p for p, _ in pins], float).reshape(-1, 2)
+        m2 = mass - mp.sum()
+        c2 = (mass * c - (mp[:, None] * xy).sum(0)) / m2
+        i2 = moment - m2 * float(((c2 - c) ** 2).sum()) - float((mp * ((xy - c) ** 2).sum(1)).sum())
+        if m2 >= 0.5 * mass and i2 >= 0.5 * moment:
+            return m2, (float(c2[0]), float(c2[1])), i2, scale
+        scale *= 0.5
+    return mass, cog, moment, 0.0  # pragma: no cover - a vanishing pin mass always fits
+
+
+def _motor_impulse_offset() -> int:
+    """Offset (in doubles) of ``jAcc`` in Chipmunk's ``cpSimpleMotor``, found by probing.
+
+    pymunk reports a motor's impulse as a magnitude only; the signed value
+    (the accumulated impulse ``jAcc``) sits after the ``rate`` and ``iSum``
+    fields.  Found here on a probe with known values, and every reading in
+    :func:`simulate` is checked against pymunk's magnitude, so a different
+    layout fails loudly instead of reading garbage.
+    """
+    import pymunk
+    from pymunk._chipmunk import ffi
+
+    space = pymunk.Space()
+    body = pymunk.Body(1.0, 1.0)
+    space.add(body)
+    motor = pymunk.SimpleMotor(space.static_body, body, 1.375)
+    space.add(motor)
+    body.torque = 5.0
+    space.step(0.01)  # body b wants w = -rate = -1.375, torque gives +0.05: jAcc = -1.425
+    addr = int(ffi.cast("uintptr_t", motor._constraint))
+    vals = (ctypes.c_double * 32).from_address(addr)
+    for k in range(2, 32):
+        if vals[k] == -motor.impulse and vals[k - 2] == 1.375 and motor.impulse == 1.425:
+            return k
+    raise SimulationError("this pymunk version's motor layout is unknown: the motor torque's sign cannot be read")
+
+
+_JACC: list[int] = []
+
+
 class _Rebuild:
-    """pymunk space, bodies and constraints for one mechanism."""
+    """pymunk space, bodies and constraints for one mechanism.
+
+    Units inside the space are scaled to one time unit per step (``dt``
+    seconds): velocities x dt, forces and gravity x dt^2, damping per step.
+    """
 
     def __init__(self, mech: Mechanism, analytic: Motion, effects: Effects | None, settings: SimSettings,
-                 mode: str, densities: dict[str, float] | None = None) -> None:
+                 mode: str, dt: float, densities: dict[str, float] | None = None,
+                 overrides: dict[str, tuple[float, tuple[float, float], float, float]] | None = None) -> None:
         import pymunk
 
         self.pymunk = pymunk
         self.mech = mech
         self.settings = settings
         self.mode = mode
+        self.dt = dt
         space = pymunk.Space()
-        space.iterations = settings.iterations
         built: dict[str, Any] = {"gravity": None, "shapes": 0, "friction": None, "damping": None,
                                  "springs": 0, "loads": 0, "constraints": 0, "bodies": 0}
+        if effects is not None and effects.contact:
+            raise SimulationError(
+                f"{mech.name}: [effects] contact = true is not supported: the parts of a mechanism sit in "
+                "layers and never touch each other; remove 'contact' from the scene")
         if effects is not None and effects.gravity is not None:
-            space.gravity = tuple(effects.gravity)
+            space.gravity = (float(effects.gravity[0]) * dt * dt, float(effects.gravity[1]) * dt * dt)
             built["gravity"] = tuple(effects.gravity)
         if effects is not None and effects.damping is not None:
-            space.damping = effects.damping
+            space.damping = float(effects.damping) ** dt
             built["damping"] = effects.damping
         density = effects.density if effects is not None else 1.0
         self.bodies: dict[str, Any] = {}
         self.cog: dict[str, tuple[float, float]] = {}
-        self.driven = [p for p in _driven_parts(mech)]
-        # every stage of a toy has its own ground part: all are the static body
+        self.driven = list(_driven_parts(mech))
+        #: per part: (mass, cog, moment, pin scale) of the part without its pins (see _compensated)
+        self.overrides = dict(overrides or {})
+        self.true_mass: dict[str, tuple[float, tuple[float, float], float]] = {}
+        masses = []
         for p in mech.parts:
             pose0 = analytic.poses[p.name][0]
             if p.ground:
-                body = space.static_body
                 if p.name not in self.bodies:
-                    self.bodies[p.name] = body
+                    self.bodies[p.name] = space.static_body
                 continue
             if p.name in self.driven and mode == "kinematic":
                 body = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
                 self.cog[p.name] = (0.0, 0.0)
             else:
                 d = (densities or {}).get(p.name, density)
-                m, cog, I = mass_properties(p, d)
-                body = pymunk.Body(m, I)
+                m, cog, inertia = mass_properties(p, d)
+                self.true_mass[p.name] = (m, cog, inertia)
+                if p.name in self.overrides:
+                    m, cog, inertia, _ = self.overrides[p.name]
+                body = pymunk.Body(m, inertia)
+                masses.append(m)
                 # The body's frame is put at the part's centre of gravity (``center_of_gravity``
                 # stays (0, 0)): with an offset centre of gravity pymunk 7.3's GrooveJoint lets the
-                # pin leave its groove (measured: 0.07 units off a 1.5-unit groove under a side
-                # load), so part-frame anchors are shifted by ``cog`` instead.
+                # pin leave its groove, so part-frame anchors are shifted by ``cog`` instead.
                 self.cog[p.name] = cog
             c, s_ = math.cos(pose0[2]), math.sin(pose0[2])
             cx, cy = self.cog[p.name]
@@ -222,11 +353,21 @@ class _Rebuild:
             space.add(body)
             self.bodies[p.name] = body
             built["bodies"] += 1
+        self.iterations = solver_iterations(settings, masses)
+        space.iterations = self.iterations
+        built["iterations"] = self.iterations
         self.static_pose = {p.name: analytic.poses[p.name][0] for p in mech.parts if p.ground}
-        self.constraints = []
+        self.constraints: list[Any] = []
         self.pins: list[tuple[Any, str, tuple[float, float]]] = []
         self.space_pending: list[Any] = []
         built["imposed"] = []
+        self.correction = settings.step_correction(dt)
+        if settings.adaptive and self.iterations > settings.iterations:
+            # strong correction of a light part against a heavy one overshoots: measured on a four-bar with a
+            # 1:1000 rocker/coupler mass ratio, 0.05 per step holds to 3e-4 of the size, 0.1 and more fly off
+            self.correction = min(self.correction, _MASS_RATIO_CORRECTION)
+        built["correction"] = self.correction
+        bias = 1.0 - self.correction  # error left per step = per time unit here
         for j in mech.joints:
             rebuild = REBUILDERS.get(j, f"joint {j.name!r} of {mech.name}")
             if all(self.bodies[p].body_type != pymunk.Body.DYNAMIC for p in (j.a, j.b)):
@@ -237,10 +378,11 @@ class _Rebuild:
                 for body in self.space_pending:
                     space.add(body)
                 self.space_pending.clear()
-                c.error_bias = settings.error_bias
+                c.error_bias = bias
                 space.add(c)
                 self.constraints.append(c)
         built["constraints"] = len(self.constraints)
+        self.loads: list[tuple[str, tuple[float, float], Array]] = []
         if effects is not None:
             for s in effects.springs:
                 a, b = self.bodies[s.a], self.bodies[s.b]
@@ -251,23 +393,20 @@ class _Rebuild:
                     pa = a.local_to_world(aa)
                     pb = b.local_to_world(bb)
                     rest = float(np.hypot(pa[0] - pb[0], pa[1] - pb[1]))
-                space.add(pymunk.DampedSpring(a, b, aa, bb, rest, s.stiffness, s.damping))
+                space.add(pymunk.DampedSpring(a, b, aa, bb, rest, s.stiffness * dt * dt, s.damping * dt))
                 built["springs"] += 1
-            if effects.contact:
-                built["shapes"] = self._shapes(space, effects)
-            self.loads = [(mech.points[l.point][0], mech.points[l.point][1], np.asarray(l.force, float))
-                          for l in effects.loads]
+            self.loads = [(mech.points[ld.point][0], mech.points[ld.point][1], np.asarray(ld.force, float))
+                          for ld in effects.loads]
             built["loads"] = len(self.loads)
-        else:
-            self.loads = []
         self.motor = None
+        self.motor_limit: float | None = None
         if mode == "motor":
             drv = self.bodies[mech.driver.part]
-            ground = space.static_body
-            # Chipmunk drives w_b - w_a = -rate
-            self.motor = pymunk.SimpleMotor(ground, drv, -mech.driver.rate)
+            # Chipmunk drives w_b - w_a = -rate (per time unit: per step here)
+            self.motor = pymunk.SimpleMotor(space.static_body, drv, -mech.driver.rate * dt)
             if effects is not None and effects.motor_force_limit is not None:
-                self.motor.max_force = effects.motor_force_limit
+                self.motor_limit = float(effects.motor_force_limit)
+                self.motor.max_force = self.motor_limit * dt * dt
             space.add(self.motor)
         self.space = space
         self.built = built
@@ -275,16 +414,15 @@ class _Rebuild:
     def _local(self, part: str, xy) -> tuple[float, float]:
         """A point in ``part``'s frame, in the frame of its pymunk body (static parts: world)."""
         if part in self.static_pose:
-            from .geometry import poses_apply
-
             w = poses_apply(np.asarray(self.static_pose[part]), np.asarray(xy, float))
             return (float(w[0]), float(w[1]))
         cx, cy = self.cog[part]
         return (float(xy[0] - cx), float(xy[1] - cy))
 
-    def _groove(self, slot_body, a, b, part: str, xy) -> list:
+    def _groove(self, slot_part: str, a, b, part: str, xy) -> list:
         pm = self.pymunk
-        ref = slot_body.mass if slot_body.body_type == pm.Body.DYNAMIC else None
+        slot_body = self.bodies[slot_part]
+        ref = self.true_mass[slot_part][0] if slot_part in self.true_mass else None
         pin, pivot = self._pin(part, xy, ref)
         return [pm.GrooveJoint(slot_body, pin, a, b, (0.0, 0.0)), pivot]
 
@@ -297,12 +435,17 @@ class _Rebuild:
         groove on a body's origin plus a pivot holds to 1e-7.  The pin weighs
         a tenth of its part (of the slotted part when its own is driven): at
         1/1000 the solver needed 4x the substeps for the same error (wind-up
-        #4: 8e-2 vs 5e-4 of the size at 16 substeps).
+        #4: 8e-2 vs 5e-4 of the size at 16 substeps).  Its mass is taken out
+        of its part (:func:`_compensated`), so the inertia is the model's.
         """
         pm = self.pymunk
         owner = self.bodies[part]
-        ref = owner.mass if owner.body_type == pm.Body.DYNAMIC else (ref_mass or 1.0)
-        mass = max(0.1 * ref, 1e-12)
+        if part in self.true_mass:
+            scale = self.overrides[part][3] if part in self.overrides else 1.0
+            mass = _PIN_FRACTION * self.true_mass[part][0] * scale
+        else:
+            mass = _PIN_FRACTION * (ref_mass or 1.0)
+        mass = max(mass, 1e-12)
         r = 1e-2 * max(self.mech.size, 1e-12)
         body = pm.Body(mass, 0.5 * mass * r * r)
         local = self._local(part, xy)
@@ -312,32 +455,22 @@ class _Rebuild:
         self.pins.append((body, part, (float(xy[0]), float(xy[1]))))
         return body, pm.PivotJoint(body, owner, (0.0, 0.0), local)
 
-    def _shapes(self, space, effects) -> int:
-        import shapely
-
-        pm = self.pymunk
-        n = 0
-        for p in self.mech.parts:
-            body = self.bodies[p.name]
-            tris = shapely.constrained_delaunay_triangles(p.outline)
-            for t in getattr(tris, "geoms", []):
-                pts = [self._local(p.name, c) for c in list(t.exterior.coords)[:-1]]
-                shape = pm.Poly(body, pts)
-                shape.friction = effects.friction if effects.friction is not None else 0.0
-                # parts of one mechanism pass through each other (they sit in layers); only contact
-                # with what the scene adds would collide: one group for the whole mechanism
-                shape.filter = pm.ShapeFilter(group=1)
-                space.add(shape)
-                n += 1
-        return n
+    def compensation(self) -> dict[str, tuple[float, tuple[float, float], float, float]]:
+        """Per dynamic part carrying pins: itself without them (see :func:`_compensated`)."""
+        per: dict[str, list[tuple[tuple[float, float], float]]] = {}
+        for body, part, xy in self.pins:
+            if part in self.true_mass:
+                per.setdefault(part, []).append((xy, body.mass))
+        return {p: _compensated(*self.true_mass[p], pins) for p, pins in per.items()}
 
     def set_state(self, poses: dict[str, Array], vel: dict[str, Array]) -> None:
-        """Place every moving body at a pose with a velocity (origin velocity, angular velocity)."""
+        """Place every moving body at a pose with a velocity (origin velocity, angular velocity; per s)."""
+        dt = self.dt
         for name, body in self.bodies.items():
             if body is self.space.static_body:
                 continue
             x, y, a = poses[name]
-            vx, vy, w = vel[name]
+            vx, vy, w = vel[name] * dt
             cx, cy = self.cog[name]
             c, s = math.cos(a), math.sin(a)
             rx, ry = c * cx - s * cy, s * cx + c * cy
@@ -345,28 +478,18 @@ class _Rebuild:
             body.angle = float(a)
             body.velocity = (float(vx - w * ry), float(vy + w * rx))
             body.angular_velocity = float(w)
-
         for body, part, xy in self.pins:
             x, y, a = poses[part]
-            vx, vy, w = vel[part]
+            vx, vy, w = vel[part] * dt
             c, s = math.cos(a), math.sin(a)
             rx, ry = c * xy[0] - s * xy[1], s * xy[0] + c * xy[1]
             body.position = (float(x + rx), float(y + ry))
             body.velocity = (float(vx - w * ry), float(vy + w * rx))
             body.angular_velocity = 0.0
 
-    def poses(self) -> dict[str, tuple[float, float, float]]:
-        out = {}
-        for name, body in self.bodies.items():
-            if body is self.space.static_body:
-                sp = self.static_pose[name]
-                out[name] = (float(sp[0]), float(sp[1]), float(sp[2]))
-            else:
-                a = body.angle
-                cx, cy = self.cog[name]
-                c, s = math.cos(a), math.sin(a)
-                out[name] = (body.position[0] - (c * cx - s * cy), body.position[1] - (s * cx + c * cy), a)
-        return out
+    def moving(self) -> list[str]:
+        """Names of the parts with a body of their own, in a fixed order."""
+        return [n for n, b in self.bodies.items() if b is not self.space.static_body]
 
 
 #: pymunk constraints for each joint kind: (rebuild, joint, effects) -> constraints
@@ -383,7 +506,7 @@ def _pivot(rb: _Rebuild, j: Pivot, effects: Effects | None) -> list[Any]:
 def _pin_in_slot(rb: _Rebuild, j: PinInSlot, effects: Effects | None) -> list[Any]:
     """``GrooveJoint`` with the groove on the slot's part ``a``, the pin a body pivoted to ``b``."""
     s0, s1 = _padded(rb._local(j.a, j.start), rb._local(j.a, j.end))
-    return rb._groove(rb.bodies[j.a], s0, s1, j.b, j.pin)
+    return rb._groove(j.a, s0, s1, j.b, j.pin)
 
 
 @REBUILDERS.register(Slide)
@@ -392,7 +515,7 @@ def _slide(rb: _Rebuild, j: Slide, effects: Effects | None) -> list[Any]:
     B = rb.bodies
     s0, s1 = _padded(rb._local(j.a, j.start), rb._local(j.a, j.end))
     phase = B[j.b].angle - B[j.a].angle
-    return rb._groove(B[j.a], s0, s1, j.b, j.anchor) + [rb.pymunk.GearJoint(B[j.a], B[j.b], phase, 1.0)]
+    return rb._groove(j.a, s0, s1, j.b, j.anchor) + [rb.pymunk.GearJoint(B[j.a], B[j.b], phase, 1.0)]
 
 
 @REBUILDERS.register(PinInArcSlot)
@@ -412,7 +535,7 @@ def _cam_on_line(rb: _Rebuild, j: CamOnLine, effects: Effects | None) -> list[An
     if j.radius != 0.0:
         raise SimulationError(f"{rb.mech.name}: joint {j.name!r}: a round cam on a face is not rebuilt")
     s0, s1 = _padded(rb._local(j.a, j.start), rb._local(j.a, j.end))
-    return rb._groove(rb.bodies[j.a], s0, s1, j.b, j.centre)
+    return rb._groove(j.a, s0, s1, j.b, j.centre)
 
 
 def _padded(a, b, frac: float = 0.1) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -444,18 +567,98 @@ def _analytic_pose_velocity(mech: Mechanism, t: Array) -> tuple[dict[str, Array]
     return m0.poses, vel, m0
 
 
+def _hull_points(mech: Mechanism, part: str) -> Array:
+    """Points that stand for a part: its hull circle centres (so rotation errors count too)."""
+    p = mech.part(part)
+    return np.array([(x, y) for x, y, _ in p.hull] or [(0.0, 0.0)], float)
+
+
+class _PoseCheck:
+    """Deviation of simulated poses from the analytic ones, a block of samples at a time."""
+
+    def __init__(self, mech: Mechanism, analytic: dict[str, Array], names: list[str],
+                 cogs: Array, settings: SimSettings) -> None:
+        self.mech = mech
+        self.names = names
+        self.cogs = cogs  # (B, 2) body frame origin in the part frame
+        self.pts = {n: _hull_points(mech, n) for n in names}
+        self.ref = {n: poses_apply(analytic[n], self.pts[n]) for n in names}  # (N, M, 2)
+        self.size = mech.size
+        self.tol = settings.tolerance * self.size
+        self.worst = {n: 0.0 for n in names}
+
+    def part_poses(self, raw: Array) -> Array:
+        """``(N, B, 3)`` body states (centre of gravity, angle) -> part frame poses."""
+        a = raw[..., 2]
+        c, s = np.cos(a), np.sin(a)
+        cx, cy = self.cogs[:, 0], self.cogs[:, 1]
+        out = np.empty_like(raw)
+        out[..., 0] = raw[..., 0] - (c * cx - s * cy)
+        out[..., 1] = raw[..., 1] - (s * cx + c * cy)
+        out[..., 2] = a
+        return out
+
+    def block(self, poses: Array, i0: int) -> tuple[int, str, float] | None:
+        """First sample of the block (absolute index) where a part is off, that part and its error."""
+        n = poses.shape[0]
+        dev = np.empty((n, len(self.names)))
+        for k, name in enumerate(self.names):
+            pts = poses_apply(poses[:, k], self.pts[name])
+            d = np.hypot(*(pts - self.ref[name][i0:i0 + n]).transpose(2, 0, 1)).max(axis=1)
+            dev[:, k] = np.where(np.isfinite(d), d, np.inf)
+        bad = (dev > self.tol).any(axis=1)
+        if not bad.any():
+            for k, name in enumerate(self.names):
+                self.worst[name] = max(self.worst[name], float(dev[:, k].max()))
+            return None
+        i = int(np.flatnonzero(bad)[0])
+        for k, name in enumerate(self.names):
+            self.worst[name] = max(self.worst[name], float(dev[: i + 1, k].max()))
+        k = int(np.argmax(dev[i]))
+        return i0 + i, self.names[k], float(dev[i, k])
+
+
+def _classify(mech: Mechanism, poses: dict[str, Array], i: int, part: str, err: float, t: float,
+              settings: SimSettings) -> SimFailure:
+    size = mech.size
+    one = {k: v[i:i + 1] for k, v in poses.items()}
+    finite = all(np.isfinite(v).all() for v in one.values())
+    res = {j.name: float(np.max(j.residual(one))) for j in mech.joints} if finite else {}
+    worst_joint = max(res, key=lambda k: res[k]) if res else None
+    worst = res[worst_joint] if worst_joint is not None else math.inf
+    where = f"at sample {i} (t = {t:.6g} s) part {part!r}"
+    if not finite or not math.isfinite(err):
+        return SimFailure(i, t, part, "blow-up", math.inf, f"blew up {where}: non-finite body state")
+    rel = err / size
+    if worst > settings.blowup_tol * size:
+        return SimFailure(i, t, part, "blow-up", rel,
+                          f"blew up {where}: joint {worst_joint!r} residual {worst / size:.3g} of the size "
+                          f"(part off its analytic pose by {rel:.3g} of the size)")
+    if worst < 0.1 * err:
+        return SimFailure(i, t, part, "branch", rel,
+                          f"switched assembly branch {where}: the part is {rel:.3g} of the size from its "
+                          f"analytic pose while every joint holds (worst residual {worst / size:.2g} of the size)")
+    return SimFailure(i, t, part, "drift", rel,
+                      f"left the analytic motion {where}: {rel:.3g} of the size off (tolerance "
+                      f"{settings.tolerance:g}); joint {worst_joint!r} residual {worst / size:.3g} of the size")
+
+
 def simulate(mech: Mechanism, t: Array, effects: Effects | None = None,
              settings: SimSettings = DEFAULT_SETTINGS, mode: str = "kinematic",
-             densities: dict[str, float] | None = None, torque_bias: float | None = None) -> SimResult:
-    """Simulate ``mech`` at output times ``t`` (evenly spaced), driven by the analytic input.
+             densities: dict[str, float] | None = None) -> SimResult:
+    """Simulate ``mech`` at output times ``t`` (s, evenly spaced), driven by the analytic input.
 
-    ``mode="motor"`` turns the driver with a ``SimpleMotor`` and measures the
-    motor torque from its constraint impulse: pymunk reports an impulse's
-    magnitude only, so a known constant torque ``torque_bias`` is applied to
-    the driver as well, which the motor must always oppose; the torque the
-    mechanism needs is then ``torque_bias - |impulse| / dt``, signed.
+    ``mode="motor"`` turns the driver with a ``SimpleMotor`` at the driver's
+    rate; ``SimResult.torque[i]`` is the mean torque the motor applied to the
+    driven part over the interval ending at sample ``i`` (counter-clockwise
+    positive, model force x length units), and ``SimResult.saturated`` the
+    samples where it reached ``effects.motor_force_limit``.  ``densities``
+    overrides the density per part.  The run stops at the first failure
+    (:class:`SimFailure`); later samples are marked invalid.
     """
     _check_mechanism(mech)
+    if mode not in ("kinematic", "motor"):
+        raise SimulationError(f"{mech.name}: mode {mode!r} is neither 'kinematic' nor 'motor'")
     t = np.asarray(t, float)
     if t.size < 2:
         raise PlanarError("simulate: needs at least two output times")
@@ -472,93 +675,145 @@ def simulate(mech: Mechanism, t: Array, effects: Effects | None = None,
         i = int(np.flatnonzero(~analytic.valid)[0])
         raise SimulationError(f"{mech.name}: the analytic motion is invalid at sample {i} "
                               f"({analytic.reason(i)}); the rebuild needs an assemblable cycle")
-    rb = _Rebuild(mech, analytic, effects, settings, mode, densities)
+    rb = _Rebuild(mech, analytic, effects, settings, mode, dt, densities)
+    comp = rb.compensation()
+    if comp:  # rebuild with the pins' mass taken out of their parts
+        rb = _Rebuild(mech, analytic, effects, settings, mode, dt, densities, overrides=comp)
     rb.set_state({k: v[0] for k, v in poses_a.items()}, {k: v[0] for k, v in vel_a.items()})
-    # analytic driver poses at every step end, all at once
-    t_steps = t[0] + dt * np.arange(1, (t.size - 1) * sub + 1)
-    driver_targets = {}
-    if mode == "kinematic":
-        for name in rb.driven:
-            driver_targets[name] = mech.solve(mech.driver.value(t_steps)).poses[name]
-    size = mech.size
     n = t.size
-    out = {p.name: np.empty((n, 3)) for p in mech.parts}
-    cur = rb.poses()
-    for k in out:
-        out[k][0] = cur[k]
+    size = mech.size
+    names = rb.moving()
+    bodies = [rb.bodies[k] for k in names]
+    check = _PoseCheck(mech, poses_a, names, np.array([rb.cog[k] for k in names], float).reshape(-1, 2), settings)
+    raw = np.empty((n, len(names), 3))
+    raw[0] = [(b.position.x, b.position.y, b.angle) for b in bodies]
+
+    # imposed parts (kinematic mode): steady ones (fixed position, constant angular rate) get one velocity per
+    # sample; the others one per step, closing on the analytic pose at the end of each step
+    steady: list[tuple[Any, float, float, float]] = []
+    per_step: list[tuple[Any, list[float], list[float], list[float]]] = []
+    step_targets: dict[str, Array] = {}
+    if mode == "kinematic":
+        t_steps = t[0] + dt * np.arange(1, (n - 1) * sub + 1)
+        m_steps = mech.solve(mech.driver.value(t_steps))
+        for name in rb.driven:
+            if name not in rb.bodies or rb.bodies[name] is rb.space.static_body:
+                continue
+            tg = m_steps.poses[name]
+            step_targets[name] = tg
+            inc = np.diff(np.vstack([poses_a[name][:1], tg]), axis=0)
+            inc[:, 2] = wrap_angle(inc[:, 2])
+            if np.abs(inc[:, :2]).max() <= 1e-12 * size and np.ptp(inc[:, 2]) <= 1e-9 * abs(inc[0, 2]) + 1e-15:
+                steady.append((rb.bodies[name], float(tg[0, 0]), float(tg[0, 1]), float(tg[0, 2])))
+            else:
+                per_step.append((rb.bodies[name], tg[:, 0].tolist(), tg[:, 1].tolist(), tg[:, 2].tolist()))
+    loads = [(rb.bodies[part], rb._local(part, xy), (float(-F[0]) * dt * dt, float(-F[1]) * dt * dt))
+             for part, xy, F in rb.loads]
+    motor = rb.motor
     torque = np.full(n, np.nan) if mode == "motor" else None
-    bias = float(torque_bias or 0.0)
-    blowup = None
-    loads = [(rb.bodies[part], rb._local(part, xy), F) for part, xy, F in rb.loads]
-    t0 = time.perf_counter()
-    steps = 0
+    sat = np.zeros(n, dtype=bool)
+    jacc = None
+    jmax = math.inf
+    if motor is not None:
+        if not _JACC:
+            _JACC.append(_motor_impulse_offset())
+        from pymunk._chipmunk import ffi
+
+        jacc = ctypes.c_double.from_address(int(ffi.cast("uintptr_t", motor._constraint)) + 8 * _JACC[0])
+        if rb.motor_limit is not None:
+            jmax = rb.motor_limit * dt * dt * (1.0 - 1e-9)
+    angle0 = {id(b): a for b, _, _, a in steady}
+    rate = {id(b): wrap_angle(step_targets[nm][0, 2] - poses_a[nm][0, 2]) for nm, b in
+            ((nm, rb.bodies[nm]) for nm in step_targets)}
     space = rb.space
-    drv_body = rb.bodies[mech.driver.part]
-    done = n
+    step = space.step
+    simple = not per_step and not loads and motor is None
+    block = max(4, min(64, 1024 // sub))
+    failure: SimFailure | None = None
+    checked = 1
+    steps = 0
+    t0 = time.perf_counter()
     for i in range(1, n):
-        imp_sum = 0.0
-        for s in range(sub):
-            k = (i - 1) * sub + s
-            for name, target in driver_targets.items():
-                body = rb.bodies[name]
-                x, y, a = target[k]
-                body.velocity = ((x - body.position[0]) / dt, (y - body.position[1]) / dt)
-                da = math.remainder(a - body.angle, 2 * math.pi)
-                body.angular_velocity = da / dt
-            for body, xy, F in loads:
-                # the mechanism exerts F on its load: the load pushes back with -F
-                wp = body.local_to_world(xy)
-                body.apply_force_at_world_point((float(-F[0]), float(-F[1])), wp)
-            if mode == "motor":
-                drv_body.torque = bias
-            space.step(dt)
-            steps += 1
-            if mode == "motor":
-                imp_sum += rb.motor.impulse
-        cur = rb.poses()
-        for name in out:
-            out[name][i] = cur[name]
-        if mode == "motor":
-            torque[i] = bias - imp_sum / dt_out
-        # blow-up check on this sample
-        if not all(np.isfinite(v).all() for v in cur.values()):
-            blowup = (i, "non-finite body state")
+        k0 = (i - 1) * sub
+        for body, _, _, _ in steady:
+            # one velocity per sample: exact for a steady turn, closing on the analytic angle at the sample's end
+            target = angle0[id(body)] + rate[id(body)] * (k0 + sub - 1)
+            body.angular_velocity = math.remainder(target - body.angle, 2 * math.pi) / sub
+            body.velocity = (0.0, 0.0)
+        if simple:
+            for _ in range(sub):
+                step(1.0)
         else:
-            worst = 0.0
-            for j in mech.joints:
-                r = float(np.max(j.residual({k: v[i:i + 1] for k, v in out.items()})))
-                worst = max(worst, r)
-            if worst > settings.blowup_tol * size:
-                blowup = (i, f"joint residual {worst:.3g} exceeds {settings.blowup_tol:g} of the size {size:.3g}")
-        if blowup is not None:
-            done = i + 1
-            break
+            jsum = 0.0
+            jbig = 0.0
+            for s in range(sub):
+                k = k0 + s
+                for body, xs, ys, angs in per_step:
+                    p = body.position
+                    body.velocity = (xs[k] - p.x, ys[k] - p.y)
+                    body.angular_velocity = math.remainder(angs[k] - body.angle, 2 * math.pi)
+                for body, xy, F in loads:
+                    # the mechanism exerts F on its load: the load pushes back with -F
+                    body.apply_force_at_world_point(F, body.local_to_world(xy))
+                step(1.0)
+                if jacc is not None:
+                    j = jacc.value
+                    jsum += j
+                    jbig = max(jbig, abs(j))
+            if jacc is not None and motor is not None:
+                if abs(jacc.value) != motor.impulse:
+                    raise SimulationError("the motor's signed impulse does not match pymunk's magnitude: "
+                                          "unknown pymunk motor layout")
+                torque[i] = jsum / (sub * dt * dt)  # type: ignore[index]
+                sat[i] = jbig >= jmax
+        steps += sub
+        raw[i] = [(b.position.x, b.position.y, b.angle) for b in bodies]
+        if i + 1 - checked >= block or i == n - 1:
+            hit = check.block(check.part_poses(raw[checked:i + 1]), checked)
+            checked = i + 1
+            if hit is not None:
+                done = hit[0]
+                poses_all = check.part_poses(raw[: done + 1])
+                pp = {nm: poses_all[:, kk] for kk, nm in enumerate(names)}
+                for p in mech.parts:
+                    if p.name not in pp:
+                        pp[p.name] = np.repeat(rb.static_pose[p.name][None, :], done + 1, axis=0)
+                failure = _classify(mech, pp, done, hit[1], hit[2], float(t[done]), settings)
+                break
     wall = time.perf_counter() - t0
-    valid = np.zeros(n, dtype=bool)
-    valid[:done] = True
+    done = n if failure is None else failure.sample + 1
+    poses_all = check.part_poses(raw[:done])
+    out: dict[str, Array] = {}
+    for p in mech.parts:
+        if p.name in names:
+            track = poses_all[:, names.index(p.name)]
+        else:
+            track = np.repeat(np.asarray(rb.static_pose[p.name], float)[None, :], done, axis=0)
+        full = np.empty((n, 3))
+        full[:done] = track
+        full[done:] = track[-1]
+        full[~np.isfinite(full)] = 0.0
+        out[p.name] = full
+    valid = np.ones(n, dtype=bool)
     code = np.full(n, -1, dtype=np.int16)
     table: list[tuple[str, str]] = []
-    if blowup is not None:
-        valid[blowup[0]:] = False
-        code[blowup[0]:] = 0
-        table.append(("simulation", f"blew up at sample {blowup[0]} (t = {t[blowup[0]]:.6g} s): {blowup[1]}"))
-        for k in out:
-            out[k][done:] = out[k][done - 1]
-            if not np.isfinite(out[k]).all():
-                out[k][~np.isfinite(out[k])] = 0.0
-    from .geometry import poses_apply
-
+    if failure is not None:
+        valid[failure.sample:] = False
+        code[failure.sample:] = 0
+        table.append(("simulation", failure.message))
     pts = {nm: poses_apply(out[part], xy) for nm, (part, xy) in mech.points.items()}
     motion = Motion(driver=analytic.driver, poses=out, valid=valid, fail_code=code, fail_table=table,
                     points=pts, t=t)
     res = joint_residuals(mech, motion)
-    built = dict(rb.built, mode=mode)
+    built = dict(rb.built, mode=mode, pins_compensated=sorted(comp))
     pins = [(part, xy, body.mass) for body, part, xy in rb.pins]
-    return SimResult(motion, settings, mode, built, wall, steps, torque, blowup, residuals=res, pins=pins)
+    pose_error = {k: v / size for k, v in check.worst.items()}
+    return SimResult(motion, settings, mode, built, wall, steps, torque, failure, pins=pins, residuals=res,
+                     saturated=np.flatnonzero(sat), pose_error=pose_error)
 
 
-def simulate_scene(scene: "Scene", settings: SimSettings = DEFAULT_SETTINGS, mode: str | None = None) -> SimResult:
-    """Simulate a scene over its cycles with its effects (kinematic driver unless dynamics are asked for)."""
+def simulate_scene(scene: Scene, settings: SimSettings = DEFAULT_SETTINGS, mode: str | None = None) -> SimResult:
+    """Simulate a scene over its cycles with its effects (kinematic driver unless a motor limit is named)."""
     e = scene.effects
     if mode is None:
         mode = "motor" if e.motor_force_limit is not None else "kinematic"
@@ -569,95 +824,49 @@ def simulate_scene(scene: "Scene", settings: SimSettings = DEFAULT_SETTINGS, mod
 # --------------------------------------------------------------------------- torque
 
 
-def inverse_dynamics_torque(mech: Mechanism, t: Array, effects: Effects | None,
-                            point_masses: list[tuple[str, tuple[float, float], float]] | None = None) -> Array:
-    """Motor torque by virtual work with inertia (d'Alembert), for a driver turning at a constant rate.
+def torque_comparison(mech: Mechanism, t: Array, effects: Effects | None,
+                      settings: SimSettings = DEFAULT_SETTINGS,
+                      densities: dict[str, float] | None = None) -> dict[str, Any]:
+    """pymunk's motor torque (signed, read every step) against inverse dynamics with every named effect.
 
-    ``tau dq = sum_parts (m (a_G - g) . dX_G + I_G alpha dphi) + sum_loads F . dX``
-    over one evenly sampled cycle ``t``; ``dX/dq`` and accelerations by
-    periodic central differences of the analytic motion.  ``point_masses``
-    adds point masses riding on parts (the rebuild's pin bodies).
+    pymunk's torque over an output interval is the mean of its step
+    impulses; it is compared with the mean of the analytic torque
+    (:func:`planar.dynamics.inverse_dynamics_torque`) over the same interval,
+    sampled at the steps' ends, after one sample of lead-in.  Only samples before a simulation
+    failure are compared.  ``saturated`` lists the samples where the motor
+    reached ``effects.motor_force_limit``.
     """
     t = np.asarray(t, float)
-    drv = mech.driver
-    m = mech.solve(drv.value(t), t=t)
-    dt = float(t[1] - t[0])
-    w = drv.rate
-    dq = w * dt
-    g = np.asarray(effects.gravity, float) if effects is not None and effects.gravity is not None else np.zeros(2)
-    density = effects.density if effects is not None else 1.0
-    from .geometry import poses_apply
-
-    def d1(x: Array) -> Array:
-        return (np.roll(x, -1, axis=0) - np.roll(x, 1, axis=0)) / (2 * dq)
-
-    def d2(x: Array) -> Array:
-        return (np.roll(x, -1, axis=0) - 2 * x + np.roll(x, 1, axis=0)) / (dq * dq)
-
-    tau = np.zeros(t.size)
-    masses = []
-    for p in mech.parts:
-        if p.ground:
-            continue
-        # (the driver turns steadily about its axle: its inertia terms vanish, its weight does not)
-        mass, cog, I = mass_properties(p, density)
-        masses.append((p.name, cog, mass, I))
-    for part, xy, mass in point_masses or []:
-        masses.append((part, xy, mass, 0.0))
-    for part, cog, mass, I in masses:
-        X = poses_apply(m.poses[part], np.asarray(cog, float))
-        phi = m.poses[part][:, 2]
-        fwd = np.remainder(np.roll(phi, -1) - phi + np.pi, 2 * np.pi) - np.pi  # wrapped steps
-        back = np.roll(fwd, 1)
-        dphi = (fwd + back) / (2 * dq)
-        ddphi = (fwd - back) / (dq * dq)
-        dX = d1(X)
-        acc = d2(X) * w * w
-        tau += mass * ((acc - g) * dX).sum(-1)
-        tau += I * (ddphi * w * w) * dphi
-    if effects is not None:
-        for load in effects.loads:
-            X = m.points[load.point]
-            tau += (np.asarray(load.force, float) * d1(X)).sum(-1)
-    return tau
-
-
-def torque_comparison(mech: Mechanism, t: Array, effects: Effects | None,
-                      settings: SimSettings = DEFAULT_SETTINGS) -> dict[str, Any]:
-    """pymunk's motor torque (from the motor's constraint impulses) against inverse dynamics by virtual work.
-
-    ``t`` must cover exactly one cycle, evenly (the analytic side uses
-    periodic differences).
-    """
-    # pymunk's torque over an output interval is the mean of its substep impulses: compare it with
-    # the mean of the analytic torque over the same interval (sampled at the substeps' midpoints)
     K = settings.substeps
     dt = float(t[1] - t[0])
-    t_fine = t[0] + (np.arange(t.size * K) + 0.5) * (dt / K)
-
-    def interval_means(pins) -> Array:
-        fine = inverse_dynamics_torque(mech, t_fine, effects, pins)
-        return np.roll(fine.reshape(t.size, K).mean(axis=1), 1)  # interval ending at sample i
-
-    # the bias only has to exceed the torque; the pins (a tenth of their parts) are added once known
-    bias = 3.0 * float(np.abs(interval_means(None)).max()) + 1e-9
-    for _ in range(4):
-        sim = simulate(mech, t, effects, settings, mode="motor", torque_bias=bias)
-        if sim.blowup is not None:
-            raise SimulationError(f"{mech.name}: the motor-driven simulation {sim.motion.reason(sim.blowup[0])}")
-        tau = sim.torque
-        if np.all(tau[1:] < bias * 0.999):
-            break
-        bias *= 4.0  # the motor must always oppose the bias; give it more room
-    analytic = interval_means(sim.pins)
-    peak = float(np.abs(analytic).max()) or 1.0
-    diff = np.abs(tau[1:] - analytic[1:])
-    return {
+    # one sample of lead-in, so that the first compared interval starts with settled joint forces
+    sim = simulate(mech, np.concatenate([[t[0] - dt], t]), effects, settings, mode="motor", densities=densities)
+    # a step's impulse is what holds the motion at the step's end (symplectic Euler): compare with the
+    # analytic torque at the ends of the steps of the interval ending at each sample, averaged
+    t_fine = t[0] - dt + (np.arange(t.size * K) + 1.0) * (dt / K)
+    fine = inverse_dynamics_torque(mech, t_fine, effects, densities, t_rest=float(t[0] - dt))
+    analytic = fine.reshape(t.size, K).mean(axis=1)
+    tau = np.asarray(sim.torque, float)[1:]
+    upto = t.size if sim.failure is None else sim.failure.sample - 1
+    peak = float(np.abs(analytic[1:]).max()) or 1.0
+    diff = np.abs(tau[1:upto] - analytic[1:upto]) if upto > 1 else np.zeros(1)
+    limit = effects.motor_force_limit if effects is not None else None
+    out = {
         "analytic": analytic.tolist(),
-        "simulated": [None] + tau[1:].tolist(),
+        "simulated": [None] + [None if not np.isfinite(v) else float(v) for v in tau[1:]],
         "peak": peak,
         "max_abs_diff": float(diff.max()),
         "max_rel_diff": float(diff.max() / peak),
-        "bias": bias,
-        "note": "simulated torque = bias - |motor impulse| / dt (pymunk reports impulse magnitudes)",
+        "samples_compared": max(upto - 1, 0),
+        "motor_force_limit": limit,
+        "saturated": (sim.saturated[sim.saturated > 0] - 1).tolist(),
+        "failure": None if sim.failure is None else sim.failure.message,
+        "pose_error": max(sim.pose_error.values(), default=0.0),
+        "pins": "each groove's pin is a body of its own whose mass is taken out of its part "
+                "(same mass, centre and moment), so both sides model the same inertia",
+        "note": "simulated torque: the motor's signed impulse per step / dt (mean over the interval)",
+        "wall_time": sim.wall_time,
     }
+    return out
+
+
