@@ -82,3 +82,13 @@ def test_bench_kinematics_json_has_ratio_and_agrees_with_peer():
     out = run("bench", "kinematics", "--json", "-n", "20000", "--repeats", "1")
     assert out.returncode == 0, out.stderr
     assert "ratio" in json.loads(out.stdout)
+
+
+def test_output_piped_into_a_closed_reader_gives_no_traceback():
+    import subprocess
+    import sys
+
+    root = Path(__file__).resolve().parents[1]
+    cmd = f"{sys.executable} -m planar chains | head -c 10"  # the reader closes after 10 bytes
+    r = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, cwd=root)
+    assert "Traceback" not in r.stderr and "BrokenPipe" not in r.stderr, r.stderr
