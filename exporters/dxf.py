@@ -74,7 +74,7 @@ def build_document(layout: Layout, sheet: int = 0, settings: Any = None, note: s
     colours = {"CUT_INNER": cut, "CUT_OUTER": cut, "ENGRAVE": eng, "SHEET": "#808080"}
     for name, hexcol in colours.items():
         layer = doc.layers.add(name, color=aci(hexcol))
-        layer.rgb = tuple(int(hexcol[i:i + 2], 16) for i in (1, 3, 5))
+        layer.rgb = (int(hexcol[1:3], 16), int(hexcol[3:5], 16), int(hexcol[5:7], 16))
         if name == "SHEET":
             layer.dxf.plot = 0
     msp.add_lwpolyline([(0, 0), (W, 0), (W, H), (0, H)], close=True, dxfattribs={"layer": "SHEET"})

@@ -9,7 +9,7 @@ shorter delays as 100 ms).
 from __future__ import annotations
 
 import os
-from typing import Iterable, Sequence
+from typing import BinaryIO, cast, Iterable, Sequence
 
 import numpy as np
 
@@ -85,6 +85,6 @@ def write_gif(path: str | os.PathLike, frames: Iterable, delay_ms: int,
     stack = np.stack(idx)
     with atomic_write(path, "wb") as fh:
         # mode "L" carries the indices; the palette argument gives them their colours
-        iio.imwrite(fh, stack, plugin="pillow", extension=".gif", mode="L", palette=flat,
+        iio.imwrite(cast(BinaryIO, fh), stack, plugin="pillow", extension=".gif", mode="L", palette=flat,
                     duration=[int(delay_ms)] * len(idx), loop=0, optimize=False, disposal=1)
     return len(idx)

@@ -189,7 +189,7 @@ def _legend(fab: Any) -> list[str]:
         names = by_plane[pl]
         if pl != "xy":
             lines.append(f"standing in the {pl} plane:")
-        for k in range(max(asm.layers[n] for n in names) + 1):  # type: ignore[type-var]
+        for k in range(max(asm.layers[n] or 0 for n in names) + 1):
             lines.append(f"  layer {k + 1}: " + ", ".join(n for n in names if asm.layers[n] == k))
     for pp in asm.pins:
         lo, hi = pp.layers or (0, 0)

@@ -22,10 +22,11 @@
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -175,12 +176,12 @@ def plan_assembly(mech: Any, material: dict[str, Any], pins: list[PinSpec], cont
         members = [n for n in names if plane[n] == pl]
         nodes = sorted({find(n) for n in members}, key=names.index)
         group = {r: [n for n in members if find(n) == r] for r in nodes}
-        for r, g in group.items():  # parts in contact share a layer: they must not overlap at any instant
+        for g in group.values():  # parts in contact share a layer: they must not overlap at any instant
             for x, y in itertools.combinations(g, 2):
                 worst = worst_overlap(x, y)
                 if worst > OVERLAP_MM2:
                     notes.append(f"{x} and {y} touch (a contact) on one layer but overlap by {worst:.1f} mm^2")
-        adj = {r: set() for r in nodes}
+        adj: dict[str, set[str]] = {r: set() for r in nodes}
         for x, y in itertools.combinations(nodes, 2):
             if any(swept[p].intersection(swept[q]).area > OVERLAP_MM2 for p in group[x] for q in group[y]):
                 adj[x].add(y)
@@ -196,9 +197,9 @@ def plan_assembly(mech: Any, material: dict[str, Any], pins: list[PinSpec], cont
     plans = []
     for i, (st, sp) in enumerate(zip(stacks, stack_parts)):
         pin = pins[st[0]]
-        ls = sorted({layers[p] for p in sp if layers[p] is not None})  # type: ignore[type-var]
+        ls = sorted({lp for p in sp if (lp := layers[p]) is not None})
         lo, hi = (ls[0], ls[-1]) if ls else (0, 0)
-        clashes = [q for q in crossing[i] if layers[q] is not None and lo < layers[q] < hi]  # type: ignore[operator]
+        clashes = [q for q in crossing[i] if (lq := layers[q]) is not None and lo < lq < hi]
         shaft = any(pins[j].joint == shaft_pin for j in st)
         joints = tuple(pins[j].joint for j in st)
         plans.append(PinPlan(letter(i), pin, (lo, hi), (hi - lo + 1) - len(ls), thickness * (hi - lo + 1) + 2 * pin_head,
@@ -209,6 +210,49 @@ def plan_assembly(mech: Any, material: dict[str, Any], pins: list[PinSpec], cont
     pose = {n: (float(motion.poses[n][first, 0] * u), float(motion.poses[n][first, 1] * u),
                 float(motion.poses[n][first, 2])) for n in names}
     return Assembly(layers, n_layers, plans, contacts, pose, notes, plane, u)
+
+
+def _score(pins_q: list, a: dict[str, int]) -> tuple[int, int, int]:
+    """(pin clashes, spacers, spread) of a partial layer assignment ``a`` (only placed pins count)."""
+    clash = spacers = spread = 0
+    for _, ns, qs in pins_q:
+        if any(n not in a for n in ns):
+            continue
+        ls = {a[n] for n in ns}
+        lo, hi = min(ls), max(ls)
+        spacers += hi - lo + 1 - len(ls)
+        spread += hi - lo
+        clash += sum(1 for q in qs if q in a and lo < a[q] < hi)
+    return clash, spacers, spread
+
+
+def _search(order: list[str], adj: dict, k: int,
+            score: Callable[[dict[str, int]], tuple[int, int, int]]) -> tuple[tuple[int, int, int], dict[str, int]] | None:
+    """Best assignment of ``k`` layers to ``order`` (neighbours in ``adj`` apart), depth first with bounds."""
+    best: list = [None]
+    count = [0]
+    assign: dict[str, int] = {}
+
+    def dfs(idx: int) -> None:
+        if count[0] >= MAX_ASSIGNMENTS:
+            return
+        count[0] += 1
+        sc = score(assign)
+        if best[0] is not None and sc >= best[0][0]:
+            return
+        if idx == len(order):
+            best[0] = (sc, dict(assign))
+            return
+        r = order[idx]
+        used = {assign[n] for n in adj[r] if n in assign}
+        for c in range(k):
+            if c not in used:
+                assign[r] = c
+                dfs(idx + 1)
+                del assign[r]
+
+    dfs(0)
+    return best[0]
 
 
 def _best_layers(nodes, adj, node_pins, crossing, group, find) -> tuple[dict[str, int], int]:
@@ -225,47 +269,13 @@ def _best_layers(nodes, adj, node_pins, crossing, group, find) -> tuple[dict[str
     for k in range(1, len(nodes) + 1):
         if chromatic and k > chromatic + 2:  # two more layers did not clear the clashes
             break
-        best: list = [None]
-        count = [0]
-        assign: dict[str, int] = {}
-
-        def score(a: dict[str, int]) -> tuple[int, int, int]:
-            clash = spacers = spread = 0
-            for _, ns, qs in pins_q:
-                if any(n not in a for n in ns):
-                    continue
-                ls = {a[n] for n in ns}
-                lo, hi = min(ls), max(ls)
-                spacers += hi - lo + 1 - len(ls)
-                spread += hi - lo
-                clash += sum(1 for q in qs if q in a and lo < a[q] < hi)
-            return clash, spacers, spread
-
-        def dfs(idx: int) -> None:
-            if count[0] >= MAX_ASSIGNMENTS:
-                return
-            count[0] += 1
-            sc = score(assign)
-            if best[0] is not None and sc >= best[0][0]:
-                return
-            if idx == len(order):
-                best[0] = (sc, dict(assign))
-                return
-            r = order[idx]
-            used = {assign[n] for n in adj[r] if n in assign}
-            for c in range(k):
-                if c not in used:
-                    assign[r] = c
-                    dfs(idx + 1)
-                    del assign[r]
-
-        dfs(0)
-        if best[0] is None:
+        best = _search(order, adj, k, functools.partial(_score, pins_q))
+        if best is None:
             continue
         chromatic = chromatic or k
-        if chosen is None or best[0][0][0] < chosen[0][0]:
-            chosen = (best[0][0], best[0][1], k)
-        if best[0][0][0] == 0:
+        if chosen is None or best[0][0] < chosen[0][0]:
+            chosen = (best[0], best[1], k)
+        if best[0][0] == 0:
             break
     if chosen is None:
         return {r: i for i, r in enumerate(nodes)}, len(nodes)

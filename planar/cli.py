@@ -9,8 +9,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from collections.abc import Callable, Sequence
-from pathlib import Path
+from collections.abc import Sequence
 
 from .errors import PlanarError
 
@@ -123,10 +122,12 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     settings = SimSettings(**{k: v for k, v in (("substeps", args.substeps), ("iterations", args.iterations),
                                                  ("error_bias", args.error_bias)) if v is not None})
     result, sim = compare_scene(scene, settings, args.threshold, args.torque_threshold, with_series=args.json)
+    t = sim.motion.t
+    assert t is not None  # a simulation records its output times
     if args.json:
         d = result.to_dict()
         d["settings"] = {"substeps": settings.substeps, "iterations": sim.built.get("iterations"),
-                         "correction": settings.step_correction(sim.motion.t[1] - sim.motion.t[0]),
+                         "correction": settings.step_correction(t[1] - t[0]),
                          "error_bias": settings.error_bias}
         d["wall_time_s"] = sim.wall_time
         d["built"] = {k: v for k, v in sim.built.items()}
@@ -135,7 +136,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         print(format_comparison(result))
         print(f"  simulated in {sim.wall_time:.3f} s ({sim.steps} steps; substeps {settings.substeps}, "
               f"iterations {sim.built.get('iterations')}, correction per step "
-              f"{settings.step_correction((sim.motion.t[1] - sim.motion.t[0]) / settings.substeps):.3g})")
+              f"{settings.step_correction((t[1] - t[0]) / settings.substeps):.3g})")
     return 0 if result.passed else EXIT_MISMATCH
 
 

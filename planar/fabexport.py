@@ -134,7 +134,7 @@ def kerf_test_layout(settings: FabSettings) -> Layout:
     inner = [Circle((0.0, 3.0), 5.0 - k2)]
     engrave = text_strokes(f"K {settings.kerf:.2f}", 2.0, (0.0, -5.5), 0.0)
     engrave += text_strokes("20 / 10", 1.6, (0.0, -8.3), 0.0)
-    pc = PartCut("kerf test", outer, inner, engrave, f"K {settings.kerf:.2f}", 2.0, nominal_holes=[((0.0, 3.0), 5.0)])
+    pc = PartCut("kerf test", outer, list(inner), engrave, f"K {settings.kerf:.2f}", 2.0, nominal_holes=[((0.0, 3.0), 5.0)])
     return nest([pc], settings.sheet, settings.spacing, settings.margin, settings.kerf, settings.unit_mm)
 
 

@@ -54,6 +54,10 @@ def _hole_at(part: Part, p: tuple[float, float]) -> Hole | None:
     return None
 
 
+def _v(p: Any) -> tuple[float, float]:
+    return (float(p[0]), float(p[1]))
+
+
 def _close(a: Any, b: Any) -> bool:
     return math.dist(a, b) < TOL * max(1.0, abs(a[0]) + abs(a[1]))
 
@@ -65,25 +69,25 @@ PIN_RULES: Registry[Callable[[Mechanism, Any], tuple[list[PinSpec], list[Contact
 @PIN_RULES.register(Pivot)
 def _pivot(mech: Mechanism, j: Pivot) -> tuple[list[PinSpec], list[Contact]]:
     if _hole_at(mech.part(j.a), j.anchor_a) and _hole_at(mech.part(j.b), j.anchor_b):
-        return [PinSpec(j.name, (j.a, j.b), (tuple(j.anchor_a), tuple(j.anchor_b)), ("hole", "hole"))], []
+        return [PinSpec(j.name, (j.a, j.b), (_v(j.anchor_a), _v(j.anchor_b)), ("hole", "hole"))], []
     return [], [Contact(j.name, (j.a, j.b), True)]  # a round cam running in a hole: the disc is the pin
 
 
 @PIN_RULES.register(PinInSlot)
 def _pin_in_slot(mech: Mechanism, j: PinInSlot) -> tuple[list[PinSpec], list[Contact]]:
-    return [PinSpec(j.name, (j.b, j.a), (tuple(j.pin), tuple(j.start)), ("hole", "slot"))], []
+    return [PinSpec(j.name, (j.b, j.a), (_v(j.pin), _v(j.start)), ("hole", "slot"))], []
 
 
 @PIN_RULES.register(PinInArcSlot)
 def _pin_in_arc_slot(mech: Mechanism, j: PinInArcSlot) -> tuple[list[PinSpec], list[Contact]]:
     on_arc = (float(j.centre[0] + j.radius), float(j.centre[1]))
-    return [PinSpec(j.name, (j.b, j.a), (tuple(j.pin), on_arc), ("hole", "slot"))], []
+    return [PinSpec(j.name, (j.b, j.a), (_v(j.pin), on_arc), ("hole", "slot"))], []
 
 
 @PIN_RULES.register(Slide)
 def _slide(mech: Mechanism, j: Slide) -> tuple[list[PinSpec], list[Contact]]:
     pts = (j.anchor, (j.anchor[0] + j.axis[0], j.anchor[1] + j.axis[1]))
-    return [PinSpec(f"{j.name}#{k + 1}", (j.b, j.a), (tuple(p), tuple(j.start)), ("hole", "slot"))
+    return [PinSpec(f"{j.name}#{k + 1}", (j.b, j.a), (_v(p), _v(j.start)), ("hole", "slot"))
             for k, p in enumerate(pts)], []
 
 

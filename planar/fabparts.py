@@ -85,7 +85,7 @@ class FabSettings:
     def from_spec(cls, fab: Any, kerf: float | None = None, sheet: tuple[float, float] | None = None) -> FabSettings:
         return cls(unit_mm=fab.unit_mm, thickness_mm=fab.thickness_mm, kerf=fab.kerf_mm if kerf is None else kerf,
                    pin_mm=fab.pin_diameter_mm, clearance=fab.clearance_mm,
-                   sheet=tuple(sheet or fab.sheet_mm),  # type: ignore[arg-type]
+                   sheet=(float((sheet or fab.sheet_mm)[0]), float((sheet or fab.sheet_mm)[1])),
                    min_wall=fab.min_wall_mm, min_part=fab.min_part_mm, min_label=fab.min_label_mm,
                    slot_end=fab.slot_end_margin_mm, widen=fab.widen, pin_head=fab.pin_head_mm,
                    shaft_mm=fab.shaft_diameter_mm, shaft_flat_mm=fab.shaft_flat_mm,
@@ -307,7 +307,7 @@ def _label(material, name: str, number: int, s: FabSettings, notes: list[str]) -
     c = np.asarray(rect.centroid.coords[0])
     d = np.array([math.cos(angle), math.sin(angle)])
     half = 0.5 * max(np.hypot(*e1), np.hypot(*e2))
-    centres = [(float(p.x), float(p.y))] + [tuple(map(float, c + t * half * d)) for t in np.linspace(-0.6, 0.6, 7)]
+    centres = [(float(p.x), float(p.y))] + [(float(x), float(y)) for x, y in (c + t * half * d for t in np.linspace(-0.6, 0.6, 7))]
     for text in (name, str(number)):
         h, at = _fit_text(room, text, angle, centres)
         if h >= s.min_label:

@@ -12,7 +12,7 @@ import io
 import os
 import tempfile
 from pathlib import Path
-from typing import Iterator
+from typing import Any, IO, Iterator
 
 import numpy as np
 
@@ -23,7 +23,7 @@ __all__ = ["atomic_write", "motion_columns", "write_motion_csv"]
 
 
 @contextlib.contextmanager
-def atomic_write(path: str | os.PathLike, mode: str = "wb") -> Iterator[io.IOBase]:
+def atomic_write(path: str | os.PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
     """Open a temporary file beside ``path``; rename it over ``path`` on success."""
     target = Path(path)
     parent = target.parent if str(target.parent) else Path(".")

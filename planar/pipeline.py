@@ -9,11 +9,10 @@ functions that need them, so ``import planar.pipeline`` stays light.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
-from .errors import InputError, PlanarError
+from .errors import InputError
 
 if TYPE_CHECKING:
     from .compare import Comparison

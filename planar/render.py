@@ -133,10 +133,9 @@ class Renderer:
     style: Style = field(default_factory=Style)
     overlay: Motion | None = None
     polygons: Mapping[str, tuple[str, Array]] = field(default_factory=dict)
-    view: str | None = None
+    view: str = ""  # default: the mechanism's own view plane ("xy" unless it says otherwise)
 
     def __post_init__(self) -> None:
-        from PIL import Image, ImageDraw
 
         self.view = self.view or getattr(self.mech, "view", "xy")
         s = self.style
@@ -322,8 +321,8 @@ class Renderer:
         if s.show_pins:
             dot = self.dot[s.pin]
             h = dot.size[0] // 2
-            for pts in self.pins.values():
-                x, y = pts[i]
+            for track in self.pins.values():
+                x, y = track[i]
                 img.paste(dot, (int(round(x)) - h, int(round(y)) - h), dot)
         dot = self.dot[s.trail]
         h = dot.size[0] // 2

@@ -345,8 +345,9 @@ class Scene:
         return Effects(
             gravity=None if e.gravity is None else (float(e.gravity[0]), float(e.gravity[1])),
             contact=e.contact, friction=e.friction, damping=e.damping, density=e.density,
-            springs=tuple(Spring(s.a, s.b, s.stiffness, tuple(s.anchor_a), tuple(s.anchor_b), s.rest_length,
-                                 s.damping) for s in e.springs),
+            springs=tuple(Spring(s.a, s.b, s.stiffness, (float(s.anchor_a[0]), float(s.anchor_a[1])),
+                                 (float(s.anchor_b[0]), float(s.anchor_b[1])), s.rest_length, s.damping)
+                          for s in e.springs),
             loads=tuple(Load(ld.point, (float(ld.force[0]), float(ld.force[1]))) for ld in e.loads),
             motor_force_limit=e.motor_force_limit,
         )
@@ -435,7 +436,7 @@ def _rocking(spec: SceneSpec, m: Any) -> dict[str, Any]:
 def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, Any]) -> Mechanism:
     from .catalog import get
 
-    placement = None
+    placement: tuple[float, float, float] = (0.0, 0.0, 0.0)
     if hasattr(m, "placement"):
         placement = (m.placement[0], m.placement[1], _angle(spec, m.placement[2]))
     if isinstance(m, FourBarSpec):
@@ -457,7 +458,7 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, A
             cls = NODE_KINDS[n.kind]  # each node kind declares the scene keys it is built from
             args = [_angle(spec, getattr(n, f)) if f in cls.angle_fields else getattr(n, f)
                     for f in cls.scene_fields]
-            nodes.append(cls(n.name, *args))
+            nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
         links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
         return Linkage(spec.name or "linkage", nodes, links, points=m.points, placement=placement,
                        rate=rate, phase=phase, **rock)

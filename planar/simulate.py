@@ -818,6 +818,7 @@ def simulate_scene(scene: Scene, settings: SimSettings = DEFAULT_SETTINGS, mode:
     if mode is None:
         mode = "motor" if e.motor_force_limit is not None else "kinematic"
     motion = scene.motion()
+    assert motion.t is not None  # a scene's motion is sampled in time
     return simulate(scene.mechanism, motion.t, e, settings, mode)
 
 

@@ -1,6 +1,5 @@
 """Laser-cut export read back: audit, units, closed contours, counts, distances, kerf, layout, SVG."""
 
-import hashlib
 import math
 import subprocess
 import sys
@@ -14,7 +13,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from shapely.geometry import Point, Polygon
 
-from planar.catalog import CATALOG
 from fabcheck import dxf_cut_polygons, match_contours, svg_closed_polygons
 from planar.cli import main
 from planar.fabexport import build

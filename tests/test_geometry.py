@@ -1,7 +1,7 @@
 """Transforms and intersections: properties (hypothesis) and exact cases."""
 
 import numpy as np
-from hypothesis import assume, given, settings
+from hypothesis import assume, given
 from hypothesis import strategies as st
 
 from planar import geometry as g

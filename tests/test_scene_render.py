@@ -13,7 +13,7 @@ from PIL import Image
 from planar import SceneError
 from planar.cli import main
 from planar.pipeline import gallery_scenes, render_scene
-from planar.scene import load_scene, parse_scene, scene_schema
+from planar.scene import load_scene, scene_schema
 
 ROOT = Path(__file__).resolve().parents[1]
 GALLERY = ROOT / "gallery"

@@ -31,7 +31,6 @@ LEG = {"mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 
 
 def test_mass_properties_match_shapely_and_integration():
     import shapely
-    from shapely.geometry import Point
 
     fb = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0))
     for part in fb.parts:

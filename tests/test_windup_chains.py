@@ -1,7 +1,6 @@
 """Motion transfer table, chain counts, composition, trees, failure boundaries, inverse sizing."""
 
 import json
-import math
 import subprocess
 import sys
 
@@ -216,7 +215,10 @@ def test_3_fails_where_circles_part_and_stays_finite_at_the_boundary():
     s = p0 + np.array(P.S_c[:2])
     m0 = np.array(P.D_jc)
     Rr, r = np.hypot(*(p0 - m0)), np.hypot(*(p0 - s))
-    g = lambda t: np.hypot(*(cam_centre(P.D_o, P.D_jc, np.array([t]))[0] - s)) - (Rr + r)
+
+    def g(t: float) -> float:
+        return float(np.hypot(*(cam_centre(P.D_o, P.D_jc, np.array([t]))[0] - s)) - (Rr + r))
+
     th = np.linspace(0, 2 * np.pi, 3601)
     st = mech.stage(th)
     gv = np.array([g(t) for t in th])

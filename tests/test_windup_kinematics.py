@@ -13,7 +13,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from planar import InputError
 from planar.windup import elemental, params_for
-from planar.windup.kinematics import cam_centre, rot
+from planar.windup.kinematics import cam_centre
 
 TOL = 1e-9
 

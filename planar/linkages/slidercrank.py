@@ -40,7 +40,8 @@ class SliderCrank(Linkage):
         l = check_positive(f"{name}.rod", rod)
         e = float(check_finite(f"{name}.offset", offset))
         if abs(e) >= r + l:
-            raise InputError(f"{name}.offset", offset, f"|offset| < crank + rod = {r + l:g} (else the rod never reaches the guide)")
+            raise InputError(f"{name}.offset", offset,
+                             f"|offset| < crank + rod = {r + l:g} (else the rod never reaches the guide)")
         self.r, self.l, self.e = r, l, e
         span = r + l
         nodes = [

@@ -236,7 +236,7 @@ class ToyMechanism(Mechanism):
         self._last_bases = bases
         return outs, checks
 
-    def _solve_poses(self, q: Array):  # type: ignore[override]
+    def _solve_poses(self, q: Array):
         _, checks = self.world_motion(q)
         poses: dict[str, Array] = {}
         for st in self.stages:

@@ -136,7 +136,7 @@ class ElementalMechanism(Mechanism):
         """Follower motion for driver motion ``u`` (see :mod:`planar.windup.kinematics`)."""
         return self.record.forward(self.params, np.asarray(u, float))
 
-    def _solve_poses(self, q: Array):  # type: ignore[override]
+    def _solve_poses(self, q: Array):
         u = self.driver_motion(q)
         st = self.forward(u)
         poses = {"ground": np.zeros((q.size, 3))}
@@ -252,7 +252,8 @@ class ElementalMechanism(Mechanism):
         follower = Part("follower", ((0.0, 0.0, 2 * P.F_jr), (*hole, P.D_jr * 1.35)),
                         (Hole((0.0, 0.0), 2 * P.F_jr), Hole(hole, 2 * P.D_jr)))
         drv = self._cam_driver()
-        ends = [(s[0] + r * np.cos(a), s[1] + r * np.sin(a)) for a in (track.angle0, track.angle1, 0.5 * (track.angle0 + track.angle1))]
+        mid = 0.5 * (track.angle0 + track.angle1)
+        ends = [(s[0] + r * np.cos(a), s[1] + r * np.sin(a)) for a in (track.angle0, track.angle1, mid)]
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), *[(x, y, 2 * P.F_jr) for x, y in ends]),
                       (Hole(_xy(P.D_o), 2 * P.D_ar), track), ground=True)
         joints = [
@@ -342,7 +343,8 @@ class ElementalMechanism(Mechanism):
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar),), (Hole(_xy(P.D_o), 2 * P.D_ar),), ground=True)
         joints = [
             Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
-            SkewContact("edge-pin", "driver", "follower", edge_point=(0.0, h), edge_dir=(1.0, 0.0), pin_x=float(P.F_o[0]), radius=r, plane_z=float(P.D_o[2])),
+            SkewContact("edge-pin", "driver", "follower", edge_point=(0.0, h), edge_dir=(1.0, 0.0),
+                        pin_x=float(P.F_o[0]), radius=r, plane_z=float(P.D_o[2])),
         ]
         return [ground, drv, follower], joints
 
@@ -434,7 +436,8 @@ class ElementalMechanism(Mechanism):
         ground = Part("ground", ((*g0, 2 * P.D_ar), (*g1, 2 * P.D_ar)), (gslot,), ground=True)
         joints = [
             Slide("driver-slide", "ground", "driver", start=g0, end=g1, anchor=(0.0, 0.0), axis=(L, 0.0)),
-            SkewContact("slot-pin", "driver", "follower", edge_point=e_loc, edge_dir=_xy(d), pin_x=float(P.F_o[0]), radius=r, plane_z=float(P.D_o[2])),
+            SkewContact("slot-pin", "driver", "follower", edge_point=e_loc, edge_dir=_xy(d),
+                        pin_x=float(P.F_o[0]), radius=r, plane_z=float(P.D_o[2])),
         ]
         return [ground, drv, follower], joints
 
