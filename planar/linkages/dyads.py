@@ -56,6 +56,7 @@ from numpy.typing import NDArray
 
 from ..errors import AssemblyError, InputError
 from ..geometry import circle_circle, line_circle, poses_apply, poses_compose, poses_invert
+from .chunked import _Plan, fast_solve, plan_for
 from ..model import (
     Driver,
     Mechanism,
@@ -638,6 +639,19 @@ class Linkage(Mechanism):
                 d = pos[lk.nodes[1]] - o
             poses[lk.name] = np.column_stack([o[:, 0], o[:, 1], np.arctan2(d[:, 1], d[:, 0])])
         return poses
+
+    def _fast_plan(self) -> "_Plan | None":
+        """The chunked solver's plan (built on first use; ``None`` if a node kind has no chunk kernel)."""
+        if "_plan" not in self.__dict__:
+            self.__dict__["_plan"] = plan_for(self)
+        return self.__dict__["_plan"]
+
+    def _solve_points(self, q: Array):  # type: ignore[override]
+        """The chunked, threaded path (:mod:`planar.linkages.chunked`), else the reference path."""
+        fast = fast_solve(self, q) if q.ndim == 1 else None
+        if fast is not None:
+            return fast
+        return super()._solve_points(q)
 
     def _solve_poses(self, q: Array):  # type: ignore[override]
         pos, checks = self.solve_nodes(q)
