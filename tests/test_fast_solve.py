@@ -25,6 +25,9 @@ QS = {
     "backward": np.linspace(3.0, -3.0, 2001),
     "scattered": np.random.default_rng(5).uniform(-10, 10, 2000),
     "one": np.array([0.3]),
+    # steps alternate in sign (no path: the chunked path throughout); 0 puts the kite's crank pin
+    # on its rocker pivot (concentric circles, invalid)
+    "zigzag": np.resize([0.0, 2.0, -1.0, 3.0, 0.5, -2.5], 4000) + np.repeat([0.0, 1e-3], 2000),
 }
 
 

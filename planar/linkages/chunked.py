@@ -21,7 +21,9 @@ motion faster:
   sample that may switch (or follows an invalid one on a path) sends the whole
   batch to the reference solve, which then decides exactly as before;
 * link angles are one ``arctan2`` per moving link; named points are the nodes'
-  positions (no pose round trip); validity is merged only when a sample fails.
+  positions (no pose round trip; at a failing sample, where a part's frame may
+  degenerate, through the part's pose as the reference); validity is merged
+  only when a sample fails.
 
 Node kinds without a chunk kernel here (a kind registered elsewhere) make
 :func:`fast_solve` return ``None``: the caller uses the reference path.
@@ -37,7 +39,7 @@ from typing import TYPE_CHECKING, Callable, Union
 import numpy as np
 from numpy.typing import NDArray
 
-from ..geometry import TANGENCY_RTOL, line_circle
+from ..geometry import TANGENCY_RTOL, line_circle, poses_apply
 
 if TYPE_CHECKING:
     from .dyads import Linkage, NodeKind
@@ -65,6 +67,7 @@ class Scratch:
         self.bufs: list[Array] = []
         self.i = 0
         self.n = size
+        self.pair: Array | None = None
 
     def reset(self, n: int) -> None:
         self.i = 0
@@ -76,6 +79,12 @@ class Scratch:
         b = self.bufs[self.i]
         self.i += 1
         return b[: self.n]
+
+    def get2(self) -> Array:
+        """A ``(2, n)`` buffer (kept apart from :meth:`get`'s)."""
+        if self.pair is None:
+            self.pair = np.empty((2, self.size))
+        return self.pair[:, : self.n]
 
 
 Kernel = Callable[["NodeKind", dict[str, tuple[Coord, Coord]], Array, Scratch, Array, Array], Placed]
@@ -153,14 +162,14 @@ def _rrr(node, pos, q, w, ox, oy) -> Placed:
     np.subtract(s2, d2, out=prod)
     np.subtract(d2, f2, out=t)
     prod *= t  # 4 d^2 h^2
-    d2min = float(d2.min()) if d2.size else 1.0
     ok: Mask | bool = True
-    # the threshold -rtol max(s2, d2)^2 is at most -rtol s2^2: above that, every sample closes
-    if d2.size and (float(prod.min()) < -TANGENCY_RTOL * s2 * s2 or d2min <= 0.0):
+    # every sample closes when the product clears -rtol s2^2 (the threshold -rtol max(s2, d2)^2
+    # is lower) and d > 0; at d = 0 the product is -s2 f2, below that unless the radii are equal
+    equal_radii = f2 <= 2.0 * TANGENCY_RTOL * s2
+    if d2.size and (float(prod.min()) < -TANGENCY_RTOL * s2 * s2 or (equal_radii and float(d2.min()) <= 0.0)):
         scale = np.maximum(s2, d2)
         ok = (prod >= -TANGENCY_RTOL * scale * scale) & (d2 > 0.0)
-        if d2min <= 0.0:
-            d2[d2 <= 0.0] = 1.0
+        d2[d2 <= 0.0] = 1.0  # concentric: invalid, kept finite as the reference does
     np.maximum(prod, 0.0, out=prod)
     np.reciprocal(d2, out=d2)  # 1 / d^2
     np.sqrt(prod, out=t)
@@ -322,24 +331,23 @@ def _path_ok(q: Array, k: NDArray[np.intp]) -> Mask:
     return same & (mag.max(0) <= 1.5 * mag.min(0))
 
 
-def _may_switch(x: Array, y: Array, ok: Mask | bool, sep2: Array, tol: float, q: Array, first: int,
-                w: Scratch) -> bool:
+def _may_switch(xy: Array, ok: Mask | bool, sep2: Array, tol: float, q: Array, first: int, w: Scratch) -> bool:
     """Whether a two-root node may leave its declared root at a window sample ``k >= first``.
 
-    ``x, y`` are the node's declared-root positions over the window, ``q`` the
-    driver values (same window), ``first`` >= 3 the first sample to test.
-    Conservative: ``False`` guarantees that :func:`carry_branch` flips nothing there.
+    ``xy`` ``(2, n)`` holds the node's declared-root positions over the window,
+    ``q`` the driver values (same window), ``first`` >= 3 the first sample to
+    test.  Conservative: ``False`` guarantees that :func:`carry_branch` flips
+    nothing there.
     """
-    n = x.shape[0]
+    n = xy.shape[1]
     if n <= first:
         return False
+    x, y = xy
     if ok is True:
-        d = w.get()[: n - 1]
-        np.subtract(x[1:], x[:-1], out=d)
-        mx = max(float(d.max()), -float(d.min()))
-        np.subtract(y[1:], y[:-1], out=d)
-        my = max(float(d.max()), -float(d.min()))
-        if 64.0 * (mx * mx + my * my) + tol * tol < float(sep2[first:].min()):
+        d = w.get2()[:, : n - 1]
+        np.subtract(xy[:, 1:], xy[:, :-1], out=d)
+        step = max(float(d.max()), -float(d.min()))  # |step| <= sqrt(2) * step
+        if 128.0 * step * step + tol * tol < float(sep2[first:].min()):
             return False
         valid = np.ones(n, bool)
     else:
@@ -364,8 +372,7 @@ def _solve_range(plan: _Plan, q: Array, lo: int, hi: int, chunk: int, poses: dic
     """Solve samples ``lo:hi`` chunk by chunk into ``poses`` and ``points``."""
     size = min(chunk, hi - lo) + _OVERLAP
     w = Scratch(size)
-    nx = [np.empty(size) for _ in plan.nodes]
-    ny = [np.empty(size) for _ in plan.nodes]
+    nxy = [np.empty((2, size)) for _ in plan.nodes]  # x and y rows of each node
     px, py, pa = plan.placement
     placed = bool(px or py or pa)
     c, s = float(np.cos(pa)), float(np.sin(pa))
@@ -381,14 +388,14 @@ def _solve_range(plan: _Plan, q: Array, lo: int, hi: int, chunk: int, poses: dic
         switch = False
         for idx, (nd, kern) in enumerate(zip(plan.nodes, plan.kernels)):
             w.reset(L)
-            x, y, ok, sep2 = kern(nd, pos, qw, w, nx[idx][:L], ny[idx][:L])
+            x, y, ok, sep2 = kern(nd, pos, qw, w, nxy[idx][0, :L], nxy[idx][1, :L])
             pos[nd.name] = (x, y)
             if ok is not None:
                 oks[idx] = ok
             if sep2 is not None and not switch:
                 assert isinstance(x, np.ndarray) and isinstance(y, np.ndarray) and ok is not None
                 w.reset(L)
-                switch = _may_switch(x, y, ok, sep2, tols[idx], qw, max(_OVERLAP, off), w)
+                switch = _may_switch(nxy[idx][:, :L], ok, sep2, tols[idx], qw, max(_OVERLAP, off), w)
         masks: list[Mask | None] = []
         for idx, _, _ in plan.checks:
             ok = oks[idx]
@@ -488,6 +495,12 @@ def fast_solve(lk: "Linkage", q: Array, threads: int | None = None, chunk: int =
                 if m is not None:
                     full[a:b] = m
             checks.append((full, node, why))
+        # where a sample fails a frame may degenerate (two nodes meet): there the named points
+        # are taken through the part's pose, as the reference does
+        bad = ~np.logical_and.reduce([m for m, _, _ in checks])
+        if bad.any():
+            for name, (part, xy) in lk.points.items():
+                points[name][bad] = poses_apply(poses[part][bad], xy)
     return poses, checks, points
 
 
