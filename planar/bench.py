@@ -61,6 +61,7 @@ def _pylinkage_of(lk: Any, step: float) -> Any:
         return c.output if isinstance(c, pl.Crank) else c
 
     for nd in lk.nodes:
+        c: Any
         if isinstance(nd, Fixed):
             c = pl.Ground(float(nd.xy[0]), float(nd.xy[1]), name=nd.name)
         elif isinstance(nd, Crank):
@@ -120,7 +121,7 @@ def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
             planar_rates.append(n / (time.perf_counter() - t0))
             valid = valid and bool(mo.valid.all())
 
-        def run_peer() -> None:
+        def run_peer(peer: Any = peer) -> None:
             t0 = time.perf_counter()
             peer.step_fast(iterations=n)
             peer_rates.append(n / (time.perf_counter() - t0))
@@ -174,16 +175,16 @@ def bench_kinematics(n: int = 1_000_000, repeats: int = 5) -> dict[str, Any]:
 
 def format_kinematics(r: dict[str, Any]) -> str:
     """Human-readable table of :func:`bench_kinematics` results."""
-    lines = [f"public solve vs {r['peer']}, {r['n']:,} crank angles, median (min-max) of {r['repeats']} "
-             f"interleaved repeats, {r['cores']} cores"]
+    lines = [(f"public solve vs {r['peer']}, {r['n']:,} crank angles, median (min-max) of {r['repeats']} "
+              f"interleaved repeats, {r['cores']} cores")]
     for c in r["cases"]:
         p, q, k = c["planar_samples_per_s"], c["peer_samples_per_s"], c["ratio_per_repeat"]
         lines += [
             f"  {c['linkage']} ({c['nodes']} nodes, {c['parts']} parts)",
-            f"    planar solve ({c['threads']} threads) {p['median'] / 1e6:8.2f} M samples/s "
-            f"({p['min'] / 1e6:.2f}-{p['max'] / 1e6:.2f})",
-            f"    pylinkage step_fast        {q['median'] / 1e6:8.2f} M samples/s "
-            f"({q['min'] / 1e6:.2f}-{q['max'] / 1e6:.2f})",
+            (f"    planar solve ({c['threads']} threads) {p['median'] / 1e6:8.2f} M samples/s "
+             f"({p['min'] / 1e6:.2f}-{p['max'] / 1e6:.2f})"),
+            (f"    pylinkage step_fast        {q['median'] / 1e6:8.2f} M samples/s "
+             f"({q['min'] / 1e6:.2f}-{q['max'] / 1e6:.2f})"),
             f"    ratio                      {c['ratio']:8.2f}  (per repeat {k['min']:.2f}-{k['max']:.2f})",
             f"    max |planar - peer|        {c['max_abs_diff_vs_peer']:8.1e}  (size {c['size']:.3g})",
         ]

@@ -607,8 +607,9 @@ class Mechanism:
         qa = np.atleast_1d(check_finite(f"{self.name}.driver value", q)).astype(float)
         poses, checks, pts = self._solve_points(qa)
         n = qa.shape[0]
+        table: list[tuple[str, str]] = []
         if checks is None:  # every sample closes
-            valid, code, table = np.ones(n, dtype=bool), np.full(n, -1, dtype=np.int16), []
+            valid, code = np.ones(n, dtype=bool), np.full(n, -1, dtype=np.int16)
         else:
             valid, code, table = merge_failures(n, checks)
         if pts is None:

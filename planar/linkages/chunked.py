@@ -32,9 +32,11 @@ Node kinds without a chunk kernel here (a kind registered elsewhere) make
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Callable, Union
+from itertools import pairwise
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -44,11 +46,11 @@ from ..geometry import TANGENCY_RTOL, line_circle, poses_apply
 if TYPE_CHECKING:
     from .dyads import Linkage, NodeKind
 
-__all__ = ["CHUNK", "fast_solve", "KERNELS"]
+__all__ = ["CHUNK", "KERNELS", "fast_solve", "plan_for", "threads_default"]
 
 Array = NDArray[np.float64]
 Mask = NDArray[np.bool_]
-Coord = Union[Array, float]
+Coord = Array | float
 #: a kernel's result: x, y, validity (None: no check, True: all close) and,
 #: for a two-root node, the squared distance between its roots
 Placed = tuple[Coord, Coord, "Mask | bool | None", "Array | None"]
@@ -250,18 +252,19 @@ def _rigid(node, pos, q, w, ox, oy) -> Placed:
 class _Plan:
     """What one linkage's fast solve needs, built once."""
 
-    nodes: list["NodeKind"]
+    nodes: list[NodeKind]
     kernels: list[Kernel]
     checks: list[tuple[int, str, str]]  # (node index, node, why) in solve order
-    links: list[tuple[str, int, int, int] | tuple[str, None, None, None]]  # (link, origin, from, to)
+    links: list[tuple[str, int, int, int]]  # (link, origin, from, to); origin -1: the ground
     points: list[tuple[str, int]]
     placement: tuple[float, float, float]
     bound: list[float]  # a bound on |coordinate| of each node, for q = 0 (actuators add |q|)
     grows: list[bool]  # node moves with |q| (downstream of an actuator)
 
 
-def plan_for(lk: "Linkage") -> _Plan | None:
+def plan_for(lk: Linkage) -> _Plan | None:
     """The fast-solve plan of ``lk``, or ``None`` when a node kind has no chunk kernel."""
+    from .dyads import RRP, RRR, Actuator, Crank, Fixed, Rigid
     kernels = []
     for nd in lk.nodes:
         k = KERNELS.get(type(nd).kind)
@@ -271,10 +274,10 @@ def plan_for(lk: "Linkage") -> _Plan | None:
     index = {nd.name: i for i, nd in enumerate(lk.nodes)}
     _, ref_checks = lk.solve_nodes(np.zeros(1))
     checks = [(index[node], node, why) for _, node, why in ref_checks]
-    links: list = []
+    links: list[tuple[str, int, int, int]] = []
     for link in lk.links:
         if link.name == lk.ground_name:
-            links.append((link.name, None, None, None))
+            links.append((link.name, -1, -1, -1))
             continue
         d = link.guide if link.guide is not None else (link.nodes[0], link.nodes[1])
         links.append((link.name, index[link.nodes[0]], index[d[0]], index[d[1]]))
@@ -284,24 +287,23 @@ def plan_for(lk: "Linkage") -> _Plan | None:
         refs = [index[r] for r in nd.refs()]
         b = max((bound[i] for i in refs), default=0.0)
         g = any(grows[i] for i in refs)
-        kind = type(nd).kind
-        if kind == "fixed":
+        if isinstance(nd, Fixed):
             b = float(np.hypot(*nd.xy))
-        elif kind == "crank":
+        elif isinstance(nd, Crank):
             b += nd.radius
-        elif kind == "actuator":
+        elif isinstance(nd, Actuator):
             b += abs(nd.offset)
             g = True
-        elif kind in ("rrr", "rrp"):
+        elif isinstance(nd, (RRR, RRP)):
             b = bound[index[nd.a]] + nd.ra
             g = grows[index[nd.a]]
-        elif kind == "rigid":
+        elif isinstance(nd, Rigid):
             b += float(np.hypot(*nd.local))
         bound.append(b)
         grows.append(g)
     return _Plan(list(lk.nodes), kernels, checks, links,
                  [(p, index[n]) for p, n in lk.point_nodes.items()],
-                 tuple(lk.placement), bound, grows)  # type: ignore[arg-type]
+                 (lk.placement[0], lk.placement[1], lk.placement[2]), bound, grows)
 
 
 # ------------------------------------------------------------------ solving
@@ -399,14 +401,14 @@ def _solve_range(plan: _Plan, q: Array, lo: int, hi: int, chunk: int, poses: dic
         masks: list[Mask | None] = []
         for idx, _, _ in plan.checks:
             ok = oks[idx]
-            masks.append(None if ok is True or bool(np.all(ok[off:])) else np.array(ok[off:]))
+            masks.append(None if isinstance(ok, bool) or bool(np.all(ok[off:])) else np.array(ok[off:]))
         out.append(_ChunkOut(masks, switch))
         if switch:
             break
         # link poses and named points (placement applied)
         w.reset(L - off)
         for name, o, a, b in plan.links:
-            if o is None:
+            if o < 0:
                 continue
             P = poses[name]
             ax_, ay_ = pos[plan.nodes[a].name]
@@ -451,7 +453,7 @@ def _place(x: Coord, y: Coord, ox: Array, oy: Array, placed: bool, px: float, py
     oy += m
 
 
-def fast_solve(lk: "Linkage", q: Array, threads: int | None = None, chunk: int = CHUNK):
+def fast_solve(lk: Linkage, q: Array, threads: int | None = None, chunk: int = CHUNK):
     """``(poses, checks, points)`` for driver values ``q`` by the chunked path, or ``None``.
 
     ``None``: a node kind has no kernel, or a branch may switch by continuity
@@ -468,7 +470,7 @@ def fast_solve(lk: "Linkage", q: Array, threads: int | None = None, chunk: int =
     poses: dict[str, Array] = {}
     px, py, pa = plan.placement
     for name, o, _, _ in plan.links:
-        if o is None:
+        if o < 0:
             poses[name] = np.zeros((n, 3)) if not (px or py or pa) else np.tile(np.array([px, py, pa]), (n, 1))
         else:
             poses[name] = np.empty((n, 3))
@@ -479,7 +481,7 @@ def fast_solve(lk: "Linkage", q: Array, threads: int | None = None, chunk: int =
         nthreads = min(nthreads, nchunks)
         cuts = [chunk * (nchunks * t // nthreads) for t in range(nthreads)] + [n]
         futs = [_pool().submit(_solve_range, plan, q, a, b, chunk, poses, points, tols)
-                for a, b in zip(cuts[:-1], cuts[1:])]
+                for a, b in pairwise(cuts)]
         results = [r for f in futs for r in f.result()]
     else:
         results = _solve_range(plan, q, 0, n, chunk, poses, points, tols)
