@@ -15,11 +15,14 @@ motion faster:
   switches to the other root at sample ``k`` only if the quadratic
   extrapolation of the node's previous three samples misses the declared root
   by more than 0.8 of the distance ``sep`` between the roots; that miss (the
-  third difference) is at most 4 times the node's largest step in the chunk.
-  A chunk where ``64 step^2 + tol^2 < min sep^2`` and every sample closes needs
-  no check; otherwise the third differences are tested sample by sample, and a
-  sample that may switch (or follows an invalid one on a path) sends the whole
-  batch to the reference solve, which then decides exactly as before;
+  third difference) is at most 4 times the node's largest step in the chunk,
+  and a step is at most ``sqrt(2) m`` with ``m`` the largest coordinate
+  change.  A chunk where ``128 m^2 + tol^2 < min sep^2`` (``tol`` = 1e-9 of a
+  bound on the node's coordinates, above any rounding) and every sample closes
+  needs no check; otherwise the third differences are tested sample by
+  sample, and a sample that may switch (or follows an invalid one on a path)
+  sends the whole batch to the reference solve, which then decides exactly as
+  before;
 * link angles are one ``arctan2`` per moving link; named points are the nodes'
   positions (no pose round trip; at a failing sample, where a part's frame may
   degenerate, through the part's pose as the reference); validity is merged
