@@ -16,6 +16,9 @@ def _linkages():
     out["parallelogram"] = FourBar(2.0, 1.0, 2.0, 1.0)
     out["kite"] = FourBar(1.0, 1.0, 2.0, 2.0)
     out["toggle"] = FourBar(4.0, 2.5, 2.0, 3.0, coupler_point=(1.0, -0.5))
+    # near a change point: the two roots come close but the motion need not switch
+    out["near-parallelogram"] = FourBar(2.0, 1.0, 2.0, 1.001)
+    out["near-parallelogram-fine"] = FourBar(2.0, 1.0, 2.0, 1.02)
     return out
 
 

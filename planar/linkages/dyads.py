@@ -44,6 +44,11 @@ Continuity is only applied where the driver steps of those samples have one
 sign and agree within a factor of 1.5 (a path, not a scattered batch), so a
 batch of unrelated driver values gets the declared branch throughout.
 Where a dyad cannot close the sample is invalid with the node named.
+
+:meth:`Linkage.solve` takes the chunked, threaded path of
+:mod:`planar.linkages.chunked`, which gives the same motion and hands a batch
+to the reference solve here (:meth:`Linkage.solve_nodes`) wherever a branch
+may switch by continuity.
 """
 
 from __future__ import annotations
