@@ -33,6 +33,8 @@ def _best_time(fn: Callable[[], Any], repeats: int) -> float:
 
 #: the linkages the kinematics benchmark solves (catalog names)
 KINEMATICS_CASES = ("fourbar-crank-rocker", "jansen")
+#: largest joint difference from pylinkage (model units) for the two to agree
+AGREEMENT = 1e-9
 
 
 def _pylinkage_of(lk: Any, step: float) -> Any:
@@ -141,6 +143,7 @@ def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
         "max_abs_diff_points_vs_peer": diff_points,
         "size": float(mech.size),
         "all_valid": valid,
+        "agrees": diff <= AGREEMENT and diff_points <= AGREEMENT and valid,
         "threads": threads_default(),
     }
 
@@ -156,8 +159,10 @@ def bench_kinematics(n: int = 1_000_000, repeats: int = 5) -> dict[str, Any]:
     each (order swapped every repeat); samples/s are reported as median, min
     and max, and ``ratio`` is the ratio of the medians.  Agreement: planar
     solves at the crank angles pylinkage reached and every joint is compared
-    (``max_abs_diff_vs_peer``, model units).  The top-level ``ratio`` is the
-    smaller of the two linkages' ratios.
+    (``max_abs_diff_vs_peer``, model units); ``ok`` is false (and the
+    command's exit status 1) unless every joint agrees within
+    :data:`AGREEMENT` and every sample is valid.  The top-level ``ratio`` is
+    the smaller of the two linkages' ratios.
     """
     if n < 1 or repeats < 1:
         raise PlanarError("planar bench kinematics needs n >= 1 and repeats >= 1")
@@ -170,6 +175,7 @@ def bench_kinematics(n: int = 1_000_000, repeats: int = 5) -> dict[str, Any]:
         "cores": os.cpu_count(),
         "cases": cases,
         "ratio": min(c["ratio"] for c in cases),
+        "ok": all(c["agrees"] for c in cases),
     }
 
 
@@ -186,7 +192,8 @@ def format_kinematics(r: dict[str, Any]) -> str:
             (f"    pylinkage step_fast        {q['median'] / 1e6:8.2f} M samples/s "
              f"({q['min'] / 1e6:.2f}-{q['max'] / 1e6:.2f})"),
             f"    ratio                      {c['ratio']:8.2f}  (per repeat {k['min']:.2f}-{k['max']:.2f})",
-            f"    max |planar - peer|        {c['max_abs_diff_vs_peer']:8.1e}  (size {c['size']:.3g})",
+            f"    max |planar - peer|        {c['max_abs_diff_vs_peer']:8.1e}  (size {c['size']:.3g})"
+            + ("" if c["agrees"] else f"  DISAGREES (more than {AGREEMENT:g}, or invalid samples)"),
         ]
     return "\n".join(lines)
 

@@ -82,8 +82,17 @@ def test_bench_kinematics_json_has_ratio_and_agrees_with_peer():
         assert c["ratio"] == pytest.approx(s["median"] / c["peer_samples_per_s"]["median"])
         # every joint agrees with pylinkage (an independent solver) at the same crank angles
         assert c["max_abs_diff_vs_peer"] < 1e-9 and c["max_abs_diff_points_vs_peer"] < 1e-9
-        assert c["all_valid"]
-    assert r["ratio"] == min(c["ratio"] for c in r["cases"])
+        assert c["all_valid"] and c["agrees"]
+    assert r["ratio"] == min(c["ratio"] for c in r["cases"]) and r["ok"]
     out = run("bench", "kinematics", "--json", "-n", "20000", "--repeats", "1")
     assert out.returncode == 0, out.stderr
     assert "ratio" in json.loads(out.stdout)
+
+
+def test_bench_kinematics_disagreement_changes_the_exit_status(monkeypatch, capsys):
+    pytest.importorskip("pylinkage")
+    import planar.bench
+
+    monkeypatch.setattr(planar.bench, "AGREEMENT", -1.0)  # no difference can pass
+    assert main(["bench", "kinematics", "-n", "2000", "--repeats", "1"]) == 1
+    assert "DISAGREES" in capsys.readouterr().out
