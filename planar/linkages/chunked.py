@@ -49,7 +49,7 @@ from ..geometry import TANGENCY_RTOL, line_circle, poses_apply
 if TYPE_CHECKING:
     from .dyads import Linkage, NodeKind
 
-__all__ = ["CHUNK", "KERNELS", "fast_solve", "plan_for", "threads_default"]
+__all__ = ["CHUNK", "KERNELS", "Solved", "fast_solve", "plan_for", "threads_default"]
 
 Array = NDArray[np.float64]
 Mask = NDArray[np.bool_]
@@ -57,6 +57,9 @@ Coord = Array | float
 #: a kernel's result: x, y, validity (None: no check, True: all close) and,
 #: for a two-root node, the squared distance between its roots
 Placed = tuple[Coord, Coord, "Mask | bool | None", "Array | None"]
+
+#: what a solve returns: poses, validity checks (None: every sample closes), named points
+Solved = tuple[dict[str, Array], "list[tuple[Mask, str, str]] | None", "dict[str, Array] | None"]
 
 #: samples per chunk: the working set of a chunk stays in the L2 cache
 CHUNK = 8192
@@ -466,7 +469,7 @@ def _place(x: Coord, y: Coord, ox: Array, oy: Array, placed: bool, px: float, py
     oy += m
 
 
-def fast_solve(lk: Linkage, q: Array, threads: int | None = None, chunk: int = CHUNK):
+def fast_solve(lk: Linkage, q: Array, threads: int | None = None, chunk: int = CHUNK) -> Solved | None:
     """``(poses, checks, points)`` for driver values ``q`` by the chunked path, or ``None``.
 
     ``None``: a node kind has no kernel, or a branch may switch by continuity
@@ -500,7 +503,7 @@ def fast_solve(lk: Linkage, q: Array, threads: int | None = None, chunk: int = C
         results = _solve_range(plan, q, 0, n, chunk, poses, points, tols)
     if any(r.switch for r in results):
         return None
-    checks = None
+    checks: list[tuple[Mask, str, str]] | None = None
     if any(m is not None for r in results for m in r.masks):
         checks = []
         for c_i, (_, node, why) in enumerate(plan.checks):

@@ -61,7 +61,6 @@ from numpy.typing import NDArray
 
 from ..errors import AssemblyError, InputError
 from ..geometry import circle_circle, line_circle, poses_apply, poses_compose, poses_invert
-from .chunked import _Plan, fast_solve, plan_for
 from ..model import (
     Driver,
     Mechanism,
@@ -72,6 +71,7 @@ from ..model import (
     check_finite,
     check_positive,
 )
+from .chunked import Solved, _Plan, fast_solve, plan_for
 
 __all__ = ["Fixed", "Crank", "Actuator", "RRR", "RRP", "Rigid", "Link", "Linkage", "Node", "NodeKind",
            "NODE_KINDS", "node_kind", "carry_branch"]
@@ -645,13 +645,14 @@ class Linkage(Mechanism):
             poses[lk.name] = np.column_stack([o[:, 0], o[:, 1], np.arctan2(d[:, 1], d[:, 0])])
         return poses
 
-    def _fast_plan(self) -> "_Plan | None":
+    def _fast_plan(self) -> _Plan | None:
         """The chunked solver's plan (built on first use; ``None`` if a node kind has no chunk kernel)."""
         if "_plan" not in self.__dict__:
             self.__dict__["_plan"] = plan_for(self)
-        return self.__dict__["_plan"]
+        plan: _Plan | None = self.__dict__["_plan"]
+        return plan
 
-    def _solve_points(self, q: Array):  # type: ignore[override]
+    def _solve_points(self, q: Array) -> Solved:
         """The chunked, threaded path (:mod:`planar.linkages.chunked`), else the reference path."""
         fast = fast_solve(self, q) if q.ndim == 1 else None
         if fast is not None:
