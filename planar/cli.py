@@ -45,7 +45,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         kwargs["quick"] = args.quick
     result = fn(**kwargs)
     print(json.dumps(result, indent=2) if args.json else fmt(result))
-    return 0
+    return 0 if result.get("ok", True) else 1
 
 
 def _cmd_motion_catalog(args: argparse.Namespace) -> int:

@@ -307,7 +307,8 @@ def _label(material, name: str, number: int, s: FabSettings, notes: list[str]) -
     c = np.asarray(rect.centroid.coords[0])
     d = np.array([math.cos(angle), math.sin(angle)])
     half = 0.5 * max(np.hypot(*e1), np.hypot(*e2))
-    centres = [(float(p.x), float(p.y))] + [(float(x), float(y)) for x, y in (c + t * half * d for t in np.linspace(-0.6, 0.6, 7))]
+    along = (c + t * half * d for t in np.linspace(-0.6, 0.6, 7))
+    centres = [(float(p.x), float(p.y))] + [(float(x), float(y)) for x, y in along]
     for text in (name, str(number)):
         h, at = _fit_text(room, text, angle, centres)
         if h >= s.min_label:

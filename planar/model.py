@@ -573,9 +573,15 @@ class Mechanism:
     def solve(self, q: ArrayLike, t: ArrayLike | None = None) -> Motion:
         """Solve all samples at once for driver values ``q`` (scalar or array)."""
         qa = np.atleast_1d(check_finite(f"{self.name}.driver value", q)).astype(float)
-        poses, checks = self._solve_poses(qa)
-        valid, code, table = merge_failures(qa.shape[0], checks)
-        pts = {n: poses_apply(poses[part], xy) for n, (part, xy) in self.points.items()}
+        poses, checks, pts = self._solve_points(qa)
+        n = qa.shape[0]
+        table: list[tuple[str, str]] = []
+        if checks is None:  # every sample closes
+            valid, code = np.ones(n, dtype=bool), np.full(n, -1, dtype=np.int16)
+        else:
+            valid, code, table = merge_failures(n, checks)
+        if pts is None:
+            pts = {name: poses_apply(poses[part], xy) for name, (part, xy) in self.points.items()}
         return Motion(
             driver=qa,
             poses=poses,
@@ -585,6 +591,16 @@ class Mechanism:
             points=pts,
             t=None if t is None else np.asarray(t, dtype=float),
         )
+
+    def _solve_points(
+        self, q: Array
+    ) -> tuple[dict[str, Array], list[tuple[NDArray[np.bool_], str, str]] | None, dict[str, Array] | None]:
+        """Poses, validity checks (``None``: every sample closes) and named points (``None``: from the poses).
+
+        A subclass with a faster path than :meth:`_solve_poses` overrides this.
+        """
+        poses, checks = self._solve_poses(q)
+        return poses, checks, None
 
     def run(self, samples_per_cycle: int = 360, cycles: float = 1.0) -> Motion:
         """Solve over time with the driver's law (``cycles`` periods)."""

@@ -8,6 +8,7 @@ functions that need them, so ``import planar.pipeline`` stays light.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -32,7 +33,7 @@ __all__ = [
 # --------------------------------------------------------------------------- scenes of a folder
 
 
-def gallery_scenes(folder: str | Path) -> list[Path]:
+def gallery_scenes(folder: str | os.PathLike[str]) -> list[Path]:
     """The scene files (``*.toml``) directly in ``folder``, sorted by name.
 
     The folder is always given by the caller (``planar gallery --source``,

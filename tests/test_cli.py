@@ -74,11 +74,16 @@ def test_bench_kinematics_json_has_ratio_and_agrees_with_peer():
     pytest.importorskip("pylinkage")
     from planar.bench import bench_kinematics
 
-    r = bench_kinematics(n=20_000, repeats=1)
-    assert r["ratio"] > 0 and r["peer_steps_per_s"] > 0
-    assert r["max_abs_diff_vs_peer"] < 1e-9
-    assert r["max_abs_diff_vs_model"] < 1e-12
-    assert r["all_valid"]
+    r = bench_kinematics(n=20_000, repeats=2)
+    assert [c["linkage"] for c in r["cases"]] == ["fourbar-crank-rocker", "jansen"]
+    for c in r["cases"]:
+        s = c["planar_samples_per_s"]
+        assert 0 < s["min"] <= s["median"] <= s["max"] and c["peer_samples_per_s"]["median"] > 0
+        assert c["ratio"] == pytest.approx(s["median"] / c["peer_samples_per_s"]["median"])
+        # every joint agrees with pylinkage (an independent solver) at the same crank angles
+        assert c["max_abs_diff_vs_peer"] < 1e-9 and c["max_abs_diff_points_vs_peer"] < 1e-9
+        assert c["all_valid"] and c["agrees"]
+    assert r["ratio"] == min(c["ratio"] for c in r["cases"]) and r["ok"]
     out = run("bench", "kinematics", "--json", "-n", "20000", "--repeats", "1")
     assert out.returncode == 0, out.stderr
     assert "ratio" in json.loads(out.stdout)
@@ -92,3 +97,12 @@ def test_output_piped_into_a_closed_reader_gives_no_traceback():
     cmd = f"{sys.executable} -m planar chains | head -c 10"  # the reader closes after 10 bytes
     r = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, cwd=root)
     assert "Traceback" not in r.stderr and "BrokenPipe" not in r.stderr, r.stderr
+
+
+def test_bench_kinematics_disagreement_changes_the_exit_status(monkeypatch, capsys):
+    pytest.importorskip("pylinkage")
+    import planar.bench
+
+    monkeypatch.setattr(planar.bench, "AGREEMENT", -1.0)  # no difference can pass
+    assert main(["bench", "kinematics", "-n", "2000", "--repeats", "1"]) == 1
+    assert "DISAGREES" in capsys.readouterr().out

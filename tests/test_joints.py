@@ -269,3 +269,12 @@ def test_a_point_named_like_a_part_is_refused():
         Linkage("l", [Fixed("O", (0, 0)), Fixed("Q", (3, 0)), Crank("A", "O", 1.0), RRR("B", "A", 3.0, "Q", 2.0)],
                 [Link("crank", ("O", "A")), Link("coupler", ("A", "B")), Link("rocker", ("Q", "B"))],
                 points={"coupler": "B"})
+
+
+def test_parallelogram_path_that_starts_past_a_flat_position_stays_a_parallelogram():
+    # no singular sample inside the path: the circuit still comes from the reference (crank at pi/2)
+    fb = FourBar(3.0, 1.5, 3.0, 1.5)
+    th = np.linspace(3.5, 6.0, 100)
+    m = fb.solve(th)
+    assert np.abs(wrap_angle(m.poses["coupler"][:, 2])).max() < 1e-9  # the coupler stays parallel to the ground
+    assert np.abs(wrap_angle(m.poses["rocker"][:, 2] - th)).max() < 1e-9

@@ -44,11 +44,16 @@ Continuity is only applied where the driver steps of those samples have one
 sign and agree within a factor of 1.5 (a path, not a scattered batch), so a
 batch of unrelated driver values gets the declared branch throughout.
 Where a dyad cannot close the sample is invalid with the node named.
+
+:meth:`Linkage.solve` takes the chunked, threaded path of
+:mod:`planar.linkages.chunked`, which gives the same motion and hands a batch
+to the reference solve here (:meth:`Linkage.solve_nodes`) wherever a branch
+may switch by continuity.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import ClassVar, Mapping, Sequence
 
 import numpy as np
@@ -66,6 +71,7 @@ from ..model import (
     check_finite,
     check_positive,
 )
+from .chunked import Solved, _Plan, fast_solve, plan_for
 
 __all__ = ["Fixed", "Crank", "Actuator", "RRR", "RRP", "Rigid", "Link", "Linkage", "Node", "NodeKind",
            "NODE_KINDS", "node_kind", "carry_branch"]
@@ -723,7 +729,41 @@ class Linkage(Mechanism):
             poses[lk.name] = np.column_stack([o[:, 0], o[:, 1], np.arctan2(d[:, 1], d[:, 0])])
         return poses
 
-    def _solve_poses(self, q: Array):  # type: ignore[override]
+    def _fast_plan(self) -> _Plan | None:
+        """The chunked solver's plan (built on first use; ``None`` if a node kind has no chunk kernel)."""
+        if "_plan" not in self.__dict__:
+            self.__dict__["_plan"] = plan_for(self)
+        plan: _Plan | None = self.__dict__["_plan"]
+        return plan
+
+    def _declared_branches_hold(self, q: Array) -> bool:
+        """Whether the branch carried from :attr:`branch_reference` is the declared one at ``q[0]``.
+
+        The chunked path starts every dyad on its declared branch; where the
+        lead-in from the reference arrives on the other one (a change-point
+        four-bar starting past a flat position), the reference path is used.
+        """
+        lead = self._lead_in(q)
+        if lead.size == 0:
+            return True
+        k = lead.shape[0]
+        pos, checks = self._solve_nodes(np.concatenate([lead, q[:1]]), self.nodes)
+        if not all(bool(m[k]) for m, _, _ in checks):
+            return False
+        for node in self.nodes:
+            b = node.branch_of(pos)
+            if b is not None and b != getattr(node, "branch", b):
+                return False
+        return True
+
+    def _solve_points(self, q: Array) -> Solved:
+        """The chunked, threaded path (:mod:`planar.linkages.chunked`), else the reference path."""
+        fast = fast_solve(self, q) if q.ndim == 1 and self._declared_branches_hold(q) else None
+        if fast is not None:
+            return fast
+        return super()._solve_points(q)
+
+    def _solve_poses(self, q: Array):
         pos, checks = self.solve_nodes(q)
         poses = self._link_poses(pos, q.shape[0])
         if any(self.placement):

@@ -26,7 +26,7 @@ from ..errors import InputError
 from ..model import check_positive
 from .dyads import RRR, Crank, Fixed, Link, Linkage, Rigid
 
-__all__ = ["FourBar", "grashof_class", "freudenstein_angles", "coupler_points_fast"]
+__all__ = ["FourBar", "grashof_class", "freudenstein_angles"]
 
 Array = NDArray[np.float64]
 Circuit = Literal["open", "crossed"]
@@ -93,96 +93,6 @@ def freudenstein_angles(
     th4, v4 = half_angle(ct - K1 - K2 * ct + K3, -2.0 * st, K1 - (K2 + 1.0) * ct + K3)
     th3, v3 = half_angle(ct - K1 + K4 * ct + K5, -2.0 * st, K1 + (K4 - 1.0) * ct + K5)
     return th3, th4, v3 & v4
-
-
-def coupler_points_fast(
-    a: float, b: float, c: float, d: float, u: float, v: float, theta: Array,
-    branch: float = 1.0, chunk: int = 1 << 13, threads: int = 1,
-) -> tuple[Array, NDArray[np.bool_]]:
-    """Coupler point ``(N, 2)`` and validity for crank angles ``theta``: the lean kernel.
-
-    Same closed form as :class:`FourBar` (circle-circle through the stable
-    Heron product, see :func:`planar.geometry.circle_circle`), fused and
-    evaluated in cache-sized chunks with preallocated buffers.  Used by
-    ``planar bench kinematics``; tests check it against :class:`FourBar`.
-    ``threads > 1`` splits the batch over threads (numpy releases the GIL in
-    its ufuncs); results are identical to one thread.
-    """
-    theta = np.ascontiguousarray(theta, dtype=float)
-    n = theta.shape[0]
-    out = np.empty((n, 2))
-    valid = np.empty(n, dtype=bool)
-    if threads > 1 and n >= 2 * chunk:
-        from concurrent.futures import ThreadPoolExecutor
-
-        bounds = np.linspace(0, n, threads + 1).astype(int)
-        with ThreadPoolExecutor(threads) as ex:
-            futs = [ex.submit(_coupler_kernel, a, b, c, d, u, v, theta[i:j], branch, chunk,
-                              out[i:j], valid[i:j]) for i, j in zip(bounds[:-1], bounds[1:])]
-            for f in futs:
-                f.result()
-        return out, valid
-    _coupler_kernel(a, b, c, d, u, v, theta, branch, chunk, out, valid)
-    return out, valid
-
-
-def _coupler_kernel(a, b, c, d, u, v, theta, branch, chunk, out, valid) -> None:
-    """Fill ``out`` and ``valid`` for ``theta`` (see :func:`coupler_points_fast`)."""
-    n = theta.shape[0]
-    s2, d2r = (b + c) ** 2, (b - c) ** 2
-    k = b * b - c * c
-    m = min(chunk, n) if n else 0
-    bx, by, dx, dy, dd, h, t, w = (np.empty(m) for _ in range(8))
-    for i in range(0, n, chunk):
-        j = min(i + chunk, n)
-        L = j - i
-        th = theta[i:j]
-        Bx, By, Dx, Dy, D2, H, T, W = bx[:L], by[:L], dx[:L], dy[:L], dd[:L], h[:L], t[:L], w[:L]
-        # crank pin by the tangent half-angle (one vectorised tan instead of cos and sin):
-        # t = tan(th/2), cos th = (1 - t^2)/(1 + t^2), sin th = 2t/(1 + t^2); t stays finite
-        # in floating point (tan of the double nearest pi/2 is 1.6e16), so no special case
-        np.multiply(th, 0.5, out=T)
-        np.tan(T, out=T)
-        np.multiply(T, T, out=W)
-        np.add(W, 1.0, out=D2)
-        np.reciprocal(D2, out=D2)  # 1/(1 + t^2)
-        np.subtract(1.0, W, out=Bx)
-        Bx *= D2
-        Bx *= a
-        np.multiply(T, D2, out=By)
-        By *= 2.0 * a
-        np.subtract(d, Bx, out=Dx)  # O4 - B
-        np.negative(By, out=Dy)
-        np.multiply(Dx, Dx, out=D2)
-        np.multiply(Dy, Dy, out=T)
-        D2 += T
-        # 4 d^2 h^2 = (s2 - d2)(d2 - d2r)
-        np.subtract(s2, D2, out=H)
-        np.subtract(D2, d2r, out=T)
-        H *= T
-        np.greater_equal(H, -1e-12 * s2 * s2, out=valid[i:j])
-        np.maximum(H, 0.0, out=H)
-        np.sqrt(H, out=H)
-        np.reciprocal(D2, out=W)  # 1 / d^2
-        H *= W  # 2 h / d
-        H *= 0.5 * branch
-        # alpha = (d2 + b^2 - c^2) / (2 d2) = 0.5 + 0.5 k / d2
-        W *= 0.5 * k
-        W += 0.5
-        # C - B = alpha * D + h * perp(D);  P - B = ((C-B) * u + perp(C-B) * v) / b
-        # (C-B)x = W Dx - H Dy ; (C-B)y = W Dy + H Dx
-        np.multiply(W, Dx, out=T)
-        T -= H * Dy  # (C-B)x
-        np.multiply(W, Dy, out=W)
-        W += H * Dx  # (C-B)y
-        ox, oy = out[i:j, 0], out[i:j, 1]
-        ub, vb = u / b, v / b
-        np.multiply(T, ub, out=ox)
-        ox -= W * vb
-        ox += Bx
-        np.multiply(W, ub, out=oy)
-        oy += T * vb
-        oy += By
 
 
 @dataclass(frozen=True)

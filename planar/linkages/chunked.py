@@ -1,0 +1,526 @@
+"""The fast path behind :meth:`Linkage.solve`: chunked, threaded, branch screen.
+
+The reference solve (:meth:`Linkage.solve_nodes`) places each node for all
+samples at once and carries every two-root node's branch by continuity
+(:func:`~planar.linkages.dyads.carry_branch`).  This module gives the same
+motion faster:
+
+* samples are processed in chunks of :data:`CHUNK` (cache-sized) with
+  preallocated per-thread buffers and ufunc ``out=`` arguments; coordinates
+  are kept as separate x and y arrays (a fixed node stays a float);
+* chunks run on a thread pool (numpy releases the GIL inside its ufuncs);
+  every sample's arithmetic is independent of the chunking, so the result does
+  not depend on the number of threads;
+* the branch continuity check runs only where it can matter.  The motion
+  switches to the other root at sample ``k`` only if the quadratic
+  extrapolation of the node's previous three samples misses the declared root
+  by more than 0.8 of the distance ``sep`` between the roots; that miss (the
+  third difference) is at most 4 times the node's largest step in the chunk,
+  and a step is at most ``sqrt(2) m`` with ``m`` the largest coordinate
+  change.  A chunk where ``128 m^2 + tol^2 < min sep^2`` (``tol`` = 1e-9 of a
+  bound on the node's coordinates, above any rounding) and every sample closes
+  needs no check; otherwise the third differences are tested sample by
+  sample, and a sample that may switch (or follows an invalid one on a path)
+  sends the whole batch to the reference solve, which then decides exactly as
+  before;
+* link angles are one ``arctan2`` per moving link; named points are the nodes'
+  positions (no pose round trip; at a failing sample, where a part's frame may
+  degenerate, through the part's pose as the reference); validity is merged
+  only when a sample fails.
+
+Node kinds without a chunk kernel here (a kind registered elsewhere) make
+:func:`fast_solve` return ``None``: the caller uses the reference path.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from itertools import pairwise
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..geometry import TANGENCY_RTOL, line_circle, poses_apply
+
+if TYPE_CHECKING:
+    from .dyads import Linkage, NodeKind
+
+__all__ = ["CHUNK", "KERNELS", "Solved", "fast_solve", "plan_for", "threads_default"]
+
+Array = NDArray[np.float64]
+Mask = NDArray[np.bool_]
+Coord = Array | float
+#: a kernel's result: x, y, validity (None: no check, True: all close) and,
+#: for a two-root node, the squared distance between its roots
+Placed = tuple[Coord, Coord, "Mask | bool | None", "Array | None"]
+
+#: what a solve returns: poses, validity checks (None: every sample closes), named points
+Solved = tuple[dict[str, Array], "list[tuple[Mask, str, str]] | None", "dict[str, Array] | None"]
+
+#: samples per chunk: the working set of a chunk stays in the L2 cache
+CHUNK = 8192
+#: samples at the start of a chunk recomputed from the previous chunk (branch screen history)
+_OVERLAP = 3
+
+
+class Scratch:
+    """Per-thread scratch buffers of one chunk's length, handed out in turn."""
+
+    def __init__(self, size: int) -> None:
+        self.size = size
+        self.bufs: list[Array] = []
+        self.i = 0
+        self.n = size
+        self.pair: Array | None = None
+
+    def reset(self, n: int) -> None:
+        self.i = 0
+        self.n = n
+
+    def get(self) -> Array:
+        if self.i == len(self.bufs):
+            self.bufs.append(np.empty(self.size))
+        b = self.bufs[self.i]
+        self.i += 1
+        return b[: self.n]
+
+    def get2(self) -> Array:
+        """A ``(2, n)`` buffer (kept apart from :meth:`get`'s)."""
+        if self.pair is None:
+            self.pair = np.empty((2, self.size))
+        return self.pair[:, : self.n]
+
+
+Kernel = Callable[["NodeKind", dict[str, tuple[Coord, Coord]], Array, Scratch, Array, Array], Placed]
+#: chunk kernels by node kind name: ``kernel(node, pos, q, scratch, out_x, out_y)``
+KERNELS: dict[str, Kernel] = {}
+
+
+def _kernel(kind: str) -> Callable[[Kernel], Kernel]:
+    def reg(fn: Kernel) -> Kernel:
+        KERNELS[kind] = fn
+        return fn
+    return reg
+
+
+@_kernel("fixed")
+def _fixed(node, pos, q, w, ox, oy) -> Placed:
+    return float(node.xy[0]), float(node.xy[1]), None, None
+
+
+@_kernel("crank")
+def _crank(node, pos, q, w, ox, oy) -> Placed:
+    # cos and sin by the tangent half-angle: t = tan(a/2), cos = (1 - t^2)/(1 + t^2),
+    # sin = 2t/(1 + t^2); tan of a double stays finite (at most ~1e16 near pi/2)
+    cx, cy = pos[node.centre]
+    r = node.radius
+    t, t2 = w.get(), w.get()
+    if node.phase:
+        np.add(q, node.phase, out=t)
+        t *= 0.5
+    else:
+        np.multiply(q, 0.5, out=t)
+    np.tan(t, out=t)
+    np.multiply(t, t, out=t2)
+    np.subtract(1.0, t2, out=ox)
+    t2 += 1.0
+    np.reciprocal(t2, out=t2)
+    ox *= t2
+    ox *= r
+    np.multiply(t, t2, out=oy)
+    oy *= 2.0 * r
+    if not (isinstance(cx, float) and cx == 0.0):
+        ox += cx
+    if not (isinstance(cy, float) and cy == 0.0):
+        oy += cy
+    return ox, oy, None, None
+
+
+@_kernel("actuator")
+def _actuator(node, pos, q, w, ox, oy) -> Placed:
+    ux, uy = (float(v) for v in node.unit_axis)
+    sx, sy = pos[node.origin]
+    s = w.get()
+    np.add(q, node.offset, out=s)
+    np.multiply(s, ux, out=ox)
+    ox += sx
+    np.multiply(s, uy, out=oy)
+    oy += sy
+    return ox, oy, None, None
+
+
+@_kernel("rrr")
+def _rrr(node, pos, q, w, ox, oy) -> Placed:
+    """Circle-circle as :func:`planar.geometry.circle_circle` (same validity, bit for bit)."""
+    ax, ay = pos[node.a]
+    bx, by = pos[node.b]
+    ra, rb = node.ra, node.rb
+    s, f = ra + rb, ra - rb
+    s2, f2 = s * s, f * f
+    dx, dy, d2, t, prod = w.get(), w.get(), w.get(), w.get(), w.get()
+    np.subtract(bx, ax, out=dx)
+    np.subtract(by, ay, out=dy)
+    np.multiply(dx, dx, out=d2)
+    np.multiply(dy, dy, out=t)
+    d2 += t
+    np.subtract(s2, d2, out=prod)
+    np.subtract(d2, f2, out=t)
+    prod *= t  # 4 d^2 h^2
+    ok: Mask | bool = True
+    # every sample closes when the product clears -rtol s2^2 (the threshold -rtol max(s2, d2)^2
+    # is lower) and d > 0; at d = 0 the product is -s2 f2, below that unless the radii are equal
+    equal_radii = f2 <= 2.0 * TANGENCY_RTOL * s2
+    if d2.size and (float(prod.min()) < -TANGENCY_RTOL * s2 * s2 or (equal_radii and float(d2.min()) <= 0.0)):
+        scale = np.maximum(s2, d2)
+        ok = (prod >= -TANGENCY_RTOL * scale * scale) & (d2 > 0.0)
+        d2[d2 <= 0.0] = 1.0  # concentric: invalid, kept finite as the reference does
+    np.maximum(prod, 0.0, out=prod)
+    np.reciprocal(d2, out=d2)  # 1 / d^2
+    np.sqrt(prod, out=t)
+    t *= d2
+    t *= 0.5 * node.branch  # branch * h / d
+    prod *= d2  # sep^2 = 4 h^2 = prod / d^2
+    d2 *= 0.5 * (ra * ra - rb * rb)
+    d2 += 0.5  # fraction along a -> b
+    m = w.get()
+    np.multiply(d2, dx, out=ox)
+    ox += ax
+    np.multiply(t, dy, out=m)
+    ox -= m
+    np.multiply(d2, dy, out=oy)
+    oy += ay
+    np.multiply(t, dx, out=m)
+    oy += m
+    return ox, oy, ok, prod
+
+
+def _column(v: Coord, n: int) -> Array:
+    return np.broadcast_to(np.asarray(v, float), (n,))
+
+
+@_kernel("rrp")
+def _rrp(node, pos, q, w, ox, oy) -> Placed:
+    """Line-circle through the reference functions (not on the benchmarked paths)."""
+    n = q.shape[0]
+    st = {k: np.column_stack([_column(pos[k][0], n), _column(pos[k][1], n)]) for k in (node.a, node.p, node.q)}
+    p0, p1 = st[node.p], st[node.q]
+    u = p1 - p0
+    un = np.hypot(u[:, 0], u[:, 1])[:, None]
+    base = p0 + node.offset * np.stack([-u[:, 1], u[:, 0]], -1) / np.where(un > 0, un, 1.0)
+    keep, ok, _ = line_circle(base, u, st[node.a], node.ra, node.branch)
+    other, _, _ = line_circle(base, u, st[node.a], node.ra, -node.branch)
+    ox[:] = keep[:, 0]
+    oy[:] = keep[:, 1]
+    sep2 = ((keep - other) ** 2).sum(-1)
+    return ox, oy, (True if ok.all() else ok), sep2
+
+
+@_kernel("rigid")
+def _rigid(node, pos, q, w, ox, oy) -> Placed:
+    ax, ay = pos[node.a]
+    bx, by = pos[node.b]
+    ex, ey, en, m = w.get(), w.get(), w.get(), w.get()
+    np.subtract(bx, ax, out=ex)
+    np.subtract(by, ay, out=ey)
+    np.multiply(ex, ex, out=en)
+    np.multiply(ey, ey, out=m)
+    en += m
+    np.sqrt(en, out=en)
+    ok: Mask | bool = True
+    if en.size and float(en.min()) <= 0.0:  # coincident nodes (or an underflow): as the reference
+        h = np.hypot(ex, ey)
+        ok = h > 0
+        en[:] = np.where(ok, h, 1.0)
+    np.reciprocal(en, out=en)
+    ex *= en
+    ey *= en
+    u, v = (float(c) for c in node.local)
+    np.multiply(ex, u, out=ox)
+    np.multiply(ey, u, out=oy)
+    if v:
+        np.multiply(ey, v, out=m)
+        ox -= m
+        np.multiply(ex, v, out=m)
+        oy += m
+    ox += ax
+    oy += ay
+    return ox, oy, ok, None
+
+
+# ------------------------------------------------------------------ the plan
+
+
+@dataclass
+class _Plan:
+    """What one linkage's fast solve needs, built once."""
+
+    nodes: list[NodeKind]
+    kernels: list[Kernel]
+    checks: list[tuple[int, str, str]]  # (node index, node, why) in solve order
+    links: list[tuple[str, int, int, int]]  # (link, origin, from, to); origin -1: the ground
+    points: list[tuple[str, int]]
+    placement: tuple[float, float, float]
+    bound: list[float]  # a bound on |coordinate| of each node, for q = 0 (actuators add |q|)
+    grows: list[bool]  # node moves with |q| (downstream of an actuator)
+
+
+#: per node kind: (node, bound from its refs, grows from its refs, bounds, grows, index) -> (bound, grows),
+#: a bound on the node's |coordinate| at q = 0 and whether it moves with |q| (downstream of an actuator)
+BOUNDS: dict[str, Callable[..., tuple[float, bool]]] = {
+    "fixed": lambda nd, b, g, bound, grows, index: (float(np.hypot(*nd.xy)), g),
+    "crank": lambda nd, b, g, bound, grows, index: (b + nd.radius, g),
+    "actuator": lambda nd, b, g, bound, grows, index: (b + abs(nd.offset), True),
+    "rrr": lambda nd, b, g, bound, grows, index: (bound[index[nd.a]] + nd.ra, grows[index[nd.a]]),
+    "rrp": lambda nd, b, g, bound, grows, index: (bound[index[nd.a]] + nd.ra, grows[index[nd.a]]),
+    "rigid": lambda nd, b, g, bound, grows, index: (b + float(np.hypot(*nd.local)), g),
+}
+
+
+def plan_for(lk: Linkage) -> _Plan | None:
+    """The fast-solve plan of ``lk``, or ``None`` when a node kind has no chunk kernel or bound."""
+    kernels = []
+    for nd in lk.nodes:
+        k = KERNELS.get(type(nd).kind)
+        if k is None or type(nd).kind not in BOUNDS:
+            return None
+        kernels.append(k)
+    index = {nd.name: i for i, nd in enumerate(lk.nodes)}
+    _, ref_checks = lk.solve_nodes(np.zeros(1))
+    checks = [(index[node], node, why) for _, node, why in ref_checks]
+    links: list[tuple[str, int, int, int]] = []
+    for link in lk.links:
+        if link.name == lk.ground_name:
+            links.append((link.name, -1, -1, -1))
+            continue
+        d = link.guide if link.guide is not None else (link.nodes[0], link.nodes[1])
+        links.append((link.name, index[link.nodes[0]], index[d[0]], index[d[1]]))
+    bound: list[float] = []
+    grows: list[bool] = []
+    for nd in lk.nodes:
+        refs = [index[r] for r in nd.refs()]
+        b = max((bound[i] for i in refs), default=0.0)
+        g = any(grows[i] for i in refs)
+        b, g = BOUNDS[type(nd).kind](nd, b, g, bound, grows, index)
+        bound.append(b)
+        grows.append(g)
+    return _Plan(list(lk.nodes), kernels, checks, links,
+                 [(p, index[n]) for p, n in lk.point_nodes.items()],
+                 (lk.placement[0], lk.placement[1], lk.placement[2]), bound, grows)
+
+
+# ------------------------------------------------------------------ solving
+
+
+_POOL: ThreadPoolExecutor | None = None
+
+
+def _forget_pool() -> None:
+    """In a forked child the parent's pool threads do not exist: make a new pool on next use."""
+    global _POOL
+    _POOL = None
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forget_pool)
+
+
+def _pool() -> ThreadPoolExecutor:
+    global _POOL
+    if _POOL is None:
+        _POOL = ThreadPoolExecutor(max_workers=os.cpu_count() or 1, thread_name_prefix="planar-solve")
+    return _POOL
+
+
+def threads_default() -> int:
+    """Threads the fast solve uses: ``PLANAR_THREADS`` if set, else the number of cores."""
+    env = os.environ.get("PLANAR_THREADS")
+    return max(1, int(env)) if env else (os.cpu_count() or 1)
+
+
+def _path_ok(q: Array, k: NDArray[np.intp]) -> Mask:
+    """``path_mask(q)[k]`` for the samples ``k`` (>= 3) only."""
+    a, b, c = q[k - 2] - q[k - 3], q[k - 1] - q[k - 2], q[k] - q[k - 1]
+    same = ((a > 0) & (b > 0) & (c > 0)) | ((a < 0) & (b < 0) & (c < 0))
+    mag = np.abs(np.stack([a, b, c]))
+    return same & (mag.max(0) <= 1.5 * mag.min(0))
+
+
+def _may_switch(xy: Array, ok: Mask | bool, sep2: Array, tol: float, q: Array, first: int, w: Scratch) -> bool:
+    """Whether a two-root node may leave its declared root at a window sample ``k >= first``.
+
+    ``xy`` ``(2, n)`` holds the node's declared-root positions over the window,
+    ``q`` the driver values (same window), ``first`` >= 3 the first sample to
+    test.  Conservative: ``False`` guarantees that :func:`carry_branch` flips
+    nothing there.
+    """
+    n = xy.shape[1]
+    if n <= first:
+        return False
+    x, y = xy
+    if ok is True:
+        d = w.get2()[:, : n - 1]
+        np.subtract(xy[:, 1:], xy[:, :-1], out=d)
+        step = max(float(d.max()), -float(d.min()))  # |step| <= sqrt(2) * step
+        if 128.0 * step * step + tol * tol < float(sep2[first:].min()):
+            return False
+        valid = np.ones(n, bool)
+    else:
+        valid = np.asarray(ok)
+    k = np.arange(first, n)
+    ex = x[k] - 3.0 * x[k - 1] + 3.0 * x[k - 2] - x[k - 3]
+    ey = y[k] - 3.0 * y[k - 1] + 3.0 * y[k - 2] - y[k - 3]
+    hist = valid[k - 1] & valid[k - 2] & valid[k - 3]
+    cand = valid[k] & (~hist | (4.0 * (ex * ex + ey * ey) + tol * tol >= sep2[k]))
+    ks = k[cand]
+    return bool(ks.size and _path_ok(q, ks).any())
+
+
+@dataclass
+class _ChunkOut:
+    masks: list[Mask | None]  # per check, None: all samples close
+    switch: bool  # a branch may switch: use the reference solve
+
+
+def _solve_range(plan: _Plan, q: Array, lo: int, hi: int, chunk: int, poses: dict[str, Array],
+                 points: dict[str, Array], tols: list[float]) -> list[_ChunkOut]:
+    """Solve samples ``lo:hi`` chunk by chunk into ``poses`` and ``points``."""
+    size = min(chunk, hi - lo) + _OVERLAP
+    w = Scratch(size)
+    nxy = [np.empty((2, size)) for _ in plan.nodes]  # x and y rows of each node
+    px, py, pa = plan.placement
+    placed = bool(px or py or pa)
+    c, s = float(np.cos(pa)), float(np.sin(pa))
+    out: list[_ChunkOut] = []
+    for i in range(lo, hi, chunk):
+        j = min(i + chunk, hi)
+        start = max(0, i - _OVERLAP)
+        off = i - start
+        L = j - start
+        qw = q[start:j]
+        pos: dict[str, tuple[Coord, Coord]] = {}
+        oks: dict[int, Mask | bool] = {}
+        switch = False
+        for idx, (nd, kern) in enumerate(zip(plan.nodes, plan.kernels)):
+            w.reset(L)
+            x, y, ok, sep2 = kern(nd, pos, qw, w, nxy[idx][0, :L], nxy[idx][1, :L])
+            pos[nd.name] = (x, y)
+            if ok is not None:
+                oks[idx] = ok
+            if sep2 is not None and not switch:
+                assert isinstance(x, np.ndarray) and isinstance(y, np.ndarray) and ok is not None
+                w.reset(L)
+                switch = _may_switch(nxy[idx][:, :L], ok, sep2, tols[idx], qw, max(_OVERLAP, off), w)
+        masks: list[Mask | None] = []
+        for idx, _, _ in plan.checks:
+            ok = oks[idx]
+            masks.append(None if isinstance(ok, bool) or bool(np.all(ok[off:])) else np.array(ok[off:]))
+        out.append(_ChunkOut(masks, switch))
+        if switch:
+            break
+        # link poses and named points (placement applied)
+        w.reset(L - off)
+        for name, o, a, b in plan.links:
+            if o < 0:
+                continue
+            P = poses[name]
+            ax_, ay_ = pos[plan.nodes[a].name]
+            bx_, by_ = pos[plan.nodes[b].name]
+            dx, dy = w.get(), w.get()
+            np.subtract(_tail(bx_, off), _tail(ax_, off), out=dx)
+            np.subtract(_tail(by_, off), _tail(ay_, off), out=dy)
+            ang = P[i:j, 2]
+            np.arctan2(dy, dx, out=ang)
+            ox_, oy_ = pos[plan.nodes[o].name]
+            _place(_tail(ox_, off), _tail(oy_, off), P[i:j, 0], P[i:j, 1], placed, px, py, c, s, w)
+            if pa:
+                ang += pa
+            w.reset(L - off)
+        for name, nidx in plan.points:
+            x, y = pos[plan.nodes[nidx].name]
+            pt = points[name]
+            _place(_tail(x, off), _tail(y, off), pt[i:j, 0], pt[i:j, 1], placed, px, py, c, s, w)
+            w.reset(L - off)
+    return out
+
+
+def _tail(v: Coord, off: int) -> Coord:
+    return v[off:] if isinstance(v, np.ndarray) else v
+
+
+def _place(x: Coord, y: Coord, ox: Array, oy: Array, placed: bool, px: float, py: float, c: float, s: float,
+           w: Scratch) -> None:
+    """``(ox, oy) = placement applied to (x, y)``, as :func:`planar.geometry.poses_compose`."""
+    if not placed:
+        ox[...] = x
+        oy[...] = y
+        return
+    m = w.get()
+    np.multiply(x, c, out=m)
+    np.add(px, m, out=ox)
+    np.multiply(y, s, out=m)
+    ox -= m
+    np.multiply(x, s, out=m)
+    np.add(py, m, out=oy)
+    np.multiply(y, c, out=m)
+    oy += m
+
+
+def fast_solve(lk: Linkage, q: Array, threads: int | None = None, chunk: int = CHUNK) -> Solved | None:
+    """``(poses, checks, points)`` for driver values ``q`` by the chunked path, or ``None``.
+
+    ``None``: a node kind has no kernel, or a branch may switch by continuity
+    somewhere (the caller then solves by the reference path).  ``checks`` is
+    ``None`` when every sample closes, else the reference's
+    ``[(mask, node, why)]``.
+    """
+    plan = lk._fast_plan()
+    if plan is None:
+        return None
+    n = q.shape[0]
+    qmax = float(np.abs(q).max()) if n and any(plan.grows) else 0.0
+    tols = [1e-9 * (1.0 + b + (qmax if g else 0.0)) for b, g in zip(plan.bound, plan.grows)]
+    poses: dict[str, Array] = {}
+    px, py, pa = plan.placement
+    for name, o, _, _ in plan.links:
+        if o < 0:
+            poses[name] = np.zeros((n, 3)) if not (px or py or pa) else np.tile(np.array([px, py, pa]), (n, 1))
+        else:
+            poses[name] = np.empty((n, 3))
+    points = {name: np.empty((n, 2)) for name, _ in plan.points}
+    nthreads = threads if threads is not None else threads_default()
+    nchunks = -(-n // chunk) if n else 0
+    if nthreads > 1 and nchunks >= 2:
+        nthreads = min(nthreads, nchunks)
+        cuts = [chunk * (nchunks * t // nthreads) for t in range(nthreads)] + [n]
+        futs = [_pool().submit(_solve_range, plan, q, a, b, chunk, poses, points, tols)
+                for a, b in pairwise(cuts)]
+        results = [r for f in futs for r in f.result()]
+    else:
+        results = _solve_range(plan, q, 0, n, chunk, poses, points, tols)
+    if any(r.switch for r in results):
+        return None
+    checks: list[tuple[Mask, str, str]] | None = None
+    if any(m is not None for r in results for m in r.masks):
+        checks = []
+        for c_i, (_, node, why) in enumerate(plan.checks):
+            full = np.ones(n, bool)
+            for r, (a, b) in zip(results, _chunk_bounds(n, chunk)):
+                m = r.masks[c_i]
+                if m is not None:
+                    full[a:b] = m
+            checks.append((full, node, why))
+        # where a sample fails a frame may degenerate (two nodes meet): there the named points
+        # are taken through the part's pose, as the reference does
+        bad = ~np.logical_and.reduce([m for m, _, _ in checks])
+        if bad.any():
+            for name, (part, xy) in lk.points.items():
+                points[name][bad] = poses_apply(poses[part][bad], xy)
+    return poses, checks, points
+
+
+def _chunk_bounds(n: int, chunk: int) -> list[tuple[int, int]]:
+    return [(i, min(i + chunk, n)) for i in range(0, n, chunk)]
