@@ -36,6 +36,8 @@ def _upright(pc: PartCut) -> PartCut:
     e1, e2 = rect[1] - rect[0], rect[2] - rect[1]
     long = e1 if np.hypot(*e1) >= np.hypot(*e2) else e2
     angle = -math.atan2(long[1], long[0])
+    # the same rectangle either way round: turn by less than a quarter turn, so labels stay readable
+    angle = (angle + math.pi / 2) % math.pi - math.pi / 2
     x0, y0, x1, y1 = poly.bounds
     turned = pc.transformed(angle, 0.0, 0.0)
     a0, b0, a1, b1 = _bbox(turned)
