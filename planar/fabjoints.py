@@ -86,7 +86,7 @@ def _pin_in_arc_slot(mech: Mechanism, j: PinInArcSlot) -> tuple[list[PinSpec], l
 
 @PIN_RULES.register(Slide)
 def _slide(mech: Mechanism, j: Slide) -> tuple[list[PinSpec], list[Contact]]:
-    pts = (j.anchor, (j.anchor[0] + j.axis[0], j.anchor[1] + j.axis[1]))
+    pts = j.pin_points()
     return [PinSpec(f"{j.name}#{k + 1}", (j.b, j.a), (_v(p), _v(j.start)), ("hole", "slot"))
             for k, p in enumerate(pts)], []
 
@@ -132,8 +132,7 @@ def pin_features(mech: Mechanism) -> set[tuple[str, int]]:
                 out.add((j.b, pb.features.index(hb)))
         elif isinstance(j, (PinInSlot, PinInArcSlot, Slide)):
             pin_part, slot_part = by_name[j.b], by_name[j.a]
-            anchors = [j.anchor, (j.anchor[0] + j.axis[0], j.anchor[1] + j.axis[1])] if isinstance(j, Slide) \
-                else [j.pin]
+            anchors = list(j.pin_points()) if isinstance(j, Slide) else [j.pin]
             for p in anchors:
                 h = _hole_at(pin_part, p)
                 if h is not None:

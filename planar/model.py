@@ -312,12 +312,13 @@ class Slide:
     axis: Vec
     width: float | None = None
 
-    def _pin_points(self) -> tuple[Vec, Vec]:
+    def pin_points(self) -> tuple[Vec, Vec]:
+        """The two pins of ``b`` in its own frame: ``anchor`` and ``anchor + axis``."""
         return self.anchor, (self.anchor[0] + self.axis[0], self.anchor[1] + self.axis[1])
 
     def residual(self, poses: Mapping[str, Array]) -> Array:
         q = _pose(poses, self.b)
-        p1, p2 = (poses_apply(q, p) for p in self._pin_points())
+        p1, p2 = (poses_apply(q, p) for p in self.pin_points())
         s0 = poses_apply(_pose(poses, self.a), self.start)
         s1 = poses_apply(_pose(poses, self.a), self.end)
         return np.maximum(np.abs(_point_line_distance(p1, s0, s1)), np.abs(_point_line_distance(p2, s0, s1)))
@@ -325,12 +326,12 @@ class Slide:
     def features(self) -> tuple[tuple[str, Feature], ...]:
         if self.width is None:
             return ()
-        p1, p2 = self._pin_points()
+        p1, p2 = self.pin_points()
         return ((self.a, Slot(self.start, self.end, self.width, "pin")),
                 (self.b, Hole(p1, self.width, "pin")), (self.b, Hole(p2, self.width, "pin")))
 
     def pins(self) -> tuple[tuple[str, Vec], ...]:
-        return tuple((self.b, p) for p in self._pin_points())
+        return tuple((self.b, p) for p in self.pin_points())
 
 
 @joint_kind

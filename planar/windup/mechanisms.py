@@ -110,10 +110,8 @@ class ElementalMechanism(Mechanism):
                  phase: float = 0.0, sizing_input: Array | None = None, **overrides: Any) -> None:
         """``sizing_input``: the driver motions the parts must serve (slot and track lengths);
         by default one cycle of the standalone driver law."""
-        if not isinstance(number, (int, np.integer)) or isinstance(number, bool) or number not in ELEMENTAL:
-            raise InputError("mechanism", number, f"an elemental mechanism number, one of {sorted(ELEMENTAL)}")
-        self.number = int(number)
-        self.record = rec = ELEMENTAL[self.number]
+        self.record = rec = elemental_record(number)
+        self.number = rec.number
         self._sizing_input = None if sizing_input is None else np.asarray(sizing_input, float)
         #: the mechanism's parameter record (its ``ElementalRecord.params`` class; fields vary by mechanism)
         self.params: Any = params.replace(**overrides) if params is not None else params_for(self.number, **overrides)
@@ -673,6 +671,11 @@ CONTACT_JOINT: dict[int, str] = {k: r.contact_joint for k, r in ELEMENTAL.items(
 
 def params_for(number: int, **overrides: Any) -> P_.Params:
     """Parameters of elemental mechanism ``number``: the supplement's defaults with ``overrides``."""
+    return elemental_record(number).params().replace(**overrides)
+
+
+def elemental_record(number: object) -> ElementalRecord:
+    """The record of elemental mechanism ``number``; :class:`InputError` for anything else."""
     if not isinstance(number, (int, np.integer)) or isinstance(number, bool) or number not in ELEMENTAL:
         raise InputError("mechanism", number, f"an elemental mechanism number, one of {sorted(ELEMENTAL)}")
-    return ELEMENTAL[int(number)].params().replace(**overrides)
+    return ELEMENTAL[int(number)]
