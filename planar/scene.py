@@ -225,6 +225,10 @@ class RenderSpec(_Strict):
     sweep: list[str] = []
     background: Annotated[str, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#ffffff"
     show_pins: bool = True
+    # frames per second of the animation (default: 25, or 50 for fast cycles; a GIF plays at most 50)
+    fps: Annotated[float, Field(gt=0, le=240)] | None = None
+    # fill opacity of moving parts, 0..1 (below 1 what lies under a part shows through)
+    opacity: Annotated[float, Field(ge=0, le=1)] = 1.0
 
 
 class FabricationSpec(_Strict):
