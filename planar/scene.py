@@ -189,6 +189,7 @@ class CamSpec(_Strict):
     follower: CamFollowerSpec
     segments: Annotated[list[CamSegmentSpec], Field(min_length=2)]
     max_pressure_angle: Pos | None = None
+    link_width: Pos | None = None
     nodes: list[NodeSpec] = []
     links: list[LinkSpec] = []
     points: dict[str, str] = {}
@@ -566,4 +567,4 @@ def _build_cam(spec: SceneSpec, m: CamSpec, rate: float, phase: float) -> Mechan
         nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
     links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
     return CamMechanism(spec.name or "cam", profile, nodes, links, points=m.points or None, rate=rate, phase=phase,
-                        max_pressure_angle=limit, unit=spec.angle_unit)
+                        max_pressure_angle=limit, unit=spec.angle_unit, width=m.link_width)

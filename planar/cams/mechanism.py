@@ -46,14 +46,16 @@ class CamMechanism(Mechanism):
     ``max_pressure_angle`` (rad) is the largest pressure angle allowed; the
     cam is checked when built (:meth:`CamProfile.check`) and :attr:`report`
     keeps the figures.  ``points`` maps names to node names (default: the
-    follower's ``tip``).
+    follower's ``tip``).  ``width``: the links' width (model units; default
+    the linkage's, 8 % of its span).
     """
 
     def __init__(self, name: str, profile: CamProfile, nodes: Sequence[NodeKind] = (),
                  links: Sequence[Link] = (), points: Mapping[str, str] | None = None,
                  rate: float = 2 * math.pi, phase: float = 0.0, max_pressure_angle: float = math.radians(30.0),
-                 unit: str = "deg") -> None:
+                 unit: str = "deg", width: float | None = None) -> None:
         self.profile = profile
+        self._width = width
         self.report: CamReport = profile.check(max_pressure_angle, unit=unit)
         where = profile.where
         f = profile.follower
@@ -97,7 +99,8 @@ class CamMechanism(Mechanism):
         else:
             contact_body = "follower"
             hull, contact_point, normal = self._face_hull(hull, tip_local, w)
-        parts["follower"] = Part("follower", tuple(hull), fol.features, polygon=None)
+        polygon = _hull_polygon(hull) if f.kind == "flat" else None  # a flat face is never widened, only refused
+        parts["follower"] = Part("follower", tuple(hull), fol.features, polygon=polygon)
         poly, _ = profile.outline_polygon()
         rmax = float(np.hypot(*poly.T).max())
         cam = Part("cam", ((0.0, 0.0, rmax),), polygon=tuple((float(x), float(y)) for x, y in poly))
@@ -140,7 +143,7 @@ class CamMechanism(Mechanism):
             follower = Link("follower", ("pivot", "tip") + extra)
         lo, hi = q
         return Linkage(name, own + list(nodes), [follower] + links, points=points,
-                       amplitude=max(0.5 * (hi - lo), 1e-12), centre=0.5 * (hi + lo))
+                       amplitude=max(0.5 * (hi - lo), 1e-12), centre=0.5 * (hi + lo), width=self._width)
 
     def _face_hull(self, hull: list[tuple[float, float, float]], tip: tuple[float, float],
                    w: float) -> tuple[list[tuple[float, float, float]], tuple[float, float], tuple[float, float]]:
@@ -190,3 +193,13 @@ class CamMechanism(Mechanism):
         s, v, a = self.profile.follower_output(qa)
         w = self.driver.rate
         return {"q": s, "dq_dt": v * w, "d2q_dt2": a * w * w}
+
+
+def _hull_polygon(hull: Sequence[tuple[float, float, float]]) -> tuple[tuple[float, float], ...]:
+    """The convex hull of circles as a counter-clockwise polygon (arcs every 1 deg; flat edges exact)."""
+    a = np.radians(np.arange(360.0))
+    pts = np.concatenate([np.column_stack([x + r * np.cos(a), y + r * np.sin(a)]) for x, y, r in hull])
+    from shapely.geometry import MultiPoint
+
+    ring = np.asarray(MultiPoint([tuple(p) for p in pts]).convex_hull.exterior.coords)[:-1]
+    return tuple((float(x), float(y)) for x, y in ring)
