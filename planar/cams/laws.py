@@ -136,14 +136,20 @@ class Program:
         self.levels = levels[:-1]
         self.max_lift = float(levels.max())
 
+    @staticmethod
+    def _wrap(theta: ArrayLike) -> Array:
+        """Cam angles in ``[0, 2 pi)`` (``np.mod`` of a tiny negative angle rounds to ``2 pi`` itself)."""
+        t = np.mod(np.asarray(theta, float), TWO_PI)
+        return np.where(t >= TWO_PI, 0.0, t)
+
     def segment_of(self, theta: ArrayLike) -> NDArray[np.intp]:
         """Index of the segment each cam angle (rad, any real value) falls in."""
-        t = np.mod(np.asarray(theta, float), TWO_PI)
+        t = self._wrap(theta)
         return np.clip(np.searchsorted(self.starts, t, side="right") - 1, 0, len(self.segments) - 1)
 
     def evaluate(self, theta: ArrayLike) -> tuple[Array, Array, Array]:
         """``s, ds/dtheta, d2s/dtheta2`` at cam angles ``theta`` (rad); arrays of ``theta``'s shape."""
-        t = np.mod(np.asarray(theta, float), TWO_PI)
+        t = self._wrap(theta)
         k = self.segment_of(t)
         s = np.empty_like(t)
         v = np.empty_like(t)
@@ -153,7 +159,7 @@ class Program:
             if not m.any():
                 continue
             law = LAWS[sg.law]
-            u = (t[m] - self.starts[i]) / sg.angle
+            u = np.clip((t[m] - self.starts[i]) / sg.angle, 0.0, 1.0)
             s[m] = self.levels[i] + sg.lift * law.y(u)
             v[m] = sg.lift / sg.angle * law.dy(u)
             a[m] = sg.lift / sg.angle**2 * law.d2y(u)

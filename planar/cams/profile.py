@@ -289,7 +289,7 @@ class CamProfile:
         else:
             q, _, _ = self.follower_output(th)
             t = np.stack([-np.sin(q), np.cos(q)], -1)
-        return np.arccos(np.clip(np.abs((Nw * t).sum(-1)), 0.0, 1.0))
+        return np.arctan2(np.abs(_cross(Nw, t)), np.abs((Nw * t).sum(-1)))
 
     def face_position(self, theta: ArrayLike) -> Array:
         """Flat faces: the contact's position along the face (model units) from the face's reference point
