@@ -116,7 +116,8 @@ def test_follower_touches_the_cut_outline_at_every_sample(name):
         dist = np.array([P.exterior.distance(Point(x)) for x in q])
         assert np.abs(dist - cp.rr).max() < tol
         if cp.rr > 0:
-            assert not any(P.contains(Point(x)) for x in q)  # the roller never cuts into the cam: no outline vertex inside the roller circle
+            assert not any(P.contains(Point(x)) for x in q)
+            # the roller never cuts into the cam: no outline vertex inside its circle
             r = np.hypot(poly[:, None, 0] - q[None, :, 0], poly[:, None, 1] - q[None, :, 1]).min(0)
             assert r.min() > cp.rr - tol
     else:

@@ -64,15 +64,15 @@ class CamMechanism(Mechanism):
                 raise InputError(f"{where}.nodes.{n.name}", n.name, f"a name the cam does not use ({', '.join(RESERVED)})")
         extra_follower: tuple[str, ...] = ()
         user_links = []
-        for lk in links:
-            if lk.name in ("cam", "roller", "ground"):
-                raise InputError(f"{where}.links.{lk.name}", lk.name, "a link name other than cam, roller, ground")
-            if lk.name == "follower":
-                if lk.guide is not None:
-                    raise InputError(f"{where}.links.follower.guide", lk.guide, "no guide (the follower's is given)")
-                extra_follower = tuple(n for n in lk.nodes if n not in ("tip", "pivot"))
+        for link in links:
+            if link.name in ("cam", "roller", "ground"):
+                raise InputError(f"{where}.links.{link.name}", link.name, "a link name other than cam, roller, ground")
+            if link.name == "follower":
+                if link.guide is not None:
+                    raise InputError(f"{where}.links.follower.guide", link.guide, "no guide (the follower's is given)")
+                extra_follower = tuple(n for n in link.nodes if n not in ("tip", "pivot"))
             else:
-                user_links.append(lk)
+                user_links.append(link)
         q = self._q_range()
         self._back = 0.0
         self.linkage = self._linkage(name, nodes, extra_follower, user_links, points, q)
