@@ -368,3 +368,32 @@ def test_gallery_cam_scene_joints_close():
     res = joint_residuals(sc.mechanism, mo)
     assert max(float(r.max()) for r in res.values()) <= 1e-9 * sc.mechanism.size
     assert math.degrees(sc.mechanism.report.max_pressure_angle) < 45.0
+
+
+def test_follower_motion_in_time_matches_differences_of_the_solved_poses():
+    # the solved arm angle over time (from the Motion, through the linkage) against the law's derivatives
+    sc = cam_scene({"kind": "roller", "roller_radius": 0.4, "motion": "oscillating", "pivot": [3.0, 1.5], "arm": 2.6,
+                    "branch": -1},
+                   [{"law": "harmonic", "angle": 150, "lift": 10}, {"law": "dwell", "angle": 30},
+                    {"law": "polynomial-345", "angle": 150, "lift": -10}, {"law": "dwell", "angle": 30}])
+    m = sc.mechanism
+    t = np.linspace(0.0, 1.0, 20001)
+    mo = m.solve(m.driver.value(t), t=t)
+    psi = np.unwrap(mo.poses["follower"][:, 2])
+    fm = m.follower_motion(mo.driver)
+    h = t[1] - t[0]
+    keep = np.ones_like(t, bool)
+    keep[:2] = keep[-2:] = False
+    for b in np.radians([0.0, 150.0, 180.0, 330.0, 360.0]):
+        keep &= np.abs(mo.driver - b) > 4 * h * m.driver.rate
+    assert np.abs(np.angle(np.exp(1j * (psi - fm["q"])))).max() < 1e-12
+    assert np.abs(np.gradient(psi, h) - fm["dq_dt"])[keep].max() < 1e-6
+    assert np.abs(np.gradient(np.gradient(psi, h), h) - fm["d2q_dt2"])[keep].max() < 1e-3 * np.abs(fm["d2q_dt2"]).max()
+
+
+def test_export_notes_report_the_checked_figures(tmp_path):
+    sc = cam_scene({"kind": "roller", "roller_radius": 0.4})
+    notes = sc.mechanism.design_notes
+    r = sc.mechanism.report
+    assert f"{math.degrees(r.max_pressure_angle):.3g} deg" in notes[0] and "mechanism.segments[" in notes[0]
+    assert f"{r.min_radius:.4g}" in notes[1] and "roller radius 0.4" in notes[1]

@@ -56,6 +56,7 @@ class CamMechanism(Mechanism):
                  unit: str = "deg", width: float | None = None) -> None:
         self.profile = profile
         self._width = width
+        self._unit = unit
         self.report: CamReport = profile.check(max_pressure_angle, unit=unit)
         where = profile.where
         f = profile.follower
@@ -102,6 +103,7 @@ class CamMechanism(Mechanism):
         polygon = _hull_polygon(hull) if f.kind == "flat" else None  # a flat face is never widened, only refused
         parts["follower"] = Part("follower", tuple(hull), fol.features, polygon=polygon)
         poly, _ = profile.outline_polygon()
+        self._outline_points = len(poly)
         rmax = float(np.hypot(*poly.T).max())
         cam = Part("cam", ((0.0, 0.0, rmax),), polygon=tuple((float(x), float(y)) for x, y in poly))
         out_parts = list(parts.values()) + [cam]
@@ -120,6 +122,22 @@ class CamMechanism(Mechanism):
         if not pts:
             pts = {"tip": ("follower", tip_local)}
         super().__init__(name, out_parts, joints, Driver("cam", "rotation", (0.0, 0.0), rate=rate, phase=phase), pts)
+
+    @property
+    def design_notes(self) -> list[str]:
+        """The checks' figures, one line each (``planar export`` prints them as notes)."""
+        r = self.report
+        p = self.profile
+        deg = self._unit == "deg"
+        ang = (lambda a: f"{math.degrees(a):.3g} deg") if deg else (lambda a: f"{a:.3g} rad")
+        what = "the outline's" if p.follower.kind == "flat" else "the pitch curve's convex"
+        out = [f"cam: largest pressure angle {ang(r.max_pressure_angle)} at cam angle {ang(r.pressure_angle_at)}, "
+               f"in {p.program.describe(r.pressure_segment, self._unit)}",
+               f"cam: least radius of curvature ({what}) {r.min_radius:.4g} at cam angle {ang(r.min_radius_at)}"
+               + (f" against the roller radius {p.rr:g}" if p.follower.kind == "roller" else ""),
+               f"cam: outline cut as {self._outline_points} straight segments within {r.chord_sag:.2g} of the exact "
+               "curve (model units)"]
+        return out
 
     # ------------------------------------------------------------------ building
     def _q_range(self) -> tuple[float, float]:
