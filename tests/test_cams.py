@@ -397,3 +397,41 @@ def test_export_notes_report_the_checked_figures(tmp_path):
     r = sc.mechanism.report
     assert f"{math.degrees(r.max_pressure_angle):.3g} deg" in notes[0] and "mechanism.segments[" in notes[0]
     assert f"{r.min_radius:.4g}" in notes[1] and "roller radius 0.4" in notes[1]
+
+
+@pytest.mark.parametrize("motion", ["translating", "oscillating"])
+def test_roller_rolls_on_the_cam_without_slipping(motion):
+    # the roller's material point at the contact moves with the cam's material point there: differences
+    # of the solved poses (the roller's angle comes from the pitch curve's arc length, Gauss-Legendre)
+    from planar.geometry import poses_apply
+
+    fol = {"kind": "roller", "roller_radius": 0.4}
+    if motion == "oscillating":
+        fol.update(motion="oscillating", pivot=[3.0, 1.5], arm=2.6, branch=-1)
+    sc = cam_scene(fol, [{"law": "cycloidal", "angle": 150, "lift": 12 if motion == "oscillating" else 0.5},
+                         {"law": "dwell", "angle": 30},
+                         {"law": "harmonic", "angle": 150, "lift": -12 if motion == "oscillating" else -0.5},
+                         {"law": "dwell", "angle": 30}])
+    m = sc.mechanism
+    th = np.linspace(0.05, 4 * np.pi, 97)  # two turns: the arc length carries on
+    h = 1e-6
+    c = _rot(th, m.profile.outline(th)[0])  # the contact in the world
+    rel = []
+    for part in ("roller", "cam"):
+        pose = m.solve(th).poses[part]
+        c_local = np.array([poses_apply(_inv(pz), cz) for pz, cz in zip(pose, c)])
+        plus = m.solve(th + h).poses[part]
+        minus = m.solve(th - h).poses[part]
+        v = (np.array([poses_apply(p, x) for p, x in zip(plus, c_local)])
+             - np.array([poses_apply(p, x) for p, x in zip(minus, c_local)])) / (2 * h)
+        rel.append(v)
+    slip = np.hypot(*(rel[0] - rel[1]).T)
+    assert slip.max() < 1e-6 * np.hypot(*rel[1].T).max()
+    spin = np.ptp(np.unwrap(m.solve(th).poses["roller"][:, 2]))
+    assert spin > 2 * 2 * np.pi  # it does turn (a roller keeping its arm's angle would fail the slip check)
+
+
+def _inv(pose):
+    x, y, a = pose
+    c, s = math.cos(a), math.sin(a)
+    return np.array([-(c * x + s * y), s * x - c * y, -a])

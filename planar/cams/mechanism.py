@@ -13,8 +13,9 @@ follower.  Parts: ``ground``, ``cam`` (its outline the exact profile,
 :mod:`planar.cams.profile`), ``follower``, ``roller`` (roller followers),
 and the linkage's links.  The driver turns the cam counter-clockwise.
 
-The roller is drawn and cut as a disc pinned to the follower; its spin is
-not modelled (it keeps the follower's angle), since nothing else depends on it.
+The roller is a disc pinned to the follower that rolls on the cam without
+slipping: relative to the cam it turns by minus the pitch curve's arc length
+over its radius (its angle at cam angle 0 is the follower's).
 """
 
 from __future__ import annotations
@@ -118,6 +119,9 @@ class CamMechanism(Mechanism):
             joints.append(Pivot("roller", "follower", "roller", tip_local, (0.0, 0.0), diameter=pin))
         joints.append(CamContact("contact", "cam", contact_body, profile, contact_point, normal))
         self.tip_local = tip_local
+        self._roller0 = 0.0
+        if f.kind == "roller":  # the roller's angle at cam angle 0: the follower's
+            self._roller0 = float(self.linkage.solve(self.profile.follower_output(np.zeros(1))[0]).poses["follower"][0, 2])
         pts = {k: (lk.points[k][0], lk.points[k][1]) for k in lk.points}
         if not pts:
             pts = {"tip": ("follower", tip_local)}
@@ -199,9 +203,11 @@ class CamMechanism(Mechanism):
         poses = dict(lm.poses)
         poses["cam"] = np.column_stack([np.zeros_like(q), np.zeros_like(q), q])
         fol = poses["follower"]
-        if "roller" in {p.name for p in self.parts}:
+        if self.profile.follower.kind == "roller":
+            # rolling without slip: relative to the cam the roller turns by -(pitch arc length) / radius
             c = poses_apply(fol, self.tip_local)
-            poses["roller"] = np.column_stack([c, fol[:, 2]])
+            spin = q - self.profile.pitch_length(q) / self.profile.rr
+            poses["roller"] = np.column_stack([c, self._roller0 + spin])
         checks = [(lm.fail_code != k, joint, why) for k, (joint, why) in enumerate(lm.fail_table)]
         return poses, checks
 

@@ -335,6 +335,37 @@ class CamProfile:
             out.append(starts[i] + sg.angle * np.arange(k) / k)
         return np.concatenate(out)
 
+    # ------------------------------------------------------------------ rolling
+    _GL_X, _GL_W = np.polynomial.legendre.leggauss(6)
+
+    def _speed(self, theta: Array) -> Array:
+        P1 = self.pitch(theta)[1]
+        return np.hypot(P1[:, 0], P1[:, 1])
+
+    def _gauss(self, a: Array, b: Array) -> Array:
+        """``integral |P'| dtheta`` from ``a`` to ``b`` per sample (6-point Gauss-Legendre)."""
+        mid, half = 0.5 * (a + b), 0.5 * (b - a)
+        t = mid[:, None] + half[:, None] * self._GL_X[None, :]
+        return half * (self._speed(t.ravel()).reshape(t.shape) @ self._GL_W)
+
+    def pitch_length(self, theta: ArrayLike, cells: int = 4096) -> Array:
+        """Arc length of the pitch curve from cam angle 0 to ``theta`` (rad, any real value; model units).
+
+        Gauss-Legendre over ``cells`` equal cells per turn, cumulated once, plus the part cell up to
+        ``theta``; a whole turn adds the pitch curve's length.
+        """
+        if "_cum" not in self.__dict__:
+            edges = np.linspace(0.0, TWO_PI, cells + 1)
+            self.__dict__["_cum"] = np.concatenate([[0.0], np.cumsum(self._gauss(edges[:-1], edges[1:]))])
+        cum: Array = self.__dict__["_cum"]
+        n = cum.shape[0] - 1
+        th = np.atleast_1d(np.asarray(theta, float))
+        turns = np.floor(th / TWO_PI)
+        t = th - turns * TWO_PI
+        k = np.clip((t / TWO_PI * n).astype(np.intp), 0, n - 1)
+        start = k * (TWO_PI / n)
+        return turns * cum[-1] + cum[k] + self._gauss(start, t)
+
     # ------------------------------------------------------------------ contact (joint residuals)
     def pitch_distance(self, q_cam: Array, t0: Array) -> Array:
         """Distance from points ``q_cam`` (cam frame) to the pitch curve, by Newton from parameters ``t0``."""
