@@ -435,3 +435,20 @@ def _inv(pose):
     x, y, a = pose
     c, s = math.cos(a), math.sin(a)
     return np.array([-(c * x + s * y), s * x - c * y, -a])
+
+
+def test_a_follower_that_cuts_into_the_cam_is_refused():
+    # a knife on a straight arm nearly along the cam's tangent: its flank crosses the outline (shapely, in
+    # the cam's frame); the roller on the same arm sits in another layer and is accepted
+    segs = [{"law": "harmonic", "angle": 150, "lift": 15}, {"law": "dwell", "angle": 30},
+            {"law": "cycloidal", "angle": 150, "lift": -15}, {"law": "dwell", "angle": 30}]
+    arm = {"motion": "oscillating", "pivot": [2.6, 1.2], "arm": 2.2}
+    with pytest.raises(SceneError, match=r"mechanism\.follower: the follower's outline overlaps the cam by .* at cam "
+                                         r"angle \d+ deg"):
+        cam_scene({"kind": "knife", **arm}, segs)
+    assert cam_scene({"kind": "roller", "roller_radius": 0.3, **arm}, segs).motion().valid.all()
+    # a flat face whose pivot boss would stand proud of the face: the face_offset it needs is named
+    with pytest.raises(SceneError, match=r"follower\.face_offset: .* a face_offset of at least"):
+        cam_scene({"kind": "flat", "motion": "oscillating", "pivot": [2.6, 0.4], "arm": 2.0, "face_offset": 0.0},
+                  [{"law": "harmonic", "angle": 150, "lift": 10}, {"law": "dwell", "angle": 30},
+                   {"law": "cycloidal", "angle": 150, "lift": -10}, {"law": "dwell", "angle": 30}])

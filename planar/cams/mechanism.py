@@ -3,7 +3,9 @@
 The follower is the input link of a :class:`~planar.linkages.Linkage`
 whose input is driven by the cam instead of a motor: a translating
 follower is an ``actuator`` node ``tip`` sliding along the follower's axis
-(its link ``follower`` a block on the ground's line ``axis0 -> axis1``);
+(its link ``follower`` a block on the ground's line ``axis0 -> axis1``,
+held by two pins either side of its node ``stem``, two link widths behind
+the tip);
 an oscillating follower is a ``crank`` node ``tip`` turning about the
 ground node ``pivot`` (link ``follower``, the arm).  The cam's centre is the
 ground node ``cam_centre`` at ``(0, 0)``.  Further nodes and links (a
@@ -38,7 +40,7 @@ __all__ = ["CamMechanism", "RESERVED"]
 
 Array = NDArray[np.float64]
 #: names the cam mechanism gives its own nodes and parts
-RESERVED = ("cam_centre", "pivot", "axis0", "axis1", "tip", "cam", "roller", "ground")
+RESERVED = ("cam_centre", "pivot", "axis0", "axis1", "tip", "stem", "cam", "roller", "ground")
 
 
 class CamMechanism(Mechanism):
@@ -72,21 +74,23 @@ class CamMechanism(Mechanism):
             if link.name == "follower":
                 if link.guide is not None:
                     raise InputError(f"{where}.links.follower.guide", link.guide, "no guide (the follower's is given)")
-                extra_follower = tuple(n for n in link.nodes if n not in ("tip", "pivot"))
+                extra_follower = tuple(n for n in link.nodes if n not in ("tip", "pivot", "stem"))
             else:
                 user_links.append(link)
         q = self._q_range()
         self._back = 0.0
         self.linkage = self._linkage(name, nodes, extra_follower, user_links, points, q)
-        if f.kind == "flat" and f.motion == "translating":
-            # the follower's slide pins sit either side of its node: move the node behind the face
-            self._back = 2.0 * self.linkage.width
+        if f.motion == "translating":
+            # the follower slides on two pins either side of its node "stem", two widths behind the tip
+            if self._width is None:
+                self._width = self.linkage.width
+            self._back = 2.0 * self._width
             self.linkage = self._linkage(name, nodes, extra_follower, user_links, points, q)
         lk = self.linkage
         w = lk.width
         parts = {p.name: p for p in lk.parts}
         fol = parts["follower"]
-        tip_local = (0.0, 0.0) if f.motion == "translating" else (float(f.arm), 0.0)
+        tip_local = (-self._back, 0.0) if f.motion == "translating" else (float(f.arm), 0.0)
         hull = list(fol.hull)
         joints: list[Any] = list(lk.joints)
         contact_point, normal = tip_local, (0.0, 1.0)
@@ -126,6 +130,8 @@ class CamMechanism(Mechanism):
         if not pts:
             pts = {"tip": ("follower", tip_local)}
         super().__init__(name, out_parts, joints, Driver("cam", "rotation", (0.0, 0.0), rate=rate, phase=phase), pts)
+        if f.kind != "roller":
+            self._check_clear()
 
     @property
     def design_notes(self) -> list[str]:
@@ -156,10 +162,11 @@ class CamMechanism(Mechanism):
         own: list[NodeKind] = [Fixed("cam_centre", (0.0, 0.0))]
         if f.motion == "translating":
             o = p.e * p.n
+            ax = (float(p.a[0]), float(p.a[1]))
             own += [Fixed("axis0", (float(o[0]), float(o[1]))),
                     Fixed("axis1", (float(o[0] + p.a[0]), float(o[1] + p.a[1]))),
-                    Actuator("tip", "axis0", (float(p.a[0]), float(p.a[1])), p.s0 + self._back)]
-            follower = Link("follower", ("tip",) + extra, guide=("axis0", "axis1"))
+                    Actuator("tip", "axis0", ax, p.s0), Actuator("stem", "axis0", ax, p.s0 + (self._back or 1.0))]
+            follower = Link("follower", ("stem", "tip") + extra, guide=("axis0", "axis1"))
         else:
             own += [Fixed("pivot", (float(f.pivot[0]), float(f.pivot[1]))), Crank("tip", "pivot", float(f.arm))]
             follower = Link("follower", ("pivot", "tip") + extra)
@@ -174,8 +181,9 @@ class CamMechanism(Mechanism):
         f = p.follower
         lo, hi = self.report.face_travel
         r = w / 2
+        hull = [c for c in hull if math.dist(c[:2], tip) > 1e-12]  # the tip is on the face
         if f.motion == "translating":
-            # link frame: origin at the node (``_back`` behind the face), x along the axis, y along J axis
+            # link frame: origin at the node "stem" (``_back`` behind the face), x along the axis, y along J axis
             x_face = -self._back
             add = [(x_face + r, lo - r, r), (x_face + r, hi + r, r)]
             point, normal = (x_face, 0.0), (1.0, 0.0)
@@ -184,7 +192,6 @@ class CamMechanism(Mechanism):
             # link frame: origin at the pivot, x along the arm, y along J arm; the face at y = -sf * face_offset
             sf = p.sf
             y_face = -sf * f.face_offset
-            hull = [c for c in hull if math.dist(c[:2], tip) > 1e-12]
             add = [(lo - r, y_face + sf * r, r), (hi + r, y_face + sf * r, r)]
             point, normal = (0.0, y_face), (0.0, sf)
             behind = [sf * (c[1] - y_face) - c[2] for c in hull]
@@ -195,6 +202,26 @@ class CamMechanism(Mechanism):
                            f"{-worst:.4g} past the flat face toward the cam; a face_offset of at least {need:.4g} "
                            "keeps it behind the face")
         return hull + add, point, normal
+
+    def _check_clear(self, samples: int = 72) -> None:
+        """A knife-edge or flat-faced follower touches the cam in one layer: refuse one that cuts into it."""
+        from shapely import affinity
+
+        cam = self.part("cam").outline
+        fol = self.part("follower").outline
+        th = np.arange(samples) * (2 * np.pi / samples)
+        pose = self.solve(th).poses["follower"]
+        limit = 1e-4 * self.profile.base_radius ** 2
+        for k in range(samples):
+            x, y, a = pose[k]
+            c, s = math.cos(a - th[k]), math.sin(a - th[k])  # the follower seen from the cam
+            cx, cy = math.cos(-th[k]), math.sin(-th[k])
+            seen = affinity.affine_transform(fol, [c, -s, s, c, cx * x - cy * y, cy * x + cx * y])
+            area = float(seen.intersection(cam).area)
+            if area > limit:
+                raise CamError(f"{self.profile.where}.follower: the follower's outline overlaps the cam by {area:.3g} "
+                               f"(model units^2) at cam angle {math.degrees(th[k]):.4g} deg; it touches the cam in one "
+                               "layer, so move its pivot or give a smaller link_width")
 
     # ------------------------------------------------------------------ solving
     def _solve_poses(self, q: Array) -> tuple[dict[str, Array], list[tuple[NDArray[np.bool_], str, str]]]:
