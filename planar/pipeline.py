@@ -109,12 +109,35 @@ def build_gallery(source: str | Path, output: str | Path | None = None,
 # --------------------------------------------------------------------------- motion tables
 
 
-def write_scene_motion(scene: Scene, out: str | Path) -> Motion:
-    """Write the scene's analytic motion table (CSV) to ``out``; returns the motion."""
-    from .fileio import write_motion_csv
+def write_scene_motion(scene: Scene, out: str | Path, derivatives: bool = False) -> Motion:
+    """Write the scene's analytic motion table (CSV) to ``out``; returns the motion.
+
+    ``derivatives``: add the rates of :func:`planar.derivatives.derivative_columns`
+    (point velocities and accelerations, part omega and alpha, transmission
+    angles, motor torque under the scene's ``[effects]``) before ``valid``.
+    Nothing is written if they cannot be computed.
+    """
+    import io
+
+    import numpy as np
+
+    from .fileio import atomic_write, motion_columns, write_motion_csv
 
     motion = scene.motion()
-    write_motion_csv(out, scene.mechanism, motion)
+    if not derivatives:
+        write_motion_csv(out, scene.mechanism, motion)
+        return motion
+    from .derivatives import derivative_columns
+
+    names, table = motion_columns(scene.mechanism, motion)
+    extra_names, extra = derivative_columns(scene.mechanism, motion, scene.effects)
+    names = names[:-1] + extra_names + names[-1:]
+    table = np.column_stack([table[:, :-1], *extra, table[:, -1]])
+    buf = io.StringIO()
+    buf.write(",".join(names) + "\n")
+    np.savetxt(buf, table, fmt=",".join(["%.17g"] * (len(names) - 1) + ["%d"]))
+    with atomic_write(out, "w") as fh:
+        fh.write(buf.getvalue())
     return motion
 
 
