@@ -1,0 +1,159 @@
+"""Accelerations by the differentiated closures, checked against differences and independent formulations."""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+import pytest
+
+from planar import analysis
+from planar.catalog import CATALOG, get
+from planar.cli import main
+from planar.derivatives import driver_rates, motion_derivatives, motor_torque
+from planar.dynamics import inverse_dynamics_torque
+from planar.linkages import FourBar, Linkage, SliderCrank
+from planar.scene import load_scene
+
+LINKAGES = [n for n in CATALOG if isinstance(get(n), Linkage)]
+GALLERY = ["quick-return", "oscillating-cylinder", "peaucellier", "watt-straight-line", "double-rocker",
+           "jansen-leg", "slider-crank"]
+
+
+def _central(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
+    """First and second central differences along axis 0 (interior samples only)."""
+    return (x[2:] - x[:-2]) / (2 * h), (x[2:] - 2 * x[1:-1] + x[:-2]) / (h * h)
+
+
+def _check_against_differences(mech, n: int) -> float:
+    """Worst relative difference of analytic rates from central differences over one cycle of ``n`` samples."""
+    t = mech.driver.times(n)
+    mo = mech.solve(mech.driver.value(t), t=t)
+    der = motion_derivatives(mech, mo)
+    h = t[1] - t[0]
+    ok = der.valid[1:-1] & der.valid[:-2] & der.valid[2:]
+    assert ok.mean() > 0.9
+    worst = 0.0
+    for name, (v, a) in der.points.items():
+        fv, fa = _central(mo.points[name], h)
+        worst = max(worst, np.abs(fv - v[1:-1])[ok].max() / np.abs(v).max(),
+                    np.abs(fa - a[1:-1])[ok].max() / np.abs(a).max())
+    for name, r in der.parts.items():
+        ang = np.unwrap(mo.poses[name][:, 2])
+        fo, fal = _central(ang, h)
+        # a part turning with the crank has alpha 0 (to round-off): measure against the driver's rate
+        scale_o = max(np.abs(r.omega).max(), mech.driver.rate)
+        scale_a = max(np.abs(r.alpha).max(), mech.driver.rate**2)
+        worst = max(worst, np.abs(fo - r.omega[1:-1])[ok].max() / scale_o,
+                    np.abs(fal - r.alpha[1:-1])[ok].max() / scale_a)
+        fv, fa = _central(mo.poses[name][:, :2], h)
+        if np.abs(r.a).max() > 0:
+            worst = max(worst, np.abs(fa - r.a[1:-1])[ok].max() / np.abs(r.a).max())
+    return worst
+
+
+@pytest.mark.parametrize("name", LINKAGES)
+def test_catalog_linkage_rates_match_central_differences_second_order(name: str) -> None:
+    mech = get(name)
+    e1 = _check_against_differences(mech, 720)
+    e2 = _check_against_differences(mech, 1440)
+    assert e1 < 2e-3
+    assert e2 < e1 / 3  # second order: halving the step quarters the difference
+
+
+@pytest.mark.parametrize("name", GALLERY)
+def test_gallery_linkages_rates_match_differences(name: str) -> None:
+    """Moving guides (quick return, oscillating cylinder), straight-line linkages and rocking drivers."""
+    mech = load_scene(f"gallery/{name}.toml").mechanism
+    assert _check_against_differences(mech, 2000) < 1e-3
+
+
+def test_fourbar_node_accelerations_equal_angle_formulation_rocking_input() -> None:
+    """Point formulation (node kinds) against Norton's link-angle loop equations, with a nonzero crank alpha."""
+    fb = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(5.5, -2.0), amplitude=0.8, centre=1.0, rate=3.0)
+    t = np.linspace(0.0, fb.driver.period, 97)
+    q = fb.driver.value(t)
+    qd, qdd = driver_rates(fb.driver, t)
+    assert np.abs(qdd).max() > 1.0
+    mo = fb.solve(q, t=t)
+    der = motion_derivatives(fb, mo)
+    w3, w4, okv = analysis.fourbar_velocities(fb, q, qd)
+    al3, al4, oka = analysis.fourbar_accelerations(fb, q, qd, qdd)
+    assert okv.all() and oka.all() and der.valid.all()
+    scale = np.abs(al3).max()
+    assert np.abs(der.parts["coupler"].omega - w3).max() < 1e-12 * np.abs(w3).max()
+    assert np.abs(der.parts["rocker"].omega - w4).max() < 1e-12 * np.abs(w4).max()
+    assert np.abs(der.parts["coupler"].alpha - al3).max() < 1e-11 * scale
+    assert np.abs(der.parts["rocker"].alpha - al4).max() < 1e-11 * np.abs(al4).max()
+    # and the transmission angle against the law-of-cosines formula
+    assert np.allclose(der.transmission["C"], fb.transmission_angle(q), atol=1e-12)
+
+
+def test_slider_crank_acceleration_equals_textbook_closed_form() -> None:
+    """x = r cos t + sqrt(l^2 - (r sin t - e)^2), differentiated by hand."""
+    r, l, e = 1.0, 3.0, 0.4
+    sc = SliderCrank(r, l, offset=e, rate=5.0)
+    t = np.linspace(0, sc.driver.period, 50, endpoint=False)
+    th = sc.driver.value(t)
+    mo = sc.solve(th, t=t)
+    v, a = motion_derivatives(sc, mo).points["slider_pin"]
+    w = 5.0
+    h, hd, hdd = r * np.sin(th) - e, r * np.cos(th), -r * np.sin(th)
+    s = np.sqrt(l * l - h * h)
+    xd = -r * np.sin(th) - h * hd / s
+    xdd = -r * np.cos(th) - (hd * hd + h * hdd) / s - (h * hd) ** 2 / s**3
+    assert np.allclose(v[:, 0], w * xd, rtol=0, atol=1e-12 * w)
+    assert np.allclose(a[:, 0], w * w * xdd, rtol=0, atol=1e-11 * w * w)
+    assert np.abs(v[:, 1]).max() < 1e-12 and np.abs(a[:, 1]).max() < 1e-10
+
+
+def test_torque_equals_inverse_dynamics_by_differences() -> None:
+    """Exact-rate torque against planar.dynamics (central differences in time): inertia, gravity, loads, springs."""
+    from planar.effects import Effects, Load, Spring
+
+    mech = get("jansen")
+    eff = Effects(gravity=(0.0, -9.81), damping=0.9, density=0.01, loads=(Load("foot", (3.0, 10.0)),),
+                  springs=(Spring("crank", "lower", 2.0, damping=0.3),))
+    t = mech.driver.times(90)
+    mo = mech.solve(mech.driver.value(t), t=t)
+    tau, ok = motor_torque(mech, mo, eff)
+    ref = inverse_dynamics_torque(mech, t, eff)
+    assert ok.all()
+    assert np.abs(tau - ref).max() < 1e-5 * np.abs(ref).max()
+
+
+def test_torque_of_a_rocking_driver_divides_power_by_its_own_speed() -> None:
+    """planar.dynamics divides power by the constant rate; a rocking input's torque is power / dq/dt."""
+    sc = load_scene("gallery/double-rocker.toml")
+    mech = sc.mechanism
+    t = np.linspace(0, mech.driver.period, 40, endpoint=False)
+    mo = mech.solve(mech.driver.value(t), t=t)
+    tau, ok = motor_torque(mech, mo, sc.effects)
+    power_over_rate = inverse_dynamics_torque(mech, t, sc.effects)
+    qd, _ = driver_rates(mech.driver, t)
+    keep = np.abs(qd) > 0.2 * np.abs(qd).max()
+    assert np.allclose(tau[keep], (power_over_rate * mech.driver.rate / qd)[keep], rtol=1e-5,
+                       atol=1e-6 * np.abs(tau).max())
+
+
+def test_motion_derivatives_columns(tmp_path) -> None:
+    out = tmp_path / "m.csv"
+    assert main(["motion", "gallery/kangaroo-leg.toml", "-o", str(out), "--derivatives"]) == 0
+    rows = list(csv.DictReader(out.open()))
+    cols = rows[0].keys()
+    for c in ("coupler_point.vx", "coupler_point.vy", "coupler_point.ax", "coupler_point.ay", "coupler.omega",
+              "rocker.alpha", "C.transmission", "torque", "torque.loads", "rates_valid"):
+        assert c in cols
+    assert list(cols)[-1] == "valid"
+    sc = load_scene("gallery/kangaroo-leg.toml")
+    mo = sc.motion()
+    ax = np.array([float(r["coupler_point.ax"]) for r in rows])
+    assert np.array_equal(ax, motion_derivatives(sc.mechanism, mo).points["coupler_point"][1][:, 0])
+    # the loads' torque is the velocity-coefficient torque of planar.analysis
+    tau_l = np.array([float(r["torque.loads"]) for r in rows])
+    ref, _ = analysis.motor_torque(sc.mechanism, mo.driver, {"coupler_point": [0.0, 10.0]})
+    assert np.allclose(tau_l, ref, rtol=1e-12, atol=1e-12)
+    # the plain table is unchanged by the option's existence
+    plain = tmp_path / "p.csv"
+    assert main(["motion", "gallery/kangaroo-leg.toml", "-o", str(plain)]) == 0
+    assert "torque" not in plain.read_text().splitlines()[0]
