@@ -890,9 +890,9 @@ class Linkage(Mechanism):
             vel[node.name] = v
             a, ok2 = node.acceleration(pos, vel, acc, qd, qdd)
             acc[node.name] = a
-            for m in (ok, ok2):
-                if m is not None:
-                    valid &= m
+            for mask in (ok, ok2):
+                if mask is not None:
+                    valid &= mask
         return pos, vel, acc, valid
 
     def link_rates(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array]
