@@ -249,6 +249,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("-o", "--output", required=True, help="CSV file to write")
     c.add_argument("--samples", type=int, default=360)
     c.set_defaults(func=_cmd_motion_catalog)
+    from .cli_plot import add_parser as add_plot_parser; add_plot_parser(sub)  # noqa: E702
     return p
 
 
