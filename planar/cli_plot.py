@@ -13,7 +13,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     from .scene import load_scene
 
     what = [w.strip() for w in args.what.split(",") if w.strip()] if args.what else None
-    charts = write_plot(load_scene(args.scene), args.output, what)
+    charts = write_plot(load_scene(args.scene), args.output, what, args.samples)
     print(f"wrote {args.output}: {', '.join(charts)}")
     return 0
 
@@ -32,4 +32,6 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--what", default=None,
                    help="comma-separated charts: curve,transmission,velocity,acceleration,torque "
                         "(default: every chart that applies)")
+    p.add_argument("--samples", type=int, default=None,
+                   help="samples per cycle for the charts (default: the scene's [driver] samples_per_cycle)")
     p.set_defaults(func=_cmd_plot)

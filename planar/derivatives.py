@@ -126,13 +126,16 @@ def transmission_angles(mech: "Mechanism", q: ArrayLike) -> dict[str, Array]:
 
     The angle between the two links meeting at the dyad's joint (a four-bar's
     at ``C``: coupler and rocker); 90 degrees transmits best, near 0 or 180
-    the linkage toggles.  Empty for mechanisms without dyads.
+    the linkage toggles.  Only dyads whose two links are different parts (a
+    node fixed on a ternary link has none).  Empty for mechanisms without dyads.
     """
     from .linkages import RRR, Linkage
 
     if not isinstance(mech, Linkage):
         return {}
-    rrr = [n for n in mech.nodes if isinstance(n, RRR)]
+    # a dyad whose two links are one part (a node on a ternary link) transmits nothing: no angle
+    rrr = [n for n in mech.nodes if isinstance(n, RRR)
+           and not any({n.name, n.a, n.b} <= set(lk.nodes) for lk in mech.links)]
     if not rrr:
         return {}
     pos, _ = mech.solve_nodes(np.atleast_1d(np.asarray(q, float)))

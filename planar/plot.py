@@ -36,6 +36,7 @@ from .errors import InputError
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
+    from .model import Motion
     from .scene import Scene
 
 __all__ = ["CHARTS", "scene_figure", "write_plot", "available_charts"]
@@ -74,8 +75,26 @@ def _parse_what(scene: "Scene", what: Sequence[str] | None) -> list[str]:
     return chosen
 
 
-def scene_figure(scene: "Scene", what: Sequence[str] | None = None, width_in: float = 6.4) -> "Figure":
+def _motion(scene: "Scene", samples_per_cycle: int | None) -> "Motion":
+    """The scene's motion, over its own cycles or duration, at ``samples_per_cycle`` (default: the scene's)."""
+    if samples_per_cycle is None:
+        return scene.motion()
+    if samples_per_cycle < 4:
+        raise InputError("--samples", samples_per_cycle, "at least 4 samples per cycle")
+    d = scene.spec.driver
+    drv = scene.mechanism.driver
+    cycles = d.duration / drv.period if d.duration is not None else (d.cycles if d.cycles is not None else 1.0)
+    n = max(2, int(round(samples_per_cycle * cycles)))
+    t = np.arange(n) * (drv.period / samples_per_cycle)
+    return scene.mechanism.solve(drv.value(t), t=t)
+
+
+def scene_figure(scene: "Scene", what: Sequence[str] | None = None, width_in: float = 6.4,
+                 samples_per_cycle: int | None = None) -> "Figure":
     """The charts ``what`` (default: every chart that applies) of ``scene``, stacked in one figure.
+
+    ``samples_per_cycle``: sample the motion this finely instead of the
+    scene's ``[driver] samples_per_cycle`` (smoother curves).
 
     Each axes carries a ``gid`` naming its chart (``"chart-curve"``, ...), and
     each line a ``gid`` naming what it plots (``"curve:coupler_point"``,
@@ -88,7 +107,7 @@ def scene_figure(scene: "Scene", what: Sequence[str] | None = None, width_in: fl
 
     charts = _parse_what(scene, what)
     mech = scene.mechanism
-    motion = scene.motion()
+    motion = _motion(scene, samples_per_cycle)
     names, cols = derivative_columns(mech, motion, scene.effects)
     col = dict(zip(names, cols))
     drv = mech.driver
@@ -166,15 +185,19 @@ def _render(fig: Any, fmt: str) -> bytes:
     return buf.getvalue()
 
 
-def write_plot(scene: "Scene", out: str | os.PathLike[str], what: Sequence[str] | None = None) -> list[str]:
-    """Write the charts of ``scene`` to ``out`` (``.png`` or ``.svg``, reproducible bytes); returns the charts."""
+def write_plot(scene: "Scene", out: str | os.PathLike[str], what: Sequence[str] | None = None,
+               samples_per_cycle: int | None = None) -> list[str]:
+    """Write the charts of ``scene`` to ``out`` (``.png`` or ``.svg``, reproducible bytes); returns the charts.
+
+    ``what`` and ``samples_per_cycle`` as for :func:`scene_figure`.
+    """
     from .fileio import atomic_write
 
     ext = os.path.splitext(str(out))[1].lower().lstrip(".")
     if ext not in ("png", "svg"):
         raise InputError("-o", str(out), "a .png or .svg file name")
     charts = _parse_what(scene, what)
-    fig = scene_figure(scene, charts)
+    fig = scene_figure(scene, charts, samples_per_cycle=samples_per_cycle)
     data = _render(fig, ext)
     with atomic_write(out, "wb") as fh:
         fh.write(data)
