@@ -111,7 +111,8 @@ def mechanism_rates(mech: "Mechanism", q: ArrayLike, qd: ArrayLike = 1.0, qdd: A
         return out, valid, "linkage closure equations differentiated twice (node kinds)"
     from .windup.rates import windup_rates
 
-    return windup_rates(mech, qa, qdv, qddv)
+    raw, valid, method = windup_rates(mech, qa, qdv, qddv)
+    return {k: PartRates(*v) for k, v in raw.items()}, valid, method
 
 
 def point_rates(poses: ArrayLike, rates: PartRates, world_points: ArrayLike) -> tuple[Array, Array]:

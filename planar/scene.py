@@ -519,6 +519,17 @@ class Scene:
     def name(self) -> str:
         return self.spec.name or Path(self.path).stem
 
+    def save(self, path: str | Path) -> None:
+        """Write this scene as a TOML scene file that :func:`load_scene` reads back to the same motion.
+
+        The keys the scene was given are written (defaults left out), angles
+        as given with the scene's ``angle_unit``; atomic.  A mechanism built in
+        Python becomes a scene with :func:`planar.pipeline.scene_from_mechanism`.
+        """
+        from .scenewrite import write_scene
+
+        write_scene(self.spec, path)
+
     @property
     def effects(self) -> Effects:
         """The scene's ``[effects]`` as the model's plain record (what ``simulate`` takes)."""

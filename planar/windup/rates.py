@@ -35,7 +35,6 @@ from . import params as P_
 from .mechanisms import ELEMENTAL, ElementalMechanism
 
 if TYPE_CHECKING:
-    from ..derivatives import PartRates
     from ..model import Mechanism
 
 __all__ = ["forward_rates", "driver_motion_rates", "elemental_rates", "windup_rates"]
@@ -312,18 +311,16 @@ def toy_rates(toy: Any, q: Array, qd: Array, qdd: Array) -> tuple[dict[str, tupl
 
 
 def windup_rates(mech: "Mechanism", q: Array, qd: Array, qdd: Array
-                 ) -> tuple[dict[str, "PartRates"], Mask, str]:
-    """Part rates of an elemental mechanism or a toy (see the module's note); others are refused by name."""
-    from ..derivatives import PartRates
+                 ) -> tuple[dict[str, tuple[Array, ...]], Mask, str]:
+    """Part rates ``(v, a, omega, alpha)`` of an elemental mechanism or a toy (see the module's note), with the
+    validity and the method's name; other mechanisms are refused by name."""
     from .chain import ToyMechanism
 
     if isinstance(mech, ElementalMechanism):
         raw, ok = elemental_rates(mech, q, qd, qdd)
-        method = "wind-up closed forms differentiated analytically"
-    elif isinstance(mech, ToyMechanism):
+        return raw, ok, "wind-up closed forms differentiated analytically"
+    if isinstance(mech, ToyMechanism):
         raw, ok = toy_rates(mech, q, qd, qdd)
-        method = "wind-up closed forms differentiated analytically, composed through the toy's stages"
-    else:
-        raise UnsupportedError(f"rates (velocities, accelerations, torque): no closed-form derivatives for "
-                               f"{type(mech).__name__} {mech.name!r}")
-    return {k: PartRates(*v) for k, v in raw.items()}, ok, method
+        return raw, ok, "wind-up closed forms differentiated analytically, composed through the toy's stages"
+    raise UnsupportedError(f"rates (velocities, accelerations, torque): no closed-form derivatives for "
+                           f"{type(mech).__name__} {mech.name!r}")
