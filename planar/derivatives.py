@@ -75,8 +75,26 @@ def _perp(v: Array) -> Array:
 
 
 def _rotate(v: Array, ang: float) -> Array:
+    if ang == 0.0:
+        return v
     c, s = math.cos(ang), math.sin(ang)
-    return np.stack([c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1]], -1)
+    return np.column_stack([c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1]])
+
+
+#: the last linkage node solve, ``(mechanism, digest of q, solve_nodes result)``: a motion table asks for
+#: rates at two driver speeds and the transmission angles of the same samples
+_LAST_SOLVE: list[tuple[Any, bytes, Any]] = []
+
+
+def _node_solve(mech: Any, q: Array) -> Any:
+    import hashlib
+
+    key = hashlib.blake2b(np.ascontiguousarray(q).tobytes(), digest_size=16).digest() + str(q.shape).encode()
+    if _LAST_SOLVE and _LAST_SOLVE[0][0] is mech and _LAST_SOLVE[0][1] == key:
+        return _LAST_SOLVE[0][2]
+    solved = mech.solve_nodes(q)
+    _LAST_SOLVE[:] = [(mech, key, solved)]
+    return solved
 
 
 def driver_rates(driver: "Driver", t: ArrayLike) -> tuple[Array, Array]:
@@ -103,7 +121,7 @@ def mechanism_rates(mech: "Mechanism", q: ArrayLike, qd: ArrayLike = 1.0, qdd: A
     qdv = np.broadcast_to(np.asarray(qd, float), qa.shape)
     qddv = np.broadcast_to(np.asarray(qdd, float), qa.shape)
     if isinstance(mech, Linkage):
-        pos, vel, acc, valid = mech.node_accelerations(qa, qdv, qddv)
+        pos, vel, acc, valid = mech.node_accelerations(qa, qdv, qddv, solved=_node_solve(mech, qa))
         ang = mech.placement[2]
         out = {}
         for name, (v, a, om, al) in mech.link_rates(pos, vel, acc).items():
@@ -117,9 +135,13 @@ def mechanism_rates(mech: "Mechanism", q: ArrayLike, qd: ArrayLike = 1.0, qdd: A
 
 def point_rates(poses: ArrayLike, rates: PartRates, world_points: ArrayLike) -> tuple[Array, Array]:
     """Velocity and acceleration ``(N, 2)`` of points fixed to a part, at world positions ``(N, 2)``."""
-    r = np.asarray(world_points, float) - np.asarray(poses, float)[:, :2]
-    om, al = rates.omega[:, None], rates.alpha[:, None]
-    return rates.v + om * _perp(r), rates.a + al * _perp(r) - om * om * r
+    P, O = np.asarray(world_points, float), np.asarray(poses, float)
+    rx, ry = P[:, 0] - O[:, 0], P[:, 1] - O[:, 1]
+    om, al = rates.omega, rates.alpha
+    om2 = om * om
+    v = np.column_stack([rates.v[:, 0] - om * ry, rates.v[:, 1] + om * rx])
+    a = np.column_stack([rates.a[:, 0] - al * ry - om2 * rx, rates.a[:, 1] + al * rx - om2 * ry])
+    return v, a
 
 
 def transmission_angles(mech: "Mechanism", q: ArrayLike) -> dict[str, Array]:
@@ -139,7 +161,7 @@ def transmission_angles(mech: "Mechanism", q: ArrayLike) -> dict[str, Array]:
            and not any({n.name, n.a, n.b} <= set(lk.nodes) for lk in mech.links)]
     if not rrr:
         return {}
-    pos, _ = mech.solve_nodes(np.atleast_1d(np.asarray(q, float)))
+    pos, _ = _node_solve(mech, np.atleast_1d(np.asarray(q, float)))
     return {n.name: n.transmission(pos) for n in rrr}
 
 
@@ -149,6 +171,11 @@ def motion_derivatives(mech: "Mechanism", motion: "Motion") -> Derivatives:
         raise InputError(f"{mech.name}.motion.t", None, "sample times (solve with t=..., or Mechanism.run)")
     qd, qdd = driver_rates(mech.driver, motion.t)
     parts, ok, method = mechanism_rates(mech, motion.driver, qd, qdd)
+    return _derivatives(mech, motion, parts, ok, method)
+
+
+def _derivatives(mech: "Mechanism", motion: "Motion", parts: dict[str, PartRates], ok: Mask,
+                 method: str = "") -> Derivatives:
     points = {}
     for name, (part, _) in mech.points.items():
         points[name] = point_rates(motion.poses[part], parts[part], motion.points[name])
@@ -161,16 +188,30 @@ def motor_torque(mech: "Mechanism", motion: "Motion", effects: Any = None, t_res
 
     ``effects``: an :class:`~planar.effects.Effects` (gravity, loads, springs,
     damping, density) or ``None`` (inertia at density 1 only); ``t_rest``:
-    when a spring without a rest length has it (default the first sample).
+    when a spring without a rest length has it (default the first sample);
+    ``densities``: per-part densities overriding ``effects.density``.
     Returns ``(tau, valid)``.
     """
-    from .dynamics import part_mass_table
+    rates, coef, ok = _rates_and_coefficients(mech, motion)
+    return _torque(mech, motion, rates, coef, effects, t_rest, densities), ok
 
+
+def _rates_and_coefficients(mech: "Mechanism", motion: "Motion"
+                            ) -> tuple[dict[str, PartRates], dict[str, PartRates], Mask]:
+    """Rates at the driver's law and at unit driver speed (the velocity coefficients ``d/dq``)."""
     if motion.t is None:
         raise InputError(f"{mech.name}.motion.t", None, "sample times (solve with t=..., or Mechanism.run)")
     qd, qdd = driver_rates(mech.driver, motion.t)
     rates, ok, _ = mechanism_rates(mech, motion.driver, qd, qdd)
-    coef, ok1, _ = mechanism_rates(mech, motion.driver, 1.0, 0.0)  # d/dq: the rates at unit driver speed
+    coef, ok1, _ = mechanism_rates(mech, motion.driver, 1.0, 0.0)
+    return rates, coef, ok & ok1 & motion.valid
+
+
+def _torque(mech: "Mechanism", motion: "Motion", rates: dict[str, PartRates], coef: dict[str, PartRates],
+            effects: Any, t_rest: float | None, densities: dict[str, float] | None) -> Array:
+    from .dynamics import part_mass_table
+
+    assert motion.t is not None
     g = np.zeros(2)
     lam = 0.0
     if effects is not None:
@@ -178,19 +219,20 @@ def motor_torque(mech: "Mechanism", motion: "Motion", effects: Any = None, t_res
             g = np.asarray(effects.gravity, float)
         if effects.damping is not None:
             lam = -math.log(float(effects.damping))
-    n = len(motion)
-    tau = np.zeros(n)
+    tau = np.zeros(len(motion))
     for name, (mass, cog, inertia) in part_mass_table(mech, effects, densities).items():
+        if mass == 0.0 and inertia == 0.0:
+            continue
         G = poses_apply(motion.poses[name], np.asarray(cog, float))
         vG, aG = point_rates(motion.poses[name], rates[name], G)
         cG, _ = point_rates(motion.poses[name], coef[name], G)
         r, c = rates[name], coef[name]
-        tau += mass * ((aG - g + lam * vG) * cG).sum(-1) + inertia * (r.alpha + lam * r.omega) * c.omega
+        tau += mass * _dot(aG - g + lam * vG, cG) + inertia * (r.alpha + lam * r.omega) * c.omega
     if effects is not None:
         for load in effects.loads:
             part, _ = mech.points[load.point]
             cX, _ = point_rates(motion.poses[part], coef[part], motion.points[load.point])
-            tau += (np.asarray(load.force, float) * cX).sum(-1)
+            tau += cX @ np.asarray(load.force, float)
         i0 = 0 if t_rest is None else int(np.argmin(np.abs(motion.t - t_rest)))
         for s in effects.springs:
             pa = poses_apply(motion.poses[s.a], np.asarray(s.anchor_a, float))
@@ -203,9 +245,13 @@ def motor_torque(mech: "Mechanism", motion: "Motion", effects: Any = None, t_res
             L = np.hypot(d[:, 0], d[:, 1])
             Ls = np.where(L > 0, L, 1.0)
             rest = float(L[i0]) if s.rest_length is None else s.rest_length
-            f = s.stiffness * (L - rest) + s.damping * (d * (vb - va)).sum(-1) / Ls
-            tau += f * (d * (cb - ca)).sum(-1) / Ls
-    return tau, ok & ok1 & motion.valid
+            f = s.stiffness * (L - rest) + s.damping * _dot(d, vb - va) / Ls
+            tau += f * _dot(d, cb - ca) / Ls
+    return tau
+
+
+def _dot(a: Array, b: Array) -> Array:
+    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]
 
 
 def derivative_columns(mech: "Mechanism", motion: "Motion", effects: Any = None) -> tuple[list[str], list[Array]]:
@@ -221,7 +267,8 @@ def derivative_columns(mech: "Mechanism", motion: "Motion", effects: Any = None)
     """
     from .effects import Effects
 
-    der = motion_derivatives(mech, motion)
+    rates, coef, ok = _rates_and_coefficients(mech, motion)
+    der = _derivatives(mech, motion, rates, ok)
     names: list[str] = []
     cols: list[Array] = []
     for pname, (v, a) in der.points.items():
@@ -234,9 +281,9 @@ def derivative_columns(mech: "Mechanism", motion: "Motion", effects: Any = None)
     for node, ang in der.transmission.items():
         names.append(f"{node}.transmission")
         cols.append(ang)
-    tau, ok = motor_torque(mech, motion, effects)
+    tau = _torque(mech, motion, rates, coef, effects, None, None)
     loads_only = Effects(loads=tuple(effects.loads)) if effects is not None else Effects()
-    tau_l, _ = motor_torque(mech, motion, loads_only, densities={p.name: 0.0 for p in mech.parts})
+    tau_l = _torque(mech, motion, rates, coef, loads_only, None, {p.name: 0.0 for p in mech.parts})
     names += ["torque", "torque.loads"]
     cols += [tau, tau_l]
     good = der.valid & ok

@@ -112,10 +112,10 @@ def scene_figure(scene: "Scene", what: Sequence[str] | None = None, width_in: fl
     col = dict(zip(names, cols))
     drv = mech.driver
     if drv.kind == "rotation" and drv.amplitude is None:
-        x, xlabel = np.degrees(motion.driver), "crank angle (deg)"
+        x, xlabel, xunit = np.degrees(motion.driver), "crank angle (deg)", "°"
     else:
         assert motion.t is not None
-        x, xlabel = motion.t, "time (s)"
+        x, xlabel, xunit = motion.t, "time (s)", " s"
     good = col["rates_valid"] == 1.0
     moving = [p.name for p in mech.parts if not p.ground]
 
@@ -167,7 +167,7 @@ def scene_figure(scene: "Scene", what: Sequence[str] | None = None, width_in: fl
             ax.set_ylabel("torque (force x unit)")
             if good.any():
                 k = int(np.nanargmax(np.abs(col["torque"])))
-                ax.set_title(f"motor torque: peak {abs(col['torque'][k]):.4g} at {x[k]:.4g}", fontsize=9)
+                ax.set_title(f"motor torque: peak {abs(col['torque'][k]):.4g} at {x[k]:.4g}{xunit}", fontsize=9)
         if chart != "curve":
             ax.set_xlabel(xlabel)
         if len(ax.get_lines()) > 1 or chart == "curve":

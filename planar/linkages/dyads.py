@@ -104,6 +104,11 @@ def _cross(a: Array, b: Array) -> Array:
     return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
 
 
+def _dot(a: Array, b: Array) -> Array:
+    """Row-wise dot product of ``(N, 2)`` arrays (faster than ``(a * b).sum(-1)``)."""
+    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]
+
+
 def _solve2(r1: Array, b1: Array, r2: Array, b2: Array) -> tuple[Array, Mask]:
     """Solve ``r1 . v = b1, r2 . v = b2`` per sample (Cramer); ``ok`` false where singular."""
     det = r1[:, 0] * r2[:, 1] - r1[:, 1] * r2[:, 0]
@@ -121,10 +126,10 @@ def frame_rates(d: Array, vd: Array, ad: Array) -> tuple[Array, Array]:
     ``phi = atan2(d)``: ``omega = cross(d, d') / |d|^2`` and
     ``alpha = cross(d, d'') / |d|^2 - 2 omega (d . d') / |d|^2``.
     """
-    n2 = (d * d).sum(-1)
+    n2 = _dot(d, d)
     n2 = np.where(n2 > 0, n2, 1.0)
     omega = _cross(d, vd) / n2
-    return omega, _cross(d, ad) / n2 - 2.0 * omega * (d * vd).sum(-1) / n2
+    return omega, _cross(d, ad) / n2 - 2.0 * omega * _dot(d, vd) / n2
 
 
 def carry_branch(keep: Array, other: Array, valid: Mask, path: Mask) -> NDArray[np.bool_]:
@@ -386,13 +391,13 @@ class RRR(NodeKind):
         P, vP = pos[self.name], vel[self.name]
         r1, r2 = P - pos[self.a], P - pos[self.b]
         w1, w2 = vP - vel[self.a], vP - vel[self.b]
-        return _solve2(r1, (r1 * acc[self.a]).sum(-1) - (w1 * w1).sum(-1),
-                       r2, (r2 * acc[self.b]).sum(-1) - (w2 * w2).sum(-1))
+        return _solve2(r1, _dot(r1, acc[self.a]) - _dot(w1, w1),
+                       r2, _dot(r2, acc[self.b]) - _dot(w2, w2))
 
     def transmission(self, pos: Mapping[str, Array]) -> Array:
         """Transmission angle (rad, in ``[0, pi]``) at this node: between the links to ``a`` and to ``b``."""
         r1, r2 = pos[self.a] - pos[self.name], pos[self.b] - pos[self.name]
-        return np.arctan2(np.abs(_cross(r1, r2)), (r1 * r2).sum(-1))
+        return np.arctan2(np.abs(_cross(r1, r2)), _dot(r1, r2))
 
 
 @node_kind
@@ -460,10 +465,10 @@ class RRP(NodeKind):
         p0, vp0, ap0 = pos[self.p], vel[self.p], acc[self.p]
         w, vw, aw = pos[self.q] - p0, vel[self.q] - vp0, acc[self.q] - ap0
         wn = np.hypot(w[:, 0], w[:, 1])
-        wv = (w * vw).sum(-1)
+        wv = _dot(w, vw)
         b2 = (_cross(w, ap0) - _cross(aw, P - p0) - 2.0 * _cross(vw, vP - vp0)
-              + self.offset * (((vw * vw).sum(-1) + (w * aw).sum(-1)) / wn - wv * wv / wn**3))
-        return _solve2(r1, (r1 * acc[self.a]).sum(-1) - (v1 * v1).sum(-1), _perp(w), b2)
+              + self.offset * ((_dot(vw, vw) + _dot(w, aw)) / wn - wv * wv / wn**3))
+        return _solve2(r1, _dot(r1, acc[self.a]) - _dot(v1, v1), _perp(w), b2)
 
 
 @node_kind
@@ -865,7 +870,8 @@ class Linkage(Mechanism):
                 valid &= ok
         return vel, valid
 
-    def node_accelerations(self, q: ArrayLike, qdot: ArrayLike = 1.0, qddot: ArrayLike = 0.0
+    def node_accelerations(self, q: ArrayLike, qdot: ArrayLike = 1.0, qddot: ArrayLike = 0.0,
+                           solved: tuple[dict[str, Array], list[tuple[Mask, str, str]]] | None = None,
                            ) -> tuple[dict[str, Array], dict[str, Array], dict[str, Array], Mask]:
         """Position, velocity and acceleration ``(N, 2)`` of every node (own frame, before placement).
 
@@ -875,11 +881,12 @@ class Linkage(Mechanism):
         sample; with ``qdot = 1, qddot = 0`` the accelerations are the second
         coefficients ``d2X/dq2``.  ``valid`` is false where the position does
         not close or a differentiated closure is singular (a toggle).
+        ``solved``: :meth:`solve_nodes` of ``q`` if the caller has it already.
         """
         qa = np.atleast_1d(np.asarray(q, float))
         qd = np.broadcast_to(np.asarray(qdot, float), qa.shape)
         qdd = np.broadcast_to(np.asarray(qddot, float), qa.shape)
-        pos, checks = self.solve_nodes(qa)
+        pos, checks = solved if solved is not None else self.solve_nodes(qa)
         valid = np.ones(qa.shape, bool)
         for m, _, _ in checks:
             valid &= m
