@@ -225,3 +225,26 @@ def test_motion_derivatives_of_a_toy(tmp_path) -> None:
     head = out.read_text().splitlines()[0].split(",")
     assert "s0.driver.omega" in head and "torque" in head
     assert not any(c.endswith(".transmission") for c in head)  # no dyads in a toy
+
+
+def test_rrp_on_a_moving_line_with_offset_and_an_actuator() -> None:
+    """The RRP terms a fixed guide leaves untested: a slot on the turning crank, shifted off its centre line;
+    and a translating input that rocks (qdd != 0)."""
+    from planar.linkages import RRP, RRR, Actuator, Crank, Fixed, Link, Rigid
+
+    slot = Linkage("slot", [Fixed("O", (0.0, 0.0)), Fixed("Z", (2.5, 0.5)), Crank("A", "O", 3.0),
+                            RRP("S", "Z", 3.0, "O", "A", 1, 0.3), Rigid("T", "Z", "S", (3.0, 0.5))],
+                   [Link("crank", ("O", "A")), Link("arm", ("Z", "S", "T"))], points={"tip": "T", "pin": "S"})
+    act = Linkage("act", [Fixed("O", (0.0, 0.0)), Fixed("Z", (0.0, 2.0)), Actuator("P", "O", (1.0, 0.2)),
+                          RRR("B", "P", 2.5, "Z", 2.0)],
+                  [Link("rod", ("P", "B")), Link("arm", ("Z", "B"))], points={"b": "B"}, amplitude=0.6, centre=0.5)
+    for mech in (slot, act):
+        assert _check_against_differences(mech, 2000) < 1e-3
+        t = mech.driver.times(256)
+        mo = mech.solve(mech.driver.value(t), t=t)
+        der = motion_derivatives(mech, mo)
+        assert der.valid.all()
+        for name, (v, a) in der.points.items():
+            fv, fa = _spectral(mo.points[name], mech.driver.period)
+            assert np.abs(fv.real - v).max() < 1e-8 * np.abs(v).max(), (mech.name, name)
+            assert np.abs(fa.real - a).max() < 1e-8 * np.abs(a).max(), (mech.name, name)
