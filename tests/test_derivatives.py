@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+from typing import ClassVar
 
 import numpy as np
 import pytest
@@ -12,7 +13,7 @@ from planar.catalog import CATALOG, get
 from planar.cli import main
 from planar.derivatives import driver_rates, motion_derivatives, motor_torque
 from planar.dynamics import inverse_dynamics_torque
-from planar.linkages import FourBar, Linkage, SliderCrank
+from planar.linkages import RRR, FourBar, Linkage, SliderCrank
 from planar.scene import load_scene
 
 LINKAGES = [n for n in CATALOG if isinstance(get(n), Linkage)]
@@ -248,3 +249,33 @@ def test_rrp_on_a_moving_line_with_offset_and_an_actuator() -> None:
             fv, fa = _spectral(mo.points[name], mech.driver.period)
             assert np.abs(fv.real - v).max() < 1e-8 * np.abs(v).max(), (mech.name, name)
             assert np.abs(fa.real - a).max() < 1e-8 * np.abs(a).max(), (mech.name, name)
+
+
+def test_a_node_kind_without_acceleration_is_refused_by_name() -> None:
+    from dataclasses import dataclass
+
+    from planar.linkages import NODE_KINDS, Crank, Fixed, Link, NodeKind, node_kind
+    from planar.registry import UnsupportedError
+
+    @dataclass(frozen=True)
+    class Pinned(NodeKind):  # a ground point that does not say how it accelerates
+        kind: ClassVar[str] = "test-no-acceleration"
+        name: str
+        xy: tuple[float, float]
+
+        def position(self, pos, q, path):  # type: ignore[no-untyped-def]
+            return np.broadcast_to(np.asarray(self.xy, float), (q.shape[0], 2)), None
+
+        def velocity(self, pos, vel, qd):  # type: ignore[no-untyped-def]
+            return np.zeros((qd.shape[0], 2)), None
+
+    node_kind(Pinned)
+    try:
+        link = Linkage("l", [Fixed("O", (0.0, 0.0)), Pinned("Z", (3.0, 0.0)), Crank("A", "O", 1.0),
+                             RRR("B", "A", 3.0, "Z", 2.0)],
+                       [Link("crank", ("O", "A")), Link("c", ("A", "B")), Link("r", ("Z", "B"))])
+        t = link.driver.times(8)
+        with pytest.raises(UnsupportedError, match="test-no-acceleration"):
+            motion_derivatives(link, link.solve(link.driver.value(t), t=t))
+    finally:
+        del NODE_KINDS["test-no-acceleration"]

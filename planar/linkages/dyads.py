@@ -225,8 +225,12 @@ class NodeKind:
         included), ``acc`` the accelerations of the nodes before it; ``qd`` and
         ``qdd`` the driver's rate and its rate of change per sample.  ``ok``
         false where the closure is singular (a toggle), as for :meth:`velocity`.
+        A kind without one refuses rates (velocities, accelerations, torque) by name.
         """
-        raise NotImplementedError
+        from ..registry import UnsupportedError
+
+        raise UnsupportedError(f"rates (accelerations): node kind {self.kind!r} ({type(self).__name__}) "
+                               "has no acceleration method")
 
     def held_by(self) -> tuple[tuple[str, ...], ...]:
         """Groups of nodes (this one included) that one link must carry to hold this node's constraint."""
