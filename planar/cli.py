@@ -85,8 +85,13 @@ def _cmd_motion(args: argparse.Namespace) -> int:
     from .pipeline import write_scene_motion
     from .scene import load_scene
 
-    motion = write_scene_motion(load_scene(args.scene), args.output, derivatives=args.derivatives)
+    scene = load_scene(args.scene)
+    motion = write_scene_motion(scene, args.output, derivatives=args.derivatives)
     print(f"wrote {args.output}: {len(motion)} samples, {int(motion.valid.sum())} valid")
+    if args.derivatives:
+        from .derivatives import rates_method
+
+        print(f"rates: {rates_method(scene.mechanism)}")
     return 0
 
 

@@ -42,7 +42,7 @@ from .geometry import poses_apply
 if TYPE_CHECKING:
     from .model import Driver, Mechanism, Motion
 
-__all__ = ["PartRates", "Derivatives", "driver_rates", "mechanism_rates", "motion_derivatives", "motor_torque",
+__all__ = ["PartRates", "Derivatives", "driver_rates", "rates_method", "mechanism_rates", "motion_derivatives", "motor_torque",
            "point_rates", "transmission_angles", "derivative_columns"]
 
 Array = NDArray[np.float64]
@@ -131,6 +131,12 @@ def mechanism_rates(mech: "Mechanism", q: ArrayLike, qd: ArrayLike = 1.0, qdd: A
 
     raw, valid, method = windup_rates(mech, qa, qdv, qddv)
     return {k: PartRates(*v) for k, v in raw.items()}, valid, method
+
+
+def rates_method(mech: "Mechanism") -> str:
+    """How :func:`mechanism_rates` finds ``mech``'s rates (one line, for reports), from one sample."""
+    q = np.zeros(1)
+    return mechanism_rates(mech, mech.driver.value(q), 1.0, 0.0)[2]
 
 
 def point_rates(poses: ArrayLike, rates: PartRates, world_points: ArrayLike) -> tuple[Array, Array]:
