@@ -1,4 +1,4 @@
-"""``planar plot SCENE -o fig.png|svg [--what curve,transmission,velocity,acceleration,torque]``."""
+"""``planar plot SCENE -o fig.png|svg [--what curve,transmission,velocity,speed,acceleration,torque]``."""
 
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ def add_parser(sub: Any) -> None:
     p.add_argument("scene", help="scene file (TOML)")
     p.add_argument("-o", "--output", required=True, help="figure to write: .png or .svg")
     p.add_argument("--what", default=None,
-                   help="comma-separated charts: curve,transmission,velocity,acceleration,torque "
+                   help="comma-separated charts: curve,transmission,velocity,speed,acceleration,torque "
                         "(default: every chart that applies)")
     p.add_argument("--samples", type=int, default=None,
                    help="samples per cycle for the charts (default: the scene's [driver] samples_per_cycle)")

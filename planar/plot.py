@@ -14,6 +14,7 @@ Charts (``what``):
 * ``transmission`` — transmission angle of every RRR dyad (degrees) with the
   40-140 degree band designers aim for; only for linkages with dyads;
 * ``velocity`` — angular velocity of every moving part (rad/s);
+* ``speed`` — speed ``|v|`` of every named point (model units/s; a foot's);
 * ``acceleration`` — angular acceleration of every moving part (rad/s^2);
 * ``torque`` — the motor torque under the scene's ``[effects]`` (inverse
   dynamics) and the loads' share alone.
@@ -42,7 +43,7 @@ if TYPE_CHECKING:
 __all__ = ["CHARTS", "scene_figure", "write_plot", "available_charts"]
 
 #: every chart :func:`scene_figure` can draw, in drawing order
-CHARTS = ("curve", "transmission", "velocity", "acceleration", "torque")
+CHARTS = ("curve", "transmission", "velocity", "speed", "acceleration", "torque")
 #: the transmission angles designers keep to (degrees)
 GOOD_TRANSMISSION = (40.0, 140.0)
 
@@ -54,7 +55,10 @@ def available_charts(scene: "Scene") -> list[str]:
     out = ["curve"] if scene.mechanism.points else []
     if transmission_angles(scene.mechanism, scene.mechanism.driver.value(np.zeros(1))):
         out.append("transmission")
-    return out + ["velocity", "acceleration", "torque"]
+    out.append("velocity")
+    if scene.mechanism.points:
+        out.append("speed")
+    return out + ["acceleration", "torque"]
 
 
 def _parse_what(scene: "Scene", what: Sequence[str] | None) -> list[str]:
@@ -66,7 +70,7 @@ def _parse_what(scene: "Scene", what: Sequence[str] | None) -> list[str]:
         if w not in CHARTS:
             raise InputError("--what", w, f"one of {', '.join(CHARTS)}")
         if w not in avail:
-            why = "it has no named points" if w == "curve" else "it has no RRR dyad"
+            why = "it has no named points" if w in ("curve", "speed") else "it has no RRR dyad"
             raise InputError("--what", w, f"a chart that applies to {scene.name!r} ({why}); it has {', '.join(avail)}")
         if w not in chosen:
             chosen.append(w)
@@ -152,6 +156,13 @@ def scene_figure(scene: "Scene", what: Sequence[str] | None = None, width_in: fl
             ax.set_ylim(0, 180)
             ax.set_ylabel("transmission angle (deg)")
             ax.set_title(f"transmission angle at each dyad (band: {lo:g}-{hi:g}°)", fontsize=9)
+        elif chart == "speed":
+            for pname in motion.points:
+                sp = np.hypot(col[f"{pname}.vx"], col[f"{pname}.vy"])
+                (ln,) = ax.plot(x, sp, lw=1.2, label=pname)
+                ln.set_gid(f"speed:{pname}")
+            ax.set_ylabel("speed (model units/s)")
+            ax.set_ylim(bottom=0)
         elif chart in ("velocity", "acceleration"):
             key, unit = ("omega", "rad/s") if chart == "velocity" else ("alpha", "rad/s²")
             for p in moving:

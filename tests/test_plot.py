@@ -27,7 +27,7 @@ def test_figure_lines_hold_the_motion_and_independent_formulas() -> None:
     sc = load_scene(KANGAROO)
     fig = scene_figure(sc)
     assert [ax.get_gid() for ax in fig.axes if ax.get_gid()] == [
-        "chart-curve", "chart-transmission", "chart-velocity", "chart-acceleration", "chart-torque"]
+        "chart-curve", "chart-transmission", "chart-velocity", "chart-speed", "chart-acceleration", "chart-torque"]
     mo = sc.motion()
     curve = _line(fig, "curve:coupler_point")
     xy = np.column_stack([curve.get_xdata(), curve.get_ydata()])
@@ -39,6 +39,9 @@ def test_figure_lines_hold_the_motion_and_independent_formulas() -> None:
     # the coupler's angular velocity against Norton's loop equations
     w3, _, _ = analysis.fourbar_velocities(sc.mechanism, mo.driver, sc.mechanism.driver.rate)
     assert np.allclose(_line(fig, "omega:coupler").get_ydata(), w3, rtol=1e-10, atol=1e-12)
+    # the foot's speed against the velocity of planar.analysis (loop equations, the velocity coefficient x rate)
+    vel, _ = analysis.point_velocities(sc.mechanism, mo.driver, sc.mechanism.driver.rate)
+    assert np.allclose(_line(fig, "speed:coupler_point").get_ydata(), np.hypot(*vel["coupler_point"].T), rtol=1e-12)
     # torque: the loads' line is planar.analysis' velocity-coefficient torque; the total is the inverse dynamics
     ref, _ = analysis.motor_torque(sc.mechanism, mo.driver, {"coupler_point": [0.0, 10.0]})
     assert np.allclose(_line(fig, "torque.loads").get_ydata(), ref, atol=1e-12)
@@ -81,7 +84,7 @@ def test_plot_bytes_reproducible(tmp_path) -> None:
 
 @pytest.mark.parametrize("args, msg", [
     (["-o", "x.pdf"], "a .png or .svg"),
-    (["-o", "x.png", "--what", "speed"], "one of curve"),
+    (["-o", "x.png", "--what", "jerk"], "one of curve"),
     (["-o", "x.png", "--what", "transmission"], "no RRR dyad"),
 ])
 def test_plot_user_errors_exit_2_and_write_nothing(tmp_path, capsys, monkeypatch, args, msg) -> None:
