@@ -384,10 +384,11 @@ class ElementalMechanism(Mechanism):
         g0 = (o[0] - P.amplitude - L, o[1])
         g1 = (o[0] + P.amplitude + 2 * L, o[1])
         gslot = Slot(g0, g1, 2 * P.D_ar)
-        # driver plate: a window whose left edge passes through the contact point A (drawn as a
-        # straight-sided slot of width D_w1; the taper to D_w2 does not change the contact)
+        # driver plate: a window whose right edge passes through the contact point A, so that the tab
+        # (its face x = F_jcx is the tab's +x side) stands in the window (drawn as a straight-sided slot
+        # of width D_w1; the taper to D_w2 does not change the contact)
         w = P.D_w1
-        cx = a_loc[0] + w / 2
+        cx = a_loc[0] - w / 2
         win = Slot((cx, a_loc[1] - 0.08), (cx, a_loc[1] + 0.08), w)
         rim = w / 2 + 0.04
         drv = Part("driver", ((0.0, 0.0, 2 * P.D_ar), (L, 0.0, 2 * P.D_ar), (cx, a_loc[1] - 0.08, rim),

@@ -1,0 +1,169 @@
+"""Issue 11 items 1, 3, 4: a toy as one assembly (merged parts, one frame, keyed cams), cut and simulated coupled."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from planar.geometry import poses_apply, poses_compose, poses_invert
+from planar.outlines import feature_shape
+from planar.windup.assembly import KeyedShaft, assembly_residual, toy_assembly
+from planar.windup.chain import bunny, horse
+
+
+@pytest.fixture(scope="module")
+def toys():
+    return {"horse": toy_assembly(horse(rate=math.pi)), "bunny": toy_assembly(bunny(rate=math.pi))}
+
+
+def test_every_joint_closes_on_the_merged_parts(toys):
+    # the placement is physically consistent: every stage's joint, moved onto the merged pieces, holds
+    for asm in toys.values():
+        res = assembly_residual(asm, samples=37)
+        assert max(res.values()) < 1e-9 * asm.size, res
+
+
+def test_piece_count_is_the_rigid_bodies(toys):
+    for name, asm in toys.items():
+        m = asm.run(samples_per_cycle=24)
+        # independent of the assembly's own grouping: pieces of one plane whose relative pose is constant over
+        # the cycle are one rigid body; only the cams (keyed to the shaft) may be so and still be cut apart
+        keyed = {frozenset((j.a, j.b)) for j in asm.joints if isinstance(j, KeyedShaft)}
+        for plane in ("xy", "xz"):
+            names = [p.name for p in asm.parts if p.plane == plane]
+            for i, a in enumerate(names):
+                for b in names[i + 1:]:
+                    rel = poses_compose(poses_invert(m.poses[a]), m.poses[b])
+                    rel[:, 2] = np.unwrap(rel[:, 2])
+                    rigid = float(np.ptp(rel, axis=0).max()) < 1e-9
+                    assert not rigid or frozenset((a, b)) in keyed, (name, a, b)
+        # one frame per plane, every stage ground in it
+        assert sum(p.ground for p in asm.parts if p.plane == "xy") == 1
+        # every stage part is in exactly one piece; distinct bodies = grounds merged, merged groups, the rest
+        toy = asm.toy
+        stage_parts = {f"{s.label}.{p.name}" for s in toy.stages for p in s.mech.parts}
+        assert set(asm.piece_of) == stage_parts
+        merged = {n for g in toy.merged for n in g}
+        bodies = 1 + len(toy.merged) + sum(1 for n in stage_parts if n not in merged and not n.endswith("ground"))
+        assert len(asm.bodies) == bodies
+    assert len(toys["horse"].parts) == len(toys["horse"].bodies) == 8  # all in xy: one piece per body
+
+
+def test_merged_part_keeps_every_feature(toys):
+    import shapely
+
+    for asm in toys.values():
+        for piece, members in asm.members.items():
+            part = asm.part(piece)
+            material = part.outline
+            for full, m in members:
+                src = asm._stage_part(full)
+                for f in src.features:
+                    # the member's feature placed by its own transform must be a hole in the merged material
+                    shape = feature_shape(f).buffer(-1e-6)
+                    from shapely import affinity
+
+                    c, s = math.cos(m[2]), math.sin(m[2])
+                    placed = affinity.affine_transform(shape, [c, -s, s, c, m[0], m[1]])
+                    assert placed.intersection(material).area < 1e-9, (piece, full, f)
+                    assert shapely.union_all([material, placed]).area > material.area  # inside the outline's reach
+
+
+def test_export_cuts_the_assembly_once(tmp_path, toys):
+    import ezdxf
+
+    from planar.fabexport import build, write_outputs
+    from planar.fabparts import FabSettings
+    from planar.scene import load_scene
+    from fabcheck import dxf_cut_polygons
+
+    scene = load_scene("gallery/horse.toml")
+    fab = build(scene, FabSettings(unit_mm=100.0, sheet=(600.0, 400.0)))
+    names = [pc.name for pc in fab.layout.parts if not pc.name.startswith("spacer")]
+    assert sorted(names) == sorted(p.name for p in toys["horse"].parts)
+    assert names.count("frame") == 1
+    out = tmp_path / "h.dxf"
+    write_outputs(fab, dxf=out)
+    doc = ezdxf.readfile(out)
+    outer = [e for e in doc.modelspace() if e.dxf.layer == "CUT_OUTER"]
+    assert len(outer) == len(fab.layout.parts)
+    polys = dxf_cut_polygons(out)
+    # the merged leg piece: the DXF's outer contour of its area holds as many inner cuts as its features (+ none lost)
+    pc = next(p for p in fab.layout.parts if p.name == "s2.follower+s3.driver+s4.driver")
+    from planar.fabrication import cut_polygon
+
+    target = cut_polygon(pc.outer)
+    best = max(polys, key=lambda p: p.intersection(target).area / max(p.union(target).area, 1e-12))
+    # (measured: the ezdxf reading differs from planar's contour by one 360 mm^2 triangle in a concave notch of
+    # this merged outline, 3 % of its area; not yet explained, so only the match and its holes are asserted)
+    assert best.symmetric_difference(target).area < 5e-2 * target.area, "merged part outline not found in the DXF"
+    inner = [p for p in polys if p is not best and best.contains(p)]
+    assert len(inner) == len(toys["horse"].part("s2.follower+s3.driver+s4.driver").features)
+
+
+def test_cam_d_holes_are_turned_by_their_phase(toys):
+    from planar.fabexport import build
+    from planar.fabparts import FabSettings, part_cuts
+    from planar.fabrication import cut_polygon
+    from planar.scene import load_scene
+
+    asm = toys["horse"]
+    s = FabSettings(unit_mm=100.0)
+    m = asm.solve([0.0])
+    world = []
+    for cam, phase in asm.keyed.items():
+        pc = part_cuts(asm.part(cam), s, 1, set(), (0.0, 0.0), None, drive_flat=math.pi / 2 - phase)
+        d = min((cut_polygon(c) for c in pc.inner), key=lambda q: q.area)
+        cx, cy = d.centroid.coords[0]
+        # the D's centroid lies opposite its flat
+        flat = math.atan2(-cy, -cx)
+        world.append(flat + m.poses[cam][0, 2])
+    assert abs(math.remainder(world[0] - world[1], 2 * math.pi)) < 1e-3
+    fab = build(load_scene("gallery/horse.toml"), FabSettings(unit_mm=100.0, sheet=(600.0, 400.0)))
+    assert any("keyed to the motor shaft at 180 degrees" in n for n in fab.notes)
+
+
+def test_horse_motor_torque_matches_inverse_dynamics(toys):
+    from planar.simulate import simulate, torque_comparison
+    from planar.windup.toy_physics import plane_mechanism
+
+    flat = plane_mechanism(toys["horse"])
+    t = flat.driver.times(24, 1.0)
+    sim = simulate(flat, t, None, mode="motor")
+    assert sim.failure is None
+    assert sim.built["mode"] == "motor" and len(sim.pose_error) >= 7  # every moving piece is one body
+    r = torque_comparison(flat, t, None)
+    assert r["failure"] is None and r["samples_compared"] >= 20
+    assert r["max_rel_diff"] < 0.01, r["max_rel_diff"]
+    assert r["pose_error"] < 1e-3
+
+
+def test_bunny_simulates_what_it_can_and_reports_the_rest():
+    from planar.effects import Effects
+    from planar.windup.toy_physics import simulate_toy
+
+    toy = bunny(rate=math.pi)
+    tp = simulate_toy(toy, toy.driver.times(24, 1.0), Effects(gravity=(9.81, 0.0)), speeds=[0.5, 1.0, 2.0])
+    assert tp.torque["failure"] is None and tp.torque["max_rel_diff"] < 0.01
+    labels = {s.stage: s for s in tp.stages}
+    assert labels["s0"].simulated
+    for s in tp.not_simulated:  # each refusal names its measured reason
+        assert "of the size" in s.detail or "names none" in s.detail
+
+
+def test_eight_holds_at_its_gallery_speed_and_lets_go_faster():
+    from planar.scene import load_scene
+    from planar.windup.toy_physics import contact_hold, hold_margin
+
+    sc = load_scene("gallery/windup-08.toml")
+    g = tuple(sc.effects.gravity)
+    mech = sc.mechanism
+    crit = hold_margin(mech, g)
+    assert crit > 0.5  # inverse dynamics: the contact pushes over the whole cycle at the gallery's 0.5 cycles/s
+    assert contact_hold(mech, 0.5, g, samples_per_cycle=36, substeps=32).liftoff is None
+    run = contact_hold(mech, 4.0, g, samples_per_cycle=36, substeps=32)
+    assert run.liftoff is not None  # well above the predicted speed it lets go, and the sample is reported
+    # gravity the other way cannot hold it even at rest
+    assert hold_margin(mech, (-g[0], -g[1])) == 0.0
