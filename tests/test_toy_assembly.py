@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from planar.geometry import poses_apply, poses_compose, poses_invert
+from planar.geometry import poses_compose, poses_invert
 from planar.outlines import feature_shape
 from planar.windup.assembly import KeyedShaft, assembly_residual, toy_assembly
 from planar.windup.chain import bunny, horse
@@ -96,9 +96,7 @@ def test_export_cuts_the_assembly_once(tmp_path, toys):
 
     target = cut_polygon(pc.outer)
     best = max(polys, key=lambda p: p.intersection(target).area / max(p.union(target).area, 1e-12))
-    # (measured: the ezdxf reading differs from planar's contour by one 360 mm^2 triangle in a concave notch of
-    # this merged outline, 3 % of its area; not yet explained, so only the match and its holes are asserted)
-    assert best.symmetric_difference(target).area < 5e-2 * target.area, "merged part outline not found in the DXF"
+    assert best.symmetric_difference(target).area < 1e-3 * target.area, "merged part outline not found in the DXF"
     inner = [p for p in polys if p is not best and best.contains(p)]
     assert len(inner) == len(toys["horse"].part("s2.follower+s3.driver+s4.driver").features)
 

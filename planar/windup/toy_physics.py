@@ -130,7 +130,7 @@ def contact_hold(mech: Any, speed: float, gravity: tuple[float, float], cycles: 
     d0 = ana.poses[drv.name][0]
     kin.position = (float(d0[0]), float(d0[1]))
     piv = next(jj for jj in mech.joints if type(jj).__name__ == "Pivot" and fol.name in (jj.a, jj.b))
-    anchor = piv.anchor_a if piv.a != fol.name else piv.anchor_b
+    anchor = piv.anchor_b if piv.b == fol.name else piv.anchor_a  # the pivot in the tab's own frame
     ga = poses_apply(ana.poses[fol.name][0], anchor)
     body.velocity = (-w0 * (body.position.y - ga[1]), w0 * (body.position.x - ga[0]))
     rc = 1e-4 * size
@@ -206,7 +206,7 @@ def hold_margin(mech: Any, gravity: tuple[float, float], density: float = 1.0, s
     alpha1 = (ang[2] - 2 * ang[1] + ang[0]) / h**2  # at 1 cycle/s
     pose = mech.solve(one.value(t)).poses[fol.name]
     piv = next(jj for jj in mech.joints if type(jj).__name__ == "Pivot" and fol.name in (jj.a, jj.b))
-    anchor = piv.anchor_a if piv.a != fol.name else piv.anchor_b
+    anchor = piv.anchor_b if piv.b == fol.name else piv.anchor_a  # the pivot in the tab's own frame
     B = poses_apply(pose, anchor)
     G = poses_apply(pose, cog)
     r = G - B
@@ -353,7 +353,7 @@ def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, 
         label, pat, num = st.label, st.realisation.pattern, st.realisation.number
         if num == 8:
             if g == (0.0, 0.0):
-                out.stages.append(StageReport(label, pat, False, f"#8: its contact is held by gravity or a spring in "
+                out.stages.append(StageReport(label, pat, False, "#8: its contact is held by gravity or a spring in "
                                               "its plane; the scene names none"))
                 continue
             crit = hold_margin(st.mech, g, getattr(effects, "density", 1.0))
