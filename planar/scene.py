@@ -225,6 +225,7 @@ class RenderSpec(_Strict):
     sweep: list[str] = []
     background: Annotated[str, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#ffffff"
     show_pins: bool = True
+    exploded: bool = False  # a wind-up toy as its exploded stage panels (default: assembled)
 
 
 class FabricationSpec(_Strict):

@@ -265,7 +265,10 @@ def _merge(name: str, members: list[tuple[Part, XForm]], plane: str, ground: boo
     if union.geom_type != "Polygon":
         notes.append(f"{name}: its members' outlines do not touch; the outline is their rounded convex hull")
         return Part(name, tuple(hull), tuple(feats), ground=ground, plane=plane, offset=offset), notes
-    union = union.simplify(1e-6)
+    # a closing (grow, then shrink by as much) fills the narrow notches where two members meet at an acute angle
+    lo_x, lo_y, hi_x, hi_y = union.bounds
+    d = 0.03 * math.hypot(hi_x - lo_x, hi_y - lo_y)
+    union = union.buffer(d, quad_segs=16).buffer(-d, quad_segs=16).union(union).simplify(1e-6)
     ring = [(float(x), float(y)) for x, y in np.asarray(union.exterior.coords)[:-1]]
     return Part(name, tuple(hull), tuple(feats), ground=ground, plane=plane, offset=offset, polygon=tuple(ring)), notes
 

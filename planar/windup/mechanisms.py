@@ -400,7 +400,10 @@ class ElementalMechanism(Mechanism):
         w = st.aux["A"] - np.asarray(B)
         t = np.sqrt(np.maximum((w * w).sum(-1) - P.F_jcx**2, 0.0))
         t_lo, t_hi = float(t.min()) - P.F_jr, float(t.max()) + P.F_jr
-        follower = Part("follower", ((0.0, 0.0, 2 * P.F_ar), (0.0, t_hi, P.F_jr), (P.F_jcx - P.F_jr, t_hi, P.F_jr)),
+        # the tab's +x side is its contact face x = F_jcx all along (a convex hull: the pivot's boss
+        # reaches no further than the face where it can, keeping 0.3 F_ar of wall round the hole)
+        boss = min(2 * P.F_ar, max(P.F_jcx, 1.3 * P.F_ar))
+        follower = Part("follower", ((0.0, 0.0, boss), (P.F_jcx - P.F_jr, t_hi, P.F_jr)),
                         (Hole((0.0, 0.0), 2 * P.F_ar),), plane="xz")
         ground = Part("ground", ((*g0, 2 * P.D_ar), (*g1, 2 * P.D_ar), (*B, 3 * P.F_ar)),
                       (gslot, Hole(B, 2 * P.F_ar)), ground=True, plane="xz")
