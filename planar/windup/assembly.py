@@ -193,9 +193,11 @@ def _placements(toy: Any) -> list[_Placed]:
             raise InputError(f"{toy.name}.stage {' '.join(st.key)}", st.realisation.rotation,
                              "a stage turned about z only (a mirrored stage is not assembled)")
         plane = st.mech.part("driver").plane
-        if plane != "xy" and abs(ang) > 1e-12:
+        other = sorted({p.plane for p in st.mech.parts} - {"xy"})
+        if other and abs(ang) > 1e-12:
             raise InputError(f"{toy.name}.stage {' '.join(st.key)}", st.realisation.rotation,
-                             f"a stage moving in {plane} that is not turned (its plane's axes are fixed)")
+                             f"a stage with parts moving in {', '.join(other)} that is not turned (a turned "
+                             f"#{st.realisation.number} would move in another plane, which no part records)")
         d0 = _rest_pose(st, "driver")
         if st.parent is None:
             anchor = (0.0, 0.0)  # the motor axis
