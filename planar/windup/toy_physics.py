@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -68,6 +68,28 @@ def plane_mechanism(asm: ToyAssembly, plane: str = "xy") -> Mechanism:
     return _PlaneView(asm, plane)
 
 
+# ---------------------------------------------------------------------------- driving one stage
+
+#: how a stage is driven inside a toy: the toy's driver law and a map from its values to the stage's motion
+StageDrive = tuple[Driver, Callable[[Array], Array]]
+
+
+def _law(mech: Any, drive: StageDrive | None, speed: float) -> Driver:
+    """The driver law at ``speed`` cycles/s: the toy's (``drive``) or the stage's standalone one."""
+    from dataclasses import replace
+
+    return replace(drive[0] if drive is not None else mech.driver, rate=2 * math.pi * speed)
+
+
+def _poses(mech: Any, q: Array, drive: StageDrive | None) -> dict[str, Array]:
+    """The stage's part poses (its own frames) for driver values ``q``."""
+    if drive is None:
+        return mech.solve(q).poses
+    u = drive[1](np.asarray(q, float))
+    return {"ground": np.zeros((len(u), 3)), "driver": mech._driver_pose(u),
+            "follower": mech._follower_pose(mech.forward(u).out)}
+
+
 # ---------------------------------------------------------------------------- #8: a contact that can let go
 
 
@@ -89,11 +111,11 @@ def _hold_gravity(effects: Any) -> tuple[float, float]:
 
 def contact_hold(mech: Any, speed: float, gravity: tuple[float, float], cycles: float = 1.0,
                  samples_per_cycle: int = 72, substeps: int = 64, density: float = 1.0,
-                 tolerance: float = 1e-3) -> ContactRun:
+                 tolerance: float = 1e-3, drive: StageDrive | None = None) -> ContactRun:
     """Simulate an elemental #8 (its own plane) with a contact that can only push.
 
-    ``mech``: an :class:`~planar.windup.mechanisms.ElementalMechanism` #8 whose
-    driver law is used at ``speed`` cycles/s; ``gravity``: in the stage's plane
+    ``mech``: an :class:`~planar.windup.mechanisms.ElementalMechanism` #8 driven
+    by its standalone law, or inside a toy by ``drive``, at ``speed`` cycles/s; ``gravity``: in the stage's plane
     (model units / s^2).  The window is kinematic; the tab is a dynamic body on
     a pivot; the contact is a segment (the tab's face) and a circle of radius
     ``1e-4`` of the size on the window's edge.
@@ -104,15 +126,12 @@ def contact_hold(mech: Any, speed: float, gravity: tuple[float, float], cycles: 
 
     j = next(j for j in mech.joints if isinstance(j, CamOnLine))
     fol, drv = mech.part(j.a), mech.part(j.b)
-    drv_law: Driver = mech.driver
-    rate = 2 * math.pi * speed
-    law = Driver(drv_law.part, drv_law.kind, drv_law.origin, rate=rate, phase=drv_law.phase,
-                 amplitude=drv_law.amplitude)
+    law = _law(mech, drive, speed)
     t = law.times(samples_per_cycle, cycles)
-    ana = mech.solve(law.value(t), t=t)
+    ana_poses = _poses(mech, law.value(t), drive)
     h = 1e-6 / speed
-    fp = mech.solve(law.value(t + h)).poses
-    fm = mech.solve(law.value(t - h)).poses
+    fp = _poses(mech, law.value(t + h), drive)
+    fm = _poses(mech, law.value(t - h), drive)
     size = mech.size
     m, cog, inertia = mass_properties(fol, density)
     space = pymunk.Space()
@@ -120,18 +139,18 @@ def contact_hold(mech: Any, speed: float, gravity: tuple[float, float], cycles: 
     space.iterations = 30
     space.collision_slop = 1e-7 * size
     body = pymunk.Body(m, inertia)
-    p0 = ana.poses[fol.name][0]
+    p0 = ana_poses[fol.name][0]
     c, s = math.cos(p0[2]), math.sin(p0[2])
     body.position = (p0[0] + c * cog[0] - s * cog[1], p0[1] + s * cog[0] + c * cog[1])
     body.angle = float(p0[2])
     w0 = float((fp[fol.name][0, 2] - fm[fol.name][0, 2]) / (2 * h))
     body.angular_velocity = w0
     kin = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
-    d0 = ana.poses[drv.name][0]
+    d0 = ana_poses[drv.name][0]
     kin.position = (float(d0[0]), float(d0[1]))
     piv = next(jj for jj in mech.joints if type(jj).__name__ == "Pivot" and fol.name in (jj.a, jj.b))
     anchor = piv.anchor_b if piv.b == fol.name else piv.anchor_a  # the pivot in the tab's own frame
-    ga = poses_apply(ana.poses[fol.name][0], anchor)
+    ga = poses_apply(ana_poses[fol.name][0], anchor)
     body.velocity = (-w0 * (body.position.y - ga[1]), w0 * (body.position.x - ga[0]))
     rc = 1e-4 * size
     rs = 0.02 * size  # a thick face (into the tab, -x of it) so that the edge cannot tunnel through in a step
@@ -142,7 +161,7 @@ def contact_hold(mech: Any, speed: float, gravity: tuple[float, float], cycles: 
     space.add(body, kin, face, edge, pymunk.PivotJoint(space.static_body, body, (float(ga[0]), float(ga[1]))))
     n = t.size
     dt = float(t[1] - t[0]) / substeps
-    xs = ana.poses[drv.name][:, 0]
+    xs = ana_poses[drv.name][:, 0]
     gap = np.zeros(n)
     err = np.zeros(n)
     track = np.zeros((n, 3))
@@ -159,13 +178,13 @@ def contact_hold(mech: Any, speed: float, gravity: tuple[float, float], cycles: 
         oy = body.position.y - (s * cog[0] + c * cog[1])
         track[i] = (ox, oy, a)
     # the gap: the edge point's distance from the face line, positive on the window's open side (the tab let go)
-    A = poses_apply(ana.poses[drv.name], j.centre)
+    A = poses_apply(ana_poses[drv.name], j.centre)
     s0 = poses_apply(track, j.start)
     s1 = poses_apply(track, j.end)
     d = s1 - s0
     nrm = np.column_stack([d[:, 1], -d[:, 0]]) / np.hypot(d[:, 0], d[:, 1])[:, None]
     gap = ((A - s0) * nrm).sum(1)  # > 0: the face has moved away from the edge (the tab let go, towards -x)
-    ref = poses_apply(ana.poses[fol.name], np.asarray(fol.hull)[:, :2])
+    ref = poses_apply(ana_poses[fol.name], np.asarray(fol.hull)[:, :2])
     got = poses_apply(track, np.asarray(fol.hull)[:, :2])
     err = np.hypot(*(got - ref).transpose(2, 0, 1)).max(1) / size
     bad = np.flatnonzero(np.abs(gap) > tolerance * size)
@@ -200,7 +219,8 @@ def liftoff_speed(mech: Any, gravity: tuple[float, float], speeds: Any, refine: 
     return None, runs
 
 
-def hold_margin(mech: Any, gravity: tuple[float, float], density: float = 1.0, samples: int = 720) -> float:
+def hold_margin(mech: Any, gravity: tuple[float, float], density: float = 1.0, samples: int = 720,
+                drive: StageDrive | None = None) -> float:
     """The speed (cycles/s) above which inverse dynamics needs the #8 contact to pull (it lets go); inf if never,
     0 if gravity cannot hold it even at rest.
 
@@ -213,13 +233,13 @@ def hold_margin(mech: Any, gravity: tuple[float, float], density: float = 1.0, s
     j = next(j for j in mech.joints if isinstance(j, CamOnLine))
     fol = mech.part(j.a)
     m, cog, ic = mass_properties(fol, density)
-    law = mech.driver
-    one = Driver(law.part, law.kind, law.origin, rate=2 * math.pi, phase=law.phase, amplitude=law.amplitude)
+    one = _law(mech, drive, 1.0)
     t = np.linspace(0.0, 1.0, samples, endpoint=False)
     h = 1e-4
-    ang = [mech.solve(one.value(t + k * h)).poses[fol.name][:, 2] for k in (-1, 0, 1)]
+    ang = [_poses(mech, one.value(t + k * h), drive)[fol.name][:, 2] for k in (-1, 0, 1)]
     alpha1 = (ang[2] - 2 * ang[1] + ang[0]) / h**2  # at 1 cycle/s
-    pose = mech.solve(one.value(t)).poses[fol.name]
+    now = _poses(mech, one.value(t), drive)
+    pose = now[fol.name]
     piv = next(jj for jj in mech.joints if type(jj).__name__ == "Pivot" and fol.name in (jj.a, jj.b))
     anchor = piv.anchor_b if piv.b == fol.name else piv.anchor_a  # the pivot in the tab's own frame
     B = poses_apply(pose, anchor)
@@ -228,7 +248,7 @@ def hold_margin(mech: Any, gravity: tuple[float, float], density: float = 1.0, s
     Mg = m * (r[:, 0] * gravity[1] - r[:, 1] * gravity[0])
     IB = ic + m * float(((np.asarray(cog) - np.asarray(anchor)) ** 2).sum())
     # the push direction: the contact's moment sign from the face normal and the edge point (window side: -x)
-    A = poses_apply(mech.solve(one.value(t)).poses[j.b], j.centre)
+    A = poses_apply(now[j.b], j.centre)
     push = np.array([-1.0, 0.0])  # the window's edge pushes the tab's face towards -x
     sgn = np.sign((A[:, 0] - B[:, 0]) * push[1] - (A[:, 1] - B[:, 1]) * push[0])
     # need sgn * M >= 0 with M(s) = s^2 IB alpha1 - Mg
@@ -244,7 +264,7 @@ def hold_margin(mech: Any, gravity: tuple[float, float], density: float = 1.0, s
 
 
 def skew_stage(mech: Any, speed: float, cycles: float = 1.0, samples_per_cycle: int = 72, substeps: int = 128,
-               density: float = 1.0, tolerance: float = 1e-3) -> tuple[float, str | None]:
+               density: float = 1.0, tolerance: float = 1e-3, drive: StageDrive | None = None) -> tuple[float, str | None]:
     """Rebuild #6/#9 in its follower's plane (yz) and run it; ``(worst error / size, refusal or None)``."""
     import pymunk
 
@@ -252,15 +272,13 @@ def skew_stage(mech: Any, speed: float, cycles: float = 1.0, samples_per_cycle: 
 
     j = next(j for j in mech.joints if isinstance(j, SkewContact))
     fol = mech.part(j.b)
-    rate = 2 * math.pi * speed
-    d = mech.driver
-    law = Driver(d.part, d.kind, d.origin, rate=rate, phase=d.phase, amplitude=d.amplitude)
+    law = _law(mech, drive, speed)
     t = law.times(samples_per_cycle, cycles)
     n = t.size
     sub_t = t[0] + (np.arange((n - 1) * substeps + 1)) * (float(t[1] - t[0]) / substeps)
-    mo = mech.solve(law.value(sub_t))
-    dp = mo.poses[j.a]
-    fpose = mo.poses[j.b]
+    mo = _poses(mech, law.value(sub_t), drive)
+    dp = mo[j.a]
+    fpose = mo[j.b]
     # the edge's trace on the plane x = pin_x, and its direction's angle phi to x (per step)
     e0 = poses_apply(dp, j.edge_point)
     ang = dp[:, 2] + math.atan2(j.edge_dir[1], j.edge_dir[0])
@@ -369,14 +387,20 @@ def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, 
     for p in asm.placed:
         st = p.stage
         label, pat, num = st.label, st.realisation.pattern, st.realisation.number
+
+        def stage_u(q: Array, _i: int = st.index) -> Array:
+            toy.world_motion(q)
+            return np.asarray(toy._last_bases[_i][0], float)
+
+        drive: StageDrive = (toy.driver, stage_u)  # the stage as the toy drives it
         if num == 8:
             if g == (0.0, 0.0):
                 out.stages.append(StageReport(label, pat, False, "#8: its contact is held by gravity or a spring in "
                                               "its plane; the scene names none"))
                 continue
-            crit = hold_margin(st.mech, g, getattr(effects, "density", 1.0))
+            crit = hold_margin(st.mech, g, getattr(effects, "density", 1.0), drive=drive)
             sc = list(speeds) if speeds is not None else [speed * f for f in (1.0, 2.0, 4.0, 8.0)]
-            lift, runs = liftoff_speed(st.mech, g, sc)
+            lift, runs = liftoff_speed(st.mech, g, sc, drive=drive)
             r0 = runs[0]
             out.liftoff[label] = {"predicted_speed": crit, "scanned": sc, "liftoff_speed": lift,
                                   "sample": runs[-1].liftoff, "pose_error": r0.pose_error}
@@ -390,7 +414,7 @@ def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, 
                 + (f"at {lift:g} cycles/s, sample {runs[-1].liftoff}" if lift is not None else "not seen in the scan")
                 + f"; inverse dynamics predicts {crit:.3g} cycles/s")))
         elif st.mech.spatial:
-            err, why = skew_stage(st.mech, speed)
+            err, why = skew_stage(st.mech, speed, drive=drive)
             out.stages.append(StageReport(label, pat, why is None,
                                           why or f"rebuilt in the follower's plane: {err:.2g} of the size"))
         else:
