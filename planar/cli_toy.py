@@ -61,7 +61,7 @@ def _cmd_toy(args: argparse.Namespace) -> int:
         "bodies": asm.bodies,
         "keyed": {k: math.degrees(v) for k, v in asm.keyed.items()},
         "worst_joint_residual": worst,
-        "torque": {k: tq[k] for k in ("peak", "max_rel_diff", "samples_compared", "failure", "pose_error")},
+        "torque": {k: tq[k] for k in ("peak", "max_rel_diff", "samples_compared", "failure", "pose_error", "pieces")},
         "stages": [{"stage": s.stage, "pattern": s.pattern, "simulated": s.simulated, "detail": s.detail}
                    for s in phys.stages],
         "liftoff": phys.liftoff,
@@ -79,9 +79,12 @@ def _cmd_toy(args: argparse.Namespace) -> int:
               + f"; worst joint residual on the merged pieces {worst:.2g} of the size "
               + ("[ok]" if ok_joints else "[FAIL]"))
         fail = f"; {tq['failure']}" if tq["failure"] else ""
-        print(f"motor on the cam shaft, the only driver: torque peak {tq['peak']:.4g}, pymunk vs inverse dynamics "
-              f"{tq['max_rel_diff']:.2%} of the peak over {tq['samples_compared']} samples, pose error "
-              f"{tq['pose_error']:.2g} of the size{fail} " + ("[ok]" if ok_torque else "[FAIL]"))
+        out_of_run = sorted({p.name for p in asm.parts} - set(tq["pieces"]))
+        print(f"motor on the cam shaft, the only driver, turning {len(tq['pieces'])} pieces"
+              + (f" (not {', '.join(out_of_run)})" if out_of_run else "")
+              + f": torque peak {tq['peak']:.4g}, pymunk vs inverse dynamics {tq['max_rel_diff']:.2g} of the peak "
+              f"over {tq['samples_compared']} samples, pose error {tq['pose_error']:.2g} of the size{fail} "
+              + ("[ok]" if ok_torque else "[FAIL]"))
         for s in phys.stages:
             print(f"  {s.stage} {s.pattern}: {'simulated' if s.simulated else 'NOT simulated'}: {s.detail}")
         for k in lets_go:
