@@ -242,12 +242,13 @@ def write_outputs(fab: Fabrication | None, dxf=None, svg=None, preview=None, bom
 
 
 def summary(fab: Fabrication) -> str:
-    """One line: parts, sheets, utilisation, layers, pins, spacers."""
+    """One line: parts (and the spacer rings cut beside them), sheets, utilisation, layers, pins."""
     lay, asm = fab.layout, fab.assembly
     util = ", ".join(f"{u:.0%}" for u in lay.utilisation)
     layers = max(asm.n_layers.values()) if asm.n_layers else 0
     spacers = sum(p.spacers for p in asm.pins)
-    return (f"{len(lay.parts)} parts on {lay.sheets} sheet(s) of {lay.sheet_size[0]:g} x {lay.sheet_size[1]:g} mm "
-            f"(utilisation {util}), kerf {lay.kerf:g} mm, {layers} layer(s) of {fab.settings.thickness_mm:g} mm, "
-            f"{len(asm.pins)} pin(s), {spacers} spacer(s)")
+    rings = f" + {spacers} spacer ring(s)" if spacers else ""
+    return (f"{len(lay.parts) - spacers} parts{rings} on {lay.sheets} sheet(s) of {lay.sheet_size[0]:g} x "
+            f"{lay.sheet_size[1]:g} mm (utilisation {util}), kerf {lay.kerf:g} mm, {layers} layer(s) of "
+            f"{fab.settings.thickness_mm:g} mm, {len(asm.pins)} pin(s)")
 
