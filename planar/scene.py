@@ -72,6 +72,9 @@ _NODE_FIELDS = {
     "rrr": ("a", "ra", "b", "rb"),
     "rrp": ("a", "ra", "p", "q"),
     "rigid": ("a", "b", "local"),
+    "geared": ("centre", "radius", "mesh", "ratio"),
+    "driven": ("centre", "radius"),
+    "triad": ("a", "ra", "local", "at"),
 }
 
 
@@ -79,7 +82,7 @@ class NodeSpec(_Strict):
     """A joint centre of a general linkage; which fields it needs depends on ``kind``."""
 
     name: str
-    kind: Literal["fixed", "crank", "actuator", "rrr", "rrp", "rigid"]
+    kind: Literal["fixed", "crank", "actuator", "rrr", "rrp", "rigid", "geared", "driven", "triad"]
     at: tuple[Real, Real] | None = None
     centre: str | None = None
     radius: Pos | None = None
@@ -95,6 +98,15 @@ class NodeSpec(_Strict):
     branch: Literal[1, -1] = 1
     offset: Real = 0.0
     local: tuple[Real, Real] | None = None
+    # geared: the crank it meshes with and the angular velocity ratio (negative: external gears)
+    mesh: str | None = None
+    ratio: Real | None = None
+    # driven: its own law of the clock theta (turns per clock cycle; a rocking input: amplitude, mean)
+    cycles: Pos = 1.0
+    amplitude: Pos | None = None
+    mean: Real = 0.0
+    # triad: the first node names the two others; each node's position near driver value 0
+    members: tuple[str, str] | None = None
 
     @model_validator(mode="after")
     def _needs(self) -> "NodeSpec":
@@ -456,8 +468,8 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, A
         nodes = []
         for n in m.nodes:
             cls = NODE_KINDS[n.kind]  # each node kind declares the scene keys it is built from
-            args = [_angle(spec, getattr(n, f)) if f in cls.angle_fields else getattr(n, f)
-                    for f in cls.scene_fields]
+            args = [_angle(spec, getattr(n, f)) if f in cls.angle_fields and getattr(n, f) is not None
+                    else getattr(n, f) for f in cls.scene_fields]
             nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
         links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
         return Linkage(spec.name or "linkage", nodes, links, points=m.points, placement=placement,

@@ -67,6 +67,7 @@ from .model import (
     Slide,
     joint_residuals,
 )
+from .linkages.gears import GearMesh
 from .registry import Registry
 
 if TYPE_CHECKING:
@@ -203,6 +204,7 @@ def _check_mechanism(mech: Mechanism) -> None:
 def _driven_parts(mech: Mechanism) -> list[str]:
     """Parts whose motion is imposed: the driver, and in toys every stage's driver that has no parent."""
     out = [mech.driver.part]
+    out += [p for p in getattr(mech, "extra_driven_parts", []) if p not in out]  # a two-input linkage
     for st in getattr(mech, "stages", []):
         name = f"{st.label}.driver"
         if name not in out:
@@ -516,6 +518,14 @@ def _slide(rb: _Rebuild, j: Slide, effects: Effects | None) -> list[Any]:
     s0, s1 = _padded(rb._local(j.a, j.start), rb._local(j.a, j.end))
     phase = B[j.b].angle - B[j.a].angle
     return rb._groove(j.a, s0, s1, j.b, j.anchor) + [rb.pymunk.GearJoint(B[j.a], B[j.b], phase, 1.0)]
+
+
+@REBUILDERS.register(GearMesh)
+def _gear_mesh(rb: _Rebuild, j: GearMesh, effects: Effects | None) -> list[Any]:
+    """A ``GearJoint``: pymunk holds ``ratio_pm * angle_b - angle_a = phase``, so ``ratio_pm = 1 / ratio``."""
+    B = rb.bodies
+    r = 1.0 / j.ratio
+    return [rb.pymunk.GearJoint(B[j.a], B[j.b], r * B[j.b].angle - B[j.a].angle, r)]
 
 
 @REBUILDERS.register(PinInArcSlot)
