@@ -1,0 +1,276 @@
+"""Gears between cranks, two-input linkages and triads, checked against scipy's root finders."""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import fsolve, root
+
+from planar.errors import InputError, SceneError
+from planar.fileio import motion_columns
+from planar.linkages import Crank, Fixed, Geared, Link, Linkage, RRR, Triad
+from planar.model import joint_residuals
+from planar.scene import build_scene, load_scene, parse_scene
+
+GALLERY = Path(__file__).resolve().parent.parent / "gallery"
+
+
+def _five_bar(ratio: float = -1.0, phase: float = 0.5) -> Linkage:
+    nodes = [Fixed("O1", (0.0, 0.0)), Fixed("O2", (4.0, 0.0)), Crank("A", "O1", 1.2),
+             Geared("B", "O2", 1.2, "A", ratio, phase), RRR("P", "A", 4.0, "B", 4.0, 1)]
+    links = [Link("ga", ("O1", "A")), Link("gb", ("O2", "B")), Link("ca", ("A", "P")), Link("cb", ("B", "P"))]
+    return Linkage("five", nodes, links, points={"pen": "P"})
+
+
+@pytest.mark.parametrize("ratio", [-1.0, -0.5, -2.0])
+def test_gear_ratio_held_exactly(ratio: float) -> None:
+    lk = _five_bar(ratio)
+    q = np.linspace(0.0, 4 * np.pi, 401)
+    pos = lk.node_positions(q)
+    a = np.unwrap(np.arctan2(*(pos["A"] - pos["O1"]).T[::-1]))
+    b = np.unwrap(np.arctan2(*(pos["B"] - pos["O2"]).T[::-1]))
+    # angles measured from the node positions, unwrapped: b = ratio a + phase
+    off = b - ratio * a
+    assert np.ptp(off) < 1e-12
+    assert abs(np.remainder(off[0] - 0.5 + np.pi, 2 * np.pi) - np.pi) < 1e-12
+    vals = lk.input_values(q)
+    assert np.array_equal(vals["B"], ratio * vals["A"] + 0.5)
+    m = lk.solve(q)
+    gear = next(j for j in lk.joints if j.kind == "gear")
+    assert float(gear.residual(m.poses).max()) < 1e-12
+    # pitch circles: radii sum to the centre distance, in the ratio of the speeds
+    assert gear.radius_a + gear.radius_b == pytest.approx(4.0)
+    assert gear.radius_a / gear.radius_b == pytest.approx(abs(ratio))
+    # a wrong ratio shows in the residual
+    worse = type(gear)(gear.name, gear.a, gear.b, gear.ratio * 1.01, gear.phase, gear.centre_a, gear.centre_b,
+                       gear.radius_a, gear.radius_b)
+    assert float(worse.residual(m.poses).max()) > 1e-3
+
+
+def test_five_bar_closure_against_scipy() -> None:
+    lk = _five_bar()
+    rng = np.random.default_rng(3)
+    q = np.sort(rng.uniform(0, 2 * np.pi, 12))
+    pos = lk.node_positions(q)
+    for i in range(q.size):
+        A, B = pos["A"][i], pos["B"][i]
+        # the crank pins from their own angles, independently of the solver
+        assert np.allclose(A, 1.2 * np.array([np.cos(q[i]), np.sin(q[i])]), atol=1e-12)
+        bb = -q[i] + 0.5
+        assert np.allclose(B, [4 + 1.2 * np.cos(bb), 1.2 * np.sin(bb)], atol=1e-12)
+
+        def f(p: np.ndarray) -> list[float]:
+            return [float(np.hypot(*(p - A)) - 4.0), float(np.hypot(*(p - B)) - 4.0)]
+
+        sol = root(f, pos["P"][i] + [0.3, -0.2], tol=1e-13)
+        assert np.max(np.abs(f(sol.x))) < 1e-12
+        assert np.allclose(sol.x, pos["P"][i], atol=1e-10)
+    m = lk.solve(q)
+    assert m.valid.all()
+    assert max(float(r.max()) for r in joint_residuals(lk, m).values()) < 1e-9 * lk.size
+
+
+def test_gear_velocity_matches_differences() -> None:
+    lk = _five_bar(-0.5)
+    q = np.linspace(0.2, 2.0, 7)
+    v, ok = lk.node_velocities(q)
+    h = 1e-6
+    d = (lk.node_positions(q + h)["P"] - lk.node_positions(q - h)["P"]) / (2 * h)
+    assert ok.all() and np.allclose(v["P"], d, atol=1e-7)
+    d = (lk.node_positions(q + h)["B"] - lk.node_positions(q - h)["B"]) / (2 * h)
+    assert np.allclose(v["B"], d, atol=1e-7)
+
+
+def test_geared_refusals() -> None:
+    with pytest.raises(InputError, match="ratio"):
+        _five_bar(ratio=1.0)
+    nodes = [Fixed("O1", (0.0, 0.0)), Fixed("O2", (4.0, 0.0)), Crank("A", "O1", 1.2),
+             RRR("M", "A", 3.0, "O2", 3.0), Geared("B", "M", 1.0, "A", -1.0), RRR("P", "A", 4.0, "B", 4.0)]
+    links = [Link("ga", ("O1", "A")), Link("m", ("A", "M", "O2")), Link("gb", ("M", "B")),
+             Link("ca", ("A", "P")), Link("cb", ("B", "P"))]
+    with pytest.raises(InputError, match="fixed nodes"):
+        Linkage("bad", nodes, links)
+
+
+def test_geared_five_bar_scene_export_and_compare(tmp_path: Path) -> None:
+    from planar.compare import compare_scene
+
+    scene = load_scene(GALLERY / "geared-five-bar.toml")
+    m = scene.motion()
+    assert m.valid.all()
+    names, table = motion_columns(scene.mechanism, m)
+    assert names[:4] == ["t", "driver", "driver.A", "driver.B"]
+    result, sim = compare_scene(scene)
+    assert sim.failure is None
+    assert result.torque is not None and result.torque["max_rel_diff"] < 0.01  # the GearJoint carries the load
+
+
+def _two_input_scene() -> dict:
+    d = tomllib.loads((GALLERY / "geared-five-bar.toml").read_text())
+    nodes = d["mechanism"]["nodes"]
+    nodes[2] = {"name": "A", "kind": "driven", "centre": "O1", "radius": 1.2, "amplitude": 40.0, "mean": 60.0}
+    nodes[3] = {"name": "B", "kind": "driven", "centre": "O2", "radius": 1.2, "cycles": 2.0, "phase": 30.0,
+                "amplitude": 30.0, "mean": 120.0}
+    d["driver"] = {"speed": 0.5, "samples_per_cycle": 48}
+    return d
+
+
+def test_two_drivers_scene_columns_and_laws() -> None:
+    scene = build_scene(parse_scene(_two_input_scene()))
+    m = scene.motion()
+    assert m.valid.all()
+    names, table = motion_columns(scene.mechanism, m)
+    col = {n: table[:, i] for i, n in enumerate(names)}
+    theta = col["driver"]
+    assert np.allclose(theta, np.pi * col["t"])  # the clock: 2 pi speed t
+    a = np.radians(60) + np.radians(40) * np.sin(theta)
+    b = np.radians(120) + np.radians(30) * np.sin(2 * theta + np.radians(30))
+    assert np.allclose(col["driver.A"], a, atol=1e-14) and np.allclose(col["driver.B"], b, atol=1e-14)
+    pos = scene.mechanism.node_positions(theta)
+    assert np.allclose(pos["A"], 1.2 * np.c_[np.cos(a), np.sin(a)], atol=1e-12)
+    assert np.allclose(pos["B"], [4, 0] + 1.2 * np.c_[np.cos(b), np.sin(b)], atol=1e-12)
+    # velocities of the two-input linkage by its own closure against differences in the clock
+    v, ok = scene.mechanism.node_velocities(theta[:8])
+    h = 1e-6
+    d = (scene.mechanism.node_positions(theta[:8] + h)["P"] - scene.mechanism.node_positions(theta[:8] - h)["P"]) / (2 * h)
+    assert ok.all() and np.allclose(v["P"], d, atol=1e-6)
+
+
+def test_two_drivers_compare_kinematic_and_refusals() -> None:
+    from planar.compare import compare_scene
+
+    scene = build_scene(parse_scene(_two_input_scene()))
+    result, sim = compare_scene(scene)
+    assert sim.failure is None  # both inputs imposed: the simulation follows
+    assert result.torque is None  # no steadily turning motor: not compared
+    bad = _two_input_scene()
+    bad["driver"]["amplitude"] = 10.0
+    with pytest.raises(SceneError, match="amplitude"):
+        build_scene(parse_scene(bad))
+
+
+# ---------------------------------------------------------------------------- triads
+
+
+def _six_bar() -> Linkage:
+    return load_scene(GALLERY / "stephenson-six-bar.toml").mechanism  # type: ignore[return-value]
+
+
+def _loop_equations(lk: Linkage, q: float):
+    """The full loop of the triad in node coordinates (six unknowns), independent of the solver's pose form."""
+    byname = {n.name: n for n in lk.nodes}
+    tri = [byname[k] for k in ("T1", "T2", "T3")]
+    S = np.array([t.local for t in tri])
+    C = 0.7 * np.array([np.cos(q), np.sin(q)])
+    K = [C, np.array(byname["G2"].xy), np.array(byname["G3"].xy)]
+
+    def f(x: np.ndarray) -> list[float]:
+        T = x.reshape(3, 2)
+        out = [float(np.hypot(*(T[i] - K[i])) - tri[i].ra) for i in range(3)]
+        for i, j in ((0, 1), (1, 2), (0, 2)):
+            out.append(float(np.hypot(*(T[i] - T[j])) - np.hypot(*(S[i] - S[j]))))
+        return out
+
+    return f
+
+
+def test_triad_against_scipy_continuation() -> None:
+    lk = _six_bar()
+    q = np.linspace(0.0, 2 * np.pi, 97)
+    pos = lk.node_positions(q)
+    assert all(np.isfinite(v).all() for v in pos.values())
+    m = lk.solve(q)
+    assert m.valid.all()
+    rng = np.random.default_rng(7)
+    for k in rng.choice(np.arange(1, q.size), 10, replace=False):
+        prev = np.concatenate([pos[n][k - 1] for n in ("T1", "T2", "T3")])
+        x = fsolve(_loop_equations(lk, float(q[k])), prev, xtol=1e-12)
+        assert np.max(np.abs(_loop_equations(lk, float(q[k]))(x))) < 1e-10
+        ours = np.concatenate([pos[n][k] for n in ("T1", "T2", "T3")])
+        assert np.allclose(x, ours, atol=1e-9)
+        # our solution satisfies the loop equations
+        assert np.max(np.abs(_loop_equations(lk, float(q[k]))(ours))) < 1e-9 * lk.size
+    # the ternary link stays rigid and the chirality is kept (no mirror assembly)
+    T1, T2, T3 = pos["T1"], pos["T2"], pos["T3"]
+    cross = (T2[:, 0] - T1[:, 0]) * (T3[:, 1] - T1[:, 1]) - (T2[:, 1] - T1[:, 1]) * (T3[:, 0] - T1[:, 0])
+    assert (cross > 0).all()
+
+
+def test_triad_same_branch_either_direction_and_from_elsewhere() -> None:
+    lk = _six_bar()
+    q = np.linspace(0.0, 2 * np.pi, 145)
+    fwd = lk.node_positions(q)
+    back = lk.node_positions(q[::-1])
+    for n in ("T1", "T2", "T3", "E"):
+        assert np.allclose(fwd[n], back[n][::-1], atol=1e-9)
+    # a path starting elsewhere is led in from driver value 0: the same assembly
+    part = lk.node_positions(q[60:100])
+    assert np.allclose(part["T3"], fwd["T3"][60:100], atol=1e-9)
+    # a scattered batch: every value from the declared assembly; the same here (one circuit)
+    idx = np.array([100, 3, 77, 40, 12])
+    assert np.allclose(lk.node_positions(q[idx])["T2"], fwd["T2"][idx], atol=1e-9)
+
+
+def test_triad_velocity_matches_differences() -> None:
+    lk = _six_bar()
+    q = np.linspace(0.3, 2.5, 6)
+    v, ok = lk.node_velocities(q)
+    h = 1e-6
+    assert ok.all()
+    for n in ("T1", "T2", "T3", "E"):
+        d = (lk.node_positions(q + h)[n] - lk.node_positions(q - h)[n]) / (2 * h)
+        assert np.allclose(v[n], d, atol=1e-6)
+
+
+def test_triad_failures_are_invalid_samples_with_reason() -> None:
+    d = tomllib.loads((GALLERY / "stephenson-six-bar.toml").read_text())
+    d["mechanism"]["nodes"][2]["at"] = [2.0, 8.0]
+    d["mechanism"]["nodes"][3]["radius"] = 1.0
+    d["mechanism"]["nodes"][4]["ra"] = float(np.hypot(1.0, 3.0))
+    d["mechanism"]["nodes"][6]["ra"] = float(np.hypot(1.5, 3.5))
+    scene = build_scene(parse_scene(d))
+    m = scene.motion()
+    assert 0 < m.valid.sum() < len(m)
+    i = int(np.flatnonzero(~m.valid)[0])
+    assert "triad" in m.reason(i) and "'T1'" in m.reason(i)
+    # scipy agrees there is no assembly there: least squares keeps a residual
+    from scipy.optimize import least_squares
+
+    lk = scene.mechanism
+    byname = {n.name: n for n in lk.nodes}
+    bad_q = float(m.driver[np.flatnonzero(~m.valid)[len(np.flatnonzero(~m.valid)) // 2]])
+    S = np.array([byname[k].local for k in ("T1", "T2", "T3")])
+    L = [byname[k].ra for k in ("T1", "T2", "T3")]
+    K = [np.array([np.cos(bad_q), np.sin(bad_q)]), np.array([6.0, 0.0]), np.array([2.0, 8.0])]
+
+    def g(u: np.ndarray) -> list[float]:
+        c, s = np.cos(u[2]), np.sin(u[2])
+        return [float(np.hypot(*(u[:2] + [c * S[i, 0] - s * S[i, 1], s * S[i, 0] + c * S[i, 1]] - K[i])) - L[i])
+                for i in range(3)]
+
+    rng = np.random.default_rng(0)
+    best = min(least_squares(g, rng.uniform([-5, -5, -np.pi], [10, 10, np.pi])).cost for _ in range(60))
+    assert best > 1e-6
+
+
+def test_triad_declaration_errors() -> None:
+    d = tomllib.loads((GALLERY / "stephenson-six-bar.toml").read_text())
+    orphan = copy.deepcopy(d)
+    del orphan["mechanism"]["nodes"][4]["members"]
+    with pytest.raises(SceneError, match="members"):
+        build_scene(parse_scene(orphan))
+    before = copy.deepcopy(d)
+    nodes = before["mechanism"]["nodes"]
+    nodes[4], nodes[5] = nodes[5], nodes[4]  # a member declared before the triad's first node
+    with pytest.raises(SceneError, match="triad"):
+        build_scene(parse_scene(before))
+    line = copy.deepcopy(d)
+    line["mechanism"]["nodes"][6]["local"] = [6.0, 0.0]
+    with pytest.raises(SceneError, match="one line"):
+        build_scene(parse_scene(line))
+    with pytest.raises(InputError):
+        Triad("T", "A", 1.0, (0.0, 0.0), (0.0, 0.0), ("T", "U")).validate("x")
