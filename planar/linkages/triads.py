@@ -140,6 +140,19 @@ def solve_triad(K: Array, L: Array, S: Array, u_ref: Array, cont: NDArray[np.boo
         while base >= 0 and not ok[base]:
             base -= 1
         ub = u[base] if base >= 0 else u_ref
+        if base != p - 1:
+            # after an invalid sample every sample continues the last valid one until one closes: all at once
+            z, zok, zsing = _newton(K[rows], np.broadcast_to(ub, (rows.size, 3)), L, S, scale)
+            m = int(np.argmax(zok)) if zok.any() else rows.size
+            u[rows[:m]] = ub
+            ok[rows[:m]] = False
+            code[rows[:m]] = np.where(zsing[:m], 2, 1)
+            if m < rows.size:
+                u[rows[m]], ok[rows[m]], code[rows[m]] = z[m], True, 0
+                m += 1
+            i += m
+            block = min(2 * block, 4096)
+            continue
         # tangent prediction from the two previous valid samples, when they are neighbours
         slope = np.zeros(3)
         if base >= 1 and ok[base - 1] and base == p - 1:
@@ -151,8 +164,6 @@ def solve_triad(K: Array, L: Array, S: Array, u_ref: Array, cont: NDArray[np.boo
         prev = np.vstack([ub[None, :], w[:-1]])
         y, yok, ysing = _newton(K[rows], prev, L, S, scale)
         agree = wok & yok & (_pose_distance(w, y, scale) <= 1e-7 * scale)
-        if base != p - 1:  # after an invalid sample the first continues the last valid one
-            agree[0] = False
         m = int(np.argmin(agree)) if not agree.all() else rows.size
         if m:
             u[rows[:m]] = w[:m]
