@@ -63,7 +63,7 @@ def test_five_bar_closure_against_scipy() -> None:
         bb = -q[i] + 0.5
         assert np.allclose(B, [4 + 1.2 * np.cos(bb), 1.2 * np.sin(bb)], atol=1e-12)
 
-        def f(p: np.ndarray) -> list[float]:
+        def f(p: np.ndarray, A: np.ndarray = A, B: np.ndarray = B) -> list[float]:
             return [float(np.hypot(*(p - A)) - 4.0), float(np.hypot(*(p - B)) - 4.0)]
 
         sol = root(f, pos["P"][i] + [0.3, -0.2], tol=1e-13)

@@ -319,9 +319,9 @@ class Triad(NodeKind):
             M[:, r, 2 * j:2 * j + 2] = -d
         scale = self._data()[3]
         det = np.linalg.det(M)
-        ok = np.abs(det) > 1e-12 * scale ** 6
+        ok: Mask = np.abs(det) > 1e-12 * scale ** 6
         M[~ok] = np.eye(6)
-        v = np.linalg.solve(M, b[:, :, None])[:, :, 0]
+        v = np.asarray(np.linalg.solve(M, b[:, :, None])[:, :, 0], dtype=np.float64)
         out = cast(dict, vel)
         for k, g in enumerate(self.group[1:], 1):
             out[g.name] = v[:, 2 * k:2 * k + 2]
