@@ -274,3 +274,77 @@ def test_triad_declaration_errors() -> None:
         build_scene(parse_scene(line))
     with pytest.raises(InputError):
         Triad("T", "A", 1.0, (0.0, 0.0), (0.0, 0.0), ("T", "U")).validate("x")
+
+
+def _dead_centre_six_bar() -> Linkage:
+    """A Stephenson six-bar whose triad reaches a dead centre near crank angle 1.99 rad (found by a search)."""
+    G2, G3, r = (6.312451035078426, -0.4134985153095454), (-0.45359010799997446, 5.930763662478237), 0.8286678037109922
+    T = np.array([[2.4080079945914776, 3.223385904964576], [5.0476084374687495, 3.3911156677558036],
+                  [3.7776357488676, 4.723780354556157]])
+    S = T - T[0]
+    L = [float(np.hypot(*(T[0] - (r, 0.0)))), float(np.hypot(*(T[1] - G2))), float(np.hypot(*(T[2] - G3)))]
+    nodes = [Fixed("G1", (0.0, 0.0)), Fixed("G2", G2), Fixed("G3", G3), Crank("C", "G1", r),
+             Triad("T1", "C", L[0], (0.0, 0.0), tuple(T[0]), ("T2", "T3")),
+             Triad("T2", "G2", L[1], tuple(S[1]), tuple(T[1])), Triad("T3", "G3", L[2], tuple(S[2]), tuple(T[2]))]
+    links = [Link("crank", ("G1", "C")), Link("rod", ("C", "T1")), Link("ternary", ("T1", "T2", "T3")),
+             Link("rocker", ("G2", "T2")), Link("hanger", ("G3", "T3"))]
+    return Linkage("dead-centre", nodes, links)
+
+
+def test_triad_dead_centre_jump_is_flagged() -> None:
+    lk = _dead_centre_six_bar()
+    q = np.linspace(0.0, 2 * np.pi, 720)
+    m = lk.solve(q)
+    bad = np.flatnonzero(~m.valid)
+    assert 1 <= bad.size <= 3
+    k = int(bad[-1])
+    assert "jumped to another branch" in m.reason(k)
+    pos = lk.node_positions(q)
+    # the triad moves far in one step there, and little in the steps either side
+    step = np.hypot(*(pos["T3"][1:] - pos["T3"][:-1]).T)
+    assert step[k - 1] > 10 * max(step[k - 3], step[k + 1])
+    # scipy, continued from the last valid sample, finds no assembly near it either: the branch ends
+    f = _loop_equations_general(lk, float(q[k]))
+    prev = np.concatenate([pos[n][bad[0] - 1] for n in ("T1", "T2", "T3")])
+    x, info, ier, msg = fsolve(f, prev, full_output=True)
+    near = ier == 1 and np.max(np.abs(f(x))) < 1e-9 and np.abs(x - prev).max() < 0.2
+    assert not near
+
+
+def _loop_equations_general(lk: Linkage, q: float):
+    byname = {n.name: n for n in lk.nodes}
+    tri = [byname[k] for k in ("T1", "T2", "T3")]
+    S = np.array([t.local for t in tri])
+    crank = byname["C"]
+    C = crank.radius * np.array([np.cos(q), np.sin(q)])
+    K = [C, np.array(byname["G2"].xy), np.array(byname["G3"].xy)]
+
+    def f(x: np.ndarray) -> list[float]:
+        T = x.reshape(3, 2)
+        out = [float(np.hypot(*(T[i] - K[i])) - tri[i].ra) for i in range(3)]
+        for i, j in ((0, 1), (1, 2), (0, 2)):
+            out.append(float(np.hypot(*(T[i] - T[j])) - np.hypot(*(S[i] - S[j]))))
+        return out
+
+    return f
+
+
+def test_blocked_continuation_equals_sample_by_sample() -> None:
+    from planar.linkages.triads import _newton, solve_triad
+
+    lk = _six_bar()
+    t1 = next(n for n in lk.nodes if isinstance(n, Triad) and n.members)
+    S, L, u_ref, scale = t1._data()
+    n = 400
+    q = np.linspace(0.0, 6 * np.pi, n)
+    K = np.stack([0.7 * np.c_[np.cos(q), np.sin(q)], np.broadcast_to([6.0, 0.0], (n, 2)),
+                  np.broadcast_to([1.0, 7.5], (n, 2))], 1)
+    cont = np.ones(n, bool)
+    cont[0] = False
+    u, ok, code = solve_triad(K, L, S, u_ref, cont, scale)
+    seq = np.empty((n, 3))
+    prev = u_ref
+    for k in range(n):  # the definition: Newton from the previous sample's assembly
+        w, _, _ = _newton(K[k:k + 1], prev[None], L, S, scale)
+        seq[k] = prev = w[0]
+    assert ok.all() and np.abs(u - seq).max() < 1e-9

@@ -787,7 +787,9 @@ class Linkage(Mechanism):
 
     def _solve_points(self, q: Array) -> Solved:
         """The chunked, threaded path (:mod:`planar.linkages.chunked`), else the reference path."""
-        fast = fast_solve(self, q) if q.ndim == 1 and self._declared_branches_hold(q) else None
+        # kinds without a chunk kernel (gears, driven inputs, triads): no plan, straight to the reference path
+        usable = q.ndim == 1 and self._fast_plan() is not None
+        fast = fast_solve(self, q) if usable and self._declared_branches_hold(q) else None
         if fast is not None:
             return fast
         return super()._solve_points(q)

@@ -28,8 +28,11 @@ assembly reached from ``at`` at every sample.
 
 **Failures** are invalid samples with the reason: Newton does not converge
 (the loop cannot close), the Jacobian is singular (a dead centre), or the
-solution jumps to another branch (a step more than 10x its neighbours').
-An invalid sample holds the last valid pose.
+solution jumps to another branch (a step from the last valid sample, per
+sample, more than 10x the steps of the valid samples either side; after a
+dead centre the assembly Newton finds may be another branch: that first sample
+is flagged, and the path continues from it).  An invalid sample holds the last
+valid pose.
 """
 
 from __future__ import annotations
@@ -180,17 +183,24 @@ def solve_triad(K: Array, L: Array, S: Array, u_ref: Array, cont: NDArray[np.boo
             u[r], ok[r], code[r] = ub, False, (2 if ysing[0] else 1)
         block = max(8, block // 2)
         i += 1
-    # a jump to another branch: a step much larger than both neighbours'
+    # a jump to another branch: a step (per sample, from the last valid one) much larger than the steps of
+    # the valid samples either side
     if n >= 3 and ks.size:
-        step = np.full(n, np.nan)
-        both = ok[1:] & ok[:-1] & cont[1:]
-        step[1:][both] = _pose_distance(u[1:][both], u[:-1][both], scale)
-        big = np.zeros(n, bool)
-        s_prev = np.concatenate([[np.nan], step[:-1]])
-        s_next = np.concatenate([step[1:], [np.nan]])
+        idx = np.arange(n)
+        last = np.maximum.accumulate(np.where(ok, idx, -1))
+        prev = np.concatenate([[-1], last[:-1]])
+        after = np.minimum.accumulate(np.where(ok, idx, n)[::-1])[::-1]
+        nxt = np.concatenate([after[1:], [n]])
+        kk = np.flatnonzero(ok & (prev >= 0) & cont)
+        dist = np.zeros(n)
+        rate = np.full(n + 1, np.nan)
+        dist[kk] = _pose_distance(u[kk], u[prev[kk]], scale)
+        rate[kk] = dist[kk] / (kk - prev[kk])
+        before_rate = np.where(prev >= 0, rate[np.maximum(prev, 0)], np.nan)
+        after_rate = rate[nxt]
         with np.errstate(invalid="ignore"):
-            big = (step > JUMP_FACTOR * np.fmax(s_prev, s_next)) & (step > 1e-3 * scale)
-        big &= np.isfinite(s_prev) | np.isfinite(s_next)
+            big = (rate[:n] > JUMP_FACTOR * np.fmax(before_rate, after_rate)) & (dist > 1e-3 * scale)
+        big &= np.isfinite(before_rate) | np.isfinite(after_rate)
         ok &= ~big
         code[big] = 3
     return u, ok, code
