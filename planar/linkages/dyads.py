@@ -944,10 +944,17 @@ class Linkage(Mechanism):
         inputs = [n for n in self.nodes if n.is_input]
         if len(inputs) < 2:
             return {}
-        from .gears import input_angle
-
         qa = np.atleast_1d(np.asarray(q, float))
-        return {n.name: input_angle(n, qa) if not isinstance(n, Actuator) else qa + n.offset for n in inputs}
+        out: dict[str, Array] = {}
+        for n in inputs:
+            own = getattr(n, "input_angle", None)  # a geared or driven node's law
+            if own is not None:
+                out[n.name] = own(qa)
+            elif isinstance(n, Crank):
+                out[n.name] = qa + n.phase
+            elif isinstance(n, Actuator):
+                out[n.name] = qa + n.offset
+        return out
 
     def node_positions(self, q) -> dict[str, Array]:
         """World positions ``(N, 2)`` of every node, placement applied."""
