@@ -19,11 +19,14 @@ from planar.scene import build_scene, load_scene, parse_scene
 GALLERY = Path(__file__).resolve().parent.parent / "gallery"
 
 
-def _five_bar(ratio: float = -1.0, phase: float = 0.5) -> Linkage:
-    nodes = [Fixed("O1", (0.0, 0.0)), Fixed("O2", (4.0, 0.0)), Crank("A", "O1", 1.2),
-             Geared("B", "O2", 1.2, "A", ratio, phase), RRR("P", "A", 4.0, "B", 4.0, 1)]
+R = 0.9  # crank radius: inside both pitch circles for the ratios tested
+
+
+def _five_bar(ratio: float = -1.0, phase: float = 0.5, radius: float = R) -> Linkage:
+    nodes = [Fixed("O1", (0.0, 0.0)), Fixed("O2", (4.0, 0.0)), Crank("A", "O1", radius),
+             Geared("B", "O2", radius, "A", ratio, phase), RRR("P", "A", 4.0, "B", 4.0, 1)]
     links = [Link("ga", ("O1", "A")), Link("gb", ("O2", "B")), Link("ca", ("A", "P")), Link("cb", ("B", "P"))]
-    return Linkage("five", nodes, links, points={"pen": "P"})
+    return Linkage("five", nodes, links, points={"pen": "P"}, width=0.3)
 
 
 @pytest.mark.parametrize("ratio", [-1.0, -0.5, -2.0])
@@ -59,9 +62,9 @@ def test_five_bar_closure_against_scipy() -> None:
     for i in range(q.size):
         A, B = pos["A"][i], pos["B"][i]
         # the crank pins from their own angles, independently of the solver
-        assert np.allclose(A, 1.2 * np.array([np.cos(q[i]), np.sin(q[i])]), atol=1e-12)
+        assert np.allclose(A, R * np.array([np.cos(q[i]), np.sin(q[i])]), atol=1e-12)
         bb = -q[i] + 0.5
-        assert np.allclose(B, [4 + 1.2 * np.cos(bb), 1.2 * np.sin(bb)], atol=1e-12)
+        assert np.allclose(B, [4 + R * np.cos(bb), R * np.sin(bb)], atol=1e-12)
 
         def f(p: np.ndarray, A: np.ndarray = A, B: np.ndarray = B) -> list[float]:
             return [float(np.hypot(*(p - A)) - 4.0), float(np.hypot(*(p - B)) - 4.0)]
@@ -88,6 +91,9 @@ def test_gear_velocity_matches_differences() -> None:
 def test_geared_refusals() -> None:
     with pytest.raises(InputError, match="ratio"):
         _five_bar(ratio=1.0)
+    # a crank pin past the small gear's pitch circle (4 / 3 for ratio -0.5): the gears could not share a layer
+    with pytest.raises(InputError, match="pitch circle"):
+        _five_bar(ratio=-0.5, radius=1.2)
     nodes = [Fixed("O1", (0.0, 0.0)), Fixed("O2", (4.0, 0.0)), Crank("A", "O1", 1.2),
              RRR("M", "A", 3.0, "O2", 3.0), Geared("B", "M", 1.0, "A", -1.0), RRR("P", "A", 4.0, "B", 4.0)]
     links = [Link("ga", ("O1", "A")), Link("m", ("A", "M", "O2")), Link("gb", ("M", "B")),
@@ -107,6 +113,20 @@ def test_geared_five_bar_scene_export_and_compare(tmp_path: Path) -> None:
     result, sim = compare_scene(scene)
     assert sim.failure is None
     assert result.torque is not None and result.torque["max_rel_diff"] < 0.01  # the GearJoint carries the load
+    # cut: both gears as their pitch circles (2 units each, 12 mm a unit, kerf 0.15 mm), read back with ezdxf;
+    # the assembly puts them in one layer
+    import csv
+
+    import ezdxf
+
+    from planar.pipeline import export_scene
+
+    export_scene(scene, dxf=tmp_path / "p.dxf", bom=tmp_path / "bom.csv")
+    doc = ezdxf.readfile(tmp_path / "p.dxf")
+    outer = sorted(round(e.dxf.radius, 6) for e in doc.modelspace().query("CIRCLE") if e.dxf.layer == "CUT_OUTER")
+    assert outer.count(round(2.0 * 12.0 + 0.075, 6)) == 2
+    rows = {r["id"]: r for r in csv.DictReader((tmp_path / "bom.csv").open()) if r["item"] == "part"}
+    assert rows["gear-left"]["layer"] == rows["gear-right"]["layer"]
 
 
 def _two_input_scene() -> dict:

@@ -11,7 +11,8 @@
   ``R_mesh / R = |ratio|`` for centres ``d`` apart), and a
   :class:`GearMesh` joint holds the ratio.  Drawings and cut files show and
   cut the pitch circles (no teeth); the assembly puts the two gears in one
-  layer.
+  layer, so a gear part that reaches past its pitch circle (a crank pin
+  further out) is refused.
 * :class:`Driven` (``"driven"``) — a crank with a driving law of its own,
   for two-input mechanisms (a five-bar or pantograph guided by two inputs).
   With driven nodes the scene's ``[driver]`` is a clock: its value is
@@ -129,6 +130,14 @@ class Geared(NodeKind):
         ra, rb = d * k / (1 + k), d / (1 + k)
         xa, ya = lk._anchors[la][mesh_centre]
         xb, yb = lk._anchors[lb][self.centre]
+        # the two gears share a layer: nothing on either gear part may reach past its pitch circle
+        for link, (cx, cy), radius in ((la, (xa, ya), ra), (lb, (xb, yb), rb)):
+            reach = max(float(np.hypot(x - cx, y - cy)) + r for x, y, r in hulls[link])
+            if reach > radius * (1 + 1e-9):
+                raise InputError(f"{lk.name}.links.{link}", list(next(k.nodes for k in lk.links if k.name == link)),
+                                 f"a gear part within its pitch circle (radius {radius:.4g}): it reaches "
+                                 f"{reach:.4g} from its centre (part width {lk.width:.4g}), so the two gears "
+                                 "could not turn in one layer; shorten the crank or move the centres apart")
         hulls[la].append((xa, ya, ra))
         hulls[lb].append((xb, yb, rb))
         ref = lk._link_poses({n: v[None, :] for n, v in lk._ref_nodes.items()}, 1)
