@@ -677,6 +677,9 @@ def simulate(mech: Mechanism, t: Array, effects: Effects | None = None,
     dt = dt_out / sub
     if mode == "motor" and (mech.driver.kind != "rotation" or mech.driver.amplitude is not None):
         raise SimulationError(f"{mech.name}: motor mode needs a driver turning at a constant rate")
+    if mode == "motor" and getattr(mech, "extra_driven_parts", []):
+        raise SimulationError(f"{mech.name}: motor mode drives one part; this linkage has more inputs "
+                              f"({', '.join(mech.extra_driven_parts)}), each imposed kinematically")  # type: ignore[attr-defined]
     if mode == "motor" and len(_driven_parts(mech)) > 1:
         raise SimulationError(f"{mech.name}: motor mode drives one part; this toy's stages are drawn apart, "
                               "so each stage's driver must follow its parent kinematically")
