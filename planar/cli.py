@@ -76,7 +76,7 @@ def _cmd_render(args: argparse.Namespace) -> int:
 
     scene = load_scene(args.scene)
     overlay = overlay_motion(scene) if args.overlay else None
-    n = render_scene(scene, args.output, overlay=overlay)
+    n = render_scene(scene, args.output, overlay=overlay, fps=args.fps)
     print(f"wrote {args.output}: {n} frames")
     return 0
 
@@ -198,9 +198,13 @@ def build_parser() -> argparse.ArgumentParser:
     ch.add_argument("--json", action="store_true", help='print {"Ox": [["Rz->Tx", "Tx->Ox"], ...], ...}')
     ch.set_defaults(func=_cmd_chains)
 
-    r = sub.add_parser("render", help="render a scene's animation to a GIF")
+    r = sub.add_parser("render", help="render a scene's animation to a GIF (or MP4/WebM)")
     r.add_argument("scene", help="scene file (TOML)")
-    r.add_argument("-o", "--output", required=True, help="GIF file to write")
+    r.add_argument("-o", "--output", required=True,
+                   help="animation to write: .gif, or .mp4/.webm with the video extra (pip install 'planar[video]')")
+    r.add_argument("--fps", type=float, default=None,
+                   help="frames per second (default: the scene's [render] fps, else 25, or 50 for fast cycles; "
+                        "a GIF plays at most 50); a cycle plays for 1/speed seconds within one frame")
     r.add_argument("--overlay", action="store_true", help="draw the pymunk simulation over the analytic motion")
     r.set_defaults(func=_cmd_render)
 

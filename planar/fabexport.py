@@ -64,7 +64,7 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
     pins, contacts = joint_pins(mech)
     pinned = pin_features(mech)
     shaft = _shaft_pin(mech, pins)
-    notes: list[str] = []
+    notes: list[str] = list(getattr(mech, "design_notes", ()))  # what a mechanism reports of its own design
     if mech.driver.kind != "rotation":
         notes.append(f"driver {mech.driver.part!r} is a {mech.driver.kind} drive: no motor shaft hole")
     elif shaft is None:

@@ -15,6 +15,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Callable
 
+from .cams.joint import CamContact
 from .errors import PlanarError
 from .model import ArcSlot, CamOnLine, Hole, Mechanism, Part, PinInArcSlot, PinInSlot, Pivot, Slide, Slot
 from .registry import Registry
@@ -108,6 +109,7 @@ def register_contact(kind: type, coplanar: bool) -> None:
 
 register_contact(SkewContact, coplanar=False)  # a tilting pin on an edge: across layers
 register_contact(GearMesh, coplanar=True)  # two gears in mesh: one layer
+register_contact(CamContact, coplanar=True)  # a profile cam and its roller or follower: in one layer
 
 
 def joint_pins(mech: Mechanism) -> tuple[list[PinSpec], list[Contact]]:

@@ -59,7 +59,7 @@ def scene_style(scene: Scene) -> Style:
 
     r = scene.spec.render
     return Style(width=r.width, height=r.height, supersample=r.supersample, background=r.background,
-                 trails=r.trails, show_pins=r.show_pins)
+                 trails=r.trails, show_pins=r.show_pins, opacity=r.opacity)
 
 
 def overlay_motion(scene: Scene) -> Motion:
@@ -76,18 +76,50 @@ def overlay_motion(scene: Scene) -> Motion:
     return sim.motion
 
 
-def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, progress: bool = True) -> int:
-    """Render a scene's analytic motion (and optionally an overlay motion) to a GIF; returns frames."""
-    from exporters.gif import frame_delay_ms, indexer, write_gif
+#: output suffixes ``render_scene`` writes
+ANIMATION_SUFFIXES = (".gif", ".mp4", ".webm")
 
+
+def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, progress: bool = True,
+                 fps: float | None = None) -> int:
+    """Render a scene's analytic motion (and optionally an overlay motion) to ``out``; returns the frame count.
+
+    The format follows the suffix: ``.gif`` (streamed, reproducible), ``.mp4``
+    or ``.webm`` (the ``video`` extra).  Frames are resampled so that a cycle
+    plays for what the scene's ``speed`` says, within one frame delay
+    (:func:`planar.animation.plan_frames`); ``fps`` (or the scene's
+    ``[render] fps``) sets the frame rate.  The overlay, a simulated motion
+    with sample times, is interpolated to the frame instants.
+    """
+    from .animation import animation_motion, plan_frames, resample, scene_duration
+    from .errors import InputError
     from .render import Renderer, palette_colors
 
-    motion = scene.motion()
+    suffix = Path(out).suffix.lower()
+    if suffix not in ANIMATION_SUFFIXES:
+        raise InputError("-o", str(out), f"an animation file ending in {', '.join(ANIMATION_SUFFIXES)}")
+    if suffix != ".gif":
+        from exporters.video import video_available
+
+        if not video_available():
+            raise InputError("-o", str(out), f"the video extra for {suffix} output: pip install 'planar[video]' "
+                                             "(imageio-ffmpeg), or write a .gif")
+    fps = fps if fps is not None else scene.spec.render.fps
+    plan = plan_frames(scene.mechanism.driver.period, scene_duration(scene), fps,
+                       tick_ms=10.0 if suffix == ".gif" else None)
+    motion, fine = animation_motion(scene, plan)
+    if overlay is not None:
+        overlay = resample(overlay, plan.times())
     polys = {n: scene.polygons[n] for n in scene.spec.render.sweep}
-    r = Renderer(scene.mechanism, motion, scene_style(scene), overlay=overlay, polygons=polys)
-    pal = palette_colors(r.style, len(scene.mechanism.parts))
-    delay = frame_delay_ms(scene.mechanism.driver.period, scene.spec.driver.samples_per_cycle)
-    return write_gif(out, r.frames(progress=progress, post=indexer(pal)), delay, pal)
+    r = Renderer(scene.mechanism, motion, scene_style(scene), overlay=overlay, polygons=polys, trail_motion=fine)
+    if suffix == ".gif":
+        from exporters.gif import indexer, write_gif
+
+        pal = palette_colors(r.style, len(scene.mechanism.parts))
+        return write_gif(out, r.frames(progress=progress, post=indexer(pal)), int(plan.delay_ms), pal)
+    from exporters.video import write_video
+
+    return write_video(out, r.frames(progress=progress), plan.fps)
 
 
 def build_gallery(source: str | Path, output: str | Path | None = None,

@@ -160,8 +160,56 @@ class CatalogSpec(_Strict):
     name: str
 
 
+class CamSegmentSpec(_Strict):
+    """One segment of a cam's program: ``law`` over ``angle`` of cam turn (angle unit), changing the
+    follower's displacement by ``lift`` (model units; an oscillating follower's in the angle unit)."""
+
+    law: Literal["cycloidal", "harmonic", "polynomial-345", "dwell"]
+    angle: Pos
+    lift: Real = 0.0
+
+
+class CamFollowerSpec(_Strict):
+    """A cam's follower: what touches the cam (``kind``) and how it moves (``motion``); see planar.cams."""
+
+    kind: Literal["knife", "roller", "flat"]
+    motion: Literal["translating", "oscillating"] = "translating"
+    roller_radius: Pos | None = None
+    axis: tuple[Real, Real] = (0.0, 1.0)
+    offset: Real = 0.0
+    pivot: tuple[Real, Real] | None = None
+    arm: Pos | None = None
+    face_offset: Real = 0.0
+    branch: Literal[1, -1] = 1
+
+    @model_validator(mode="after")
+    def _needs(self) -> "CamFollowerSpec":
+        if (self.kind == "roller") != (self.roller_radius is not None):
+            raise ValueError("roller_radius is given for a roller follower, and only for one")
+        if self.motion == "oscillating" and (self.pivot is None or self.arm is None):
+            raise ValueError("an oscillating follower needs pivot and arm")
+        if self.motion == "translating" and (self.pivot is not None or self.arm is not None):
+            raise ValueError("pivot and arm are for an oscillating follower (a translating one has axis, offset)")
+        return self
+
+
+class CamSpec(_Strict):
+    """A disc cam turning about (0, 0), its follower, and the linkage the follower drives (planar.cams)."""
+
+    type: Literal["cam"]
+    base_radius: Pos
+    follower: CamFollowerSpec
+    segments: Annotated[list[CamSegmentSpec], Field(min_length=2)]
+    max_pressure_angle: Pos | None = None
+    link_width: Pos | None = None
+    nodes: list[NodeSpec] = []
+    links: list[LinkSpec] = []
+    points: dict[str, str] = {}
+    polygons: list[PolygonSpec] = []
+
+
 MechanismSpec = Annotated[
-    Union[FourBarSpec, SliderCrankSpec, LinkageSpec, ElementalSpec, ChainSpec, ToySpec, CatalogSpec],
+    Union[FourBarSpec, SliderCrankSpec, LinkageSpec, ElementalSpec, ChainSpec, ToySpec, CatalogSpec, CamSpec],
     Field(discriminator="type"),
 ]
 
@@ -237,6 +285,10 @@ class RenderSpec(_Strict):
     sweep: list[str] = []
     background: Annotated[str, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#ffffff"
     show_pins: bool = True
+    # frames per second of the animation (default: 25, or 50 for fast cycles; a GIF plays at most 50)
+    fps: Annotated[float, Field(gt=0, le=240)] | None = None
+    # fill opacity of moving parts, 0..1 (below 1 what lies under a part shows through)
+    opacity: Annotated[float, Field(ge=0, le=1)] = 1.0
 
 
 class FabricationSpec(_Strict):
@@ -295,7 +347,8 @@ def _loc(loc: tuple) -> str:
     for part in loc:
         if isinstance(part, int):
             out += f"[{part}]"
-        elif part in ("fourbar", "slidercrank", "linkage", "elemental", "chain", "toy", "catalog") and out == "mechanism":
+        elif part in ("fourbar", "slidercrank", "linkage", "elemental", "chain", "toy", "catalog",
+                      "cam") and out == "mechanism":
             continue  # the discriminated union's tag
         else:
             out += ("." if out else "") + str(part)
@@ -499,9 +552,35 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, A
         if m.right:
             cams["right"] = [tuple(c) for c in m.right]
         return ToyMechanism(cams, phase=_angle(spec, m.phase), rate=rate, name=spec.name or "toy")
+    if isinstance(m, CamSpec):
+        return _build_cam(spec, m, rate, phase)
     mech = get(m.name)
     if rate != 2 * math.pi or phase:
         from dataclasses import replace
 
         mech.driver = replace(mech.driver, rate=rate, phase=phase)
     return mech
+
+
+def _build_cam(spec: SceneSpec, m: CamSpec, rate: float, phase: float) -> Mechanism:
+    """A :class:`planar.cams.CamMechanism` from a ``type = "cam"`` mechanism table."""
+    from .cams import CamMechanism, CamProfile, FollowerGeometry, Program, Segment
+    from .linkages import NODE_KINDS, Link
+
+    f = m.follower
+    osc = f.motion == "oscillating"
+    program = Program([Segment(sg.law, _angle(spec, sg.angle), _angle(spec, sg.lift) if osc else float(sg.lift))
+                       for sg in m.segments], "mechanism.segments")
+    geom = FollowerGeometry(f.kind, f.motion, float(f.roller_radius or 0.0), (float(f.axis[0]), float(f.axis[1])),
+                            float(f.offset), (0.0, 0.0) if f.pivot is None else (float(f.pivot[0]), float(f.pivot[1])),
+                            float(f.arm or 0.0), float(f.face_offset), int(f.branch))
+    profile = CamProfile(program, float(m.base_radius), geom, "mechanism")
+    limit = math.radians(45.0 if osc else 30.0) if m.max_pressure_angle is None else _angle(spec, m.max_pressure_angle)
+    nodes = []
+    for n in m.nodes:
+        cls = NODE_KINDS[n.kind]
+        args = [_angle(spec, getattr(n, k)) if k in cls.angle_fields else getattr(n, k) for k in cls.scene_fields]
+        nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
+    links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
+    return CamMechanism(spec.name or "cam", profile, nodes, links, points=m.points or None, rate=rate, phase=phase,
+                        max_pressure_angle=limit, unit=spec.angle_unit, width=m.link_width)

@@ -53,6 +53,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .cams.joint import CamContact
 from .dynamics import inverse_dynamics_torque, mass_properties
 from .effects import Effects
 from .errors import PlanarError
@@ -546,6 +547,16 @@ def _cam_on_line(rb: _Rebuild, j: CamOnLine, effects: Effects | None) -> list[An
         raise SimulationError(f"{rb.mech.name}: joint {j.name!r}: a round cam on a face is not rebuilt")
     s0, s1 = _padded(rb._local(j.a, j.start), rb._local(j.a, j.end))
     return rb._groove(j.a, s0, s1, j.b, j.centre)
+
+
+@REBUILDERS.register(CamContact)
+def _cam_profile(rb: _Rebuild, j: CamContact, effects: Effects | None) -> list[Any]:
+    """Refused: no pymunk constraint keeps a follower on a cam's profile without being told the answer."""
+    raise SimulationError(
+        f"{rb.mech.name}: joint {j.name!r} is a profile cam (joint kind 'cam-profile'), which is not rebuilt in "
+        "pymunk: holding the follower on the outline would take collision contact, which the rebuild does not use "
+        "(parts sit in layers), and a groove along the analytic profile would only replay the analytic motion; "
+        "no comparison is made")
 
 
 def _padded(a, b, frac: float = 0.1) -> tuple[tuple[float, float], tuple[float, float]]:

@@ -81,7 +81,7 @@ def test_purely_kinematic_render_builds_no_space(monkeypatch, tmp_path):
         raise AssertionError("a space was built")
 
     monkeypatch.setattr(sim_mod, "_Rebuild", boom)
-    assert render_scene(scene_of(LEG), tmp_path / "k.gif", progress=False) == 36
+    assert render_scene(scene_of(LEG), tmp_path / "k.gif", progress=False) == 25  # 1 cycle/s at 25 frames/s
 
 
 def test_spatial_mechanisms_are_refused_with_a_clear_message():
