@@ -368,3 +368,31 @@ def test_blocked_continuation_equals_sample_by_sample() -> None:
         w, _, _ = _newton(K[k:k + 1], prev[None], L, S, scale)
         seq[k] = prev = w[0]
     assert ok.all() and np.abs(u - seq).max() < 1e-9
+
+
+def test_random_triads_never_silently_wrong() -> None:
+    """Random six-bars: every sample marked valid closes every loop (distances from node positions)."""
+    rng = np.random.default_rng(11)
+    checked = 0
+    for _ in range(8):
+        G2, G3, r = rng.uniform([3, -2], [8, 2]), rng.uniform([-1, 5], [5, 9]), float(rng.uniform(0.3, 1.5))
+        T = np.array([[2, 3], [5, 3], [3.5, 4.5]]) + rng.normal(0, 0.3, (3, 2))
+        S = T - T[0]
+        L = [float(np.hypot(*(T[0] - (r, 0.0)))), float(np.hypot(*(T[1] - G2))), float(np.hypot(*(T[2] - G3)))]
+        nodes = [Fixed("G1", (0.0, 0.0)), Fixed("G2", tuple(G2)), Fixed("G3", tuple(G3)), Crank("C", "G1", r),
+                 Triad("T1", "C", L[0], (0.0, 0.0), tuple(T[0]), ("T2", "T3")),
+                 Triad("T2", "G2", L[1], tuple(S[1]), tuple(T[1])), Triad("T3", "G3", L[2], tuple(S[2]), tuple(T[2]))]
+        links = [Link("crank", ("G1", "C")), Link("rod", ("C", "T1")), Link("ternary", ("T1", "T2", "T3")),
+                 Link("rocker", ("G2", "T2")), Link("hanger", ("G3", "T3"))]
+        lk = Linkage("random", nodes, links)
+        q = np.linspace(0.0, 2 * np.pi, 360)
+        pos, checks = lk.solve_nodes(q)
+        ok = np.logical_and.reduce([c for c, _, _ in checks])
+        outer = [pos["C"], pos["G2"], pos["G3"]]
+        for i, n in enumerate(("T1", "T2", "T3")):
+            assert np.abs(np.hypot(*(pos[n][ok] - outer[i][ok]).T) - L[i]).max() < 1e-9 * lk.size
+        for i, j in ((0, 1), (1, 2), (0, 2)):
+            a, b = pos[f"T{i + 1}"][ok], pos[f"T{j + 1}"][ok]
+            assert np.abs(np.hypot(*(a - b).T) - np.hypot(*(S[i] - S[j]))).max() < 1e-9 * lk.size
+        checked += int(ok.sum())
+    assert checked > 700

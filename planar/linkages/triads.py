@@ -125,11 +125,15 @@ def solve_triad(K: Array, L: Array, S: Array, u_ref: Array, cont: NDArray[np.boo
     singular Jacobian, 3 jump to another branch.
     """
     n = K.shape[0]
-    u, ok, sing = _newton(K, np.broadcast_to(u_ref, (n, 3)), L, S, scale)
-    code = np.where(ok, 0, np.where(sing, 2, 1)).astype(np.int8)
-    ks = np.flatnonzero(cont)
-    if ks.size:
-        ks = ks[ks >= 1]
+    # the samples that start from the declared assembly (the first, and every one of a scattered batch)
+    first = ~np.asarray(cont, bool).copy()
+    first[0] = True
+    u = np.broadcast_to(u_ref, (n, 3)).copy()
+    ok = np.zeros(n, bool)
+    code = np.ones(n, np.int8)
+    u[first], ok[first], sing = _newton(K[first], u[first], L, S, scale)
+    code[first] = np.where(ok[first], 0, np.where(sing, 2, 1))
+    ks = np.flatnonzero(~first)
     block = 8
     i = 0
     while i < ks.size:
