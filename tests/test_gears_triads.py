@@ -396,3 +396,22 @@ def test_random_triads_never_silently_wrong() -> None:
             assert np.abs(np.hypot(*(a - b).T) - np.hypot(*(S[i] - S[j]))).max() < 1e-9 * lk.size
         checked += int(ok.sum())
     assert checked > 700
+
+
+@pytest.mark.parametrize("edit,expect", [
+    (("ratio = -1.0", "ratio = 0.5"), "nodes.B.ratio"),
+    (('mesh = "A"', 'mesh = "O1"'), "nodes.B.mesh"),
+])
+def test_bad_gear_scene_is_one_line_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                           edit: tuple[str, str], expect: str) -> None:
+    from planar.cli import main
+
+    text = (GALLERY / "geared-five-bar.toml").read_text()
+    assert edit[0] in text
+    p = tmp_path / "bad.toml"
+    p.write_text(text.replace(edit[0], edit[1]))
+    out = tmp_path / "m.csv"
+    assert main(["motion", str(p), "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and expect in err[0] and "Traceback" not in err[0]
+    assert not out.exists()
