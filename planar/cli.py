@@ -85,8 +85,13 @@ def _cmd_motion(args: argparse.Namespace) -> int:
     from .pipeline import write_scene_motion
     from .scene import load_scene
 
-    motion = write_scene_motion(load_scene(args.scene), args.output)
+    scene = load_scene(args.scene)
+    motion = write_scene_motion(scene, args.output, derivatives=args.derivatives)
     print(f"wrote {args.output}: {len(motion)} samples, {int(motion.valid.sum())} valid")
+    if args.derivatives:
+        from .derivatives import rates_method
+
+        print(f"rates: {rates_method(scene.mechanism)}")
     return 0
 
 
@@ -211,6 +216,8 @@ def build_parser() -> argparse.ArgumentParser:
     mo = sub.add_parser("motion", help="write a scene's motion table (CSV)")
     mo.add_argument("scene", help="scene file (TOML)")
     mo.add_argument("-o", "--output", required=True, help="CSV file to write")
+    mo.add_argument("--derivatives", action="store_true",
+                    help="add <point>.vx/.vy/.ax/.ay, <part>.omega/.alpha, transmission angles and motor torque")
     mo.set_defaults(func=_cmd_motion)
 
     g = sub.add_parser("gallery", help="render every scene of a folder to a GIF")
@@ -251,6 +258,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("-o", "--output", required=True, help="CSV file to write")
     c.add_argument("--samples", type=int, default=360)
     c.set_defaults(func=_cmd_motion_catalog)
+    from .cli_plot import add_parser as add_plot_parser; add_plot_parser(sub)  # noqa: E702
     return p
 
 

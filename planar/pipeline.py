@@ -11,22 +11,22 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from .errors import InputError
 
 if TYPE_CHECKING:
     from .compare import Comparison
     from .fabexport import Fabrication
-    from .model import Motion
+    from .model import Mechanism, Motion
     from .render import Style
     from .scene import Scene
     from .simulate import SimResult, SimSettings
 
 __all__ = [
-    "DEMO_EXTRAS", "DEMO_SCENES", "build_gallery", "compare_scene", "export_scene",
-    "gallery_scenes", "overlay_motion", "render_scene", "run_demo", "scene_style", "write_catalog_motion",
-    "write_scene_motion",
+    "DEMO_EXTRAS", "DEMO_SCENES", "build_gallery", "compare_scene", "export_mechanism", "export_scene",
+    "gallery_scenes", "overlay_motion", "plot_mechanism", "render_mechanism", "render_scene", "run_demo",
+    "scene_from_mechanism", "scene_style", "write_catalog_motion", "write_mechanism_motion", "write_scene_motion",
 ]
 
 
@@ -141,12 +141,35 @@ def build_gallery(source: str | Path, output: str | Path | None = None,
 # --------------------------------------------------------------------------- motion tables
 
 
-def write_scene_motion(scene: Scene, out: str | Path) -> Motion:
-    """Write the scene's analytic motion table (CSV) to ``out``; returns the motion."""
-    from .fileio import write_motion_csv
+def write_scene_motion(scene: Scene, out: str | Path, derivatives: bool = False) -> Motion:
+    """Write the scene's analytic motion table (CSV) to ``out``; returns the motion.
+
+    ``derivatives``: add the rates of :func:`planar.derivatives.derivative_columns`
+    (point velocities and accelerations, part omega and alpha, transmission
+    angles, motor torque under the scene's ``[effects]``) before ``valid``.
+    Nothing is written if they cannot be computed.
+    """
+    import io
+
+    import numpy as np
+
+    from .fileio import atomic_write, motion_columns, write_motion_csv
 
     motion = scene.motion()
-    write_motion_csv(out, scene.mechanism, motion)
+    if not derivatives:
+        write_motion_csv(out, scene.mechanism, motion)
+        return motion
+    from .derivatives import derivative_columns
+
+    names, table = motion_columns(scene.mechanism, motion)
+    extra_names, extra = derivative_columns(scene.mechanism, motion, scene.effects)
+    names = names[:-1] + extra_names + names[-1:]
+    table = np.column_stack([table[:, :-1], *extra, table[:, -1]])
+    buf = io.StringIO()
+    buf.write(",".join(names) + "\n")
+    np.savetxt(buf, table, fmt=",".join(["%.17g"] * (len(names) - 1) + ["%d"]))
+    with atomic_write(out, "w") as fh:
+        fh.write(buf.getvalue())
     return motion
 
 
@@ -195,6 +218,56 @@ def compare_scene(scene: Scene, settings: SimSettings | None = None, threshold: 
     from .compare import compare_scene as _compare_scene
 
     return _compare_scene(scene, settings, threshold, torque_threshold, with_series=with_series)
+
+
+# --------------------------------------------------------------------------- mechanisms built in Python
+
+
+def scene_from_mechanism(mech: Mechanism, **tables: Any) -> Scene:
+    """A :class:`~planar.scene.Scene` of a mechanism built in Python, validated like a scene file.
+
+    ``tables`` (see :func:`planar.scenewrite.scene_data`): ``name``, ``driver``,
+    ``effects``, ``render``, ``fabrication`` (dicts of scene keys) and
+    ``polygons``; ``scene.save(path)`` writes it as a scene file.  The
+    scene's mechanism is rebuilt from the keys: what is saved is what runs.
+    """
+    from .scene import build_scene, parse_scene
+    from .scenewrite import scene_data
+
+    where = f"<{type(mech).__name__} {mech.name!r}>"
+    return build_scene(parse_scene(scene_data(mech, **tables), where), where)
+
+
+def render_mechanism(mech: Mechanism, out: str | Path, progress: bool = False, **tables: Any) -> int:
+    """Render a mechanism built in Python to a GIF, as ``planar render`` would its scene; returns frames.
+
+    ``tables`` as for :func:`scene_from_mechanism`, e.g. ``driver={"samples_per_cycle": 48}``,
+    ``render={"width": 320, "trails": ["coupler_point"]}``.
+    """
+    return render_scene(scene_from_mechanism(mech, **tables), out, progress=progress)
+
+
+def export_mechanism(mech: Mechanism, dxf: str | Path | None = None, svg: str | Path | None = None,
+                     fabrication: dict[str, Any] | None = None, **files: Any) -> "Fabrication":
+    """Lay out a mechanism built in Python for cutting, as ``planar export`` would its scene.
+
+    ``fabrication``: ``[fabrication]`` keys (``unit_mm``, ``kerf_mm``, ...);
+    ``files``: the other outputs of :func:`export_scene` (``preview``, ``bom``,
+    ``assembly``, ``kerf_test``) and its ``kerf``/``sheet`` overrides.
+    """
+    return export_scene(scene_from_mechanism(mech, fabrication=fabrication), dxf, svg, **files)
+
+
+def write_mechanism_motion(mech: Mechanism, out: str | Path, derivatives: bool = False, **tables: Any) -> Motion:
+    """The motion table (CSV) of a mechanism built in Python, as ``planar motion [--derivatives]`` writes it."""
+    return write_scene_motion(scene_from_mechanism(mech, **tables), out, derivatives=derivatives)
+
+
+def plot_mechanism(mech: Mechanism, out: str | Path, what: list[str] | None = None, **tables: Any) -> list[str]:
+    """The charts of a mechanism built in Python (PNG or SVG), as ``planar plot`` draws them."""
+    from .plot import write_plot
+
+    return write_plot(scene_from_mechanism(mech, **tables), out, what)
 
 
 # --------------------------------------------------------------------------- the demo

@@ -415,3 +415,22 @@ def test_bad_gear_scene_is_one_line_exit_2(tmp_path: Path, capsys: pytest.Captur
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and expect in err[0] and "Traceback" not in err[0]
     assert not out.exists()
+
+
+def test_accelerations_match_differences_of_velocities() -> None:
+    """Gears, a second input and a triad: the closure differentiated twice against central differences."""
+    cases = [(_five_bar(-0.5), np.linspace(0.2, 2.0, 6), ("B", "P")),
+             (_six_bar(), np.linspace(0.3, 2.5, 6), ("T1", "T2", "T3", "E")),
+             (build_scene(parse_scene(_two_input_scene())).mechanism, np.linspace(0.2, 3.0, 6), ("A", "B", "P"))]
+    h = 1e-5
+    for lk, q, names in cases:
+        assert isinstance(lk, Linkage)
+        qd, qdd = 1.7, -0.4  # a driver speeding down: both terms of the chain rule count
+        pos, vel, acc, ok = lk.node_accelerations(q, qd, qdd)
+        assert ok.all()
+        vp, _ = lk.node_velocities(q + h, 1.0)
+        vm, _ = lk.node_velocities(q - h, 1.0)
+        v1, _ = lk.node_velocities(q, 1.0)
+        for n in names:
+            d2 = (vp[n] - vm[n]) / (2 * h)  # second coefficient d2X/dq2
+            assert np.allclose(acc[n], d2 * qd * qd + v1[n] * qdd, atol=1e-6), (lk.name, n)

@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..model import Driver, check_finite, check_positive, joint_kind
-from .dyads import Check, Crank, Fixed, Mask, NodeKind, _perp, node_kind
+from .dyads import Check, Crank, Fixed, Mask, NodeKind, _perp, frame_rates, node_kind
 
 if TYPE_CHECKING:
     from .dyads import Linkage
@@ -115,6 +115,13 @@ class Geared(NodeKind):
         w = self.ratio * _omega(pos, vel, self.base.name, self.base.centre)
         return vel[self.centre] + w[:, None] * _perp(pos[self.name] - pos[self.centre]), None
 
+    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
+                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+        assert isinstance(self.base, (Crank, Geared, Driven))
+        m, c = self.base.name, self.base.centre
+        w, al = frame_rates(pos[m] - pos[c], vel[m] - vel[c], acc[m] - acc[c])
+        return _turning(pos, vel, acc, self.name, self.centre, self.ratio * w, self.ratio * al), None
+
     def extra_joints(self, lk: "Linkage", hulls: dict[str, list[tuple[float, float, float]]]) -> list[Any]:
         """The gear pair: pitch-circle discs on both crank links and the :class:`GearMesh` joint."""
         assert self.base is not None
@@ -143,6 +150,13 @@ class Geared(NodeKind):
         ref = lk._link_poses({n: v[None, :] for n, v in lk._ref_nodes.items()}, 1)
         phase = float(ref[lb][0, 2] - self.ratio * ref[la][0, 2])
         return [GearMesh(f"{self.name}-gear", la, lb, float(self.ratio), phase, (xa, ya), (xb, yb), ra, rb)]
+
+
+def _turning(pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array], node: str, centre: str,
+             w: Array, al: Array) -> Array:
+    """Acceleration of ``node`` turning about ``centre`` at ``w`` (rad/s), ``al`` (rad/s^2)."""
+    r = pos[node] - pos[centre]
+    return acc[centre] + al[:, None] * _perp(r) - (w * w)[:, None] * r
 
 
 def _crank_link(lk: "Linkage", node: str, centre: str) -> str:
@@ -197,6 +211,12 @@ class Driven(NodeKind):
             return np.full_like(q, self.cycles)
         return self.amplitude * self.cycles * np.cos(self.cycles * q + self.phase)
 
+    def input_accel(self, q: Array) -> Array:
+        """``d2 angle / d theta2``."""
+        if self.amplitude is None:
+            return np.zeros_like(q)
+        return -self.amplitude * self.cycles ** 2 * np.sin(self.cycles * q + self.phase)
+
     def make_driver(self, link: str, origin: tuple[float, float], rate: float, phase: float) -> Driver:
         """The linkage's driver when this node is its first input: the clock (kind ``"path"``)."""
         return Driver(link, "path", origin=origin, rate=rate, phase=phase)
@@ -212,6 +232,16 @@ class Driven(NodeKind):
                     qd: Array) -> tuple[Array, Mask | None]:
         w = self.input_rate(q) * qd
         return vel[self.centre] + w[:, None] * _perp(pos[self.name] - pos[self.centre]), None
+
+    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
+                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+        raise NotImplementedError("a driven node's acceleration needs the clock value: call acceleration_at")
+
+    def acceleration_at(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
+                        q: Array, qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+        w = self.input_rate(q) * qd
+        al = self.input_accel(q) * qd * qd + self.input_rate(q) * qdd
+        return _turning(pos, vel, acc, self.name, self.centre, w, al), None
 
 
 def _ratio_period(ratio: float) -> float:

@@ -315,28 +315,50 @@ class Triad(NodeKind):
         why = f"the triad {names}: " + ("; ".join(kinds) if kinds else "cannot close")
         return T[:, 0], (ok, why)
 
-    def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
-        if not self.members:
-            return vel[self.name], None
-        # (T_i - A_i) . (v_i - vA_i) = 0 and (T_i - T_j) . (v_i - v_j) = 0: six equations in v_1..v_3
+    _PAIRS: ClassVar[tuple[tuple[int, int], ...]] = ((0, 1), (1, 2), (0, 2))
+
+    def _rates(self, pos: Mapping[str, Array], b: Array, out: Mapping[str, Array]) -> tuple[Array, Mask]:
+        """Solve the differentiated closure ``M x = b`` (six equations, see :meth:`velocity`) into ``out``."""
         T = [pos[g.name] for g in self.group]
         n = T[0].shape[0]
         M = np.zeros((n, 6, 6))
-        b = np.zeros((n, 6))
         for i, g in enumerate(self.group):
-            d = T[i] - pos[g.a]
-            M[:, i, 2 * i:2 * i + 2] = d
-            b[:, i] = (d * vel[g.a]).sum(-1)
-        for r, (i, j) in enumerate(((0, 1), (1, 2), (0, 2)), 3):
+            M[:, i, 2 * i:2 * i + 2] = T[i] - pos[g.a]
+        for r, (i, j) in enumerate(self._PAIRS, 3):
             d = T[i] - T[j]
             M[:, r, 2 * i:2 * i + 2] = d
             M[:, r, 2 * j:2 * j + 2] = -d
         scale = self._data()[3]
-        det = np.linalg.det(M)
-        ok: Mask = np.abs(det) > 1e-12 * scale ** 6
+        ok: Mask = np.abs(np.linalg.det(M)) > 1e-12 * scale ** 6
         M[~ok] = np.eye(6)
-        v = np.asarray(np.linalg.solve(M, b[:, :, None])[:, :, 0], dtype=np.float64)
-        out = cast(dict, vel)
+        x = np.asarray(np.linalg.solve(M, b[:, :, None])[:, :, 0], dtype=np.float64)
+        dest = cast(dict, out)  # the first node places its members' rates too
         for k, g in enumerate(self.group[1:], 1):
-            out[g.name] = v[:, 2 * k:2 * k + 2]
-        return v[:, :2], ok
+            dest[g.name] = x[:, 2 * k:2 * k + 2]
+        return x[:, :2], ok
+
+    def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
+        if not self.members:
+            return vel[self.name], None
+        # (T_i - A_i) . (v_i - vA_i) = 0 and (T_i - T_j) . (v_i - v_j) = 0: six equations in v_1..v_3
+        n = pos[self.name].shape[0]
+        b = np.zeros((n, 6))
+        for i, g in enumerate(self.group):
+            b[:, i] = ((pos[g.name] - pos[g.a]) * vel[g.a]).sum(-1)
+        return self._rates(pos, b, vel)
+
+    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
+                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+        if not self.members:
+            return acc[self.name], None
+        # differentiated again: (T_i - A_i) . (a_i - aA_i) + |v_i - vA_i|^2 = 0,
+        # (T_i - T_j) . (a_i - a_j) + |v_i - v_j|^2 = 0
+        n = pos[self.name].shape[0]
+        b = np.zeros((n, 6))
+        for i, g in enumerate(self.group):
+            dv = vel[g.name] - vel[g.a]
+            b[:, i] = ((pos[g.name] - pos[g.a]) * acc[g.a]).sum(-1) - (dv * dv).sum(-1)
+        for r, (i, j) in enumerate(self._PAIRS, 3):
+            dv = vel[self.group[i].name] - vel[self.group[j].name]
+            b[:, r] = -(dv * dv).sum(-1)
+        return self._rates(pos, b, acc)
