@@ -253,6 +253,8 @@ def build_parser() -> argparse.ArgumentParser:
     ex.add_argument("--kerf-test", default=None, help="a kerf calibration piece (.dxf or .svg)")
     ex.set_defaults(func=_cmd_export)
 
+    __import__("planar.cli_toy", fromlist=["add_parser"]).add_parser(sub)
+
     c = sub.add_parser("catalog", help="write the motion table of a built-in mechanism")
     c.add_argument("mechanism", help="catalog name, e.g. jansen, kangaroo, slider-crank")
     c.add_argument("-o", "--output", required=True, help="CSV file to write")

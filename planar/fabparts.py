@@ -141,7 +141,7 @@ class Feature:
 
 
 def _features(part: Part, s: FabSettings, pinned: set[int], drive_at: tuple[float, float] | None,
-              motor_at: tuple[float, float] | None) -> list[Feature]:
+              motor_at: tuple[float, float] | None, drive_flat: float = math.pi / 2) -> list[Feature]:
     u = s.unit_mm
     out: list[Feature] = []
     for i, f in enumerate(part.features):
@@ -153,7 +153,7 @@ def _features(part: Part, s: FabSettings, pinned: set[int], drive_at: tuple[floa
                     raise FabricationError(f"fabrication.shaft_flat_mm: {s.shaft_flat_mm:g} mm across the flat must be "
                                            f"less than the shaft diameter {s.shaft_mm:g} mm")
                 out.append(Feature("d", f"motor shaft D-hole {s.shaft_mm:g} mm", c, s.shaft_mm / 2,
-                                   flat=s.shaft_flat_mm - s.shaft_mm / 2, t0=math.pi / 2))
+                                   flat=s.shaft_flat_mm - s.shaft_mm / 2, t0=drive_flat))
                 continue
             if motor_at is not None and math.dist(f.centre, motor_at) < 1e-9 * max(1.0, u):
                 d = s.shaft_mm + 4 * s.clearance + 0.5
@@ -344,15 +344,17 @@ def letter_marks(material, holes: list[tuple[tuple[float, float], float, str]], 
 
 def part_cuts(part: Part, s: FabSettings, number: int, pinned: set[int] = frozenset(),  # type: ignore[assignment]
               drive_at: tuple[float, float] | None = None, motor_at: tuple[float, float] | None = None,
-              mounting: bool = False, letters: Sequence[tuple[tuple[float, float], str]] = ()) -> PartCut:
+              mounting: bool = False, letters: Sequence[tuple[tuple[float, float], str]] = (),
+              drive_flat: float = math.pi / 2) -> PartCut:
     """A part's cuts in mm in its own frame, kerf applied, checked (see the module docstring).
 
     ``pinned``: indices of the part's features a pin goes through; ``drive_at`` / ``motor_at``: the
     motor axis (model units, own frame) on the driven part / the plate holding the motor;
-    ``letters``: hole letters at pin positions (model units, own frame).
+    ``letters``: hole letters at pin positions (model units, own frame); ``drive_flat``: direction
+    (rad, own frame) of the D-hole's flat (a toy's cams are keyed to one shaft at their phase).
     """
     k2 = s.kerf / 2.0
-    feats = _features(part, s, set(pinned), drive_at, motor_at)
+    feats = _features(part, s, set(pinned), drive_at, motor_at, drive_flat)
     for f in feats:
         if f.r - k2 <= 0 or (f.kind == "d" and f.flat - k2 <= -(f.r - k2)):
             raise FabricationError(f"part {part.name!r}: {f.what} {2 * f.r:.2f} mm wide is not wider than the "

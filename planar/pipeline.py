@@ -59,7 +59,7 @@ def scene_style(scene: Scene) -> Style:
 
     r = scene.spec.render
     return Style(width=r.width, height=r.height, supersample=r.supersample, background=r.background,
-                 trails=r.trails, show_pins=r.show_pins, opacity=r.opacity)
+                 trails=r.trails, show_pins=r.show_pins, opacity=r.opacity, exploded=r.exploded)
 
 
 def overlay_motion(scene: Scene) -> Motion:

@@ -69,6 +69,8 @@ class Style:
     labels: bool = False
     #: opacity of moving parts' fill (1: opaque); what lies under a part shows through below 1
     opacity: float = 1.0
+    #: a wind-up toy as its exploded stage panels instead of assembled (planar.windup.toy_view)
+    exploded: bool = False
 
 
 def project(part: Part, pts: Array, view: str) -> Array:
@@ -144,7 +146,14 @@ class Renderer:
     trail_motion: Motion | None = None
 
     def __post_init__(self) -> None:
+        from .windup.toy_view import Marks, assembled
 
+        self.marks = Marks()
+        if not self.style.exploded and self.overlay is None:  # toys, #6, #8, #9: the assembled view
+            orig = self.mech
+            self.mech, self.motion, self.marks = assembled(orig, self.motion)
+            if self.mech is not orig and self.trail_motion is not None:
+                self.trail_motion = assembled(orig, self.trail_motion)[1]
         self.view = self.view or getattr(self.mech, "view", "xy")
         s = self.style
         self.S = max(1, int(s.supersample))
@@ -177,7 +186,9 @@ class Renderer:
             self.overlay_parts = [[self._px(r) for r in rings] for rings in ow["parts"]]
         self.base = self._static_layer()
         self.trail_layer = self._trail_layer()
-        self.dot = {c: self._dot(_rgb(c), 2.2) for c in (s.pin, s.trail)}
+        self.dot = {c: self._dot(_rgb(c), 2.2) for c in (s.pin, s.trail, s.invalid)}
+        self.mark_px = ([(self._px(r), c) for r, c in self.marks.rings], [(self._px(r), c) for r, c in self.marks.lines],
+                        [(self._px(r), c) for r, c in self.marks.dots])
 
     # -- geometry, all frames at once --------------------------------------------
     def _world_geometry(self, motion: Motion) -> dict:
@@ -349,6 +360,7 @@ class Renderer:
             self._draw_rings(img, [r[i] for r in self.world_parts[idx]], fill, self.style.opacity)
         for rings in self.sweep_rings:
             self._draw_rings(img, [r[i] for r in rings], _rgb(s.sweep), self.style.opacity)
+        self._draw_marks(img, draw, i)
         if self.trail_layer is not None:
             img.paste(_rgb(s.trail), (0, 0, self.W, self.H), self.trail_layer)
         for rings in self.overlay_parts:
@@ -369,6 +381,20 @@ class Renderer:
         if not valid:
             self._mark_invalid(draw, i)
         return img
+
+    def _draw_marks(self, img, draw, i: int) -> None:
+        """The view's per-frame marks (a #6/#9 pin's oval and contact point, #8's window taper)."""
+        s = self.style
+        rings, lines, dots = self.mark_px
+        for ring, c in rings:
+            self._draw_rings(img, [ring[i]], _rgb(getattr(s, c)))
+        for line, c in lines:
+            draw.line(line[i].ravel().tolist(), fill=_rgb(getattr(s, c)), width=max(1, int(round(self.lw))))
+        for pts, c in dots:
+            dot = self.dot[getattr(s, c)]
+            h = dot.size[0] // 2
+            x, y = pts[i]
+            img.paste(dot, (int(round(x)) - h, int(round(y)) - h), dot)
 
     def _mark_invalid(self, draw, i: int) -> None:
         s = self.style

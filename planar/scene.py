@@ -481,6 +481,8 @@ class RenderSpec(_Strict):
     frames; a GIF plays at most 50. A cycle plays for ``1/speed`` seconds within one frame delay."""
     opacity: Annotated[float, Field(ge=0, le=1)] = 1.0
     """Fill opacity of moving parts, 0-1, e.g. ``0.6``: below 1 what lies under a part shows through."""
+    exploded: bool = False
+    """Draw a wind-up toy as its exploded stage panels instead of assembled (default: assembled), e.g. ``true``."""
 
 
 class FabricationSpec(_Strict):

@@ -157,7 +157,10 @@ def test_every_gallery_scene_exports_checked_files(tmp_path, path):
     for p in fab.layout.parts:
         assert p.label == "" or p.label_height >= s.min_label - 1e-9
     # parts on one layer never overlap at any instant of the cycle (shapely, from the parts' own outlines)
-    motion = scene.mechanism.run(samples_per_cycle=24)
+    from planar.fabexport import _fab_mechanism
+
+    cut = _fab_mechanism(scene.mechanism)  # a wind-up toy is cut as its assembly
+    motion = cut.run(samples_per_cycle=24)
     from shapely import affinity
 
     asm = fab.assembly
@@ -176,7 +179,7 @@ def test_every_gallery_scene_exports_checked_files(tmp_path, path):
 
     rows = list(csv.DictReader((tmp_path / "b.csv").open()))
     parts = [r for r in rows if r["item"] == "part"]
-    assert {r["id"] for r in parts} == {p.name for p in scene.mechanism.parts}
+    assert {r["id"] for r in parts} == {p.name for p in cut.parts}
     for r in rows:
         if r["item"] == "pin":
             lo, hi = map(int, r["layer"].split("-"))
@@ -304,18 +307,19 @@ def test_slots_leave_margin_past_the_pins_travel():
 
 def test_nesting_horse_on_one_sheet_and_several_files(tmp_path):
     scene = load_scene(GALLERY / "horse.toml")
-    fab = export_scene(scene, tmp_path / "h.dxf", sheet=(300, 200))
+    # the Horse is cut as its assembly (one 182 x 142 mm frame, merged parts): one 400 x 300 mm sheet
+    fab = export_scene(scene, tmp_path / "h.dxf", sheet=(400, 300))
     assert fab.layout.sheets == 1 and (tmp_path / "h.dxf").exists()
     area = sum(Polygon(bulge_points(p.outer, math.radians(1))).area if isinstance(p.outer, Contour)
                else math.pi * p.outer.radius ** 2 for p in fab.layout.parts)
-    assert abs(fab.layout.utilisation[0] - area / (300 * 200)) < 1e-3
-    fab = export_scene(scene, tmp_path / "s.dxf", tmp_path / "s.svg", sheet=(160, 120))
+    assert abs(fab.layout.utilisation[0] - area / (400 * 300)) < 1e-3
+    fab = export_scene(scene, tmp_path / "s.dxf", tmp_path / "s.svg", sheet=(200, 160))
     n = fab.layout.sheets
     assert n >= 2
     assert [p.name for p in _sheets(tmp_path, "s", "dxf")] == [f"s-{k + 1}.dxf" for k in range(n)]
     assert not (tmp_path / "s.dxf").exists()
     for k, p in enumerate(_sheets(tmp_path, "s", "dxf")):
-        check_dxf(p, len(fab.layout.on_sheet(k)), fab.settings.kerf, (160, 120))
+        check_dxf(p, len(fab.layout.on_sheet(k)), fab.settings.kerf, (200, 160))
 
 
 def test_drive_and_mounting_holes(tmp_path):
