@@ -19,6 +19,7 @@ from .cams.joint import CamContact
 from .errors import PlanarError
 from .model import ArcSlot, CamOnLine, Hole, Mechanism, Part, PinInArcSlot, PinInSlot, Pivot, Slide, Slot
 from .registry import Registry
+from .linkages.gears import GearMesh
 from .windup.mechanisms import SkewContact
 
 __all__ = ["Contact", "FabricationError", "PIN_RULES", "PinSpec", "joint_pins", "pin_features", "register_contact"]
@@ -107,6 +108,7 @@ def register_contact(kind: type, coplanar: bool) -> None:
 
 
 register_contact(SkewContact, coplanar=False)  # a tilting pin on an edge: across layers
+register_contact(GearMesh, coplanar=True)  # two gears in mesh: one layer
 register_contact(CamContact, coplanar=True)  # a profile cam and its roller or follower: in one layer
 
 

@@ -111,6 +111,9 @@ _NODE_FIELDS = {
     "rrr": ("a", "ra", "b", "rb"),
     "rrp": ("a", "ra", "p", "q"),
     "rigid": ("a", "b", "local"),
+    "geared": ("centre", "radius", "mesh", "ratio"),
+    "driven": ("centre", "radius"),
+    "triad": ("a", "ra", "local", "at"),
 }
 
 
@@ -131,29 +134,40 @@ class NodeSpec(_Strict):
       ``offset``: ``{ name = "S", kind = "rrp", a = "A", ra = 3.0, p = "G1", q = "G2", branch = 1 }``
       (``branch = 1``: the root further along p -> q);
     * ``rigid`` — fixed in the frame of ``a`` (origin) and ``b`` (x axis): coupler points, ternary
-      links: ``{ name = "T", kind = "rigid", a = "Q", b = "A", local = [4.0, 0.0] }``.
+      links: ``{ name = "T", kind = "rigid", a = "Q", b = "A", local = [4.0, 0.0] }``;
+    * ``geared`` — a crank geared to another: ``{ name = "B", kind = "geared", centre = "O2", radius = 1.2,
+      mesh = "A", ratio = -1.0, phase = 90.0 }`` (angle = ratio * angle(mesh) + phase; both centres fixed);
+    * ``driven`` — an input with its own law of the ``[driver]`` clock theta: ``{ name = "B", kind = "driven",
+      centre = "O2", radius = 1.5, cycles = 2.0, phase = 90.0, mean = 110.0, amplitude = 30.0 }``;
+    * ``triad`` — one of three nodes on a ternary link, each ``ra`` from its node ``a``, solved together:
+      ``{ name = "T1", kind = "triad", members = ["T2", "T3"], a = "C", ra = 3.27, local = [0.0, 0.0],
+      at = [2.0, 3.0] }`` (``at``: roughly where it is with the driver at 0; the members give ``a``, ``ra``,
+      ``local``, ``at``).
     """
 
     name: str
     """The node's name (links, points and later nodes refer to it), e.g. ``"B"``."""
-    kind: Literal["fixed", "crank", "actuator", "rrr", "rrp", "rigid"]
-    """One of ``fixed``, ``crank``, ``actuator``, ``rrr``, ``rrp``, ``rigid`` (see the node's description)."""
+    kind: Literal["fixed", "crank", "actuator", "rrr", "rrp", "rigid", "geared", "driven", "triad"]
+    """One of ``fixed``, ``crank``, ``actuator``, ``rrr``, ``rrp``, ``rigid``, ``geared``, ``driven``, ``triad``
+    (see the node's description)."""
     at: tuple[Real, Real] | None = None
-    """``fixed``: the ground point ``[x, y]`` (model units), e.g. ``[-38.0, -7.8]``."""
+    """``fixed``: the ground point ``[x, y]`` (model units), e.g. ``[-38.0, -7.8]``; ``triad``: roughly where the
+    node is with the driver at 0 (picks the assembly)."""
     centre: str | None = None
-    """``crank``: the node it turns about, e.g. ``"O"``."""
+    """``crank``, ``geared``, ``driven``: the node it turns about, e.g. ``"O"``."""
     radius: Pos | None = None
-    """``crank``: its radius (model units), e.g. ``15.0``."""
+    """``crank``, ``geared``, ``driven``: its radius (model units), e.g. ``15.0``."""
     phase: Real = 0.0
-    """``crank``: added to the driver angle (scene's angle unit), e.g. ``90``."""
+    """``crank``: added to the driver angle; ``geared``: added to ratio * angle(mesh); ``driven``: in its law
+    (scene's angle unit), e.g. ``90``."""
     origin: str | None = None
     """``actuator``: the node it translates from, e.g. ``"O"``."""
     axis: tuple[Real, Real] = (1.0, 0.0)
     """``actuator``: the direction it translates along (normalised), e.g. ``[0.0, 1.0]``."""
     a: str | None = None
-    """``rrr``, ``rrp``: the node at distance ``ra``; ``rigid``: the frame's origin node. E.g. ``"A"``."""
+    """``rrr``, ``rrp``, ``triad``: the node at distance ``ra``; ``rigid``: the frame's origin node. E.g. ``"A"``."""
     ra: Pos | None = None
-    """``rrr``, ``rrp``: the link length from ``a`` (model units), e.g. ``50.0``."""
+    """``rrr``, ``rrp``, ``triad``: the link length from ``a`` (model units), e.g. ``50.0``."""
     b: str | None = None
     """``rrr``: the node at distance ``rb``; ``rigid``: the node the frame's x axis points to. E.g. ``"Z"``."""
     rb: Pos | None = None
@@ -169,7 +183,23 @@ class NodeSpec(_Strict):
     """``rrp``: the slot line shifted left of p -> q by this (model units); ``actuator``: added to the
     driver value."""
     local: tuple[Real, Real] | None = None
-    """``rigid``: ``[u, v]`` in the frame of ``a`` (origin) and ``b`` (x axis), model units, e.g. ``[4.0, 0.0]``."""
+    """``rigid``: ``[u, v]`` in the frame of ``a`` (origin) and ``b`` (x axis), model units, e.g. ``[4.0, 0.0]``;
+    ``triad``: the node's place on the ternary link (any frame), e.g. ``[3.0, 0.0]``."""
+    mesh: str | None = None
+    """``geared``: the crank node it meshes with (``crank``, ``geared`` or ``driven``), e.g. ``"A"``."""
+    ratio: Real | None = None
+    """``geared``: angular velocity ratio, negative (external spur gears): angle = ratio * angle(mesh) + phase,
+    e.g. ``-1.0``."""
+    cycles: Pos = 1.0
+    """``driven``: turns (or rocking cycles) per cycle of the ``[driver]`` clock, e.g. ``2.0``."""
+    amplitude: Pos | None = None
+    """``driven``: a rocking input: angle = mean + amplitude sin(cycles theta + phase) (scene's angle unit),
+    e.g. ``30.0``; without it the node turns: angle = phase + cycles theta."""
+    mean: Real = 0.0
+    """``driven``: the middle of a rocking input's swing (scene's angle unit), e.g. ``110.0``."""
+    members: tuple[str, str] | None = None
+    """``triad``: on the triad's first node only, the two other nodes (declared after it), e.g.
+    ``["T2", "T3"]``."""
 
     @model_validator(mode="after")
     def _needs(self) -> "NodeSpec":
@@ -727,8 +757,8 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, A
         nodes = []
         for n in m.nodes:
             cls = NODE_KINDS[n.kind]  # each node kind declares the scene keys it is built from
-            args = [_angle(spec, getattr(n, f)) if f in cls.angle_fields else getattr(n, f)
-                    for f in cls.scene_fields]
+            args = [_angle(spec, getattr(n, f)) if f in cls.angle_fields and getattr(n, f) is not None
+                    else getattr(n, f) for f in cls.scene_fields]
             nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
         links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
         return Linkage(spec.name or "linkage", nodes, links, points=m.points, placement=placement,

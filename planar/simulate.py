@@ -68,6 +68,7 @@ from .model import (
     Slide,
     joint_residuals,
 )
+from .linkages.gears import GearMesh
 from .registry import Registry
 
 if TYPE_CHECKING:
@@ -204,6 +205,7 @@ def _check_mechanism(mech: Mechanism) -> None:
 def _driven_parts(mech: Mechanism) -> list[str]:
     """Parts whose motion is imposed: the driver, and in toys every stage's driver that has no parent."""
     out = [mech.driver.part]
+    out += [p for p in getattr(mech, "extra_driven_parts", []) if p not in out]  # a two-input linkage
     for st in getattr(mech, "stages", []):
         name = f"{st.label}.driver"
         if name not in out:
@@ -519,6 +521,14 @@ def _slide(rb: _Rebuild, j: Slide, effects: Effects | None) -> list[Any]:
     return rb._groove(j.a, s0, s1, j.b, j.anchor) + [rb.pymunk.GearJoint(B[j.a], B[j.b], phase, 1.0)]
 
 
+@REBUILDERS.register(GearMesh)
+def _gear_mesh(rb: _Rebuild, j: GearMesh, effects: Effects | None) -> list[Any]:
+    """A ``GearJoint``: pymunk holds ``ratio_pm * angle_b - angle_a = phase``, so ``ratio_pm = 1 / ratio``."""
+    B = rb.bodies
+    r = 1.0 / j.ratio
+    return [rb.pymunk.GearJoint(B[j.a], B[j.b], r * B[j.b].angle - B[j.a].angle, r)]
+
+
 @REBUILDERS.register(PinInArcSlot)
 def _pin_in_arc_slot(rb: _Rebuild, j: PinInArcSlot, effects: Effects | None) -> list[Any]:
     """The equivalent link: a ``PinJoint`` holding the pin at the arc's radius from its centre."""
@@ -678,6 +688,9 @@ def simulate(mech: Mechanism, t: Array, effects: Effects | None = None,
     dt = dt_out / sub
     if mode == "motor" and (mech.driver.kind != "rotation" or mech.driver.amplitude is not None):
         raise SimulationError(f"{mech.name}: motor mode needs a driver turning at a constant rate")
+    if mode == "motor" and getattr(mech, "extra_driven_parts", []):
+        raise SimulationError(f"{mech.name}: motor mode drives one part; this linkage has more inputs "
+                              f"({', '.join(mech.extra_driven_parts)}), each imposed kinematically")  # type: ignore[attr-defined]
     if mode == "motor" and len(_driven_parts(mech)) > 1:
         raise SimulationError(f"{mech.name}: motor mode drives one part; this toy's stages are drawn apart, "
                               "so each stage's driver must follow its parent kinematically")

@@ -240,6 +240,25 @@ class NodeKind:
         """Which branch (+1 or -1) the node's last position in ``pos`` is on; ``None`` for kinds without one."""
         return None
 
+    def bind(self, where: str, nodes: Mapping[str, "NodeKind"]) -> "NodeKind":
+        """This node, given every node of its linkage (those before it bound): a kind that needs another node's
+        declaration (a gear's partner, a triad's members) returns a copy holding it, or raises :class:`InputError`."""
+        return self
+
+    def velocity_at(self, pos: Mapping[str, Array], vel: Mapping[str, Array], q: Array,
+                    qd: Array) -> tuple[Array, Mask | None]:
+        """:meth:`velocity` for kinds that also need the driver values ``q``."""
+        return self.velocity(pos, vel, qd)
+
+    def acceleration_at(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
+                        q: Array, qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+        """:meth:`acceleration` for kinds that also need the driver values ``q``."""
+        return self.acceleration(pos, vel, acc, qd, qdd)
+
+    def extra_joints(self, lk: "Linkage", hulls: dict[str, list[tuple[float, float, float]]]) -> list:
+        """Joints this node adds beyond those its links imply (a gear mesh); may add hull circles."""
+        return []
+
 
 @node_kind
 @dataclass(frozen=True)
@@ -576,6 +595,17 @@ class Linkage(Mechanism):
         self.nodes: tuple[NodeKind, ...] = tuple(nodes)
         self.placement = tuple(float(v) for v in check_finite(f"{name}.placement", placement))
         self._validate_nodes(name)
+        bound: dict[str, NodeKind] = {n.name: n for n in self.nodes}
+        for n in self.nodes:
+            bound[n.name] = n.bind(f"{name}.nodes.{n.name}", bound)
+        self.nodes = tuple(bound.values())
+        if any(getattr(n, "continued", False) for n in self.nodes):
+            self.branch_reference = 0.0  # a triad's declared assembly holds at driver value 0
+        clocked = [n.name for n in self.nodes if getattr(n, "clocked", False)]
+        if clocked and amplitude is not None:
+            raise InputError(f"{name}.driver.amplitude", amplitude,
+                             f"no amplitude: with driven nodes ({', '.join(clocked)}) the driver is a clock "
+                             "(phase + rate t); give each driven node its own amplitude")
         self.ground_name = ground
         self.links = self._with_ground(tuple(links), ground)
         self._validate_links(name)
@@ -586,7 +616,11 @@ class Linkage(Mechanism):
         self._driver_node = inputs[0]
         driver_link = self._link_of(self._driver_node.name, exclude_ground=True)
         byname = {n.name: n for n in self.nodes}
-        if isinstance(self._driver_node, Crank):
+        make = getattr(self._driver_node, "make_driver", None)
+        if make is not None:
+            c = byname[self._driver_node.centre]  # type: ignore[attr-defined]
+            driver = make(driver_link, c.xy if isinstance(c, Fixed) else (0.0, 0.0), rate, phase)
+        elif isinstance(self._driver_node, Crank):
             c = byname[self._driver_node.centre]
             origin = c.xy if isinstance(c, Fixed) else (0.0, 0.0)
             driver = Driver(driver_link, "rotation", origin=origin, rate=rate, phase=phase,
@@ -841,7 +875,9 @@ class Linkage(Mechanism):
 
     def _solve_points(self, q: Array) -> Solved:
         """The chunked, threaded path (:mod:`planar.linkages.chunked`), else the reference path."""
-        fast = fast_solve(self, q) if q.ndim == 1 and self._declared_branches_hold(q) else None
+        # kinds without a chunk kernel (gears, driven inputs, triads): no plan, straight to the reference path
+        usable = q.ndim == 1 and self._fast_plan() is not None
+        fast = fast_solve(self, q) if usable and self._declared_branches_hold(q) else None
         if fast is not None:
             return fast
         return super()._solve_points(q)
@@ -868,7 +904,7 @@ class Linkage(Mechanism):
             valid &= m
         vel: dict[str, Array] = {}
         for node in self.nodes:
-            v, ok = node.velocity(pos, vel, qd)
+            v, ok = node.velocity_at(pos, vel, qa, qd)
             vel[node.name] = v
             if ok is not None:
                 valid &= ok
@@ -897,9 +933,9 @@ class Linkage(Mechanism):
         vel: dict[str, Array] = {}
         acc: dict[str, Array] = {}
         for node in self.nodes:
-            v, ok = node.velocity(pos, vel, qd)
+            v, ok = node.velocity_at(pos, vel, qa, qd)
             vel[node.name] = v
-            a, ok2 = node.acceleration(pos, vel, acc, qd, qdd)
+            a, ok2 = node.acceleration_at(pos, vel, acc, qa, qd, qdd)
             acc[node.name] = a
             for mask in (ok, ok2):
                 if mask is not None:
@@ -981,6 +1017,8 @@ class Linkage(Mechanism):
         for (guide, nd), lk in guided.items():
             assert guide is not None
             self._block_slide(lk, nd, guide, hulls, joints)
+        for node in self.nodes:
+            joints.extend(node.extra_joints(self, hulls))
         parts = []
         for lk in self.links:
             hull = hulls[lk.name] or [(0.0, 0.0, r)]
@@ -1032,6 +1070,32 @@ class Linkage(Mechanism):
             hulls[lk.name].append((px, py, self.width / 2))
         joints.append(Slide(f"{lk.name}-slide", owner, lk.name, start, end, pins[0], (2 * self.width, 0.0),
                             width=self.pin_diameter))
+
+    @property
+    def extra_driven_parts(self) -> list[str]:
+        """Links of the inputs beyond the first that no gear ties to it (a simulation imposes their motion)."""
+        return [self._link_of(n.name, exclude_ground=True) for n in self.nodes
+                if getattr(n, "clocked", False) and n is not self._driver_node]
+
+    def input_values(self, q: ArrayLike) -> dict[str, Array]:
+        """Each input node's value (crank angle, rad, unwrapped) at driver values ``q`` when there are several.
+
+        Empty for a single-input linkage (its value is the driver value).
+        """
+        inputs = [n for n in self.nodes if n.is_input]
+        if len(inputs) < 2:
+            return {}
+        qa = np.atleast_1d(np.asarray(q, float))
+        out: dict[str, Array] = {}
+        for n in inputs:
+            own = getattr(n, "input_angle", None)  # a geared or driven node's law
+            if own is not None:
+                out[n.name] = own(qa)
+            elif isinstance(n, Crank):
+                out[n.name] = qa + n.phase
+            elif isinstance(n, Actuator):
+                out[n.name] = qa + n.offset
+        return out
 
     def node_positions(self, q) -> dict[str, Array]:
         """World positions ``(N, 2)`` of every node, placement applied."""
