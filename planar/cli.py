@@ -76,8 +76,13 @@ def _cmd_render(args: argparse.Namespace) -> int:
 
     scene = load_scene(args.scene)
     overlay = overlay_motion(scene) if args.overlay else None
+    from .pipeline import animation_plan
+
+    plan = animation_plan(scene, args.output, args.fps)
+    if plan.note():
+        print(f"note: {plan.note()}")
     n = render_scene(scene, args.output, overlay=overlay, fps=args.fps)
-    print(f"wrote {args.output}: {n} frames")
+    print(f"wrote {args.output}: {n} frames, {plan.fps:.3g} frames/s, a cycle plays {plan.cycle_play_s:.3g} s")
     return 0
 
 

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 from .errors import InputError
 
 if TYPE_CHECKING:
+    from .animation import FramePlan
     from .compare import Comparison
     from .fabexport import Fabrication
     from .model import Mechanism, Motion
@@ -80,6 +81,15 @@ def overlay_motion(scene: Scene) -> Motion:
 ANIMATION_SUFFIXES = (".gif", ".mp4", ".webm")
 
 
+def animation_plan(scene: Scene, out: str | Path, fps: float | None = None) -> "FramePlan":
+    """The frames ``render_scene`` draws for ``out`` (GIF delays are whole 10 ms ticks; video any rate)."""
+    from .animation import plan_frames, scene_duration
+
+    fps = fps if fps is not None else scene.spec.render.fps
+    return plan_frames(scene.mechanism.driver.period, scene_duration(scene), fps,
+                       tick_ms=10.0 if Path(out).suffix.lower() == ".gif" else None)
+
+
 def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, progress: bool = True,
                  fps: float | None = None) -> int:
     """Render a scene's analytic motion (and optionally an overlay motion) to ``out``; returns the frame count.
@@ -91,7 +101,7 @@ def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, p
     ``[render] fps``) sets the frame rate.  The overlay, a simulated motion
     with sample times, is interpolated to the frame instants.
     """
-    from .animation import animation_motion, plan_frames, resample, scene_duration
+    from .animation import animation_motion, resample
     from .errors import InputError
     from .render import Renderer, palette_colors
 
@@ -104,9 +114,7 @@ def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, p
         if not video_available():
             raise InputError("-o", str(out), f"the video extra for {suffix} output: pip install 'planar[video]' "
                                              "(imageio-ffmpeg), or write a .gif")
-    fps = fps if fps is not None else scene.spec.render.fps
-    plan = plan_frames(scene.mechanism.driver.period, scene_duration(scene), fps,
-                       tick_ms=10.0 if suffix == ".gif" else None)
+    plan = animation_plan(scene, out, fps)
     motion, fine = animation_motion(scene, plan)
     if overlay is not None:
         overlay = resample(overlay, plan.times())
