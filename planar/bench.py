@@ -682,10 +682,11 @@ BENCHMARKS["accuracy"] = (bench_accuracy, format_accuracy)
 
 def _bare_space(mech, t, settings):
     """The same pymunk space planar builds (bodies, joints, pins), placed at the first sample, and its step count."""
-    from .simulate import _analytic_pose_velocity, _Rebuild
+    from .simulate import _analytic_pose_velocity, _Rebuild, substeps_for
 
-    dt = float(t[1] - t[0]) / settings.substeps
     poses, vel, analytic = _analytic_pose_velocity(mech, t)
+    sub = substeps_for(mech, poses, vel, float(t[1] - t[0]), settings)
+    dt = float(t[1] - t[0]) / sub
     rb = _Rebuild(mech, analytic, None, settings, "kinematic", dt)
     comp = rb.compensation()
     if comp:
@@ -693,7 +694,7 @@ def _bare_space(mech, t, settings):
     rb.set_state({k: v[0] for k, v in poses.items()}, {k: v[0] for k, v in vel.items()})
     drv = rb.bodies[mech.driver.part]
     drv.angular_velocity = mech.driver.rate * dt  # one time unit per step, as planar runs it
-    return rb.space, (t.size - 1) * settings.substeps
+    return rb.space, (t.size - 1) * sub
 
 
 def bench_sim(n: int = 360, repeats: int = 7) -> dict[str, Any]:
@@ -736,6 +737,7 @@ def bench_sim(n: int = 360, repeats: int = 7) -> dict[str, Any]:
             "ratio": float(np.median(ratios)),
             "ratio_spread": [float(min(ratios)), float(max(ratios))],
             "steps": int(r.steps),
+            "substeps": int(r.built["substeps"]),
             "iterations": int(r.built["iterations"]),
         }
     worst = max(out["mechanisms"].values(), key=lambda m: m["ratio"])

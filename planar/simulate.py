@@ -82,6 +82,7 @@ __all__ = [
     "mass_properties",
     "simulate",
     "simulate_scene",
+    "joint_drift",
     "substeps_for",
     "torque_comparison",
 ]
@@ -247,25 +248,16 @@ def solver_iterations(settings: SimSettings, masses: list[float]) -> int:
     return math.ceil(settings.iterations * (1.0 + math.log10(ratio)))
 
 
-def substeps_for(mech: Mechanism, poses: dict[str, Array], vel: dict[str, Array], dt_out: float,
-                 settings: SimSettings) -> int:
-    """Physics steps per output sample: ``settings.substeps``, raised for fast-turning joints.
+def joint_drift(mech: Mechanism, poses: dict[str, Array], vel: dict[str, Array]) -> float:
+    """Largest rate at which a linear position update parts a joint's two sides, / size (1/s^2).
 
-    A step moves every body along a straight line with its new velocity,
-    so a point at ``r`` from a body's centre that turns at ``w`` (rad/s)
-    ends ``w^2 |r| dt^2`` (to second order, up to a half) off its arc.  At a
-    joint the two sides' points part by ``|w_a^2 r_a - w_b^2 r_b| dt^2``;
-    the error correction takes out a fraction per step, so the standing
-    joint error, and the pose error it causes, scale with that drift.
-    With ``settings.step_drift`` given, the substeps are the fewest (at
-    least ``settings.substeps``, at most :data:`MAX_SUBSTEP_FACTOR` times
-    it) that keep the largest drift over the cycle (analytic ``poses`` and
-    velocities ``vel`` at the output samples, ``dt_out`` s apart) at most
-    ``step_drift`` of the size per step.
+    A step moves every body along a straight line with its new velocity, so
+    a point at ``r`` from a body's centre that turns at ``w`` (rad/s) ends
+    about ``w^2 |r| dt^2`` off its arc; at a joint the two sides' points part
+    by ``|w_a^2 r_a - w_b^2 r_b| dt^2``.  Returned: the largest
+    ``|w_a^2 r_a - w_b^2 r_b| / size`` over the joints (at their first pin)
+    and over the analytic ``poses`` and velocities ``vel`` (per second).
     """
-    base = settings.substeps
-    if settings.step_drift is None:
-        return base
     size = mech.size
     worst = 0.0
     for j in mech.joints:
@@ -282,7 +274,25 @@ def substeps_for(mech: Mechanism, poses: dict[str, Array], vel: dict[str, Array]
             c = poses_apply(poses[side], np.asarray(mass_properties(p, 1.0)[1], float))
             acc += sign * (vel[side][:, 2] ** 2)[:, None] * (w - c)
         worst = max(worst, float(np.nanmax(np.hypot(acc[:, 0], acc[:, 1]))))
-    need = dt_out * math.sqrt(worst / (size * settings.step_drift))
+    return worst / size
+
+
+def substeps_for(mech: Mechanism, poses: dict[str, Array], vel: dict[str, Array], dt_out: float,
+                 settings: SimSettings) -> int:
+    """Physics steps per output sample: ``settings.substeps``, raised for fast-turning joints.
+
+    The error correction takes out a fraction ``c`` of a joint's error per
+    step, so a drift ``d`` per step (:func:`joint_drift` x step^2) stands at
+    ``d (1 - c) / c``, and the pose error it causes with it.  With
+    ``settings.step_drift`` given, the substeps are the fewest (at least
+    ``settings.substeps``, at most :data:`MAX_SUBSTEP_FACTOR` times it) that
+    keep ``d`` at most ``step_drift`` of the size (output samples ``dt_out``
+    s apart).
+    """
+    base = settings.substeps
+    if settings.step_drift is None:
+        return base
+    need = dt_out * math.sqrt(joint_drift(mech, poses, vel) / settings.step_drift)
     return int(min(max(base, math.ceil(need - 1e-9)), base * MAX_SUBSTEP_FACTOR))
 
 
