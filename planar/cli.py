@@ -116,13 +116,15 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     from .compare import EXIT_MISMATCH, format_comparison
     from .pipeline import compare_scene
     from .scene import load_scene
+    from dataclasses import replace
+
     from .simulate import SimSettings
 
     scene = load_scene(args.scene)
-    drift = None if args.step_drift == 0 else args.step_drift
     settings = SimSettings(**{k: v for k, v in (("substeps", args.substeps), ("iterations", args.iterations),
-                                                 ("error_bias", args.error_bias)) if v is not None},
-                           **({} if args.step_drift is None else {"step_drift": drift}))
+                                                 ("error_bias", args.error_bias)) if v is not None})
+    if args.step_drift is not None:  # 0: fixed substeps
+        settings = replace(settings, step_drift=args.step_drift or None)
     result, sim = compare_scene(scene, settings, args.threshold, args.torque_threshold, with_series=args.json)
     t = sim.motion.t
     assert t is not None  # a simulation records its output times
