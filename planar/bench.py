@@ -574,7 +574,7 @@ def _effects_cost(repeats: int = 3, fraction: float = 1.0) -> dict[str, float]:
                           "coupler_point": [2.0, 1.0]}, "driver": {"samples_per_cycle": 360}}
     variants = {
         "none": None,
-        "unused": {"contact": False, "springs": [], "loads": []},
+        "unused": {"springs": [], "loads": []},
         "gravity": {"gravity": [0.0, -9.81]},
         "damping": {"damping": 0.5},
     }

@@ -208,13 +208,20 @@ class EffectsSpec(_Strict):
     """Physical effects for the physics rebuild; none unless named."""
 
     gravity: tuple[Real, Real] | None = None
-    contact: bool = False
-    friction: Annotated[float, Field(ge=0)] | None = None
     damping: Annotated[float, Field(gt=0, le=1)] | None = None
     density: Pos = 1.0
     springs: list[SpringSpec] = []
     loads: list[LoadSpec] = []
     motor_force_limit: Pos | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_contact(cls, data: Any) -> Any:
+        for key in ("contact", "friction"):
+            if isinstance(data, dict) and key in data:
+                raise ValueError(f"'{key}' was removed: the parts of a mechanism sit on layers and never touch, "
+                                 "so collisions (and their friction) are not simulated; delete the key")
+        return data
 
 
 class RenderSpec(_Strict):
@@ -344,7 +351,7 @@ class Scene:
         e = self.spec.effects
         return Effects(
             gravity=None if e.gravity is None else (float(e.gravity[0]), float(e.gravity[1])),
-            contact=e.contact, friction=e.friction, damping=e.damping, density=e.density,
+            damping=e.damping, density=e.density,
             springs=tuple(Spring(s.a, s.b, s.stiffness, (float(s.anchor_a[0]), float(s.anchor_a[1])),
                                  (float(s.anchor_b[0]), float(s.anchor_b[1])), s.rest_length, s.damping)
                           for s in e.springs),

@@ -28,10 +28,11 @@ the same at any rate and step, and never underflows (pymunk's per-second
 ``error_bias`` cannot express more than ~3 % per step at 64 substeps of a
 1 s cycle).  Velocities, forces, stiffnesses and damping are scaled to match.
 
-Only the effects a scene names exist in the space: no gravity, friction,
-damping, springs or loads otherwise (``SimResult.built`` lists what was
-built).  Wind-up #6 and #9 are spatial and are refused, as is
-``contact = true`` (parts of one mechanism sit in layers and never touch).
+Only the effects a scene names exist in the space: no gravity, damping,
+springs or loads otherwise (``SimResult.built`` lists what was built).
+Wind-up #6 and #9 are spatial and are refused.  There are no collisions:
+the parts of a mechanism sit on layers and never touch (a scene's
+``contact`` and ``friction`` keys are refused when the scene is read).
 
 Failures are found by comparing poses, in blocks of samples with arrays:
 a sample where any part leaves its analytic pose by more than
@@ -370,12 +371,8 @@ class _Rebuild:
         self.mode = mode
         self.dt = dt
         space = pymunk.Space()
-        built: dict[str, Any] = {"gravity": None, "shapes": 0, "friction": None, "damping": None,
+        built: dict[str, Any] = {"gravity": None, "damping": None,
                                  "springs": 0, "loads": 0, "constraints": 0, "bodies": 0}
-        if effects is not None and effects.contact:
-            raise SimulationError(
-                f"{mech.name}: [effects] contact = true is not supported: the parts of a mechanism sit in "
-                "layers and never touch each other; remove 'contact' from the scene")
         if effects is not None and effects.gravity is not None:
             space.gravity = (float(effects.gravity[0]) * dt * dt, float(effects.gravity[1]) * dt * dt)
             built["gravity"] = tuple(effects.gravity)
