@@ -572,7 +572,7 @@ def _effects_cost(repeats: int = 3, fraction: float = 1.0) -> dict[str, float]:
 
     base = {"mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0,
                           "coupler_point": [2.0, 1.0]}, "driver": {"samples_per_cycle": 360}}
-    variants = {
+    variants: dict[str, dict[str, Any] | None] = {
         "none": None,
         "unused": {"springs": [], "loads": []},
         "gravity": {"gravity": [0.0, -9.81]},
