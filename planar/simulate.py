@@ -279,7 +279,7 @@ def joint_drift(mech: Mechanism, poses: dict[str, Array], vel: dict[str, Array])
 
 
 def substeps_for(mech: Mechanism, poses: dict[str, Array], vel: dict[str, Array], dt_out: float,
-                 settings: SimSettings) -> int:
+                 settings: SimSettings, correction: float | None = None) -> int:
     """Physics steps per output sample: ``settings.substeps``, raised for fast-turning joints.
 
     The error correction takes out a fraction ``c`` of a joint's error per
@@ -288,16 +288,45 @@ def substeps_for(mech: Mechanism, poses: dict[str, Array], vel: dict[str, Array]
     ``settings.step_drift`` given, the substeps are the fewest (at least
     ``settings.substeps``, at most :data:`MAX_SUBSTEP_FACTOR` times it) that
     keep ``d`` at most ``step_drift`` of the size (output samples ``dt_out``
-    s apart).
+    s apart).  ``correction``: the correction per step the solver will use
+    when lower than the settings' (see :func:`mass_ratio_correction`); the
+    substeps rise so that ``d (1 - c) / c`` stays what the settings ask.
     """
+    if correction is None:
+        correction = settings.correction
     base = settings.substeps
     if settings.step_drift is None:
         return base
     need = dt_out * math.sqrt(joint_drift(mech, poses, vel) / settings.step_drift)
+    c0 = settings.correction
+    if settings.error_bias is None and 0.0 < correction < c0 < 1.0:
+        # a correction lowered for a mass ratio leaves more of the drift standing, d (1 - c) / c: more
+        # substeps keep the standing error where the settings' correction would have it
+        need *= math.sqrt(c0 * (1.0 - correction) / (correction * (1.0 - c0)))
     return int(min(max(base, math.ceil(need - 1e-9)), base * MAX_SUBSTEP_FACTOR))
 
 
 _MASS_RATIO_CORRECTION = 0.05
+
+
+def mass_ratio_correction(settings: SimSettings, masses: list[float]) -> float:
+    """Correction per step for bodies of these masses (``settings.correction`` unless
+    iterations were raised for a mass ratio, then at most 0.05; see :func:`solver_iterations`)."""
+    c = settings.correction
+    if settings.adaptive and solver_iterations(settings, masses) > settings.iterations:
+        # strong correction of a light part against a heavy one overshoots: measured on a four-bar with a
+        # 1:1000 rocker/coupler mass ratio, 0.05 per step holds to 3e-4 of the size, 0.1 and more fly off
+        c = min(c, _MASS_RATIO_CORRECTION)
+    return c
+
+
+def moving_masses(mech: Mechanism, mode: str, effects: Effects | None,
+                  densities: dict[str, float] | None = None) -> list[float]:
+    """Masses of the parts that move under the solver (not ground, not an imposed driver)."""
+    density = effects.density if effects is not None else 1.0
+    driven = _driven_parts(mech)
+    return [mass_properties(p, (densities or {}).get(p.name, density))[0] for p in mech.parts
+            if not p.ground and not (p.name in driven and mode == "kinematic")]
 _PIN_FRACTION = 0.1  # pin mass / its part's mass (see _Rebuild._pin)
 
 
@@ -425,8 +454,6 @@ class _Rebuild:
         built["imposed"] = []
         self.correction = settings.step_correction(dt)
         if settings.adaptive and self.iterations > settings.iterations:
-            # strong correction of a light part against a heavy one overshoots: measured on a four-bar with a
-            # 1:1000 rocker/coupler mass ratio, 0.05 per step holds to 3e-4 of the size, 0.1 and more fly off
             self.correction = min(self.correction, _MASS_RATIO_CORRECTION)
         built["correction"] = self.correction
         bias = 1.0 - self.correction  # error left per step = per time unit here
@@ -735,7 +762,8 @@ def simulate(mech: Mechanism, t: Array, effects: Effects | None = None,
         i = int(np.flatnonzero(~analytic.valid)[0])
         raise SimulationError(f"{mech.name}: the analytic motion is invalid at sample {i} "
                               f"({analytic.reason(i)}); the rebuild needs an assemblable cycle")
-    sub = substeps_for(mech, poses_a, vel_a, dt_out, settings)
+    sub = substeps_for(mech, poses_a, vel_a, dt_out, settings,
+                       mass_ratio_correction(settings, moving_masses(mech, mode, effects, densities)))
     dt = dt_out / sub
     rb = _Rebuild(mech, analytic, effects, settings, mode, dt, densities)
     comp = rb.compensation()
