@@ -614,8 +614,11 @@ def _accuracy_chart(path, agg: list[dict[str, Any]]) -> None:
     dflt = [i for i, a in enumerate(agg) if a["default"]]
     for axis, y, label, line in ((ax, e, "worst position error / size (kinematic and motor mode)", 1e-4),
                                  (ax2, tq, "worst motor torque error / peak", 1e-2)):
-        y = np.where(np.isfinite(y), y, 1.0)
-        axis.scatter(t[~f], y[~f], s=14, c="#9a9a9a", label="setting")
+        bad = ~np.isfinite(y)
+        y = np.where(bad, 1.0, y)
+        axis.scatter(t[~f & ~bad], y[~f & ~bad], s=14, c="#9a9a9a", label="setting")
+        if bad.any():
+            axis.scatter(t[bad], y[bad], s=18, marker="x", c="#9a9a9a", label="failed somewhere (drawn at 1)")
         axis.plot(t[f][order], y[f][order], "-o", c="#4e79a7", ms=4, label="Pareto frontier (positions)")
         adapt = np.array([a.get("step_drift") is not None and not a["default"] for a in agg])
         if adapt.any():
