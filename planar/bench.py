@@ -690,10 +690,10 @@ def _bare_space(mech, t, settings):
     poses, vel, analytic = _analytic_pose_velocity(mech, t)
     sub = substeps_for(mech, poses, vel, float(t[1] - t[0]), settings)
     dt = float(t[1] - t[0]) / sub
-    rb = _Rebuild(mech, analytic, None, settings, "kinematic", dt, substeps=sub)
+    rb = _Rebuild(mech, analytic, None, settings, "kinematic", dt)
     comp = rb.compensation()
     if comp:
-        rb = _Rebuild(mech, analytic, None, settings, "kinematic", dt, overrides=comp, substeps=sub)
+        rb = _Rebuild(mech, analytic, None, settings, "kinematic", dt, overrides=comp)
     rb.set_state({k: v[0] for k, v in poses.items()}, {k: v[0] for k, v in vel.items()})
     drv = rb.bodies[mech.driver.part]
     drv.angular_velocity = mech.driver.rate * dt  # one time unit per step, as planar runs it
