@@ -634,6 +634,11 @@ def _accuracy_chart(path, agg: list[dict[str, Any]]) -> None:
         axis.axhline(line, ls=":", c="#e15759", lw=1)
         axis.set_xscale("log")
         axis.set_yscale("log")
+        from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+        axis.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+        axis.xaxis.set_minor_formatter(NullFormatter())  # minor labels overlap on less than two decades
+        axis.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
         axis.set_xlabel("wall seconds per simulated second (all gallery mechanisms)")
         axis.set_ylabel(label)
         axis.legend(loc="upper right", fontsize=8)
