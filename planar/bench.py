@@ -669,9 +669,12 @@ def format_accuracy(r: dict[str, Any]) -> str:
         lines.append(f"  defaults before issue 12 ({p['setting']}): worst error {p['max_error']:.2e}, torque "
                      f"{p['torque_error']:.2e}, {p['seconds_per_sim_second']:.3f} s per simulated second "
                      f"(defaults / before = {d['seconds_per_sim_second'] / p['seconds_per_sim_second']:.2f})")
+    def num(x: float) -> str:
+        return "-" if math.isnan(x) else f"{x:.2e}"  # "-": no steady motor (a rocking driver, staged toys)
+
     for k, v in sorted(r["default_errors"].items()):
-        lines.append(f"    {k:<22} substeps {v['substeps']:>3}  kinematic {v['kinematic']:.2e}  motor {v['motor']:.2e}"
-                     f"  torque {v['torque']:.2e}")
+        lines.append(f"    {k:<22} substeps {v['substeps']:>3}  kinematic {num(v['kinematic']):>8}  "
+                     f"motor {num(v['motor']):>8}  torque {num(v['torque']):>8}")
     for k, v in r["skipped"].items():
         lines.append(f"  skipped {k}: {v}")
     ec = r["effects_cost"]
