@@ -157,3 +157,38 @@ def test_jansen_motor_mode_holds_at_many_steps_per_turn(samples, substeps):
     tc = torque_comparison(sc.mechanism, t, None, st)
     assert tc["substeps"] * samples == 4608
     assert tc["failure"] is None and tc["pose_error"] < 1e-4 and tc["max_rel_diff"] < 1e-2
+
+
+def _long_kangaroo(factor):
+    import tomllib
+
+    from planar.scene import build_scene, parse_scene
+
+    data = tomllib.loads((GALLERY / "kangaroo-leg.toml").read_text())
+    data["render"].pop("sweep", None)
+    data["mechanism"]["polygons"] = []
+    data["mechanism"]["coupler_point"] = [5.5 * factor, -2.0 * factor]
+    return build_scene(parse_scene(data))
+
+
+def test_a_long_lever_raises_substeps_and_iterations():
+    # the kangaroo leg with its coupler point 10x further out: the coupler reaches ~15x its joints' spacing,
+    # so joint errors come out 15x larger in its pose; the motor run flew off at the plain settings
+    from planar.simulate import lever
+
+    sc = _long_kangaroo(10)
+    mech, ref = sc.mechanism, sc.motion()
+    assert 10 < lever(mech, ref.poses) < 20
+    assert lever(load_scene(GALLERY / "kangaroo-leg.toml").mechanism, ref.poses) < 4  # gallery: below 4
+    sim = simulate(mech, ref.t, sc.effects)
+    assert sim.built["substeps"] > 2 * DEFAULT_SETTINGS.substeps and sim.built["iterations"] > 4 * 40
+    assert sim.failure is None and compare(mech, ref, sim.motion).max_rel_error < 1e-4
+    tc = torque_comparison(mech, ref.t, sc.effects)
+    assert tc["failure"] is None and tc["pose_error"] < 1e-4 and tc["max_rel_diff"] < 1e-2
+
+
+def test_a_lever_beyond_the_solver_is_reported():
+    # 100x further out (lever 150): no affordable setting holds it; the run stops, reported with its sample
+    sc = _long_kangaroo(100)
+    sim = simulate(sc.mechanism, sc.motion().t, sc.effects)
+    assert sim.failure is not None and "sample" in sim.failure.message
