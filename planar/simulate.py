@@ -110,9 +110,11 @@ class SimSettings:
 
     ``substeps``: physics steps per output sample; ``iterations``: solver
     iterations per step (raised automatically where the moving parts'
-    masses differ a lot, see :func:`solver_iterations`, unless ``adaptive``
-    is off); ``correction``: fraction of a joint's position error corrected
-    per step (0 = none, 1 = all of it in one step); ``error_bias``: pymunk's
+    masses differ a lot, see :func:`solver_iterations`, or a part is a long
+    lever, see :func:`lever`, unless ``adaptive`` is off); ``correction``:
+    fraction of a joint's position error corrected per step (0 = none, 1 =
+    all of it in one step; lowered for mass ratios and, in motor mode, past
+    2400 steps per turn, unless ``adaptive`` is off); ``error_bias``: pymunk's
     fraction of joint error left uncorrected after one second, if given it
     replaces ``correction`` (``correction = 1 - error_bias ** dt``);
     ``tolerance``: a part further than this fraction of the mechanism's size
