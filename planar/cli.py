@@ -230,7 +230,7 @@ def build_parser() -> argparse.ArgumentParser:
     cp.add_argument("--torque-threshold", type=float, default=0.01,
                     help="motor torque vs inverse dynamics, fraction of its peak (0.01)")
     cp.add_argument("--substeps", type=int, default=None,
-                    help="physics steps per sample, at least (32); raised where joints turn fast, see --step-drift")
+                    help="physics steps per sample, at least (28); raised where joints turn fast, see --step-drift")
     cp.add_argument("--step-drift", type=float, default=None,
                     help="largest predicted joint drift per step, fraction of size (3.5e-6); 0 keeps --substeps fixed")
     cp.add_argument("--iterations", type=int, default=None, help="solver iterations per step, at least (40)")

@@ -125,7 +125,7 @@ class SimSettings:
     (see :func:`substeps_for`); ``None`` keeps ``substeps`` as it is.
     """
 
-    substeps: int = 32
+    substeps: int = 28
     iterations: int = 40
     correction: float = 0.2
     error_bias: float | None = None
