@@ -113,11 +113,11 @@ def _cmd_schema(args: argparse.Namespace) -> int:
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
+    from dataclasses import replace
+
     from .compare import EXIT_MISMATCH, format_comparison
     from .pipeline import compare_scene
     from .scene import load_scene
-    from dataclasses import replace
-
     from .simulate import SimSettings
 
     scene = load_scene(args.scene)
