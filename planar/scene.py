@@ -443,10 +443,6 @@ class EffectsSpec(_Strict):
 
     gravity: tuple[Real, Real] | None = None
     """``[gx, gy]`` in model units per s^2, e.g. ``[0.0, -9.81]``; none unless given."""
-    contact: bool = False
-    """Collisions between parts: refused (``true`` is an error; parts sit in layers and never touch)."""
-    friction: Annotated[float, Field(ge=0)] | None = None
-    """Friction coefficient of the rebuild's contacts (kept for the schema; contacts are refused)."""
     damping: Annotated[float, Field(gt=0, le=1)] | None = None
     """Space damping: fraction of every body's velocity kept per second, in (0, 1], e.g. ``0.99``."""
     density: Pos = 1.0
@@ -457,6 +453,15 @@ class EffectsSpec(_Strict):
     """Forces at named points: ``[{ point = "coupler_point", force = [0.0, 10.0] }]``."""
     motor_force_limit: Pos | None = None
     """``compare`` drives with a motor of this largest torque instead of an exact input, e.g. ``50.0``."""
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_contact(cls, data: Any) -> Any:
+        for key in ("contact", "friction"):
+            if isinstance(data, dict) and key in data:
+                raise ValueError(f"'{key}' was removed: the parts of a mechanism sit on layers and never touch, "
+                                 "so collisions (and their friction) are not simulated; delete the key")
+        return data
 
 
 class RenderSpec(_Strict):
@@ -645,7 +650,7 @@ class Scene:
         e = self.spec.effects
         return Effects(
             gravity=None if e.gravity is None else (float(e.gravity[0]), float(e.gravity[1])),
-            contact=e.contact, friction=e.friction, damping=e.damping, density=e.density,
+            damping=e.damping, density=e.density,
             springs=tuple(Spring(s.a, s.b, s.stiffness, (float(s.anchor_a[0]), float(s.anchor_a[1])),
                                  (float(s.anchor_b[0]), float(s.anchor_b[1])), s.rest_length, s.damping)
                           for s in e.springs),
