@@ -26,8 +26,7 @@ __all__ = ["FourBarDesign", "synthesise_path", "SIXBAR_REFUSAL"]
 Array = NDArray[np.float64]
 
 #: what ``--type sixbar`` answers (six-bar path synthesis is not built)
-SIXBAR_REFUSAL = ("six-bar (Watt, Stephenson) path synthesis is not implemented yet; "
-                  "use --type fourbar")
+SIXBAR_REFUSAL = "six-bar (Watt, Stephenson) path synthesis is not implemented; use --type fourbar"
 
 
 @dataclass
