@@ -188,7 +188,8 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("-n", type=int, default=None, help="problem size (samples)")
     b.add_argument("--repeats", type=int, default=None, help="timing repeats (best is kept)")
     b.add_argument("-o", "--output", default="planar-bench-accuracy", help="accuracy: folder for the CSV and chart")
-    b.add_argument("--quick", action="store_true", help="accuracy: a small grid on three mechanisms; synthesis: one repeat, small budgets")
+    b.add_argument("--quick", action="store_true",
+                   help="accuracy: a small grid on three mechanisms; synthesis: one repeat, small budgets")
     b.add_argument("--scenes", default="gallery",
                    help="accuracy: folder of scene files to measure (default: ./gallery, the repository's)")
     b.set_defaults(func=_cmd_bench)

@@ -168,14 +168,11 @@ def bench_synthesis(repeats: int = 3, quick: bool = False, n: int | None = None,
         ours: list[FourBarDesign] = []
         peer: list[dict[str, Any]] = []
         for r in range(repeats):
-            def run_planar(r: int = r) -> None:
-                ours.append(synthesise_path(t, th, Constraints(), budget=budget, seed=r))
-
-            def run_peer() -> None:
-                peer.append(_pylinkage_run(name, prob, quick, require_grashof=True))
-
-            for fn in ((run_planar, run_peer) if r % 2 == 0 else (run_peer, run_planar)):
-                fn()
+            for side in (("planar", "peer") if r % 2 == 0 else ("peer", "planar")):
+                if side == "planar":
+                    ours.append(synthesise_path(t, th, Constraints(), budget=budget, seed=r))
+                else:
+                    peer.append(_pylinkage_run(name, prob, quick, require_grashof=True))
         loose = _pylinkage_run(name, prob, quick, require_grashof=False)
         best = min(ours, key=lambda d: d.sse)
         times = [d.seconds for d in ours]

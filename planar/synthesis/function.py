@@ -88,7 +88,7 @@ def freudenstein_fit(phi: Array, psi: Array, ground: float = 1.0) -> FunctionDes
     b = float(np.sqrt(b2))
     best: tuple[float, str, Array] | None = None
     for circuit in ("open", "crossed"):
-        _, th4, ok = freudenstein_angles(a, b, c, d, phi, circuit)  # type: ignore[arg-type]
+        _, th4, ok = freudenstein_angles(a, b, c, d, phi, circuit)
         err = np.where(ok, _wrap(th4 - psi), np.inf)
         e = float(np.max(np.abs(err)))
         if best is None or e < best[0]:

@@ -99,7 +99,7 @@ def check_design(d: FourBarDesign, kernel_points: Array | None = None) -> None:
 def synthesise_path(
     targets: Array,
     theta: Array | None = None,
-    cons: Constraints = Constraints(),
+    cons: Constraints | None = None,
     budget: str = "normal",
     seed: int = 0,
 ) -> FourBarDesign:
@@ -110,6 +110,7 @@ def synthesise_path(
     ``"normal"`` or ``"thorough"``.  Raises :class:`InputError` for fewer
     than 3 targets or mismatched lengths.
     """
+    cons = cons if cons is not None else Constraints()
     t = np.asarray(targets, float)
     if t.ndim != 2 or t.shape[1] != 2 or len(t) < 3:
         raise InputError("targets", t.shape, "3 or more (x, y) points")

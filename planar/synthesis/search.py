@@ -199,7 +199,7 @@ def _refine(obj: PathObjective, row: Array, bounds: list[tuple[float, float]], m
 def search_fourbar(
     targets: Array,
     theta: Array | None = None,
-    cons: Constraints = Constraints(),
+    cons: Constraints | None = None,
     bounds: list[tuple[float, float]] | None = None,
     n_sample: int = 100_000,
     maxiter: int = 200,
@@ -209,6 +209,7 @@ def search_fourbar(
     samples: int = 64,
 ) -> SearchResult:
     """Random sample, differential evolution, least-squares refinement (see the module)."""
+    cons = cons if cons is not None else Constraints()
     import time
 
     from scipy.optimize import differential_evolution
