@@ -140,7 +140,10 @@ def kernel_rate(n: int = 200_000, samples: int = 64, repeats: int = 5) -> dict[s
         t0 = time.perf_counter()
         coupler_points(X, th)
         rates.append(n / (time.perf_counter() - t0))
-    return {"candidates": n, "samples": samples, "median": float(np.median(rates)), "min": float(min(rates)),
+    from ..linkages.chunked import threads_default
+
+    return {"candidates": n, "samples": samples, "threads": threads_default(),
+            "median": float(np.median(rates)), "min": float(min(rates)),
             "max": float(max(rates))}
 
 

@@ -23,6 +23,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from ..linkages.chunked import threads_default
+
 __all__ = ["N_PARAMS", "coupler_points", "PARAM_NAMES"]
 
 Array = NDArray[np.float64]
@@ -32,36 +34,61 @@ Mask = NDArray[np.bool_]
 PARAM_NAMES = ("ground", "crank", "coupler", "rocker", "u", "v", "x0", "y0", "phi")
 N_PARAMS = len(PARAM_NAMES)
 
-#: candidates per block (block x samples doubles stay within a few hundred kB)
-BLOCK = 2048
+#: candidates per block (512 x 64 doubles: 256 kB per array, within the cache)
+BLOCK = 512
 
 
 def _block(X: Array, ct: Array, st: Array, circuit: Array) -> tuple[Array, Array, Mask]:
-    """One block: ``ct, st`` are ``(S,)`` (shared crank angles) or ``(P, S)`` (per candidate)."""
+    """One block: ``ct, st`` are ``(S,)`` (shared crank angles) or ``(P, S)`` (per candidate).
+
+    Worked in the world frame: the crank pin ``B = O2 + crank (cos(phi + theta), sin(phi + theta))``,
+    ``d = O4 - B``; ``alpha`` and ``beta`` do not depend on the frame.  In-place operations keep
+    the number of temporaries small.
+    """
     r1, r2, r3, r4 = X[:, 0:1], X[:, 1:2], X[:, 2:3], X[:, 3:4]
     u, v = X[:, 4:5], X[:, 5:6]
     x0, y0, phi = X[:, 6:7], X[:, 7:8], X[:, 8:9]
-    bx = r2 * ct
-    by = r2 * st
-    dx = r1 - bx
-    dy = -by
-    L2 = r1 * r1 + r2 * r2 - 2.0 * r1 * bx
-    A = 0.5 * (r3 * r3 - r4 * r4) + 0.5 * L2
-    h2 = r3 * r3 * L2 - A * A
+    cp, sp = np.cos(phi), np.sin(phi)
+    bx = (r2 * cp) * ct
+    bx -= (r2 * sp) * st                   # B - O2, world
+    by = (r2 * sp) * ct
+    by += (r2 * cp) * st
+    dx = r1 * cp - bx                      # O4 - B
+    dy = r1 * sp - by
+    L2 = r1 * r2 * ct
+    L2 *= -2.0
+    L2 += r1 * r1 + r2 * r2                # |O4 - B|^2 (law of cosines)
+    A = 0.5 * L2
+    A += 0.5 * (r3 * r3 - r4 * r4)
+    h2 = (r3 * r3) * L2
+    h2 -= A * A
     ok = h2 >= 0.0
-    w = np.sqrt(np.maximum(h2, 0.0))
+    np.maximum(h2, 0.0, out=h2)
+    w = np.sqrt(h2, out=h2)
     w *= circuit[:, None]
-    inv = 1.0 / (r3 * np.maximum(L2, 1e-300))
+    np.maximum(L2, 1e-300, out=L2)
+    inv = np.reciprocal(L2, out=L2)
+    inv *= 1.0 / r3
     # alpha = (u A - v w) / (r3 L2), beta = (u w + v A) / (r3 L2)
-    alpha = (u * A - v * w) * inv
-    beta = (u * w + v * A) * inv
-    px = bx + alpha * dx - beta * dy
-    py = by + alpha * dy + beta * dx
-    c, s = np.cos(phi), np.sin(phi)
-    return x0 + c * px - s * py, y0 + s * px + c * py, ok
+    alpha = u * A
+    alpha -= v * w
+    alpha *= inv
+    beta = u * w
+    beta += v * A
+    beta *= inv
+    px = alpha * dx
+    px -= beta * dy
+    px += bx
+    px += x0
+    py = alpha * dy
+    py += beta * dx
+    py += by
+    py += y0
+    return px, py, ok
 
 
-def coupler_points(X: Array, theta: Array, circuit: Array | None = None) -> tuple[Array, Array, Mask]:
+def coupler_points(X: Array, theta: Array, circuit: Array | None = None,
+                   threads: int | None = None) -> tuple[Array, Array, Mask]:
     """World coupler points ``(x, y)`` each ``(P, S)`` and validity ``(P, S)``.
 
     ``theta`` is ``(S,)`` crank angles shared by every candidate or ``(P, S)``
@@ -80,11 +107,23 @@ def coupler_points(X: Array, theta: Array, circuit: Array | None = None) -> tupl
     shared = th.ndim == 1
     if shared:
         ct_all, st_all = np.cos(th), np.sin(th)
-    for i in range(0, P, BLOCK):
+
+    def run(i: int) -> None:
         j = min(P, i + BLOCK)
         if shared:
             ct, st = ct_all, st_all
         else:
             ct, st = np.cos(th[i:j]), np.sin(th[i:j])
         xs[i:j], ys[i:j], ok[i:j] = _block(X[i:j], ct, st, circ[i:j])
+
+    starts = range(0, P, BLOCK)
+    workers = min(threads_default(), len(starts)) if threads is None else max(1, threads)
+    if workers <= 1 or P * S < 1 << 16:
+        for i in starts:
+            run(i)
+    else:
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(workers) as pool:  # numpy releases the GIL inside each operation
+            list(pool.map(run, starts))
     return xs, ys, ok

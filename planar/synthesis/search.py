@@ -47,8 +47,13 @@ class Constraints:
     region: tuple[float, float, float, float] | None = None
 
 
-def violation(X: Array, cons: Constraints, scale: float) -> Array:
-    """How far each candidate ``(P, 9)`` breaks the constraints, in units of ``scale`` (0 when it keeps them)."""
+def violation(X: Array, cons: Constraints, scale: float, margin: float = GRASHOF_MARGIN) -> Array:
+    """How far each candidate ``(P, 9)`` breaks the constraints, in units of ``scale`` (0 when it keeps them).
+
+    ``margin`` (a fraction of the links' total length) is kept from a
+    change-point; the search uses :data:`GRASHOF_MARGIN`, the refinement
+    twice that (so it stays inside), the final check none.
+    """
     L = X[:, :4]
     r1, r2 = X[:, 0], X[:, 1]
     lo, hi = L.min(1), L.max(1)
@@ -56,8 +61,8 @@ def violation(X: Array, cons: Constraints, scale: float) -> Array:
     if cons.full_turn:
         total = L.sum(1)
         pq = total - lo - hi
-        v += np.maximum(0.0, lo + hi - pq + GRASHOF_MARGIN * total)
-        v += np.maximum(0.0, np.minimum(r1, r2) - np.minimum(X[:, 2], X[:, 3]) + GRASHOF_MARGIN * total)
+        v += np.maximum(0.0, lo + hi - pq + margin * total)
+        v += np.maximum(0.0, np.minimum(r1, r2) - np.minimum(X[:, 2], X[:, 3]) + margin * total)
     v += np.maximum(0.0, hi - cons.max_ratio * lo)
     if cons.region is not None:
         x0, y0, x1, y1 = cons.region
@@ -177,7 +182,7 @@ def _refine(obj: PathObjective, row: Array, bounds: list[tuple[float, float]], m
         x, y, ok = coupler_points(p[None, :], np.asarray(th)[None, :], circ)
         r = np.concatenate([x[0] - obj.targets[:, 0], y[0] - obj.targets[:, 1]])
         r = np.where(np.concatenate([ok[0], ok[0]]), r, obj.scale)
-        v = violation(p[None, :], obj.cons, obj.scale)[0]
+        v = violation(p[None, :], obj.cons, obj.scale, 2 * GRASHOF_MARGIN)[0]
         return np.append(r, w * v)
 
     z0 = np.clip(row[:N_PARAMS], lo, hi)
@@ -253,5 +258,5 @@ def search_fourbar(
     stages["refine_s"] = time.perf_counter() - t2
     assert best is not None
     e, r, tt = best
-    feasible = bool(violation(r[None, :N_PARAMS], cons, obj.scale)[0] <= 0)
+    feasible = bool(violation(r[None, :N_PARAMS], cons, obj.scale, margin=0.0)[0] <= 0)
     return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), feasible, evals, stages)
