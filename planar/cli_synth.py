@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import InputError, PlanarError
+from .errors import InputError
 
 __all__ = ["add_parser"]
 
@@ -66,19 +66,19 @@ def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, An
 
 
 def _cmd_path(args: argparse.Namespace) -> int:
-    from .synthesis.path import SIXBAR_REFUSAL, synthesise_path
+    from .synthesis.path import synthesise_path
     from .synthesis.scene_out import fourbar_scene_text
     from .synthesis.search import Constraints
     from .synthesis.targets import read_path_targets
 
-    if args.type == "sixbar":
-        raise PlanarError(f"--type sixbar: {SIXBAR_REFUSAL}")
     if not args.max_ratio > 1:
         raise InputError("--max-ratio", args.max_ratio, "a ratio greater than 1")
     targets, theta = read_path_targets(args.target, args.points)
     if theta is not None and args.deg:
         theta = np.radians(theta)
     cons = Constraints(full_turn=True, max_ratio=args.max_ratio, region=_region(args.pivots))
+    if args.type == "sixbar":
+        return _sixbar(args, targets, theta, cons)
     d = synthesise_path(targets, theta, cons, budget=args.budget, seed=args.seed)
     failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]
     fb = d.fourbar()
@@ -92,6 +92,23 @@ def _cmd_path(args: argparse.Namespace) -> int:
     report = {"command": "synth path", "targets": len(targets), **d.to_dict()}
     return _finish(args, f"four-bar ({fb.grashof}, {d.circuit}), sse {d.sse:.3g} over {len(targets)} targets "
                    f"in {d.seconds:.2f} s", text, report, d.ok, failing)
+
+
+def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | None, cons: Any) -> int:
+    from .synthesis.scene_out import linkage_scene_text
+    from .synthesis.sixbar import synthesise_sixbar
+
+    d = synthesise_sixbar(targets, theta, args.topology, cons, budget=args.budget, seed=args.seed)
+    failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]
+    text = linkage_scene_text(
+        f"synth-sixbar-{d.topology}", d.nodes(), d.links(), {"tracer": "T"},
+        comments=[f"planar synth path {args.target} --type sixbar --topology {d.topology}: {len(targets)} targets, "
+                  f"{'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
+                  "crank angle at each target (rad, from the ground line O2-O4): "
+                  + ", ".join(f"{t:.6g}" for t in d.theta)])
+    report = {"command": "synth path", "targets": len(targets), **d.to_dict()}
+    return _finish(args, f"{d.topology} six-bar, sse {d.sse:.3g} over {len(targets)} targets in {d.seconds:.2f} s",
+                   text, report, d.ok, failing)
 
 
 def _cmd_function(args: argparse.Namespace) -> int:
@@ -153,6 +170,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument("target", help="CSV with columns x,y and optional theta (crank angle), or an .svg file")
     p.add_argument("-o", "--output", required=True, help="scene file (TOML) to write")
     p.add_argument("--type", choices=("fourbar", "sixbar"), default="fourbar", help="linkage type (fourbar)")
+    p.add_argument("--topology", choices=("stephenson", "watt"), default="stephenson",
+                   help="six-bar: a dyad hung from the coupler (stephenson) or from the rocker (watt)")
     p.add_argument("--json", action="store_true", help="print the design, sse and time_s as JSON")
     p.add_argument("--budget", choices=("quick", "normal", "thorough"), default="normal",
                    help="search effort (normal: about 1-4 s)")

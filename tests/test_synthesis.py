@@ -135,7 +135,7 @@ def test_cli_bad_input_one_line_nothing_written(tmp_path, capsys):
     assert "row 3: y" in err and "oops" in err and err.count("\n") == 1
     assert not out.exists()
     assert main(["synth", "path", str(bad), "-o", str(out), "--type", "sixbar"]) == 2
-    assert "six-bar" in capsys.readouterr().err and not out.exists()
+    assert "row 3: y" in capsys.readouterr().err and not out.exists()
 
 
 def test_svg_target_read_by_svgelements(tmp_path):
@@ -162,3 +162,24 @@ def test_bench_synthesis_quick_timed_problem():
     assert c["planar"]["ok"] and c["planar"]["sse_min"] < 1e-3
     assert "pylinkage" in c["pylinkage"]["call"] and c["published_best_error"]
     assert r["kernel_candidates_per_s"]["median"] > 0
+
+
+@pytest.mark.parametrize("topology", ["stephenson", "watt"])
+def test_sixbar_kernel_matches_linkage_solve_and_scene(topology, tmp_path):
+    from planar.synthesis.scene_out import linkage_scene_text, write_scene
+    from planar.synthesis.search import Constraints
+    from planar.synthesis.sixbar import SixBarDesign, check_sixbar, sixbar_points
+
+    row = np.array([4.0, 1.0, 3.5, 3.0, 1.2, 0.9, 0.4, -0.3, 0.5, -2.0, 4.0, 4.0, 5.0, 1.5, -0.5, 1.0, 1.0])
+    th = np.linspace(0.0, 2 * np.pi, 90, endpoint=False)
+    x, y, m = sixbar_points(row[None], th, topology)
+    assert (m > 0).all()
+    d = SixBarDesign(topology, row, th[:5], np.column_stack([x[0, :5], y[0, :5]]), True, 0.0, 0.0)
+    lk = d.linkage()
+    got = lk.solve(th)
+    assert got.valid.all()
+    assert np.abs(got.points["tracer"] - np.column_stack([x[0], y[0]])).max() < 1e-9
+    check_sixbar(d, Constraints(max_ratio=100.0), 1.0)
+    assert d.ok and d.sse < 1e-20, d.checks
+    scene = write_scene(tmp_path / "s.toml", linkage_scene_text("s", d.nodes(), d.links(), {"tracer": "T"}))
+    assert np.abs(scene.mechanism.solve(th).points["tracer"] - got.points["tracer"]).max() < 1e-9

@@ -21,12 +21,10 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from .search import Constraints, search_fourbar
 
-__all__ = ["FourBarDesign", "synthesise_path", "SIXBAR_REFUSAL"]
+__all__ = ["FourBarDesign", "synthesise_path"]
 
 Array = NDArray[np.float64]
 
-#: what ``--type sixbar`` answers (six-bar path synthesis is not built)
-SIXBAR_REFUSAL = "six-bar (Watt, Stephenson) path synthesis is not implemented; use --type fourbar"
 
 
 @dataclass

@@ -13,7 +13,7 @@ import tomllib
 from pathlib import Path
 from typing import Any, Sequence
 
-__all__ = ["fourbar_scene_text", "write_scene"]
+__all__ = ["fourbar_scene_text", "linkage_scene_text", "write_scene"]
 
 
 def _f(v: float) -> str:
@@ -52,6 +52,35 @@ def fourbar_scene_text(name: str, ground: float, crank: float, coupler: float, r
     if amplitude is not None:
         lines += [f"amplitude = {_f(amplitude)}", f"centre = {_f(centre)}"]
     lines += ["", "[render]", 'trails = ["coupler_point"]', ""]
+    return "\n".join(lines)
+
+
+def _value(v: Any) -> str:
+    if isinstance(v, str):
+        return '"' + v + '"'
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, (tuple, list)):
+        return "[" + ", ".join(_value(x) for x in v) + "]"
+    return _f(v)
+
+
+def linkage_scene_text(name: str, nodes: Sequence[dict[str, Any]], links: Sequence[tuple[str, Sequence[str]]],
+                       points: dict[str, str], comments: Sequence[str] = (), samples_per_cycle: int = 72) -> str:
+    """The scene text of a general linkage (``type = "linkage"``; node tables as the scene schema's)."""
+    lines = [f"# {c}" for c in comments]
+    lines += [f'name = "{name}"', 'angle_unit = "rad"', "", "[mechanism]", 'type = "linkage"',
+              "points = { " + ", ".join(f'{k} = "{v}"' for k, v in points.items()) + " }", ""]
+    for n in nodes:
+        lines.append("[[mechanism.nodes]]")
+        lines += [f"{k} = {_value(v)}" for k, v in n.items()]
+        lines.append("")
+    for lname, lnodes in links:
+        lines += ["[[mechanism.links]]", f'name = "{lname}"', f"nodes = {_value(list(lnodes))}", ""]
+    lines += ["[driver]", "speed = 1.0", "cycles = 1", f"samples_per_cycle = {int(samples_per_cycle)}", "",
+              "[render]", "trails = [" + ", ".join(f'"{k}"' for k in points) + "]", ""]
     return "\n".join(lines)
 
 
