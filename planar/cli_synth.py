@@ -122,14 +122,16 @@ def _cmd_function(args: argparse.Namespace) -> int:
         phi, psi = np.radians(phi), np.radians(psi)
     d = freudenstein_fit(phi, psi, args.ground)
     fb = d.fourbar()
-    amp, centre = _rocking(fb, phi)
+    amp, centre = _rocking(fb, phi - d.ground_angle)
     tol = args.tolerance
     exact = len(phi) == 3
     ok = bool(np.isfinite(d.max_error)) and (d.max_error <= (1e-9 if exact else tol))
     failing = [] if ok else [f"output angle error {d.max_error:.3g} rad (limit {1e-9 if exact else tol:g})"]
     text = fourbar_scene_text(
-        "synth-function", d.ground, d.crank, d.coupler, d.rocker, (0.5 * d.coupler, 0.0), d.circuit, (0.0, 0.0, 0.0),
-        comments=[f"planar synth function {args.pairs}: {len(phi)} pairs, max output error {d.max_error:.3g} rad"],
+        "synth-function", d.ground, d.crank, d.coupler, d.rocker, (0.5 * d.coupler, 0.0), d.circuit,
+        (0.0, 0.0, d.ground_angle),
+        comments=[f"planar synth function {args.pairs}: {len(phi)} pairs, max output error {d.max_error:.3g} rad",
+                  "crank and rocker angles are the pairs' minus the placement angle (from the ground line)"],
         amplitude=amp, centre=centre)
     report = {"command": "synth function", "pairs": len(phi), **d.to_dict()}
     return _finish(args, f"four-bar ({d.grashof}, {d.circuit}), max output angle error {d.max_error:.3g} rad",
@@ -176,7 +178,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--budget", choices=("quick", "normal", "thorough"), default="normal",
                    help="search effort (normal: about 1-4 s)")
     p.add_argument("--max-ratio", type=float, default=10.0, help="longest / shortest link at most this (10)")
-    p.add_argument("--pivots", default=None, help="both ground pivots inside XMIN,YMIN,XMAX,YMAX")
+    p.add_argument("--pivots", default=None,
+                   help="ground pivots inside XMIN,YMIN,XMAX,YMAX (write --pivots=-1,... when XMIN is negative)")
     p.add_argument("--points", type=int, default=12, help="points sampled along an SVG target (12)")
     p.add_argument("--deg", action="store_true", help="the theta column is in degrees")
     p.add_argument("--seed", type=int, default=0, help="random seed of the search (same seed, same result)")

@@ -183,3 +183,13 @@ def test_sixbar_kernel_matches_linkage_solve_and_scene(topology, tmp_path):
     assert d.ok and d.sse < 1e-20, d.checks
     scene = write_scene(tmp_path / "s.toml", linkage_scene_text("s", d.nodes(), d.links(), {"tracer": "T"}))
     assert np.abs(scene.mechanism.solve(th).points["tracer"] - got.points["tracer"]).max() < 1e-9
+
+
+def test_function_rocker_pivot_on_negative_axis():
+    # pairs measured from the world x axis of a four-bar whose rocker pivot is at (-ground, 0)
+    fb = FourBar(5.0, 1.5, 4.0, 3.5)
+    theta = np.array([0.3, 1.1, 2.0, 2.6])
+    _, out, _ = fb.angles(theta)
+    d = freudenstein_fit(theta + np.pi, out + np.pi, ground=5.0)
+    assert d.ground_angle == pytest.approx(np.pi)
+    assert d.max_error < 1e-9 and abs(d.crank - 1.5) < 1e-9
