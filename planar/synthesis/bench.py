@@ -128,23 +128,28 @@ def _pylinkage_run(name: str, prob: dict[str, Any], quick: bool, require_grashof
 
 
 def kernel_rate(n: int = 200_000, samples: int = 64, repeats: int = 5) -> dict[str, Any]:
-    """Candidate four-bars evaluated per second by the kernel (coupler point and validity at ``samples`` angles)."""
+    """Candidate four-bars evaluated per second by the kernel (coupler point and validity at ``samples`` angles).
+
+    float32 (the search's screening precision) and float64 (refinement), interleaved.
+    """
     from .kernel import coupler_points
 
     rng = np.random.default_rng(0)
     X = np.column_stack([rng.uniform(1, 3, (n, 4)), rng.uniform(-2, 2, (n, 2)), rng.uniform(-1, 1, (n, 3))])
     th = np.linspace(0, 2 * np.pi, samples, endpoint=False)
     coupler_points(X[:1000], th)
-    rates = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        coupler_points(X, th)
-        rates.append(n / (time.perf_counter() - t0))
+    rates: dict[type, list[float]] = {np.float32: [], np.float64: []}
+    for r in range(repeats):
+        for dt in ((np.float32, np.float64) if r % 2 == 0 else (np.float64, np.float32)):
+            t0 = time.perf_counter()
+            coupler_points(X, th, dtype=dt)
+            rates[dt].append(n / (time.perf_counter() - t0))
     from ..linkages.chunked import threads_default
 
+    r32, r64 = rates[np.float32], rates[np.float64]
     return {"candidates": n, "samples": samples, "threads": threads_default(),
-            "median": float(np.median(rates)), "min": float(min(rates)),
-            "max": float(max(rates))}
+            "median": float(np.median(r32)), "min": float(min(r32)), "max": float(max(r32)),
+            "float64": {"median": float(np.median(r64)), "min": float(min(r64)), "max": float(max(r64))}}
 
 
 def bench_synthesis(repeats: int = 3, quick: bool = False, n: int | None = None,
@@ -218,8 +223,9 @@ def format_synthesis(r: dict[str, Any]) -> str:
     k = r["kernel_candidates_per_s"]
     lines = [f"path synthesis, planar vs pylinkage's synthesis, {r['repeats']} interleaved repeat(s), "
              f"{r['cores']} cores",
-             f"  kernel: {k['median']:,.0f} candidate four-bars/s at {k['samples']} samples "
-             f"({k['min']:,.0f}-{k['max']:,.0f})"]
+             f"  kernel: {k['median']:,.0f} candidate four-bars/s at {k['samples']} samples, float32 "
+             f"({k['min']:,.0f}-{k['max']:,.0f}); float64 {k['float64']['median']:,.0f} "
+             f"({k['float64']['min']:,.0f}-{k['float64']['max']:,.0f}); {k['threads']} threads"]
     for c in r["cases"]:
         p, q, q2 = c["planar"], c["pylinkage"], c["pylinkage_without_grashof"]
         lines += [

@@ -66,7 +66,7 @@ def _block(X: Array, ct: Array, st: Array, circuit: Array) -> tuple[Array, Array
     np.maximum(h2, 0.0, out=h2)
     w = np.sqrt(h2, out=h2)
     w *= circuit[:, None]
-    np.maximum(L2, 1e-300, out=L2)
+    np.maximum(L2, 1e-12 * (r1 * r1 + r2 * r2), out=L2)   # B on O4: invalid (h2 < 0), kept finite
     inv = np.reciprocal(L2, out=L2)
     inv *= 1.0 / r3
     # alpha = (u A - v w) / (r3 L2), beta = (u w + v A) / (r3 L2)
@@ -88,7 +88,7 @@ def _block(X: Array, ct: Array, st: Array, circuit: Array) -> tuple[Array, Array
 
 
 def coupler_points(X: Array, theta: Array, circuit: Array | None = None,
-                   threads: int | None = None) -> tuple[Array, Array, Mask]:
+                   threads: int | None = None, dtype: type = np.float64) -> tuple[Array, Array, Mask]:
     """World coupler points ``(x, y)`` each ``(P, S)`` and validity ``(P, S)``.
 
     ``theta`` is ``(S,)`` crank angles shared by every candidate or ``(P, S)``
@@ -96,13 +96,13 @@ def coupler_points(X: Array, theta: Array, circuit: Array | None = None,
     ``+1``/``-1`` (default all ``+1``, FourBar's open circuit).  An invalid
     sample (the dyad cannot close) has finite but meaningless coordinates.
     """
-    X = np.asarray(X, float)
+    X = np.asarray(X, dtype)
     P = X.shape[0]
-    th = np.asarray(theta, float)
-    circ = np.ones(P) if circuit is None else np.asarray(circuit, float)
+    th: Array = np.asarray(theta, dtype)
+    circ: Array = np.ones(P, dtype) if circuit is None else np.asarray(circuit, dtype)
     S = th.shape[-1]
-    xs = np.empty((P, S))
-    ys = np.empty((P, S))
+    xs: Array = np.empty((P, S), dtype)
+    ys: Array = np.empty((P, S), dtype)
     ok = np.empty((P, S), dtype=bool)
     shared = th.ndim == 1
     if shared:
@@ -114,7 +114,8 @@ def coupler_points(X: Array, theta: Array, circuit: Array | None = None,
             ct, st = ct_all, st_all
         else:
             ct, st = np.cos(th[i:j]), np.sin(th[i:j])
-        xs[i:j], ys[i:j], ok[i:j] = _block(X[i:j], ct, st, circ[i:j])
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # degenerate rows are marked invalid
+            xs[i:j], ys[i:j], ok[i:j] = _block(X[i:j], ct, st, circ[i:j])
 
     starts = range(0, P, BLOCK)
     workers = min(threads_default(), len(starts)) if threads is None else max(1, threads)

@@ -100,24 +100,26 @@ class PathObjective:
         """``x`` ``(10, P)`` as scipy's vectorised DE passes it; returns ``(P,)``."""
         return self.population(np.asarray(x, float).T)
 
-    def population(self, X: Array) -> Array:
-        """Objective of candidates ``X`` ``(P, 10)``."""
+    def population(self, X: Array, dtype: type = np.float32) -> Array:
+        """Objective of candidates ``X`` ``(P, 10)`` (screened in ``dtype``; float64 sums)."""
         X = np.atleast_2d(X)
         circ = np.where(X[:, 9] >= 0, 1.0, -1.0)
         P9 = X[:, :N_PARAMS]
         tx, ty = self.targets[:, 0], self.targets[:, 1]
         if self.theta is not None:
-            x, y, ok = coupler_points(P9, self.theta, circ)
+            x, y, ok = coupler_points(P9, self.theta, circ, dtype=dtype)
             d2 = (x - tx) ** 2 + (y - ty) ** 2
             d2 = np.where(ok, d2, 4.0 * self.scale**2)
-            err = d2.sum(1)
+            err = d2.sum(1, dtype=float)
         else:
             th = np.linspace(0.0, 2 * np.pi, self.samples, endpoint=False)
-            x, y, ok = coupler_points(P9, th, circ)
+            x, y, ok = coupler_points(P9, th, circ, dtype=dtype)
             far = 1e6 * self.scale**2
             err = np.zeros(X.shape[0])
+            tx, ty = tx.astype(dtype), ty.astype(dtype)
             for k in range(len(tx)):
-                d2 = (x - tx[k]) ** 2 + (y - ty[k]) ** 2
+                d2 = (x - tx[k]) ** 2
+                d2 += (y - ty[k]) ** 2
                 d2[~ok] = far
                 err += d2.min(1)
         v = violation(P9, self.cons, self.scale)
@@ -197,7 +199,7 @@ def _refine(obj: PathObjective, row: Array, bounds: list[tuple[float, float]], m
     res = least_squares(resid, z0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=max_nfev)
     p, th = split(res.x)
     out = np.append(p, row[9])
-    return out, np.asarray(th, float).copy(), float(obj.population(out[None, :])[0]) if timed else float(
+    return out, np.asarray(th, float).copy(), float(obj.population(out[None, :], np.float64)[0]) if timed else float(
         np.sum(res.fun[: 2 * n] ** 2) + (obj.penalty if violation(p[None, :], obj.cons, obj.scale)[0] > 0 else 0.0))
 
 
