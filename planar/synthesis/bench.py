@@ -18,7 +18,9 @@ measure as planar's: ``sse``, the sum of squared distances from the targets
 to the coupler point, from planar's solver, at the prescribed crank angles
 (timed) or at the crank angles nearest each target on the curve (untimed).
 planar and pylinkage alternate for ``repeats`` repeats (planar's seed is the
-repeat number); times are wall seconds, median (min-max).
+repeat number); times are wall seconds, median (min-max).  Without
+``--quick``, planar's Stephenson and Watt six-bars run once each (seed 0) on
+the same targets.
 """
 
 from __future__ import annotations
@@ -182,6 +184,13 @@ def bench_synthesis(repeats: int = 3, quick: bool = False, n: int | None = None,
                 else:
                     peer.append(_pylinkage_run(name, prob, quick, require_grashof=True))
         loose = _pylinkage_run(name, prob, quick, require_grashof=False)
+        six: dict[str, Any] = {}
+        if not quick:   # one run per six-bar topology (seed 0): the same targets, what a six-bar adds
+            from .sixbar import TOPOLOGIES, synthesise_sixbar
+
+            for topo in TOPOLOGIES:
+                d6 = synthesise_sixbar(t, th, topo, Constraints(), budget=budget, seed=0)
+                six[topo] = {"sse": d6.sse, "time_s": d6.seconds, "ok": d6.ok}
         best = min(ours, key=lambda d: d.sse)
         times = [d.seconds for d in ours]
         ptimes = [p["time_s"] for p in peer]
@@ -202,6 +211,7 @@ def bench_synthesis(repeats: int = 3, quick: bool = False, n: int | None = None,
                                       "max": float(max(ptimes))},
             },
             "pylinkage_without_grashof": loose,
+            "planar_sixbar": six,
         })
     rate = kernel_rate(n or (50_000 if quick else 250_000), repeats=1 if quick else 5)
     return {
@@ -237,4 +247,7 @@ def format_synthesis(r: dict[str, Any]) -> str:
             f"    pylinkage, require_grashof=False: sse {_e(q2['sse'])} ({q2['solutions']} solutions, "
             f"crank turns fully: {q2['crank_turns_fully']})  time {q2['time_s']:.2f} s",
         ]
+        for topo, v in c.get("planar_sixbar", {}).items():
+            lines.append(f"    planar {topo} six-bar (one run): sse {_e(v['sse'])}  time {v['time_s']:.2f} s  "
+                         f"{'ok' if v['ok'] else 'CHECK FAILED'}")
     return "\n".join(lines)

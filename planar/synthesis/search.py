@@ -179,13 +179,26 @@ def _refine(obj: PathObjective, row: Array, bounds: list[tuple[float, float]], m
     def split(z: Array) -> tuple[Array, Array]:
         return z[:N_PARAMS], (obj.theta if timed else z[N_PARAMS:])  # type: ignore[return-value]
 
+    def rows(Z: Array) -> Array:
+        """Residuals of many variable vectors ``Z`` ``(K, m)`` in one kernel call: ``(K, 2 n + 1)``."""
+        P = Z[:, :N_PARAMS]
+        th = np.broadcast_to(obj.theta, (len(Z), n)) if timed else Z[:, N_PARAMS:]
+        x, y, ok = coupler_points(P, np.ascontiguousarray(th), np.full(len(Z), circ[0]))
+        r = np.concatenate([x - obj.targets[:, 0], y - obj.targets[:, 1]], axis=1)
+        r = np.where(np.concatenate([ok, ok], axis=1), r, obj.scale)
+        v = violation(P, obj.cons, obj.scale, 2 * GRASHOF_MARGIN)
+        return np.concatenate([r, (w * v)[:, None]], axis=1)
+
     def resid(z: Array) -> Array:
-        p, th = split(z)
-        x, y, ok = coupler_points(p[None, :], np.asarray(th)[None, :], circ)
-        r = np.concatenate([x[0] - obj.targets[:, 0], y[0] - obj.targets[:, 1]])
-        r = np.where(np.concatenate([ok[0], ok[0]]), r, obj.scale)
-        v = violation(p[None, :], obj.cons, obj.scale, 2 * GRASHOF_MARGIN)[0]
-        return np.append(r, w * v)
+        return rows(z[None, :])[0]
+
+    def jac(z: Array) -> Array:
+        # forward differences, every perturbed vector in one call (the kernel is vectorised over candidates)
+        h = 1.49e-8 * np.maximum(1.0, np.abs(z))
+        h = np.where(z + h > hi, -h, h)    # stay inside the bounds
+        Z = np.vstack([z[None, :], z[None, :] + np.diag(h)])
+        R = rows(Z)
+        return ((R[1:] - R[0]) / h[:, None]).T
 
     z0 = np.clip(row[:N_PARAMS], lo, hi)
     if not timed:
@@ -196,7 +209,7 @@ def _refine(obj: PathObjective, row: Array, bounds: list[tuple[float, float]], m
     fin = np.isfinite(lo) & np.isfinite(hi)
     span = np.where(fin, hi - lo, 0.0)
     z0 = np.where(fin, np.clip(z0, np.where(fin, lo, 0.0) + 1e-9 * span, np.where(fin, hi, 0.0) - 1e-9 * span), z0)
-    res = least_squares(resid, z0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=max_nfev)
+    res = least_squares(resid, z0, jac=jac, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=max_nfev)
     p, th = split(res.x)
     out = np.append(p, row[9])
     return out, np.asarray(th, float).copy(), float(obj.population(out[None, :], np.float64)[0]) if timed else float(

@@ -201,15 +201,27 @@ def _refine(obj: _Objective, row: Array, lo: Array, hi: Array, max_nfev: int) ->
     def full(z: Array) -> Array:
         return np.concatenate([z[:N6], signs])
 
+    S = obj.samples
+
+    def rows(Z: Array) -> Array:
+        """Residuals of many variable vectors ``Z`` ``(K, m)`` in one kernel call."""
+        X = np.concatenate([Z[:, :N6], np.broadcast_to(signs, (len(Z), 2))], axis=1)
+        th = np.broadcast_to(th0, (len(Z), n)) if timed else Z[:, N6:]
+        allth = np.concatenate([np.broadcast_to(turn64, (len(Z), S)), th], axis=1)
+        x, y, m = sixbar_points(X, np.ascontiguousarray(allth), obj.topology)
+        r = np.concatenate([x[:, S:] - obj.targets[:, 0], y[:, S:] - obj.targets[:, 1]], axis=1)
+        v = _violation6(X, obj.cons, obj.scale, 2 * GRASHOF_MARGIN)
+        v = v + np.maximum(0.0, 2 * DYAD_MARGIN - m[:, :S]).max(1)
+        return np.concatenate([r, (w * v)[:, None]], axis=1)
+
     def resid(z: Array) -> Array:
-        X = full(z)[None]
-        th = th0 if timed else z[N6:]
-        x, y, m = sixbar_points(X, np.concatenate([turn64, th]), obj.topology)
-        S = obj.samples
-        r = np.concatenate([x[0, S:] - obj.targets[:, 0], y[0, S:] - obj.targets[:, 1]])
-        v = _violation6(X, obj.cons, obj.scale, 2 * GRASHOF_MARGIN)[0]
-        v += np.maximum(0.0, 2 * DYAD_MARGIN - m[0, :S]).max()
-        return np.append(r, w * v)
+        return rows(z[None, :])[0]
+
+    def jac(z: Array) -> Array:
+        h = 1.49e-8 * np.maximum(1.0, np.abs(z))
+        h = np.where(z + h > bhi, -h, h)
+        R = rows(np.vstack([z[None, :], z[None, :] + np.diag(h)]))
+        return ((R[1:] - R[0]) / h[:, None]).T
 
     span = hi[:N6] - lo[:N6]
     z0 = np.clip(row[:N6], lo[:N6] + 1e-9 * span, hi[:N6] - 1e-9 * span)
@@ -218,7 +230,7 @@ def _refine(obj: _Objective, row: Array, lo: Array, hi: Array, max_nfev: int) ->
         z0 = np.concatenate([z0, th0])
         blo = np.concatenate([blo, np.full(n, -np.inf)])
         bhi = np.concatenate([bhi, np.full(n, np.inf)])
-    res = least_squares(resid, z0, bounds=(blo, bhi), x_scale="jac", max_nfev=max_nfev)
+    res = least_squares(resid, z0, jac=jac, bounds=(blo, bhi), x_scale="jac", max_nfev=max_nfev)
     out = full(res.x)
     th = th0 if timed else res.x[N6:]
     e = float(np.sum(res.fun[: 2 * n] ** 2))
