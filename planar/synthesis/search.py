@@ -173,7 +173,7 @@ def _refine(obj: PathObjective, row: Array, bounds: list[tuple[float, float]], m
     hi = np.array([b[1] for b in bounds[:N_PARAMS]])
     timed = obj.theta is not None
     n = len(obj.targets)
-    th0 = obj.theta if timed else _nearest_theta(obj, row)
+    th0: Array = obj.theta if obj.theta is not None else _nearest_theta(obj, row)
     w = np.sqrt(obj.penalty)
 
     def split(z: Array) -> tuple[Array, Array]:
@@ -182,7 +182,7 @@ def _refine(obj: PathObjective, row: Array, bounds: list[tuple[float, float]], m
     def rows(Z: Array) -> Array:
         """Residuals of many variable vectors ``Z`` ``(K, m)`` in one kernel call: ``(K, 2 n + 1)``."""
         P = Z[:, :N_PARAMS]
-        th = np.broadcast_to(obj.theta, (len(Z), n)) if timed else Z[:, N_PARAMS:]
+        th = np.broadcast_to(th0, (len(Z), n)) if timed else Z[:, N_PARAMS:]
         x, y, ok = coupler_points(P, np.ascontiguousarray(th), np.full(len(Z), circ[0]))
         r = np.concatenate([x - obj.targets[:, 0], y - obj.targets[:, 1]], axis=1)
         r = np.where(np.concatenate([ok, ok], axis=1), r, obj.scale)
