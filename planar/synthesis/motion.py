@@ -16,7 +16,8 @@ the bilinear ``row_j(z) . (c, 1) = 0`` with
   traces the centre-point curve.
 * 5 poses: the Burmester points, where the circle-point curves of poses
   1-4 and 1, 2, 3, 5 meet (0, 2 or 4 real points), by root finding started
-  at the grid minima of both determinants.
+  at the grid minima of both determinants; the grid widens (4, 16, 64 times
+  the poses' extent) while fewer than 2 or an odd number are found.
 
 Two dyads make a four-bar: the first is the crank.  Pairs are chosen with the
 body at one circuit in every pose (no branch defect), the crank turning fully
@@ -33,7 +34,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InputError
+from ..errors import InputError, PlanarError
 
 __all__ = ["MotionDesign", "burmester", "circle_point_curve", "burmester_points", "dyad_rows"]
 
@@ -215,8 +216,9 @@ def _choose(poses: Array, z: Array, c: Array, max_ratio: float) -> tuple[int, in
     ratio = hi / np.maximum(lo, 1e-300)
     usable = one_circuit & (lo > 1e-3 * L) & (ratio <= max_ratio)
     if not usable.any():
-        raise InputError("poses", len(poses), "poses some pair of dyads reaches on one circuit within the link "
-                         f"ratio {max_ratio:g} (none of {len(I)} pairs does)")
+        raise PlanarError(f"poses: none of the {len(I)} pairs of the {K} dyads found takes the body through all "
+                          f"{len(poses)} poses on one circuit with links within the ratio {max_ratio:g} "
+                          "(a larger --max-ratio, or other poses)")
     pick = usable & full if (usable & full).any() else usable
     k = int(np.flatnonzero(pick)[np.argmin(ratio[pick])])
     return int(I[k]), int(J[k]), bool(full[k])
@@ -241,10 +243,14 @@ def burmester(poses: Array, max_ratio: float = 10.0, grid: int = 24) -> MotionDe
             idx = np.linspace(0, len(z) - 1, 240).round().astype(int)
             z, c = z[idx], c[idx]
     else:
-        z, c = burmester_points(poses)
+        # real Burmester points come in pairs: widen the search while fewer than 2 or an odd number are found
+        for reach, grid in ((4.0, 60), (16.0, 120), (64.0, 160)):
+            z, c = burmester_points(poses, grid=grid, reach=reach)
+            if len(z) >= 2 and len(z) % 2 == 0:
+                break
         if len(z) < 2:
             raise InputError("poses", "5 poses", f"poses with 2 or more Burmester points (these have {len(z)}: "
-                             "no four-bar takes the body through all five)")
+                             "within 64 times the poses' extent: no four-bar takes the body through all five)")
     ok = np.isfinite(c).all(1)
     z, c = z[ok], c[ok]
     i, j, _ = _choose(poses, z, c, max_ratio)
