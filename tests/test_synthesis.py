@@ -13,7 +13,7 @@ from planar.linkages import FourBar
 from planar.scene import load_scene
 from planar.synthesis.function import freudenstein_fit
 from planar.synthesis.kernel import coupler_points
-from planar.synthesis.motion import burmester, circle_point_curve, dyad_rows
+from planar.synthesis.motion import burmester, circle_point_curve
 from planar.synthesis.path import synthesise_path
 
 KNOWN = FourBar(4.0, 1.0, 3.5, 3.0, coupler_point=(1.2, 0.9), placement=(0.4, -0.3, 0.5))
@@ -73,10 +73,14 @@ def test_function_exact_for_three_pairs():
 def test_burmester_four_poses_on_circle_point_curve_and_reached():
     P = _poses(KNOWN, np.linspace(0.3, 2.2, 4))
     z, c = circle_point_curve(P)
-    # the known linkage's moving pivots lie on the curve: det of the rows vanishes there (independent check
-    # below is the solve); every sampled point has equal distances to its centre in all four poses
-    rows = dyad_rows(P, z)
-    assert np.abs(np.linalg.det(rows)).max() < 1e-6 * np.abs(rows).max() ** 3
+    assert len(z) > 100
+    # independent of the determinant: each circle point, carried through the 4 poses, stays at one distance
+    # from its centre point
+    ca, sa = np.cos(P[:, 2]), np.sin(P[:, 2])
+    wx = P[:, 0][None] + ca[None] * z[:, :1] - sa[None] * z[:, 1:]
+    wy = P[:, 1][None] + sa[None] * z[:, :1] + ca[None] * z[:, 1:]
+    r = np.hypot(wx - c[:, :1], wy - c[:, 1:])
+    assert (np.ptp(r, axis=1) <= 1e-7 * r.max(axis=1)).all()
     d = burmester(P)
     assert d.ok, d.checks
     m = d.fourbar().solve(d.theta)
@@ -193,3 +197,18 @@ def test_function_rocker_pivot_on_negative_axis():
     d = freudenstein_fit(theta + np.pi, out + np.pi, ground=5.0)
     assert d.ground_angle == pytest.approx(np.pi)
     assert d.max_error < 1e-9 and abs(d.crank - 1.5) < 1e-9
+
+
+def test_failed_checks_are_loud(tmp_path, capsys):
+    from planar.synthesis.path import FourBarDesign, check_design
+
+    # a double-rocker's crank cannot turn: the design's own check fails
+    d = FourBarDesign(4, 3, 1.5, 3.5, (0.5, 0.2), "open", (0, 0, 0), np.array([0.5, 1.0, 1.5]), float("nan"),
+                      np.zeros((3, 2)), True, 0.0)
+    check_design(d)
+    assert not d.ok and not d.checks["ok_crank_turns_fully"]
+    # four pairs no four-bar follows within 0.01 rad: written, reported, exit 3
+    pairs = tmp_path / "p.csv"
+    pairs.write_text("input,output\n10,60\n40,75\n70,95\n100,110\n")
+    assert main(["synth", "function", str(pairs), "-o", str(tmp_path / "f.toml"), "--deg"]) == 3
+    assert "check failed: output angle error" in capsys.readouterr().out
