@@ -212,3 +212,17 @@ def test_failed_checks_are_loud(tmp_path, capsys):
     pairs.write_text("input,output\n10,60\n40,75\n70,95\n100,110\n")
     assert main(["synth", "function", str(pairs), "-o", str(tmp_path / "f.toml"), "--deg"]) == 3
     assert "check failed: output angle error" in capsys.readouterr().out
+
+
+def test_sixbar_search_recovers_known_watt_tracer_points():
+    from planar.synthesis.sixbar import sixbar_points, synthesise_sixbar
+
+    row = np.array([4.0, 1.0, 3.5, 3.0, 1.2, 0.9, 0.4, -0.3, 0.5, -2.0, 4.0, 4.0, 5.0, 1.5, -0.5, 1.0, 1.0])
+    th = np.linspace(0.2, 2.6, 5)
+    x, y, _ = sixbar_points(row[None], th, "watt")
+    pts = np.column_stack([x[0], y[0]])
+    d = synthesise_sixbar(pts, th, "watt", budget=(3000, 20, 6, 2))
+    assert d.ok, d.checks
+    # planar's general linkage solver, not the search kernel, puts the tracer on the targets
+    got = d.linkage().solve(th).points["tracer"]
+    assert np.hypot(*(got - pts).T).max() < 1e-6

@@ -263,8 +263,13 @@ def _fourbar_seed(t: Array, th: Array | None, cons: Constraints, seed: int) -> A
 
 
 def synthesise_sixbar(targets: Array, theta: Array | None = None, topology: str = "stephenson",
-                      cons: Constraints | None = None, budget: str = "normal", seed: int = 0) -> SixBarDesign:
-    """A six-bar (``topology`` ``"stephenson"`` or ``"watt"``) whose tracer passes through ``targets``."""
+                      cons: Constraints | None = None, budget: str | tuple[int, int, int, int] = "normal",
+                      seed: int = 0) -> SixBarDesign:
+    """A six-bar (``topology`` ``"stephenson"`` or ``"watt"``) whose tracer passes through ``targets``.
+
+    ``budget``: ``"quick"``, ``"normal"``, ``"thorough"`` or ``(random samples, DE generations, DE
+    population per variable, refinement starts)``.
+    """
     from scipy.optimize import differential_evolution
 
     from .search import default_bounds
@@ -278,9 +283,12 @@ def synthesise_sixbar(targets: Array, theta: Array | None = None, topology: str 
     if theta is not None and len(theta) != len(t):
         raise InputError("theta", len(theta), f"one crank angle per target ({len(t)})")
     kw = {"quick": (20_000, 60, 10, 2), "normal": (100_000, 200, 15, 4), "thorough": (400_000, 600, 25, 8)}
-    if budget not in kw:
+    if isinstance(budget, tuple):
+        n_sample, maxiter, popsize, refine = budget
+    elif budget in kw:
+        n_sample, maxiter, popsize, refine = kw[budget]
+    else:
         raise InputError("budget", budget, f"one of {', '.join(kw)}")
-    n_sample, maxiter, popsize, refine = kw[budget]
     t0 = time.perf_counter()
     th = None if theta is None else np.asarray(theta, float)
     obj = _Objective(t, th, cons, topology)
