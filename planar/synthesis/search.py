@@ -257,13 +257,15 @@ def search_fourbar(
     stages["de_s"] = time.perf_counter() - t1
     evals += (int(de.nit) + 1) * len(init)  # scipy counts vectorised calls, not candidates
     # refine the DE best and the best distinct candidates of the sample and the final population
-    pool = np.vstack([de.x[None, :], de.population[np.argsort(de.population_energies)], X[order[: 4 * refine]]])
+    # half the starts from DE's final population (its basin), half from the sample's best (other basins)
     starts: list[Array] = []
-    for row in pool:
-        if all(np.linalg.norm((row - s) / (hi - lo)) > 0.05 for s in starts):
-            starts.append(row)
-        if len(starts) >= refine:
-            break
+    for pool, k in ((np.vstack([de.x[None, :], de.population[np.argsort(de.population_energies)]]), (refine + 1) // 2),
+                    (X[order[: 50 * refine]], refine)):
+        for row in pool:
+            if len(starts) >= k:
+                break
+            if all(np.linalg.norm((row - s) / (hi - lo)) > 0.05 for s in starts):
+                starts.append(row)
     t2 = time.perf_counter()
     best: tuple[float, Array, Array] | None = None
     for row in starts:
