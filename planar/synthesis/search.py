@@ -16,9 +16,12 @@ The search: ``n_sample`` random candidates (uniform in the bounds; the
 "atlas" stage, cheap because it is one kernel call), the best of them seed
 :func:`scipy.optimize.differential_evolution` (``vectorized=True``, the
 population evaluated by one kernel call per generation), and
-:func:`scipy.optimize.least_squares` refines the best few distinct
-candidates, the crank angles at the targets becoming variables for untimed
-targets.  Same inputs and ``seed``, same result.
+:func:`scipy.optimize.least_squares` refines distinct candidates, half from
+DE's final population and half from the sample's best, the crank angles at
+the targets becoming variables for untimed targets (its Jacobian by forward
+differences, all perturbed candidates in one kernel call).  Candidates are
+screened in float32, refined and checked in float64.  Same inputs and
+``seed``, same result.
 """
 
 from __future__ import annotations
@@ -108,6 +111,7 @@ class PathObjective:
         tx, ty = self.targets[:, 0], self.targets[:, 1]
         if self.theta is not None:
             x, y, ok = coupler_points(P9, self.theta, circ, dtype=dtype)
+            tx, ty = tx.astype(dtype), ty.astype(dtype)
             d2 = (x - tx) ** 2 + (y - ty) ** 2
             d2 = np.where(ok, d2, 4.0 * self.scale**2)
             err = d2.sum(1, dtype=float)
