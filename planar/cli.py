@@ -250,8 +250,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("-o", "--output", required=True, help="CSV file to write")
     c.add_argument("--samples", type=int, default=360)
     c.set_defaults(func=_cmd_motion_catalog)
-    from .cli_synth import add_parser as add_synth  # noqa: E402
-
+    from .cli_synth import add_parser as add_synth
     add_synth(sub)
     return p
 
