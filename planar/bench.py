@@ -774,3 +774,21 @@ def format_sim(r: dict[str, Any]) -> str:
 
 
 BENCHMARKS["sim"] = (bench_sim, format_sim)
+
+
+# --------------------------------------------------------------------------- synthesis
+
+
+def _bench_synthesis(**kw: Any) -> dict[str, Any]:
+    from .synthesis.bench import bench_synthesis
+
+    return bench_synthesis(**kw)
+
+
+def _format_synthesis(r: dict[str, Any]) -> str:
+    from .synthesis.bench import format_synthesis
+
+    return format_synthesis(r)
+
+
+BENCHMARKS["synthesis"] = (_bench_synthesis, _format_synthesis)

@@ -39,6 +39,8 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         kwargs["n"] = args.n
     if args.repeats is not None:
         kwargs["repeats"] = args.repeats
+    if args.name == "synthesis":
+        kwargs["quick"] = args.quick
     if args.name == "accuracy":
         kwargs["scenes"] = args.scenes
         kwargs["out_dir"] = args.output
@@ -200,7 +202,8 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("-n", type=int, default=None, help="problem size (samples)")
     b.add_argument("--repeats", type=int, default=None, help="timing repeats (best is kept)")
     b.add_argument("-o", "--output", default="planar-bench-accuracy", help="accuracy: folder for the CSV and chart")
-    b.add_argument("--quick", action="store_true", help="accuracy: a small grid on three mechanisms")
+    b.add_argument("--quick", action="store_true",
+                   help="accuracy: a small grid on three mechanisms; synthesis: one repeat, small budgets")
     b.add_argument("--scenes", default="gallery",
                    help="accuracy: folder of scene files to measure (default: ./gallery, the repository's)")
     b.set_defaults(func=_cmd_bench)
@@ -273,7 +276,12 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("-o", "--output", required=True, help="CSV file to write")
     c.add_argument("--samples", type=int, default=360)
     c.set_defaults(func=_cmd_motion_catalog)
-    from .cli_plot import add_parser as add_plot_parser; add_plot_parser(sub)  # noqa: E702
+    from .cli_plot import add_parser as add_plot_parser
+
+    add_plot_parser(sub)
+    from .cli_synth import add_parser as add_synth
+
+    add_synth(sub)
     return p
 
 
