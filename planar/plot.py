@@ -161,11 +161,12 @@ def scene_figure(scene: "Scene", what: Sequence[str] | None = None, width_in: fl
             ax.set_ylabel("y")
             ax.set_title("path of the named points (dot: first sample)", fontsize=9)
         elif chart == "pressure":
-            prof = mech.profile
+            cm: Any = mech  # a CamMechanism (available_charts offers "pressure" only for one)
+            prof = cm.profile
             deg = np.degrees(prof.pressure_angle(np.mod(motion.driver, 2 * np.pi)))
             (ln,) = ax.plot(x, deg, lw=1.4, label="pressure angle")
             ln.set_gid("pressure")
-            limit = float(np.degrees(mech.max_pressure_angle))
+            limit = float(np.degrees(cm.max_pressure_angle))
             ax.axhline(limit, color="#d62728", lw=0.8, ls="--")
             ax.axhline(-limit, color="#d62728", lw=0.8, ls="--")
             k2 = int(np.nanargmax(np.abs(deg)))
