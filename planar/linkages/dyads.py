@@ -155,26 +155,35 @@ def carry_branch(keep: Array, other: Array, valid: Mask, path: Mask) -> NDArray[
     p1 = prev
     p2 = back(p1)
     p3 = back(p2)
-    ok = valid & (p3 >= 0) & (idx - p3 <= 8) & path
+    p4 = back(p3)
+    ok = valid & (p4 >= 0) & (idx - p4 <= 10) & path
     ks = np.flatnonzero(ok)
     if ks.size == 0:
         return flip
-    i1, i2, i3 = p1[ks], p2[ks], p3[ks]
-    # quadratic (Lagrange) extrapolation in the sample index to k
-    t, t1, t2, t3 = ks.astype(float), i1.astype(float), i2.astype(float), i3.astype(float)
-    w1 = (t - t2) * (t - t3) / ((t1 - t2) * (t1 - t3))
-    w2 = (t - t1) * (t - t3) / ((t2 - t1) * (t2 - t3))
-    w3 = (t - t1) * (t - t2) / ((t3 - t1) * (t3 - t2))
+    i1, i2, i3, i4 = p1[ks], p2[ks], p3[ks], p4[ks]
+
+    def lagrange(t: Array, t1: Array, t2: Array, t3: Array) -> tuple[Array, Array, Array]:
+        return ((t - t2) * (t - t3) / ((t1 - t2) * (t1 - t3)), (t - t1) * (t - t3) / ((t2 - t1) * (t2 - t3)),
+                (t - t1) * (t - t2) / ((t3 - t1) * (t3 - t2)))
+
+    # quadratic (Lagrange) extrapolation in the sample index to k, and (the check of its credibility) to the
+    # previous sample from the three before it
+    f = [a.astype(float) for a in (ks, i1, i2, i3, i4)]
+    w1, w2, w3 = lagrange(f[0], f[1], f[2], f[3])
+    v1, v2, v3 = lagrange(f[1], f[2], f[3], f[4])
     cur = keep.copy()
     alt = other.copy()
     start = 0
     while True:
         sel = slice(start, None)
-        k, a1, a2, a3 = ks[sel], i1[sel], i2[sel], i3[sel]
+        k, a1, a2, a3, a4 = ks[sel], i1[sel], i2[sel], i3[sel], i4[sel]
         pred = w1[sel, None] * cur[a1] + w2[sel, None] * cur[a2] + w3[sel, None] * cur[a3]
         dk = np.hypot(*(cur[k] - pred).T)
         da = np.hypot(*(alt[k] - pred).T)
-        hit = np.flatnonzero(4.0 * da < dk)
+        # the extrapolation's own miss one sample back: a flip needs the jump to stand out from it (coarse
+        # samples, a few per turn, extrapolate badly and must not trade the declared branch for the other one)
+        miss = np.hypot(*(cur[a1] - (v1[sel, None] * cur[a2] + v2[sel, None] * cur[a3] + v3[sel, None] * cur[a4])).T)
+        hit = np.flatnonzero((4.0 * da < dk) & (4.0 * miss < dk))
         if hit.size == 0:
             return flip
         j = int(k[hit[0]])
@@ -821,8 +830,13 @@ class Linkage(Mechanism):
         pos, checks = self._solve_nodes(np.concatenate([lead, q]), self.nodes)
         return {n: v[k:] for n, v in pos.items()}, [(m[k:], j, w) for m, j, w in checks]
 
+    def _path(self, q: Array) -> Mask:
+        """Where the samples are a path along which a branch may be carried (:func:`path_mask`); a subclass
+        that knows its motion has no singular position returns no path (its declared branches hold)."""
+        return path_mask(q)
+
     def _solve_nodes(self, q: Array, nodes: Sequence[NodeKind]) -> tuple[dict[str, Array], list[tuple[Mask, str, str]]]:
-        path = path_mask(q)
+        path = self._path(q)
         pos: dict[str, Array] = {}
         checks: list[tuple[Mask, str, str]] = []
         for node in nodes:

@@ -153,6 +153,15 @@ class FourBar(Linkage):
         self.branch_reference = np.pi / 2
         super().__init__(name, nodes, links, points={"coupler_point": "P"}, placement=placement, **kw)
 
+    def _path(self, q: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """Only a change-point four-bar has singular positions its motion passes through (the two circuits
+        meet there), so only its circuit is carried by continuity; any other keeps its declared circuit at
+        every sample, however coarse the sampling (a crossed crank-rocker sampled 4 or 7 times a turn was
+        carried onto the open circuit by an extrapolation that coarse samples cannot support)."""
+        if self.grashof != "change-point":
+            return np.zeros(np.shape(q), dtype=bool)
+        return super()._path(q)
+
     # -- classification and limits -----------------------------------------
     @property
     def grashof(self) -> str:
