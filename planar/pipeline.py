@@ -80,8 +80,12 @@ def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, p
     """Render a scene's analytic motion (and optionally an overlay motion) to a GIF; returns frames."""
     from exporters.gif import frame_delay_ms, indexer, write_gif
 
+    from .limits import check_count
     from .render import Renderer, palette_colors
 
+    field_name = "driver.duration" if scene.spec.driver.duration is not None else "driver.cycles"
+    check_count("frames", f"{scene.path}: {field_name}", scene.sample_count(), "frames (one per sample)",
+                shown=getattr(scene.spec.driver, field_name.split(".")[1]))
     motion = scene.motion()
     polys = {n: scene.polygons[n] for n in scene.spec.render.sweep}
     r = Renderer(scene.mechanism, motion, scene_style(scene), overlay=overlay, polygons=polys)
@@ -100,10 +104,13 @@ def build_gallery(source: str | Path, output: str | Path | None = None,
 
     scenes = gallery_scenes(source)
     out = Path(output) if output is not None else Path(source)
+    if out.exists() and not out.is_dir():
+        raise InputError("gallery output", str(out), "a folder (it is an existing file)")
+    loaded = [load_scene(path) for path in scenes]  # every scene checked before the first GIF is drawn
     out.mkdir(parents=True, exist_ok=True)
-    for path in scenes:
+    for path, scene in zip(scenes, loaded):
         target = out / (path.stem + ".gif")
-        yield path, target, render_scene(load_scene(path), target, progress=progress)
+        yield path, target, render_scene(scene, target, progress=progress)
 
 
 # --------------------------------------------------------------------------- motion tables

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Annotated, Any, Literal, Union
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, Strict, StrictBool, ValidationError, model_validator
 
 from .effects import Effects, Load, Spring
 from .errors import InputError, PlanarError, SceneError
@@ -27,8 +27,22 @@ from .model import Mechanism, Motion
 __all__ = ["SceneSpec", "Scene", "load_scene", "parse_scene", "scene_schema"]
 
 Vec2 = tuple[float, float]
-Pos = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-Real = Annotated[float, Field(allow_inf_nan=False)]
+# strict types: a number is a TOML number (true is not 1.0, "4" is not 4.0), a flag is true or false
+Pos = Annotated[float, Strict(), Field(gt=0, allow_inf_nan=False)]
+Real = Annotated[float, Strict(), Field(allow_inf_nan=False)]
+#: a name written into CSV headers, DXF groups and SVG text: no control character, comma or double quote
+_NAME = r'^[^\x00-\x1f\x7f,"]*$'
+Name = Annotated[str, Strict(), Field(min_length=1, max_length=80, pattern=_NAME)]
+Title = Annotated[str, Strict(), Field(max_length=80, pattern=_NAME)]
+
+
+def _whole(v: Any) -> Any:
+    if isinstance(v, bool) or not isinstance(v, int):
+        raise ValueError("expected 1 or -1 (a whole number)")
+    return v
+
+
+Branch = Annotated[Literal[1, -1], BeforeValidator(_whole)]
 
 
 class _Strict(BaseModel):
@@ -38,8 +52,8 @@ class _Strict(BaseModel):
 class PolygonSpec(_Strict):
     """A polygon fixed to a part (a foot), in that part's frame; drawn swept with it."""
 
-    name: str
-    part: str
+    name: Name
+    part: Name
     points: Annotated[list[tuple[Real, Real]], Field(min_length=3)]
 
 
@@ -60,7 +74,7 @@ class SliderCrankSpec(_Strict):
     crank: Pos
     rod: Pos
     offset: Real = 0.0
-    branch: Literal[1, -1] = 1
+    branch: Branch = 1
     placement: tuple[Real, Real, Real] = (0.0, 0.0, 0.0)
     polygons: list[PolygonSpec] = []
 
@@ -78,21 +92,21 @@ _NODE_FIELDS = {
 class NodeSpec(_Strict):
     """A joint centre of a general linkage; which fields it needs depends on ``kind``."""
 
-    name: str
+    name: Name
     kind: Literal["fixed", "crank", "actuator", "rrr", "rrp", "rigid"]
     at: tuple[Real, Real] | None = None
-    centre: str | None = None
+    centre: Name | None = None
     radius: Pos | None = None
     phase: Real = 0.0
-    origin: str | None = None
+    origin: Name | None = None
     axis: tuple[Real, Real] = (1.0, 0.0)
-    a: str | None = None
+    a: Name | None = None
     ra: Pos | None = None
-    b: str | None = None
+    b: Name | None = None
     rb: Pos | None = None
-    p: str | None = None
-    q: str | None = None
-    branch: Literal[1, -1] = 1
+    p: Name | None = None
+    q: Name | None = None
+    branch: Branch = 1
     offset: Real = 0.0
     local: tuple[Real, Real] | None = None
 
@@ -105,35 +119,35 @@ class NodeSpec(_Strict):
 
 
 class LinkSpec(_Strict):
-    name: str
-    nodes: Annotated[list[str], Field(min_length=1)]
-    guide: tuple[str, str] | None = None
+    name: Name
+    nodes: Annotated[list[Name], Field(min_length=1)]
+    guide: tuple[Name, Name] | None = None
 
 
 class LinkageSpec(_Strict):
     type: Literal["linkage"]
     nodes: Annotated[list[NodeSpec], Field(min_length=2)]
     links: Annotated[list[LinkSpec], Field(min_length=1)]
-    points: dict[str, str] = {}
+    points: dict[Name, Name] = {}
     placement: tuple[Real, Real, Real] = (0.0, 0.0, 0.0)
     polygons: list[PolygonSpec] = []
 
 
 class ElementalSpec(_Strict):
     type: Literal["elemental"]
-    number: Annotated[int, Field(ge=1, le=11)]
-    params: dict[str, Union[Real, list[Real]]] = {}
+    number: Annotated[int, Strict(), Field(ge=1, le=11)]
+    params: dict[Name, Union[Real, list[Real]]] = {}
 
 
 class ChainSpec(_Strict):
     type: Literal["chain"]
-    chain: Annotated[list[str], Field(min_length=1)]
+    chain: Annotated[list[Name], Field(min_length=1)]
 
 
 class ToySpec(_Strict):
     type: Literal["toy"]
-    left: list[Annotated[list[str], Field(min_length=1)]] = []
-    right: list[Annotated[list[str], Field(min_length=1)]] = []
+    left: list[Annotated[list[Name], Field(min_length=1)]] = []
+    right: list[Annotated[list[Name], Field(min_length=1)]] = []
     phase: Real = math.pi
 
     @model_validator(mode="after")
@@ -145,7 +159,7 @@ class ToySpec(_Strict):
 
 class CatalogSpec(_Strict):
     type: Literal["catalog"]
-    name: str
+    name: Name
 
 
 MechanismSpec = Annotated[
@@ -171,7 +185,7 @@ class DriverSpec(_Strict):
     speed: Pos = 1.0
     cycles: Pos | None = None
     duration: Pos | None = None
-    samples_per_cycle: Annotated[int, Field(ge=4, le=100_000)] = 72
+    samples_per_cycle: Annotated[int, Strict(), Field(ge=4, le=100_000)] = 72
     phase: Real = 0.0
     amplitude: Pos | None = None
     centre: Real = 0.0
@@ -188,29 +202,29 @@ class DriverSpec(_Strict):
 class LoadSpec(_Strict):
     """A force (model force units, world frame) the mechanism exerts at a named point."""
 
-    point: str
+    point: Name
     force: tuple[Real, Real]
 
 
 class SpringSpec(_Strict):
     """A damped spring between two parts (anchors in each part's frame)."""
 
-    a: str
+    a: Name
     anchor_a: tuple[Real, Real] = (0.0, 0.0)
-    b: str
+    b: Name
     anchor_b: tuple[Real, Real] = (0.0, 0.0)
-    rest_length: Annotated[float, Field(ge=0)] | None = None
+    rest_length: Annotated[float, Strict(), Field(ge=0)] | None = None
     stiffness: Pos
-    damping: Annotated[float, Field(ge=0)] = 0.0
+    damping: Annotated[float, Strict(), Field(ge=0)] = 0.0
 
 
 class EffectsSpec(_Strict):
     """Physical effects for the physics rebuild; none unless named."""
 
     gravity: tuple[Real, Real] | None = None
-    contact: bool = False
-    friction: Annotated[float, Field(ge=0)] | None = None
-    damping: Annotated[float, Field(gt=0, le=1)] | None = None
+    contact: StrictBool = False
+    friction: Annotated[float, Strict(), Field(ge=0)] | None = None
+    damping: Annotated[float, Strict(), Field(gt=0, le=1)] | None = None
     density: Pos = 1.0
     springs: list[SpringSpec] = []
     loads: list[LoadSpec] = []
@@ -218,21 +232,21 @@ class EffectsSpec(_Strict):
 
 
 class RenderSpec(_Strict):
-    width: Annotated[int, Field(ge=16, le=4096)] = 480
-    height: Annotated[int, Field(ge=16, le=4096)] = 360
-    supersample: Annotated[int, Field(ge=1, le=4)] = 2
-    trails: list[str] | None = None
-    sweep: list[str] = []
-    background: Annotated[str, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#ffffff"
-    show_pins: bool = True
+    width: Annotated[int, Strict(), Field(ge=16, le=4096)] = 480
+    height: Annotated[int, Strict(), Field(ge=16, le=4096)] = 360
+    supersample: Annotated[int, Strict(), Field(ge=1, le=4)] = 2
+    trails: list[Name] | None = None
+    sweep: list[Name] = []
+    background: Annotated[Name, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#ffffff"
+    show_pins: StrictBool = True
 
 
 class FabricationSpec(_Strict):
     unit_mm: Pos = 10.0
     thickness_mm: Pos = 3.0
-    kerf_mm: Annotated[float, Field(ge=0, le=2)] = 0.15
+    kerf_mm: Annotated[float, Strict(), Field(ge=0, le=2)] = 0.15
     pin_diameter_mm: Pos = 3.0
-    clearance_mm: Annotated[float, Field(ge=0, le=2)] = 0.1
+    clearance_mm: Annotated[float, Strict(), Field(ge=0, le=2)] = 0.1
     sheet_mm: tuple[Pos, Pos] = (300.0, 200.0)
     # manufacturability (planar.fabparts): thinnest material between a cut and the outline, smallest part,
     # smallest engraved text, clearance past each end of a pin's travel in its slot; narrow parts are
@@ -240,28 +254,28 @@ class FabricationSpec(_Strict):
     min_wall_mm: Pos = 1.5
     min_part_mm: Pos = 5.0
     min_label_mm: Pos = 1.5
-    slot_end_margin_mm: Annotated[float, Field(ge=0, le=50)] = 1.0
-    widen: bool = True
+    slot_end_margin_mm: Annotated[float, Strict(), Field(ge=0, le=50)] = 1.0
+    widen: StrictBool = True
     # assembly: pin head allowance per end; drive: D-shaft (diameter, distance across the flat), motor
     # screws either side of the shaft, ground-plate mounting holes
-    pin_head_mm: Annotated[float, Field(ge=0, le=50)] = 1.5
+    pin_head_mm: Annotated[float, Strict(), Field(ge=0, le=50)] = 1.5
     shaft_diameter_mm: Pos = 3.0
     shaft_flat_mm: Pos = 2.5
     motor_screw_mm: Pos = 1.7
     motor_screw_spacing_mm: Pos = 9.0
     mounting_hole_mm: Pos = 3.2
     # nesting and file conventions
-    spacing_mm: Annotated[float, Field(ge=0, le=100)] = 3.0
-    margin_mm: Annotated[float, Field(ge=0, le=100)] = 5.0
+    spacing_mm: Annotated[float, Strict(), Field(ge=0, le=100)] = 3.0
+    margin_mm: Annotated[float, Strict(), Field(ge=0, le=100)] = 5.0
     svg_stroke_mm: Pos = 0.025
-    cut_colour: Annotated[str, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#ff0000"
-    engrave_colour: Annotated[str, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#0000ff"
+    cut_colour: Annotated[Name, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#ff0000"
+    engrave_colour: Annotated[Name, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#0000ff"
 
 
 class SceneSpec(_Strict):
     """A whole scene file."""
 
-    name: str = ""
+    name: Title = ""
     angle_unit: Literal["rad", "deg"] = "rad"
     mechanism: MechanismSpec
     driver: DriverSpec = DriverSpec()
@@ -321,17 +335,33 @@ class Scene:
     path: str = "<scene>"
     polygons: dict[str, tuple[str, np.ndarray]] = field(default_factory=dict)
 
+    def sample_count(self) -> int:
+        """Samples of :meth:`motion`, checked against :mod:`planar.limits` (samples and memory)
+        before anything is allocated; :class:`~planar.errors.LimitError` names the scene's field."""
+        from .limits import check_count, check_memory
+
+        d = self.spec.driver
+        period = self.mechanism.driver.period
+        if d.duration is not None:
+            field_name, value, cycles = "driver.duration", d.duration, d.duration / period
+        else:
+            field_name, value = "driver.cycles", d.cycles
+            cycles = d.cycles if d.cycles is not None else 1.0
+        total = d.samples_per_cycle * cycles
+        where = f"{self.path}: {field_name}"
+        n = check_count("samples", where, round(total) if math.isfinite(total) else total,
+                        "samples in all (samples_per_cycle x cycles)", shown=value)
+        # poses (x, y, angle) of every part, points (x, y), driver, time and the solver's working copies
+        per_sample = 8 * (3 * len(self.mechanism.parts) + 2 * len(self.mechanism.points) + 4) * 4
+        check_memory(where, value, float(per_sample) * max(n, 2), "a motion")
+        return max(2, n)
+
     def motion(self) -> Motion:
         """The analytic motion over the scene's cycles (or duration)."""
         d = self.spec.driver
         drv = self.mechanism.driver
-        period = drv.period
-        if d.duration is not None:
-            cycles = d.duration / period
-        else:
-            cycles = d.cycles if d.cycles is not None else 1.0
-        n = max(2, int(round(d.samples_per_cycle * cycles)))
-        t = np.arange(n) * (period / d.samples_per_cycle)
+        n = self.sample_count()
+        t = np.arange(n) * (drv.period / d.samples_per_cycle)
         return self.mechanism.solve(drv.value(t), t=t)
 
     @property
@@ -353,18 +383,41 @@ class Scene:
         )
 
 
-def load_scene(path: str | Path) -> Scene:
-    """Read, validate and build the scene in ``path``."""
-    p = str(path)
+def _read_text(p: str) -> str:
+    """The scene file as text: UTF-8 (a UTF-8 byte-order mark is skipped) or UTF-16 with its byte-order mark."""
     try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
+        with open(p, "rb") as fh:
+            raw = fh.read(64 * 2**20 + 1)
     except FileNotFoundError:
         raise SceneError(f"{p}: no such file") from None
     except IsADirectoryError:
         raise SceneError(f"{p}: is a directory, not a scene file") from None
+    except OSError as e:  # a loop of symbolic links, no permission, a device
+        raise SceneError(f"{p}: cannot be read ({e.strerror or e})") from None
+    if len(raw) > 64 * 2**20:
+        raise SceneError(f"{p}: larger than 64 MiB; a scene file is a short TOML text")
+    if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        codec = "utf-16"
+    else:
+        codec = "utf-8-sig"
+    try:
+        text = raw.decode(codec)
+    except UnicodeDecodeError as e:
+        raise SceneError(f"{p}: not a text file in UTF-8 (or UTF-16 with a byte-order mark): "
+                         f"byte {e.start} is {raw[e.start:e.start + 1]!r}") from None
+    if "\x00" in text:
+        raise SceneError(f"{p}: not a text file (it holds NUL bytes); a scene is TOML text")
+    return text
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read, validate and build the scene in ``path`` (UTF-8, or UTF-16 with a byte-order mark)."""
+    p = str(path)
+    text = _read_text(p)
+    try:
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
-        raise SceneError(f"{p}: not valid TOML: {e}") from None
+        raise SceneError(f"{p}: not valid TOML: {' '.join(str(e).split())}") from None
     return build_scene(parse_scene(data, p), p)
 
 
@@ -376,6 +429,9 @@ def build_scene(spec: SceneSpec, path: str = "<scene>") -> Scene:
     """Build the mechanism a validated scene describes."""
     m = spec.mechanism
     rate = 2 * math.pi * spec.driver.speed
+    if not (math.isfinite(rate) and math.isfinite(2 * math.pi / rate) and rate > 0):
+        raise SceneError(f"{path}: driver.speed = {spec.driver.speed!r}: expected a speed whose period "
+                         "(1 / speed seconds) and angular rate are finite numbers")
     phase = _angle(spec, spec.driver.phase)
     try:
         rock = _rocking(spec, m)
@@ -388,6 +444,9 @@ def build_scene(spec: SceneSpec, path: str = "<scene>") -> Scene:
     polygons: dict[str, tuple[str, np.ndarray]] = {}
     names = {p.name for p in mech.parts}
     for i, poly in enumerate(getattr(m, "polygons", [])):
+        if poly.name in polygons:
+            raise SceneError(f"{path}: mechanism.polygons[{i}].name: a second polygon named {poly.name!r} "
+                             "(polygon names must differ)")
         if poly.part not in names:
             raise SceneError(f"{path}: mechanism.polygons[{i}].part: no part {poly.part!r} "
                              f"(got {poly.part!r}; parts are {sorted(names)})")

@@ -34,6 +34,8 @@ Node kinds without a chunk kernel here (a kind registered elsewhere) make
 
 from __future__ import annotations
 
+import math
+
 import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
@@ -158,12 +160,17 @@ def _rrr(node, pos, q, w, ox, oy) -> Placed:
     """Circle-circle as :func:`planar.geometry.circle_circle` (same validity, bit for bit)."""
     ax, ay = pos[node.a]
     bx, by = pos[node.b]
-    ra, rb = node.ra, node.rb
+    # scale-free: lengths times k, the power of two nearest 1 / (ra + rb) (exact: the same bits where
+    # nothing overflows), so the fourth powers below hold for any link length float64 can square
+    k = math.ldexp(1.0, -math.frexp(node.ra + node.rb)[1])
+    ra, rb = node.ra * k, node.rb * k
     s, f = ra + rb, ra - rb
     s2, f2 = s * s, f * f
     dx, dy, d2, t, prod = w.get(), w.get(), w.get(), w.get(), w.get()
     np.subtract(bx, ax, out=dx)
     np.subtract(by, ay, out=dy)
+    dx *= k
+    dy *= k
     np.multiply(dx, dx, out=d2)
     np.multiply(dy, dy, out=t)
     d2 += t
@@ -186,6 +193,9 @@ def _rrr(node, pos, q, w, ox, oy) -> Placed:
     prod *= d2  # sep^2 = 4 h^2 = prod / d^2
     d2 *= 0.5 * (ra * ra - rb * rb)
     d2 += 0.5  # fraction along a -> b
+    dx /= k  # back to model units (exact)
+    dy /= k
+    prod /= k * k
     m = w.get()
     np.multiply(d2, dx, out=ox)
     ox += ax
