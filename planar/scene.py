@@ -524,11 +524,16 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, A
     if isinstance(m, ElementalSpec):
         from .windup import ELEMENTAL, ElementalMechanism, params_for
 
+        from .windup.params import coerce
+
         base = params_for(m.number)
         angle_params = ELEMENTAL[m.number].angle_params
         kw: dict[str, Any] = {}
+        known = sorted(f for f in vars(base))
         for k, v in m.params.items():
-            val = tuple(v) if isinstance(v, list) else v
+            if k not in known:
+                raise InputError(f"params.{k}", v, f"a parameter of mechanism #{m.number}, one of {known}")
+            val = coerce(f"params.{k}", getattr(base, k), v)  # a vector of the right length, or a number
             if k in angle_params:
                 val = tuple(_angle(spec, x) for x in val) if isinstance(val, tuple) else _angle(spec, val)
             kw[k] = val
