@@ -357,6 +357,15 @@ def part_cuts(part: Part, s: FabSettings, number: int, pinned: set[int] = frozen
         if f.r - k2 <= 0 or (f.kind == "d" and f.flat - k2 <= -(f.r - k2)):
             raise FabricationError(f"part {part.name!r}: {f.what} {2 * f.r:.2f} mm wide is not wider than the "
                                    f"kerf {s.kerf:g} mm")
+    polys = [cut_polygon(f.cut(0.0)) for f in feats]
+    for i in range(len(feats)):  # holes that fit their part: no two cuts overlap
+        for j in range(i + 1, len(feats)):
+            gap = polys[i].distance(polys[j])
+            if gap <= 0.0:
+                raise FabricationError(
+                    f"part {part.name!r}: {feats[i].what} ({2 * feats[i].r:.2f} mm) and {feats[j].what} "
+                    f"({2 * feats[j].r:.2f} mm) overlap: the holes do not fit the part (smaller pins, or a "
+                    f"larger [fabrication] unit_mm)")
     if mounting:
         base = [(x * s.unit_mm, y * s.unit_mm, r * s.unit_mm) for x, y, r in part.hull] + \
             [c for f in feats for c in f.wall_circles(s.min_wall)]

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import csv
 import io
 import os
 import tempfile
@@ -24,7 +25,7 @@ import numpy as np
 from .errors import InputError
 from .model import Mechanism, Motion
 
-__all__ = ["atomic_write", "output_transaction", "check_output", "motion_columns", "write_motion_csv"]
+__all__ = ["atomic_write", "output_transaction", "check_output", "check_name", "motion_columns", "write_motion_csv"]
 
 #: the temporaries ``(tmp, target)`` of the innermost :func:`output_transaction`, renamed at its end
 _PENDING: contextvars.ContextVar[list[tuple[str, Path]] | None] = contextvars.ContextVar("_PENDING", default=None)
@@ -136,6 +137,20 @@ def check_output(option: str, path: str | os.PathLike | None, suffixes: Sequence
             raise InputError(option, text, f"an output other than the input {src} (it would be overwritten)")
 
 
+def check_name(field: str, name: str) -> str:
+    """``name`` if it can stand in a CSV header, a DXF group and SVG text; else :class:`InputError`.
+
+    Control characters (newline, tab, NUL, ...) cannot be represented in a DXF
+    group name or in XML, and would break a CSV row, so they are refused;
+    commas and quotes are quoted by the CSV writers.
+    """
+    bad = [c for c in str(name) if ord(c) < 32 or 127 <= ord(c) < 160]
+    if bad or not str(name):
+        raise InputError(field, name, "a name without control characters (newline, tab, ...)"
+                         if bad else "a non-empty name")
+    return str(name)
+
+
 def motion_columns(mech: Mechanism, motion: Motion) -> tuple[list[str], np.ndarray]:
     """Column names and an ``(N, k)`` float table for a motion.
 
@@ -162,8 +177,10 @@ def motion_columns(mech: Mechanism, motion: Motion) -> tuple[list[str], np.ndarr
 def write_motion_csv(path: str | os.PathLike, mech: Mechanism, motion: Motion) -> None:
     """Write the motion table as CSV (17 significant digits: round-trips exactly)."""
     names, table = motion_columns(mech, motion)
+    for name in names:
+        check_name(f"{mech.name}: column", name)
     buf = io.StringIO()
-    buf.write(",".join(names) + "\n")
+    csv.writer(buf, lineterminator="\n").writerow(names)  # a comma or quote in a name is quoted
     fmt = ",".join(["%.17g"] * (len(names) - 1) + ["%d"])
     np.savetxt(buf, table, fmt=fmt)
     with atomic_write(path, "w") as fh:
