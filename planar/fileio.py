@@ -133,7 +133,7 @@ def check_output(option: str, path: str | os.PathLike | None, suffixes: Sequence
     if suffixes and p.suffix.lower() not in suffixes:
         raise InputError(option, text, f"a file name ending in {' or '.join(suffixes)} (the format it writes)")
     for src in inputs:
-        if _same_file(p, Path(src)) or p.resolve() == Path(src).resolve():
+        if _same_file(p, Path(src)) or os.path.realpath(p) == os.path.realpath(src):
             raise InputError(option, text, f"an output other than the input {src} (it would be overwritten)")
 
 

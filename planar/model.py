@@ -53,8 +53,11 @@ Array = NDArray[np.float64]
 
 
 def check_finite(field_name: str, value: ArrayLike) -> NDArray[np.float64]:
-    """Return ``value`` as a float array or raise :class:`InputError` on NaN/inf."""
-    arr = np.asarray(value, dtype=float)
+    """Return ``value`` as a float array or raise :class:`InputError` on NaN/inf (or what is not numbers)."""
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(field_name, value, "numbers (a number or an array of them)") from None
     if not np.all(np.isfinite(arr)):
         raise InputError(field_name, value, "finite numbers")
     return arr

@@ -294,10 +294,11 @@ def scene_schema() -> dict[str, Any]:
 
 def _loc(loc: tuple) -> str:
     out = ""
-    for part in loc:
+    for i, part in enumerate(loc):
         if isinstance(part, int):
             out += f"[{part}]"
-        elif part in ("fourbar", "slidercrank", "linkage", "elemental", "chain", "toy", "catalog") and out == "mechanism":
+        elif i == 1 and loc[0] == "mechanism" and part in ("fourbar", "slidercrank", "linkage", "elemental", "chain",
+                                                           "toy", "catalog"):
             continue  # the discriminated union's tag
         else:
             out += ("." if out else "") + str(part)
@@ -309,6 +310,8 @@ def _format_validation(path: str, e: ValidationError) -> str:
     first = errs[0]
     where = _loc(tuple(first["loc"]))
     msg = first["msg"]
+    if first["type"] == "string_pattern_mismatch" and (first.get("ctx") or {}).get("pattern") == _NAME:
+        msg = "expected a name without control characters (newline, tab), commas or double quotes"
     got = first.get("input")
     text = f"{path}: {where or 'scene'}: {msg}"
     if first["type"] not in ("missing",) and not isinstance(got, dict):
