@@ -12,6 +12,7 @@ model units (``[fabrication] unit_mm`` says what one unit is in millimetres).
 from __future__ import annotations
 
 import math
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -300,6 +301,8 @@ def _loc(loc: tuple) -> str:
         elif i == 1 and loc[0] == "mechanism" and part in ("fourbar", "slidercrank", "linkage", "elemental", "chain",
                                                            "toy", "catalog"):
             continue  # the discriminated union's tag
+        elif not re.fullmatch(r"[A-Za-z0-9_\-]+", str(part)):
+            out += f"[{str(part)!r}]"  # a key with spaces, dots or control characters, shown quoted on one line
         else:
             out += ("." if out else "") + str(part)
     return out
@@ -345,6 +348,7 @@ class Scene:
 
         d = self.spec.driver
         period = self.mechanism.driver.period
+        value: float | None
         if d.duration is not None:
             field_name, value, cycles = "driver.duration", d.duration, d.duration / period
         else:

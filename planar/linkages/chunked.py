@@ -241,7 +241,7 @@ def _rigid(node, pos, q, w, ox, oy) -> Placed:
     en += m
     np.sqrt(en, out=en)
     ok: Mask | bool = True
-    if en.size and float(en.min()) <= 0.0:  # coincident nodes (or an underflow): as the reference
+    if en.size and (float(en.min()) <= 0.0 or float(en.max()) == math.inf):  # coincident, under- or overflow
         h = np.hypot(ex, ey)
         ok = h > 0
         en[:] = np.where(ok, h, 1.0)

@@ -137,7 +137,7 @@ class FourBar(Linkage):
         cp = np.asarray(coupler_point, dtype=object)
         if cp.shape != (2,) or any(isinstance(v, bool) for v in cp):
             raise InputError(f"{name}.coupler_point", coupler_point, "a point (x, y) in the coupler's frame")
-        cpf = check_finite(f"{name}.coupler_point", np.asarray(coupler_point, float))
+        cpf = check_finite(f"{name}.coupler_point", coupler_point)
         self.coupler_point = (float(cpf[0]), float(cpf[1]))
         if max(a, b, c, d) >= (a + b + c + d) - max(a, b, c, d):
             raise InputError(
