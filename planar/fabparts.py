@@ -358,8 +358,10 @@ def part_cuts(part: Part, s: FabSettings, number: int, pinned: set[int] = frozen
             raise FabricationError(f"part {part.name!r}: {f.what} {2 * f.r:.2f} mm wide is not wider than the "
                                    f"kerf {s.kerf:g} mm")
     polys = [cut_polygon(f.cut(0.0)) for f in feats]
-    for i in range(len(feats)):  # holes that fit their part: no two cuts overlap
+    for i in range(len(feats)):  # holes that fit their part: a round hole overlaps no other cut
         for j in range(i + 1, len(feats)):
+            if feats[i].kind not in ("hole", "d") and feats[j].kind not in ("hole", "d"):
+                continue  # two slots may cross by design; a round hole must stand clear of every other cut
             gap = polys[i].distance(polys[j])
             if gap <= 0.0:
                 raise FabricationError(
