@@ -310,8 +310,56 @@ def test_cli_misuse(tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: li
     assert not list(tmp_path.glob("nodir"))
 
 
+# scenes that validate but cannot be cut or drawn: (id, scene, command, needle)
+BAD_JOBS: list[tuple[str, dict, str, str]] = [
+    ("holes-overlap", fb() | {"fabrication": {"unit_mm": 3.0, "pin_diameter_mm": 20.0}}, "export", "overlap"),
+    ("kerf-wider-than-parts", fb() | {"fabrication": {"unit_mm": 0.05, "kerf_mm": 2.0}}, "export", "kerf"),
+    ("too-many-frames", fb() | {"driver": {"samples_per_cycle": 72, "cycles": 1000.0}}, "render", "PLANAR_MAX_FRAMES"),
+    ("frames-by-duration", fb() | {"driver": {"samples_per_cycle": 72, "duration": 1e5}}, "render", "driver.duration"),
+]
+
+
+@pytest.mark.parametrize("content,command,needle", [c[1:] for c in BAD_JOBS], ids=[c[0] for c in BAD_JOBS])
+def test_bad_job(tmp_path: Path, capsys: pytest.CaptureFixture[str], content: dict, command: str, needle: str) -> None:
+    src = tmp_path / "scene.toml"
+    src.write_text(toml(content))
+    outs = {"export": ["-o", str(tmp_path / "parts.dxf"), "--svg", str(tmp_path / "parts.svg"),
+                       "--bom", str(tmp_path / "bom.csv")],
+            "render": ["-o", str(tmp_path / "parts.gif")]}[command]
+    (tmp_path / "parts.dxf").write_bytes(SENTINEL)
+    (tmp_path / "parts.gif").write_bytes(SENTINEL)
+    before = _snapshot(tmp_path)
+    rc, _, err = _run([command, str(src), *outs], capsys)
+    _check_one_line(rc, err, needle)
+    assert _snapshot(tmp_path) == before
+
+
 def test_corpus_is_large_enough() -> None:
-    assert len(BAD_SCENES) + len(MISUSES) >= 100
+    assert len(BAD_SCENES) + len(MISUSES) + len(BAD_JOBS) >= 100
+
+
+def test_interrupted_gallery_writes_nothing(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                            monkeypatch: pytest.MonkeyPatch) -> None:
+    """Ctrl-C after the first GIF is finished: one line, exit 130, the finished GIF's temporary removed."""
+    import planar.pipeline as pipeline
+
+    src = tmp_path / "scenes"
+    src.mkdir()
+    for name in ("a", "b"):
+        (src / f"{name}.toml").write_text(GOOD)
+    real = pipeline.render_scene
+    calls = []
+
+    def render_then_interrupt(*a: Any, **k: Any) -> int:
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(*a, **k)
+
+    monkeypatch.setattr(pipeline, "render_scene", render_then_interrupt)
+    rc, _, err = _run(["gallery", "--source", str(src), "-o", str(tmp_path / "out")], capsys)
+    assert rc == 130 and len(err.splitlines()) == 1 and "interrupted" in err
+    assert list((tmp_path / "out").iterdir()) == []
 
 
 def test_gallery_is_all_or_nothing(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
