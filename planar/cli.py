@@ -53,13 +53,12 @@ def _positive(option: str, value: float | None, integer: bool = False) -> None:
 
 def _cmd_demo(args: argparse.Namespace) -> int:
     """The embedded default: a wind-up toy and a four-bar walking leg, animated (and cut)."""
-    from .fileio import check_output, output_transaction
+    from .fileio import check_output
     from .pipeline import run_demo
 
+    # each file is written atomically; not one transaction, as DEMO_EXTRAS may read what the demo wrote
     check_output("-o", args.output, (), directory=True)
-    with output_transaction():
-        lines = list(run_demo(args.output))
-    for line in lines:
+    for line in run_demo(args.output):
         print(line)
     return 0
 
