@@ -301,6 +301,8 @@ def _loc(loc: tuple) -> str:
         elif i == 1 and loc[0] == "mechanism" and part in ("fourbar", "slidercrank", "linkage", "elemental", "chain",
                                                            "toy", "catalog"):
             continue  # the discriminated union's tag
+        elif i > 0 and (str(part) in ("float", "int", "str", "bool") or str(part).startswith(("list[", "tuple["))):
+            continue  # which member of a union (a number or a list of numbers) pydantic tried
         elif not re.fullmatch(r"[A-Za-z0-9_\-]+", str(part)):
             out += f"[{str(part)!r}]"  # a key with spaces, dots or control characters, shown quoted on one line
         else:
@@ -412,6 +414,7 @@ def _read_text(p: str) -> str:
     except UnicodeDecodeError as e:
         raise SceneError(f"{p}: not a text file in UTF-8 (or UTF-16 with a byte-order mark): "
                          f"byte {e.start} is {raw[e.start:e.start + 1]!r}") from None
+    text = text.removeprefix("\ufeff")  # a byte-order mark some editors repeat inside the text
     if "\x00" in text:
         raise SceneError(f"{p}: not a text file (it holds NUL bytes); a scene is TOML text")
     return text
@@ -544,7 +547,12 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, A
             if k in angle_params:
                 val = tuple(_angle(spec, x) for x in val) if isinstance(val, tuple) else _angle(spec, val)
             kw[k] = val
-        return ElementalMechanism(m.number, base.replace(**kw), rate=rate, phase=phase)
+        try:
+            return ElementalMechanism(m.number, base.replace(**kw), rate=rate, phase=phase)
+        except InputError as e:  # check_params names "#5.F_o": the scene's key is params.F_o
+            if e.field.startswith(f"#{m.number}.") and e.field[len(f"#{m.number}."):] != "params":
+                raise InputError("params." + e.field[len(f"#{m.number}."):], e.value, e.expected) from None
+            raise
     if isinstance(m, ChainSpec):
         from .windup.chain import chain_mechanism
 

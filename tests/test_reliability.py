@@ -171,9 +171,9 @@ BAD_SCENES: list[tuple[str, Any, str]] = [
     ("D_o-short", scene({"type": "elemental", "number": 1, "params": {"D_o": [0.0]}}), "params.D_o"),
     ("F_o-long", scene({"type": "elemental", "number": 1, "params": {"F_o": [0.3, 0.0, 0.0, 0.0]}}), "params.F_o"),
     ("D_jr-vector", scene({"type": "elemental", "number": 1, "params": {"D_jr": [0.1, 0.2]}}), "params.D_jr"),
-    ("D_jr-neg", scene({"type": "elemental", "number": 1, "params": {"D_jr": -0.1}}), "D_jr"),
+    ("D_jr-neg", scene({"type": "elemental", "number": 1, "params": {"D_jr": -0.1}}), "params.D_jr = -0.1"),
     ("param-unknown", scene({"type": "elemental", "number": 2, "params": {"Q": 1.0}}), "params.Q"),
-    ("param-bool", scene({"type": "elemental", "number": 2, "params": {"D_jr": True}}), "mechanism.params.D_jr"),
+    ("param-bool", scene({"type": "elemental", "number": 2, "params": {"D_jr": True}}), "mechanism.params.D_jr:"),
     ("D_theta-short", scene({"type": "elemental", "number": 10, "params": {"D_theta": [0.3]}}), "params.D_theta"),
     ("path-number", scene({"type": "elemental", "number": 11, "params": {"path": 0.1}}), "params.path"),
     ("number-12", scene({"type": "elemental", "number": 12}), "mechanism.number"),
@@ -201,7 +201,7 @@ def _write_scene(path: Path, content: Any) -> None:
     elif isinstance(content, bytes):
         path.write_bytes(content)
     elif content.startswith("\ufeff"):
-        path.write_bytes(content.encode("utf-16"))
+        path.write_bytes(content[1:].encode("utf-16"))  # what Notepad writes: UTF-16 with a byte-order mark
     else:
         path.write_text(content)
 
@@ -332,6 +332,14 @@ def test_bad_job(tmp_path: Path, capsys: pytest.CaptureFixture[str], content: di
     rc, _, err = _run([command, str(src), *outs], capsys)
     _check_one_line(rc, err, needle)
     assert _snapshot(tmp_path) == before
+
+
+def test_utf16_scene_with_a_byte_order_mark_is_read(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    src = tmp_path / "scene.toml"
+    src.write_bytes(GOOD.encode("utf-16"))
+    rc, out, err = _run(["motion", str(src), "-o", str(tmp_path / "m.csv")], capsys)
+    assert rc == 0, err
+    assert (tmp_path / "m.csv").read_text().count("\n") == 13
 
 
 def test_corpus_is_large_enough() -> None:
