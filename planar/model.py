@@ -579,7 +579,7 @@ class Mechanism:
     def solve(self, q: ArrayLike, t: ArrayLike | None = None) -> Motion:
         """Solve all samples at once for driver values ``q`` (scalar or array)."""
         qa = np.atleast_1d(check_finite(f"{self.name}.driver value", q)).astype(float)
-        if qa.ndim != 1 and not (qa.ndim == 2 and qa.shape[1] == 3 and getattr(self.driver, "kind", "") == "path"):
+        if qa.ndim != 1:  # an OzT driver's path is a function of its 1-D driver value too
             raise InputError(f"{self.name}.solve(q)", f"an array of shape {qa.shape}",
                              "a scalar or a 1-D array of driver values")
         if t is not None and np.shape(t) != qa.shape[:1]:

@@ -70,6 +70,16 @@ def test_bad_input_raises_a_named_planar_error(leg: FourBar, call, needle: str) 
     assert "\n" not in str(info.value)
 
 
+@pytest.mark.parametrize("number", [1, 10])
+def test_solve_takes_one_driver_value_per_sample(number: int) -> None:
+    mech = elemental(number)
+    for shape in ((4, 3), (4, 1), (2, 2, 2)):
+        with pytest.raises(InputError, match="1-D array"):
+            mech.solve(np.zeros(shape))
+    m = mech.solve(np.linspace(0.0, 1.0, 4))
+    assert {v.shape[0] for v in m.poses.values()} == {4}
+
+
 def test_long_values_are_summarised_in_messages(leg: FourBar) -> None:
     with pytest.raises(InputError) as info:
         leg.solve(np.r_[np.zeros(1000), math.nan])

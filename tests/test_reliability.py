@@ -410,6 +410,12 @@ def test_limits_are_configurable(tmp_path: Path, capsys: pytest.CaptureFixture[s
     rc, out, err = _run(["motion", str(src), "-o", str(tmp_path / "m.csv")], capsys)
     assert rc == 0, err
     assert len((tmp_path / "m.csv").read_text().splitlines()) == 121
+    monkeypatch.setenv("PLANAR_MAX_MEMORY", "1")  # MiB: 120 samples fit, 12 000 do not
+    src.write_text(toml(fb() | {"driver": {"samples_per_cycle": 12, "cycles": 1000.0}}))
+    monkeypatch.setenv("PLANAR_MAX_SAMPLES", "20000")
+    rc, _, err = _run(["motion", str(src), "-o", str(tmp_path / "m.csv")], capsys)
+    _check_one_line(rc, err, "PLANAR_MAX_MEMORY")
+    assert len((tmp_path / "m.csv").read_text().splitlines()) == 121  # the earlier output intact
     monkeypatch.setenv("PLANAR_MAX_SAMPLES", "many")
     rc, _, err = _run(["motion", str(src), "-o", str(tmp_path / "m.csv")], capsys)
     _check_one_line(rc, err, "PLANAR_MAX_SAMPLES")
