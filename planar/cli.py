@@ -334,6 +334,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     Warnings (numpy's RuntimeWarnings on invalid samples) are silenced: the
     validity masks carry that information.  ``--debug`` re-raises errors.
     """
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:  # while parsing or importing, or a second Ctrl-C while unwinding
+        print("planar: interrupted (no output written)", file=sys.stderr)
+        rc = 130
+    if argv is None:  # the command itself: leave now, before shutdown handlers (threads, writers) can print
+        sys.stderr.flush()
+        os._exit(rc)
+    return rc
+
+
+def _main(argv: Sequence[str] | None) -> int:
     import warnings
 
     parser = build_parser()
@@ -353,9 +365,6 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise
         print(f"planar: error: {_one_line(e)}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("planar: interrupted (no output written)", file=sys.stderr)
-        return 130
     except BrokenPipeError:
         # the reader of our output went away (``planar compare | head``): stop quietly, as Unix tools do
         devnull = os.open(os.devnull, os.O_WRONLY)
@@ -379,6 +388,20 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"planar: internal error: {type(e).__name__}: {_one_line(e)[:300]} "
               f"(a bug in planar; run again with --debug for the traceback)", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:
+        # a writer interrupted mid-file (imageio's plugin) complains from its __del__ when the
+        # traceback's frames are freed: keep that off the terminal, the one line below says it all
+        hook = sys.unraisablehook
+        sys.unraisablehook = _quiet
+    import gc
+
+    gc.collect()
+    sys.unraisablehook = hook
+    raise KeyboardInterrupt  # main prints the one line and, for the command, exits at once
+
+
+def _quiet(unraisable: object) -> None:
+    """An unraisable-exception hook that prints nothing (used while an interrupted command unwinds)."""
 
 
 if __name__ == "__main__":  # pragma: no cover
