@@ -5,7 +5,7 @@ and *what* (the offending value and what was expected).  The CLI prints the
 message on one line and exits with status 2; no traceback is shown.  Every
 class here derives from :class:`PlanarError`; :class:`InputError` and
 :class:`LimitError` are also :class:`ValueError`, so Python callers may catch
-either.
+either; so are :class:`AssemblyError` and :class:`SceneError`.
 """
 
 from __future__ import annotations
@@ -52,9 +52,9 @@ class LimitError(InputError):
     """A request needs more work or memory than a configured limit allows (see :mod:`planar.limits`)."""
 
 
-class AssemblyError(PlanarError):
+class AssemblyError(PlanarError, ValueError):
     """A mechanism cannot be assembled at any (or at a required) driver value."""
 
 
-class SceneError(PlanarError):
+class SceneError(PlanarError, ValueError):
     """A scene file is malformed; the message names the file and field path."""
