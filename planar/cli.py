@@ -334,11 +334,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     Warnings (numpy's RuntimeWarnings on invalid samples) are silenced: the
     validity masks carry that information.  ``--debug`` re-raises errors.
     """
+    hook = sys.unraisablehook
+    debug = "--debug" in (sys.argv[1:] if argv is None else argv)
+    if not debug:  # a writer abandoned by an error complains from its __del__: not a user's concern
+        sys.unraisablehook = _quiet
     try:
         return _main(argv)
     except KeyboardInterrupt:  # while parsing or importing, or a second Ctrl-C while unwinding
         print("planar: interrupted (no output written)", file=sys.stderr)
         rc = 130
+    finally:
+        import gc
+
+        gc.collect()
+        sys.unraisablehook = hook
     if argv is None:  # the command itself: leave now, before shutdown handlers (threads, writers) can print
         sys.stderr.flush()
         os._exit(rc)
@@ -388,16 +397,6 @@ def _main(argv: Sequence[str] | None) -> int:
         print(f"planar: internal error: {type(e).__name__}: {_one_line(e)[:300]} "
               f"(a bug in planar; run again with --debug for the traceback)", file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
-        # a writer interrupted mid-file (imageio's plugin) complains from its __del__ when the
-        # traceback's frames are freed: keep that off the terminal, the one line below says it all
-        hook = sys.unraisablehook
-        sys.unraisablehook = _quiet
-    import gc
-
-    gc.collect()
-    sys.unraisablehook = hook
-    raise KeyboardInterrupt  # main prints the one line and, for the command, exits at once
 
 
 def _quiet(unraisable: object) -> None:

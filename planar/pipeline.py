@@ -8,6 +8,7 @@ functions that need them, so ``import planar.pipeline`` stays light.
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -52,6 +53,12 @@ def gallery_scenes(folder: str | os.PathLike[str]) -> list[Path]:
 
 # --------------------------------------------------------------------------- render
 
+#: the longest frame delay a GIF can hold (65535 hundredths of a second)
+GIF_MAX_DELAY_MS = 655_350.0
+
+#: the largest sheet side (mm) the fabrication geometry is computed for
+MAX_SHEET_MM = 100_000.0
+
 
 def scene_style(scene: Scene) -> Style:
     """The renderer's :class:`~planar.render.Style` from a scene's ``[render]`` table."""
@@ -86,6 +93,11 @@ def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, p
     field_name = "driver.duration" if scene.spec.driver.duration is not None else "driver.cycles"
     check_count("frames", f"{scene.path}: {field_name}", scene.sample_count(), "frames (one per sample)",
                 shown=getattr(scene.spec.driver, field_name.split(".")[1]))
+    spc = scene.spec.driver.samples_per_cycle
+    if 1000.0 * scene.mechanism.driver.period / spc > GIF_MAX_DELAY_MS:
+        raise InputError(f"{scene.path}: driver.speed", scene.spec.driver.speed,
+                         f"a speed of at least {1000.0 / (GIF_MAX_DELAY_MS * spc):.3g} cycles per second at "
+                         f"{spc} samples per cycle (a GIF frame lasts at most {GIF_MAX_DELAY_MS / 1000:g} s)")
     motion = scene.motion()
     polys = {n: scene.polygons[n] for n in scene.spec.render.sweep}
     r = Renderer(scene.mechanism, motion, scene_style(scene), overlay=overlay, polygons=polys)
@@ -152,7 +164,17 @@ def export_scene(scene: Scene, dxf: str | Path | None = None, svg: str | Path | 
     from .fabexport import build, write_outputs
     from .fabparts import FabSettings
 
-    fab = build(scene, FabSettings.from_spec(scene.spec.fabrication, kerf, sheet))
+    spec = scene.spec.fabrication
+    w, h = sheet if sheet is not None else spec.sheet_mm
+    where = "--sheet" if sheet is not None else f"{scene.path}: fabrication.sheet_mm"
+    if not all(math.isfinite(v) and 0 < v <= MAX_SHEET_MM for v in (w, h)):
+        raise InputError(where, f"{w:g} x {h:g}", f"a sheet of finite, positive sides up to {MAX_SHEET_MM:g} mm")
+    across = scene.mechanism.size * spec.unit_mm  # the largest part's diameter, mm
+    if not across <= math.hypot(w, h):
+        raise InputError(f"{scene.path}: fabrication.unit_mm", spec.unit_mm,
+                         f"parts that fit the {w:g} x {h:g} mm sheet (the largest part is {across:.4g} mm across; "
+                         "a smaller unit_mm or a larger sheet)")
+    fab = build(scene, FabSettings.from_spec(spec, kerf, sheet))
     fab.written = write_outputs(fab, dxf, svg, preview, bom, assembly, kerf_test)
     return fab
 

@@ -315,6 +315,10 @@ BAD_JOBS: list[tuple[str, dict, str, str]] = [
     ("holes-overlap", fb() | {"fabrication": {"unit_mm": 3.0, "pin_diameter_mm": 20.0}}, "export", "overlap"),
     ("kerf-wider-than-parts", fb() | {"fabrication": {"unit_mm": 0.05, "kerf_mm": 2.0}}, "export", "kerf"),
     ("too-many-frames", fb() | {"driver": {"samples_per_cycle": 72, "cycles": 1000.0}}, "render", "PLANAR_MAX_FRAMES"),
+    ("parts-larger-than-sheet", scene({"type": "elemental", "number": 6}, fabrication={"unit_mm": 1e20}), "export",
+     "fabrication.unit_mm"),
+    ("sheet-too-large", fb() | {"fabrication": {"sheet_mm": [1e30, 200.0]}}, "export", "fabrication.sheet_mm"),
+    ("gif-delay-too-long", scene({"type": "elemental", "number": 3}, driver={"speed": 1e-12}), "render", "driver.speed"),
     ("frames-by-duration", fb() | {"driver": {"samples_per_cycle": 72, "duration": 1e5}}, "render", "driver.duration"),
 ]
 
