@@ -100,10 +100,16 @@ def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, p
                          f"{spc} samples per cycle (a GIF frame lasts at most {GIF_MAX_DELAY_MS / 1000:g} s)")
     motion = scene.motion()
     polys = {n: scene.polygons[n] for n in scene.spec.render.sweep}
-    r = Renderer(scene.mechanism, motion, scene_style(scene), overlay=overlay, polygons=polys)
-    pal = palette_colors(r.style, len(scene.mechanism.parts))
-    delay = frame_delay_ms(scene.mechanism.driver.period, scene.spec.driver.samples_per_cycle)
-    return write_gif(out, r.frames(progress=progress, post=indexer(pal)), delay, pal)
+    from shapely.errors import GEOSException
+
+    try:
+        r = Renderer(scene.mechanism, motion, scene_style(scene), overlay=overlay, polygons=polys)
+        pal = palette_colors(r.style, len(scene.mechanism.parts))
+        delay = frame_delay_ms(scene.mechanism.driver.period, scene.spec.driver.samples_per_cycle)
+        return write_gif(out, r.frames(progress=progress, post=indexer(pal)), delay, pal)
+    except GEOSException as e:  # part outlines of extreme sizes (a coupler point at 1e305) defeat GEOS
+        raise InputError(f"{scene.path}: mechanism", f"parts up to {scene.mechanism.size:.4g} units across",
+                         f"part sizes the outline geometry can draw (shapely: {' '.join(str(e).split())})") from None
 
 
 def build_gallery(source: str | Path, output: str | Path | None = None,

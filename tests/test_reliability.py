@@ -319,6 +319,7 @@ BAD_JOBS: list[tuple[str, dict, str, str]] = [
      "fabrication.unit_mm"),
     ("sheet-too-large", fb() | {"fabrication": {"sheet_mm": [1e30, 200.0]}}, "export", "fabrication.sheet_mm"),
     ("gif-delay-too-long", scene({"type": "elemental", "number": 3}, driver={"speed": 1e-12}), "render", "driver.speed"),
+    ("coupler-point-1e305", fb(coupler_point=[0.75, -9.24e305]), "render", "mechanism"),
     ("frames-by-duration", fb() | {"driver": {"samples_per_cycle": 72, "duration": 1e5}}, "render", "driver.duration"),
 ]
 
