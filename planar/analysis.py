@@ -29,7 +29,7 @@ speeds in rad/s, torques in force x model-unit.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -128,11 +128,44 @@ def node_velocities(
     * Rigid: ``vP = vA + omega perp(P - A)`` with the frame's ``omega``.
 
     With ``qdot = 1`` the results are velocity coefficients ``dX/dq``.
-    ``valid`` is false where a system is singular (a toggle) or the
-    position does not close.  Velocities are in the linkage's own frame
-    before placement; rotate them by ``placement[2]`` for the world.
+    ``valid`` is false where the position does not close, within
+    :data:`TOGGLE_SINE` of a dyad's toggle (the rule of
+    :func:`fourbar_velocities`) or where a velocity is not finite; invalid
+    samples hold 0.  Velocities are in the linkage's own frame before
+    placement; rotate them by ``placement[2]`` for the world.
     """
-    return link.node_velocities(q, qdot)
+    vel, valid = link.node_velocities(q, qdot)
+    ok = np.asarray(valid, bool) & _dyad_mask(link, q)
+    for v in vel.values():
+        ok &= np.isfinite(v).all(-1)
+    return {k: np.where(ok[:, None], v, 0.0) for k, v in vel.items()}, ok
+
+
+def _dyad_mask(link: "Linkage", q: ArrayLike) -> NDArray[np.bool_]:
+    """The one validity rule for a linkage's velocities: no dyad within :data:`TOGGLE_SINE` of its toggle.
+
+    An RRR node ``P`` (links from ``A`` and ``B``) toggles where ``P - A`` and ``P - B`` fall into
+    line; an RRP node where its rod ``P - A`` stands square to the slide line ``p -> q``.  Scale-free:
+    sines of angles, not lengths.
+    """
+    qa = np.atleast_1d(np.asarray(q, float))
+    pos, _ = link.solve_nodes(qa)
+    ok = np.ones(qa.shape[0], bool)
+
+    def unit(v: Array) -> Array:
+        n = np.hypot(v[:, 0], v[:, 1])
+        return v / np.where(n > 0, n, 1.0)[:, None]
+
+    P: dict[str, Array] = {k: np.asarray(v, float) for k, v in pos.items()}
+    for node in link.nodes:
+        nd: Any = node  # an RRR carries a and b, an RRP a, p and q
+        if nd.kind == "rrr":
+            u, w = unit(P[nd.name] - P[nd.a]), unit(P[nd.name] - P[nd.b])
+            ok &= np.abs(_cross(u, w)) > TOGGLE_SINE
+        elif nd.kind == "rrp":
+            u, w = unit(P[nd.name] - P[nd.a]), unit(P[nd.q] - P[nd.p])
+            ok &= np.abs((u * w).sum(-1)) > TOGGLE_SINE
+    return ok
 
 
 def point_velocities(

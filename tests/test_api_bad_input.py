@@ -131,6 +131,11 @@ def test_one_validity_rule_for_velocities_and_instant_centres() -> None:
     toggles = dr.toggle_angles()
     _, _, at_toggle = analysis.fourbar_velocities(dr, toggles)
     assert not at_toggle.any()
+    # the same rule through the general linkage path (node velocities, motor torque), toggles included
+    q = np.sort(np.r_[TH, toggles, toggles + 1e-9, toggles - 1e-9])
+    _, _, ok_fb = analysis.fourbar_velocities(dr, q)
+    tau, ok_tau = analysis.motor_torque(dr, q, {"coupler_point": [0.0, 1.0]})
+    assert (ok_fb == ok_tau).all() and np.isfinite(tau).all() and (tau[~ok_tau] == 0).all()
     # where valid: central differences of the solved rocker angle, a step of 1e-6 either side
     h = 1e-6
     up, down = dr.solve(TH + h), dr.solve(TH - h)
