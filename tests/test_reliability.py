@@ -480,3 +480,40 @@ def test_subprocess_errors_are_one_line_without_traceback(tmp_path: Path) -> Non
         assert r.returncode == 2, r.stderr
         assert len(r.stderr.splitlines()) == 1 and needle in r.stderr and "Traceback" not in r.stderr, r.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml", "loop.toml"]
+
+
+def test_awkward_names_survive_every_format_or_are_refused(tmp_path: Path) -> None:
+    """From Python a link may be named with a comma, quotes and XML specials: ezdxf, the csv module and
+    svgelements read the outputs back; a newline is refused with the name, and nothing is written."""
+    import csv
+
+    import ezdxf
+    import svgelements
+
+    from planar.errors import InputError
+    from planar.linkages import RRR, Crank, Fixed, Link, Linkage
+    from planar.pipeline import export_scene
+    from planar.scene import Scene, parse_scene
+
+    spec = parse_scene(linkage())
+
+    def leg(name: str) -> Scene:
+        mech = Linkage("leg", [Fixed("O", (0.0, 0.0)), Fixed("Q", (4.0, 0.0)), Crank("A", "O", 1.0),
+                               RRR("B", "A", 4.0, "Q", 3.0)],
+                       [Link(name, ("O", "A")), Link("coupler", ("A", "B")), Link("rocker", ("Q", "B"))])
+        return Scene(spec, mech, "leg.toml")
+
+    outs = {"dxf": tmp_path / "p.dxf", "svg": tmp_path / "p.svg", "bom": tmp_path / "b.csv",
+            "assembly": tmp_path / "a.svg"}
+    export_scene(leg('cr,ank "x" <&>'), **outs)
+    groups = [g for g, _ in ezdxf.readfile(outs["dxf"]).groups]
+    assert 'cr,ank_"x"_<&>' in groups
+    rows = list(csv.reader(outs["bom"].open()))
+    assert {len(r) for r in rows} == {8} and any(r[1] == 'cr,ank "x" <&>' for r in rows)
+    assert list(svgelements.SVG.parse(outs["assembly"]).elements())  # well-formed XML
+    assert 'cr,ank "x" &lt;&amp;&gt;' in outs["assembly"].read_text()  # the name, escaped
+    for p in outs.values():
+        p.unlink()
+    with pytest.raises(InputError, match="control characters"):
+        export_scene(leg("cr\nank"), **outs)
+    assert list(tmp_path.iterdir()) == []
