@@ -593,7 +593,8 @@ class Mechanism:
         # the final finite check: a sample whose numbers overflowed float64 is never valid (and holds 0, not NaN)
         finite = np.ones(n, dtype=bool)
         for arr in (*poses.values(), *pts.values()):
-            finite &= np.isfinite(arr).reshape(n, -1).all(axis=1)
+            if not np.isfinite(arr.sum()):  # a cheap screen (a sum of finite numbers may overflow: then look closer)
+                finite &= np.isfinite(arr).reshape(n, -1).all(axis=1)
         if not finite.all():
             checks = list(checks or []) + [(finite, "result", "a number overflowed float64 (non-finite result)")]
             poses = {k: np.nan_to_num(v, nan=0.0, posinf=0.0, neginf=0.0) for k, v in poses.items()}
