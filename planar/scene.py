@@ -566,7 +566,10 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, A
         if m.right:
             cams["right"] = [tuple(c) for c in m.right]
         return ToyMechanism(cams, phase=_angle(spec, m.phase), rate=rate, name=spec.name or "toy")
-    mech = get(m.name)
+    try:
+        mech = get(m.name)
+    except InputError as e:
+        raise InputError("name", m.name, e.expected) from None
     if rate != 2 * math.pi or phase:
         from dataclasses import replace
 

@@ -185,7 +185,7 @@ BAD_SCENES: list[tuple[str, Any, str]] = [
     ("toy-empty", scene({"type": "toy"}), "mechanism"),
     ("toy-bad", scene({"type": "toy", "right": [["Rz->Tx", "Oz->Ox"]]}), "right[0][1]"),
     ("toy-phase-nan", scene({"type": "toy", "left": [["Rz->Tx"]], "phase": math.nan}), "mechanism.phase"),
-    ("catalog-bad", scene({"type": "catalog", "name": "nope"}), "nope"),
+    ("catalog-bad", scene({"type": "catalog", "name": "nope"}), "mechanism: name = 'nope'"),
     # files that are not scenes
     ("binary", b"\x00\x01\x02\xff\xfe garbage", "not a text file"),
     ("utf16-bom", "\ufeff" + toml({"mechanism": FOURBAR}) + "bad = = 1\n", "not valid TOML"),
