@@ -43,6 +43,7 @@ if TYPE_CHECKING:
 __all__ = [
     "TOGGLE_SINE",
     "fourbar_velocities",
+    "fourbar_accelerations",
     "node_velocities",
     "point_velocities",
     "finite_difference",
@@ -112,6 +113,38 @@ def fourbar_velocities(
     w3 = np.where(valid, sol[..., 0], 0.0)
     w4 = np.where(valid, sol[..., 1], 0.0)
     return w3, w4, valid
+
+
+def fourbar_accelerations(
+    fb: "FourBar", theta: ArrayLike, omega2: ArrayLike = 1.0, alpha2: ArrayLike = 0.0
+) -> tuple[Array, Array, NDArray[np.bool_]]:
+    """Coupler and rocker angular accelerations ``(alpha3, alpha4, valid)`` (rad/s^2).
+
+    The loop ``a e^(i t2) + b e^(i t3) - c e^(i t4) - d = 0`` differentiated
+    twice, in the link angles (Norton's formulation, independent of the node
+    kinds' point formulation)::
+
+        -b sin t3 al3 + c sin t4 al4 = a al2 sin t2 + a w2^2 cos t2 + b w3^2 cos t3 - c w4^2 cos t4
+         b cos t3 al3 - c cos t4 al4 = -a al2 cos t2 + a w2^2 sin t2 + b w3^2 sin t3 - c w4^2 sin t4
+
+    with ``w3, w4`` from :func:`fourbar_velocities`; the same matrix, singular
+    at a toggle.
+    """
+    th2 = np.atleast_1d(np.asarray(theta, float))
+    w2 = np.broadcast_to(np.asarray(omega2, float), th2.shape)
+    al2 = np.broadcast_to(np.asarray(alpha2, float), th2.shape)
+    th3, th4, ok = fb.angles(th2)
+    w3, w4, okv = fourbar_velocities(fb, th2, w2)
+    g = fb.dims
+    s2, c2, s3, c3, s4, c4 = np.sin(th2), np.cos(th2), np.sin(th3), np.cos(th3), np.sin(th4), np.cos(th4)
+    r1 = g.a * al2 * s2 + g.a * w2**2 * c2 + g.b * w3**2 * c3 - g.c * w4**2 * c4
+    r2 = -g.a * al2 * c2 + g.a * w2**2 * s2 + g.b * w3**2 * s3 - g.c * w4**2 * s4
+    det = (-g.b * s3) * (-g.c * c4) - (g.c * s4) * (g.b * c3)
+    sing = np.abs(det) <= 1e-12 * g.b * g.c
+    det = np.where(sing, 1.0, det)
+    al3 = (r1 * (-g.c * c4) - (g.c * s4) * r2) / det
+    al4 = ((-g.b * s3) * r2 - (g.b * c3) * r1) / det
+    return al3, al4, ok & okv & ~sing
 
 
 def node_velocities(

@@ -81,6 +81,8 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         kwargs["n"] = args.n
     if args.repeats is not None:
         kwargs["repeats"] = args.repeats
+    if args.name == "synthesis":
+        kwargs["quick"] = args.quick
     if args.name == "accuracy":
         kwargs["scenes"] = args.scenes
         kwargs["out_dir"] = args.output
@@ -123,11 +125,18 @@ def _cmd_render(args: argparse.Namespace) -> int:
     from .pipeline import overlay_motion, render_scene
     from .scene import load_scene
 
-    _outputs(args, (args.scene,), ("-o", "output", (".gif",)))
+    from .pipeline import ANIMATION_SUFFIXES
+
+    _outputs(args, (args.scene,), ("-o", "output", ANIMATION_SUFFIXES))
     scene = load_scene(args.scene)
     overlay = overlay_motion(scene) if args.overlay else None
-    n = render_scene(scene, args.output, overlay=overlay)
-    print(f"wrote {args.output}: {n} frames")
+    from .pipeline import animation_plan
+
+    plan = animation_plan(scene, args.output, args.fps)
+    if plan.note():
+        print(f"note: {plan.note()}")
+    n = render_scene(scene, args.output, overlay=overlay, fps=args.fps)
+    print(f"wrote {args.output}: {n} frames, {plan.fps:.3g} frames/s, a cycle plays {plan.cycle_play_s:.3g} s")
     return 0
 
 
@@ -136,8 +145,13 @@ def _cmd_motion(args: argparse.Namespace) -> int:
     from .scene import load_scene
 
     _outputs(args, (args.scene,), ("-o", "output", (".csv",)))
-    motion = write_scene_motion(load_scene(args.scene), args.output)
+    scene = load_scene(args.scene)
+    motion = write_scene_motion(scene, args.output, derivatives=args.derivatives)
     print(f"wrote {args.output}: {len(motion)} samples, {int(motion.valid.sum())} valid")
+    if args.derivatives:
+        from .derivatives import rates_method
+
+        print(f"rates: {rates_method(scene.mechanism)}")
     return 0
 
 
@@ -169,6 +183,8 @@ def _cmd_schema(args: argparse.Namespace) -> int:
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
+    from dataclasses import replace
+
     from .compare import EXIT_MISMATCH, format_comparison
     from .pipeline import compare_scene
     from .scene import load_scene
@@ -178,27 +194,31 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         _positive(option, v)
     _positive("--substeps", args.substeps, integer=True)
     _positive("--iterations", args.iterations, integer=True)
+    if args.step_drift is not None and not (math.isfinite(args.step_drift) and args.step_drift >= 0):
+        raise InputError("--step-drift", args.step_drift, "a drift fraction >= 0 (0 keeps --substeps fixed)")
     if args.error_bias is not None and not (0 <= args.error_bias <= 1):
         raise InputError("--error-bias", args.error_bias, "a number between 0 and 1")
     scene = load_scene(args.scene)
     settings = SimSettings(**{k: v for k, v in (("substeps", args.substeps), ("iterations", args.iterations),
                                                  ("error_bias", args.error_bias)) if v is not None})
+    if args.step_drift is not None:  # 0: fixed substeps
+        settings = replace(settings, step_drift=args.step_drift or None)
     result, sim = compare_scene(scene, settings, args.threshold, args.torque_threshold, with_series=args.json)
     t = sim.motion.t
     assert t is not None  # a simulation records its output times
     if args.json:
         d = result.to_dict()
-        d["settings"] = {"substeps": settings.substeps, "iterations": sim.built.get("iterations"),
-                         "correction": settings.step_correction(t[1] - t[0]),
+        d["settings"] = {"substeps": sim.built.get("substeps"), "iterations": sim.built.get("iterations"),
+                         "step_drift": settings.step_drift,
+                         "correction": sim.built.get("correction"),
                          "error_bias": settings.error_bias}
         d["wall_time_s"] = sim.wall_time
         d["built"] = {k: v for k, v in sim.built.items()}
         print(json.dumps(d, indent=2, default=str))
     else:
         print(format_comparison(result))
-        print(f"  simulated in {sim.wall_time:.3f} s ({sim.steps} steps; substeps {settings.substeps}, "
-              f"iterations {sim.built.get('iterations')}, correction per step "
-              f"{settings.step_correction((t[1] - t[0]) / settings.substeps):.3g})")
+        print(f"  simulated in {sim.wall_time:.3f} s ({sim.steps} steps; substeps {sim.built.get('substeps')}, "
+              f"iterations {sim.built.get('iterations')}, correction per step {sim.built.get('correction'):.3g})")
     return 0 if result.passed else EXIT_MISMATCH
 
 
@@ -260,7 +280,8 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("-n", type=int, default=None, help="problem size (samples)")
     b.add_argument("--repeats", type=int, default=None, help="timing repeats (best is kept)")
     b.add_argument("-o", "--output", default="planar-bench-accuracy", help="accuracy: folder for the CSV and chart")
-    b.add_argument("--quick", action="store_true", help="accuracy: a small grid on three mechanisms")
+    b.add_argument("--quick", action="store_true",
+                   help="accuracy: a small grid on three mechanisms; synthesis: one repeat, small budgets")
     b.add_argument("--scenes", default="gallery",
                    help="accuracy: folder of scene files to measure (default: ./gallery, the repository's)")
     b.set_defaults(func=_cmd_bench)
@@ -272,15 +293,21 @@ def build_parser() -> argparse.ArgumentParser:
     ch.add_argument("--json", action="store_true", help='print {"Ox": [["Rz->Tx", "Tx->Ox"], ...], ...}')
     ch.set_defaults(func=_cmd_chains)
 
-    r = sub.add_parser("render", help="render a scene's animation to a GIF")
+    r = sub.add_parser("render", help="render a scene's animation to a GIF (or MP4/WebM)")
     r.add_argument("scene", help="scene file (TOML)")
-    r.add_argument("-o", "--output", required=True, help="GIF file to write")
+    r.add_argument("-o", "--output", required=True,
+                   help="animation to write: .gif, or .mp4/.webm with the video extra (pip install 'planar[video]')")
+    r.add_argument("--fps", type=float, default=None,
+                   help="frames per second (default: the scene's [render] fps, else 25, or 50 for fast cycles; "
+                        "a GIF plays at most 50); a cycle plays for 1/speed seconds within one frame")
     r.add_argument("--overlay", action="store_true", help="draw the pymunk simulation over the analytic motion")
     r.set_defaults(func=_cmd_render)
 
     mo = sub.add_parser("motion", help="write a scene's motion table (CSV)")
     mo.add_argument("scene", help="scene file (TOML)")
     mo.add_argument("-o", "--output", required=True, help="CSV file to write")
+    mo.add_argument("--derivatives", action="store_true",
+                    help="add <point>.vx/.vy/.ax/.ay, <part>.omega/.alpha, transmission angles and motor torque")
     mo.set_defaults(func=_cmd_motion)
 
     g = sub.add_parser("gallery", help="render every scene of a folder to a GIF")
@@ -299,9 +326,13 @@ def build_parser() -> argparse.ArgumentParser:
                     help="error threshold, fraction of size (1e-3); exit status 3 when a check fails")
     cp.add_argument("--torque-threshold", type=float, default=0.01,
                     help="motor torque vs inverse dynamics, fraction of its peak (0.01)")
-    cp.add_argument("--substeps", type=int, default=None)
-    cp.add_argument("--iterations", type=int, default=None)
-    cp.add_argument("--error-bias", type=float, default=None)
+    cp.add_argument("--substeps", type=int, default=None,
+                    help="physics steps per sample, at least (28); raised where joints turn fast, see --step-drift")
+    cp.add_argument("--step-drift", type=float, default=None,
+                    help="largest predicted joint drift per step, fraction of size (3.5e-6); 0 keeps --substeps fixed")
+    cp.add_argument("--iterations", type=int, default=None, help="solver iterations per step, at least (40)")
+    cp.add_argument("--error-bias", type=float, default=None,
+                    help="joint error left after one second (replaces the correction of 0.2 per step)")
     cp.set_defaults(func=_cmd_compare)
 
     ex = sub.add_parser("export", help="every part laid flat for a laser cutter (DXF, SVG)")
@@ -316,11 +347,19 @@ def build_parser() -> argparse.ArgumentParser:
     ex.add_argument("--kerf-test", default=None, help="a kerf calibration piece (.dxf or .svg)")
     ex.set_defaults(func=_cmd_export)
 
+    __import__("planar.cli_toy", fromlist=["add_parser"]).add_parser(sub)
+
     c = sub.add_parser("catalog", help="write the motion table of a built-in mechanism")
     c.add_argument("mechanism", help="catalog name, e.g. jansen, kangaroo, slider-crank")
     c.add_argument("-o", "--output", required=True, help="CSV file to write")
     c.add_argument("--samples", type=int, default=360)
     c.set_defaults(func=_cmd_motion_catalog)
+    from .cli_plot import add_parser as add_plot_parser
+
+    add_plot_parser(sub)
+    from .cli_synth import add_parser as add_synth
+
+    add_synth(sub)
     return p
 
 

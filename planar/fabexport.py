@@ -10,6 +10,7 @@ With several sheets, ``parts.dxf`` becomes ``parts-1.dxf``, ``parts-2.dxf``
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -53,16 +54,43 @@ def _shaft_pin(mech: Any, pins) -> Any:
     return None
 
 
+def _fab_mechanism(mech: Any) -> Any:
+    """The mechanism whose parts are cut: a wind-up toy is cut as its assembly (merged parts, one frame,
+    cams keyed to the shaft; :mod:`planar.windup.assembly`), anything else as it is."""
+    from .windup.chain import ToyMechanism
+
+    if isinstance(mech, ToyMechanism):
+        from .windup.assembly import toy_assembly
+
+        return toy_assembly(mech)
+    return mech
+
+
+def _phase_mark(pc: PartCut, at: tuple[float, float], flat: float, phase: float) -> None:
+    """Engrave a keyed cam's phase: a tick from its shaft hole along the D's flat and the phase in degrees."""
+    import numpy as np
+
+    from .strokefont import text_strokes
+
+    c, s = math.cos(flat), math.sin(flat)
+    pc.engrave.append(np.array([(at[0] + 2.5 * c, at[1] + 2.5 * s), (at[0] + 5.0 * c, at[1] + 5.0 * s)]))
+    deg = f"{math.degrees(phase) % 360:.0f}"
+    pc.engrave.extend(text_strokes(deg, 1.5, (at[0] - 3.5 * c, at[1] - 3.5 * s), flat - math.pi / 2))
+    pc.notes.append(f"{pc.name}: keyed to the motor shaft at {deg} degrees (engraved tick along the D's flat)")
+
+
 def build(scene: Any, settings: FabSettings) -> Fabrication:
     """Cut-ready, checked, layered and nested parts of ``scene`` (raises FabricationError/InputError)."""
     s = settings
     if not (0 <= s.kerf <= 2):
         raise InputError("kerf", s.kerf, "a kerf between 0 and 2 mm")
-    mech = scene.mechanism
+    mech = _fab_mechanism(scene.mechanism)
+    keyed: dict[str, float] = dict(getattr(mech, "keyed", {}))
     pins, contacts = joint_pins(mech)
     pinned = pin_features(mech)
     shaft = _shaft_pin(mech, pins)
-    notes: list[str] = []
+    notes: list[str] = list(getattr(mech, "design_notes", ()))  # what a mechanism reports of its own design
+    notes += list(getattr(mech, "notes", []))
     if mech.driver.kind != "rotation":
         notes.append(f"driver {mech.driver.part!r} is a {mech.driver.kind} drive: no motor shaft hole")
     elif shaft is None:
@@ -86,8 +114,13 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
                 drive_at = shaft.at[k]
             else:
                 motor_at = shaft.at[k]
+        flat = math.pi / 2
+        if shaft is not None and part.name in keyed:  # a toy's cam: a D on the shaft, turned by its phase
+            drive_at, flat = (0.0, 0.0), math.pi / 2 - keyed[part.name]
         pc = part_cuts(part, s, n, {i for (pn, i) in pinned if pn == part.name}, drive_at, motor_at,
-                       mounting=part.ground and part.plane == "xy", letters=letters[part.name])
+                       mounting=part.ground and part.plane == "xy", letters=letters[part.name], drive_flat=flat)
+        if drive_at is not None and part.name in keyed:
+            _phase_mark(pc, (drive_at[0] * s.unit_mm, drive_at[1] * s.unit_mm), flat, keyed[part.name])
         notes.extend(pc.notes)
         cuts.append(pc)
     material = {pc.name: nominal_material(pc.outer, pc.inner, s.kerf / 2) for pc in cuts}
@@ -199,12 +232,13 @@ def write_outputs(fab: Fabrication | None, dxf=None, svg=None, preview=None, bom
 
 
 def summary(fab: Fabrication) -> str:
-    """One line: parts, sheets, utilisation, layers, pins, spacers."""
+    """One line: parts (and the spacer rings cut beside them), sheets, utilisation, layers, pins."""
     lay, asm = fab.layout, fab.assembly
     util = ", ".join(f"{u:.0%}" for u in lay.utilisation)
     layers = max(asm.n_layers.values()) if asm.n_layers else 0
     spacers = sum(p.spacers for p in asm.pins)
-    return (f"{len(lay.parts)} parts on {lay.sheets} sheet(s) of {lay.sheet_size[0]:g} x {lay.sheet_size[1]:g} mm "
-            f"(utilisation {util}), kerf {lay.kerf:g} mm, {layers} layer(s) of {fab.settings.thickness_mm:g} mm, "
-            f"{len(asm.pins)} pin(s), {spacers} spacer(s)")
+    rings = f" + {spacers} spacer ring(s)" if spacers else ""
+    return (f"{len(lay.parts) - spacers} parts{rings} on {lay.sheets} sheet(s) of {lay.sheet_size[0]:g} x "
+            f"{lay.sheet_size[1]:g} mm (utilisation {util}), kerf {lay.kerf:g} mm, {layers} layer(s) of "
+            f"{fab.settings.thickness_mm:g} mm, {len(asm.pins)} pin(s)")
 

@@ -15,9 +15,11 @@ import math
 from dataclasses import dataclass
 from typing import Any, Callable
 
+from .cams.joint import CamContact
 from .errors import PlanarError
 from .model import ArcSlot, CamOnLine, Hole, Mechanism, Part, PinInArcSlot, PinInSlot, Pivot, Slide, Slot
 from .registry import Registry
+from .linkages.gears import GearMesh
 from .windup.mechanisms import SkewContact
 
 __all__ = ["Contact", "FabricationError", "PIN_RULES", "PinSpec", "joint_pins", "pin_features", "register_contact"]
@@ -106,6 +108,8 @@ def register_contact(kind: type, coplanar: bool) -> None:
 
 
 register_contact(SkewContact, coplanar=False)  # a tilting pin on an edge: across layers
+register_contact(GearMesh, coplanar=True)  # two gears in mesh: one layer
+register_contact(CamContact, coplanar=True)  # a profile cam and its roller or follower: in one layer
 
 
 def joint_pins(mech: Mechanism) -> tuple[list[PinSpec], list[Contact]]:

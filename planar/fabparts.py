@@ -141,7 +141,7 @@ class Feature:
 
 
 def _features(part: Part, s: FabSettings, pinned: set[int], drive_at: tuple[float, float] | None,
-              motor_at: tuple[float, float] | None) -> list[Feature]:
+              motor_at: tuple[float, float] | None, drive_flat: float = math.pi / 2) -> list[Feature]:
     u = s.unit_mm
     out: list[Feature] = []
     for i, f in enumerate(part.features):
@@ -153,7 +153,7 @@ def _features(part: Part, s: FabSettings, pinned: set[int], drive_at: tuple[floa
                     raise FabricationError(f"fabrication.shaft_flat_mm: {s.shaft_flat_mm:g} mm across the flat must be "
                                            f"less than the shaft diameter {s.shaft_mm:g} mm")
                 out.append(Feature("d", f"motor shaft D-hole {s.shaft_mm:g} mm", c, s.shaft_mm / 2,
-                                   flat=s.shaft_flat_mm - s.shaft_mm / 2, t0=math.pi / 2))
+                                   flat=s.shaft_flat_mm - s.shaft_mm / 2, t0=drive_flat))
                 continue
             if motor_at is not None and math.dist(f.centre, motor_at) < 1e-9 * max(1.0, u):
                 d = s.shaft_mm + 4 * s.clearance + 0.5
@@ -246,6 +246,56 @@ def _min_wall(outer, feats: Sequence[Feature]) -> float:
             d = -float(shapely.distance(outer, shapely.points(np.asarray(c.exterior.coords))).max())
         best = min(best, d)
     return best
+
+
+def _drop_contained(feats: list[Feature]) -> list[Feature]:
+    """``feats`` without a cut that lies wholly inside another one (it removes nothing more: e.g. a merged
+    toy body sliding on one line through two stages' slots, one inside the other)."""
+    polys = [cut_polygon(f.cut(0.0)) for f in feats]
+    keep = []
+    for i, p in enumerate(polys):
+        inside = any(j != i and (polys[j].buffer(1e-6).contains(p) and (polys[j].area > p.area or j < i)
+                                 or _same_guide(feats[i], feats[j], j < i))
+                     for j in range(len(polys)))
+        if not inside:
+            keep.append(feats[i])
+    return keep
+
+
+def _same_guide(f: Feature, g: Feature, g_first: bool, tol: float = 1e-6) -> bool:
+    """Whether slot ``f`` runs on the line of slot ``g`` within ``g``'s ends (mm): one guide, cut once as ``g``.
+
+    A merged toy body is guided on one line by two stages' slots of different widths; only the slot the
+    pins run in is kept (the ``g`` that is not itself inside a longer one; ties: the first)."""
+    if f.kind != "slot" or g.kind != "slot" or f is g:
+        return False
+    a, b = np.asarray(g.a), np.asarray(g.b)
+    L = float(np.hypot(*(b - a)))
+    if L <= tol:
+        return False
+    e = (b - a) / L
+    ends = [np.asarray(f.a) - a, np.asarray(f.b) - a]
+    off = [abs(float(e[0] * v[1] - e[1] * v[0])) for v in ends]
+    along = [float(e @ v) for v in ends]
+    if max(off) > tol or min(along) < -tol or max(along) > L + tol:
+        return False
+    flen = float(np.hypot(*(np.asarray(f.b) - np.asarray(f.a))))
+    return L > flen + tol or (abs(L - flen) <= tol and g_first)
+
+
+def _closest_cuts(feats: Sequence[Feature]) -> tuple[float, Feature | None, Feature | None]:
+    """The least material (mm) between two cuts of one part and the two features (0 where they overlap).
+
+    Widening the outline cannot mend this, so a part whose holes run into each other is refused.
+    """
+    polys = [cut_polygon(f.cut(0.0)) for f in feats]
+    best, fa, fb = math.inf, None, None
+    for i in range(len(polys)):
+        for j in range(i + 1, len(polys)):
+            d = float(polys[i].distance(polys[j]))
+            if d < best:
+                best, fa, fb = d, feats[i], feats[j]
+    return best, fa, fb
 
 
 def _fit_text(poly, text: str, angle: float, centres: list[tuple[float, float]]) -> tuple[float, tuple[float, float]]:
@@ -344,41 +394,41 @@ def letter_marks(material, holes: list[tuple[tuple[float, float], float, str]], 
 
 def part_cuts(part: Part, s: FabSettings, number: int, pinned: set[int] = frozenset(),  # type: ignore[assignment]
               drive_at: tuple[float, float] | None = None, motor_at: tuple[float, float] | None = None,
-              mounting: bool = False, letters: Sequence[tuple[tuple[float, float], str]] = ()) -> PartCut:
+              mounting: bool = False, letters: Sequence[tuple[tuple[float, float], str]] = (),
+              drive_flat: float = math.pi / 2) -> PartCut:
     """A part's cuts in mm in its own frame, kerf applied, checked (see the module docstring).
 
     ``pinned``: indices of the part's features a pin goes through; ``drive_at`` / ``motor_at``: the
     motor axis (model units, own frame) on the driven part / the plate holding the motor;
-    ``letters``: hole letters at pin positions (model units, own frame).
+    ``letters``: hole letters at pin positions (model units, own frame); ``drive_flat``: direction
+    (rad, own frame) of the D-hole's flat (a toy's cams are keyed to one shaft at their phase).
     """
     k2 = s.kerf / 2.0
-    feats = _features(part, s, set(pinned), drive_at, motor_at)
+    feats = _features(part, s, set(pinned), drive_at, motor_at, drive_flat)
     for f in feats:
         if f.r - k2 <= 0 or (f.kind == "d" and f.flat - k2 <= -(f.r - k2)):
             raise FabricationError(f"part {part.name!r}: {f.what} {2 * f.r:.2f} mm wide is not wider than the "
                                    f"kerf {s.kerf:g} mm")
-    polys = [cut_polygon(f.cut(0.0)) for f in feats]
-    for i in range(len(feats)):  # holes that fit their part: a round hole overlaps no other cut
-        for j in range(i + 1, len(feats)):
-            if feats[i].kind not in ("hole", "d") and feats[j].kind not in ("hole", "d"):
-                continue  # two slots may cross by design; a round hole must stand clear of every other cut
-            gap = polys[i].distance(polys[j])
-            if gap <= 0.0:
-                raise FabricationError(
-                    f"part {part.name!r}: {feats[i].what} ({2 * feats[i].r:.2f} mm) and {feats[j].what} "
-                    f"({2 * feats[j].r:.2f} mm) overlap: the holes do not fit the part (smaller pins, or a "
-                    f"larger [fabrication] unit_mm)")
     if mounting:
         base = [(x * s.unit_mm, y * s.unit_mm, r * s.unit_mm) for x, y, r in part.hull] + \
             [c for f in feats for c in f.wall_circles(s.min_wall)]
         feats = feats + _mounting_holes(base, s)
+    feats = _drop_contained(feats)
+    gap, fa, fb = _closest_cuts(feats)
+    if fa is not None and fb is not None and gap < s.min_wall - WALL_TOL:
+        raise FabricationError(
+            f"part {part.name!r}: {gap:.2f} mm of material between its {fa.what} at "
+            f"({fa.a[0]:.1f}, {fa.a[1]:.1f}) mm and its {fb.what} at ({fb.a[0]:.1f}, {fb.a[1]:.1f}) mm, less than "
+            f"min_wall_mm {s.min_wall:g} (a larger unit_mm, a smaller pin_diameter_mm or a smaller min_wall_mm)")
     nominal_outer, notes = _outer(part, s, feats, 0.0)
     outer = nominal_outer if k2 == 0 else _outer(part, s, feats, k2)[0]
     outer_poly = cut_polygon(nominal_outer)
     wall = _min_wall(outer_poly, feats)
     if wall < s.min_wall - WALL_TOL:
         raise FabricationError(f"part {part.name!r}: {wall:.2f} mm wall between a cut and the outline, less than "
-                               f"min_wall_mm {s.min_wall:g}" + (" (an explicit polygon is not widened)"
+                               f"min_wall_mm {s.min_wall:g}" + (" (a part with an explicit outline, such as a "
+                                                              "cam, roller or flat follower, is not widened: make "
+                                                              "it larger or the pin smaller)"
                                                               if part.polygon is not None else ""))
     rect = outer_poly.minimum_rotated_rectangle
     xy = np.asarray(rect.exterior.coords)[:4]

@@ -154,7 +154,8 @@ def check_name(field: str, name: str) -> str:
 def motion_columns(mech: Mechanism, motion: Motion) -> tuple[list[str], np.ndarray]:
     """Column names and an ``(N, k)`` float table for a motion.
 
-    Columns: ``t``, ``driver``, then ``<part>.x, <part>.y, <part>.angle`` for
+    Columns: ``t``, ``driver`` (and ``driver.<node>`` per input node of a
+    linkage with several), then ``<part>.x, <part>.y, <part>.angle`` for
     every part, ``<point>.x, <point>.y`` for every named point, and ``valid``
     (1 or 0).  Model units and radians.
     """
@@ -162,6 +163,10 @@ def motion_columns(mech: Mechanism, motion: Motion) -> tuple[list[str], np.ndarr
     t = motion.t if motion.t is not None else np.arange(n, dtype=float)
     names = ["t", "driver"]
     cols = [t, motion.driver]
+    inputs = getattr(mech, "input_values", None)  # a linkage with several inputs: each one's value
+    for node, value in (inputs(motion.driver) if inputs is not None else {}).items():
+        names.append(f"driver.{node}")
+        cols.append(value)
     for p in mech.parts:
         pose = motion.poses[p.name]
         names += [f"{p.name}.x", f"{p.name}.y", f"{p.name}.angle"]

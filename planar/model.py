@@ -475,6 +475,19 @@ class Motion:
             (int(i), float(self.driver[i]), *self.fail_table[int(self.fail_code[i])]) for i in idx
         ]
 
+    def take(self, index: ArrayLike) -> Motion:
+        """The samples ``index`` (an index array or boolean mask) as a new motion."""
+        idx = np.asarray(index)
+        return Motion(
+            driver=self.driver[idx],
+            poses={k: v[idx] for k, v in self.poses.items()},
+            valid=self.valid[idx],
+            fail_code=self.fail_code[idx],
+            fail_table=list(self.fail_table),
+            points={k: v[idx] for k, v in self.points.items()},
+            t=None if self.t is None else self.t[idx],
+        )
+
     @property
     def failed_joints(self) -> set[str]:
         """Names of the joints that failed anywhere."""

@@ -12,22 +12,23 @@ import math
 import os
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from .errors import InputError
 
 if TYPE_CHECKING:
+    from .animation import FramePlan
     from .compare import Comparison
     from .fabexport import Fabrication
-    from .model import Motion
+    from .model import Mechanism, Motion
     from .render import Style
     from .scene import Scene
     from .simulate import SimResult, SimSettings
 
 __all__ = [
-    "DEMO_EXTRAS", "DEMO_SCENES", "build_gallery", "compare_scene", "export_scene",
-    "gallery_scenes", "overlay_motion", "render_scene", "run_demo", "scene_style", "write_catalog_motion",
-    "write_scene_motion",
+    "DEMO_EXTRAS", "DEMO_SCENES", "build_gallery", "compare_scene", "export_mechanism", "export_scene",
+    "gallery_scenes", "overlay_motion", "plot_mechanism", "render_mechanism", "render_scene", "run_demo",
+    "scene_from_mechanism", "scene_style", "write_catalog_motion", "write_mechanism_motion", "write_scene_motion",
 ]
 
 
@@ -66,7 +67,7 @@ def scene_style(scene: Scene) -> Style:
 
     r = scene.spec.render
     return Style(width=r.width, height=r.height, supersample=r.supersample, background=r.background,
-                 trails=r.trails, show_pins=r.show_pins)
+                 trails=r.trails, show_pins=r.show_pins, opacity=r.opacity, exploded=r.exploded)
 
 
 def overlay_motion(scene: Scene) -> Motion:
@@ -83,30 +84,84 @@ def overlay_motion(scene: Scene) -> Motion:
     return sim.motion
 
 
-def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, progress: bool = True) -> int:
-    """Render a scene's analytic motion (and optionally an overlay motion) to a GIF; returns frames."""
-    from exporters.gif import frame_delay_ms, indexer, write_gif
+#: output suffixes ``render_scene`` writes
+ANIMATION_SUFFIXES = (".gif", ".mp4", ".webm")
 
-    from .limits import check_count
+
+def animation_plan(scene: Scene, out: str | Path, fps: float | None = None) -> "FramePlan":
+    """The frames ``render_scene`` draws for ``out`` (GIF delays are whole 10 ms ticks; video any rate)."""
+    from .animation import plan_frames, scene_duration
+
+    fps = fps if fps is not None else scene.spec.render.fps
+    try:
+        return plan_frames(scene.mechanism.driver.period, scene_duration(scene), fps,
+                           tick_ms=10.0 if Path(out).suffix.lower() == ".gif" else None)
+    except InputError as e:  # the planner names "duration" or "speed": say which key of which scene
+        d = scene.spec.driver
+        if e.field == "duration":
+            key, value = ("driver.duration", d.duration) if d.duration is not None else \
+                ("driver.cycles", d.cycles if d.cycles is not None else 1.0)
+            raise InputError(f"{scene.path}: {key}", value, e.expected) from None
+        if e.field == "speed":
+            raise InputError(f"{scene.path}: driver.speed", d.speed, e.expected) from None
+        raise
+
+
+def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, progress: bool = True,
+                 fps: float | None = None) -> int:
+    """Render a scene's analytic motion (and optionally an overlay motion) to ``out``; returns the frame count.
+
+    The format follows the suffix: ``.gif`` (streamed, reproducible), ``.mp4``
+    or ``.webm`` (the ``video`` extra).  Frames are resampled so that a cycle
+    plays for what the scene's ``speed`` says, within one frame delay
+    (:func:`planar.animation.plan_frames`); ``fps`` (or the scene's
+    ``[render] fps``) sets the frame rate.  The overlay, a simulated motion
+    with sample times, is interpolated to the frame instants.
+    """
+    from .animation import animation_motion, resample
+    from .errors import InputError
     from .render import Renderer, palette_colors
 
-    field_name = "driver.duration" if scene.spec.driver.duration is not None else "driver.cycles"
-    check_count("frames", f"{scene.path}: {field_name}", scene.sample_count(), "frames (one per sample)",
-                shown=getattr(scene.spec.driver, field_name.split(".")[1]))
-    spc = scene.spec.driver.samples_per_cycle
-    if 1000.0 * scene.mechanism.driver.period / spc > GIF_MAX_DELAY_MS:
-        raise InputError(f"{scene.path}: driver.speed", scene.spec.driver.speed,
-                         f"a speed of at least {1000.0 / (GIF_MAX_DELAY_MS * spc):.3g} cycles per second at "
-                         f"{spc} samples per cycle (a GIF frame lasts at most {GIF_MAX_DELAY_MS / 1000:g} s)")
-    motion = scene.motion()
-    polys = {n: scene.polygons[n] for n in scene.spec.render.sweep}
+    suffix = Path(out).suffix.lower()
+    if suffix not in ANIMATION_SUFFIXES:
+        raise InputError("-o", str(out), f"an animation file ending in {', '.join(ANIMATION_SUFFIXES)}")
+    if suffix != ".gif":
+        from exporters.video import video_available
+
+        if not video_available():
+            raise InputError("-o", str(out), f"the video extra for {suffix} output: pip install 'planar[video]' "
+                                             "(imageio-ffmpeg), or write a .gif")
     from shapely.errors import GEOSException
 
+    from .limits import check_count
+
+    # bounds before any frame is planned or drawn: the scene's samples (and memory), then the frames
+    scene.sample_count()
+    field_name = "driver.duration" if scene.spec.driver.duration is not None else "driver.cycles"
+    shown = getattr(scene.spec.driver, field_name.split(".")[1])
+    shown = 1.0 if shown is None else shown  # one cycle unless the scene says
+    plan = animation_plan(scene, out, fps)
+    check_count("frames", f"{scene.path}: {field_name}", plan.frames, "frames", shown=shown)
+    check_count("samples", f"{scene.path}: {field_name}", plan.frames * max(
+        1, math.ceil(scene.spec.driver.samples_per_cycle / plan.frames_per_cycle)), "samples to draw from", shown=shown)
+    if suffix == ".gif" and plan.delay_ms > GIF_MAX_DELAY_MS:
+        raise InputError(f"{scene.path}: driver.speed", scene.spec.driver.speed,
+                         f"a frame delay a GIF can hold (at most {GIF_MAX_DELAY_MS / 1000:g} s; this needs "
+                         f"{plan.delay_ms / 1000:.4g} s): a higher speed or frame rate")
+    motion, fine = animation_motion(scene, plan)
+    if overlay is not None:
+        overlay = resample(overlay, plan.times())
+    polys = {n: scene.polygons[n] for n in scene.spec.render.sweep}
     try:
-        r = Renderer(scene.mechanism, motion, scene_style(scene), overlay=overlay, polygons=polys)
-        pal = palette_colors(r.style, len(scene.mechanism.parts))
-        delay = frame_delay_ms(scene.mechanism.driver.period, scene.spec.driver.samples_per_cycle)
-        return write_gif(out, r.frames(progress=progress, post=indexer(pal)), delay, pal)
+        r = Renderer(scene.mechanism, motion, scene_style(scene), overlay=overlay, polygons=polys, trail_motion=fine)
+        if suffix == ".gif":
+            from exporters.gif import indexer, write_gif
+
+            pal = palette_colors(r.style, len(scene.mechanism.parts))
+            return write_gif(out, r.frames(progress=progress, post=indexer(pal)), int(plan.delay_ms), pal)
+        from exporters.video import write_video
+
+        return write_video(out, r.frames(progress=progress), plan.fps)
     except GEOSException as e:  # part outlines of extreme sizes (a coupler point at 1e305) defeat GEOS
         raise InputError(f"{scene.path}: mechanism", f"parts up to {scene.mechanism.size:.4g} units across",
                          f"part sizes the outline geometry can draw (shapely: {' '.join(str(e).split())})") from None
@@ -134,12 +189,35 @@ def build_gallery(source: str | Path, output: str | Path | None = None,
 # --------------------------------------------------------------------------- motion tables
 
 
-def write_scene_motion(scene: Scene, out: str | Path) -> Motion:
-    """Write the scene's analytic motion table (CSV) to ``out``; returns the motion."""
-    from .fileio import write_motion_csv
+def write_scene_motion(scene: Scene, out: str | Path, derivatives: bool = False) -> Motion:
+    """Write the scene's analytic motion table (CSV) to ``out``; returns the motion.
+
+    ``derivatives``: add the rates of :func:`planar.derivatives.derivative_columns`
+    (point velocities and accelerations, part omega and alpha, transmission
+    angles, motor torque under the scene's ``[effects]``) before ``valid``.
+    Nothing is written if they cannot be computed.
+    """
+    import io
+
+    import numpy as np
+
+    from .fileio import atomic_write, motion_columns, write_motion_csv
 
     motion = scene.motion()
-    write_motion_csv(out, scene.mechanism, motion)
+    if not derivatives:
+        write_motion_csv(out, scene.mechanism, motion)
+        return motion
+    from .derivatives import derivative_columns
+
+    names, table = motion_columns(scene.mechanism, motion)
+    extra_names, extra = derivative_columns(scene.mechanism, motion, scene.effects)
+    names = names[:-1] + extra_names + names[-1:]
+    table = np.column_stack([table[:, :-1], *extra, table[:, -1]])
+    buf = io.StringIO()
+    buf.write(",".join(names) + "\n")
+    np.savetxt(buf, table, fmt=",".join(["%.17g"] * (len(names) - 1) + ["%d"]))
+    with atomic_write(out, "w") as fh:
+        fh.write(buf.getvalue())
     return motion
 
 
@@ -198,6 +276,56 @@ def compare_scene(scene: Scene, settings: SimSettings | None = None, threshold: 
     from .compare import compare_scene as _compare_scene
 
     return _compare_scene(scene, settings, threshold, torque_threshold, with_series=with_series)
+
+
+# --------------------------------------------------------------------------- mechanisms built in Python
+
+
+def scene_from_mechanism(mech: Mechanism, **tables: Any) -> Scene:
+    """A :class:`~planar.scene.Scene` of a mechanism built in Python, validated like a scene file.
+
+    ``tables`` (see :func:`planar.scenewrite.scene_data`): ``name``, ``driver``,
+    ``effects``, ``render``, ``fabrication`` (dicts of scene keys) and
+    ``polygons``; ``scene.save(path)`` writes it as a scene file.  The
+    scene's mechanism is rebuilt from the keys: what is saved is what runs.
+    """
+    from .scene import build_scene, parse_scene
+    from .scenewrite import scene_data
+
+    where = f"<{type(mech).__name__} {mech.name!r}>"
+    return build_scene(parse_scene(scene_data(mech, **tables), where), where)
+
+
+def render_mechanism(mech: Mechanism, out: str | Path, progress: bool = False, **tables: Any) -> int:
+    """Render a mechanism built in Python to a GIF, as ``planar render`` would its scene; returns frames.
+
+    ``tables`` as for :func:`scene_from_mechanism`, e.g. ``driver={"samples_per_cycle": 48}``,
+    ``render={"width": 320, "trails": ["coupler_point"]}``.
+    """
+    return render_scene(scene_from_mechanism(mech, **tables), out, progress=progress)
+
+
+def export_mechanism(mech: Mechanism, dxf: str | Path | None = None, svg: str | Path | None = None,
+                     fabrication: dict[str, Any] | None = None, **files: Any) -> "Fabrication":
+    """Lay out a mechanism built in Python for cutting, as ``planar export`` would its scene.
+
+    ``fabrication``: ``[fabrication]`` keys (``unit_mm``, ``kerf_mm``, ...);
+    ``files``: the other outputs of :func:`export_scene` (``preview``, ``bom``,
+    ``assembly``, ``kerf_test``) and its ``kerf``/``sheet`` overrides.
+    """
+    return export_scene(scene_from_mechanism(mech, fabrication=fabrication), dxf, svg, **files)
+
+
+def write_mechanism_motion(mech: Mechanism, out: str | Path, derivatives: bool = False, **tables: Any) -> Motion:
+    """The motion table (CSV) of a mechanism built in Python, as ``planar motion [--derivatives]`` writes it."""
+    return write_scene_motion(scene_from_mechanism(mech, **tables), out, derivatives=derivatives)
+
+
+def plot_mechanism(mech: Mechanism, out: str | Path, what: list[str] | None = None, **tables: Any) -> list[str]:
+    """The charts of a mechanism built in Python (PNG or SVG), as ``planar plot`` draws them."""
+    from .plot import write_plot
+
+    return write_plot(scene_from_mechanism(mech, **tables), out, what)
 
 
 # --------------------------------------------------------------------------- the demo

@@ -1,8 +1,9 @@
 """Off-screen raster frames of a mechanism's motion (no display, no window system).
 
-Parts are drawn as filled outlines with their holes and slots cut out, pins
-as dots, the ground as a grey plate, trails of named points (coupler curves)
-and polygons swept along with a part (a foot).  Drawing happens at
+Parts are drawn as filled outlines with their holes and slots cut out
+(optionally translucent), pins as dots, the ground as a light plate, trails
+of named points (coupler curves, drawn above the parts) and polygons swept
+along with a part (a foot).  Drawing happens at
 ``supersample`` times the size and is reduced with a box filter, which
 antialiases every edge.  The camera fits every part over the whole motion,
 so nothing leaves the frame.  Invalid samples are drawn at their nearest real
@@ -51,7 +52,8 @@ class Style:
     height: int = 360
     supersample: int = 2
     background: str = "#ffffff"
-    ground: str = "#c8c8c8"
+    ground: str = "#ebebeb"
+    ground_outline: str = "#a0a0a0"
     outline: str = "#303030"
     pin: str = "#202020"
     trail: str = "#7f3fbf"
@@ -65,6 +67,10 @@ class Style:
     trails: Sequence[str] | None = None
     show_pins: bool = True
     labels: bool = False
+    #: opacity of moving parts' fill (1: opaque); what lies under a part shows through below 1
+    opacity: float = 1.0
+    #: a wind-up toy as its exploded stage panels instead of assembled (planar.windup.toy_view)
+    exploded: bool = False
 
 
 def project(part: Part, pts: Array, view: str) -> Array:
@@ -97,7 +103,7 @@ def palette_colors(style: Style, n_parts: int) -> list[RGB]:
     bg = np.array(_rgb(style.background), float)
     ol = np.array(_rgb(style.outline), float)
     base = [_rgb(c) for c in (style.background, style.ground, style.outline, style.pin, style.trail, style.invalid,
-                              style.overlay, style.sweep)]
+                              style.overlay, style.sweep, style.ground_outline)]
     base += [_rgb(style.part_colors[i % len(style.part_colors)]) for i in range(min(n_parts, len(style.part_colors)))]
     out: list[RGB] = []
     for c in base:
@@ -118,14 +124,17 @@ class Renderer:
     """Renders ``motion`` of ``mech`` (and optionally an ``overlay`` motion) frame by frame.
 
     ``polygons`` maps a name to ``(part, points)`` in that part's frame: drawn
-    swept with the part (the notes' foot).
+    swept with the part (the notes' foot).  ``trail_motion`` (default:
+    ``motion``) is the finer motion the trails are drawn from when ``motion``
+    holds only the frames.
 
     How: every part's outline is transformed for all frames at once (numpy);
-    a frame is the static layer (ground, parts that do not move, the trails,
-    drawn once, supersampled) plus, for each moving part, a scanline fill
-    through a coverage mask (holes cleared) and its outline strokes drawn at
-    twice the size and box-reduced: the antialiasing.  The fill's aliased edge
-    lies under the antialiased outline.
+    a frame is the static layer (ground, parts that do not move, drawn once,
+    supersampled) plus, for each moving part, a scanline fill through a
+    coverage mask (holes cleared) and its outline strokes drawn at twice the
+    size and box-reduced: the antialiasing.  The fill's aliased edge lies
+    under the antialiased outline.  The trails (drawn once, supersampled, as
+    a mask) are pasted over the parts.
     """
 
     mech: Mechanism
@@ -134,14 +143,27 @@ class Renderer:
     overlay: Motion | None = None
     polygons: Mapping[str, tuple[str, Array]] = field(default_factory=dict)
     view: str = ""  # default: the mechanism's own view plane ("xy" unless it says otherwise)
+    trail_motion: Motion | None = None
 
     def __post_init__(self) -> None:
+        from .windup.toy_view import Marks, assembled
 
+        self.marks = Marks()
+        if not self.style.exploded and self.overlay is None:  # toys, #6, #8, #9: the assembled view
+            orig = self.mech
+            self.mech, self.motion, self.marks = assembled(orig, self.motion)
+            if self.mech is not orig and self.trail_motion is not None:
+                self.trail_motion = assembled(orig, self.trail_motion)[1]
         self.view = self.view or getattr(self.mech, "view", "xy")
         s = self.style
         self.S = max(1, int(s.supersample))
         self.W, self.H = s.width, s.height
         world = self._world_geometry(self.motion)
+        fine = self.trail_motion if self.trail_motion is not None else self.motion
+        self._fine_valid = np.asarray(fine.valid, bool)
+        frame_trails = world["trails"]  # the point on its trail at each frame
+        if self.trail_motion is not None:
+            world["trails"] = self._trails(self.trail_motion)
         self._fit(world)
         self.lw = max(1.0, s.line_width)
         # static parts (pose constant over the motion) go into the pre-drawn layer
@@ -156,13 +178,17 @@ class Renderer:
         self.world_parts = [[self._px(r) for r in rings] for rings in world["parts"]]
         self.sweep_rings = [[self._px(v)] for v in world["sweeps"].values()]
         self.trails = {k: self._px(v) for k, v in world["trails"].items()}
+        self.trail_dots = {k: self._px(v) for k, v in frame_trails.items()}
         self.pins = {k: self._px(v) for k, v in world["pins"].items()}
         self.overlay_parts = []
         if self.overlay is not None:
             ow = self._world_geometry(self.overlay)
             self.overlay_parts = [[self._px(r) for r in rings] for rings in ow["parts"]]
         self.base = self._static_layer()
-        self.dot = {c: self._dot(_rgb(c), 2.2) for c in (s.pin, s.trail)}
+        self.trail_layer = self._trail_layer()
+        self.dot = {c: self._dot(_rgb(c), 2.2) for c in (s.pin, s.trail, s.invalid)}
+        self.mark_px = ([(self._px(r), c) for r, c in self.marks.rings], [(self._px(r), c) for r, c in self.marks.lines],
+                        [(self._px(r), c) for r, c in self.marks.dots])
 
     # -- geometry, all frames at once --------------------------------------------
     def _world_geometry(self, motion: Motion) -> dict:
@@ -170,12 +196,7 @@ class Renderer:
         for p in self.mech.parts:
             pose = motion.poses[p.name]
             parts.append([project(p, poses_apply(pose, r), self.view) for r in _rings(p)])
-        names = self.style.trails if self.style.trails is not None else list(motion.points)
-        trails = {}
-        for n in names:
-            if n in motion.points:
-                part = self.mech.part(self.mech.points[n][0])
-                trails[n] = project(part, motion.points[n], self.view)
+        trails = self._trails(motion)
         sweeps = {}
         for n, (pname, pts) in self.polygons.items():
             part = self.mech.part(pname)
@@ -189,6 +210,15 @@ class Renderer:
                 pins[key] = project(part, poses_apply(motion.poses[pname], xy), self.view)
         return {"parts": parts, "trails": trails, "sweeps": sweeps, "pins": pins}
 
+    def _trails(self, motion: Motion) -> dict[str, Array]:
+        names = self.style.trails if self.style.trails is not None else list(motion.points)
+        trails = {}
+        for n in names:
+            if n in motion.points:
+                part = self.mech.part(self.mech.points[n][0])
+                trails[n] = project(part, motion.points[n], self.view)
+        return trails
+
     def _fit(self, world: dict) -> None:
         """Scale and origin that frame the geometry of the motion's valid samples.
 
@@ -198,10 +228,11 @@ class Renderer:
         """
         valid = np.asarray(self.motion.valid, bool)
         keep = valid if valid.any() else np.ones_like(valid)
+        fine_keep = self._fine_valid if self._fine_valid.any() else np.ones_like(self._fine_valid)
         tracks = [r for rings in world["parts"] for r in rings]  # (N, M, 2) each
-        tracks += list(world["trails"].values())  # (N, 2)
         tracks += list(world["sweeps"].values())  # (N, M, 2)
-        allp = np.concatenate([np.asarray(v)[keep].reshape(-1, 2) for v in tracks])
+        allp = np.concatenate([np.asarray(v)[keep].reshape(-1, 2) for v in tracks]
+                              + [np.asarray(v)[fine_keep].reshape(-1, 2) for v in world["trails"].values()])
         allp = allp[np.all(np.isfinite(allp), axis=1)]
         if allp.size == 0:
             allp = np.zeros((1, 2))
@@ -219,6 +250,9 @@ class Renderer:
         out[..., 0] = self.origin[0] + self.scale * xy[..., 0]
         out[..., 1] = self.origin[1] - self.scale * xy[..., 1]
         return out
+
+    def _outline(self, part: Part) -> RGB:
+        return _rgb(self.style.ground_outline if part.ground else self.style.outline)
 
     def _fill(self, i: int, part: Part) -> RGB:
         if part.ground:
@@ -257,20 +291,32 @@ class Renderer:
             img.paste(self._fill(i, p), (0, 0, *img.size), mask)
             for r in rings:
                 pts = [tuple(q) for q in r]
-                draw.line(pts + [pts[0]], fill=_rgb(s.outline), width=lw, joint="curve")
-        for tr in self.trails.values():
-            ok = self.motion.valid
-            seg = [tuple(q * S) for q, v in zip(tr, ok) if v]
-            if len(seg) > 1:
-                draw.line(seg + [seg[0]], fill=_rgb(s.trail), width=lw, joint="curve")
+                draw.line(pts + [pts[0]], fill=self._outline(p), width=lw, joint="curve")
         return img.reduce(S) if S > 1 else img
+
+    def _trail_layer(self):
+        """The trails (valid samples of the fine motion) as an antialiased mask, pasted above the parts."""
+        from PIL import Image, ImageDraw
+
+        if not self.trails:
+            return None
+        S = self.S
+        mask = Image.new("L", (self.W * S, self.H * S), 0)
+        draw = ImageDraw.Draw(mask)
+        lw = max(1, int(round(self.lw * S)))
+        for tr in self.trails.values():
+            seg = (tr[self._fine_valid] * S).ravel().tolist()
+            if len(seg) > 2:
+                draw.line(seg + seg[:2], fill=255, width=lw, joint="curve")
+        return mask.reduce(S) if S > 1 else mask
 
     # -- per frame ---------------------------------------------------------------------
     def __len__(self) -> int:
         return len(self.motion)
 
-    def _draw_rings(self, img, rings: list[Array], fill: RGB) -> None:
-        """Fill a polygon with holes and stroke its rings, antialiased, within its bounding box."""
+    def _draw_rings(self, img, rings: list[Array], fill: RGB, opacity: float = 1.0) -> None:
+        """Fill a polygon with holes (``opacity`` of the fill, 0..1) and stroke its rings, antialiased,
+        within its bounding box."""
         from PIL import Image, ImageDraw
 
         ext = rings[0]
@@ -285,7 +331,7 @@ class Renderer:
         off = np.array([x0, y0], float)
         fm = Image.new("L", size, 0)
         md = ImageDraw.Draw(fm)
-        md.polygon((ext - off).ravel().tolist(), fill=255)  # flat lists: no per-point tuples
+        md.polygon((ext - off).ravel().tolist(), fill=int(round(255 * min(1.0, max(0.0, opacity)))))  # flat lists
         for hole in rings[1:]:
             md.polygon((hole - off).ravel().tolist(), fill=0)
         img.paste(fill, box, fm)
@@ -311,9 +357,12 @@ class Renderer:
             fill = self._fill(idx, self.mech.parts[idx])
             if not valid:
                 fill = tuple(int(0.5 * a + 0.5 * b) for a, b in zip(fill, tint))  # type: ignore[assignment]
-            self._draw_rings(img, [r[i] for r in self.world_parts[idx]], fill)
+            self._draw_rings(img, [r[i] for r in self.world_parts[idx]], fill, self.style.opacity)
         for rings in self.sweep_rings:
-            self._draw_rings(img, [r[i] for r in rings], _rgb(s.sweep))
+            self._draw_rings(img, [r[i] for r in rings], _rgb(s.sweep), self.style.opacity)
+        self._draw_marks(img, draw, i)
+        if self.trail_layer is not None:
+            img.paste(_rgb(s.trail), (0, 0, self.W, self.H), self.trail_layer)
         for rings in self.overlay_parts:
             for r in rings:
                 pts = np.vstack([r[i], r[i][:1]]).ravel().tolist()
@@ -326,12 +375,26 @@ class Renderer:
                 img.paste(dot, (int(round(x)) - h, int(round(y)) - h), dot)
         dot = self.dot[s.trail]
         h = dot.size[0] // 2
-        for tr in self.trails.values():
+        for tr in self.trail_dots.values():
             x, y = tr[i]
             img.paste(dot, (int(round(x)) - h, int(round(y)) - h), dot)
         if not valid:
             self._mark_invalid(draw, i)
         return img
+
+    def _draw_marks(self, img, draw, i: int) -> None:
+        """The view's per-frame marks (a #6/#9 pin's oval and contact point, #8's window taper)."""
+        s = self.style
+        rings, lines, dots = self.mark_px
+        for ring, c in rings:
+            self._draw_rings(img, [ring[i]], _rgb(getattr(s, c)))
+        for line, c in lines:
+            draw.line(line[i].ravel().tolist(), fill=_rgb(getattr(s, c)), width=max(1, int(round(self.lw))))
+        for pts, c in dots:
+            dot = self.dot[getattr(s, c)]
+            h = dot.size[0] // 2
+            x, y = pts[i]
+            img.paste(dot, (int(round(x)) - h, int(round(y)) - h), dot)
 
     def _mark_invalid(self, draw, i: int) -> None:
         s = self.style

@@ -34,15 +34,16 @@ def _dxf_points(e) -> list[tuple[float, float]]:
         return [(v.x, v.y) for v in e.flattening(1e-5)]
     x0, y0, *_ = e.get_points("xy")[0]
     pts: list[tuple[float, float]] = []
+    here: tuple[float, float] = (x0, y0)  # where the previous segment ended
     for ve in e.virtual_entities():
         if ve.dxftype() == "LINE":
             seg = [(ve.dxf.start.x, ve.dxf.start.y), (ve.dxf.end.x, ve.dxf.end.y)]
         else:  # ARC, always counter-clockwise in DXF: reverse when the polyline runs clockwise
             seg = [(v.x, v.y) for v in ve.flattening(1e-5)]
-        here = pts[-1] if pts else (x0, y0)
         if np.hypot(*np.subtract(seg[-1], here)) < np.hypot(*np.subtract(seg[0], here)):
             seg = seg[::-1]
         pts.extend(seg[:-1])
+        here = seg[-1]
     return pts
 
 

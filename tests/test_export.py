@@ -121,7 +121,7 @@ def test_fourbar_holes_at_the_joint_distances_and_kerf():
 
 
 def test_slot_kerf_and_arc_slots():
-    part = Part("p", ((0, 0, 1.0), (4, 0, 1.0)), (Slot((0.5, 0), (3.5, 0), 0.4), ArcSlot((2, 0), 1.0, 0.2, 2.0, 0.3)))
+    part = Part("p", ((0, 0, 1.0), (4, 0, 1.0)), (Slot((0.5, 0), (3.5, 0), 0.4), ArcSlot((2, 0), 1.0, 0.9, 2.2, 0.3)))
     a = part_cuts(part, FabSettings(unit_mm=10.0, kerf=0.0, clearance=0.0, slot_end=0.0), 1)
     b = part_cuts(part, FabSettings(unit_mm=10.0, kerf=0.4, clearance=0.0, slot_end=0.0), 1)
     for c0, c1 in zip(a.inner, b.inner):
@@ -157,7 +157,10 @@ def test_every_gallery_scene_exports_checked_files(tmp_path, path):
     for p in fab.layout.parts:
         assert p.label == "" or p.label_height >= s.min_label - 1e-9
     # parts on one layer never overlap at any instant of the cycle (shapely, from the parts' own outlines)
-    motion = scene.mechanism.run(samples_per_cycle=24)
+    from planar.fabexport import _fab_mechanism
+
+    cut = _fab_mechanism(scene.mechanism)  # a wind-up toy is cut as its assembly
+    motion = cut.run(samples_per_cycle=24)
     from shapely import affinity
 
     asm = fab.assembly
@@ -176,7 +179,7 @@ def test_every_gallery_scene_exports_checked_files(tmp_path, path):
 
     rows = list(csv.DictReader((tmp_path / "b.csv").open()))
     parts = [r for r in rows if r["item"] == "part"]
-    assert {r["id"] for r in parts} == {p.name for p in scene.mechanism.parts}
+    assert {r["id"] for r in parts} == {p.name for p in cut.parts}
     for r in rows:
         if r["item"] == "pin":
             lo, hi = map(int, r["layer"].split("-"))
@@ -304,18 +307,19 @@ def test_slots_leave_margin_past_the_pins_travel():
 
 def test_nesting_horse_on_one_sheet_and_several_files(tmp_path):
     scene = load_scene(GALLERY / "horse.toml")
-    fab = export_scene(scene, tmp_path / "h.dxf", sheet=(300, 200))
+    # the Horse is cut as its assembly (one 182 x 142 mm frame, merged parts): one 400 x 300 mm sheet
+    fab = export_scene(scene, tmp_path / "h.dxf", sheet=(400, 300))
     assert fab.layout.sheets == 1 and (tmp_path / "h.dxf").exists()
     area = sum(Polygon(bulge_points(p.outer, math.radians(1))).area if isinstance(p.outer, Contour)
                else math.pi * p.outer.radius ** 2 for p in fab.layout.parts)
-    assert abs(fab.layout.utilisation[0] - area / (300 * 200)) < 1e-3
-    fab = export_scene(scene, tmp_path / "s.dxf", tmp_path / "s.svg", sheet=(160, 120))
+    assert abs(fab.layout.utilisation[0] - area / (400 * 300)) < 1e-3
+    fab = export_scene(scene, tmp_path / "s.dxf", tmp_path / "s.svg", sheet=(200, 160))
     n = fab.layout.sheets
     assert n >= 2
     assert [p.name for p in _sheets(tmp_path, "s", "dxf")] == [f"s-{k + 1}.dxf" for k in range(n)]
     assert not (tmp_path / "s.dxf").exists()
     for k, p in enumerate(_sheets(tmp_path, "s", "dxf")):
-        check_dxf(p, len(fab.layout.on_sheet(k)), fab.settings.kerf, (160, 120))
+        check_dxf(p, len(fab.layout.on_sheet(k)), fab.settings.kerf, (200, 160))
 
 
 def test_drive_and_mounting_holes(tmp_path):
@@ -378,3 +382,21 @@ def test_no_duplicate_cut_entities_and_jansen_link_lengths(tmp_path):
     tri = sorted(math.dist(a, b) for i, a in enumerate(centres("upper")) for j, b in enumerate(centres("upper")) if i < j)
     assert np.allclose(tri, sorted([41.5, 40.1, 55.8]), atol=1e-6)  # the ternary link Z-B-D
     assert len(centres("lower")) == 2  # the foot F is a point of the lower link, not a joint
+
+
+def test_holes_running_into_each_other_are_refused(tmp_path, capsys):
+    # at 1 mm per unit a 2.5 mm crank's D-shaped drive hole and its pin hole overlap: widening the outline
+    # cannot mend that, so the export stops with one line naming the part and the two cuts
+    scene = tmp_path / "small.toml"
+    scene.write_text('[mechanism]\ntype = "fourbar"\nground = 8.0\ncrank = 2.5\ncoupler = 7.0\nrocker = 6.0\n'
+                     '[fabrication]\nunit_mm = 1.0\n')
+    out = tmp_path / "p.dxf"
+    assert main(["export", str(scene), "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "of material between its" in err[0] and "min_wall_mm" in err[0], err
+    assert not out.exists()
+    # and the geometry: pin hole (3 mm pin + 0.1 clearance) 2.5 mm from the drive hole's centre overlaps it
+    from planar.fabparts import FabSettings
+
+    st_ = FabSettings()
+    assert 2.5 < (st_.pin_mm + st_.clearance) / 2 + st_.shaft_mm / 2

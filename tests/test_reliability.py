@@ -84,8 +84,8 @@ BAD_SCENES: list[tuple[str, Any, str]] = [
     ("crank-true", fb(crank=True), "mechanism.crank"),
     ("ground-str", fb(ground="4"), "mechanism.ground"),
     ("coupler-list", fb(coupler=[4.0]), "mechanism.coupler"),
-    ("contact-yes", fb() | {"effects": {"contact": "yes"}}, "effects.contact"),
-    ("contact-1", fb() | {"effects": {"contact": 1}}, "effects.contact"),
+    ("exploded-yes", fb() | {"render": {"exploded": "yes"}}, "render.exploded"),
+    ("exploded-1", fb() | {"render": {"exploded": 1}}, "render.exploded"),
     ("samples-float", fb() | {"driver": {"samples_per_cycle": 12.0}}, "driver.samples_per_cycle"),
     ("samples-bool", fb() | {"driver": {"samples_per_cycle": True}}, "driver.samples_per_cycle"),
     ("samples-str", fb() | {"driver": {"samples_per_cycle": "12"}}, "driver.samples_per_cycle"),
@@ -256,7 +256,7 @@ MISUSES: list[tuple[str, list[str], str]] = [
     ("output-wrong-ext", ["motion", "{scene}", "-o", "{dir}/m.gif"], ".csv"),
     ("output-no-dir", ["motion", "{scene}", "-o", "{dir}/nodir/m.csv"], "nodir"),
     ("output-is-dir", ["motion", "{scene}", "-o", "{dir}"], "-o"),
-    ("render-ext", ["render", "{scene}", "-o", "{dir}/x.csv"], ".gif"),
+    ("render-ext", ["render", "{scene}", "-o", "{dir}/x.csv"], ".gif or .mp4 or .webm"),
     ("render-is-input", ["render", "{scene}", "-o", "{scene}"], "-o"),
     ("export-nothing", ["export", "{scene}"], "an output"),
     ("export-dxf-ext", ["export", "{scene}", "-o", "{dir}/parts.svg"], ".dxf"),
@@ -312,13 +312,14 @@ def test_cli_misuse(tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: li
 
 # scenes that validate but cannot be cut or drawn: (id, scene, command, needle)
 BAD_JOBS: list[tuple[str, dict, str, str]] = [
-    ("holes-overlap", fb() | {"fabrication": {"unit_mm": 3.0, "pin_diameter_mm": 20.0}}, "export", "overlap"),
+    ("holes-overlap", fb() | {"fabrication": {"unit_mm": 3.0, "pin_diameter_mm": 20.0}}, "export", "min_wall_mm"),
     ("kerf-wider-than-parts", fb() | {"fabrication": {"unit_mm": 0.05, "kerf_mm": 2.0}}, "export", "kerf"),
     ("too-many-frames", fb() | {"driver": {"samples_per_cycle": 72, "cycles": 1000.0}}, "render", "PLANAR_MAX_FRAMES"),
     ("parts-larger-than-sheet", scene({"type": "elemental", "number": 6}, fabrication={"unit_mm": 1e20}), "export",
      "fabrication.unit_mm"),
     ("sheet-too-large", fb() | {"fabrication": {"sheet_mm": [1e30, 200.0]}}, "export", "fabrication.sheet_mm"),
-    ("gif-delay-too-long", scene({"type": "elemental", "number": 3}, driver={"speed": 1e-12}), "render", "driver.speed"),
+    ("cycle-too-slow-to-draw", scene({"type": "elemental", "number": 3}, driver={"speed": 1e-12}), "render",
+     "driver.cycles = 1.0: expected an animation of at most"),
     ("coupler-point-1e305", fb(coupler_point=[0.75, -9.24e305]), "render", "mechanism"),
     ("frames-by-duration", fb() | {"driver": {"samples_per_cycle": 72, "duration": 1e5}}, "render", "driver.duration"),
 ]
@@ -398,7 +399,7 @@ def test_export_failure_after_some_outputs_leaves_none(tmp_path: Path, capsys: p
     (tmp_path / "parts.dxf").write_bytes(SENTINEL)
     before = _snapshot(tmp_path)
     rc, _, err = _run(["export", str(src), "-o", str(tmp_path / "parts.dxf"), "--svg", str(tmp_path / "p.svg")], capsys)
-    _check_one_line(rc, err, "overlap")
+    _check_one_line(rc, err, "min_wall_mm")
     assert _snapshot(tmp_path) == before
 
 

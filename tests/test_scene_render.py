@@ -135,7 +135,8 @@ def test_gif_properties_and_reproducibility(tmp_path):
     assert hashlib.sha256(a.read_bytes()).digest() == hashlib.sha256(b.read_bytes()).digest()
     im, frames, delays = _gif_frames(a)
     assert im.info.get("loop") == 0  # loops forever
-    assert len(frames) == 24
+    # speed 2 cycles/s: 0.5 s per cycle at the default 25 frames/s -> 12 frames of 40 ms (not 24 samples)
+    assert len(frames) == 12 and delays == [40] * 12
     assert all(d is not None and d >= 20 and d % 10 == 0 for d in delays)
     assert frames[0].shape == (150, 200, 3)
     for f in frames:
@@ -154,7 +155,11 @@ def test_render_marks_invalid_samples(tmp_path):
     out = tmp_path / "inv.gif"
     render_scene(scene, out, progress=False)
     _, frames, _ = _gif_frames(out)
-    assert len(frames) == len(m)  # invalid samples are not skipped
+    from planar.animation import animation_motion, plan_frames, scene_duration
+
+    m, _ = animation_motion(scene, plan_frames(scene.mechanism.driver.period, scene_duration(scene)))
+    assert len(frames) == len(m)  # invalid frames are not skipped
+    assert m.valid.any() and not m.valid.all()
     red = np.array([214, 39, 40])
     for i in range(len(m)):
         has_red = np.any(np.all(np.abs(frames[i][:3, :, :].astype(int) - red) < 30, axis=-1))

@@ -74,7 +74,7 @@ from ..model import (
 from .chunked import Solved, _Plan, fast_solve, plan_for
 
 __all__ = ["Fixed", "Crank", "Actuator", "RRR", "RRP", "Rigid", "Link", "Linkage", "Node", "NodeKind",
-           "NODE_KINDS", "node_kind", "carry_branch"]
+           "NODE_KINDS", "node_kind", "carry_branch", "frame_rates"]
 
 Vec = tuple[float, float]
 Array = NDArray[np.float64]
@@ -104,6 +104,11 @@ def _cross(a: Array, b: Array) -> Array:
     return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
 
 
+def _dot(a: Array, b: Array) -> Array:
+    """Row-wise dot product of ``(N, 2)`` arrays (faster than ``(a * b).sum(-1)``)."""
+    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]
+
+
 def _solve2(r1: Array, b1: Array, r2: Array, b2: Array) -> tuple[Array, Mask]:
     """Solve ``r1 . v = b1, r2 . v = b2`` per sample (Cramer); ``ok`` false where singular."""
     det = r1[:, 0] * r2[:, 1] - r1[:, 1] * r2[:, 0]
@@ -113,6 +118,18 @@ def _solve2(r1: Array, b1: Array, r2: Array, b2: Array) -> tuple[Array, Mask]:
     vx = (b1 * r2[:, 1] - b2 * r1[:, 1]) / det
     vy = (r1[:, 0] * b2 - r2[:, 0] * b1) / det
     return np.stack([vx, vy], -1), ~sing
+
+
+def frame_rates(d: Array, vd: Array, ad: Array) -> tuple[Array, Array]:
+    """Angular velocity and acceleration of the direction ``d`` ``(N, 2)`` (rad/s, rad/s^2, CCW positive).
+
+    ``phi = atan2(d)``: ``omega = cross(d, d') / |d|^2`` and
+    ``alpha = cross(d, d'') / |d|^2 - 2 omega (d . d') / |d|^2``.
+    """
+    n2 = _dot(d, d)
+    n2 = np.where(n2 > 0, n2, 1.0)
+    omega = _cross(d, vd) / n2
+    return omega, _cross(d, ad) / n2 - 2.0 * omega * _dot(d, vd) / n2
 
 
 def carry_branch(keep: Array, other: Array, valid: Mask, path: Mask) -> NDArray[np.bool_]:
@@ -200,6 +217,21 @@ class NodeKind:
         """
         raise NotImplementedError
 
+    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
+                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+        """Acceleration ``(N, 2)`` from the closure differentiated twice (no differencing).
+
+        ``pos``, ``vel`` hold every node's position and velocity (this one's
+        included), ``acc`` the accelerations of the nodes before it; ``qd`` and
+        ``qdd`` the driver's rate and its rate of change per sample.  ``ok``
+        false where the closure is singular (a toggle), as for :meth:`velocity`.
+        A kind without one refuses rates (velocities, accelerations, torque) by name.
+        """
+        from ..registry import UnsupportedError
+
+        raise UnsupportedError(f"rates (accelerations): node kind {self.kind!r} ({type(self).__name__}) "
+                               "has no acceleration method")
+
     def held_by(self) -> tuple[tuple[str, ...], ...]:
         """Groups of nodes (this one included) that one link must carry to hold this node's constraint."""
         return ()
@@ -207,6 +239,25 @@ class NodeKind:
     def branch_of(self, pos: Mapping[str, Array]) -> int | None:
         """Which branch (+1 or -1) the node's last position in ``pos`` is on; ``None`` for kinds without one."""
         return None
+
+    def bind(self, where: str, nodes: Mapping[str, "NodeKind"]) -> "NodeKind":
+        """This node, given every node of its linkage (those before it bound): a kind that needs another node's
+        declaration (a gear's partner, a triad's members) returns a copy holding it, or raises :class:`InputError`."""
+        return self
+
+    def velocity_at(self, pos: Mapping[str, Array], vel: Mapping[str, Array], q: Array,
+                    qd: Array) -> tuple[Array, Mask | None]:
+        """:meth:`velocity` for kinds that also need the driver values ``q``."""
+        return self.velocity(pos, vel, qd)
+
+    def acceleration_at(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
+                        q: Array, qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+        """:meth:`acceleration` for kinds that also need the driver values ``q``."""
+        return self.acceleration(pos, vel, acc, qd, qdd)
+
+    def extra_joints(self, lk: "Linkage", hulls: dict[str, list[tuple[float, float, float]]]) -> list:
+        """Joints this node adds beyond those its links imply (a gear mesh); may add hull circles."""
+        return []
 
 
 @node_kind
@@ -226,6 +277,10 @@ class Fixed(NodeKind):
         return np.broadcast_to(np.asarray(self.xy, float), (q.shape[0], 2)), None
 
     def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
+        return np.zeros((qd.shape[0], 2)), None
+
+    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
+                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
         return np.zeros((qd.shape[0], 2)), None
 
 
@@ -260,6 +315,12 @@ class Crank(NodeKind):
     def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
         return vel[self.centre] + qd[:, None] * _perp(pos[self.name] - pos[self.centre]), None
 
+    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
+                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+        # P = C + r (cos, sin)(q + phase): aP = aC + qdd perp(P - C) - qd^2 (P - C)
+        r = pos[self.name] - pos[self.centre]
+        return acc[self.centre] + qdd[:, None] * _perp(r) - (qd * qd)[:, None] * r, None
+
 
 @node_kind
 @dataclass(frozen=True)
@@ -293,6 +354,10 @@ class Actuator(NodeKind):
 
     def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
         return vel[self.origin] + qd[:, None] * self.unit_axis, None
+
+    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
+                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+        return acc[self.origin] + qdd[:, None] * self.unit_axis, None
 
 
 def _check_branch(where: str, branch: int) -> None:
@@ -342,6 +407,20 @@ class RRR(NodeKind):
         P = pos[self.name]
         r1, r2 = P - pos[self.a], P - pos[self.b]
         return _solve2(r1, (r1 * vel[self.a]).sum(-1), r2, (r2 * vel[self.b]).sum(-1))
+
+    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
+                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+        # (P - A) . (vP - vA) = 0 differentiated: (P - A) . aP = (P - A) . aA - |vP - vA|^2 (and for B)
+        P, vP = pos[self.name], vel[self.name]
+        r1, r2 = P - pos[self.a], P - pos[self.b]
+        w1, w2 = vP - vel[self.a], vP - vel[self.b]
+        return _solve2(r1, _dot(r1, acc[self.a]) - _dot(w1, w1),
+                       r2, _dot(r2, acc[self.b]) - _dot(w2, w2))
+
+    def transmission(self, pos: Mapping[str, Array]) -> Array:
+        """Transmission angle (rad, in ``[0, pi]``) at this node: between the links to ``a`` and to ``b``."""
+        r1, r2 = pos[self.a] - pos[self.name], pos[self.b] - pos[self.name]
+        return np.arctan2(np.abs(_cross(r1, r2)), _dot(r1, r2))
 
 
 @node_kind
@@ -398,6 +477,22 @@ class RRP(NodeKind):
         b2 = self.offset * (w * vw).sum(-1) / wn - _cross(vw, P - p0) + _cross(w, vp0)
         return _solve2(r1, (r1 * vel[self.a]).sum(-1), _perp(w), b2)
 
+    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
+                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+        # the velocity's two conditions differentiated once more:
+        # (P - A) . aP = (P - A) . aA - |vP - vA|^2
+        # cross(w, aP) = cross(w, ap) - cross(aw, P - p) - 2 cross(vw, vP - vp)
+        #                + e ((|vw|^2 + w . aw) / |w| - (w . vw)^2 / |w|^3)
+        P, vP = pos[self.name], vel[self.name]
+        r1, v1 = P - pos[self.a], vP - vel[self.a]
+        p0, vp0, ap0 = pos[self.p], vel[self.p], acc[self.p]
+        w, vw, aw = pos[self.q] - p0, vel[self.q] - vp0, acc[self.q] - ap0
+        wn = np.hypot(w[:, 0], w[:, 1])
+        wv = _dot(w, vw)
+        b2 = (_cross(w, ap0) - _cross(aw, P - p0) - 2.0 * _cross(vw, vP - vp0)
+              + self.offset * ((_dot(vw, vw) + _dot(w, aw)) / wn - wv * wv / wn**3))
+        return _solve2(r1, _dot(r1, acc[self.a]) - _dot(v1, v1), _perp(w), b2)
+
 
 @node_kind
 @dataclass(frozen=True)
@@ -435,6 +530,13 @@ class Rigid(NodeKind):
         d = pos[self.b] - a
         omega = _cross(d, vel[self.b] - vel[self.a]) / (d * d).sum(-1)
         return vel[self.a] + omega[:, None] * _perp(pos[self.name] - a), None
+
+    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
+                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+        # aP = aA + alpha perp(P - A) - omega^2 (P - A), omega and alpha of the frame a -> b
+        omega, alpha = frame_rates(pos[self.b] - pos[self.a], vel[self.b] - vel[self.a], acc[self.b] - acc[self.a])
+        r = pos[self.name] - pos[self.a]
+        return acc[self.a] + alpha[:, None] * _perp(r) - (omega * omega)[:, None] * r, None
 
 
 Node = Fixed | Crank | Actuator | RRR | RRP | Rigid
@@ -496,6 +598,17 @@ class Linkage(Mechanism):
             raise InputError(f"{name}.placement", placement, "(x, y, angle): three numbers")
         self.placement = tuple(float(v) for v in pl)
         self._validate_nodes(name)
+        bound: dict[str, NodeKind] = {n.name: n for n in self.nodes}
+        for n in self.nodes:
+            bound[n.name] = n.bind(f"{name}.nodes.{n.name}", bound)
+        self.nodes = tuple(bound.values())
+        if any(getattr(n, "continued", False) for n in self.nodes):
+            self.branch_reference = 0.0  # a triad's declared assembly holds at driver value 0
+        clocked = [n.name for n in self.nodes if getattr(n, "clocked", False)]
+        if clocked and amplitude is not None:
+            raise InputError(f"{name}.driver.amplitude", amplitude,
+                             f"no amplitude: with driven nodes ({', '.join(clocked)}) the driver is a clock "
+                             "(phase + rate t); give each driven node its own amplitude")
         self.ground_name = ground
         self.links = self._with_ground(tuple(links), ground)
         self._validate_links(name)
@@ -506,7 +619,11 @@ class Linkage(Mechanism):
         self._driver_node = inputs[0]
         driver_link = self._link_of(self._driver_node.name, exclude_ground=True)
         byname = {n.name: n for n in self.nodes}
-        if isinstance(self._driver_node, Crank):
+        make = getattr(self._driver_node, "make_driver", None)
+        if make is not None:
+            c = byname[self._driver_node.centre]  # type: ignore[attr-defined]
+            driver = make(driver_link, c.xy if isinstance(c, Fixed) else (0.0, 0.0), rate, phase)
+        elif isinstance(self._driver_node, Crank):
             c = byname[self._driver_node.centre]
             origin = c.xy if isinstance(c, Fixed) else (0.0, 0.0)
             driver = Driver(driver_link, "rotation", origin=origin, rate=rate, phase=phase,
@@ -761,7 +878,9 @@ class Linkage(Mechanism):
 
     def _solve_points(self, q: Array) -> Solved:
         """The chunked, threaded path (:mod:`planar.linkages.chunked`), else the reference path."""
-        fast = fast_solve(self, q) if q.ndim == 1 and self._declared_branches_hold(q) else None
+        # kinds without a chunk kernel (gears, driven inputs, triads): no plan, straight to the reference path
+        usable = q.ndim == 1 and self._fast_plan() is not None
+        fast = fast_solve(self, q) if usable and self._declared_branches_hold(q) else None
         if fast is not None:
             return fast
         return super()._solve_points(q)
@@ -788,11 +907,64 @@ class Linkage(Mechanism):
             valid &= m
         vel: dict[str, Array] = {}
         for node in self.nodes:
-            v, ok = node.velocity(pos, vel, qd)
+            v, ok = node.velocity_at(pos, vel, qa, qd)
             vel[node.name] = v
             if ok is not None:
                 valid &= ok
         return vel, valid
+
+    def node_accelerations(self, q: ArrayLike, qdot: ArrayLike = 1.0, qddot: ArrayLike = 0.0,
+                           solved: tuple[dict[str, Array], list[tuple[Mask, str, str]]] | None = None,
+                           ) -> tuple[dict[str, Array], dict[str, Array], dict[str, Array], Mask]:
+        """Position, velocity and acceleration ``(N, 2)`` of every node (own frame, before placement).
+
+        Each node kind differentiates its closure twice
+        (:meth:`NodeKind.acceleration`), no differencing: ``qdot`` is the
+        driver's rate (rad/s or units/s) and ``qddot`` its rate of change per
+        sample; with ``qdot = 1, qddot = 0`` the accelerations are the second
+        coefficients ``d2X/dq2``.  ``valid`` is false where the position does
+        not close or a differentiated closure is singular (a toggle).
+        ``solved``: :meth:`solve_nodes` of ``q`` if the caller has it already.
+        """
+        qa = np.atleast_1d(np.asarray(q, float))
+        qd = np.broadcast_to(np.asarray(qdot, float), qa.shape)
+        qdd = np.broadcast_to(np.asarray(qddot, float), qa.shape)
+        pos, checks = solved if solved is not None else self.solve_nodes(qa)
+        valid = np.ones(qa.shape, bool)
+        for m, _, _ in checks:
+            valid &= m
+        vel: dict[str, Array] = {}
+        acc: dict[str, Array] = {}
+        for node in self.nodes:
+            v, ok = node.velocity_at(pos, vel, qa, qd)
+            vel[node.name] = v
+            a, ok2 = node.acceleration_at(pos, vel, acc, qa, qd, qdd)
+            acc[node.name] = a
+            for mask in (ok, ok2):
+                if mask is not None:
+                    valid &= mask
+        return pos, vel, acc, valid
+
+    def link_rates(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array]
+                   ) -> dict[str, tuple[Array, Array, Array, Array]]:
+        """Per link: ``(origin velocity, origin acceleration, omega, alpha)`` in the linkage's own frame.
+
+        The link's frame is its pose's (origin at its first node, x toward its
+        second, or along its guide), so these are the time derivatives of the
+        poses :meth:`solve` returns (placement rotates the vectors, not the rates).
+        """
+        out: dict[str, tuple[Array, Array, Array, Array]] = {}
+        n = next(iter(pos.values())).shape[0] if pos else 0
+        for lk in self.links:
+            if lk.name == self.ground_name:
+                z = np.zeros((n, 2))
+                out[lk.name] = (z, z, np.zeros(n), np.zeros(n))
+                continue
+            a, b = lk.guide if lk.guide is not None else (lk.nodes[0], lk.nodes[1])
+            omega, alpha = frame_rates(pos[b] - pos[a], vel[b] - vel[a], acc[b] - acc[a])
+            o = lk.nodes[0]
+            out[lk.name] = (vel[o], acc[o], omega, alpha)
+        return out
 
     # -- parts and joints -----------------------------------------------------
     def _span(self) -> float:
@@ -848,6 +1020,8 @@ class Linkage(Mechanism):
         for (guide, nd), lk in guided.items():
             assert guide is not None
             self._block_slide(lk, nd, guide, hulls, joints)
+        for node in self.nodes:
+            joints.extend(node.extra_joints(self, hulls))
         parts = []
         for lk in self.links:
             hull = hulls[lk.name] or [(0.0, 0.0, r)]
@@ -899,6 +1073,32 @@ class Linkage(Mechanism):
             hulls[lk.name].append((px, py, self.width / 2))
         joints.append(Slide(f"{lk.name}-slide", owner, lk.name, start, end, pins[0], (2 * self.width, 0.0),
                             width=self.pin_diameter))
+
+    @property
+    def extra_driven_parts(self) -> list[str]:
+        """Links of the inputs beyond the first that no gear ties to it (a simulation imposes their motion)."""
+        return [self._link_of(n.name, exclude_ground=True) for n in self.nodes
+                if getattr(n, "clocked", False) and n is not self._driver_node]
+
+    def input_values(self, q: ArrayLike) -> dict[str, Array]:
+        """Each input node's value (crank angle, rad, unwrapped) at driver values ``q`` when there are several.
+
+        Empty for a single-input linkage (its value is the driver value).
+        """
+        inputs = [n for n in self.nodes if n.is_input]
+        if len(inputs) < 2:
+            return {}
+        qa = np.atleast_1d(np.asarray(q, float))
+        out: dict[str, Array] = {}
+        for n in inputs:
+            own = getattr(n, "input_angle", None)  # a geared or driven node's law
+            if own is not None:
+                out[n.name] = own(qa)
+            elif isinstance(n, Crank):
+                out[n.name] = qa + n.phase
+            elif isinstance(n, Actuator):
+                out[n.name] = qa + n.offset
+        return out
 
     def node_positions(self, q) -> dict[str, Array]:
         """World positions ``(N, 2)`` of every node, placement applied."""

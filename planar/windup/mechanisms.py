@@ -384,10 +384,11 @@ class ElementalMechanism(Mechanism):
         g0 = (o[0] - P.amplitude - L, o[1])
         g1 = (o[0] + P.amplitude + 2 * L, o[1])
         gslot = Slot(g0, g1, 2 * P.D_ar)
-        # driver plate: a window whose left edge passes through the contact point A (drawn as a
-        # straight-sided slot of width D_w1; the taper to D_w2 does not change the contact)
+        # driver plate: a window whose right edge passes through the contact point A, so that the tab
+        # (its face x = F_jcx is the tab's +x side) stands in the window (drawn as a straight-sided slot
+        # of width D_w1; the taper to D_w2 does not change the contact)
         w = P.D_w1
-        cx = a_loc[0] + w / 2
+        cx = a_loc[0] - w / 2
         win = Slot((cx, a_loc[1] - 0.08), (cx, a_loc[1] + 0.08), w)
         rim = w / 2 + 0.04
         drv = Part("driver", ((0.0, 0.0, 2 * P.D_ar), (L, 0.0, 2 * P.D_ar), (cx, a_loc[1] - 0.08, rim),
@@ -399,7 +400,10 @@ class ElementalMechanism(Mechanism):
         w = st.aux["A"] - np.asarray(B)
         t = np.sqrt(np.maximum((w * w).sum(-1) - P.F_jcx**2, 0.0))
         t_lo, t_hi = float(t.min()) - P.F_jr, float(t.max()) + P.F_jr
-        follower = Part("follower", ((0.0, 0.0, 2 * P.F_ar), (0.0, t_hi, P.F_jr), (P.F_jcx - P.F_jr, t_hi, P.F_jr)),
+        # the tab's +x side is its contact face x = F_jcx all along (a convex hull: the pivot's boss
+        # reaches no further than the face where it can, keeping 0.3 F_ar of wall round the hole)
+        boss = min(2 * P.F_ar, max(P.F_jcx, 1.3 * P.F_ar))
+        follower = Part("follower", ((0.0, 0.0, boss), (P.F_jcx - P.F_jr, t_hi, P.F_jr)),
                         (Hole((0.0, 0.0), 2 * P.F_ar),), plane="xz")
         ground = Part("ground", ((*g0, 2 * P.D_ar), (*g1, 2 * P.D_ar), (*B, 3 * P.F_ar)),
                       (gslot, Hole(B, 2 * P.F_ar)), ground=True, plane="xz")
