@@ -293,6 +293,9 @@ MISUSES: list[tuple[str, list[str], str]] = [
     ("gallery-no-source", ["gallery", "--source", "{dir}/nodir"], "nodir"),
     ("schema-ext", ["schema", "-o", "{dir}/s.txt"], ".json"),
     ("demo-output-file", ["demo", "-o", "{dir}/m.csv"], "-o"),
+    ("plot-samples-huge", ["plot", "{scene}", "-o", "{dir}/p.png", "--samples", "100000000"], "PLANAR_MAX_SAMPLES"),
+    ("plot-ext", ["plot", "{scene}", "-o", "{dir}/p.txt"], "-o"),
+    ("plot-is-input", ["plot", "{scene}", "-o", "{scene}"], "-o"),
 ]
 
 
