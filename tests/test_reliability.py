@@ -296,6 +296,8 @@ MISUSES: list[tuple[str, list[str], str]] = [
     ("plot-samples-huge", ["plot", "{scene}", "-o", "{dir}/p.png", "--samples", "100000000"], "PLANAR_MAX_SAMPLES"),
     ("plot-ext", ["plot", "{scene}", "-o", "{dir}/p.txt"], "-o"),
     ("plot-is-input", ["plot", "{scene}", "-o", "{scene}"], "-o"),
+    ("synth-output-is-input", ["synth", "path", "{dir}/m.csv", "-o", "{dir}/m.csv"], "-o"),
+    ("synth-ext", ["synth", "function", "{dir}/m.csv", "-o", "{dir}/s.txt"], ".toml"),
 ]
 
 
