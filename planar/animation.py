@@ -118,10 +118,12 @@ def plan_frames(period_s: float, duration_s: float, fps: float | None = None, ti
             delay = 20.0 if tick_ms is not None else 1000.0 * period_s / MIN_FRAMES_PER_CYCLE
     per_cycle = max(MIN_FRAMES_ASKED, int(round(1000.0 * period_s / delay)))
     frames = max(1, int(round(per_cycle * duration_s / period_s)))
-    if frames > MAX_FRAMES:
-        raise InputError("duration", duration_s, f"an animation of at most {MAX_FRAMES} frames ({frames} asked for at "
-                                                 f"{1000.0 / delay:.3g} frames per second; shorten the duration or "
-                                                 "lower --fps)")
+    from .limits import limit
+
+    if frames > limit("frames"):  # MAX_FRAMES unless PLANAR_MAX_FRAMES raises it
+        raise InputError("duration", duration_s, f"an animation of at most {limit('frames')} frames ({frames} asked "
+                                                 f"for at {1000.0 / delay:.3g} frames per second; shorten the duration, "
+                                                 "lower --fps or raise PLANAR_MAX_FRAMES)")
     return FramePlan(float(period_s), float(delay), per_cycle, frames)
 
 

@@ -43,6 +43,13 @@ def _rocking(fb: Any, theta: np.ndarray) -> tuple[float | None, float]:
     return max(0.5 * (hi - lo), 1e-6), 0.5 * (hi + lo)
 
 
+def _check_output(args: argparse.Namespace, source: str) -> None:
+    """The scene to write, checked before the search: a .toml file in an existing folder, not the input."""
+    from .fileio import check_output
+
+    check_output("-o", args.output, (".toml",), (source,))
+
+
 def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, Any], ok: bool,
             failing: list[str]) -> int:
     from .synthesis.scene_out import write_scene
@@ -66,6 +73,7 @@ def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, An
 
 
 def _cmd_path(args: argparse.Namespace) -> int:
+    _check_output(args, args.target)
     from .synthesis.path import synthesise_path
     from .synthesis.scene_out import fourbar_scene_text
     from .synthesis.search import Constraints
@@ -112,6 +120,7 @@ def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | N
 
 
 def _cmd_function(args: argparse.Namespace) -> int:
+    _check_output(args, args.pairs)
     from .synthesis.function import freudenstein_fit
     from .synthesis.scene_out import fourbar_scene_text
     from .synthesis.targets import read_table
@@ -139,6 +148,7 @@ def _cmd_function(args: argparse.Namespace) -> int:
 
 
 def _cmd_motion(args: argparse.Namespace) -> int:
+    _check_output(args, args.poses)
     from .synthesis.motion import burmester
     from .synthesis.scene_out import fourbar_scene_text
     from .synthesis.targets import read_table

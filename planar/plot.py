@@ -29,6 +29,8 @@ are gaps.
 
 from __future__ import annotations
 
+import math
+
 import io
 import os
 from typing import TYPE_CHECKING, Any, Sequence
@@ -100,7 +102,13 @@ def _motion(scene: "Scene", samples_per_cycle: int | None) -> "Motion":
     d = scene.spec.driver
     drv = scene.mechanism.driver
     cycles = d.duration / drv.period if d.duration is not None else (d.cycles if d.cycles is not None else 1.0)
-    n = max(2, int(round(samples_per_cycle * cycles)))
+    from .limits import check_count, check_memory
+
+    total = samples_per_cycle * cycles  # bounded before anything is allocated (planar.limits)
+    n = max(2, check_count("samples", "--samples", round(total) if math.isfinite(total) else total,
+                           "samples in all (--samples x the scene's cycles)", shown=samples_per_cycle))
+    check_memory("--samples", samples_per_cycle,
+                 8.0 * 4 * n * (3 * len(scene.mechanism.parts) + 2 * len(scene.mechanism.points) + 4), "the charts' motion")
     t = np.arange(n) * (drv.period / samples_per_cycle)
     return scene.mechanism.solve(drv.value(t), t=t)
 

@@ -602,7 +602,10 @@ class Linkage(Mechanism):
     ) -> None:
         self.name = name
         self.nodes: tuple[NodeKind, ...] = tuple(nodes)
-        self.placement = tuple(float(v) for v in check_finite(f"{name}.placement", placement))
+        pl = check_finite(f"{name}.placement", placement)
+        if pl.shape != (3,):
+            raise InputError(f"{name}.placement", placement, "(x, y, angle): three numbers")
+        self.placement = tuple(float(v) for v in pl)
         self._validate_nodes(name)
         bound: dict[str, NodeKind] = {n.name: n for n in self.nodes}
         for n in self.nodes:

@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
-from ..model import check_positive
+from ..model import check_finite, check_positive
 from .dyads import RRR, Crank, Fixed, Link, Linkage, Rigid
 
 __all__ = ["FourBar", "grashof_class", "freudenstein_angles"]
@@ -134,7 +134,11 @@ class FourBar(Linkage):
         self.dims = _Dims(a, b, c, d)
         self.circuit: Circuit = circuit
         self.branch = 1 if circuit == "open" else -1
-        self.coupler_point = (float(coupler_point[0]), float(coupler_point[1]))
+        cp = np.asarray(coupler_point, dtype=object)
+        if cp.shape != (2,) or any(isinstance(v, bool) for v in cp):
+            raise InputError(f"{name}.coupler_point", coupler_point, "a point (x, y) in the coupler's frame")
+        cpf = check_finite(f"{name}.coupler_point", coupler_point)
+        self.coupler_point = (float(cpf[0]), float(cpf[1]))
         if max(a, b, c, d) >= (a + b + c + d) - max(a, b, c, d):
             raise InputError(
                 f"{name}.links", (a, b, c, d),
