@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
+    "CONCENTRIC",
     "TANGENCY_RTOL",
     "translation",
     "rotation",
@@ -37,6 +38,9 @@ __all__ = [
     "line_circle",
     "perp",
 ]
+
+#: centres closer than sqrt(CONCENTRIC) of the radii's sum are concentric (circle_circle and its fast kernel)
+CONCENTRIC = 1e-200
 
 Array = NDArray[np.float64]
 
@@ -217,7 +221,9 @@ def circle_circle(
     dif = q1 - q2
     prod = (sum_ * sum_ - d2) * (d2 - dif * dif)  # = 4 d^2 h^2 (scaled)
     scale = np.maximum(sum_ * sum_, d2)
-    ok_d = d2 > 0.0  # concentric circles: no (or infinitely many) intersections
+    # concentric circles (centres within 1e-100 of the radii's sum): no (or infinitely many) intersections;
+    # closer than that, a / d^2 overflows and the (invalid) point would not be finite
+    ok_d = d2 > CONCENTRIC * sum_ * sum_
     valid = (prod >= -rtol * scale * scale) & ok_d
     safe_d2 = np.where(ok_d, d2, 1.0)
     a = 0.5 * (d2 + q1 * q1 - q2 * q2) / safe_d2  # fraction of d along c1->c2

@@ -46,7 +46,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from ..geometry import TANGENCY_RTOL, line_circle, poses_apply
+from ..geometry import CONCENTRIC, TANGENCY_RTOL, line_circle, poses_apply
 
 if TYPE_CHECKING:
     from .dyads import Linkage, NodeKind
@@ -182,11 +182,11 @@ def _rrr(node, pos, q, w, ox, oy) -> Placed:
     ok: Mask | bool = True
     # every sample closes when the product clears -rtol s2^2 (the threshold -rtol max(s2, d2)^2
     # is lower) and d > 0; at d = 0 the product is -s2 f2, below that unless the radii are equal
-    equal_radii = f2 <= 2.0 * TANGENCY_RTOL * s2
-    if d2.size and (float(prod.min()) < -TANGENCY_RTOL * s2 * s2 or (equal_radii and float(d2.min()) <= 0.0)):
+    tiny = CONCENTRIC * s2
+    if d2.size and (float(prod.min()) < -TANGENCY_RTOL * s2 * s2 or float(d2.min()) <= tiny):
         scale = np.maximum(s2, d2)
-        ok = (prod >= -TANGENCY_RTOL * scale * scale) & (d2 > 0.0)
-        d2[d2 <= 0.0] = 1.0  # concentric: invalid, kept finite as the reference does
+        ok = (prod >= -TANGENCY_RTOL * scale * scale) & (d2 > tiny)
+        d2[d2 <= tiny] = 1.0  # concentric: invalid, kept finite as the reference does
     np.maximum(prod, 0.0, out=prod)
     np.reciprocal(d2, out=d2)  # 1 / d^2
     np.sqrt(prod, out=t)
