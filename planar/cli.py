@@ -117,7 +117,8 @@ def _cmd_chains(args: argparse.Namespace) -> int:
     for motion, cs in chains.items():
         print(f"{motion}: {len(cs)} chains")
         for c in cs:
-            print("   " + " -> ".join([c[0].split("->")[0]] + [p.split("->")[1] for p in c]))
+            path = " -> ".join([c[0].split("->")[0]] + [p.split("->")[1] for p in c])
+            print(f"   {path:<28} chain = {json.dumps(list(c))}")  # the second column pastes into a scene
     return 0
 
 
@@ -135,6 +136,11 @@ def _cmd_render(args: argparse.Namespace) -> int:
     plan = animation_plan(scene, args.output, args.fps)
     if plan.note():
         print(f"note: {plan.note()}")
+    m = scene.motion()
+    bad = ~m.valid
+    if bad.any():  # drawn (tinted red, the joint ringed), and said
+        print(f"note: {int(bad.sum())} of {len(m)} samples cannot be assembled and are drawn tinted red; first: "
+              f"{m.reason(int(bad.argmax()))}")
     n = render_scene(scene, args.output, overlay=overlay, fps=args.fps)
     print(f"wrote {args.output}: {n} frames, {plan.fps:.3g} frames/s, a cycle plays {plan.cycle_play_s:.3g} s")
     return 0

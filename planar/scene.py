@@ -560,6 +560,10 @@ class FabricationSpec(_Strict):
     """Colour of engraved lines (labels, letters) ``#rrggbb``."""
 
 
+#: millimetres per model unit of a wind-up scene that does not say (the paper's toys are about 0.9 units across)
+WINDUP_UNIT_MM = 100.0
+
+
 class SceneSpec(_Strict):
     """A whole scene file."""
 
@@ -576,7 +580,14 @@ class SceneSpec(_Strict):
     render: RenderSpec = RenderSpec()
     """Drawing options."""
     fabrication: FabricationSpec = FabricationSpec()
-    """Laser-cutting options (mm)."""
+    """Laser-cutting options (mm); a wind-up scene (elemental, chain, toy) cuts at 100 mm per unit unless its
+    ``unit_mm`` says otherwise (the supplement's units: a toy about 9 cm across)."""
+
+    @model_validator(mode="after")
+    def _windup_unit(self) -> "SceneSpec":
+        if self.mechanism.type in ("elemental", "chain", "toy") and "unit_mm" not in self.fabrication.model_fields_set:
+            self.fabrication = self.fabrication.model_copy(update={"unit_mm": WINDUP_UNIT_MM})
+        return self
 
 
 def scene_schema() -> dict[str, Any]:
