@@ -117,26 +117,33 @@ def _part_points(mech: Mechanism, part: str) -> NDArray[np.float64]:
 def compare(mech: Mechanism, reference: Motion, other: Motion, threshold: float = 1e-3) -> Comparison:
     """Errors of ``other`` against ``reference`` (same samples) for every part and joint."""
     size = mech.size
-    ok = reference.valid & other.valid
+    # samples the simulation marked as failed still count (their poses are what it did), so the table agrees
+    # with the failure it reports; a non-finite pose counts as infinitely far
+    finite = np.ones(len(reference), bool)
+    for p in mech.parts:
+        finite &= np.isfinite(other.poses[p.name]).all(axis=1)
+    ok = reference.valid.copy()
     parts = []
     first_all: int | None = None
     for p in mech.parts:
         pts = _part_points(mech, p.name)
         a = poses_apply(reference.poses[p.name], pts)  # (N, M, 2)
         b = poses_apply(other.poses[p.name], pts)
-        d = np.hypot(*(a - b).transpose(2, 0, 1)).max(axis=1)  # worst point per sample
-        d = np.where(ok, d, 0.0)
-        ang = np.abs(wrap_angle(reference.poses[p.name][:, 2] - other.poses[p.name][:, 2]))
-        ang = np.where(ok, ang, 0.0)
+        with np.errstate(invalid="ignore", over="ignore"):
+            d = np.hypot(*(a - b).transpose(2, 0, 1)).max(axis=1)  # worst point per sample
+        d = np.where(ok, np.where(finite, d, np.inf), 0.0)
+        with np.errstate(invalid="ignore"):
+            ang = np.abs(wrap_angle(reference.poses[p.name][:, 2] - other.poses[p.name][:, 2]))
+        ang = np.where(ok & finite, ang, 0.0)
         over = np.flatnonzero(d > threshold * size)
         first = int(over[0]) if over.size else None
         if first is not None and (first_all is None or first < first_all):
             first_all = first
         n = max(int(ok.sum()), 1)
-        parts.append(PartError(p.name, float(d.max()), float(np.sqrt((d[ok] ** 2).sum() / n)),
+        parts.append(PartError(p.name, float(d.max()), float(np.sqrt((d[ok & finite] ** 2).sum() / n)),
                                float(d.max() / size), float(ang.max()), first))
     res = joint_residuals(mech, other)
-    joints = {k: float(np.max(np.where(ok, v, 0.0))) for k, v in res.items()}
+    joints = {k: float(np.max(np.where(ok & finite, v, 0.0))) for k, v in res.items()}
     failure = None
     if not other.valid.all():
         i = int(np.flatnonzero(~other.valid)[0])
