@@ -371,6 +371,8 @@ class ToyAssembly(Mechanism):
             if name == main_cam:
                 continue
             ph = toy.cam_phase[self.placed[i].stage.cam] - toy.cam_phase[self.placed[min(cam_name)].stage.cam]
+            # a root stage turned by its realisation (Rz->Ty is #1 turned a quarter) turns its cam as much
+            ph = float(wrap_angle(np.array([ph + self.placed[i].place[2] - self.placed[min(cam_name)].place[2]]))[0])
             self.keyed[name] = float(ph)
             joints.append(KeyedShaft(f"{name}.key", main_cam, name, (0.0, 0.0), (0.0, 0.0), float(ph), size))
         self.main_cam = main_cam

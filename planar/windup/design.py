@@ -101,6 +101,8 @@ class Design:
     layers: dict[str, int] = field(default_factory=dict)
     collisions: list[tuple[str, str, float]] = field(default_factory=list)
     seconds: dict[str, float] = field(default_factory=dict)
+    placement: "Placement | None" = None
+    layers_before: int | None = None  # layers of the toy before placement
 
     def report(self) -> dict[str, Any]:
         return {
@@ -118,6 +120,12 @@ class Design:
             "trees_considered": self.candidates,
             "trees_sized": self.tried,
             "layers": self.layers,
+            "layer_count": len(set(self.layers.values())),
+            "layer_count_before_placement": self.layers_before,
+            "placement": None if self.placement is None else {
+                "variables": self.placement.variables, "objective": list(self.placement.objective),
+                "footprint": list(self.placement.footprint), "overlap": list(self.placement.overlap),
+                "evaluations": self.placement.evaluations, "rejected": self.placement.rejected},
             "collisions": [{"a": a, "b": b, "overlap": ov} for a, b, ov in self.collisions],
             "seconds": self.seconds,
         }
@@ -429,11 +437,154 @@ def layer_collisions(toy: ToyMechanism, samples: int = 24, unit_mm: float = 100.
     return layers, found
 
 
+# ----------------------------------------------------------------------------- placement
+
+#: stages whose follower can move relative to the driver without changing any motion (the slider of #1,
+#: the pivot of #9): ``F_o``'s in-plane components are the placement variables (checked again at run time)
+PLACEABLE = {1: "F_o", 9: "F_o"}
+#: annealing: iterations, step (model units), box around the default position (model units), overlap weight
+ANNEAL_STEPS = 40
+ANNEAL_STEP = 0.08
+ANNEAL_BOX = 0.4
+OVERLAP_WEIGHT = 10.0
+
+
+@dataclass
+class Placement:
+    """What the annealing did: variables, objective and footprint before and after, evaluations."""
+
+    variables: list[str]
+    objective: tuple[float, float]
+    footprint: tuple[float, float]
+    overlap: tuple[float, float]
+    evaluations: int
+    rejected: int
+    seconds: float
+
+
+def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
+    """``(footprint, overlap)``: the convex hull area of every xy piece's swept region over one cycle, and the
+    summed swept overlap of xy pieces no joint connects (pairs that must go on different layers); units^2."""
+    import shapely
+    from shapely import affinity
+
+    from .assembly import ToyAssembly
+
+    asm = ToyAssembly(toy)
+    m = asm.run(samples_per_cycle=samples)
+    joined = {frozenset((j.a, j.b)) for j in asm.joints}
+    swept = {}
+    for p in asm.parts:
+        if p.plane != "xy":
+            continue
+        pose = np.asarray(m.poses[p.name])
+        c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+        swept[p.name] = shapely.union_all([affinity.affine_transform(p.outline, [c[k], -s[k], s[k], c[k],
+                                                                                pose[k, 0], pose[k, 1]])
+                                           for k in range(len(pose))])
+    footprint = float(shapely.union_all(list(swept.values())).convex_hull.area)
+    overlap = 0.0
+    names = [n for n in swept if n != "frame"]
+    for a, b in itertools.combinations(names, 2):
+        if frozenset((a, b)) not in joined:
+            overlap += float(swept[a].intersection(swept[b]).area)
+    return footprint, overlap
+
+
+def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, overrides: dict[tuple[str, Chain], dict[str, Any]],
+                 names: dict[tuple[str, Chain], str], seed: int = 0) -> tuple[dict[tuple[str, Chain], dict[str, Any]], Placement]:
+    """Anneal the placement variables (:data:`PLACEABLE`) to a compact toy whose pieces overlap little.
+
+    Objective: footprint + ``OVERLAP_WEIGHT`` x overlap (:func:`_layout_score`).
+    A move that changes any stage's motion (compared on 181 samples to 1e-9)
+    or that the toy cannot be built with is rejected.  Simulated annealing
+    with a fixed seed (same request, same toy), ``ANNEAL_STEPS`` moves.
+    """
+    t0 = time.perf_counter()
+    q = np.linspace(0.0, 2 * math.pi, 181)
+    stages = []
+    for cam, chains in cams.items():
+        seen = set()
+        for c in chains:
+            for d in range(1, len(c) + 1):
+                key = c[:d]
+                if key in seen:
+                    continue
+                seen.add(key)
+                number = realise(key[-1]).number
+                if number in PLACEABLE:
+                    stages.append((cam, key, PLACEABLE[number], getattr(params_for(number), PLACEABLE[number])))
+
+    def build(x: Array) -> ToyMechanism | None:
+        ov = {k: dict(v) for k, v in overrides.items()}
+        for i, (cam, key, pname, default) in enumerate(stages):
+            cur = list(ov.get((cam, key), {}).get(pname, default))
+            cur[0], cur[1] = float(x[2 * i]), float(x[2 * i + 1])
+            ov.setdefault((cam, key), {})[pname] = tuple(cur)
+        try:
+            return ToyMechanism(cams, phase=phase, name=name, overrides=ov, names=names)
+        except InputError:
+            return None
+
+    base = ToyMechanism(cams, phase=phase, name=name, overrides=overrides, names=names)
+    ref, _ = base.world_motion(q)
+    ref = {k: v.copy() for k, v in ref.items()}
+
+    def score(x: Array) -> tuple[float, float, float, ToyMechanism | None]:
+        toy = build(x)
+        if toy is None:
+            return math.inf, math.inf, math.inf, None
+        outs, checks = toy.world_motion(q)
+        if not all(np.all(ok) for ok, _, _ in checks) or any(
+                not np.allclose(outs[k], ref[k], rtol=0, atol=1e-9) for k in ref):
+            return math.inf, math.inf, math.inf, None
+        try:
+            fp, ovl = _layout_score(toy)
+        except InputError:
+            return math.inf, math.inf, math.inf, None
+        return fp + OVERLAP_WEIGHT * ovl, fp, ovl, toy
+
+    x0 = np.array([v for _, _, _, d in stages for v in (d[0], d[1])], float)
+    # the sized overrides may already hold the variables
+    for i, (cam, key, pname, _) in enumerate(stages):
+        if pname in overrides.get((cam, key), {}):
+            x0[2 * i:2 * i + 2] = overrides[(cam, key)][pname][:2]
+    f0, fp0, ov0, _ = score(x0)
+    if not stages or not math.isfinite(f0):
+        return overrides, Placement([], (f0, f0), (fp0, fp0), (ov0, ov0), 1, 0, time.perf_counter() - t0)
+    rng = np.random.default_rng(seed)
+    lo, hi = x0 - ANNEAL_BOX, x0 + ANNEAL_BOX
+    x, fx = x0.copy(), f0
+    best = (f0, fp0, ov0, x0.copy())
+    temp0 = 0.05 * f0
+    evals, rejected = 1, 0
+    for k in range(ANNEAL_STEPS):
+        temp = temp0 * (1 - k / ANNEAL_STEPS) + 1e-12
+        y = np.clip(x + rng.normal(0.0, ANNEAL_STEP, x.size), lo, hi)
+        fy, fpy, ovy, _ = score(y)
+        evals += 1
+        if not math.isfinite(fy):
+            rejected += 1
+            continue
+        if fy <= fx or rng.random() < math.exp(-(fy - fx) / temp):
+            x, fx = y, fy
+            if fy < best[0]:
+                best = (fy, fpy, ovy, y.copy())
+    out = {k: dict(v) for k, v in overrides.items()}
+    for i, (cam, key, pname, default) in enumerate(stages):
+        cur = list(out.get((cam, key), {}).get(pname, default))
+        cur[0], cur[1] = float(best[3][2 * i]), float(best[3][2 * i + 1])
+        out.setdefault((cam, key), {})[pname] = tuple(cur)
+    labels = [f"{cam} {' '.join(key)}: {pname}" for cam, key, pname, _ in stages]
+    return out, Placement(labels, (f0, best[0]), (fp0, best[1]), (ov0, best[2]), evals, rejected,
+                          time.perf_counter() - t0)
+
+
 # ----------------------------------------------------------------------------- the pipeline
 
 
 def design_toy(effectors: list[Effector], name: str = "designed toy", max_length: int = 3,
-               max_trees: int = 200) -> Design:
+               max_trees: int = 200, place: bool = True) -> Design:
     """Design a toy for ``effectors`` (see the module docstring); an unreachable request is an
     :class:`InputError` naming the effector and the ranges its chains reach."""
     t0 = time.perf_counter()
@@ -478,6 +629,15 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
         except InputError:
             continue  # a tree the assembly refuses (a mirrored or turned out-of-plane stage)
         t_size = time.perf_counter() - t0 - t_enum
+        placement = None
+        layers_before = None
+        if place:
+            from .toy_view import layer_order
+
+            layers_before = len(set(layer_order(toy_assembly(toy)).values()))
+            placed, placement = place_stages(cams, phase, name, overrides, names)
+            if placement.variables:
+                toy = ToyMechanism(cams, phase=phase, name=name, overrides=placed, names=names)
         t1 = time.perf_counter()
         measured = effector_ranges(toy)
         ranges = {}
@@ -485,8 +645,11 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
             _, val = measured[e.name]
             ranges[e.name] = math.degrees(val) if e.motion[0] == "O" else val
         layers, collisions = layer_collisions(toy)
-        d = Design(toy, effectors, pairs, cost, ranges, len(cands), tried, sizing, layers, collisions,
-                   {"enumerate": t_enum, "rank_and_size": t_size, "check": time.perf_counter() - t1})
+        secs = {"enumerate": t_enum, "rank_and_size": t_size, "check": time.perf_counter() - t1}
+        if placement is not None:
+            secs["place"] = placement.seconds
+        d = Design(toy, effectors, pairs, cost, ranges, len(cands), tried, sizing, layers, collisions, secs,
+                   placement, layers_before)
         return d
     for e, opts in zip(effectors, options):
         if not any(can(e, c) for c in opts):
