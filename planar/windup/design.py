@@ -103,6 +103,8 @@ class Design:
     seconds: dict[str, float] = field(default_factory=dict)
     placement: "Placement | None" = None
     layers_before: int | None = None  # layers of the toy before placement
+    clashes: list[str] = field(default_factory=list)  # pins crossing a piece between their layers
+    rejected: list[str] = field(default_factory=list)  # cheaper trees whose fabrication collided
 
     def report(self) -> dict[str, Any]:
         return {
@@ -125,8 +127,11 @@ class Design:
             "placement": None if self.placement is None else {
                 "variables": self.placement.variables, "objective": list(self.placement.objective),
                 "footprint": list(self.placement.footprint), "overlap": list(self.placement.overlap),
-                "evaluations": self.placement.evaluations, "rejected": self.placement.rejected},
+                "evaluations": self.placement.evaluations, "rejected": self.placement.rejected,
+                "kept": self.placement.kept},
             "collisions": [{"a": a, "b": b, "overlap": ov} for a, b, ov in self.collisions],
+            "pin_clashes": self.clashes,
+            "rejected_trees": self.rejected,
             "seconds": self.seconds,
         }
 
@@ -402,29 +407,38 @@ def effector_ranges(toy: ToyMechanism, samples: int = SAMPLES) -> dict[str, tupl
 
 
 def layer_collisions(toy: ToyMechanism, samples: int = 24, unit_mm: float = 100.0
-                     ) -> tuple[dict[str, int], list[tuple[str, str, float]]]:
-    """The fabrication's layers and every pair of pieces on one layer (same plane) whose outlines overlap
-    at some sampled pose by more than the fabrication's tolerance (``planar.assembly.OVERLAP_MM2``, 0.5
-    mm^2 at ``unit_mm`` mm per unit: a cam's polygon touching its follower's window stays below it):
-    ``(layers, [(a, b, worst overlap in model units squared)])``."""
+                     ) -> tuple[dict[str, int], list[tuple[str, str, float]], list[str]]:
+    """The toy's fabrication (what ``planar export`` cuts) checked for collisions over ``samples`` poses.
+
+    Returns ``(layers, collisions, pin clashes)``: the export's layer of every
+    piece; every pair of pieces on one layer (same plane) whose cut material
+    (outline minus holes and slots, mm) overlaps at some sampled pose by more
+    than the fabrication's tolerance (``planar.assembly.OVERLAP_MM2``, 0.5 mm^2),
+    with the worst overlap (mm^2); and the export's pin clashes (a pin whose
+    path crosses a piece on a layer between its ends).
+    """
     from shapely import affinity
 
-    from .assembly import toy_assembly
     from ..assembly import OVERLAP_MM2
-    from .toy_view import layer_order
+    from ..fabexport import build
+    from ..fabparts import FabSettings
+    from ..pipeline import scene_from_mechanism
+    from .assembly import toy_assembly
 
-    tol = OVERLAP_MM2 / unit_mm ** 2
+    scene = scene_from_mechanism(toy, fabrication={"unit_mm": unit_mm})
+    fab = build(scene, FabSettings.from_spec(scene.spec.fabrication, None, None))
+    plan = fab.assembly
+    layers = {k: (v if v is not None else 0) for k, v in plan.layers.items()}
+    clashes = [f"pin {pp.letter} ({', '.join(pp.joints)}) through {q}" for pp in plan.pins for q in pp.clashes]
     asm = toy_assembly(toy)
-    layers = layer_order(asm, unit_mm=unit_mm, samples=samples)
     m = asm.run(samples_per_cycle=samples)
     ok = np.flatnonzero(m.valid)
-    outline = {p.name: p.outline for p in asm.parts}
     plane = {p.name: p.plane for p in asm.parts}
 
     def placed(name: str, k: int) -> Any:
         x, y, a = m.poses[name][k]
         c, s = math.cos(a), math.sin(a)
-        return affinity.affine_transform(outline[name], [c, -s, s, c, x, y])
+        return affinity.affine_transform(fab.own[name], [c, -s, s, c, x * unit_mm, y * unit_mm])
 
     found = []
     names = [p.name for p in asm.parts]
@@ -432,9 +446,9 @@ def layer_collisions(toy: ToyMechanism, samples: int = 24, unit_mm: float = 100.
         if plane[a] != plane[b] or layers.get(a) != layers.get(b):
             continue
         worst = max(placed(a, k).intersection(placed(b, k)).area for k in ok)
-        if worst > tol:
+        if worst > OVERLAP_MM2:
             found.append((a, b, float(worst)))
-    return layers, found
+    return layers, found, clashes
 
 
 # ----------------------------------------------------------------------------- placement
@@ -447,6 +461,8 @@ ANNEAL_STEPS = 40
 ANNEAL_STEP = 0.08
 ANNEAL_BOX = 0.4
 OVERLAP_WEIGHT = 10.0
+#: a pin's radius in the placement's clash penalty (model units: 1.5 mm)
+PIN_RADIUS = 0.015
 
 
 @dataclass
@@ -460,6 +476,7 @@ class Placement:
     evaluations: int
     rejected: int
     seconds: float
+    kept: bool = True  # False when the annealed placement added a collision, clash or layer (not used)
 
 
 def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
@@ -468,6 +485,8 @@ def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
     import shapely
     from shapely import affinity
 
+    from ..assembly import pin_stacks
+    from ..fabjoints import joint_pins
     from .assembly import ToyAssembly
 
     asm = ToyAssembly(toy)
@@ -488,6 +507,23 @@ def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
     for a, b in itertools.combinations(names, 2):
         if frozenset((a, b)) not in joined:
             overlap += float(swept[a].intersection(swept[b]).area)
+    # pins crossing pieces they do not join (the fabrication would need them on layers outside the pin)
+    pins, _ = joint_pins(asm)
+    for stack in pin_stacks(pins):
+        on = {n for i in stack for n in pins[i].parts}
+        pin = pins[stack[0]]
+        a = pin.parts[0]
+        if a not in swept:
+            continue
+        pose = np.asarray(m.poses[a])
+        c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+        x, y = pin.at[0]
+        path = np.c_[pose[:, 0] + c * x - s * y, pose[:, 1] + s * x + c * y]
+        geom = shapely.buffer(shapely.points(path[0]) if np.ptp(path, axis=0).max() < 1e-9
+                              else shapely.linestrings(path), PIN_RADIUS)
+        for n in names:
+            if n not in on:
+                overlap += float(swept[n].intersection(geom).area)
     return footprint, overlap
 
 
@@ -584,7 +620,7 @@ def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, override
 
 
 def design_toy(effectors: list[Effector], name: str = "designed toy", max_length: int = 3,
-               max_trees: int = 200, place: bool = True) -> Design:
+               max_trees: int = 200, place: bool = True, max_fabricated: int = 4) -> Design:
     """Design a toy for ``effectors`` (see the module docstring); an unreachable request is an
     :class:`InputError` naming the effector and the ranges its chains reach."""
     t0 = time.perf_counter()
@@ -603,7 +639,9 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
     options = [enumerate_chains(e.motion, max_length)[e.motion] for e in effectors]
     cands = _candidates(effectors, options)
     t_enum = time.perf_counter() - t0
-    tried = 0
+    tried = fabricated = 0
+    rejected: list[str] = []
+    first: Design | None = None
     for cost, _, pairs in cands:
         if tried >= max_trees:
             break
@@ -629,28 +667,44 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
         except InputError:
             continue  # a tree the assembly refuses (a mirrored or turned out-of-plane stage)
         t_size = time.perf_counter() - t0 - t_enum
+        t1 = time.perf_counter()
         placement = None
-        layers_before = None
-        if place:
-            from .toy_view import layer_order
+        checked = layer_collisions(toy)
+        layers_before = len(set(checked[0].values()))
 
-            layers_before = len(set(layer_order(toy_assembly(toy)).values()))
+        def bad(c: tuple[dict[str, int], list, list]) -> tuple[int, int, int]:
+            return len(c[1]), len(c[2]), len(set(c[0].values()))
+        if place:
             placed, placement = place_stages(cams, phase, name, overrides, names)
             if placement.variables:
-                toy = ToyMechanism(cams, phase=phase, name=name, overrides=placed, names=names)
-        t1 = time.perf_counter()
+                moved = ToyMechanism(cams, phase=phase, name=name, overrides=placed, names=names)
+                after = layer_collisions(moved)
+                # keep the placement only where it adds no collision, no pin clash and no layer
+                if bad(after) <= bad(checked):
+                    toy, checked = moved, after
+                else:
+                    placement.kept = False
+        fabricated += 1
         measured = effector_ranges(toy)
         ranges = {}
         for e in effectors:
             _, val = measured[e.name]
             ranges[e.name] = math.degrees(val) if e.motion[0] == "O" else val
-        layers, collisions = layer_collisions(toy)
-        secs = {"enumerate": t_enum, "rank_and_size": t_size, "check": time.perf_counter() - t1}
-        if placement is not None:
-            secs["place"] = placement.seconds
+        layers, collisions, clashes = checked
+        secs = {"enumerate": t_enum, "rank_and_size": t_size, "place_and_check": time.perf_counter() - t1}
         d = Design(toy, effectors, pairs, cost, ranges, len(cands), tried, sizing, layers, collisions, secs,
-                   placement, layers_before)
-        return d
+                   placement, layers_before, clashes, rejected)
+        if not collisions and not clashes:
+            return d
+        # a tree whose pieces collide or whose pins cross pieces: try the next cheapest (a few)
+        rejected.append(f"cost {cost:g} " + "; ".join(f"{cam}: {' '.join(c)}" for cam, c in pairs) + ": "
+                        + ", ".join([f"{a}/{b} collide" for a, b, _ in collisions] + clashes))
+        if first is None:
+            first = d
+        if fabricated >= max_fabricated:
+            break
+    if first is not None:
+        return first  # every tree tried collides: the cheapest, its failures reported
     for e, opts in zip(effectors, options):
         if not any(can(e, c) for c in opts):
             spans = [r for r in (reach(c) for c in opts) if r is not None]
