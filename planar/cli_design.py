@@ -41,13 +41,16 @@ def _cmd_design(args: argparse.Namespace) -> int:
     rep = d.report()
     rep["output"] = str(args.output)
     bad = [e for e in rep["effectors"] if e["error"] > TOLERANCE]
-    ok = not bad and not d.collisions
+    ok = not bad and not d.collisions and not d.clashes
     if args.json:
         print(json.dumps(rep, indent=2, sort_keys=True, default=float))
     else:
         trees = "; ".join(f"{cam}: " + ", ".join(" ".join(c) for c in chains) for cam, chains in rep["cams"].items())
-        print(f"{name}: cost {d.cost:g} ({d.toy.mechanism_count} mechanisms), {trees}; right cam "
-              f"{math.degrees(d.toy.phase):.0f} deg ahead; {d.tried} of {d.candidates} trees sized")
+        lead = f"; right cam {math.degrees(d.toy.phase):.0f} deg ahead" if len(d.toy.cams) == 2 else ""
+        print(f"{name}: cost {d.cost:g} ({d.toy.mechanism_count} mechanisms), {trees}{lead}; "
+              f"{d.tried} of {d.candidates} trees sized")
+        for r in d.rejected:
+            print(f"  passed over (its pieces collide): {r}")
         for e in rep["effectors"]:
             unit = "deg" if e["motion"][0] == "O" else "units"
             flag = "[ok]" if e["error"] <= TOLERANCE else "[FAIL]"
@@ -55,9 +58,18 @@ def _cmd_design(args: argparse.Namespace) -> int:
                   f"measured {e['achieved']:.6g} {unit} ({100 * e['error']:.2g} %) {flag}; "
                   f"{e['sized']['stage']}: {e['sized']['parameter']} = {e['sized']['value']:.6g}")
         n_layers = len(set(d.layers.values()))
-        print(f"  {len(d.layers)} pieces in {n_layers} layers; same-layer collisions over 24 poses: "
-              f"{len(d.collisions)} " + ("[ok]" if not d.collisions else "[FAIL] " + ", ".join(
-                  f"{a}/{b} {ov:.3g}" for a, b, ov in d.collisions)))
+        pl = d.placement
+        if pl is not None and pl.variables:
+            print(f"  placement ({', '.join(pl.variables)}; {pl.evaluations} layouts annealed"
+                  + ("" if pl.kept else ", not kept: it added a collision, clash or layer") + "): footprint "
+                  f"{pl.footprint[0]:.3g} -> {pl.footprint[1]:.3g} units^2, overlap of unjoined pieces "
+                  f"{pl.overlap[0]:.3g} -> {pl.overlap[1]:.3g}")
+        else:
+            print("  placement: no stage of this tree can move without changing a motion")
+        print(f"  {len(d.layers)} pieces in {n_layers} layers (the export's plan); same-layer collisions over 24 "
+              f"poses: {len(d.collisions)}, pins through pieces: {len(d.clashes)} "
+              + ("[ok]" if not (d.collisions or d.clashes) else "[FAIL] " + ", ".join(
+                  [f"{a}/{b} {ov:.3g} mm^2" for a, b, ov in d.collisions] + d.clashes)))
         print(f"  wrote {args.output} ({sum(d.seconds.values()):.2f} s)")
     return 0 if ok else EXIT_MISMATCH
 

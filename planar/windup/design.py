@@ -457,7 +457,7 @@ def layer_collisions(toy: ToyMechanism, samples: int = 24, unit_mm: float = 100.
 #: the pivot of #9): ``F_o``'s in-plane components are the placement variables (checked again at run time)
 PLACEABLE = {1: "F_o", 9: "F_o"}
 #: annealing: iterations, step (model units), box around the default position (model units), overlap weight
-ANNEAL_STEPS = 40
+ANNEAL_STEPS = 30
 ANNEAL_STEP = 0.08
 ANNEAL_BOX = 0.4
 OVERLAP_WEIGHT = 10.0
@@ -479,7 +479,7 @@ class Placement:
     kept: bool = True  # False when the annealed placement added a collision, clash or layer (not used)
 
 
-def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
+def _layout_score(toy: ToyMechanism, samples: int = 6) -> tuple[float, float]:
     """``(footprint, overlap)``: the convex hull area of every xy piece's swept region over one cycle, and the
     summed swept overlap of xy pieces no joint connects (pairs that must go on different layers); units^2."""
     import shapely
