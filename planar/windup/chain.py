@@ -133,7 +133,7 @@ class ToyMechanism(Mechanism):
                         u = _to_base(r, q + self.cam_phase[cam])
                     else:
                         u = _to_base(r, world_out[parent])
-                    kw = dict(overrides.get((cam, key), overrides.get(key, {})))
+                    kw = dict(overrides.get((cam, key)) or overrides.get(key) or {})
                     if kw:
                         self.stage_overrides[(cam, key)] = dict(kw)
                     mech = self._build_stage(r, u, kw, name, key)

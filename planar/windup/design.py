@@ -4,31 +4,33 @@ A request lists end effectors (``[[effector]]``: ``name``, ``motion``,
 ``range``, optional ``cam`` and ``phase``).  :func:`design_toy`
 
 1. **enumerates** every chain from the motor to each effector's motion (up to
-   three stages, :func:`~planar.windup.table.enumerate_chains`) and drops the
-   chains that cannot reach the requested range (each chain's reachable range
-   is scanned once, composed, the sized stage's design parameter varied);
+   three stages, :func:`~planar.windup.table.enumerate_chains`);
 2. **merges** one chain per effector into trees on the two cams (chains on one
    cam share their common prefix: one stage each), respecting a requested
    ``cam`` and putting effectors with different ``phase`` on different cams;
 3. **ranks** the trees by the paper's cost (:func:`~planar.windup.chain.tree_cost`:
-   mechanisms + 2 x mean chain length), cheapest first;
+   mechanisms + 2 x mean chain length), cheapest first, skipping trees with a
+   chain that cannot reach its effector's range (each chain's reachable range
+   is scanned once, lazily, its sized stage's parameter varied);
 4. **sizes** the cheapest tree that works: each effector's last stage's design
    parameter (:data:`~planar.windup.sizing.DESIGN_PARAMETER`; its parent's for a
    #10, whose stroke follows its driver's travel) is solved with
    :func:`scipy.optimize.brentq` so that the effector's range, composed
    through the tree (its parent's actual output, not a standalone law), is the
    request; stages are sized parents first;
-5. **checks** the result independently: the toy is rebuilt from the sized
-   parameters, assembled (:func:`~planar.windup.assembly.toy_assembly`), run,
-   and each effector's range measured from its piece's pose track; the
-   fabrication's layer plan (:func:`~planar.windup.toy_view.layer_order`) is
-   checked with shapely for pieces of one layer overlapping at any sampled
-   pose.
-
-Placement: a toy's stages sit where the assembly puts them (a child's driver
-on its parent's follower, the roots on the motor axis), so positions are not
-free variables here; collisions are avoided by the layer assignment and
-verified afterwards (see the README's "Designing a toy").
+5. **places** the stages (:func:`place_stages`): a toy's stages sit where the
+   assembly puts them (a child's driver on its parent's follower, the roots on
+   the motor axis); the free variables are the follower positions that change
+   no motion (#1's slider, #9's pivot: ``F_o``), annealed toward a small
+   footprint and little overlap of unjoined pieces; the result is kept only if
+   it adds no collision, pin clash or layer;
+6. **checks** the result independently: each effector's range is measured on
+   the assembled toy's piece poses, and the export's own layer plan
+   (:func:`planar.fabexport.build`) is checked with shapely for pieces of one
+   layer overlapping at any of 24 sampled poses and for pins running through
+   a piece.  A tree that fails is passed over for the next cheapest (up to
+   ``max_fabricated``); if all fail, the cheapest is returned with its
+   failures (``planar design`` exits 3).
 
 Units: ranges of O motions (and the rotation of OzT) in degrees, of T
 motions in model units (one unit is 100 mm when cut); phases in cycles.
@@ -445,7 +447,7 @@ def layer_collisions(toy: ToyMechanism, samples: int = 24, unit_mm: float = 100.
     for a, b in itertools.combinations(names, 2):
         if plane[a] != plane[b] or layers.get(a) != layers.get(b):
             continue
-        worst = max(placed(a, k).intersection(placed(b, k)).area for k in ok)
+        worst = max(placed(a, int(k)).intersection(placed(b, int(k))).area for k in ok)
         if worst > OVERLAP_MM2:
             found.append((a, b, float(worst)))
     return layers, found, clashes
