@@ -634,9 +634,26 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
         f, _, _, bracket, _ = _span_fn(c, _sized_depth(c), 0.0, {}, q)
         return _scan(f, bracket, cache, _scan_key(c, _sized_depth(c), {})).reachable()
 
-    def can(e: Effector, c: Chain) -> bool:
+    built: dict[Chain, str | None] = {}
+
+    def refused(c: Chain) -> str | None:
+        """Why the assembly cannot build the chain alone (a stage turned out of its plane), or None."""
+        if c not in built:
+            from .assembly import toy_assembly
+
+            try:
+                toy_assembly(ToyMechanism({"left": [c]}, name="chain"))
+                built[c] = None
+            except InputError as err:
+                built[c] = str(err)
+        return built[c]
+
+    def reaches(e: Effector, c: Chain) -> bool:
         r = reach(c)
         return r is not None and r[0] * (1 - 1e-6) <= e.target <= r[1] * (1 + 0.02)  # scan maxima run low
+
+    def can(e: Effector, c: Chain) -> bool:
+        return reaches(e, c) and refused(c) is None
 
     options = [enumerate_chains(e.motion, max_length)[e.motion] for e in effectors]
     cands = _candidates(effectors, options)
@@ -708,6 +725,11 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
     if first is not None:
         return first  # every tree tried collides: the cheapest, its failures reported
     for e, opts in zip(effectors, options):
+        if any(reaches(e, c) for c in opts) and not any(can(e, c) for c in opts):
+            why = next(refused(c) for c in opts if reaches(e, c))
+            raise InputError(f"effector {e.name!r} ({e.motion})", e.motion,
+                             f"a motion with a chain the toy assembly can build (every {e.motion} chain up to "
+                             f"{max_length} stages reaching {e.range:g} is refused, e.g. {why})")
         if not any(can(e, c) for c in opts):
             spans = [r for r in (reach(c) for c in opts) if r is not None]
             if spans:
