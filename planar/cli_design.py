@@ -59,11 +59,18 @@ def _cmd_design(args: argparse.Namespace) -> int:
                   f"{e['sized']['stage']}: {e['sized']['parameter']} = {e['sized']['value']:.6g}")
         n_layers = len(set(d.layers.values()))
         pl = d.placement
+        b = d.before
         if pl is not None and pl.variables:
-            print(f"  placement ({', '.join(pl.variables)}; {pl.evaluations} layouts annealed"
-                  + ("" if pl.kept else ", not kept: it added a collision, clash or layer") + "): footprint "
-                  f"{pl.footprint[0]:.3g} -> {pl.footprint[1]:.3g} units^2, overlap of unjoined pieces "
-                  f"{pl.overlap[0]:.3g} -> {pl.overlap[1]:.3g}")
+            print(f"  before placement: {b['layers']} layers, {b['collisions']} same-layer collisions, "
+                  f"{b['pin_clashes']} pins through pieces")
+            if pl.kept:
+                print(f"  placement ({', '.join(pl.variables)}; {pl.evaluations} layouts annealed, "
+                      f"{pl.checked} checked against the export): footprint {pl.footprint[0]:.3g} -> "
+                      f"{pl.footprint[1]:.3g} units^2, overlap of unjoined pieces {pl.overlap[0]:.3g} -> "
+                      f"{pl.overlap[1]:.3g}")
+            else:
+                print(f"  placement ({', '.join(pl.variables)}; {pl.evaluations} layouts annealed): none of the "
+                      f"{pl.checked} best kept (each added a collision, pin clash or layer, or none improved)")
         else:
             print("  placement: no stage of this tree can move without changing a motion")
         print(f"  {len(d.layers)} pieces in {n_layers} layers (the export's plan); same-layer collisions over 24 "

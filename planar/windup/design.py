@@ -107,6 +107,7 @@ class Design:
     layers_before: int | None = None  # layers of the toy before placement
     clashes: list[str] = field(default_factory=list)  # pins crossing a piece between their layers
     rejected: list[str] = field(default_factory=list)  # cheaper trees whose fabrication collided
+    before: dict[str, int] = field(default_factory=dict)  # layers, collisions, pin clashes before placement
 
     def report(self) -> dict[str, Any]:
         return {
@@ -125,12 +126,12 @@ class Design:
             "trees_sized": self.tried,
             "layers": self.layers,
             "layer_count": len(set(self.layers.values())),
-            "layer_count_before_placement": self.layers_before,
+            "before_placement": self.before,
             "placement": None if self.placement is None else {
                 "variables": self.placement.variables, "objective": list(self.placement.objective),
                 "footprint": list(self.placement.footprint), "overlap": list(self.placement.overlap),
                 "evaluations": self.placement.evaluations, "rejected": self.placement.rejected,
-                "kept": self.placement.kept},
+                "kept": self.placement.kept, "checked": self.placement.checked},
             "collisions": [{"a": a, "b": b, "overlap": ov} for a, b, ov in self.collisions],
             "pin_clashes": self.clashes,
             "rejected_trees": self.rejected,
@@ -459,10 +460,12 @@ def layer_collisions(toy: ToyMechanism, samples: int = 24, unit_mm: float = 100.
 #: the pivot of #9): ``F_o``'s in-plane components are the placement variables (checked again at run time)
 PLACEABLE = {1: "F_o", 9: "F_o"}
 #: annealing: iterations, step (model units), box around the default position (model units), overlap weight
-ANNEAL_STEPS = 30
+ANNEAL_STEPS = 24
 ANNEAL_STEP = 0.08
 ANNEAL_BOX = 0.4
 OVERLAP_WEIGHT = 10.0
+#: how many of the best annealed layouts are checked against the fabrication
+PLACEMENT_OPTIONS = 3
 #: a pin's radius in the placement's clash penalty (model units: 1.5 mm)
 PIN_RADIUS = 0.015
 
@@ -478,10 +481,11 @@ class Placement:
     evaluations: int
     rejected: int
     seconds: float
-    kept: bool = True  # False when the annealed placement added a collision, clash or layer (not used)
+    kept: bool = True  # False when no annealed layout passed the fabrication check (the start is kept)
+    checked: int = 0  # annealed layouts checked against the fabrication
 
 
-def _layout_score(toy: ToyMechanism, samples: int = 6) -> tuple[float, float]:
+def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
     """``(footprint, overlap)``: the convex hull area of every xy piece's swept region over one cycle, and the
     summed swept overlap of xy pieces no joint connects (pairs that must go on different layers); units^2."""
     import shapely
@@ -530,8 +534,14 @@ def _layout_score(toy: ToyMechanism, samples: int = 6) -> tuple[float, float]:
 
 
 def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, overrides: dict[tuple[str, Chain], dict[str, Any]],
-                 names: dict[tuple[str, Chain], str], seed: int = 0) -> tuple[dict[tuple[str, Chain], dict[str, Any]], Placement]:
+                 names: dict[tuple[str, Chain], str], seed: int = 0
+                 ) -> tuple[list[tuple[dict[tuple[str, Chain], dict[str, Any]], tuple[float, float, float]]], Placement]:
     """Anneal the placement variables (:data:`PLACEABLE`) to a compact toy whose pieces overlap little.
+
+    Returns the best ``PLACEMENT_OPTIONS`` distinct layouts the annealing
+    accepted that improve on the start (overrides and ``(objective,
+    footprint, overlap)``, best first) and what it did; the caller checks
+    them against the fabrication in turn.
 
     Objective: footprint + ``OVERLAP_WEIGHT`` x overlap (:func:`_layout_score`).
     A move that changes any stage's motion (compared on 181 samples to 1e-9)
@@ -589,11 +599,11 @@ def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, override
             x0[2 * i:2 * i + 2] = overrides[(cam, key)][pname][:2]
     f0, fp0, ov0, _ = score(x0)
     if not stages or not math.isfinite(f0):
-        return overrides, Placement([], (f0, f0), (fp0, fp0), (ov0, ov0), 1, 0, time.perf_counter() - t0)
+        return [], Placement([], (f0, f0), (fp0, fp0), (ov0, ov0), 1, 0, time.perf_counter() - t0, kept=False)
     rng = np.random.default_rng(seed)
     lo, hi = x0 - ANNEAL_BOX, x0 + ANNEAL_BOX
     x, fx = x0.copy(), f0
-    best = (f0, fp0, ov0, x0.copy())
+    states: list[tuple[float, float, float, Array]] = []  # accepted layouts better than the start
     temp0 = 0.05 * f0
     evals, rejected = 1, 0
     for k in range(ANNEAL_STEPS):
@@ -606,16 +616,19 @@ def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, override
             continue
         if fy <= fx or rng.random() < math.exp(-(fy - fx) / temp):
             x, fx = y, fy
-            if fy < best[0]:
-                best = (fy, fpy, ovy, y.copy())
-    out = {k: dict(v) for k, v in overrides.items()}
-    for i, (cam, key, pname, default) in enumerate(stages):
-        cur = list(out.get((cam, key), {}).get(pname, default))
-        cur[0], cur[1] = float(best[3][2 * i]), float(best[3][2 * i + 1])
-        out.setdefault((cam, key), {})[pname] = tuple(cur)
+            if fy < f0 and all(np.abs(y - st[3]).max() > 1e-9 for st in states):
+                states.append((fy, fpy, ovy, y.copy()))
     labels = [f"{cam} {' '.join(key)}: {pname}" for cam, key, pname, _ in stages]
-    return out, Placement(labels, (f0, best[0]), (fp0, best[1]), (ov0, best[2]), evals, rejected,
-                          time.perf_counter() - t0)
+    options = []
+    for f, fp, ov, xs in sorted(states, key=lambda t: t[0])[:PLACEMENT_OPTIONS]:
+        out = {k: dict(v) for k, v in overrides.items()}
+        for i, (cam, key, pname, default) in enumerate(stages):
+            cur = list(out.get((cam, key), {}).get(pname, default))
+            cur[0], cur[1] = float(xs[2 * i]), float(xs[2 * i + 1])
+            out.setdefault((cam, key), {})[pname] = tuple(cur)
+        options.append((out, (f, fp, ov)))
+    return options, Placement(labels, (f0, f0), (fp0, fp0), (ov0, ov0), evals, rejected,
+                              time.perf_counter() - t0, kept=False)
 
 
 # ----------------------------------------------------------------------------- the pipeline
@@ -690,19 +703,24 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
         placement = None
         checked = layer_collisions(toy)
         layers_before = len(set(checked[0].values()))
+        before = {"layers": layers_before, "collisions": len(checked[1]), "pin_clashes": len(checked[2])}
 
         def bad(c: tuple[dict[str, int], list, list]) -> tuple[int, int, int]:
             return len(c[1]), len(c[2]), len(set(c[0].values()))
         if place:
-            placed, placement = place_stages(cams, phase, name, overrides, names)
-            if placement.variables:
+            layouts, placement = place_stages(cams, phase, name, overrides, names)
+            for placed, (f, fp, ov) in layouts:
                 moved = ToyMechanism(cams, phase=phase, name=name, overrides=placed, names=names)
                 after = layer_collisions(moved)
-                # keep the placement only where it adds no collision, no pin clash and no layer
+                placement.checked += 1
+                # keep a placement only where it adds no collision, no pin clash and no layer
                 if bad(after) <= bad(checked):
                     toy, checked = moved, after
-                else:
-                    placement.kept = False
+                    placement.kept = True
+                    placement.objective = (placement.objective[0], f)
+                    placement.footprint = (placement.footprint[0], fp)
+                    placement.overlap = (placement.overlap[0], ov)
+                    break
         fabricated += 1
         measured = effector_ranges(toy)
         ranges = {}
@@ -712,7 +730,7 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
         layers, collisions, clashes = checked
         secs = {"enumerate": t_enum, "rank_and_size": t_size, "place_and_check": time.perf_counter() - t1}
         d = Design(toy, effectors, pairs, cost, ranges, len(cands), tried, sizing, layers, collisions, secs,
-                   placement, layers_before, clashes, rejected)
+                   placement, layers_before, clashes, rejected, before)
         if not collisions and not clashes:
             return d
         # a tree whose pieces collide or whose pins cross pieces: try the next cheapest (a few)
