@@ -464,8 +464,10 @@ ANNEAL_STEPS = 24
 ANNEAL_STEP = 0.08
 ANNEAL_BOX = 0.4
 OVERLAP_WEIGHT = 10.0
+#: outline simplification in the placement objective (model units)
+SIMPLIFY = 0.003
 #: how many of the best annealed layouts are checked against the fabrication
-PLACEMENT_OPTIONS = 3
+PLACEMENT_OPTIONS = 2
 #: a pin's radius in the placement's clash penalty (model units: 1.5 mm)
 PIN_RADIUS = 0.015
 
@@ -504,8 +506,9 @@ def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
             continue
         pose = np.asarray(m.poses[p.name])
         c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
-        swept[p.name] = shapely.union_all([affinity.affine_transform(p.outline, [c[k], -s[k], s[k], c[k],
-                                                                                pose[k, 0], pose[k, 1]])
+        shape = p.outline.simplify(SIMPLIFY)  # 0.3 mm: the objective need not follow every facet of a cam
+        swept[p.name] = shapely.union_all([affinity.affine_transform(shape, [c[k], -s[k], s[k], c[k],
+                                                                            pose[k, 0], pose[k, 1]])
                                            for k in range(len(pose))])
     footprint = float(shapely.union_all(list(swept.values())).convex_hull.area)
     overlap = 0.0
