@@ -671,6 +671,13 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
     def can(e: Effector, c: Chain) -> bool:
         return reaches(e, c) and refused(c) is None
 
+    phases = sorted({round(e.phase % 1.0, 12) for e in effectors})
+    if len(phases) > 2:
+        raise InputError("effector phases", phases, "at most two distinct phases (one per cam)")
+    for cam in CAMS:
+        on = sorted({round(e.phase % 1.0, 12) for e in effectors if e.cam == cam})
+        if len(on) > 1:
+            raise InputError(f"effector phases on the {cam} cam", on, "one phase per cam")
     options = [enumerate_chains(e.motion, max_length)[e.motion] for e in effectors]
     cands = _candidates(effectors, options)
     t_enum = time.perf_counter() - t0
