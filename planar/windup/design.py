@@ -165,8 +165,8 @@ def load_request(path: str | Path) -> list[Effector]:
         if bad:
             raise InputError(f"{where}.{bad[0]}", r[bad[0]], "one of name, motion, range, cam, phase")
         name = r.get("name")
-        if not isinstance(name, str) or not name.strip() or "." in name or ":" in name:
-            raise InputError(f"{where}.name", name, "a name without '.' or ':' (the effector's point)")
+        if not isinstance(name, str) or not name.strip() or any(c in name for c in ".:+") or name == "frame":
+            raise InputError(f"{where}.name", name, "a name without '.', ':' or '+', not 'frame' (the effector's piece)")
         motion = r.get("motion")
         if motion not in MOTION_TYPES:
             raise InputError(f"{where}.motion", motion, f"one of {', '.join(MOTION_TYPES)}")
@@ -397,7 +397,7 @@ def effector_ranges(toy: ToyMechanism, samples: int = SAMPLES) -> dict[str, tupl
     out = {}
     for (_cam, chain), name in toy.names.items():
         motion = chain[-1].split("->")[1]
-        piece, _ = asm.points[name]
+        piece = name if any(p.name == name for p in asm.parts) else asm.points[name][0]
         pose = np.asarray(m.poses[piece])
         plane = next(p.plane for p in asm.parts if p.name == piece)
         if motion[0] == "O":
