@@ -153,6 +153,8 @@ def test_a_request_no_gallery_scene_has(tmp_path: Path, capsys) -> None:
     _check(out, rows)
     toy = load_scene(out).mechanism
     assert toy.phase == pytest.approx(math.pi / 2)
+    # each effector's follower is a piece of its own here: the piece takes the effector's name
+    assert {"tail", "head"} <= {p.name for p in toy_assembly(toy).parts}
     # the named effectors are points of the scene's motion: the tail's point moves 0.3 along x
     m = load_scene(out).motion()
     assert float(np.ptp(m.points["tail"][:, 0])) == pytest.approx(0.3, rel=0.01)
