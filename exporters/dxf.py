@@ -23,7 +23,7 @@ from collections.abc import Iterator
 from typing import Any
 
 from planar.fabrication import Circle, Layout
-from planar.fileio import atomic_write
+from planar.fileio import atomic_write, check_name
 
 __all__ = ["LAYERS", "aci", "dxf_bytes", "preview_png", "write_dxf"]
 
@@ -92,7 +92,7 @@ def build_document(layout: Layout, sheet: int = 0, settings: Any = None, note: s
         ents.append(add(part.outer, "CUT_OUTER"))
         for stroke in part.engrave:
             ents.append(msp.add_lwpolyline([(float(x), float(y)) for x, y in stroke], dxfattribs={"layer": "ENGRAVE"}))
-        group = doc.groups.new(part.name.replace(" ", "_"))
+        group = doc.groups.new(check_name("part name", part.name).replace(" ", "_"))
         group.extend(ents)
     return doc
 

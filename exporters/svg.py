@@ -24,7 +24,7 @@ from typing import Any
 from xml.sax.saxutils import escape
 
 from planar.fabrication import Circle, Contour, Layout
-from planar.fileio import atomic_write
+from planar.fileio import atomic_write, check_name
 
 __all__ = ["assembly_svg_text", "svg_text", "write_svg"]
 
@@ -146,6 +146,7 @@ def assembly_svg_text(fab: Any) -> str:
            f'font-family="sans-serif">',
            f'<rect x="0" y="0" width="{_f(W)}" height="{_f(H)}" fill="#ffffff"/>']
     for layer, name, g in shapes:
+        check_name("part name", name)
         geoms = getattr(g, "geoms", [g])
         d = []
         for poly in geoms:

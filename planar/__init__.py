@@ -4,11 +4,11 @@
 are imported by the modules that use them.
 """
 
-from .errors import AssemblyError, InputError, PlanarError, SceneError
+from .errors import AssemblyError, InputError, LimitError, PlanarError, SceneError
 from .model import Driver, Mechanism, Motion, Part, joint_residuals
 
 __all__ = [
-    "AssemblyError", "InputError", "PlanarError", "SceneError",
+    "AssemblyError", "InputError", "LimitError", "PlanarError", "SceneError",
     "Driver", "Mechanism", "Motion", "Part", "joint_residuals",
 ]
 __version__ = "0.1.0"

@@ -20,13 +20,16 @@ Corrections to the notes (verified in ``tests/test_analysis.py``):
 
 Power (notes eq. 5): with ``F_i`` the force the mechanism exerts on its load
 at point ``i`` (so ``F . V > 0`` is work done on the load) and the motor
-turning at ``w``, ``tau w eta_trans eta_link = sum_i F_i . V_i``.  Angles in
-radians, angular speeds in rad/s, torques in force x model-unit.
+turning at ``w``, ``tau w eta_trans eta_link = sum_i F_i . V_i`` where the
+motor drives the load; where the load drives the motor (regenerative, power
+flowing back) the losses reduce what reaches the motor:
+``tau w = eta_trans eta_link sum_i F_i . V_i``.  Angles in radians, angular
+speeds in rad/s, torques in force x model-unit.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -38,6 +41,7 @@ if TYPE_CHECKING:
     from .linkages.fourbar import FourBar
 
 __all__ = [
+    "TOGGLE_SINE",
     "fourbar_velocities",
     "fourbar_accelerations",
     "node_velocities",
@@ -72,30 +76,43 @@ def _perp(v: Array) -> Array:
 # --------------------------------------------------------------------------
 
 
+#: the one validity rule of the four-bar's velocity analysis: a sample is valid where the linkage
+#: assembles, the coupler and rocker are not within this sine of being in line (a toggle, where the
+#: velocities grow without bound) and every number is finite
+TOGGLE_SINE = 1e-6
+
+
 def fourbar_velocities(
     fb: "FourBar", theta: ArrayLike, omega2: ArrayLike = 1.0
 ) -> tuple[Array, Array, NDArray[np.bool_]]:
     """Coupler and rocker angular velocities ``(omega3, omega4, valid)``.
 
     Notes eqs. (6)-(7), corrected (no ``r_1`` term), solved per sample with
-    ``numpy.linalg.solve`` on an ``(N, 2, 2)`` stack.  ``valid`` is false
-    where the system is singular (coupler and rocker in line: a toggle).
+    ``numpy.linalg.solve`` on an ``(N, 2, 2)`` stack, in units of the crank
+    (scale-free: lengths divided by the crank).  ``valid`` is false where
+    the linkage does not assemble, within :data:`TOGGLE_SINE` of a toggle
+    (coupler and rocker in line) or where a result is not finite; invalid
+    samples hold 0.
     """
     th2 = np.atleast_1d(np.asarray(theta, float))
     w2 = np.broadcast_to(np.asarray(omega2, float), th2.shape)
     th3, th4, ok = fb.angles(th2)
     g = fb.dims
+    b, c = g.b / g.a, g.c / g.a  # scale-free: lengths in crank lengths
     m = np.empty(th2.shape + (2, 2))
-    m[..., 0, 0] = -g.b * np.sin(th3)
-    m[..., 0, 1] = g.c * np.sin(th4)
-    m[..., 1, 0] = g.b * np.cos(th3)
-    m[..., 1, 1] = -g.c * np.cos(th4)
-    rhs = np.stack([g.a * np.sin(th2) * w2, -g.a * np.cos(th2) * w2], axis=-1)
-    det = m[..., 0, 0] * m[..., 1, 1] - m[..., 0, 1] * m[..., 1, 0]
-    sing = np.abs(det) <= 1e-12 * g.b * g.c
+    m[..., 0, 0] = -b * np.sin(th3)
+    m[..., 0, 1] = c * np.sin(th4)
+    m[..., 1, 0] = b * np.cos(th3)
+    m[..., 1, 1] = -c * np.cos(th4)
+    rhs = np.stack([np.sin(th2) * w2, -np.cos(th2) * w2], axis=-1)
+    det = m[..., 0, 0] * m[..., 1, 1] - m[..., 0, 1] * m[..., 1, 0]  # = b c sin(th4 - th3)
+    sing = ~(np.abs(det) > TOGGLE_SINE * b * c)
     m[sing] = np.eye(2)
     sol = np.linalg.solve(m, rhs[..., None])[..., 0]
-    return sol[..., 0], sol[..., 1], ok & ~sing
+    valid = ok & ~sing & np.isfinite(sol).all(-1) & np.isfinite(w2)
+    w3 = np.where(valid, sol[..., 0], 0.0)
+    w4 = np.where(valid, sol[..., 1], 0.0)
+    return w3, w4, valid
 
 
 def fourbar_accelerations(
@@ -144,11 +161,44 @@ def node_velocities(
     * Rigid: ``vP = vA + omega perp(P - A)`` with the frame's ``omega``.
 
     With ``qdot = 1`` the results are velocity coefficients ``dX/dq``.
-    ``valid`` is false where a system is singular (a toggle) or the
-    position does not close.  Velocities are in the linkage's own frame
-    before placement; rotate them by ``placement[2]`` for the world.
+    ``valid`` is false where the position does not close, within
+    :data:`TOGGLE_SINE` of a dyad's toggle (the rule of
+    :func:`fourbar_velocities`) or where a velocity is not finite; invalid
+    samples hold 0.  Velocities are in the linkage's own frame before
+    placement; rotate them by ``placement[2]`` for the world.
     """
-    return link.node_velocities(q, qdot)
+    vel, valid = link.node_velocities(q, qdot)
+    ok = np.asarray(valid, bool) & _dyad_mask(link, q)
+    for v in vel.values():
+        ok &= np.isfinite(v).all(-1)
+    return {k: np.where(ok[:, None], v, 0.0) for k, v in vel.items()}, ok
+
+
+def _dyad_mask(link: "Linkage", q: ArrayLike) -> NDArray[np.bool_]:
+    """The one validity rule for a linkage's velocities: no dyad within :data:`TOGGLE_SINE` of its toggle.
+
+    An RRR node ``P`` (links from ``A`` and ``B``) toggles where ``P - A`` and ``P - B`` fall into
+    line; an RRP node where its rod ``P - A`` stands square to the slide line ``p -> q``.  Scale-free:
+    sines of angles, not lengths.
+    """
+    qa = np.atleast_1d(np.asarray(q, float))
+    pos, _ = link.solve_nodes(qa)
+    ok = np.ones(qa.shape[0], bool)
+
+    def unit(v: Array) -> Array:
+        n = np.hypot(v[:, 0], v[:, 1])
+        return v / np.where(n > 0, n, 1.0)[:, None]
+
+    P: dict[str, Array] = {k: np.asarray(v, float) for k, v in pos.items()}
+    for node in link.nodes:
+        nd: Any = node  # an RRR carries a and b, an RRP a, p and q
+        if nd.kind == "rrr":
+            u, w = unit(P[nd.name] - P[nd.a]), unit(P[nd.name] - P[nd.b])
+            ok &= np.abs(_cross(u, w)) > TOGGLE_SINE
+        elif nd.kind == "rrp":
+            u, w = unit(P[nd.name] - P[nd.a]), unit(P[nd.q] - P[nd.p])
+            ok &= np.abs((u * w).sum(-1)) > TOGGLE_SINE
+    return ok
 
 
 def point_velocities(
@@ -214,7 +264,11 @@ def velocity_about_centre(point: ArrayLike, centre: ArrayLike, omega: ArrayLike)
 def fourbar_instant_centre(fb: "FourBar", theta: ArrayLike, omega2: float = 1.0) -> tuple[Array, Array, NDArray[np.bool_]]:
     """The coupler's instant centre (intersection of lines O2-B and O4-C) and its omega.
 
-    Graphical method of notes 2.1.1, in the linkage's own frame.
+    Graphical method of notes 2.1.1, in the linkage's own frame.  ``valid``
+    follows :func:`fourbar_velocities`' rule (assembled, not at a toggle,
+    finite) and is also false where the two lines are parallel (the coupler
+    translates: ``omega = 0``, centre at infinity).  ``omega`` is 0 where
+    invalid.
     """
     th = np.atleast_1d(np.asarray(theta, float))
     pos, _ = fb.solve_nodes(th)
@@ -222,9 +276,11 @@ def fourbar_instant_centre(fb: "FourBar", theta: ArrayLike, omega2: float = 1.0)
     vB = omega2 * _perp(B - O2)
     vC_dir = _perp(C - O4)  # direction only; the magnitude is unknown
     centre, _, ok = instant_centre(B, vB, C, vC_dir)
+    _, _, vok = fourbar_velocities(fb, th, omega2)
     r = B - centre
     omega = _cross(r, vB) / np.maximum((r * r).sum(-1), np.finfo(float).tiny)
-    return centre, np.where(ok, omega, 0.0), ok
+    valid = ok & vok & np.isfinite(centre).all(-1) & np.isfinite(omega)
+    return np.where(valid[..., None], centre, 0.0), np.where(valid, omega, 0.0), valid
 
 
 def world_velocity(v_relative: ArrayLike, v_frame: ArrayLike, omega_frame: ArrayLike = 0.0,
@@ -246,7 +302,11 @@ def world_velocity(v_relative: ArrayLike, v_frame: ArrayLike, omega_frame: Array
 
 
 def _check_eff(name: str, eta: float) -> float:
-    if not (0.0 < float(eta) <= 1.0):
+    try:
+        e = float(eta)
+    except (TypeError, ValueError):
+        raise InputError(name, eta, "an efficiency in (0, 1]") from None
+    if not (0.0 < e <= 1.0):
         raise InputError(name, eta, "an efficiency in (0, 1]")
     return float(eta)
 
@@ -258,29 +318,70 @@ def input_torque(
 
     ``coefficients`` ``(N, k, 2)`` holds ``dX_i/dq`` for ``k`` load points;
     ``forces`` ``(N, k, 2)`` or ``(k, 2)`` the forces the mechanism exerts on
-    them.  ``tau = sum_i F_i . dX_i/dq / (eta_trans eta_link)``, so that
-    ``tau * w * eta = sum F . V`` on every sample.
+    them.  With ``P = sum_i F_i . dX_i/dq`` (the power per unit input speed
+    the loads take):
+
+    * ``P >= 0`` (the motor drives the load): ``tau = P / (eta_trans eta_link)``,
+      the motor supplies the losses too;
+    * ``P < 0`` (regenerative: the load drives the motor, as a foot pushed
+      back): ``tau = P eta_trans eta_link``, the losses eat into what reaches
+      the motor, so it is held back by less than the lossless ``P``.
+
+    Efficiencies in ``(0, 1]``; non-finite coefficients or forces raise
+    :class:`InputError`.
     """
     eta = _check_eff("eta_trans", eta_trans) * _check_eff("eta_link", eta_link)
     c = np.asarray(coefficients, float)
-    f = np.broadcast_to(np.asarray(forces, float), c.shape)
-    return (c * f).sum(axis=(-1, -2)) / eta
+    f = np.asarray(forces, float)
+    if not np.isfinite(f).all():
+        raise InputError("forces", f, "finite forces")
+    if c.ndim != 3 or c.shape[-1] != 2:
+        raise InputError("coefficients", f"an array of shape {c.shape}", "shape (N, k, 2)")
+    try:
+        f = np.broadcast_to(f, c.shape)
+    except ValueError:
+        raise InputError("forces", f"an array of shape {f.shape}", f"shape (k, 2) or (N, k, 2) with {c.shape}") from None
+    p = (c * f).sum(axis=(-1, -2))
+    return np.where(p >= 0, p / eta, p * eta)
 
 
 def virtual_work_torque(
-    points: ArrayLike, q: ArrayLike, forces: ArrayLike, periodic: bool = True
-) -> Array:
-    """Torque by virtual work (notes eqs. 12-13): ``tau dq = sum_i F_i . dX_i``.
+    points: ArrayLike, q: ArrayLike, forces: ArrayLike, periodic: bool = True,
+    valid: ArrayLike | None = None,
+) -> tuple[Array, NDArray[np.bool_]]:
+    """Torque by virtual work (notes eqs. 12-13): ``tau dq = sum_i F_i . dX_i``; returns ``(tau, valid)``.
 
     ``points`` ``(N, k, 2)`` sampled at evenly spaced driver values ``q``;
     displacements by central differences (``O(dq^2)``).  Ideal (no losses).
+    ``valid`` (the motion's mask, default all) marks usable samples; a
+    torque is valid where its sample and both neighbours of the difference
+    are valid and it is finite (0 where not).
     """
     P = np.asarray(points, float)
     qa = np.asarray(q, float)
+    if P.ndim != 3 or P.shape[-1] != 2 or qa.shape != P.shape[:1] or len(qa) < 3:
+        raise InputError("points, q", f"arrays of shapes {P.shape}, {qa.shape}",
+                         "points (N, k, 2) and q (N,) with N >= 3")
+    f = np.asarray(forces, float)
+    if not np.isfinite(f).all():
+        raise InputError("forces", f, "finite forces")
     dq = float(qa[1] - qa[0])
+    if not (np.isfinite(dq) and dq != 0):
+        raise InputError("q", qa, "evenly spaced, distinct driver values")
     dX = finite_difference(P, dq, periodic)
-    f = np.broadcast_to(np.asarray(forces, float), P.shape)
-    return (dX * f).sum(axis=(-1, -2))
+    f = np.broadcast_to(f, P.shape)
+    tau = (dX * f).sum(axis=(-1, -2))
+    ok = np.ones(len(qa), bool) if valid is None else np.asarray(valid, bool).copy()
+    ok &= np.isfinite(P).all(axis=(-1, -2))
+    if periodic:
+        near = ok & np.roll(ok, 1) & np.roll(ok, -1)
+    else:
+        near = ok.copy()
+        near[1:-1] &= ok[:-2] & ok[2:]
+        near[0] &= ok[1] & ok[2]
+        near[-1] &= ok[-2] & ok[-3]
+    near &= np.isfinite(tau)
+    return np.where(near, tau, 0.0), near
 
 
 def motor_torque(
@@ -290,17 +391,33 @@ def motor_torque(
     """Input torque a linkage needs for forces at its named points (several feet, one motor).
 
     ``loads`` maps a named point to the force ``(2,)`` or ``(N, 2)`` the
-    mechanism exerts there (world frame).  Returns ``(tau, valid)``.
+    mechanism exerts there (world frame).  Returns ``(tau, valid)``; losses
+    as :func:`input_torque` (divided by the efficiency where the motor
+    drives, multiplied where the load drives the motor).  ``valid`` is the
+    velocity analysis' mask and false where the torque is not finite.
     """
     vel, valid = point_velocities(link, q, 1.0)
     for name in loads:
         if name not in vel:
             raise InputError(f"{link.name}.loads", name, f"a named point, one of {sorted(vel)}")
     names = list(loads)
-    coeff = np.stack([vel[n] for n in names], axis=1)
     qa = np.atleast_1d(np.asarray(q, float))
-    forces = np.stack([np.broadcast_to(np.asarray(loads[n], float), qa.shape + (2,)) for n in names], axis=1)
-    return input_torque(coeff, forces, eta_trans, eta_link), valid
+    forces = []
+    for n in names:
+        f = np.asarray(loads[n], float)
+        if not np.isfinite(f).all():
+            raise InputError(f"{link.name}.loads[{n!r}]", loads[n], "a finite force (x, y)")
+        try:
+            forces.append(np.broadcast_to(f, qa.shape + (2,)))
+        except ValueError:
+            raise InputError(f"{link.name}.loads[{n!r}]", f"an array of shape {f.shape}",
+                             f"a force of shape (2,) or ({len(qa)}, 2)") from None
+    if not names:
+        return np.zeros(qa.shape), np.asarray(valid, bool)
+    coeff = np.stack([vel[n] for n in names], axis=1)
+    tau = input_torque(coeff, np.stack(forces, axis=1), eta_trans, eta_link)
+    ok = np.asarray(valid, bool) & np.isfinite(tau)
+    return np.where(ok, tau, 0.0), ok
 
 
 # --------------------------------------------------------------------------

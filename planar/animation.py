@@ -34,6 +34,8 @@ __all__ = ["FramePlan", "plan_frames", "scene_duration", "animation_motion", "re
 DEFAULT_DELAY_MS = 40
 #: at least this many frames per cycle before the default falls back to 20 ms frames (50 per second)
 MIN_FRAMES_PER_CYCLE = 12
+#: fewest frames of one cycle (an explicit --fps giving fewer is refused; a cycle too fast for a GIF plays slower)
+MIN_FRAMES_ASKED = 4
 #: an animation longer than this many frames is refused before anything is drawn
 MAX_FRAMES = 20_000
 
@@ -64,6 +66,19 @@ class FramePlan:
         """How long one cycle plays, seconds."""
         return self.frames_per_cycle * self.delay_ms / 1000.0
 
+    @property
+    def slowdown(self) -> float:
+        """How much slower than the scene's speed the animation plays (1: at speed)."""
+        return self.cycle_play_s / self.period_s
+
+    def note(self) -> str:
+        """A one-line note when a cycle plays more than one frame delay away from its period, else ``""``."""
+        if abs(self.cycle_play_s - self.period_s) <= self.delay_ms / 1000.0:
+            return ""
+        return (f"a cycle of {self.period_s:.3g} s plays in {self.cycle_play_s:.3g} s ({self.slowdown:.3g}x slower: "
+                f"{self.frames_per_cycle} frames of {self.delay_ms:g} ms, the fewest that show the motion at the "
+                "fastest rate a GIF plays; an .mp4 plays it at speed)")
+
     def times(self) -> np.ndarray:
         """The motion time (s) of each frame."""
         return np.arange(self.frames, dtype=np.float64) * (self.period_s / self.frames_per_cycle)
@@ -75,9 +90,11 @@ def plan_frames(period_s: float, duration_s: float, fps: float | None = None, ti
     ``fps``: frames per second asked for; the delay is ``1000 / fps`` rounded
     to a whole number of ``tick_ms`` (GIF: 10 ms, at least 20 ms, so at most
     50 frames per second; ``tick_ms=None``: video, any rate).  By default
-    25 frames per second, or 50 when a cycle would otherwise get fewer than
-    12 frames.  Raises :class:`InputError` for a rate a GIF cannot play or
-    more than :data:`MAX_FRAMES` frames.
+    25 frames per second, or 50 (video: 12 frames a cycle) when a cycle would
+    otherwise get fewer than 12 frames; a cycle gets at least 4 frames, so a
+    cycle faster than 80 ms plays slower in a GIF (:meth:`FramePlan.note`).
+    Raises :class:`InputError` for a rate a GIF cannot play, an ``fps`` that
+    gives fewer than 4 frames a cycle, or more than :data:`MAX_FRAMES` frames.
     """
     if not (math.isfinite(period_s) and period_s > 0):
         raise InputError("speed", period_s, "a finite, positive speed (cycles per second)")
@@ -92,16 +109,21 @@ def plan_frames(period_s: float, duration_s: float, fps: float | None = None, ti
             if fps > 50 or delay < 20:
                 raise InputError("--fps", fps, "at most 50 frames per second in a GIF (browsers slow shorter "
                                                "frame delays than 20 ms)")
+        if period_s * 1000.0 / delay < MIN_FRAMES_ASKED:
+            raise InputError("--fps", fps, f"at least {MIN_FRAMES_ASKED} frames per cycle: {MIN_FRAMES_ASKED / period_s:.3g} "
+                                           f"frames per second or more for a cycle of {period_s:.3g} s")
     else:
         delay = float(DEFAULT_DELAY_MS)
         if 1000.0 * period_s / delay < MIN_FRAMES_PER_CYCLE:
-            delay = 20.0
-    per_cycle = max(2, int(round(1000.0 * period_s / delay)))
+            delay = 20.0 if tick_ms is not None else 1000.0 * period_s / MIN_FRAMES_PER_CYCLE
+    per_cycle = max(MIN_FRAMES_ASKED, int(round(1000.0 * period_s / delay)))
     frames = max(1, int(round(per_cycle * duration_s / period_s)))
-    if frames > MAX_FRAMES:
-        raise InputError("duration", duration_s, f"an animation of at most {MAX_FRAMES} frames ({frames} asked for at "
-                                                 f"{1000.0 / delay:.3g} frames per second; shorten the duration or "
-                                                 "lower --fps)")
+    from .limits import limit
+
+    if frames > limit("frames"):  # MAX_FRAMES unless PLANAR_MAX_FRAMES raises it
+        raise InputError("duration", duration_s, f"an animation of at most {limit('frames')} frames ({frames} asked "
+                                                 f"for at {1000.0 / delay:.3g} frames per second; shorten the duration, "
+                                                 "lower --fps or raise PLANAR_MAX_FRAMES)")
     return FramePlan(float(period_s), float(delay), per_cycle, frames)
 
 

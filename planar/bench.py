@@ -332,6 +332,62 @@ ACCURACY_GRID = {
 
 #: ``planar bench accuracy --quick``
 ACCURACY_QUICK_GRID = {"substeps": (8, 32), "iterations": (10, 40), "correction": (0.05, 0.2)}
+#: the scenes ``--quick`` measures first, when the folder has them (else its first three that simulate)
+ACCURACY_QUICK_SCENES = ("kangaroo-leg", "slider-crank", "jansen-leg")
+
+#: adaptive settings measured beside the fixed grid: (least substeps, step drift), 40 iterations, correction 0.2;
+#: each a factor 2 in step from the next (the drift per step goes as the step squared)
+ACCURACY_ADAPTIVE = ((16, 1.4e-5), (32, 3.5e-6), (64, 8.75e-7))
+
+
+def _setting_key(st: Any) -> tuple[Any, ...]:
+    return (st.substeps, st.iterations, st.correction, st.error_bias, st.step_drift)
+
+
+def _setting_label(st: Any) -> str:
+    """``32/40/0.2`` for fixed substeps, ``32+/40/0.2 drift 3.5e-06`` for adaptive ones, error bias if given."""
+    corr = f"bias {st.error_bias:g}" if st.error_bias is not None else f"{st.correction:g}"
+    if st.step_drift is None:
+        return f"{st.substeps}/{st.iterations}/{corr}"
+    return f"{st.substeps}+/{st.iterations}/{corr} drift {st.step_drift:g}"
+
+
+def accuracy_settings(quick: bool = False, grid: Mapping[str, Sequence[float]] | None = None) -> list[Any]:
+    """The settings ``bench accuracy`` measures: the grid with fixed substeps, adaptive ones, the defaults
+    and the defaults before issue 12 (64 substeps, 20 iterations, error bias 1e-9 per second)."""
+    from dataclasses import replace
+
+    from .simulate import DEFAULT_SETTINGS, SimSettings
+
+    if grid is None:
+        grid = ACCURACY_QUICK_GRID if quick else ACCURACY_GRID
+    out = [SimSettings(substeps=int(s), iterations=int(i), correction=float(b), tolerance=1.0, step_drift=None)
+           for s in grid["substeps"] for i in grid["iterations"] for b in grid["correction"]]
+    extra = [replace(DEFAULT_SETTINGS, tolerance=1.0)]
+    if not quick:
+        extra += [SimSettings(substeps=k, iterations=40, correction=0.2, step_drift=d, tolerance=1.0)
+                  for k, d in ACCURACY_ADAPTIVE]
+        extra.append(_previous_defaults())
+    keys = {_setting_key(x) for x in out}
+    for x in extra:
+        if _setting_key(x) not in keys:
+            out.append(x)
+            keys.add(_setting_key(x))
+    return out
+
+
+def _machine() -> str:
+    """The machine a benchmark ran on: architecture, processor, cores, Python."""
+    import platform
+
+    return (f"{platform.machine()} {platform.processor() or ''} {os.cpu_count()} cores, "
+            f"Python {platform.python_version()}").replace("  ", " ")
+
+
+def _previous_defaults() -> Any:
+    from .simulate import SimSettings
+
+    return SimSettings(substeps=64, iterations=20, error_bias=1e-9, tolerance=1.0, step_drift=None)
 
 
 def _pareto(points: list[tuple[float, float]]) -> list[bool]:
@@ -359,7 +415,7 @@ def bench_accuracy(scenes: str | os.PathLike, out_dir: str = "planar-bench-accur
     ``repeats``).  Settings are ranked on the aggregate (worst error over the
     mechanisms, total time); the Pareto frontier is marked.  Writes
     ``accuracy.csv`` and ``accuracy.png`` in ``out_dir``.  ``quick``: the
-    grid :data:`ACCURACY_QUICK_GRID` on the first three scenes; ``grid``
+    grid :data:`ACCURACY_QUICK_GRID` on three scenes (:data:`ACCURACY_QUICK_SCENES` first); ``grid``
     replaces the grid (keys as :data:`ACCURACY_GRID`).  The default settings
     are always measured.  The cost of effects (``effects_cost``) is measured
     over the first ``effects_fraction`` of a four-bar's cycle.
@@ -377,13 +433,12 @@ def bench_accuracy(scenes: str | os.PathLike, out_dir: str = "planar-bench-accur
     from .simulate import DEFAULT_SETTINGS, SimSettings, SimulationError, simulate, torque_comparison
 
     scene_files = gallery_scenes(scenes)  # checks the folder before any work
-    if grid is None:
-        grid = ACCURACY_QUICK_GRID if quick else ACCURACY_GRID
-    settings = [SimSettings(substeps=int(s), iterations=int(i), correction=float(b), tolerance=1.0)
-                for s in grid["substeps"] for i in grid["iterations"] for b in grid["correction"]]
+    if quick:  # the quick run's three: a four-bar, a slider-crank and the Jansen leg when the folder has them
+        scene_files.sort(key=lambda p: (ACCURACY_QUICK_SCENES.index(p.stem) if p.stem in ACCURACY_QUICK_SCENES
+                                        else len(ACCURACY_QUICK_SCENES), p.name))
+    settings = accuracy_settings(quick, grid)
     d = replace(DEFAULT_SETTINGS, tolerance=1.0)
-    if all((x.substeps, x.iterations, x.correction) != (d.substeps, d.iterations, d.correction) for x in settings):
-        settings.append(d)
+    prev = _previous_defaults()
     measured: list["Scene"] = []
     skipped: dict[str, str] = {}
     for path in scene_files:
@@ -424,8 +479,11 @@ def bench_accuracy(scenes: str | os.PathLike, out_dir: str = "planar-bench-accur
                     torque_err = tc["max_rel_diff"] if tc["failure"] is None else math.inf
                 except PlanarError:
                     motor_ok = False
-            rows.append({"mechanism": sc.name, "substeps": st.substeps, "iterations": st.iterations,
-                         "correction": st.correction, "dt_s": sim_seconds / (len(ref) - 1) / st.substeps,
+            rows.append({"mechanism": sc.name, "setting": _setting_label(st), "substeps": sim.built["substeps"],
+                         "iterations": sim.built["iterations"], "correction": st.correction,
+                         "step_drift": "" if st.step_drift is None else st.step_drift,
+                         "error_bias": "" if st.error_bias is None else st.error_bias,
+                         "dt_s": sim_seconds / (len(ref) - 1) / sim.built["substeps"],
                          "error": err, "motor_error": motor_err, "torque_error": torque_err,
                          "seconds_per_sim_second": best / sim_seconds})
             if bar is not None:
@@ -439,39 +497,44 @@ def bench_accuracy(scenes: str | os.PathLike, out_dir: str = "planar-bench-accur
 
     agg = []
     for st in settings:
-        rs = [r for r in rows if (r["substeps"], r["iterations"], r["correction"]) ==
-              (st.substeps, st.iterations, st.correction)]
-        agg.append({"substeps": st.substeps, "iterations": st.iterations, "correction": st.correction,
+        rs = [r for r in rows if r["setting"] == _setting_label(st)]
+        agg.append({"setting": _setting_label(st), "substeps": st.substeps, "iterations": st.iterations,
+                    "correction": st.correction, "step_drift": st.step_drift, "error_bias": st.error_bias,
                     "max_error": max(worst(rs, "error"), worst(rs, "motor_error")),
                     "kinematic_error": worst(rs, "error"), "motor_error": worst(rs, "motor_error"),
                     "torque_error": worst(rs, "torque_error"),
                     "seconds_per_sim_second": sum(r["seconds_per_sim_second"] for r in rs)})
     front = _pareto([(a["seconds_per_sim_second"], a["max_error"]) for a in agg])
     for a, f in zip(agg, front):
-        a["frontier"] = f
-        a["default"] = (a["substeps"], a["iterations"], a["correction"]) == (d.substeps, d.iterations, d.correction)
+        a["frontier"] = f and math.isfinite(a["max_error"])  # a setting that fails somewhere is no choice
+        a["default"] = a["setting"] == _setting_label(d)
+        a["previous_default"] = a["setting"] == _setting_label(prev)
     for sc_name in {r["mechanism"] for r in rows}:
         rs = [r for r in rows if r["mechanism"] == sc_name]
         for r, f in zip(rs, _pareto([(r["seconds_per_sim_second"], r["error"]) for r in rs])):
             r["frontier"] = f
     default = next(a for a in agg if a["default"])
     effects_cost = _effects_cost(repeats=max(3, repeats), fraction=effects_fraction)
-    per_mech_default = {r["mechanism"]: {"kinematic": r["error"], "motor": r["motor_error"], "torque": r["torque_error"]}
-                        for r in rows
-                        if (r["substeps"], r["iterations"], r["correction"]) == (d.substeps, d.iterations, d.correction)}
+    per_mech_default = {r["mechanism"]: {"kinematic": r["error"], "motor": r["motor_error"], "torque": r["torque_error"],
+                                         "substeps": r["substeps"]}
+                        for r in rows if r["setting"] == _setting_label(d)}
+    previous = next((a for a in agg if a["previous_default"]), None)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     from .fileio import atomic_write
 
     with atomic_write(out / "accuracy.csv", "w") as fh:
-        w = csv.DictWriter(fh, fieldnames=["mechanism", "substeps", "iterations", "correction", "dt_s", "error",
-                                           "motor_error", "torque_error", "seconds_per_sim_second", "frontier"])
+        w = csv.DictWriter(fh, fieldnames=["mechanism", "setting", "substeps", "iterations", "correction",
+                                           "step_drift", "error_bias", "dt_s", "error", "motor_error",
+                                           "torque_error", "seconds_per_sim_second", "frontier"], lineterminator="\n")
         w.writeheader()
         for r in rows:
             w.writerow(r)
         for a in agg:
-            w.writerow({"mechanism": "ALL (worst error, total time)", "substeps": a["substeps"],
-                        "iterations": a["iterations"], "correction": a["correction"], "dt_s": "",
+            w.writerow({"mechanism": "ALL (worst error, total time)", "setting": a["setting"],
+                        "substeps": a["substeps"], "iterations": a["iterations"], "correction": a["correction"],
+                        "step_drift": "" if a["step_drift"] is None else a["step_drift"],
+                        "error_bias": "" if a["error_bias"] is None else a["error_bias"], "dt_s": "",
                         "error": a["kinematic_error"], "motor_error": a["motor_error"],
                         "torque_error": a["torque_error"], "seconds_per_sim_second": a["seconds_per_sim_second"],
                         "frontier": a["frontier"]})
@@ -484,6 +547,8 @@ def bench_accuracy(scenes: str | os.PathLike, out_dir: str = "planar-bench-accur
         "default": default,
         "default_on_frontier": bool(default["frontier"]),
         "default_errors": per_mech_default,
+        "previous_default": previous,
+        "machine": _machine(),
         "frontier": [a for a in agg if a["frontier"]],
         "csv": str(out / "accuracy.csv"),
         "chart": str(out / "accuracy.png"),
@@ -512,9 +577,9 @@ def _effects_cost(repeats: int = 3, fraction: float = 1.0) -> dict[str, float]:
 
     base = {"mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0,
                           "coupler_point": [2.0, 1.0]}, "driver": {"samples_per_cycle": 360}}
-    variants = {
+    variants: dict[str, dict[str, Any] | None] = {
         "none": None,
-        "unused": {"contact": False, "springs": [], "loads": []},
+        "unused": {"springs": [], "loads": []},
         "gravity": {"gravity": [0.0, -9.81]},
         "damping": {"damping": 0.5},
     }
@@ -554,15 +619,31 @@ def _accuracy_chart(path, agg: list[dict[str, Any]]) -> None:
     dflt = [i for i, a in enumerate(agg) if a["default"]]
     for axis, y, label, line in ((ax, e, "worst position error / size (kinematic and motor mode)", 1e-4),
                                  (ax2, tq, "worst motor torque error / peak", 1e-2)):
-        y = np.where(np.isfinite(y), y, 1.0)
-        axis.scatter(t[~f], y[~f], s=14, c="#9a9a9a", label="setting")
+        bad = ~np.isfinite(y)
+        y = np.where(bad, 1.0, y)
+        axis.scatter(t[~f & ~bad], y[~f & ~bad], s=14, c="#9a9a9a", label="setting")
+        if bad.any():
+            axis.scatter(t[bad], y[bad], s=18, marker="x", c="#9a9a9a", label="failed somewhere (drawn at 1)")
         axis.plot(t[f][order], y[f][order], "-o", c="#4e79a7", ms=4, label="Pareto frontier (positions)")
+        adapt = np.array([a.get("step_drift") is not None and not a["default"] for a in agg])
+        if adapt.any():
+            axis.scatter(t[adapt], y[adapt], s=30, marker="^", c="#59a14f", label="adaptive substeps")
         if dflt:
             i = dflt[0]
             axis.scatter([t[i]], [y[i]], s=80, facecolors="none", edgecolors="#e15759", linewidths=2, label="default")
+        prev = [i for i, a in enumerate(agg) if a.get("previous_default")]
+        if prev:
+            i = prev[0]
+            axis.scatter([t[i]], [y[i]], s=80, marker="s", facecolors="none", edgecolors="#b07aa1", linewidths=2,
+                         label="defaults before issue 12")
         axis.axhline(line, ls=":", c="#e15759", lw=1)
         axis.set_xscale("log")
         axis.set_yscale("log")
+        from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+        axis.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+        axis.xaxis.set_minor_formatter(NullFormatter())  # minor labels overlap on less than two decades
+        axis.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
         axis.set_xlabel("wall seconds per simulated second (all gallery mechanisms)")
         axis.set_ylabel(label)
         axis.legend(loc="upper right", fontsize=8)
@@ -575,19 +656,30 @@ def _accuracy_chart(path, agg: list[dict[str, Any]]) -> None:
 
 
 def format_accuracy(r: dict[str, Any]) -> str:
-    lines = [f"pymunk rebuild vs analytic, {len(r['mechanisms'])} mechanisms x {r['settings']} settings",
-             f"  {'substeps':>8}{'iters':>7}{'correct':>9}{'worst err':>12}{'torque':>10}{'s/sim s':>10}"]
+    lines = [f"pymunk rebuild vs analytic, {len(r['mechanisms'])} mechanisms x {r['settings']} settings "
+             f"({r['machine']})",
+             "  frontier (substeps/iterations/correction; N+ = at least N, raised for the step drift):",
+             f"  {'setting':<28}{'worst err':>10}{'torque':>10}{'s/sim s':>10}"]
     for a in sorted(r["frontier"], key=lambda a: a["seconds_per_sim_second"]):
         mark = "  <- default" if a["default"] else ""
-        lines.append(f"  {a['substeps']:>8}{a['iterations']:>7}{a['correction']:>9.2f}{a['max_error']:>12.2e}"
-                     f"{a['torque_error']:>10.2e}{a['seconds_per_sim_second']:>10.3f}{mark}")
+        lines.append(f"  {a['setting']:<28}{a['max_error']:>10.2e}{a['torque_error']:>10.2e}"
+                     f"{a['seconds_per_sim_second']:>10.3f}{mark}")
     d = r["default"]
-    lines.append(f"  default ({d['substeps']} substeps, {d['iterations']} iterations, correction {d['correction']:g}): "
-                 f"worst error {d['max_error']:.2e}, torque {d['torque_error']:.2e}, "
+    lines.append(f"  default ({d['setting']}): worst error {d['max_error']:.2e} (kinematic {d['kinematic_error']:.2e}, "
+                 f"motor {d['motor_error']:.2e}), torque {d['torque_error']:.2e}, "
                  f"{d['seconds_per_sim_second']:.3f} s per simulated second, "
                  f"{'on' if r['default_on_frontier'] else 'NOT on'} the frontier")
+    p = r.get("previous_default")
+    if p is not None:
+        lines.append(f"  defaults before issue 12 ({p['setting']}): worst error {p['max_error']:.2e}, torque "
+                     f"{p['torque_error']:.2e}, {p['seconds_per_sim_second']:.3f} s per simulated second "
+                     f"(defaults / before = {d['seconds_per_sim_second'] / p['seconds_per_sim_second']:.2f})")
+    def num(x: float) -> str:
+        return "-" if math.isnan(x) else f"{x:.2e}"  # "-": no steady motor (a rocking driver, staged toys)
+
     for k, v in sorted(r["default_errors"].items()):
-        lines.append(f"    {k:<22} kinematic {v['kinematic']:.2e}  motor {v['motor']:.2e}  torque {v['torque']:.2e}")
+        lines.append(f"    {k:<22} substeps {v['substeps']:>3}  kinematic {num(v['kinematic']):>8}  "
+                     f"motor {num(v['motor']):>8}  torque {num(v['torque']):>8}")
     for k, v in r["skipped"].items():
         lines.append(f"  skipped {k}: {v}")
     ec = r["effects_cost"]
@@ -606,10 +698,11 @@ BENCHMARKS["accuracy"] = (bench_accuracy, format_accuracy)
 
 def _bare_space(mech, t, settings):
     """The same pymunk space planar builds (bodies, joints, pins), placed at the first sample, and its step count."""
-    from .simulate import _analytic_pose_velocity, _Rebuild
+    from .simulate import _analytic_pose_velocity, _Rebuild, substeps_for
 
-    dt = float(t[1] - t[0]) / settings.substeps
     poses, vel, analytic = _analytic_pose_velocity(mech, t)
+    sub = substeps_for(mech, poses, vel, float(t[1] - t[0]), settings)
+    dt = float(t[1] - t[0]) / sub
     rb = _Rebuild(mech, analytic, None, settings, "kinematic", dt)
     comp = rb.compensation()
     if comp:
@@ -617,7 +710,7 @@ def _bare_space(mech, t, settings):
     rb.set_state({k: v[0] for k, v in poses.items()}, {k: v[0] for k, v in vel.items()})
     drv = rb.bodies[mech.driver.part]
     drv.angular_velocity = mech.driver.rate * dt  # one time unit per step, as planar runs it
-    return rb.space, (t.size - 1) * settings.substeps
+    return rb.space, (t.size - 1) * sub
 
 
 def bench_sim(n: int = 360, repeats: int = 7) -> dict[str, Any]:
@@ -630,8 +723,6 @@ def bench_sim(n: int = 360, repeats: int = 7) -> dict[str, Any]:
     alternately ``repeats`` times.  ``ratio`` is the median of the per-repeat
     ratios planar / bare (worst mechanism), with their spread.
     """
-    import platform
-
     from .catalog import get
     from .linkages import FourBar
     from .simulate import DEFAULT_SETTINGS, simulate
@@ -639,8 +730,7 @@ def bench_sim(n: int = 360, repeats: int = 7) -> dict[str, Any]:
     st = DEFAULT_SETTINGS
     mechs = {"four-bar": FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0)), "jansen": get("jansen")}
     out: dict[str, Any] = {"benchmark": "sim", "samples": n, "substeps": st.substeps, "repeats": repeats,
-                           "machine": f"{platform.machine()} {platform.processor() or ''} "
-                                      f"{os.cpu_count()} cores, Python {platform.python_version()}".strip(),
+                           "machine": _machine(),
                            "mechanisms": {}}
     for name, mech in mechs.items():
         t = mech.driver.times(n)
@@ -663,6 +753,7 @@ def bench_sim(n: int = 360, repeats: int = 7) -> dict[str, Any]:
             "ratio": float(np.median(ratios)),
             "ratio_spread": [float(min(ratios)), float(max(ratios))],
             "steps": int(r.steps),
+            "substeps": int(r.built["substeps"]),
             "iterations": int(r.built["iterations"]),
         }
     worst = max(out["mechanisms"].values(), key=lambda m: m["ratio"])
@@ -683,3 +774,21 @@ def format_sim(r: dict[str, Any]) -> str:
 
 
 BENCHMARKS["sim"] = (bench_sim, format_sim)
+
+
+# --------------------------------------------------------------------------- synthesis
+
+
+def _bench_synthesis(**kw: Any) -> dict[str, Any]:
+    from .synthesis.bench import bench_synthesis
+
+    return bench_synthesis(**kw)
+
+
+def _format_synthesis(r: dict[str, Any]) -> str:
+    from .synthesis.bench import format_synthesis
+
+    return format_synthesis(r)
+
+
+BENCHMARKS["synthesis"] = (_bench_synthesis, _format_synthesis)

@@ -1,25 +1,63 @@
 """The ``planar`` command.
 
 Every subcommand exits 0 on success and 2 on a user error, printing one line
-``planar: error: ...`` (no traceback).  Output files are written atomically.
+``planar: error: ...`` (no traceback; ``--debug`` shows it).  Anything
+unexpected is one line too, ``planar: internal error: ...``, with exit 1.
+Output paths are checked before any work (folder exists, extension matches
+the format, not one of the inputs); every output is written to a temporary
+and renamed only when the whole command succeeded.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
+import os
 import sys
 from collections.abc import Sequence
+from typing import NoReturn
 
-from .errors import PlanarError
+from .errors import InputError, PlanarError
 
 __all__ = ["main"]
 
 
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line: ``planar: error: render: ... (see planar render --help)``."""
+
+    def error(self, message: str) -> NoReturn:
+        sub = self.prog.split(" ", 1)[1] + ": " if " " in self.prog else ""
+        self.exit(2, f"planar: error: {sub}{message} (see {self.prog} --help)\n")
+
+
+def _outputs(args: argparse.Namespace, inputs: Sequence[str], *specs: tuple[str, str, tuple[str, ...]]) -> None:
+    """Check each output ``(option, attribute, suffixes)`` of ``args`` before any work; refuse two alike."""
+    from .fileio import check_output
+
+    seen: dict[str, str] = {}
+    for option, attr, suffixes in specs:
+        path = getattr(args, attr)
+        check_output(option, path, suffixes, inputs)
+        if path is not None:
+            key = os.path.realpath(path)
+            if key in seen:
+                raise InputError(option, path, f"a different file from {seen[key]} (both name it)")
+            seen[key] = option
+
+
+def _positive(option: str, value: float | None, integer: bool = False) -> None:
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise InputError(option, value, "a positive whole number" if integer else "a positive, finite number")
+
+
 def _cmd_demo(args: argparse.Namespace) -> int:
     """The embedded default: a wind-up toy and a four-bar walking leg, animated (and cut)."""
+    from .fileio import check_output
     from .pipeline import run_demo
 
+    # each file is written atomically; not one transaction, as DEMO_EXTRAS may read what the demo wrote
+    check_output("-o", args.output, (), directory=True)
     for line in run_demo(args.output):
         print(line)
     return 0
@@ -29,16 +67,22 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     from .bench import BENCHMARKS
 
     fn, fmt = BENCHMARKS[args.name]
+    _positive("-n", args.n, integer=True)
+    _positive("--repeats", args.repeats, integer=True)
+    if args.n is not None:
+        from .limits import check_count
+
+        check_count("samples", "-n", args.n, "samples")
     kwargs = {}
     if args.n is not None:
         if args.name == "accuracy":
-            from .errors import InputError
-
             raise InputError("-n", args.n,
                              "no problem size for the accuracy benchmark (it runs the scenes of --scenes)")
         kwargs["n"] = args.n
     if args.repeats is not None:
         kwargs["repeats"] = args.repeats
+    if args.name == "synthesis":
+        kwargs["quick"] = args.quick
     if args.name == "accuracy":
         kwargs["scenes"] = args.scenes
         kwargs["out_dir"] = args.output
@@ -49,16 +93,23 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
 
 def _cmd_motion_catalog(args: argparse.Namespace) -> int:
+    from .limits import check_count
     from .pipeline import write_catalog_motion
 
+    _outputs(args, (), ("-o", "output", (".csv",)))
+    _positive("--samples", args.samples, integer=True)
+    check_count("samples", "--samples", args.samples, "samples")
     motion = write_catalog_motion(args.mechanism, args.output, args.samples)
     print(f"wrote {args.output}: {len(motion)} samples, {int(motion.valid.sum())} valid")
     return 0
 
 
 def _cmd_chains(args: argparse.Namespace) -> int:
+    from .limits import check_count
     from .windup.table import enumerate_chains
 
+    _positive("--max-length", args.max_length, integer=True)
+    check_count("chain", "--max-length", args.max_length, "patterns in a chain")
     chains = enumerate_chains(args.target, args.max_length, args.optional)
     if args.json:
         print(json.dumps({k: [list(c) for c in v] for k, v in chains.items()}))
@@ -74,10 +125,18 @@ def _cmd_render(args: argparse.Namespace) -> int:
     from .pipeline import overlay_motion, render_scene
     from .scene import load_scene
 
+    from .pipeline import ANIMATION_SUFFIXES
+
+    _outputs(args, (args.scene,), ("-o", "output", ANIMATION_SUFFIXES))
     scene = load_scene(args.scene)
     overlay = overlay_motion(scene) if args.overlay else None
+    from .pipeline import animation_plan
+
+    plan = animation_plan(scene, args.output, args.fps)
+    if plan.note():
+        print(f"note: {plan.note()}")
     n = render_scene(scene, args.output, overlay=overlay, fps=args.fps)
-    print(f"wrote {args.output}: {n} frames")
+    print(f"wrote {args.output}: {n} frames, {plan.fps:.3g} frames/s, a cycle plays {plan.cycle_play_s:.3g} s")
     return 0
 
 
@@ -85,6 +144,7 @@ def _cmd_motion(args: argparse.Namespace) -> int:
     from .pipeline import write_scene_motion
     from .scene import load_scene
 
+    _outputs(args, (args.scene,), ("-o", "output", (".csv",)))
     scene = load_scene(args.scene)
     motion = write_scene_motion(scene, args.output, derivatives=args.derivatives)
     print(f"wrote {args.output}: {len(motion)} samples, {int(motion.valid.sum())} valid")
@@ -96,9 +156,13 @@ def _cmd_motion(args: argparse.Namespace) -> int:
 
 
 def _cmd_gallery(args: argparse.Namespace) -> int:
+    from .fileio import check_output, output_transaction
     from .pipeline import build_gallery
 
-    for path, target, n in build_gallery(args.source, args.output):
+    check_output("-o", args.output, (), directory=True)
+    with output_transaction():  # all GIFs or none: a bad scene leaves no half gallery
+        done = list(build_gallery(args.source, args.output))
+    for path, target, n in done:
         print(f"{path.name}: {n} frames -> {target}")
     return 0
 
@@ -108,7 +172,8 @@ def _cmd_schema(args: argparse.Namespace) -> int:
     from .scene import scene_schema
 
     text = json.dumps(scene_schema(), indent=2, sort_keys=True) + "\n"
-    if args.output:
+    _outputs(args, (), ("-o", "output", (".json",)))
+    if args.output is not None:
         with atomic_write(args.output, "w") as fh:
             fh.write(text)
         print(f"wrote {args.output}")
@@ -118,51 +183,70 @@ def _cmd_schema(args: argparse.Namespace) -> int:
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
+    from dataclasses import replace
+
     from .compare import EXIT_MISMATCH, format_comparison
     from .pipeline import compare_scene
     from .scene import load_scene
     from .simulate import SimSettings
 
+    for option, v in (("--threshold", args.threshold), ("--torque-threshold", args.torque_threshold)):
+        _positive(option, v)
+    _positive("--substeps", args.substeps, integer=True)
+    _positive("--iterations", args.iterations, integer=True)
+    if args.step_drift is not None and not (math.isfinite(args.step_drift) and args.step_drift >= 0):
+        raise InputError("--step-drift", args.step_drift, "a drift fraction >= 0 (0 keeps --substeps fixed)")
+    if args.error_bias is not None and not (0 <= args.error_bias <= 1):
+        raise InputError("--error-bias", args.error_bias, "a number between 0 and 1")
     scene = load_scene(args.scene)
     settings = SimSettings(**{k: v for k, v in (("substeps", args.substeps), ("iterations", args.iterations),
                                                  ("error_bias", args.error_bias)) if v is not None})
+    if args.step_drift is not None:  # 0: fixed substeps
+        settings = replace(settings, step_drift=args.step_drift or None)
     result, sim = compare_scene(scene, settings, args.threshold, args.torque_threshold, with_series=args.json)
     t = sim.motion.t
     assert t is not None  # a simulation records its output times
     if args.json:
         d = result.to_dict()
-        d["settings"] = {"substeps": settings.substeps, "iterations": sim.built.get("iterations"),
-                         "correction": settings.step_correction(t[1] - t[0]),
+        d["settings"] = {"substeps": sim.built.get("substeps"), "iterations": sim.built.get("iterations"),
+                         "step_drift": settings.step_drift,
+                         "correction": sim.built.get("correction"),
                          "error_bias": settings.error_bias}
         d["wall_time_s"] = sim.wall_time
         d["built"] = {k: v for k, v in sim.built.items()}
         print(json.dumps(d, indent=2, default=str))
     else:
         print(format_comparison(result))
-        print(f"  simulated in {sim.wall_time:.3f} s ({sim.steps} steps; substeps {settings.substeps}, "
-              f"iterations {sim.built.get('iterations')}, correction per step "
-              f"{settings.step_correction((t[1] - t[0]) / settings.substeps):.3g})")
+        print(f"  simulated in {sim.wall_time:.3f} s ({sim.steps} steps; substeps {sim.built.get('substeps')}, "
+              f"iterations {sim.built.get('iterations')}, correction per step {sim.built.get('correction'):.3g})")
     return 0 if result.passed else EXIT_MISMATCH
 
 
 def _sheet(text: str) -> tuple[float, float]:
-    from .errors import InputError
-
     try:
         w, h = (float(v) for v in text.lower().split("x"))
     except ValueError:
         raise InputError("--sheet", text, "WIDTHxHEIGHT in millimetres, e.g. 300x200") from None
-    if not (w > 0 and h > 0):
-        raise InputError("--sheet", text, "a positive width and height")
+    if not (math.isfinite(w) and math.isfinite(h) and w > 0 and h > 0):
+        raise InputError("--sheet", text, "a positive, finite width and height in millimetres")
     return w, h
 
 
+#: export's outputs: (option, attribute, suffixes)
+_EXPORT_OUTPUTS = (("-o", "output", (".dxf",)), ("--svg", "svg", (".svg",)), ("--preview", "preview", (".png",)),
+                   ("--bom", "bom", (".csv",)), ("--assembly", "assembly", (".svg",)),
+                   ("--kerf-test", "kerf_test", (".dxf", ".svg")))
+
+
 def _cmd_export(args: argparse.Namespace) -> int:
-    from .errors import InputError
     from .fabexport import summary
     from .pipeline import export_scene
     from .scene import load_scene
 
+    if all(getattr(args, attr) is None for _, attr, _ in _EXPORT_OUTPUTS):
+        raise InputError("export", args.scene, "an output: -o parts.dxf, --svg, --preview, --bom, --assembly "
+                                               "or --kerf-test (nothing would be written)")
+    _outputs(args, (args.scene,), *_EXPORT_OUTPUTS)
     if args.kerf is not None and not (0 <= args.kerf <= 2):
         raise InputError("--kerf", args.kerf, "a kerf between 0 and 2 mm")
     scene = load_scene(args.scene)
@@ -178,7 +262,12 @@ def _cmd_export(args: argparse.Namespace) -> int:
 def build_parser() -> argparse.ArgumentParser:
     from .bench import BENCHMARKS
 
-    p = argparse.ArgumentParser(prog="planar", description="2D rigid-body mechanisms: exact kinematics and more.")
+    p = _Parser(prog="planar", description="2D rigid-body mechanisms: exact kinematics and more.",
+                epilog="Exit status: 0 success, 2 a user error (one line naming the file, field or option), "
+                       "3 a failed check (compare), 1 an internal error (run with --debug for the traceback). "
+                       "Limits on work (PLANAR_MAX_SAMPLES, PLANAR_MAX_FRAMES, PLANAR_MAX_CHAIN, "
+                       "PLANAR_MAX_MEMORY): see the README.")
+    p.add_argument("--debug", action="store_true", help="show the Python traceback of an error")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     d = sub.add_parser("demo", help="run the embedded default and write its outputs")
@@ -191,7 +280,8 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("-n", type=int, default=None, help="problem size (samples)")
     b.add_argument("--repeats", type=int, default=None, help="timing repeats (best is kept)")
     b.add_argument("-o", "--output", default="planar-bench-accuracy", help="accuracy: folder for the CSV and chart")
-    b.add_argument("--quick", action="store_true", help="accuracy: a small grid on three mechanisms")
+    b.add_argument("--quick", action="store_true",
+                   help="accuracy: a small grid on three mechanisms; synthesis: one repeat, small budgets")
     b.add_argument("--scenes", default="gallery",
                    help="accuracy: folder of scene files to measure (default: ./gallery, the repository's)")
     b.set_defaults(func=_cmd_bench)
@@ -236,9 +326,13 @@ def build_parser() -> argparse.ArgumentParser:
                     help="error threshold, fraction of size (1e-3); exit status 3 when a check fails")
     cp.add_argument("--torque-threshold", type=float, default=0.01,
                     help="motor torque vs inverse dynamics, fraction of its peak (0.01)")
-    cp.add_argument("--substeps", type=int, default=None)
-    cp.add_argument("--iterations", type=int, default=None)
-    cp.add_argument("--error-bias", type=float, default=None)
+    cp.add_argument("--substeps", type=int, default=None,
+                    help="physics steps per sample, at least (28); raised where joints turn fast, see --step-drift")
+    cp.add_argument("--step-drift", type=float, default=None,
+                    help="largest predicted joint drift per step, fraction of size (3.5e-6); 0 keeps --substeps fixed")
+    cp.add_argument("--iterations", type=int, default=None, help="solver iterations per step, at least (40)")
+    cp.add_argument("--error-bias", type=float, default=None,
+                    help="joint error left after one second (replaces the correction of 0.2 per step)")
     cp.set_defaults(func=_cmd_compare)
 
     ex = sub.add_parser("export", help="every part laid flat for a laser cutter (DXF, SVG)")
@@ -261,31 +355,92 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("-o", "--output", required=True, help="CSV file to write")
     c.add_argument("--samples", type=int, default=360)
     c.set_defaults(func=_cmd_motion_catalog)
-    from .cli_plot import add_parser as add_plot_parser; add_plot_parser(sub)  # noqa: E702
+    from .cli_plot import add_parser as add_plot_parser
+
+    add_plot_parser(sub)
+    from .cli_synth import add_parser as add_synth
+
+    add_synth(sub)
     return p
 
 
+def _one_line(text: object) -> str:
+    return " ".join(str(text).split())
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point: parse, run, turn user errors into exit status 2."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    """Entry point: parse, run, turn user errors into exit status 2 (one line, no traceback).
+
+    Warnings (numpy's RuntimeWarnings on invalid samples) are silenced: the
+    validity masks carry that information.  ``--debug`` re-raises errors.
+    """
+    hook = sys.unraisablehook
+    debug = "--debug" in (sys.argv[1:] if argv is None else argv)
+    if not debug:  # a writer abandoned by an error complains from its __del__: not a user's concern
+        sys.unraisablehook = _quiet
     try:
-        return int(args.func(args) or 0)
+        return _main(argv)
+    except KeyboardInterrupt:  # while parsing or importing, or a second Ctrl-C while unwinding
+        print("planar: interrupted (no output written)", file=sys.stderr)
+        rc = 130
+    finally:
+        import gc
+
+        gc.collect()
+        sys.unraisablehook = hook
+    if argv is None:  # the command itself: leave now, before shutdown handlers (threads, writers) can print
+        sys.stderr.flush()
+        os._exit(rc)
+    return rc
+
+
+def _main(argv: Sequence[str] | None) -> int:
+    import warnings
+
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as e:  # --help, or a usage error already printed on one line
+        return e.code if isinstance(e.code, int) else (0 if e.code is None else 2)
+    try:
+        import numpy as np
+
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            if not args.debug:
+                warnings.simplefilter("ignore")
+            return int(args.func(args) or 0)
     except PlanarError as e:
-        print(f"planar: error: {e}", file=sys.stderr)
+        if args.debug:
+            raise
+        print(f"planar: error: {_one_line(e)}", file=sys.stderr)
         return 2
-    except (FileNotFoundError, IsADirectoryError, PermissionError) as e:
-        print(f"planar: error: {e.filename}: {e.strerror}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:  # pragma: no cover
-        return 130
     except BrokenPipeError:
         # the reader of our output went away (``planar compare | head``): stop quietly, as Unix tools do
-        import os
-
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return 141
+    except OSError as e:  # a file the user named: unreadable, a loop of links, a full disc
+        if args.debug:
+            raise
+        where = f"{e.filename}: " if e.filename else ""
+        print(f"planar: error: {where}{_one_line(e.strerror or e)}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        if args.debug:
+            raise
+        print("planar: error: out of memory; ask for fewer samples or frames (or lower PLANAR_MAX_MEMORY "
+              "so this is refused before it starts)", file=sys.stderr)
+        return 2
+    except Exception as e:  # the guard: a bug in planar, still one line
+        if args.debug:
+            raise
+        print(f"planar: internal error: {type(e).__name__}: {_one_line(e)[:300]} "
+              f"(a bug in planar; run again with --debug for the traceback)", file=sys.stderr)
+        return 1
+
+
+def _quiet(unraisable: object) -> None:
+    """An unraisable-exception hook that prints nothing (used while an interrupted command unwinds)."""
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,4 +1,4 @@
-"""``planar plot SCENE -o fig.png|svg [--what curve,transmission,velocity,speed,acceleration,torque]``."""
+"""``planar plot SCENE -o fig.png|svg [--what curve,follower,pressure,transmission,velocity,speed,acceleration,torque]``."""
 
 from __future__ import annotations
 
@@ -22,15 +22,17 @@ def add_parser(sub: Any) -> None:
     """Register ``planar plot`` on the subcommand parsers ``sub``."""
     p = sub.add_parser("plot", help="charts of a scene: point paths, transmission angle, speeds, torque",
                        description="Draw the charts a designer looks at (matplotlib) from the scene's exact "
-                                   "motion and rates: curve (paths of the named points), transmission "
+                                   "motion and rates: curve (paths of the named points), follower and "
+                                   "pressure (a cam's follower motion and pressure angle), transmission "
                                    "(angle at each RRR dyad, linkages only), velocity and acceleration "
                                    "(angular, every moving part), torque (motor torque under [effects], "
-                                   "and the loads alone). Horizontal axis: crank angle for a turning crank, "
-                                   "else time.")
+                                   "and the loads alone). Horizontal axis: crank (cam) angle for a turning "
+                                   "input, else time.")
     p.add_argument("scene", help="scene file (TOML)")
     p.add_argument("-o", "--output", required=True, help="figure to write: .png or .svg")
     p.add_argument("--what", default=None,
-                   help="comma-separated charts: curve,transmission,velocity,speed,acceleration,torque "
+                   help="comma-separated charts: curve,follower,pressure,transmission,velocity,speed,"
+                        "acceleration,torque "
                         "(default: every chart that applies)")
     p.add_argument("--samples", type=int, default=None,
                    help="samples per cycle for the charts (default: the scene's [driver] samples_per_cycle)")

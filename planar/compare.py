@@ -159,7 +159,7 @@ def format_comparison(c: Comparison) -> str:
     if c.torque:
         t = c.torque
         lines.append(f"  motor torque: pymunk vs inverse dynamics: max |diff| {t['max_abs_diff']:.3e} "
-                     f"({t['max_rel_diff']:.2%} of peak {t['peak']:.4g}); motor-driven poses within "
+                     f"({100 * t['max_rel_diff']:.2g}% of peak {t['peak']:.4g}); motor-driven poses within "
                      f"{t['pose_error']:.2e} of the size")
     for n in c.notes:
         lines.append(f"  note: {n}")

@@ -49,8 +49,6 @@ class Effects:
     """
 
     gravity: Vec | None = None
-    contact: bool = False
-    friction: float | None = None
     damping: float | None = None
     density: float = 1.0
     springs: tuple[Spring, ...] = ()

@@ -2,16 +2,36 @@
 
 Every error carries a message that names *where* (file, field path or joint)
 and *what* (the offending value and what was expected).  The CLI prints the
-message on one line and exits with status 2; no traceback is shown.
+message on one line and exits with status 2; no traceback is shown.  Every
+class here derives from :class:`PlanarError`; :class:`InputError` and
+:class:`LimitError` are also :class:`ValueError`, so Python callers may catch
+either; so are :class:`AssemblyError` and :class:`SceneError`.
 """
 
 from __future__ import annotations
 
-__all__ = ["PlanarError", "InputError", "AssemblyError", "SceneError"]
+__all__ = ["PlanarError", "InputError", "AssemblyError", "SceneError", "LimitError", "short_repr"]
 
 
 class PlanarError(Exception):
     """Base class for errors caused by user input."""
+
+
+def short_repr(value: object, limit: int = 80) -> str:
+    """``repr(value)`` on one line and at most ``limit`` characters (an array is summarised)."""
+    try:
+        import numpy as np
+
+        if isinstance(value, np.ndarray) and value.size > 4:
+            finite = value[np.isfinite(value)] if value.dtype.kind == "f" else value
+            rng = f", from {finite.min()!r} to {finite.max()!r}" if finite.size and value.dtype.kind in "fiu" else ""
+            return f"<array of shape {value.shape}{rng}>"
+        if isinstance(value, np.generic):
+            value = value.item()
+    except Exception:  # pragma: no cover - numpy is a dependency; repr below still works
+        pass
+    text = repr(value).replace("\n", " ")
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 class InputError(PlanarError, ValueError):
@@ -25,12 +45,16 @@ class InputError(PlanarError, ValueError):
         self.field = field
         self.value = value
         self.expected = expected
-        super().__init__(f"{field} = {value!r}: expected {expected}")
+        super().__init__(f"{field} = {short_repr(value)}: expected {expected}")
 
 
-class AssemblyError(PlanarError):
+class LimitError(InputError):
+    """A request needs more work or memory than a configured limit allows (see :mod:`planar.limits`)."""
+
+
+class AssemblyError(PlanarError, ValueError):
     """A mechanism cannot be assembled at any (or at a required) driver value."""
 
 
-class SceneError(PlanarError):
+class SceneError(PlanarError, ValueError):
     """A scene file is malformed; the message names the file and field path."""

@@ -10,10 +10,8 @@ With several sheets, ``parts.dxf`` becomes ``parts-1.dxf``, ``parts-2.dxf``
 
 from __future__ import annotations
 
-import contextlib
 import math
 import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -172,28 +170,20 @@ def kerf_test_layout(settings: FabSettings) -> Layout:
 
 
 def _commit(files: dict[Path, bytes]) -> None:
-    """Write every file to a temporary beside it, then rename them all; on any failure remove the temporaries."""
+    """Write every file to a temporary beside it, then rename them all; on any failure remove the temporaries.
+
+    Inside a command's :func:`planar.fileio.output_transaction` the renames wait for the whole command.
+    """
+    from .fileio import atomic_write, output_transaction
+
     for target in files:
         parent = target.parent if str(target.parent) else Path(".")
         if not parent.is_dir():
             raise InputError("output", str(target), f"a path in an existing directory ({parent} does not exist)")
-    temps: list[tuple[str, Path]] = []
-    try:
-        umask = os.umask(0)
-        os.umask(umask)
+    with output_transaction():
         for target, data in files.items():
-            fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent)
-            temps.append((tmp, target))
-            with os.fdopen(fd, "wb") as fh:
+            with atomic_write(target, "wb") as fh:
                 fh.write(data)
-            os.chmod(tmp, 0o666 & ~umask)
-        for tmp, target in temps:
-            os.replace(tmp, target)
-    except BaseException:
-        for tmp, _ in temps:
-            with contextlib.suppress(FileNotFoundError):
-                os.unlink(tmp)
-        raise
 
 
 def write_outputs(fab: Fabrication | None, dxf=None, svg=None, preview=None, bom=None, assembly=None,
@@ -242,12 +232,13 @@ def write_outputs(fab: Fabrication | None, dxf=None, svg=None, preview=None, bom
 
 
 def summary(fab: Fabrication) -> str:
-    """One line: parts, sheets, utilisation, layers, pins, spacers."""
+    """One line: parts (and the spacer rings cut beside them), sheets, utilisation, layers, pins."""
     lay, asm = fab.layout, fab.assembly
     util = ", ".join(f"{u:.0%}" for u in lay.utilisation)
     layers = max(asm.n_layers.values()) if asm.n_layers else 0
     spacers = sum(p.spacers for p in asm.pins)
-    return (f"{len(lay.parts)} parts on {lay.sheets} sheet(s) of {lay.sheet_size[0]:g} x {lay.sheet_size[1]:g} mm "
-            f"(utilisation {util}), kerf {lay.kerf:g} mm, {layers} layer(s) of {fab.settings.thickness_mm:g} mm, "
-            f"{len(asm.pins)} pin(s), {spacers} spacer(s)")
+    rings = f" + {spacers} spacer ring(s)" if spacers else ""
+    return (f"{len(lay.parts) - spacers} parts{rings} on {lay.sheets} sheet(s) of {lay.sheet_size[0]:g} x "
+            f"{lay.sheet_size[1]:g} mm (utilisation {util}), kerf {lay.kerf:g} mm, {layers} layer(s) of "
+            f"{fab.settings.thickness_mm:g} mm, {len(asm.pins)} pin(s)")
 

@@ -19,6 +19,7 @@ from .cams.joint import CamContact
 from .errors import PlanarError
 from .model import ArcSlot, CamOnLine, Hole, Mechanism, Part, PinInArcSlot, PinInSlot, Pivot, Slide, Slot
 from .registry import Registry
+from .linkages.gears import GearMesh
 from .windup.mechanisms import SkewContact
 
 __all__ = ["Contact", "FabricationError", "PIN_RULES", "PinSpec", "joint_pins", "pin_features", "register_contact"]
@@ -76,6 +77,10 @@ def _pivot(mech: Mechanism, j: Pivot) -> tuple[list[PinSpec], list[Contact]]:
 
 @PIN_RULES.register(PinInSlot)
 def _pin_in_slot(mech: Mechanism, j: PinInSlot) -> tuple[list[PinSpec], list[Contact]]:
+    if _hole_at(mech.part(j.b), j.pin) is None:
+        # no hole at the "pin": the part's own round body runs in the slot (a wind-up eccentric cam in its
+        # follower's window), so nothing is pinned and the window keeps its own width
+        return [], [Contact(j.name, (j.a, j.b), True)]
     return [PinSpec(j.name, (j.b, j.a), (_v(j.pin), _v(j.start)), ("hole", "slot"))], []
 
 
@@ -107,6 +112,7 @@ def register_contact(kind: type, coplanar: bool) -> None:
 
 
 register_contact(SkewContact, coplanar=False)  # a tilting pin on an edge: across layers
+register_contact(GearMesh, coplanar=True)  # two gears in mesh: one layer
 register_contact(CamContact, coplanar=True)  # a profile cam and its roller or follower: in one layer
 
 
@@ -135,6 +141,8 @@ def pin_features(mech: Mechanism) -> set[tuple[str, int]]:
         elif isinstance(j, (PinInSlot, PinInArcSlot, Slide)):
             pin_part, slot_part = by_name[j.b], by_name[j.a]
             anchors = list(j.pin_points()) if isinstance(j, Slide) else [j.pin]
+            if isinstance(j, PinInSlot) and _hole_at(pin_part, j.pin) is None:
+                continue  # a round body in a window, not a pin (see _pin_in_slot)
             for p in anchors:
                 h = _hole_at(pin_part, p)
                 if h is not None:

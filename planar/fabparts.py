@@ -248,6 +248,56 @@ def _min_wall(outer, feats: Sequence[Feature]) -> float:
     return best
 
 
+def _drop_contained(feats: list[Feature]) -> list[Feature]:
+    """``feats`` without a cut that lies wholly inside another one (it removes nothing more: e.g. a merged
+    toy body sliding on one line through two stages' slots, one inside the other)."""
+    polys = [cut_polygon(f.cut(0.0)) for f in feats]
+    keep = []
+    for i, p in enumerate(polys):
+        inside = any(j != i and (polys[j].buffer(1e-6).contains(p) and (polys[j].area > p.area or j < i)
+                                 or _same_guide(feats[i], feats[j], j < i))
+                     for j in range(len(polys)))
+        if not inside:
+            keep.append(feats[i])
+    return keep
+
+
+def _same_guide(f: Feature, g: Feature, g_first: bool, tol: float = 1e-6) -> bool:
+    """Whether slot ``f`` runs on the line of slot ``g`` within ``g``'s ends (mm): one guide, cut once as ``g``.
+
+    A merged toy body is guided on one line by two stages' slots of different widths; only the slot the
+    pins run in is kept (the ``g`` that is not itself inside a longer one; ties: the first)."""
+    if f.kind != "slot" or g.kind != "slot" or f is g:
+        return False
+    a, b = np.asarray(g.a), np.asarray(g.b)
+    L = float(np.hypot(*(b - a)))
+    if L <= tol:
+        return False
+    e = (b - a) / L
+    ends = [np.asarray(f.a) - a, np.asarray(f.b) - a]
+    off = [abs(float(e[0] * v[1] - e[1] * v[0])) for v in ends]
+    along = [float(e @ v) for v in ends]
+    if max(off) > tol or min(along) < -tol or max(along) > L + tol:
+        return False
+    flen = float(np.hypot(*(np.asarray(f.b) - np.asarray(f.a))))
+    return L > flen + tol or (abs(L - flen) <= tol and g_first)
+
+
+def _closest_cuts(feats: Sequence[Feature]) -> tuple[float, Feature | None, Feature | None]:
+    """The least material (mm) between two cuts of one part and the two features (0 where they overlap).
+
+    Widening the outline cannot mend this, so a part whose holes run into each other is refused.
+    """
+    polys = [cut_polygon(f.cut(0.0)) for f in feats]
+    best, fa, fb = math.inf, None, None
+    for i in range(len(polys)):
+        for j in range(i + 1, len(polys)):
+            d = float(polys[i].distance(polys[j]))
+            if d < best:
+                best, fa, fb = d, feats[i], feats[j]
+    return best, fa, fb
+
+
 def _fit_text(poly, text: str, angle: float, centres: list[tuple[float, float]]) -> tuple[float, tuple[float, float]]:
     """Largest cap height (<= MAX_LABEL) at which ``text`` fits inside ``poly`` at one of ``centres``."""
     from shapely import affinity
@@ -363,13 +413,22 @@ def part_cuts(part: Part, s: FabSettings, number: int, pinned: set[int] = frozen
         base = [(x * s.unit_mm, y * s.unit_mm, r * s.unit_mm) for x, y, r in part.hull] + \
             [c for f in feats for c in f.wall_circles(s.min_wall)]
         feats = feats + _mounting_holes(base, s)
+    feats = _drop_contained(feats)
+    gap, fa, fb = _closest_cuts(feats)
+    if fa is not None and fb is not None and gap < s.min_wall - WALL_TOL:
+        raise FabricationError(
+            f"part {part.name!r}: {gap:.2f} mm of material between its {fa.what} at "
+            f"({fa.a[0]:.1f}, {fa.a[1]:.1f}) mm and its {fb.what} at ({fb.a[0]:.1f}, {fb.a[1]:.1f}) mm, less than "
+            f"min_wall_mm {s.min_wall:g} (a larger unit_mm, a smaller pin_diameter_mm or a smaller min_wall_mm)")
     nominal_outer, notes = _outer(part, s, feats, 0.0)
     outer = nominal_outer if k2 == 0 else _outer(part, s, feats, k2)[0]
     outer_poly = cut_polygon(nominal_outer)
     wall = _min_wall(outer_poly, feats)
     if wall < s.min_wall - WALL_TOL:
         raise FabricationError(f"part {part.name!r}: {wall:.2f} mm wall between a cut and the outline, less than "
-                               f"min_wall_mm {s.min_wall:g}" + (" (an explicit polygon is not widened)"
+                               f"min_wall_mm {s.min_wall:g}" + (" (a part with an explicit outline, such as a "
+                                                              "cam, roller or flat follower, is not widened: make "
+                                                              "it larger or the pin smaller)"
                                                               if part.polygon is not None else ""))
     rect = outer_poly.minimum_rotated_rectangle
     xy = np.asarray(rect.exterior.coords)[:4]

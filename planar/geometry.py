@@ -207,15 +207,20 @@ def circle_circle(
     r2 = np.asarray(r2, float)
     dx = c2[..., 0] - c1[..., 0]
     dy = c2[..., 1] - c1[..., 1]
-    d2 = dx * dx + dy * dy
-    sum_ = r1 + r2
-    dif = r1 - r2
-    prod = (sum_ * sum_ - d2) * (d2 - dif * dif)  # = 4 d^2 h^2
+    # scale-free: lengths divided by the power of two nearest r1 + r2, an exact scaling (the same bits
+    # as unscaled where nothing overflows), so the squares below hold from 1e-300 to 1e300
+    _, e = np.frexp(np.abs(r1) + np.abs(r2))
+    k = np.ldexp(1.0, -e)
+    ux, uy, q1, q2 = dx * k, dy * k, r1 * k, r2 * k
+    d2 = ux * ux + uy * uy
+    sum_ = q1 + q2
+    dif = q1 - q2
+    prod = (sum_ * sum_ - d2) * (d2 - dif * dif)  # = 4 d^2 h^2 (scaled)
     scale = np.maximum(sum_ * sum_, d2)
     ok_d = d2 > 0.0  # concentric circles: no (or infinitely many) intersections
     valid = (prod >= -rtol * scale * scale) & ok_d
     safe_d2 = np.where(ok_d, d2, 1.0)
-    a = 0.5 * (d2 + r1 * r1 - r2 * r2) / safe_d2  # fraction of d along c1->c2
+    a = 0.5 * (d2 + q1 * q1 - q2 * q2) / safe_d2  # fraction of d along c1->c2
     h = 0.5 * np.sqrt(np.maximum(prod, 0.0)) / safe_d2  # half-chord / d
     hb = h * np.asarray(branch, float)
     x = c1[..., 0] + a * dx - hb * dy

@@ -53,8 +53,11 @@ Array = NDArray[np.float64]
 
 
 def check_finite(field_name: str, value: ArrayLike) -> NDArray[np.float64]:
-    """Return ``value`` as a float array or raise :class:`InputError` on NaN/inf."""
-    arr = np.asarray(value, dtype=float)
+    """Return ``value`` as a float array or raise :class:`InputError` on NaN/inf (or what is not numbers)."""
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(field_name, value, "numbers (a number or an array of them)") from None
     if not np.all(np.isfinite(arr)):
         raise InputError(field_name, value, "finite numbers")
     return arr
@@ -422,7 +425,9 @@ class Driver:
 
     def times(self, samples_per_cycle: int = 360, cycles: float = 1.0) -> Array:
         """Sample times covering ``cycles`` periods, end point excluded."""
-        n = int(round(samples_per_cycle * cycles))
+        from .limits import sample_count
+
+        n = sample_count(samples_per_cycle, cycles)  # finite, positive and within PLANAR_MAX_SAMPLES
         if n < 1:
             raise InputError("samples_per_cycle", samples_per_cycle, "at least one sample")
         return np.arange(n, dtype=np.float64) * (self.period / samples_per_cycle)
@@ -587,15 +592,30 @@ class Mechanism:
     def solve(self, q: ArrayLike, t: ArrayLike | None = None) -> Motion:
         """Solve all samples at once for driver values ``q`` (scalar or array)."""
         qa = np.atleast_1d(check_finite(f"{self.name}.driver value", q)).astype(float)
+        if qa.ndim != 1:  # an OzT driver's path is a function of its 1-D driver value too
+            raise InputError(f"{self.name}.solve(q)", f"an array of shape {qa.shape}",
+                             "a scalar or a 1-D array of driver values")
+        if t is not None and np.shape(t) != qa.shape[:1]:
+            raise InputError(f"{self.name}.solve(t)", f"an array of shape {np.shape(t)}",
+                             f"one time per driver value (shape {qa.shape[:1]})")
         poses, checks, pts = self._solve_points(qa)
         n = qa.shape[0]
         table: list[tuple[str, str]] = []
+        if pts is None:
+            pts = {name: poses_apply(poses[part], xy) for name, (part, xy) in self.points.items()}
+        # the final finite check: a sample whose numbers overflowed float64 is never valid (and holds 0, not NaN)
+        finite = np.ones(n, dtype=bool)
+        for arr in (*poses.values(), *pts.values()):
+            if not np.isfinite(arr.sum()):  # a cheap screen (a sum of finite numbers may overflow: then look closer)
+                finite &= np.isfinite(arr).reshape(n, -1).all(axis=1)
+        if not finite.all():
+            checks = list(checks or []) + [(finite, "result", "a number overflowed float64 (non-finite result)")]
+            poses = {k: np.nan_to_num(v, nan=0.0, posinf=0.0, neginf=0.0) for k, v in poses.items()}
+            pts = {k: np.nan_to_num(v, nan=0.0, posinf=0.0, neginf=0.0) for k, v in pts.items()}
         if checks is None:  # every sample closes
             valid, code = np.ones(n, dtype=bool), np.full(n, -1, dtype=np.int16)
         else:
             valid, code, table = merge_failures(n, checks)
-        if pts is None:
-            pts = {name: poses_apply(poses[part], xy) for name, (part, xy) in self.points.items()}
         return Motion(
             driver=qa,
             poses=poses,

@@ -8,6 +8,7 @@ functions that need them, so ``import planar.pipeline`` stays light.
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -16,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 from .errors import InputError
 
 if TYPE_CHECKING:
+    from .animation import FramePlan
     from .compare import Comparison
     from .fabexport import Fabrication
     from .model import Mechanism, Motion
@@ -52,6 +54,12 @@ def gallery_scenes(folder: str | os.PathLike[str]) -> list[Path]:
 
 # --------------------------------------------------------------------------- render
 
+#: the longest frame delay a GIF can hold (65535 hundredths of a second)
+GIF_MAX_DELAY_MS = 655_350.0
+
+#: the largest sheet side (mm) the fabrication geometry is computed for
+MAX_SHEET_MM = 100_000.0
+
 
 def scene_style(scene: Scene) -> Style:
     """The renderer's :class:`~planar.render.Style` from a scene's ``[render]`` table."""
@@ -80,6 +88,25 @@ def overlay_motion(scene: Scene) -> Motion:
 ANIMATION_SUFFIXES = (".gif", ".mp4", ".webm")
 
 
+def animation_plan(scene: Scene, out: str | Path, fps: float | None = None) -> "FramePlan":
+    """The frames ``render_scene`` draws for ``out`` (GIF delays are whole 10 ms ticks; video any rate)."""
+    from .animation import plan_frames, scene_duration
+
+    fps = fps if fps is not None else scene.spec.render.fps
+    try:
+        return plan_frames(scene.mechanism.driver.period, scene_duration(scene), fps,
+                           tick_ms=10.0 if Path(out).suffix.lower() == ".gif" else None)
+    except InputError as e:  # the planner names "duration" or "speed": say which key of which scene
+        d = scene.spec.driver
+        if e.field == "duration":
+            key, value = ("driver.duration", d.duration) if d.duration is not None else \
+                ("driver.cycles", d.cycles if d.cycles is not None else 1.0)
+            raise InputError(f"{scene.path}: {key}", value, e.expected) from None
+        if e.field == "speed":
+            raise InputError(f"{scene.path}: driver.speed", d.speed, e.expected) from None
+        raise
+
+
 def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, progress: bool = True,
                  fps: float | None = None) -> int:
     """Render a scene's analytic motion (and optionally an overlay motion) to ``out``; returns the frame count.
@@ -91,7 +118,7 @@ def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, p
     ``[render] fps``) sets the frame rate.  The overlay, a simulated motion
     with sample times, is interpolated to the frame instants.
     """
-    from .animation import animation_motion, plan_frames, resample, scene_duration
+    from .animation import animation_motion, resample
     from .errors import InputError
     from .render import Renderer, palette_colors
 
@@ -104,22 +131,40 @@ def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, p
         if not video_available():
             raise InputError("-o", str(out), f"the video extra for {suffix} output: pip install 'planar[video]' "
                                              "(imageio-ffmpeg), or write a .gif")
-    fps = fps if fps is not None else scene.spec.render.fps
-    plan = plan_frames(scene.mechanism.driver.period, scene_duration(scene), fps,
-                       tick_ms=10.0 if suffix == ".gif" else None)
+    from shapely.errors import GEOSException
+
+    from .limits import check_count
+
+    # bounds before any frame is planned or drawn: the scene's samples (and memory), then the frames
+    scene.sample_count()
+    field_name = "driver.duration" if scene.spec.driver.duration is not None else "driver.cycles"
+    shown = getattr(scene.spec.driver, field_name.split(".")[1])
+    shown = 1.0 if shown is None else shown  # one cycle unless the scene says
+    plan = animation_plan(scene, out, fps)
+    check_count("frames", f"{scene.path}: {field_name}", plan.frames, "frames", shown=shown)
+    check_count("samples", f"{scene.path}: {field_name}", plan.frames * max(
+        1, math.ceil(scene.spec.driver.samples_per_cycle / plan.frames_per_cycle)), "samples to draw from", shown=shown)
+    if suffix == ".gif" and plan.delay_ms > GIF_MAX_DELAY_MS:
+        raise InputError(f"{scene.path}: driver.speed", scene.spec.driver.speed,
+                         f"a frame delay a GIF can hold (at most {GIF_MAX_DELAY_MS / 1000:g} s; this needs "
+                         f"{plan.delay_ms / 1000:.4g} s): a higher speed or frame rate")
     motion, fine = animation_motion(scene, plan)
     if overlay is not None:
         overlay = resample(overlay, plan.times())
     polys = {n: scene.polygons[n] for n in scene.spec.render.sweep}
-    r = Renderer(scene.mechanism, motion, scene_style(scene), overlay=overlay, polygons=polys, trail_motion=fine)
-    if suffix == ".gif":
-        from exporters.gif import indexer, write_gif
+    try:
+        r = Renderer(scene.mechanism, motion, scene_style(scene), overlay=overlay, polygons=polys, trail_motion=fine)
+        if suffix == ".gif":
+            from exporters.gif import indexer, write_gif
 
-        pal = palette_colors(r.style, len(scene.mechanism.parts))
-        return write_gif(out, r.frames(progress=progress, post=indexer(pal)), int(plan.delay_ms), pal)
-    from exporters.video import write_video
+            pal = palette_colors(r.style, len(scene.mechanism.parts))
+            return write_gif(out, r.frames(progress=progress, post=indexer(pal)), int(plan.delay_ms), pal)
+        from exporters.video import write_video
 
-    return write_video(out, r.frames(progress=progress), plan.fps)
+        return write_video(out, r.frames(progress=progress), plan.fps)
+    except GEOSException as e:  # part outlines of extreme sizes (a coupler point at 1e305) defeat GEOS
+        raise InputError(f"{scene.path}: mechanism", f"parts up to {scene.mechanism.size:.4g} units across",
+                         f"part sizes the outline geometry can draw (shapely: {' '.join(str(e).split())})") from None
 
 
 def build_gallery(source: str | Path, output: str | Path | None = None,
@@ -132,10 +177,13 @@ def build_gallery(source: str | Path, output: str | Path | None = None,
 
     scenes = gallery_scenes(source)
     out = Path(output) if output is not None else Path(source)
+    if out.exists() and not out.is_dir():
+        raise InputError("gallery output", str(out), "a folder (it is an existing file)")
+    loaded = [load_scene(path) for path in scenes]  # every scene checked before the first GIF is drawn
     out.mkdir(parents=True, exist_ok=True)
-    for path in scenes:
+    for path, scene in zip(scenes, loaded):
         target = out / (path.stem + ".gif")
-        yield path, target, render_scene(load_scene(path), target, progress=progress)
+        yield path, target, render_scene(scene, target, progress=progress)
 
 
 # --------------------------------------------------------------------------- motion tables
@@ -200,7 +248,17 @@ def export_scene(scene: Scene, dxf: str | Path | None = None, svg: str | Path | 
     from .fabexport import build, write_outputs
     from .fabparts import FabSettings
 
-    fab = build(scene, FabSettings.from_spec(scene.spec.fabrication, kerf, sheet))
+    spec = scene.spec.fabrication
+    w, h = sheet if sheet is not None else spec.sheet_mm
+    where = "--sheet" if sheet is not None else f"{scene.path}: fabrication.sheet_mm"
+    if not all(math.isfinite(v) and 0 < v <= MAX_SHEET_MM for v in (w, h)):
+        raise InputError(where, f"{w:g} x {h:g}", f"a sheet of finite, positive sides up to {MAX_SHEET_MM:g} mm")
+    across = scene.mechanism.size * spec.unit_mm  # the largest part's diameter, mm
+    if not across <= math.hypot(w, h):
+        raise InputError(f"{scene.path}: fabrication.unit_mm", spec.unit_mm,
+                         f"parts that fit the {w:g} x {h:g} mm sheet (the largest part is {across:.4g} mm across; "
+                         "a smaller unit_mm or a larger sheet)")
+    fab = build(scene, FabSettings.from_spec(spec, kerf, sheet))
     fab.written = write_outputs(fab, dxf, svg, preview, bom, assembly, kerf_test)
     return fab
 

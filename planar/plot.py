@@ -17,14 +17,19 @@ Charts (``what``):
 * ``speed`` — speed ``|v|`` of every named point (model units/s; a foot's);
 * ``acceleration`` — angular acceleration of every moving part (rad/s^2);
 * ``torque`` — the motor torque under the scene's ``[effects]`` (inverse
-  dynamics) and the loads' share alone.
+  dynamics) and the loads' share alone;
+* ``follower`` — a cam's follower: displacement, velocity and acceleration
+  against cam angle (the motion law's closed forms), one panel each;
+* ``pressure`` — a cam's pressure angle, with its allowed maximum.
 
-The horizontal axis is the crank angle in degrees for a turning crank, else
-time in seconds.  Invalid samples (and toggles, where rates are undefined)
+The horizontal axis is the crank angle (a cam's: cam angle) in degrees for a
+turning input, else time in seconds.  Invalid samples (and toggles, where rates are undefined)
 are gaps.
 """
 
 from __future__ import annotations
+
+import math
 
 import io
 import os
@@ -43,7 +48,7 @@ if TYPE_CHECKING:
 __all__ = ["CHARTS", "scene_figure", "write_plot", "available_charts"]
 
 #: every chart :func:`scene_figure` can draw, in drawing order
-CHARTS = ("curve", "transmission", "velocity", "speed", "acceleration", "torque")
+CHARTS = ("curve", "follower", "pressure", "transmission", "velocity", "speed", "acceleration", "torque")
 #: the transmission angles designers keep to (degrees)
 GOOD_TRANSMISSION = (40.0, 140.0)
 
@@ -53,12 +58,20 @@ def available_charts(scene: "Scene") -> list[str]:
     from .derivatives import transmission_angles
 
     out = ["curve"] if scene.mechanism.points else []
+    if _is_cam(scene.mechanism):
+        out += ["follower", "pressure"]
     if transmission_angles(scene.mechanism, scene.mechanism.driver.value(np.zeros(1))):
         out.append("transmission")
     out.append("velocity")
     if scene.mechanism.points:
         out.append("speed")
     return out + ["acceleration", "torque"]
+
+
+def _is_cam(mech: Any) -> bool:
+    from .cams.mechanism import CamMechanism
+
+    return isinstance(mech, CamMechanism)
 
 
 def _parse_what(scene: "Scene", what: Sequence[str] | None) -> list[str]:
@@ -70,7 +83,8 @@ def _parse_what(scene: "Scene", what: Sequence[str] | None) -> list[str]:
         if w not in CHARTS:
             raise InputError("--what", w, f"one of {', '.join(CHARTS)}")
         if w not in avail:
-            why = "it has no named points" if w in ("curve", "speed") else "it has no RRR dyad"
+            why = ("it has no named points" if w in ("curve", "speed") else
+                   "it is not a cam" if w in ("follower", "pressure") else "it has no RRR dyad")
             raise InputError("--what", w, f"a chart that applies to {scene.name!r} ({why}); it has {', '.join(avail)}")
         if w not in chosen:
             chosen.append(w)
@@ -88,7 +102,13 @@ def _motion(scene: "Scene", samples_per_cycle: int | None) -> "Motion":
     d = scene.spec.driver
     drv = scene.mechanism.driver
     cycles = d.duration / drv.period if d.duration is not None else (d.cycles if d.cycles is not None else 1.0)
-    n = max(2, int(round(samples_per_cycle * cycles)))
+    from .limits import check_count, check_memory
+
+    total = samples_per_cycle * cycles  # bounded before anything is allocated (planar.limits)
+    n = max(2, check_count("samples", "--samples", round(total) if math.isfinite(total) else total,
+                           "samples in all (--samples x the scene's cycles)", shown=samples_per_cycle))
+    check_memory("--samples", samples_per_cycle,
+                 8.0 * 4 * n * (3 * len(scene.mechanism.parts) + 2 * len(scene.mechanism.points) + 4), "the charts' motion")
     t = np.arange(n) * (drv.period / samples_per_cycle)
     return scene.mechanism.solve(drv.value(t), t=t)
 
@@ -115,20 +135,26 @@ def scene_figure(scene: "Scene", what: Sequence[str] | None = None, width_in: fl
     names, cols = derivative_columns(mech, motion, scene.effects)
     col = dict(zip(names, cols))
     drv = mech.driver
+    cam = _is_cam(mech)
     if drv.kind == "rotation" and drv.amplitude is None:
-        x, xlabel, xunit = np.degrees(motion.driver), "crank angle (deg)", "°"
+        x, xlabel, xunit = np.degrees(motion.driver), f"{'cam' if cam else 'crank'} angle (deg)", "°"
     else:
         assert motion.t is not None
         x, xlabel, xunit = motion.t, "time (s)", " s"
     good = col["rates_valid"] == 1.0
     moving = [p.name for p in mech.parts if not p.ground]
 
-    fig = Figure(figsize=(width_in, 2.6 * len(charts) + 0.6), dpi=100, layout="constrained")
+    panels = [(c, k) for c in charts for k in ((0, 1, 2) if c == "follower" else (0,))]
+    fig = Figure(figsize=(width_in, 2.6 * len(panels) + 0.6), dpi=100, layout="constrained")
     FigureCanvasAgg(fig)
     title = scene.name
     fig.suptitle(f"{title}: {drv.rate / (2 * np.pi):g} cycles/s", fontsize=11)
-    axes = fig.subplots(len(charts), 1, squeeze=False)[:, 0]
-    for ax, chart in zip(axes, charts):
+    axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0]
+    for ax, (chart, k) in zip(axes, panels):
+        if chart == "follower":
+            _follower_panel(ax, mech, motion, x, k)
+            ax.set_xlabel(xlabel)
+            continue
         ax.set_gid(f"chart-{chart}")
         ax.grid(True, lw=0.4, alpha=0.5)
         if chart == "curve":
@@ -142,6 +168,19 @@ def scene_figure(scene: "Scene", what: Sequence[str] | None = None, width_in: fl
             ax.set_xlabel("x (model units)")
             ax.set_ylabel("y")
             ax.set_title("path of the named points (dot: first sample)", fontsize=9)
+        elif chart == "pressure":
+            cm: Any = mech  # a CamMechanism (available_charts offers "pressure" only for one)
+            prof = cm.profile
+            deg = np.degrees(prof.pressure_angle(np.mod(motion.driver, 2 * np.pi)))
+            (ln,) = ax.plot(x, deg, lw=1.4, label="pressure angle")
+            ln.set_gid("pressure")
+            limit = float(np.degrees(cm.max_pressure_angle))
+            ax.axhline(limit, color="#d62728", lw=0.8, ls="--")
+            ax.axhline(-limit, color="#d62728", lw=0.8, ls="--")
+            k2 = int(np.nanargmax(np.abs(deg)))
+            ax.set_title(f"pressure angle: largest {abs(deg[k2]):.1f}° at {x[k2]:.4g}{xunit} (allowed {limit:.0f}°)",
+                         fontsize=9)
+            ax.set_ylabel("pressure angle (deg)")
         elif chart == "transmission":
             lo, hi = GOOD_TRANSMISSION
             ax.axhspan(lo, hi, color="#2ca02c", alpha=0.08, lw=0)
@@ -184,6 +223,24 @@ def scene_figure(scene: "Scene", what: Sequence[str] | None = None, width_in: fl
         if len(ax.get_lines()) > 1 or chart == "curve":
             ax.legend(fontsize=7, loc="best", ncols=2 if len(ax.get_lines()) > 6 else 1)
     return fig
+
+
+def _follower_panel(ax: Any, mech: Any, motion: "Motion", x: np.ndarray, k: int) -> None:
+    """Panel ``k`` (0 displacement, 1 velocity, 2 acceleration) of a cam's follower, from the motion law."""
+    ax.set_gid(f"chart-follower-{('displacement', 'velocity', 'acceleration')[k]}")
+    ax.grid(True, lw=0.4, alpha=0.5)
+    fm = mech.follower_motion(motion.driver)
+    osc = mech.profile.follower.motion == "oscillating"
+    y = (fm["q"], fm["dq_dt"], fm["d2q_dt2"])[k]
+    if osc:
+        y = np.degrees(y)
+    unit = ("deg", "deg/s", "deg/s²")[k] if osc else ("model units", "units/s", "units/s²")[k]
+    name = ("displacement", "velocity", "acceleration")[k]
+    (ln,) = ax.plot(x, y, lw=1.4, color=("#1f77b4", "#ff7f0e", "#2ca02c")[k], label=f"follower {name}")
+    ln.set_gid(f"follower:{name}")
+    ax.set_ylabel(f"{'arm angle' if osc and k == 0 else name} ({unit})")
+    if k == 0:
+        ax.set_title(f"follower ({'oscillating arm' if osc else 'translating'}): the cam's motion law", fontsize=9)
 
 
 def _render(fig: Any, fmt: str) -> bytes:

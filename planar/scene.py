@@ -12,13 +12,14 @@ model units (``[fabrication] unit_mm`` says what one unit is in millimetres).
 from __future__ import annotations
 
 import math
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Annotated, Any, Literal, Union
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, Strict, StrictBool, ValidationError, model_validator
 
 from .effects import Effects, Load, Spring
 from .errors import InputError, PlanarError, SceneError
@@ -27,8 +28,22 @@ from .model import Mechanism, Motion
 __all__ = ["SceneSpec", "Scene", "load_scene", "parse_scene", "scene_schema"]
 
 Vec2 = tuple[float, float]
-Pos = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-Real = Annotated[float, Field(allow_inf_nan=False)]
+# strict types: a number is a TOML number (true is not 1.0, "4" is not 4.0), a flag is true or false
+Pos = Annotated[float, Strict(), Field(gt=0, allow_inf_nan=False)]
+Real = Annotated[float, Strict(), Field(allow_inf_nan=False)]
+#: a name written into CSV headers, DXF groups and SVG text: no control character, comma or double quote
+_NAME = r'^[^\x00-\x1f\x7f,"]*$'
+Name = Annotated[str, Strict(), Field(min_length=1, max_length=80, pattern=_NAME)]
+Title = Annotated[str, Strict(), Field(max_length=80, pattern=_NAME)]
+
+
+def _whole(v: Any) -> Any:
+    if isinstance(v, bool) or not isinstance(v, int):
+        raise ValueError("expected 1 or -1 (a whole number)")
+    return v
+
+
+Branch = Annotated[Literal[1, -1], BeforeValidator(_whole)]
 
 
 class _Strict(BaseModel):
@@ -43,9 +58,9 @@ class PolygonSpec(_Strict):
     ``points = [[5.1, -2.25], [6.6, -2.25], [6.6, -1.95], [5.1, -1.95]]``.
     """
 
-    name: str
+    name: Name
     """The polygon's name (``[render] sweep`` refers to it), e.g. ``"foot"``."""
-    part: str
+    part: Name
     """The part it is fixed to, e.g. ``"coupler"`` (a four-bar's parts: crank, coupler, rocker)."""
     points: Annotated[list[tuple[Real, Real]], Field(min_length=3)]
     """At least three ``[x, y]`` vertices in the part's frame (model units), e.g. ``[[0, 0], [1, 0], [1, 0.2]]``."""
@@ -96,7 +111,7 @@ class SliderCrankSpec(_Strict):
     """Connecting-rod length from crank pin to wrist pin, e.g. ``3.0``."""
     offset: Real = 0.0
     """The slider's line ``y = offset`` (model units), e.g. ``0.2``; ``|offset| < crank + rod``."""
-    branch: Literal[1, -1] = 1
+    branch: Branch = 1
     """``1``: the slider on the +x side of the crank; ``-1``: the -x side."""
     placement: tuple[Real, Real, Real] = (0.0, 0.0, 0.0)
     """``[x, y, angle]`` of the whole mechanism in the world (angle in the scene's angle unit)."""
@@ -111,6 +126,9 @@ _NODE_FIELDS = {
     "rrr": ("a", "ra", "b", "rb"),
     "rrp": ("a", "ra", "p", "q"),
     "rigid": ("a", "b", "local"),
+    "geared": ("centre", "radius", "mesh", "ratio"),
+    "driven": ("centre", "radius"),
+    "triad": ("a", "ra", "local", "at"),
 }
 
 
@@ -131,45 +149,72 @@ class NodeSpec(_Strict):
       ``offset``: ``{ name = "S", kind = "rrp", a = "A", ra = 3.0, p = "G1", q = "G2", branch = 1 }``
       (``branch = 1``: the root further along p -> q);
     * ``rigid`` — fixed in the frame of ``a`` (origin) and ``b`` (x axis): coupler points, ternary
-      links: ``{ name = "T", kind = "rigid", a = "Q", b = "A", local = [4.0, 0.0] }``.
+      links: ``{ name = "T", kind = "rigid", a = "Q", b = "A", local = [4.0, 0.0] }``;
+    * ``geared`` — a crank geared to another: ``{ name = "B", kind = "geared", centre = "O2", radius = 1.2,
+      mesh = "A", ratio = -1.0, phase = 90.0 }`` (angle = ratio * angle(mesh) + phase; both centres fixed);
+    * ``driven`` — an input with its own law of the ``[driver]`` clock theta: ``{ name = "B", kind = "driven",
+      centre = "O2", radius = 1.5, cycles = 2.0, phase = 90.0, mean = 110.0, amplitude = 30.0 }``;
+    * ``triad`` — one of three nodes on a ternary link, each ``ra`` from its node ``a``, solved together:
+      ``{ name = "T1", kind = "triad", members = ["T2", "T3"], a = "C", ra = 3.27, local = [0.0, 0.0],
+      at = [2.0, 3.0] }`` (``at``: roughly where it is with the driver at 0; the members give ``a``, ``ra``,
+      ``local``, ``at``).
     """
 
-    name: str
+    name: Name
     """The node's name (links, points and later nodes refer to it), e.g. ``"B"``."""
-    kind: Literal["fixed", "crank", "actuator", "rrr", "rrp", "rigid"]
-    """One of ``fixed``, ``crank``, ``actuator``, ``rrr``, ``rrp``, ``rigid`` (see the node's description)."""
+    kind: Literal["fixed", "crank", "actuator", "rrr", "rrp", "rigid", "geared", "driven", "triad"]
+    """One of ``fixed``, ``crank``, ``actuator``, ``rrr``, ``rrp``, ``rigid``, ``geared``, ``driven``, ``triad``
+    (see the node's description)."""
     at: tuple[Real, Real] | None = None
-    """``fixed``: the ground point ``[x, y]`` (model units), e.g. ``[-38.0, -7.8]``."""
-    centre: str | None = None
-    """``crank``: the node it turns about, e.g. ``"O"``."""
+    """``fixed``: the ground point ``[x, y]`` (model units), e.g. ``[-38.0, -7.8]``; ``triad``: roughly where the
+    node is with the driver at 0 (picks the assembly)."""
+    centre: Name | None = None
+    """``crank``, ``geared``, ``driven``: the node it turns about, e.g. ``"O"``."""
     radius: Pos | None = None
-    """``crank``: its radius (model units), e.g. ``15.0``."""
+    """``crank``, ``geared``, ``driven``: its radius (model units), e.g. ``15.0``."""
     phase: Real = 0.0
-    """``crank``: added to the driver angle (scene's angle unit), e.g. ``90``."""
-    origin: str | None = None
+    """``crank``: added to the driver angle; ``geared``: added to ratio * angle(mesh); ``driven``: in its law
+    (scene's angle unit), e.g. ``90``."""
+    origin: Name | None = None
     """``actuator``: the node it translates from, e.g. ``"O"``."""
     axis: tuple[Real, Real] = (1.0, 0.0)
     """``actuator``: the direction it translates along (normalised), e.g. ``[0.0, 1.0]``."""
-    a: str | None = None
-    """``rrr``, ``rrp``: the node at distance ``ra``; ``rigid``: the frame's origin node. E.g. ``"A"``."""
+    a: Name | None = None
+    """``rrr``, ``rrp``, ``triad``: the node at distance ``ra``; ``rigid``: the frame's origin node. E.g. ``"A"``."""
     ra: Pos | None = None
-    """``rrr``, ``rrp``: the link length from ``a`` (model units), e.g. ``50.0``."""
-    b: str | None = None
+    """``rrr``, ``rrp``, ``triad``: the link length from ``a`` (model units), e.g. ``50.0``."""
+    b: Name | None = None
     """``rrr``: the node at distance ``rb``; ``rigid``: the node the frame's x axis points to. E.g. ``"Z"``."""
     rb: Pos | None = None
     """``rrr``: the link length from ``b`` (model units), e.g. ``41.5``."""
-    p: str | None = None
+    p: Name | None = None
     """``rrp``: the slot line's first node (the line runs p -> q), e.g. ``"G1"``."""
-    q: str | None = None
+    q: Name | None = None
     """``rrp``: the slot line's second node, e.g. ``"G2"``."""
-    branch: Literal[1, -1] = 1
+    branch: Branch = 1
     """``rrr``: ``1`` left of a -> b, ``-1`` right; ``rrp``: ``1`` further along p -> q. Holds at the first
     sample and is carried by continuity."""
     offset: Real = 0.0
     """``rrp``: the slot line shifted left of p -> q by this (model units); ``actuator``: added to the
     driver value."""
     local: tuple[Real, Real] | None = None
-    """``rigid``: ``[u, v]`` in the frame of ``a`` (origin) and ``b`` (x axis), model units, e.g. ``[4.0, 0.0]``."""
+    """``rigid``: ``[u, v]`` in the frame of ``a`` (origin) and ``b`` (x axis), model units, e.g. ``[4.0, 0.0]``;
+    ``triad``: the node's place on the ternary link (any frame), e.g. ``[3.0, 0.0]``."""
+    mesh: Name | None = None
+    """``geared``: the crank node it meshes with (``crank``, ``geared`` or ``driven``), e.g. ``"A"``."""
+    ratio: Real | None = None
+    """``geared``: angular velocity ratio, negative (external spur gears): angle = ratio * angle(mesh) + phase,
+    e.g. ``-1.0``."""
+    cycles: Pos = 1.0
+    """``driven``: turns (or rocking cycles) per cycle of the ``[driver]`` clock, e.g. ``2.0``."""
+    amplitude: Pos | None = None
+    """``driven``: a rocking input: angle = mean + amplitude sin(cycles theta + phase) (scene's angle unit),
+    e.g. ``30.0``; without it the node turns: angle = phase + cycles theta."""
+    mean: Real = 0.0
+    """``driven``: the middle of a rocking input's swing (scene's angle unit), e.g. ``110.0``."""
+    members: tuple[Name, Name] | None = None
+    """``triad``: on the triad's first node only, the two other nodes (declared after it), e.g.
+    ``["T2", "T3"]``."""
 
     @model_validator(mode="after")
     def _needs(self) -> "NodeSpec":
@@ -183,12 +228,12 @@ class LinkSpec(_Strict):
     """A rigid part carrying nodes: ``{ name = "upper", nodes = ["Z", "B", "D"] }``; a block sliding along a
     line of another link: ``{ name = "block", nodes = ["A"], guide = ["Q", "T"] }``."""
 
-    name: str
+    name: Name
     """The part's name (the ground is ``ground``, made of the fixed nodes unless declared), e.g. ``"lever"``."""
-    nodes: Annotated[list[str], Field(min_length=1)]
+    nodes: Annotated[list[Name], Field(min_length=1)]
     """The nodes it carries; its frame has its origin at the first and x toward the second, e.g.
     ``["Q", "T"]``. A node shared by two links is a pivot."""
-    guide: tuple[str, str] | None = None
+    guide: tuple[Name, Name] | None = None
     """With one node: a block on that node sliding along the line ``[p, q]`` of the link carrying both,
     e.g. ``["Q", "T"]``."""
 
@@ -204,7 +249,7 @@ class LinkageSpec(_Strict):
     ``crank`` or ``actuator`` is the input."""
     links: Annotated[list[LinkSpec], Field(min_length=1)]
     """``[[mechanism.links]]`` tables: the parts."""
-    points: dict[str, str] = {}
+    points: dict[Name, Name] = {}
     """Named points: name -> node, e.g. ``{ foot = "F" }`` (columns of the motion table, trails, loads)."""
     placement: tuple[Real, Real, Real] = (0.0, 0.0, 0.0)
     """``[x, y, angle]`` of the whole linkage in the world (angle in the scene's angle unit)."""
@@ -218,9 +263,9 @@ class ElementalSpec(_Strict):
 
     type: Literal["elemental"]
     """``"elemental"``."""
-    number: Annotated[int, Field(ge=1, le=11)]
+    number: Annotated[int, Strict(), Field(ge=1, le=11)]
     """Which mechanism, 1-11 (the supplement's numbering; README's table of parameters), e.g. ``5``."""
-    params: dict[str, Union[Real, list[Real]]] = {}
+    params: dict[Name, Union[Real, list[Real]]] = {}
     """Parameters overriding the supplement's defaults, by name (README: "Elemental parameters"), e.g.
     ``{ F_jc = [-0.5, 0.0], amplitude = 20 }``; angles (``phi``, ``D_theta``, an Oz ``amplitude``) in the
     scene's angle unit."""
@@ -231,7 +276,7 @@ class ChainSpec(_Strict):
 
     type: Literal["chain"]
     """``"chain"``."""
-    chain: Annotated[list[str], Field(min_length=1)]
+    chain: Annotated[list[Name], Field(min_length=1)]
     """Patterns ``"In->Out"``, the first driven by the motor (``Rz``), each by the previous one's output
     (``planar chains`` lists them), e.g. ``["Rz->OzT", "OzT->Oz"]``."""
 
@@ -255,9 +300,9 @@ class ToySpec(_Strict):
 
     type: Literal["toy"]
     """``"toy"``."""
-    left: list[Annotated[list[str], Field(min_length=1)]] = []
+    left: list[Annotated[list[Name], Field(min_length=1)]] = []
     """Chains on the left cam, e.g. ``[["Rz->OzT", "OzT->Oz"]]``; chains sharing a prefix share its stages."""
-    right: list[Annotated[list[str], Field(min_length=1)]] = []
+    right: list[Annotated[list[Name], Field(min_length=1)]] = []
     """Chains on the right cam, e.g. ``[["Rz->OzT", "OzT->Ty"], ["Rz->OzT", "OzT->Oz"]]``."""
     phase: Real = math.pi
     """The right cam's lead over the left (scene's angle unit), e.g. ``180`` with ``angle_unit = "deg"``."""
@@ -276,7 +321,7 @@ class CatalogSpec(_Strict):
 
     type: Literal["catalog"]
     """``"catalog"``."""
-    name: str
+    name: Name
     """A name of ``planar.catalog.CATALOG``, e.g. ``"jansen"``, ``"kangaroo"``, ``"windup-5"``, ``"horse"``."""
 
 
@@ -312,7 +357,7 @@ class CamFollowerSpec(_Strict):
     """Pivot to the roller's centre (knife: its tip) of an oscillating follower, e.g. ``3.2``."""
     face_offset: Real = 0.0
     """A flat face's distance from the pivot's line, toward the cam, e.g. ``0.3``."""
-    branch: Literal[1, -1] = 1
+    branch: Branch = 1
     """Which of the two arm positions touching the base circle (oscillating), ``1`` or ``-1``."""
 
     @model_validator(mode="after")
@@ -345,7 +390,7 @@ class CamSpec(_Strict):
     """Linkage nodes the follower drives, as in a ``linkage`` scene; the follower's are ``tip`` and ``pivot``."""
     links: list[LinkSpec] = []
     """Links of the driven linkage, as in a ``linkage`` scene (``follower`` may list extra nodes)."""
-    points: dict[str, str] = {}
+    points: dict[Name, Name] = {}
     """Named points: name to node, e.g. ``{ beak = "H" }``; default the follower's ``tip``."""
     polygons: list[PolygonSpec] = []
     """Polygons fixed to parts (drawn swept with them), as in other scenes."""
@@ -377,7 +422,7 @@ class DriverSpec(_Strict):
     """How many cycles to solve (default 1), e.g. ``2``; or give ``duration``."""
     duration: Pos | None = None
     """Seconds to solve instead of ``cycles``, e.g. ``3.0``."""
-    samples_per_cycle: Annotated[int, Field(ge=4, le=100_000)] = 72
+    samples_per_cycle: Annotated[int, Strict(), Field(ge=4, le=100_000)] = 72
     """Samples (and animation frames) per cycle, 4-100000, e.g. ``36``."""
     phase: Real = 0.0
     """Input at t = 0 for a turning input, or the sine's phase for a rocking one (scene's angle unit)."""
@@ -399,7 +444,7 @@ class DriverSpec(_Strict):
 class LoadSpec(_Strict):
     """A force (model force units, world frame) the mechanism exerts at a named point."""
 
-    point: str
+    point: Name
     """The named point it acts at, e.g. ``"coupler_point"``, ``"foot"``."""
     force: tuple[Real, Real]
     """``[fx, fy]`` the mechanism exerts there (model force units, world frame), e.g. ``[0.0, 10.0]``."""
@@ -408,19 +453,19 @@ class LoadSpec(_Strict):
 class SpringSpec(_Strict):
     """A damped spring between two parts (anchors in each part's frame)."""
 
-    a: str
+    a: Name
     """The first part, e.g. ``"crank"``."""
     anchor_a: tuple[Real, Real] = (0.0, 0.0)
     """Its anchor in part ``a``'s frame (model units), e.g. ``[0.5, 0.0]``."""
-    b: str
+    b: Name
     """The second part, e.g. ``"rocker"``."""
     anchor_b: tuple[Real, Real] = (0.0, 0.0)
     """Its anchor in part ``b``'s frame."""
-    rest_length: Annotated[float, Field(ge=0)] | None = None
+    rest_length: Annotated[float, Strict(), Field(ge=0)] | None = None
     """Unstretched length (model units); default: the anchors' distance at the first sample."""
     stiffness: Pos
     """Force per unit of stretch, e.g. ``10.0``."""
-    damping: Annotated[float, Field(ge=0)] = 0.0
+    damping: Annotated[float, Strict(), Field(ge=0)] = 0.0
     """Force per unit of stretching speed, e.g. ``0.1``."""
 
 
@@ -429,11 +474,7 @@ class EffectsSpec(_Strict):
 
     gravity: tuple[Real, Real] | None = None
     """``[gx, gy]`` in model units per s^2, e.g. ``[0.0, -9.81]``; none unless given."""
-    contact: bool = False
-    """Collisions between parts: refused (``true`` is an error; parts sit in layers and never touch)."""
-    friction: Annotated[float, Field(ge=0)] | None = None
-    """Friction coefficient of the rebuild's contacts (kept for the schema; contacts are refused)."""
-    damping: Annotated[float, Field(gt=0, le=1)] | None = None
+    damping: Annotated[float, Strict(), Field(gt=0, le=1)] | None = None
     """Space damping: fraction of every body's velocity kept per second, in (0, 1], e.g. ``0.99``."""
     density: Pos = 1.0
     """Mass per unit area of every part (inertia in ``compare`` and the motor torque), e.g. ``0.01``."""
@@ -444,30 +485,39 @@ class EffectsSpec(_Strict):
     motor_force_limit: Pos | None = None
     """``compare`` drives with a motor of this largest torque instead of an exact input, e.g. ``50.0``."""
 
+    @model_validator(mode="before")
+    @classmethod
+    def _no_contact(cls, data: Any) -> Any:
+        for key in ("contact", "friction"):
+            if isinstance(data, dict) and key in data:
+                raise ValueError(f"'{key}' was removed: the parts of a mechanism sit on layers and never touch, "
+                                 "so collisions (and their friction) are not simulated; delete the key")
+        return data
+
 
 class RenderSpec(_Strict):
     """How ``planar render`` draws the animation."""
 
-    width: Annotated[int, Field(ge=16, le=4096)] = 480
+    width: Annotated[int, Strict(), Field(ge=16, le=4096)] = 480
     """Frame width in pixels (16-4096), e.g. ``480``."""
-    height: Annotated[int, Field(ge=16, le=4096)] = 360
+    height: Annotated[int, Strict(), Field(ge=16, le=4096)] = 360
     """Frame height in pixels (16-4096), e.g. ``360``."""
-    supersample: Annotated[int, Field(ge=1, le=4)] = 2
+    supersample: Annotated[int, Strict(), Field(ge=1, le=4)] = 2
     """Antialiasing factor 1-4 (drawn this much larger, then reduced)."""
-    trails: list[str] | None = None
+    trails: list[Name] | None = None
     """Named points whose paths are drawn, e.g. ``["coupler_point"]``; default every named point."""
-    sweep: list[str] = []
+    sweep: list[Name] = []
     """Polygons drawn swept along the motion, e.g. ``["foot"]``."""
-    background: Annotated[str, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#ffffff"
+    background: Annotated[Name, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#ffffff"
     """Background colour ``#rrggbb``, e.g. ``"#ffffff"``."""
-    show_pins: bool = True
+    show_pins: StrictBool = True
     """Draw the pins of the joints."""
-    fps: Annotated[float, Field(gt=0, le=240)] | None = None
+    fps: Annotated[float, Strict(), Field(gt=0, le=240)] | None = None
     """Frames per second of the animation, e.g. ``25.0``; default 25, or 50 when a cycle would get fewer than 12
     frames; a GIF plays at most 50. A cycle plays for ``1/speed`` seconds within one frame delay."""
-    opacity: Annotated[float, Field(ge=0, le=1)] = 1.0
+    opacity: Annotated[float, Strict(), Field(ge=0, le=1)] = 1.0
     """Fill opacity of moving parts, 0-1, e.g. ``0.6``: below 1 what lies under a part shows through."""
-    exploded: bool = False
+    exploded: StrictBool = False
     """Draw a wind-up toy as its exploded stage panels instead of assembled (default: assembled), e.g. ``true``."""
 
 
@@ -478,11 +528,11 @@ class FabricationSpec(_Strict):
     """What one model unit is in millimetres, e.g. ``15.0``."""
     thickness_mm: Pos = 3.0
     """Sheet thickness (pin lengths, spacers), e.g. ``3.0``."""
-    kerf_mm: Annotated[float, Field(ge=0, le=2)] = 0.15
+    kerf_mm: Annotated[float, Strict(), Field(ge=0, le=2)] = 0.15
     """Beam width 0-2 mm: outlines grow and holes shrink by half of it."""
     pin_diameter_mm: Pos = 3.0
     """Diameter of every pin (holes and slots are cut at this plus ``clearance_mm``)."""
-    clearance_mm: Annotated[float, Field(ge=0, le=2)] = 0.1
+    clearance_mm: Annotated[float, Strict(), Field(ge=0, le=2)] = 0.1
     """Running clearance added to pivot holes and slots, 0-2 mm."""
     sheet_mm: tuple[Pos, Pos] = (300.0, 200.0)
     """Sheet ``[width, height]``; parts that do not fit go on more sheets."""
@@ -495,13 +545,13 @@ class FabricationSpec(_Strict):
     """Smallest part accepted (its smaller side)."""
     min_label_mm: Pos = 1.5
     """Smallest engraved label height; below it the part's number is engraved."""
-    slot_end_margin_mm: Annotated[float, Field(ge=0, le=50)] = 1.0
+    slot_end_margin_mm: Annotated[float, Strict(), Field(ge=0, le=50)] = 1.0
     """Slot length past each end of the pin's travel."""
-    widen: bool = True
+    widen: StrictBool = True
     """Widen a rounded part too narrow for its holes (``false``: refuse it)."""
     # assembly: pin head allowance per end; drive: D-shaft (diameter, distance across the flat), motor
     # screws either side of the shaft, ground-plate mounting holes
-    pin_head_mm: Annotated[float, Field(ge=0, le=50)] = 1.5
+    pin_head_mm: Annotated[float, Strict(), Field(ge=0, le=50)] = 1.5
     """Pin head allowance per end (pin length = thickness x layers + two heads)."""
     shaft_diameter_mm: Pos = 3.0
     """Motor shaft diameter (the driven part's D hole)."""
@@ -514,22 +564,22 @@ class FabricationSpec(_Strict):
     mounting_hole_mm: Pos = 3.2
     """Diameter of the ground plates' mounting holes (on ears)."""
     # nesting and file conventions
-    spacing_mm: Annotated[float, Field(ge=0, le=100)] = 3.0
+    spacing_mm: Annotated[float, Strict(), Field(ge=0, le=100)] = 3.0
     """Gap between nested parts."""
-    margin_mm: Annotated[float, Field(ge=0, le=100)] = 5.0
+    margin_mm: Annotated[float, Strict(), Field(ge=0, le=100)] = 5.0
     """Margin from the sheet's edge."""
     svg_stroke_mm: Pos = 0.025
     """SVG stroke width (hairline for laser software)."""
-    cut_colour: Annotated[str, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#ff0000"
+    cut_colour: Annotated[Name, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#ff0000"
     """Colour of cut lines ``#rrggbb``."""
-    engrave_colour: Annotated[str, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#0000ff"
+    engrave_colour: Annotated[Name, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#0000ff"
     """Colour of engraved lines (labels, letters) ``#rrggbb``."""
 
 
 class SceneSpec(_Strict):
     """A whole scene file."""
 
-    name: str = ""
+    name: Title = ""
     """The scene's name (titles, the mechanism's name); default the file's stem, e.g. ``"kangaroo-leg"``."""
     angle_unit: Literal["rad", "deg"] = "rad"
     """Unit of every angle in the file: ``"rad"`` or ``"deg"``."""
@@ -555,12 +605,16 @@ def scene_schema() -> dict[str, Any]:
 
 def _loc(loc: tuple) -> str:
     out = ""
-    for part in loc:
+    for i, part in enumerate(loc):
         if isinstance(part, int):
             out += f"[{part}]"
-        elif part in ("fourbar", "slidercrank", "linkage", "elemental", "chain", "toy", "catalog",
-                      "cam") and out == "mechanism":
+        elif i == 1 and loc[0] == "mechanism" and part in ("fourbar", "slidercrank", "linkage", "elemental", "chain",
+                                                           "toy", "catalog", "cam"):
             continue  # the discriminated union's tag
+        elif i > 0 and (str(part) in ("float", "int", "str", "bool") or str(part).startswith(("list[", "tuple["))):
+            continue  # which member of a union (a number or a list of numbers) pydantic tried
+        elif not re.fullmatch(r"[A-Za-z0-9_\-]+", str(part)):
+            out += f"[{str(part)!r}]"  # a key with spaces, dots or control characters, shown quoted on one line
         else:
             out += ("." if out else "") + str(part)
     return out
@@ -571,6 +625,8 @@ def _format_validation(path: str, e: ValidationError) -> str:
     first = errs[0]
     where = _loc(tuple(first["loc"]))
     msg = first["msg"]
+    if first["type"] == "string_pattern_mismatch" and (first.get("ctx") or {}).get("pattern") == _NAME:
+        msg = "expected a name without control characters (newline, tab), commas or double quotes"
     got = first.get("input")
     text = f"{path}: {where or 'scene'}: {msg}"
     if first["type"] not in ("missing",) and not isinstance(got, dict):
@@ -597,17 +653,34 @@ class Scene:
     path: str = "<scene>"
     polygons: dict[str, tuple[str, np.ndarray]] = field(default_factory=dict)
 
+    def sample_count(self) -> int:
+        """Samples of :meth:`motion`, checked against :mod:`planar.limits` (samples and memory)
+        before anything is allocated; :class:`~planar.errors.LimitError` names the scene's field."""
+        from .limits import check_count, check_memory
+
+        d = self.spec.driver
+        period = self.mechanism.driver.period
+        value: float | None
+        if d.duration is not None:
+            field_name, value, cycles = "driver.duration", d.duration, d.duration / period
+        else:
+            field_name, value = "driver.cycles", d.cycles
+            cycles = d.cycles if d.cycles is not None else 1.0
+        total = d.samples_per_cycle * cycles
+        where = f"{self.path}: {field_name}"
+        n = check_count("samples", where, round(total) if math.isfinite(total) else total,
+                        "samples in all (samples_per_cycle x cycles)", shown=value)
+        # poses (x, y, angle) of every part, points (x, y), driver, time and the solver's working copies
+        per_sample = 8 * (3 * len(self.mechanism.parts) + 2 * len(self.mechanism.points) + 4) * 4
+        check_memory(where, value, float(per_sample) * max(n, 2), "a motion")
+        return max(2, n)
+
     def motion(self) -> Motion:
         """The analytic motion over the scene's cycles (or duration)."""
         d = self.spec.driver
         drv = self.mechanism.driver
-        period = drv.period
-        if d.duration is not None:
-            cycles = d.duration / period
-        else:
-            cycles = d.cycles if d.cycles is not None else 1.0
-        n = max(2, int(round(d.samples_per_cycle * cycles)))
-        t = np.arange(n) * (period / d.samples_per_cycle)
+        n = self.sample_count()
+        t = np.arange(n) * (drv.period / d.samples_per_cycle)
         return self.mechanism.solve(drv.value(t), t=t)
 
     @property
@@ -631,7 +704,7 @@ class Scene:
         e = self.spec.effects
         return Effects(
             gravity=None if e.gravity is None else (float(e.gravity[0]), float(e.gravity[1])),
-            contact=e.contact, friction=e.friction, damping=e.damping, density=e.density,
+            damping=e.damping, density=e.density,
             springs=tuple(Spring(s.a, s.b, s.stiffness, (float(s.anchor_a[0]), float(s.anchor_a[1])),
                                  (float(s.anchor_b[0]), float(s.anchor_b[1])), s.rest_length, s.damping)
                           for s in e.springs),
@@ -640,18 +713,42 @@ class Scene:
         )
 
 
-def load_scene(path: str | Path) -> Scene:
-    """Read, validate and build the scene in ``path``."""
-    p = str(path)
+def _read_text(p: str) -> str:
+    """The scene file as text: UTF-8 (a UTF-8 byte-order mark is skipped) or UTF-16 with its byte-order mark."""
     try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
+        with open(p, "rb") as fh:
+            raw = fh.read(64 * 2**20 + 1)
     except FileNotFoundError:
         raise SceneError(f"{p}: no such file") from None
     except IsADirectoryError:
         raise SceneError(f"{p}: is a directory, not a scene file") from None
+    except OSError as e:  # a loop of symbolic links, no permission, a device
+        raise SceneError(f"{p}: cannot be read ({e.strerror or e})") from None
+    if len(raw) > 64 * 2**20:
+        raise SceneError(f"{p}: larger than 64 MiB; a scene file is a short TOML text")
+    if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        codec = "utf-16"
+    else:
+        codec = "utf-8-sig"
+    try:
+        text = raw.decode(codec)
+    except UnicodeDecodeError as e:
+        raise SceneError(f"{p}: not a text file in UTF-8 (or UTF-16 with a byte-order mark): "
+                         f"byte {e.start} is {raw[e.start:e.start + 1]!r}") from None
+    text = text.removeprefix("\ufeff")  # a byte-order mark some editors repeat inside the text
+    if "\x00" in text:
+        raise SceneError(f"{p}: not a text file (it holds NUL bytes); a scene is TOML text")
+    return text
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read, validate and build the scene in ``path`` (UTF-8, or UTF-16 with a byte-order mark)."""
+    p = str(path)
+    text = _read_text(p)
+    try:
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
-        raise SceneError(f"{p}: not valid TOML: {e}") from None
+        raise SceneError(f"{p}: not valid TOML: {' '.join(str(e).split())}") from None
     return build_scene(parse_scene(data, p), p)
 
 
@@ -663,18 +760,28 @@ def build_scene(spec: SceneSpec, path: str = "<scene>") -> Scene:
     """Build the mechanism a validated scene describes."""
     m = spec.mechanism
     rate = 2 * math.pi * spec.driver.speed
+    if not (math.isfinite(rate) and math.isfinite(2 * math.pi / rate) and rate > 0):
+        raise SceneError(f"{path}: driver.speed = {spec.driver.speed!r}: expected a speed whose period "
+                         "(1 / speed seconds) and angular rate are finite numbers")
     phase = _angle(spec, spec.driver.phase)
     try:
         rock = _rocking(spec, m)
     except InputError as e:
         raise SceneError(f"{path}: {e}") from None
     try:
-        mech = _build(spec, m, rate, phase, rock)
+        with np.errstate(all="ignore"):
+            mech = _build(spec, m, rate, phase, rock)
     except PlanarError as e:
         raise SceneError(f"{path}: mechanism: {e}") from None
+    except (ValueError, ArithmeticError) as e:  # numbers past what a builder's arithmetic holds (NaN, overflow)
+        raise SceneError(f"{path}: mechanism: cannot be built from these numbers "
+                         f"({type(e).__name__}: {' '.join(str(e).split())}); check for extreme values") from None
     polygons: dict[str, tuple[str, np.ndarray]] = {}
     names = {p.name for p in mech.parts}
     for i, poly in enumerate(getattr(m, "polygons", [])):
+        if poly.name in polygons:
+            raise SceneError(f"{path}: mechanism.polygons[{i}].name: a second polygon named {poly.name!r} "
+                             "(polygon names must differ)")
         if poly.part not in names:
             raise SceneError(f"{path}: mechanism.polygons[{i}].part: no part {poly.part!r} "
                              f"(got {poly.part!r}; parts are {sorted(names)})")
@@ -743,8 +850,8 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, A
         nodes = []
         for n in m.nodes:
             cls = NODE_KINDS[n.kind]  # each node kind declares the scene keys it is built from
-            args = [_angle(spec, getattr(n, f)) if f in cls.angle_fields else getattr(n, f)
-                    for f in cls.scene_fields]
+            args = [_angle(spec, getattr(n, f)) if f in cls.angle_fields and getattr(n, f) is not None
+                    else getattr(n, f) for f in cls.scene_fields]
             nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
         links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
         return Linkage(spec.name or "linkage", nodes, links, points=m.points, placement=placement,
@@ -752,15 +859,25 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, A
     if isinstance(m, ElementalSpec):
         from .windup import ELEMENTAL, ElementalMechanism, params_for
 
+        from .windup.params import coerce
+
         base = params_for(m.number)
         angle_params = ELEMENTAL[m.number].angle_params
         kw: dict[str, Any] = {}
+        known = sorted(f for f in vars(base))
         for k, v in m.params.items():
-            val = tuple(v) if isinstance(v, list) else v
+            if k not in known:
+                raise InputError(f"params.{k}", v, f"a parameter of mechanism #{m.number}, one of {known}")
+            val = coerce(f"params.{k}", getattr(base, k), v)  # a vector of the right length, or a number
             if k in angle_params:
                 val = tuple(_angle(spec, x) for x in val) if isinstance(val, tuple) else _angle(spec, val)
             kw[k] = val
-        return ElementalMechanism(m.number, base.replace(**kw), rate=rate, phase=phase)
+        try:
+            return ElementalMechanism(m.number, base.replace(**kw), rate=rate, phase=phase)
+        except InputError as e:  # check_params names "#5.F_o": the scene's key is params.F_o
+            if e.field.startswith(f"#{m.number}.") and e.field[len(f"#{m.number}."):] != "params":
+                raise InputError("params." + e.field[len(f"#{m.number}."):], e.value, e.expected) from None
+            raise
     if isinstance(m, ChainSpec):
         from .windup.chain import chain_mechanism
 
@@ -797,7 +914,10 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, A
                             overrides=overrides, names=names)
     if isinstance(m, CamSpec):
         return _build_cam(spec, m, rate, phase)
-    mech = get(m.name)
+    try:
+        mech = get(m.name)
+    except InputError as e:
+        raise InputError("name", m.name, e.expected) from None
     if rate != 2 * math.pi or phase:
         from dataclasses import replace
 

@@ -28,10 +28,11 @@ the same at any rate and step, and never underflows (pymunk's per-second
 ``error_bias`` cannot express more than ~3 % per step at 64 substeps of a
 1 s cycle).  Velocities, forces, stiffnesses and damping are scaled to match.
 
-Only the effects a scene names exist in the space: no gravity, friction,
-damping, springs or loads otherwise (``SimResult.built`` lists what was
-built).  Wind-up #6 and #9 are spatial and are refused, as is
-``contact = true`` (parts of one mechanism sit in layers and never touch).
+Only the effects a scene names exist in the space: no gravity, damping,
+springs or loads otherwise (``SimResult.built`` lists what was built).
+Wind-up #6 and #9 are spatial and are refused.  There are no collisions:
+the parts of a mechanism sit on layers and never touch (a scene's
+``contact`` and ``friction`` keys are refused when the scene is read).
 
 Failures are found by comparing poses, in blocks of samples with arrays:
 a sample where any part leaves its analytic pose by more than
@@ -68,6 +69,7 @@ from .model import (
     Slide,
     joint_residuals,
 )
+from .linkages.gears import GearMesh
 from .registry import Registry
 
 if TYPE_CHECKING:
@@ -83,6 +85,8 @@ __all__ = [
     "mass_properties",
     "simulate",
     "simulate_scene",
+    "joint_drift",
+    "substeps_for",
     "torque_comparison",
 ]
 
@@ -93,29 +97,44 @@ class SimulationError(PlanarError):
     """The mechanism cannot be rebuilt in pymunk (spatial mechanisms, missing effects)."""
 
 
+#: default :attr:`SimSettings.step_drift`: the Jansen leg's predicted drift at 64 substeps of its 36 samples
+#: (measured: 7.6e-5 of the size in motor mode there, 4.2e-4 at 32 substeps)
+STEP_DRIFT = 3.5e-6
+
+#: substeps never rise above this many times ``SimSettings.substeps`` (a near-singular cycle would else ask
+#: for without bound)
+MAX_SUBSTEP_FACTOR = 8
+
+
 @dataclass(frozen=True)
 class SimSettings:
     """Settings that trade accuracy for time.
 
     ``substeps``: physics steps per output sample; ``iterations``: solver
     iterations per step (raised automatically where the moving parts'
-    masses differ a lot, see :func:`solver_iterations`, unless ``adaptive``
-    is off); ``correction``: fraction of a joint's position error corrected
-    per step (0 = none, 1 = all of it in one step); ``error_bias``: pymunk's
+    masses differ a lot, see :func:`solver_iterations`, or a part is a long
+    lever, see :func:`lever`, unless ``adaptive`` is off); ``correction``:
+    fraction of a joint's position error corrected per step (0 = none, 1 =
+    all of it in one step; lowered for mass ratios and, in motor mode, past
+    2400 steps per turn, unless ``adaptive`` is off); ``error_bias``: pymunk's
     fraction of joint error left uncorrected after one second, if given it
     replaces ``correction`` (``correction = 1 - error_bias ** dt``);
     ``tolerance``: a part further than this fraction of the mechanism's size
     from its analytic pose is a failure; ``blowup_tol``: a joint residual
-    above this fraction of the size marks the failure as a blow-up.
+    above this fraction of the size marks the failure as a blow-up;
+    ``step_drift``: when given, ``substeps`` is a minimum, raised until the
+    joints' predicted drift per step is at most this fraction of the size
+    (see :func:`substeps_for`); ``None`` keeps ``substeps`` as it is.
     """
 
-    substeps: int = 32
+    substeps: int = 28
     iterations: int = 40
     correction: float = 0.2
     error_bias: float | None = None
     tolerance: float = 1e-3
     blowup_tol: float = 0.05
     adaptive: bool = True
+    step_drift: float | None = STEP_DRIFT
 
     def __post_init__(self) -> None:
         from .errors import InputError
@@ -130,6 +149,8 @@ class SimSettings:
             raise InputError("error_bias", self.error_bias, "a fraction in [0, 1)")
         if not (self.tolerance > 0.0):
             raise InputError("tolerance", self.tolerance, "a positive fraction of the size")
+        if self.step_drift is not None and not (self.step_drift > 0.0):
+            raise InputError("step_drift", self.step_drift, "a positive fraction of the size")
 
     def step_correction(self, dt: float) -> float:
         """Fraction of joint error corrected per step of ``dt`` seconds."""
@@ -146,9 +167,9 @@ class SimFailure:
     """Where and how a simulation left its analytic motion.
 
     ``kind``: ``"blow-up"`` (non-finite state or a joint came apart),
-    ``"branch"`` (every joint holds but a part is elsewhere: another assembly
-    branch) or ``"drift"`` (the joints are off by more than ``tolerance`` but
-    less than ``blowup_tol``).  ``error``: the part's distance from its
+    ``"branch"`` (every joint holds but a part is more than ten tolerances
+    elsewhere: another assembly branch) or ``"drift"`` (the part is off by
+    more than ``tolerance``, the joints by less than ``blowup_tol``).  ``error``: the part's distance from its
     analytic pose as a fraction of the size.
     """
 
@@ -204,6 +225,7 @@ def _check_mechanism(mech: Mechanism) -> None:
 def _driven_parts(mech: Mechanism) -> list[str]:
     """Parts whose motion is imposed: the driver, and in toys every stage's driver that has no parent."""
     out = [mech.driver.part]
+    out += [p for p in getattr(mech, "extra_driven_parts", []) if p not in out]  # a two-input linkage
     for st in getattr(mech, "stages", []):
         name = f"{st.label}.driver"
         if name not in out:
@@ -215,13 +237,17 @@ def _holding_effect(effects: Effects | None) -> bool:
     return effects is not None and (effects.gravity is not None or len(effects.springs) > 0)
 
 
-def solver_iterations(settings: SimSettings, masses: list[float]) -> int:
+def solver_iterations(settings: SimSettings, masses: list[float], mode: str = "kinematic") -> int:
     """Solver iterations for bodies of these masses: ``settings.iterations``, times
-    ``1 + log10`` of the largest mass ratio above 10 when ``settings.adaptive``.
+    ``1 + log10`` of the largest mass ratio above 10 when ``settings.adaptive``,
+    and in motor mode past a ratio of 100 times ``sqrt(ratio / 100)`` again.
 
     An iterative (Gauss-Seidel) solver converges more slowly the more the
     masses it couples differ: a four-bar with a 1:1000 coupler/rocker mass
-    ratio blew up in motor mode at 20 iterations and holds at 80.
+    ratio blew up in motor mode at 20 iterations and holds at 80.  The motor's
+    torque needs more: a 100x heavier coupler (ratio 772) gives it 6.8 % off
+    at 156 iterations, 0.5 % at 428; a 1000x heavier rocker (ratio 2630)
+    4.1 % at 354, 0.17 % at 531.
     """
     m = [x for x in masses if x > 0 and math.isfinite(x)]
     if not settings.adaptive or len(m) < 2:
@@ -229,10 +255,143 @@ def solver_iterations(settings: SimSettings, masses: list[float]) -> int:
     ratio = max(m) / min(m)
     if ratio <= 10.0:
         return settings.iterations
-    return math.ceil(settings.iterations * (1.0 + math.log10(ratio)))
+    factor = 1.0 + math.log10(ratio)
+    if mode == "motor" and ratio > 100.0:
+        factor *= math.sqrt(ratio / 100.0)
+    return math.ceil(settings.iterations * factor)
+
+
+def joint_drift(mech: Mechanism, poses: dict[str, Array], vel: dict[str, Array]) -> float:
+    """Largest rate at which a linear position update parts a joint's two sides, / size (1/s^2).
+
+    A step moves every body along a straight line with its new velocity, so
+    a point at ``r`` from a body's centre that turns at ``w`` (rad/s) ends
+    about ``w^2 |r| dt^2`` off its arc; at a joint the two sides' points part
+    by ``|w_a^2 r_a - w_b^2 r_b| dt^2``.  Returned: the largest
+    ``|w_a^2 r_a - w_b^2 r_b| / size`` over the joints (at their first pin)
+    and over the analytic ``poses`` and velocities ``vel`` (per second).
+    """
+    size = mech.size
+    worst = 0.0
+    for j in mech.joints:
+        pins = j.pins()
+        if not pins:
+            continue
+        part0, xy0 = pins[0]
+        w = poses_apply(poses[part0], np.asarray(xy0, float))  # (N, 2) the joint's point, world
+        acc = np.zeros_like(w)
+        for side, sign in ((j.a, 1.0), (j.b, -1.0)):
+            p = mech.part(side)
+            if p.ground:
+                continue
+            c = poses_apply(poses[side], np.asarray(mass_properties(p, 1.0)[1], float))
+            acc += sign * (vel[side][:, 2] ** 2)[:, None] * (w - c)
+        worst = max(worst, float(np.nanmax(np.hypot(acc[:, 0], acc[:, 1]))))
+    return worst / size
+
+
+#: a lever amplification up to this changes nothing in :func:`substeps_for` (the gallery's largest is 4)
+_LEVER_FREE = 4.0
+
+
+def lever(mech: Mechanism, poses: dict[str, Array]) -> float:
+    """Largest factor by which a part turns a joint error into a pose error (at least 1).
+
+    A part whose joints are ``s`` apart turns by ``e / s`` for a joint error
+    ``e``, moving a point ``D`` from a joint by ``e D / s``: the largest
+    ``D / s`` over the parts with two joints or more (``D`` to the far edge of
+    the part's hull), at the first sample of ``poses``.
+    """
+    points: dict[str, list[Array]] = {}
+    for j in mech.joints:
+        pins = j.pins()
+        if not pins:
+            continue
+        part0, xy0 = pins[0]
+        w = poses_apply(poses[part0][0], np.asarray(xy0, float))
+        for side in (j.a, j.b):
+            points.setdefault(side, []).append(w)
+    best = 1.0
+    for p in mech.parts:
+        J = np.array(points.get(p.name, []), float).reshape(-1, 2)
+        if p.ground or len(J) < 2 or not p.hull:
+            continue
+        spacing = float(np.hypot(*(J[:, None] - J[None]).transpose(2, 0, 1)).max())
+        if spacing <= 0.0:
+            continue
+        hull = poses_apply(poses[p.name][0], np.array([(x, y) for x, y, _ in p.hull], float))
+        radius = np.array([r for _, _, r in p.hull], float)
+        reach = float((np.hypot(*(hull[:, None] - J[None]).transpose(2, 0, 1)) + radius[:, None]).max())
+        best = max(best, reach / spacing)
+    return best
+
+
+def _lever_factor(mech: Mechanism, poses: dict[str, Array]) -> float:
+    """``lever / 4`` where the lever passes 4 (by more than 5 %), else 1."""
+    f = lever(mech, poses) / _LEVER_FREE
+    return f if f > 1.05 else 1.0
+
+
+def substeps_for(mech: Mechanism, poses: dict[str, Array], vel: dict[str, Array], dt_out: float,
+                 settings: SimSettings, correction: float | None = None) -> int:
+    """Physics steps per output sample: ``settings.substeps``, raised for fast-turning joints.
+
+    The error correction takes out a fraction ``c`` of a joint's error per
+    step, so a drift ``d`` per step (:func:`joint_drift` x step^2) stands at
+    ``d (1 - c) / c``, and the pose error it causes with it.  With
+    ``settings.step_drift`` given, the substeps are the fewest (at least
+    ``settings.substeps``, at most :data:`MAX_SUBSTEP_FACTOR` times it) that
+    keep ``d`` at most ``step_drift`` of the size (output samples ``dt_out``
+    s apart), or ``d x lever / 4`` where a part's :func:`lever` passes 4.
+    ``correction``: the correction per step the solver will use when lower
+    than the settings' (see :func:`mass_ratio_correction`); the
+    substeps rise so that ``d (1 - c) / c`` stays what the settings ask.
+    """
+    if correction is None:
+        correction = settings.correction
+    base = settings.substeps
+    if settings.step_drift is None:
+        return base
+    # a long lever (a part far larger than its joints' spacing) magnifies the joint error into the pose
+    amplify = _lever_factor(mech, poses)
+    need = dt_out * math.sqrt(joint_drift(mech, poses, vel) * amplify / settings.step_drift)
+    c0 = settings.correction
+    if settings.error_bias is None and 0.0 < correction < c0 < 1.0:
+        # a correction lowered for a mass ratio leaves more of the drift standing, d (1 - c) / c: more
+        # substeps keep the standing error where the settings' correction would have it
+        need *= math.sqrt(c0 * (1.0 - correction) / (correction * (1.0 - c0)))
+    return int(min(max(base, math.ceil(need - 1e-9)), base * MAX_SUBSTEP_FACTOR))
 
 
 _MASS_RATIO_CORRECTION = 0.05
+
+#: in motor mode, past this many steps per turn of the driver the correction is at most
+#: :data:`_MOTOR_FINE_CORRECTION`.  Measured on the Jansen leg (40 iterations, correction 0.2): 2304 steps per
+#: turn hold (7.6e-5 of the size), 3456 err 3e-4 with the torque 28 % off, 4608 and 9216 fly off, whether the
+#: steps come from substeps or from samples; at 0.1 per step 4608 and 9216 hold (3.3e-5, 7.6e-6).  The
+#: kinematic mode holds at 0.2 throughout.
+_MOTOR_STEPS_PER_TURN = 2400.0
+_MOTOR_FINE_CORRECTION = 0.1
+
+
+def mass_ratio_correction(settings: SimSettings, masses: list[float], mode: str = "kinematic") -> float:
+    """Correction per step for bodies of these masses (``settings.correction`` unless
+    iterations were raised for a mass ratio, then at most 0.05; see :func:`solver_iterations`)."""
+    c = settings.correction
+    if settings.adaptive and solver_iterations(settings, masses, mode) > settings.iterations:
+        # strong correction of a light part against a heavy one overshoots: measured on a four-bar with a
+        # 1:1000 rocker/coupler mass ratio, 0.05 per step holds to 3e-4 of the size, 0.1 and more fly off
+        c = min(c, _MASS_RATIO_CORRECTION)
+    return c
+
+
+def moving_masses(mech: Mechanism, mode: str, effects: Effects | None,
+                  densities: dict[str, float] | None = None) -> list[float]:
+    """Masses of the parts that move under the solver (not ground, not an imposed driver)."""
+    density = effects.density if effects is not None else 1.0
+    driven = _driven_parts(mech)
+    return [mass_properties(p, (densities or {}).get(p.name, density))[0] for p in mech.parts
+            if not p.ground and not (p.name in driven and mode == "kinematic")]
 _PIN_FRACTION = 0.1  # pin mass / its part's mass (see _Rebuild._pin)
 
 
@@ -306,12 +465,8 @@ class _Rebuild:
         self.mode = mode
         self.dt = dt
         space = pymunk.Space()
-        built: dict[str, Any] = {"gravity": None, "shapes": 0, "friction": None, "damping": None,
+        built: dict[str, Any] = {"gravity": None, "damping": None,
                                  "springs": 0, "loads": 0, "constraints": 0, "bodies": 0}
-        if effects is not None and effects.contact:
-            raise SimulationError(
-                f"{mech.name}: [effects] contact = true is not supported: the parts of a mechanism sit in "
-                "layers and never touch each other; remove 'contact' from the scene")
         if effects is not None and effects.gravity is not None:
             space.gravity = (float(effects.gravity[0]) * dt * dt, float(effects.gravity[1]) * dt * dt)
             built["gravity"] = tuple(effects.gravity)
@@ -354,7 +509,13 @@ class _Rebuild:
             space.add(body)
             self.bodies[p.name] = body
             built["bodies"] += 1
-        self.iterations = solver_iterations(settings, masses)
+        self.iterations = solver_iterations(settings, masses, mode)
+        amplify = _lever_factor(mech, analytic.poses)
+        if settings.adaptive and amplify > 1.0:
+            # a part far larger than its joints' spacing: its joints' rows are nearly parallel and the solver
+            # converges slowly (the kangaroo leg with its coupler point 10x further out, lever 15: the motor run
+            # flew off at 91 iterations, holds to 1.3e-5 of the size at 347)
+            self.iterations = math.ceil(self.iterations * amplify)
         space.iterations = self.iterations
         built["iterations"] = self.iterations
         self.static_pose = {p.name: analytic.poses[p.name][0] for p in mech.parts if p.ground}
@@ -364,9 +525,10 @@ class _Rebuild:
         built["imposed"] = []
         self.correction = settings.step_correction(dt)
         if settings.adaptive and self.iterations > settings.iterations:
-            # strong correction of a light part against a heavy one overshoots: measured on a four-bar with a
-            # 1:1000 rocker/coupler mass ratio, 0.05 per step holds to 3e-4 of the size, 0.1 and more fly off
             self.correction = min(self.correction, _MASS_RATIO_CORRECTION)
+        if settings.adaptive and mode == "motor" and mech.driver.rate != 0.0:
+            if 2.0 * math.pi / (abs(mech.driver.rate) * dt) > _MOTOR_STEPS_PER_TURN:
+                self.correction = min(self.correction, _MOTOR_FINE_CORRECTION)
         built["correction"] = self.correction
         bias = 1.0 - self.correction  # error left per step = per time unit here
         for j in mech.joints:
@@ -519,6 +681,14 @@ def _slide(rb: _Rebuild, j: Slide, effects: Effects | None) -> list[Any]:
     return rb._groove(j.a, s0, s1, j.b, j.anchor) + [rb.pymunk.GearJoint(B[j.a], B[j.b], phase, 1.0)]
 
 
+@REBUILDERS.register(GearMesh)
+def _gear_mesh(rb: _Rebuild, j: GearMesh, effects: Effects | None) -> list[Any]:
+    """A ``GearJoint``: pymunk holds ``ratio_pm * angle_b - angle_a = phase``, so ``ratio_pm = 1 / ratio``."""
+    B = rb.bodies
+    r = 1.0 / j.ratio
+    return [rb.pymunk.GearJoint(B[j.a], B[j.b], r * B[j.b].angle - B[j.a].angle, r)]
+
+
 @REBUILDERS.register(PinInArcSlot)
 def _pin_in_arc_slot(rb: _Rebuild, j: PinInArcSlot, effects: Effects | None) -> list[Any]:
     """The equivalent link: a ``PinJoint`` holding the pin at the arc's radius from its centre."""
@@ -645,7 +815,9 @@ def _classify(mech: Mechanism, poses: dict[str, Array], i: int, part: str, err: 
         return SimFailure(i, t, part, "blow-up", rel,
                           f"blew up {where}: joint {worst_joint!r} residual {worst / size:.3g} of the size "
                           f"(part off its analytic pose by {rel:.3g} of the size)")
-    if worst < 0.1 * err:
+    if worst < 0.1 * err and rel > 10.0 * settings.tolerance:
+        # every joint holds and the part is far off: another assembly branch (an offset of a few tolerances
+        # with the joints holding is drift amplified by a long lever, reported below)
         return SimFailure(i, t, part, "branch", rel,
                           f"switched assembly branch {where}: the part is {rel:.3g} of the size from its "
                           f"analytic pose while every joint holds (worst residual {worst / size:.2g} of the size)")
@@ -674,10 +846,11 @@ def simulate(mech: Mechanism, t: Array, effects: Effects | None = None,
     if t.size < 2:
         raise PlanarError("simulate: needs at least two output times")
     dt_out = float(t[1] - t[0])
-    sub = settings.substeps
-    dt = dt_out / sub
     if mode == "motor" and (mech.driver.kind != "rotation" or mech.driver.amplitude is not None):
         raise SimulationError(f"{mech.name}: motor mode needs a driver turning at a constant rate")
+    if mode == "motor" and getattr(mech, "extra_driven_parts", []):
+        raise SimulationError(f"{mech.name}: motor mode drives one part; this linkage has more inputs "
+                              f"({', '.join(mech.extra_driven_parts)}), each imposed kinematically")  # type: ignore[attr-defined]
     if mode == "motor" and len(_driven_parts(mech)) > 1:
         raise SimulationError(f"{mech.name}: motor mode drives one part; this toy's stages are drawn apart, "
                               "so each stage's driver must follow its parent kinematically")
@@ -686,6 +859,9 @@ def simulate(mech: Mechanism, t: Array, effects: Effects | None = None,
         i = int(np.flatnonzero(~analytic.valid)[0])
         raise SimulationError(f"{mech.name}: the analytic motion is invalid at sample {i} "
                               f"({analytic.reason(i)}); the rebuild needs an assemblable cycle")
+    sub = substeps_for(mech, poses_a, vel_a, dt_out, settings,
+                       mass_ratio_correction(settings, moving_masses(mech, mode, effects, densities), mode))
+    dt = dt_out / sub
     rb = _Rebuild(mech, analytic, effects, settings, mode, dt, densities)
     comp = rb.compensation()
     if comp:  # rebuild with the pins' mass taken out of their parts
@@ -816,7 +992,7 @@ def simulate(mech: Mechanism, t: Array, effects: Effects | None = None,
     motion = Motion(driver=analytic.driver, poses=out, valid=valid, fail_code=code, fail_table=table,
                     points=pts, t=t)
     res = joint_residuals(mech, motion)
-    built = dict(rb.built, mode=mode, pins_compensated=sorted(comp))
+    built = dict(rb.built, mode=mode, pins_compensated=sorted(comp), substeps=sub)
     pins = [(part, xy, body.mass) for body, part, xy in rb.pins]
     pose_error = {k: v / size for k, v in check.worst.items()}
     return SimResult(motion, settings, mode, built, wall, steps, torque, failure, pins=pins, residuals=res,
@@ -849,10 +1025,10 @@ def torque_comparison(mech: Mechanism, t: Array, effects: Effects | None,
     reached ``effects.motor_force_limit``.
     """
     t = np.asarray(t, float)
-    K = settings.substeps
     dt = float(t[1] - t[0])
     # one sample of lead-in, so that the first compared interval starts with settled joint forces
     sim = simulate(mech, np.concatenate([[t[0] - dt], t]), effects, settings, mode="motor", densities=densities)
+    K = int(sim.built["substeps"])
     # a step's impulse is what holds the motion at the step's end (symplectic Euler): compare with the
     # analytic torque at the ends of the steps of the interval ending at each sample, averaged
     t_fine = t[0] - dt + (np.arange(t.size * K) + 1.0) * (dt / K)
@@ -878,6 +1054,8 @@ def torque_comparison(mech: Mechanism, t: Array, effects: Effects | None,
                 "(same mass, centre and moment), so both sides model the same inertia",
         "note": "simulated torque: the motor's signed impulse per step / dt (mean over the interval)",
         "wall_time": sim.wall_time,
+        "substeps": K,
+        "iterations": sim.built["iterations"],
     }
     return out
 

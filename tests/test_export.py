@@ -121,7 +121,7 @@ def test_fourbar_holes_at_the_joint_distances_and_kerf():
 
 
 def test_slot_kerf_and_arc_slots():
-    part = Part("p", ((0, 0, 1.0), (4, 0, 1.0)), (Slot((0.5, 0), (3.5, 0), 0.4), ArcSlot((2, 0), 1.0, 0.2, 2.0, 0.3)))
+    part = Part("p", ((0, 0, 1.0), (4, 0, 1.0)), (Slot((0.5, 0), (3.5, 0), 0.4), ArcSlot((2, 0), 1.0, 0.9, 2.2, 0.3)))
     a = part_cuts(part, FabSettings(unit_mm=10.0, kerf=0.0, clearance=0.0, slot_end=0.0), 1)
     b = part_cuts(part, FabSettings(unit_mm=10.0, kerf=0.4, clearance=0.0, slot_end=0.0), 1)
     for c0, c1 in zip(a.inner, b.inner):
@@ -382,3 +382,21 @@ def test_no_duplicate_cut_entities_and_jansen_link_lengths(tmp_path):
     tri = sorted(math.dist(a, b) for i, a in enumerate(centres("upper")) for j, b in enumerate(centres("upper")) if i < j)
     assert np.allclose(tri, sorted([41.5, 40.1, 55.8]), atol=1e-6)  # the ternary link Z-B-D
     assert len(centres("lower")) == 2  # the foot F is a point of the lower link, not a joint
+
+
+def test_holes_running_into_each_other_are_refused(tmp_path, capsys):
+    # at 1 mm per unit a 2.5 mm crank's D-shaped drive hole and its pin hole overlap: widening the outline
+    # cannot mend that, so the export stops with one line naming the part and the two cuts
+    scene = tmp_path / "small.toml"
+    scene.write_text('[mechanism]\ntype = "fourbar"\nground = 8.0\ncrank = 2.5\ncoupler = 7.0\nrocker = 6.0\n'
+                     '[fabrication]\nunit_mm = 1.0\n')
+    out = tmp_path / "p.dxf"
+    assert main(["export", str(scene), "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "of material between its" in err[0] and "min_wall_mm" in err[0], err
+    assert not out.exists()
+    # and the geometry: pin hole (3 mm pin + 0.1 clearance) 2.5 mm from the drive hole's centre overlaps it
+    from planar.fabparts import FabSettings
+
+    st_ = FabSettings()
+    assert 2.5 < (st_.pin_mm + st_.clearance) / 2 + st_.shaft_mm / 2

@@ -203,12 +203,19 @@ def test_motor_saturation_is_reported_with_its_samples_and_fails_compare(tmp_pat
     assert r.returncode == EXIT_MISMATCH and "motor saturated" in r.stdout, r.stdout
 
 
-def test_contact_is_refused_with_a_clear_error():
-    from planar.simulate import SimulationError
-
-    sc = scene_of(dict(LEG, effects={"contact": True}))
-    with pytest.raises(SimulationError, match="contact"):
-        simulate(sc.mechanism, sc.motion().t, sc.effects)
+@pytest.mark.parametrize("key", ["contact = true", "contact = false", "friction = 0.3"])
+def test_contact_and_friction_keys_are_refused_in_one_line(tmp_path, key):
+    # collisions were removed (parts sit on layers and never touch): the scene is refused when read, exit 2,
+    # one line naming the key, nothing written
+    p = tmp_path / "c.toml"
+    p.write_text('name = "c"\n[mechanism]\ntype = "fourbar"\nground = 4.0\ncrank = 1.0\ncoupler = 4.0\n'
+                 f'rocker = 3.0\n[effects]\n{key}\n')
+    for cmd in (["compare", str(p)], ["render", str(p), "-o", str(tmp_path / "c.gif")]):
+        r = run_cli(*cmd)
+        assert r.returncode == 2 and "Traceback" not in r.stderr
+        line = r.stderr.strip()
+        assert len(line.splitlines()) == 1 and str(p) in line and key.split()[0] in line and "removed" in line
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["c.toml"]
 
 
 def test_bench_sim_json_has_both_timings_and_ratio():

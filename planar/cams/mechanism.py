@@ -60,6 +60,8 @@ class CamMechanism(Mechanism):
         self.profile = profile
         self._width = width
         self._unit = unit
+        #: the largest pressure angle allowed (rad)
+        self.max_pressure_angle = float(max_pressure_angle)
         self.report: CamReport = profile.check(max_pressure_angle, unit=unit)
         where = profile.where
         f = profile.follower

@@ -34,6 +34,8 @@ Node kinds without a chunk kernel here (a kind registered elsewhere) make
 
 from __future__ import annotations
 
+import math
+
 import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
@@ -158,12 +160,19 @@ def _rrr(node, pos, q, w, ox, oy) -> Placed:
     """Circle-circle as :func:`planar.geometry.circle_circle` (same validity, bit for bit)."""
     ax, ay = pos[node.a]
     bx, by = pos[node.b]
-    ra, rb = node.ra, node.rb
+    # scale-free: outside 1e-60..1e60, where fourth powers of lengths leave float64, lengths are taken
+    # times k, a power of two near 1 / (ra + rb): exact, so the same bits as unscaled where nothing overflows
+    span = node.ra + node.rb
+    k = 1.0 if 1e-60 < span < 1e60 else math.ldexp(1.0, -math.frexp(span)[1])
+    ra, rb = node.ra * k, node.rb * k
     s, f = ra + rb, ra - rb
     s2, f2 = s * s, f * f
     dx, dy, d2, t, prod = w.get(), w.get(), w.get(), w.get(), w.get()
     np.subtract(bx, ax, out=dx)
     np.subtract(by, ay, out=dy)
+    if k != 1.0:
+        dx *= k
+        dy *= k
     np.multiply(dx, dx, out=d2)
     np.multiply(dy, dy, out=t)
     d2 += t
@@ -186,6 +195,10 @@ def _rrr(node, pos, q, w, ox, oy) -> Placed:
     prod *= d2  # sep^2 = 4 h^2 = prod / d^2
     d2 *= 0.5 * (ra * ra - rb * rb)
     d2 += 0.5  # fraction along a -> b
+    if k != 1.0:
+        dx /= k  # back to model units (exact)
+        dy /= k
+        prod /= k * k
     m = w.get()
     np.multiply(d2, dx, out=ox)
     ox += ax
@@ -231,7 +244,7 @@ def _rigid(node, pos, q, w, ox, oy) -> Placed:
     en += m
     np.sqrt(en, out=en)
     ok: Mask | bool = True
-    if en.size and float(en.min()) <= 0.0:  # coincident nodes (or an underflow): as the reference
+    if en.size and (float(en.min()) <= 0.0 or float(en.max()) == math.inf):  # coincident, under- or overflow
         h = np.hypot(ex, ey)
         ok = h > 0
         en[:] = np.where(ok, h, 1.0)

@@ -155,26 +155,35 @@ def carry_branch(keep: Array, other: Array, valid: Mask, path: Mask) -> NDArray[
     p1 = prev
     p2 = back(p1)
     p3 = back(p2)
-    ok = valid & (p3 >= 0) & (idx - p3 <= 8) & path
+    p4 = back(p3)
+    ok = valid & (p4 >= 0) & (idx - p4 <= 10) & path
     ks = np.flatnonzero(ok)
     if ks.size == 0:
         return flip
-    i1, i2, i3 = p1[ks], p2[ks], p3[ks]
-    # quadratic (Lagrange) extrapolation in the sample index to k
-    t, t1, t2, t3 = ks.astype(float), i1.astype(float), i2.astype(float), i3.astype(float)
-    w1 = (t - t2) * (t - t3) / ((t1 - t2) * (t1 - t3))
-    w2 = (t - t1) * (t - t3) / ((t2 - t1) * (t2 - t3))
-    w3 = (t - t1) * (t - t2) / ((t3 - t1) * (t3 - t2))
+    i1, i2, i3, i4 = p1[ks], p2[ks], p3[ks], p4[ks]
+
+    def lagrange(t: Array, t1: Array, t2: Array, t3: Array) -> tuple[Array, Array, Array]:
+        return ((t - t2) * (t - t3) / ((t1 - t2) * (t1 - t3)), (t - t1) * (t - t3) / ((t2 - t1) * (t2 - t3)),
+                (t - t1) * (t - t2) / ((t3 - t1) * (t3 - t2)))
+
+    # quadratic (Lagrange) extrapolation in the sample index to k, and (the check of its credibility) to the
+    # previous sample from the three before it
+    f = [a.astype(float) for a in (ks, i1, i2, i3, i4)]
+    w1, w2, w3 = lagrange(f[0], f[1], f[2], f[3])
+    v1, v2, v3 = lagrange(f[1], f[2], f[3], f[4])
     cur = keep.copy()
     alt = other.copy()
     start = 0
     while True:
         sel = slice(start, None)
-        k, a1, a2, a3 = ks[sel], i1[sel], i2[sel], i3[sel]
+        k, a1, a2, a3, a4 = ks[sel], i1[sel], i2[sel], i3[sel], i4[sel]
         pred = w1[sel, None] * cur[a1] + w2[sel, None] * cur[a2] + w3[sel, None] * cur[a3]
         dk = np.hypot(*(cur[k] - pred).T)
         da = np.hypot(*(alt[k] - pred).T)
-        hit = np.flatnonzero(4.0 * da < dk)
+        # the extrapolation's own miss one sample back: a flip needs the jump to stand out from it (coarse
+        # samples, a few per turn, extrapolate badly and must not trade the declared branch for the other one)
+        miss = np.hypot(*(cur[a1] - (v1[sel, None] * cur[a2] + v2[sel, None] * cur[a3] + v3[sel, None] * cur[a4])).T)
+        hit = np.flatnonzero((4.0 * da < dk) & (4.0 * miss < dk))
         if hit.size == 0:
             return flip
         j = int(k[hit[0]])
@@ -239,6 +248,25 @@ class NodeKind:
     def branch_of(self, pos: Mapping[str, Array]) -> int | None:
         """Which branch (+1 or -1) the node's last position in ``pos`` is on; ``None`` for kinds without one."""
         return None
+
+    def bind(self, where: str, nodes: Mapping[str, "NodeKind"]) -> "NodeKind":
+        """This node, given every node of its linkage (those before it bound): a kind that needs another node's
+        declaration (a gear's partner, a triad's members) returns a copy holding it, or raises :class:`InputError`."""
+        return self
+
+    def velocity_at(self, pos: Mapping[str, Array], vel: Mapping[str, Array], q: Array,
+                    qd: Array) -> tuple[Array, Mask | None]:
+        """:meth:`velocity` for kinds that also need the driver values ``q``."""
+        return self.velocity(pos, vel, qd)
+
+    def acceleration_at(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
+                        q: Array, qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+        """:meth:`acceleration` for kinds that also need the driver values ``q``."""
+        return self.acceleration(pos, vel, acc, qd, qdd)
+
+    def extra_joints(self, lk: "Linkage", hulls: dict[str, list[tuple[float, float, float]]]) -> list:
+        """Joints this node adds beyond those its links imply (a gear mesh); may add hull circles."""
+        return []
 
 
 @node_kind
@@ -574,8 +602,22 @@ class Linkage(Mechanism):
     ) -> None:
         self.name = name
         self.nodes: tuple[NodeKind, ...] = tuple(nodes)
-        self.placement = tuple(float(v) for v in check_finite(f"{name}.placement", placement))
+        pl = check_finite(f"{name}.placement", placement)
+        if pl.shape != (3,):
+            raise InputError(f"{name}.placement", placement, "(x, y, angle): three numbers")
+        self.placement = tuple(float(v) for v in pl)
         self._validate_nodes(name)
+        bound: dict[str, NodeKind] = {n.name: n for n in self.nodes}
+        for n in self.nodes:
+            bound[n.name] = n.bind(f"{name}.nodes.{n.name}", bound)
+        self.nodes = tuple(bound.values())
+        if any(getattr(n, "continued", False) for n in self.nodes):
+            self.branch_reference = 0.0  # a triad's declared assembly holds at driver value 0
+        clocked = [n.name for n in self.nodes if getattr(n, "clocked", False)]
+        if clocked and amplitude is not None:
+            raise InputError(f"{name}.driver.amplitude", amplitude,
+                             f"no amplitude: with driven nodes ({', '.join(clocked)}) the driver is a clock "
+                             "(phase + rate t); give each driven node its own amplitude")
         self.ground_name = ground
         self.links = self._with_ground(tuple(links), ground)
         self._validate_links(name)
@@ -586,7 +628,11 @@ class Linkage(Mechanism):
         self._driver_node = inputs[0]
         driver_link = self._link_of(self._driver_node.name, exclude_ground=True)
         byname = {n.name: n for n in self.nodes}
-        if isinstance(self._driver_node, Crank):
+        make = getattr(self._driver_node, "make_driver", None)
+        if make is not None:
+            c = byname[self._driver_node.centre]  # type: ignore[attr-defined]
+            driver = make(driver_link, c.xy if isinstance(c, Fixed) else (0.0, 0.0), rate, phase)
+        elif isinstance(self._driver_node, Crank):
             c = byname[self._driver_node.centre]
             origin = c.xy if isinstance(c, Fixed) else (0.0, 0.0)
             driver = Driver(driver_link, "rotation", origin=origin, rate=rate, phase=phase,
@@ -787,8 +833,13 @@ class Linkage(Mechanism):
         pos, checks = self._solve_nodes(np.concatenate([lead, q]), self.nodes)
         return {n: v[k:] for n, v in pos.items()}, [(m[k:], j, w) for m, j, w in checks]
 
+    def _path(self, q: Array) -> Mask:
+        """Where the samples are a path along which a branch may be carried (:func:`path_mask`); a subclass
+        that knows its motion has no singular position returns no path (its declared branches hold)."""
+        return path_mask(q)
+
     def _solve_nodes(self, q: Array, nodes: Sequence[NodeKind]) -> tuple[dict[str, Array], list[tuple[Mask, str, str]]]:
-        path = path_mask(q)
+        path = self._path(q)
         pos: dict[str, Array] = {}
         checks: list[tuple[Mask, str, str]] = []
         for node in nodes:
@@ -841,7 +892,9 @@ class Linkage(Mechanism):
 
     def _solve_points(self, q: Array) -> Solved:
         """The chunked, threaded path (:mod:`planar.linkages.chunked`), else the reference path."""
-        fast = fast_solve(self, q) if q.ndim == 1 and self._declared_branches_hold(q) else None
+        # kinds without a chunk kernel (gears, driven inputs, triads): no plan, straight to the reference path
+        usable = q.ndim == 1 and self._fast_plan() is not None
+        fast = fast_solve(self, q) if usable and self._declared_branches_hold(q) else None
         if fast is not None:
             return fast
         return super()._solve_points(q)
@@ -868,7 +921,7 @@ class Linkage(Mechanism):
             valid &= m
         vel: dict[str, Array] = {}
         for node in self.nodes:
-            v, ok = node.velocity(pos, vel, qd)
+            v, ok = node.velocity_at(pos, vel, qa, qd)
             vel[node.name] = v
             if ok is not None:
                 valid &= ok
@@ -897,9 +950,9 @@ class Linkage(Mechanism):
         vel: dict[str, Array] = {}
         acc: dict[str, Array] = {}
         for node in self.nodes:
-            v, ok = node.velocity(pos, vel, qd)
+            v, ok = node.velocity_at(pos, vel, qa, qd)
             vel[node.name] = v
-            a, ok2 = node.acceleration(pos, vel, acc, qd, qdd)
+            a, ok2 = node.acceleration_at(pos, vel, acc, qa, qd, qdd)
             acc[node.name] = a
             for mask in (ok, ok2):
                 if mask is not None:
@@ -981,6 +1034,8 @@ class Linkage(Mechanism):
         for (guide, nd), lk in guided.items():
             assert guide is not None
             self._block_slide(lk, nd, guide, hulls, joints)
+        for node in self.nodes:
+            joints.extend(node.extra_joints(self, hulls))
         parts = []
         for lk in self.links:
             hull = hulls[lk.name] or [(0.0, 0.0, r)]
@@ -1032,6 +1087,32 @@ class Linkage(Mechanism):
             hulls[lk.name].append((px, py, self.width / 2))
         joints.append(Slide(f"{lk.name}-slide", owner, lk.name, start, end, pins[0], (2 * self.width, 0.0),
                             width=self.pin_diameter))
+
+    @property
+    def extra_driven_parts(self) -> list[str]:
+        """Links of the inputs beyond the first that no gear ties to it (a simulation imposes their motion)."""
+        return [self._link_of(n.name, exclude_ground=True) for n in self.nodes
+                if getattr(n, "clocked", False) and n is not self._driver_node]
+
+    def input_values(self, q: ArrayLike) -> dict[str, Array]:
+        """Each input node's value (crank angle, rad, unwrapped) at driver values ``q`` when there are several.
+
+        Empty for a single-input linkage (its value is the driver value).
+        """
+        inputs = [n for n in self.nodes if n.is_input]
+        if len(inputs) < 2:
+            return {}
+        qa = np.atleast_1d(np.asarray(q, float))
+        out: dict[str, Array] = {}
+        for n in inputs:
+            own = getattr(n, "input_angle", None)  # a geared or driven node's law
+            if own is not None:
+                out[n.name] = own(qa)
+            elif isinstance(n, Crank):
+                out[n.name] = qa + n.phase
+            elif isinstance(n, Actuator):
+                out[n.name] = qa + n.offset
+        return out
 
     def node_positions(self, q) -> dict[str, Array]:
         """World positions ``(N, 2)`` of every node, placement applied."""

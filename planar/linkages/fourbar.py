@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
-from ..model import check_positive
+from ..model import check_finite, check_positive
 from .dyads import RRR, Crank, Fixed, Link, Linkage, Rigid
 
 __all__ = ["FourBar", "grashof_class", "freudenstein_angles"]
@@ -134,7 +134,11 @@ class FourBar(Linkage):
         self.dims = _Dims(a, b, c, d)
         self.circuit: Circuit = circuit
         self.branch = 1 if circuit == "open" else -1
-        self.coupler_point = (float(coupler_point[0]), float(coupler_point[1]))
+        cp = np.asarray(coupler_point, dtype=object)
+        if cp.shape != (2,) or any(isinstance(v, bool) for v in cp):
+            raise InputError(f"{name}.coupler_point", coupler_point, "a point (x, y) in the coupler's frame")
+        cpf = check_finite(f"{name}.coupler_point", coupler_point)
+        self.coupler_point = (float(cpf[0]), float(cpf[1]))
         if max(a, b, c, d) >= (a + b + c + d) - max(a, b, c, d):
             raise InputError(
                 f"{name}.links", (a, b, c, d),
@@ -152,6 +156,15 @@ class FourBar(Linkage):
         # change-point linkage is the same assembly whatever sample its motion starts from
         self.branch_reference = np.pi / 2
         super().__init__(name, nodes, links, points={"coupler_point": "P"}, placement=placement, **kw)
+
+    def _path(self, q: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """Only a change-point four-bar has singular positions its motion passes through (the two circuits
+        meet there), so only its circuit is carried by continuity; any other keeps its declared circuit at
+        every sample, however coarse the sampling (a crossed crank-rocker sampled 4 or 7 times a turn was
+        carried onto the open circuit by an extrapolation that coarse samples cannot support)."""
+        if self.grashof != "change-point":
+            return np.zeros(np.shape(q), dtype=bool)
+        return super()._path(q)
 
     # -- classification and limits -----------------------------------------
     @property

@@ -42,7 +42,10 @@ class SliderCrank(Linkage):
         if abs(e) >= r + l:
             raise InputError(f"{name}.offset", offset,
                              f"|offset| < crank + rod = {r + l:g} (else the rod never reaches the guide)")
+        if isinstance(branch, bool) or branch not in (1, -1):
+            raise InputError(f"{name}.branch", branch, "1 (slider on the +x side) or -1")
         self.r, self.l, self.e = r, l, e
+        self.branch = int(branch)
         span = r + l
         nodes = [
             Fixed("O", (0.0, 0.0)),
@@ -59,7 +62,11 @@ class SliderCrank(Linkage):
         super().__init__(name, nodes, links, points={"slider_pin": "S"}, placement=placement, **kw)
 
     def slider_position(self, theta) -> np.ndarray:
-        """Slider x (before placement) by the textbook formula, for cross-checks."""
+        """Slider x (before placement) by the textbook formula, for cross-checks: ``branch`` picks the root.
+
+        ``r cos(theta) + branch sqrt(l^2 - (r sin(theta) - e)^2)``; where the rod cannot reach the
+        guide the root is taken at zero (see :meth:`solve` for the validity mask).
+        """
         th = np.asarray(theta, float)
         h = self.r * np.sin(th) - self.e
-        return self.r * np.cos(th) + np.sqrt(np.maximum(self.l**2 - h**2, 0.0))
+        return self.r * np.cos(th) + self.branch * np.sqrt(np.maximum((self.l - h) * (self.l + h), 0.0))

@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from ..model import CamOnLine, Driver, Mechanism, Part, PinInArcSlot, PinInSlot, Pivot, Slide
+from ..model import CamOnLine, Driver, Mechanism, Part, PinInArcSlot, PinInSlot, Pivot, Slide, check_finite
 from ..registry import Registry
 from .mechanisms import ELEMENTAL, ElementalMechanism, SkewContact
 from .table import MOTION_TYPES, Realisation, enumerate_chains, realise
@@ -36,16 +36,23 @@ Array = NDArray[np.float64]
 Chain = tuple[str, ...]
 
 
-def _check_chain(chain: Sequence[str]) -> Chain:
+def _check_chain(chain: Sequence[str], where: str = "chain") -> Chain:
+    if isinstance(chain, str) or not hasattr(chain, "__iter__"):
+        raise InputError(where, chain, "a list of patterns, e.g. ['Rz->Tx', 'Tx->Ox']")
     chain = tuple(chain)
     if not chain:
-        raise InputError("chain", chain, "at least one pattern")
+        raise InputError(where, chain, "at least one pattern")
     prev = "Rz"
     for i, p in enumerate(chain):
-        r = realise(p)  # validates the pattern's form
+        if not isinstance(p, str):
+            raise InputError(f"{where}[{i}]", p, "a pattern 'A->B', e.g. 'Rz->Tx'")
+        try:
+            r = realise(p)  # validates the pattern's form
+        except InputError as e:
+            raise InputError(f"{where}[{i}]", p, e.expected) from None
         a, b = p.split("->")
         if a != prev:
-            raise InputError(f"chain[{i}]", p, f"a pattern driven by {prev} (the previous stage's output)")
+            raise InputError(f"{where}[{i}]", p, f"a pattern driven by {prev} (the previous stage's output)")
         prev = b
         del r
     return chain
@@ -111,8 +118,8 @@ class ToyMechanism(Mechanism):
         for cam in cams:
             if cam not in ("left", "right"):
                 raise InputError(f"{name}.cams", cam, "'left' or 'right'")
-        self.cams = {cam: [_check_chain(c) for c in chains] for cam, chains in cams.items()}
-        self.phase = float(phase)
+        self.cams = {cam: [_check_chain(c, f"{cam}[{i}]") for i, c in enumerate(chains)] for cam, chains in cams.items()}
+        self.phase = float(check_finite(f"{name}.phase", phase))
         self.cam_phase = {"left": 0.0, "right": self.phase}
         overrides = dict(overrides or {})
         #: the parameter overrides given, by ``(cam, prefix)`` (what a scene file's ``stages`` record)
@@ -302,7 +309,8 @@ def _rename_joint(j: Any, label: str, ox: float) -> Any:
 
 def chain_mechanism(chain: Sequence[str], **kw: Any) -> ToyMechanism:
     """One chain on the left cam, composed into a mechanism."""
-    return ToyMechanism({"left": [tuple(chain)]}, name=kw.pop("name", " ".join(chain)), **kw)
+    chain = _check_chain(chain)  # errors name chain[i]
+    return ToyMechanism({"left": [chain]}, name=kw.pop("name", " ".join(chain)), **kw)
 
 
 def tree_cost(cams: Mapping[str, Iterable[Sequence[str]]]) -> float:

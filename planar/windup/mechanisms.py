@@ -497,6 +497,9 @@ def check_params(number: int, P: Any) -> None:
     from dataclasses import fields
 
     rec = ELEMENTAL[number]
+    if not isinstance(P, rec.params):
+        raise InputError(f"#{number}.params", type(P).__name__, f"a {rec.params.__name__} record")
+    P_.check_shapes(number, P)  # a vector of the wrong length, a vector for a number: one clear line
     for f in fields(P):
         v = getattr(P, f.name)
         arr = np.asarray(v, dtype=float)

@@ -34,7 +34,7 @@ from typing import Any, TypeVar
 
 from ..errors import InputError
 
-__all__ = ["in_world", "Params", "P1", "P2", "P3", "P4", "P5", "P6", "P7", "P8", "P9", "P10", "P11"]
+__all__ = ["in_world", "coerce", "check_shapes", "Params", "P1", "P2", "P3", "P4", "P5", "P6", "P7", "P8", "P9", "P10", "P11"]
 
 V2 = tuple[float, float]
 V3 = tuple[float, float, float]
@@ -45,11 +45,47 @@ class Params:
     """Base class: parameters of one elemental mechanism."""
 
     def replace(self, **kw: Any) -> "Params":
+        """A copy with ``kw`` replaced; each value checked against the field's shape (see :func:`coerce`)."""
         names = {f.name for f in fields(self)}
         for k in kw:
             if k not in names:
                 raise InputError(f"{type(self).__name__}.{k}", kw[k], f"one of the parameters {sorted(names)}")
-        return replace(self, **kw)
+        return replace(self, **{k: coerce(f"{type(self).__name__}.{k}", getattr(self, k), v) for k, v in kw.items()})
+
+
+def coerce(field: str, default: Any, value: Any) -> Any:
+    """``value`` in the form of ``default``: a finite float, or a tuple of as many finite floats.
+
+    Raises :class:`InputError` naming ``field`` for a vector of the wrong length, a number where a
+    vector is expected (or the reverse), a bool, a string or a non-finite number.
+    """
+    if isinstance(default, tuple):
+        n = len(default)
+        if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != n:
+            raise InputError(field, value, f"a vector of {n} numbers")
+        return tuple(_real(f"{field}[{i}]", v) for i, v in enumerate(value))
+    if hasattr(value, "__len__"):
+        raise InputError(field, value, "a single number")
+    return _real(field, value)
+
+
+def _real(field: str, v: Any) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float)) and not hasattr(v, "__float__"):
+        raise InputError(field, v, "a number")
+    try:
+        x = float(v)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(field, v, "a number") from None
+    if not math.isfinite(x):
+        raise InputError(field, v, "a finite number")
+    return x
+
+
+def check_shapes(number: int, P: "Params") -> None:
+    """:class:`InputError` unless every field of ``P`` has its default's shape (a number or a vector of k)."""
+    defaults = type(P)()
+    for f in fields(P):
+        coerce(f"#{number}.{f.name}", getattr(defaults, f.name), getattr(P, f.name))
 
 
 _P = TypeVar("_P", bound="Params")

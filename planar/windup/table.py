@@ -120,7 +120,8 @@ def realise(pattern: str) -> Realisation:
                     continue  # the motor turns one way: keep z up
                 rows = tuple((int(row[0]), int(row[1]), int(row[2])) for row in R)
                 return Realisation(pattern, k, rows, si, so)
-    raise InputError("pattern", pattern, "a motion transfer no elemental mechanism can realise")
+    raise InputError("pattern", pattern, "a motion transfer that some elemental mechanism realises "
+                                         "(planar chains lists them)")
 
 
 def patterns(optional: bool = False) -> list[str]:

@@ -1,0 +1,214 @@
+"""``planar synth path|function|motion``: a four-bar from target points, angle pairs or poses, as a scene.
+
+Exit status 0 when the design passes its own checks (solved again by
+planar's solver), 3 when it was written but fails one (the failing check is
+printed), 2 on bad input (one line, nothing written).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from typing import Any
+
+import numpy as np
+
+from .errors import InputError
+
+__all__ = ["add_parser"]
+
+#: exit status of a design written that fails its own check (as ``planar compare``)
+EXIT_CHECK = 3
+
+
+def _region(text: str | None) -> tuple[float, float, float, float] | None:
+    if text is None:
+        return None
+    try:
+        x0, y0, x1, y1 = (float(v) for v in text.split(","))
+    except ValueError:
+        raise InputError("--pivots", text, "XMIN,YMIN,XMAX,YMAX (four numbers)") from None
+    if not (x0 < x1 and y0 < y1) or not all(math.isfinite(v) for v in (x0, y0, x1, y1)):
+        raise InputError("--pivots", text, "a region with XMIN < XMAX and YMIN < YMAX")
+    return x0, y0, x1, y1
+
+
+def _rocking(fb: Any, theta: np.ndarray) -> tuple[float | None, float]:
+    """``(amplitude, centre)`` of a rocking driver over the crank angles ``theta``, or ``(None, 0)`` for a full turn."""
+    if fb.grashof in ("crank-rocker", "double-crank"):
+        return None, 0.0
+    t = theta[0] + (np.asarray(theta) - theta[0] + np.pi) % (2 * np.pi) - np.pi
+    lo, hi = float(t.min()), float(t.max())
+    return max(0.5 * (hi - lo), 1e-6), 0.5 * (hi + lo)
+
+
+def _check_output(args: argparse.Namespace, source: str) -> None:
+    """The scene to write, checked before the search: a .toml file in an existing folder, not the input."""
+    from .fileio import check_output
+
+    check_output("-o", args.output, (".toml",), (source,))
+
+
+def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, Any], ok: bool,
+            failing: list[str]) -> int:
+    from .synthesis.scene_out import write_scene
+
+    scene = write_scene(args.output, text)
+    mo = scene.motion()
+    report["scene_valid_samples"] = int(mo.valid.sum())
+    report["scene_samples"] = len(mo)
+    if not mo.valid.all():
+        ok = False
+        failing.append(f"the written scene's motion has {int((~mo.valid).sum())} invalid samples")
+    report["ok"] = ok
+    report["output"] = str(args.output)
+    if args.json:
+        print(json.dumps(report, indent=2, default=float))
+    else:
+        print(f"wrote {args.output}: {what}")
+        for f in failing:
+            print(f"check failed: {f}")
+    return 0 if ok else EXIT_CHECK
+
+
+def _cmd_path(args: argparse.Namespace) -> int:
+    _check_output(args, args.target)
+    from .synthesis.path import synthesise_path
+    from .synthesis.scene_out import fourbar_scene_text
+    from .synthesis.search import Constraints
+    from .synthesis.targets import read_path_targets
+
+    if not args.max_ratio > 1:
+        raise InputError("--max-ratio", args.max_ratio, "a ratio greater than 1")
+    targets, theta = read_path_targets(args.target, args.points)
+    if theta is not None and args.deg:
+        theta = np.radians(theta)
+    cons = Constraints(full_turn=True, max_ratio=args.max_ratio, region=_region(args.pivots))
+    if args.type == "sixbar":
+        return _sixbar(args, targets, theta, cons)
+    d = synthesise_path(targets, theta, cons, budget=args.budget, seed=args.seed)
+    failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]
+    fb = d.fourbar()
+    amp, centre = _rocking(fb, d.theta)
+    text = fourbar_scene_text(
+        "synth-path", d.ground, d.crank, d.coupler, d.rocker, d.coupler_point, d.circuit, d.placement,
+        comments=[f"planar synth path {args.target}: {len(targets)} targets, "
+                  f"{'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
+                  "crank angle at each target (rad): " + ", ".join(f"{t:.6g}" for t in d.theta)],
+        amplitude=amp, centre=centre)
+    report = {"command": "synth path", "targets": len(targets), **d.to_dict()}
+    return _finish(args, f"four-bar ({fb.grashof}, {d.circuit}), sse {d.sse:.3g} over {len(targets)} targets "
+                   f"in {d.seconds:.2f} s", text, report, d.ok, failing)
+
+
+def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | None, cons: Any) -> int:
+    from .synthesis.scene_out import linkage_scene_text
+    from .synthesis.sixbar import synthesise_sixbar
+
+    d = synthesise_sixbar(targets, theta, args.topology, cons, budget=args.budget, seed=args.seed)
+    failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]
+    text = linkage_scene_text(
+        f"synth-sixbar-{d.topology}", d.nodes(), d.links(), {"tracer": "T"},
+        comments=[f"planar synth path {args.target} --type sixbar --topology {d.topology}: {len(targets)} targets, "
+                  f"{'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
+                  "crank angle at each target (rad, from the ground line O2-O4): "
+                  + ", ".join(f"{t:.6g}" for t in d.theta)])
+    report = {"command": "synth path", "targets": len(targets), **d.to_dict()}
+    return _finish(args, f"{d.topology} six-bar, sse {d.sse:.3g} over {len(targets)} targets in {d.seconds:.2f} s",
+                   text, report, d.ok, failing)
+
+
+def _cmd_function(args: argparse.Namespace) -> int:
+    _check_output(args, args.pairs)
+    from .synthesis.function import freudenstein_fit
+    from .synthesis.scene_out import fourbar_scene_text
+    from .synthesis.targets import read_table
+
+    t = read_table(args.pairs, ("input", "output"), min_rows=3)
+    phi, psi = t["input"], t["output"]
+    if args.deg:
+        phi, psi = np.radians(phi), np.radians(psi)
+    d = freudenstein_fit(phi, psi, args.ground)
+    fb = d.fourbar()
+    amp, centre = _rocking(fb, phi - d.ground_angle)
+    tol = args.tolerance
+    exact = len(phi) == 3
+    ok = bool(np.isfinite(d.max_error)) and (d.max_error <= (1e-9 if exact else tol))
+    failing = [] if ok else [f"output angle error {d.max_error:.3g} rad (limit {1e-9 if exact else tol:g})"]
+    text = fourbar_scene_text(
+        "synth-function", d.ground, d.crank, d.coupler, d.rocker, (0.5 * d.coupler, 0.0), d.circuit,
+        (0.0, 0.0, d.ground_angle),
+        comments=[f"planar synth function {args.pairs}: {len(phi)} pairs, max output error {d.max_error:.3g} rad",
+                  "crank and rocker angles are the pairs' minus the placement angle (from the ground line)"],
+        amplitude=amp, centre=centre)
+    report = {"command": "synth function", "pairs": len(phi), **d.to_dict()}
+    return _finish(args, f"four-bar ({d.grashof}, {d.circuit}), max output angle error {d.max_error:.3g} rad",
+                   text, report, ok, failing)
+
+
+def _cmd_motion(args: argparse.Namespace) -> int:
+    _check_output(args, args.poses)
+    from .synthesis.motion import burmester
+    from .synthesis.scene_out import fourbar_scene_text
+    from .synthesis.targets import read_table
+
+    t = read_table(args.poses, ("x", "y", "angle"), min_rows=3)
+    ang = np.radians(t["angle"]) if args.deg else t["angle"]
+    poses = np.column_stack([t["x"], t["y"], ang])
+    if len(poses) > 5:
+        raise InputError(str(args.poses), f"{len(poses)} poses", "3, 4 or 5 poses (Burmester theory)")
+    d = burmester(poses, max_ratio=args.max_ratio)
+    fb = d.fourbar()
+    amp, centre = _rocking(fb, d.theta)
+    failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]
+    text = fourbar_scene_text(
+        "synth-motion", d.ground, d.crank, d.coupler, d.rocker, d.coupler_point, d.circuit, d.placement,
+        comments=[f"planar synth motion {args.poses}: {len(poses)} poses; the body's angle is the coupler's "
+                  f"+ {d.angle_offset:.9g} rad",
+                  "crank angle at each pose (rad): " + ", ".join(f"{v:.6g}" for v in d.theta)],
+        amplitude=amp, centre=centre)
+    report = {"command": "synth motion", "poses": len(poses), "angle_offset": d.angle_offset, **d.to_dict()}
+    return _finish(args, f"four-bar ({d.grashof}, {d.circuit}) through {len(poses)} poses, position error "
+                   f"{d.checks['max_position_error']:.3g}", text, report, d.ok, failing)
+
+
+def add_parser(sub: Any) -> None:
+    """Register ``planar synth`` on the top-level subparsers."""
+    s = sub.add_parser("synth", help="synthesise a four-bar from a path, angle pairs or poses (writes a scene)")
+    ss = s.add_subparsers(dest="synth_kind", required=True, metavar="KIND")
+
+    p = ss.add_parser("path", help="coupler curve through target points (CSV x,y[,theta] or an SVG path)")
+    p.add_argument("target", help="CSV with columns x,y and optional theta (crank angle), or an .svg file")
+    p.add_argument("-o", "--output", required=True, help="scene file (TOML) to write")
+    p.add_argument("--type", choices=("fourbar", "sixbar"), default="fourbar", help="linkage type (fourbar)")
+    p.add_argument("--topology", choices=("stephenson", "watt"), default="stephenson",
+                   help="six-bar: a dyad hung from the coupler (stephenson) or from the rocker (watt)")
+    p.add_argument("--json", action="store_true", help="print the design, sse and time_s as JSON")
+    p.add_argument("--budget", choices=("quick", "normal", "thorough"), default="normal",
+                   help="search effort (normal: about 1-4 s)")
+    p.add_argument("--max-ratio", type=float, default=10.0, help="longest / shortest link at most this (10)")
+    p.add_argument("--pivots", default=None,
+                   help="ground pivots inside XMIN,YMIN,XMAX,YMAX (write --pivots=-1,... when XMIN is negative)")
+    p.add_argument("--points", type=int, default=12, help="points sampled along an SVG target (12)")
+    p.add_argument("--deg", action="store_true", help="the theta column is in degrees")
+    p.add_argument("--seed", type=int, default=0, help="random seed of the search (same seed, same result)")
+    p.set_defaults(func=_cmd_path)
+
+    f = ss.add_parser("function", help="input/output angle pairs (Freudenstein): CSV input,output")
+    f.add_argument("pairs", help="CSV with columns input,output (crank and rocker angles from the ground line)")
+    f.add_argument("-o", "--output", required=True, help="scene file (TOML) to write")
+    f.add_argument("--ground", type=float, default=1.0, help="ground link length (sets the scale; 1)")
+    f.add_argument("--deg", action="store_true", help="angles in degrees")
+    f.add_argument("--tolerance", type=float, default=0.01,
+                   help="more than 3 pairs: largest output angle error accepted, rad (0.01)")
+    f.add_argument("--json", action="store_true", help="print the design and its errors as JSON")
+    f.set_defaults(func=_cmd_function)
+
+    m = ss.add_parser("motion", help="3, 4 or 5 poses of the coupler (Burmester): CSV x,y,angle")
+    m.add_argument("poses", help="CSV with columns x,y,angle (the guided body's origin and angle)")
+    m.add_argument("-o", "--output", required=True, help="scene file (TOML) to write")
+    m.add_argument("--max-ratio", type=float, default=10.0, help="longest / shortest link at most this (10)")
+    m.add_argument("--deg", action="store_true", help="angles in degrees")
+    m.add_argument("--json", action="store_true", help="print the design and its checks as JSON")
+    m.set_defaults(func=_cmd_motion)

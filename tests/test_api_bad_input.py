@@ -1,0 +1,177 @@
+"""Issue 13: the public Python API under bad input, at extreme scales, and one validity rule.
+
+Bad input raises a :class:`planar.errors.PlanarError` that is also a
+``ValueError``, with a message naming the argument.  Results are checked
+against a second method where one exists (circle-circle geometry by hand,
+finite differences of positions for velocities and power).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from planar import analysis
+from planar.errors import InputError, LimitError, PlanarError
+from planar.linkages import FourBar, SliderCrank
+from planar.windup import elemental
+from planar.windup.chain import ToyMechanism
+
+TH = np.linspace(0.0, 2 * np.pi, 360, endpoint=False)
+
+
+@pytest.fixture(scope="module")
+def leg() -> FourBar:
+    return FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(5.5, -2.0))
+
+
+@pytest.mark.parametrize("call,needle", [
+    (lambda m: m.solve(np.zeros((4, 2))), "solve(q)"),
+    (lambda m: m.solve(np.zeros((3, 3))), "solve(q)"),
+    (lambda m: m.solve(np.zeros(4), t=np.zeros(5)), "solve(t)"),
+    (lambda m: m.solve(np.zeros(4), t=np.zeros((4, 1))), "solve(t)"),
+    (lambda m: m.solve([0.0, math.nan]), "driver value"),
+    (lambda m: m.solve(["a"]), "driver value"),
+    (lambda m: m.run(cycles=math.nan), "cycles"),
+    (lambda m: m.run(cycles=-1.0), "cycles"),
+    (lambda m: m.run(cycles=1e308), "PLANAR_MAX_SAMPLES"),
+    (lambda m: m.run(samples_per_cycle=0), "samples_per_cycle"),
+    (lambda m: m.run(samples_per_cycle=math.inf), "samples_per_cycle"),
+    (lambda m: FourBar(4, 1, 4, 3, coupler_point=5.5), "coupler_point"),
+    (lambda m: FourBar(4, 1, 4, 3, coupler_point=(1.0, 2.0, 3.0)), "coupler_point"),
+    (lambda m: FourBar(4, 1, 4, 3, coupler_point=("a", 1.0)), "coupler_point"),
+    (lambda m: FourBar(4, 1, 4, 3, coupler_point=(math.nan, 1.0)), "coupler_point"),
+    (lambda m: FourBar(4, "x", 4, 3), "crank"),
+    (lambda m: FourBar(4, 1, 4, 3, placement=(0.0, 0.0)), "placement"),
+    (lambda m: SliderCrank(1.0, 3.0, branch=2), "branch"),
+    (lambda m: elemental(5.0), "mechanism"),
+    (lambda m: elemental("5"), "mechanism"),
+    (lambda m: elemental(1, D_jc=0.5), "D_jc"),
+    (lambda m: elemental(1, D_o=[0.0]), "D_o"),
+    (lambda m: elemental(1, F_o=(0.3, 0.0, 0.0, 0.0)), "F_o"),
+    (lambda m: elemental(1, D_jr=(0.1, 0.2)), "D_jr"),
+    (lambda m: elemental(1, D_jr=math.nan), "D_jr"),
+    (lambda m: elemental(1, D_jr=True), "D_jr"),
+    (lambda m: elemental(10, D_theta=(0.3,)), "D_theta"),
+    (lambda m: ToyMechanism({"left": [("Rz->Tx",)]}, phase=math.nan), "phase"),
+    (lambda m: ToyMechanism({"left": [("Rz->Tx", "Oz->Ox")]}), "left[0][1]"),
+    (lambda m: analysis.motor_torque(m, TH, {"coupler_point": [math.nan, 1.0]}), "coupler_point"),
+    (lambda m: analysis.motor_torque(m, TH, {"coupler_point": np.zeros((3, 2))}), "coupler_point"),
+    (lambda m: analysis.motor_torque(m, TH, {"coupler_point": [0.0, 1.0]}, eta_trans=math.nan), "eta_trans"),
+    (lambda m: analysis.virtual_work_torque(np.zeros((5, 1, 2)), np.zeros(4), [0.0, 1.0]), "points"),
+])
+def test_bad_input_raises_a_named_planar_error(leg: FourBar, call, needle: str) -> None:
+    with pytest.raises(PlanarError) as info:
+        call(leg)
+    assert isinstance(info.value, ValueError)
+    assert needle in str(info.value)
+    assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("number", [1, 10])
+def test_solve_takes_one_driver_value_per_sample(number: int) -> None:
+    mech = elemental(number)
+    for shape in ((4, 3), (4, 1), (2, 2, 2)):
+        with pytest.raises(InputError, match="1-D array"):
+            mech.solve(np.zeros(shape))
+    m = mech.solve(np.linspace(0.0, 1.0, 4))
+    assert {v.shape[0] for v in m.poses.values()} == {4}
+
+
+def test_long_values_are_summarised_in_messages(leg: FourBar) -> None:
+    with pytest.raises(InputError) as info:
+        leg.solve(np.r_[np.zeros(1000), math.nan])
+    assert len(str(info.value)) < 200
+
+
+def test_limit_error_is_an_input_error(leg: FourBar, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("PLANAR_MAX_SAMPLES", "100")
+    with pytest.raises(LimitError, match="PLANAR_MAX_SAMPLES"):
+        leg.run(samples_per_cycle=101)
+    assert len(leg.run(samples_per_cycle=100)) == 100
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")  # squares overflow in passing; the results are exact
+@pytest.mark.parametrize("scale", [1e-300, 1e-170, 1e-80, 1e80, 1e154, 1e200, 1e300])
+def test_fourbar_at_any_scale_is_the_scaled_unit_fourbar(leg: FourBar, scale: float) -> None:
+    big = FourBar(4.0 * scale, 1.0 * scale, 4.0 * scale, 3.0 * scale, coupler_point=(5.5 * scale, -2.0 * scale))
+    m, ref = big.solve(TH), leg.solve(TH)
+    assert m.valid.all() and ref.valid.all()
+    np.testing.assert_allclose(m.points["coupler_point"] / scale, ref.points["coupler_point"], rtol=0, atol=1e-12)
+    for part in ("crank", "coupler", "rocker"):
+        np.testing.assert_allclose(m.poses[part][:, 2], ref.poses[part][:, 2], atol=1e-12)
+
+
+def test_nothing_non_finite_is_valid() -> None:
+    """Elemental parameters near the float64 limit: samples are finite, or marked invalid with a reason."""
+    for number, kw in ((1, {"F_o": (1e308, 0.0)}), (2, {"D_jr": 1e300}), (7, {"D_jc": (1e308, 1e308)})):
+        try:
+            mech = elemental(number, **kw)
+        except PlanarError:
+            continue
+        with np.errstate(all="ignore"):
+            m = mech.run(36)
+        for arr in (*m.poses.values(), *m.points.values()):
+            assert np.isfinite(arr).all()
+
+
+def test_one_validity_rule_for_velocities_and_instant_centres() -> None:
+    """A double-rocker: outside its range nothing is valid, at a toggle nothing is valid, and where valid
+    the rocker speed agrees with finite differences of the solved rocker angle (a second method)."""
+    dr = FourBar(4.0, 3.0, 1.2, 2.5)
+    m = dr.solve(TH)
+    assert 0 < m.valid.sum() < len(TH)
+    w3, w4, ok = analysis.fourbar_velocities(dr, TH)
+    _, w_ic, ok_ic = analysis.fourbar_instant_centre(dr, TH)
+    assert not (ok & ~m.valid).any() and not (ok_ic & ~m.valid).any()
+    assert (w3[~ok] == 0).all() and (w_ic[~ok_ic] == 0).all()
+    np.testing.assert_allclose(w_ic[ok_ic], w3[ok_ic], rtol=1e-9, atol=1e-9)
+    toggles = dr.toggle_angles()
+    _, _, at_toggle = analysis.fourbar_velocities(dr, toggles)
+    assert not at_toggle.any()
+    # the same rule through the general linkage path (node velocities, motor torque), toggles included
+    q = np.sort(np.r_[TH, toggles, toggles + 1e-9, toggles - 1e-9])
+    _, _, ok_fb = analysis.fourbar_velocities(dr, q)
+    tau, ok_tau = analysis.motor_torque(dr, q, {"coupler_point": [0.0, 1.0]})
+    assert (ok_fb == ok_tau).all() and np.isfinite(tau).all() and (tau[~ok_tau] == 0).all()
+    # where valid: central differences of the solved rocker angle, a step of 1e-6 either side
+    h = 1e-6
+    up, down = dr.solve(TH + h), dr.solve(TH - h)
+    both = ok & up.valid & down.valid
+    d = np.angle(np.exp(1j * (up.poses["rocker"][:, 2] - down.poses["rocker"][:, 2])))
+    fd = d / (2 * h)
+    assert both.sum() > 50
+    assert np.all(np.abs(fd[both] - w4[both]) <= 1e-5 * (1 + np.abs(w4[both])))
+
+
+def test_virtual_work_torque_has_a_validity_mask() -> None:
+    dr = FourBar(4.0, 3.0, 1.2, 2.5)
+    m = dr.solve(TH)
+    tau, ok = analysis.virtual_work_torque(m.points["coupler_point"][:, None, :], TH, [0.0, -1.0], valid=m.valid)
+    assert ok.any() and not (ok & ~m.valid).any()
+    assert (tau[~ok] == 0).all() and np.isfinite(tau).all()
+
+
+def test_regenerative_samples_multiply_by_the_efficiency(leg: FourBar) -> None:
+    """Power by finite differences of the foot's path (a second method): where the load takes power the motor
+    supplies it over the efficiency; where the load gives power back the motor receives it times the efficiency."""
+    F = np.array([0.0, 10.0])
+    eta = 0.8 * 0.9
+    tau, ok = analysis.motor_torque(leg, TH, {"coupler_point": F}, eta_trans=0.8, eta_link=0.9)
+    foot = leg.solve(TH).points["coupler_point"]
+    step = TH[1] - TH[0]
+    p = ((np.roll(foot, -1, 0) - np.roll(foot, 1, 0)) / (2 * step) * F).sum(-1)  # power per unit crank speed
+    assert ok.all() and (p > 0).any() and (p < 0).any()
+    expect = np.where(p >= 0, p / eta, p * eta)
+    assert np.abs(tau - expect).max() < 1e-3 * np.abs(expect).max()
+    assert tau.min() == pytest.approx(-5.5776, abs=1e-3)  # the README example: no longer -10.76
+
+
+def test_slider_position_honours_branch() -> None:
+    for branch in (1, -1):
+        sc = SliderCrank(1.0, 3.0, offset=0.5, branch=branch)
+        m = sc.solve(TH)
+        np.testing.assert_allclose(sc.slider_position(TH), m.points["slider_pin"][:, 0], atol=1e-12)
+    assert SliderCrank(1.0, 3.0, branch=-1).slider_position(np.pi / 2) == pytest.approx(-math.sqrt(8.0))
