@@ -61,8 +61,11 @@ def _cmd_design(args: argparse.Namespace) -> int:
         pl = d.placement
         b = d.before
         if pl is not None and pl.variables:
-            print(f"  before placement: {b['layers']} layers, {b['collisions']} same-layer collisions, "
-                  f"{b['pin_clashes']} pins through pieces")
+            if b["export_refused"]:
+                print(f"  before placement: {d.before_reason}")
+            else:
+                print(f"  before placement: {b['layers']} layers, {b['collisions']} same-layer collisions, "
+                      f"{b['pin_clashes']} pins through pieces")
             if pl.kept:
                 print(f"  placement ({', '.join(pl.variables)}; {pl.evaluations} layouts annealed, "
                       f"{pl.checked} checked against the export): footprint {pl.footprint[0]:.3g} -> "

@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InputError
+from ..errors import InputError, PlanarError
 from .chain import Chain, ToyMechanism, _to_base, _to_world, tree_cost
 from .mechanisms import ELEMENTAL, check_params, params_for
 from .sizing import DESIGN_PARAMETER
@@ -108,6 +108,7 @@ class Design:
     clashes: list[str] = field(default_factory=list)  # pins crossing a piece between their layers
     rejected: list[str] = field(default_factory=list)  # cheaper trees whose fabrication collided
     before: dict[str, int] = field(default_factory=dict)  # layers, collisions, pin clashes before placement
+    before_reason: str = ""  # why the export refused the pieces before placement, if it did
 
     def report(self) -> dict[str, Any]:
         return {
@@ -418,7 +419,8 @@ def layer_collisions(toy: ToyMechanism, samples: int = 24, unit_mm: float = 100.
     (outline minus holes and slots, mm) overlaps at some sampled pose by more
     than the fabrication's tolerance (``planar.assembly.OVERLAP_MM2``, 0.5 mm^2),
     with the worst overlap (mm^2); and the export's pin clashes (a pin whose
-    path crosses a piece on a layer between its ends).
+    path crosses a piece on a layer between its ends), or the export's refusal
+    of the pieces (no layers) as the one clash.
     """
     from shapely import affinity
 
@@ -429,7 +431,10 @@ def layer_collisions(toy: ToyMechanism, samples: int = 24, unit_mm: float = 100.
     from .assembly import toy_assembly
 
     scene = scene_from_mechanism(toy, fabrication={"unit_mm": unit_mm})
-    fab = build(scene, FabSettings.from_spec(scene.spec.fabrication, None, None))
+    try:
+        fab = build(scene, FabSettings.from_spec(scene.spec.fabrication, None, None))
+    except PlanarError as e:  # the export refuses these pieces (e.g. no material left between two cuts)
+        return {}, [], [f"the export refuses it: {e}"]
     plan = fab.assembly
     layers = {k: (v if v is not None else 0) for k, v in plan.layers.items()}
     clashes = [f"pin {pp.letter} ({', '.join(pp.joints)}) through {q}" for pp in plan.pins for q in pp.clashes]
@@ -713,7 +718,9 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
         placement = None
         checked = layer_collisions(toy)
         layers_before = len(set(checked[0].values()))
-        before = {"layers": layers_before, "collisions": len(checked[1]), "pin_clashes": len(checked[2])}
+        checked_before = checked
+        before = {"layers": layers_before, "collisions": len(checked[1]), "pin_clashes": len(checked[2]),
+                  "export_refused": int(not checked[0])}
 
         def bad(c: tuple[dict[str, int], list, list]) -> tuple[int, int, int]:
             return len(c[1]), len(c[2]), len(set(c[0].values()))
@@ -740,7 +747,8 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
         layers, collisions, clashes = checked
         secs = {"enumerate": t_enum, "rank_and_size": t_size, "place_and_check": time.perf_counter() - t1}
         d = Design(toy, effectors, pairs, cost, ranges, len(cands), tried, sizing, layers, collisions, secs,
-                   placement, layers_before, clashes, rejected, before)
+                   placement, layers_before, clashes, rejected, before,
+                   before_reason=checked_before[2][0] if before["export_refused"] else "")
         if not collisions and not clashes:
             return d
         # a tree whose pieces collide or whose pins cross pieces: try the next cheapest (a few)
