@@ -27,12 +27,18 @@ def _cmd_design(args: argparse.Namespace) -> int:
     from .pipeline import scene_from_mechanism
     from .windup.design import TOLERANCE, design_toy, load_request
 
+    from .errors import InputError
+
+    out = Path(args.output)
+    parent = out.parent if str(out.parent) else Path(".")
+    if not parent.is_dir() or out.is_dir() or out.suffix != ".toml":
+        raise InputError("--output", args.output, "a .toml file name in an existing directory")
+    if out.exists() and out.resolve() == Path(args.request).resolve():
+        raise InputError("--output", args.output, "a file other than the request")
     effectors = load_request(args.request)
     with open(args.request, "rb") as fh:
         name = tomllib.load(fh).get("name") or Path(args.request).stem
     if not isinstance(name, str):
-        from .errors import InputError
-
         raise InputError(f"{args.request}: name", name, "a string")
     d = design_toy(effectors, name=name, max_length=args.max_length)
     scene = scene_from_mechanism(d.toy, name=name, driver={"speed": 0.5, "samples_per_cycle": 36},

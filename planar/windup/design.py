@@ -684,6 +684,10 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
         if len(on) > 1:
             raise InputError(f"effector phases on the {cam} cam", on, "one phase per cam")
     options = [enumerate_chains(e.motion, max_length)[e.motion] for e in effectors]
+    for e, opts in zip(effectors, options):
+        if not opts:
+            raise InputError(f"effector {e.name!r} ({e.motion}) chain length", max_length,
+                             f"enough stages for a chain from the motor to {e.motion} (--max-length)")
     cands = _candidates(effectors, options)
     t_enum = time.perf_counter() - t0
     tried = fabricated = 0
