@@ -201,15 +201,14 @@ def _stage_params(number: int, kw: dict[str, Any], u: Array) -> Any:
     return params_for(number, **kw)
 
 
-def _compose(chain: Chain, cam_phase: float, overrides: dict[Chain, dict[str, Any]], q: Array) -> Array | None:
-    """Every stage's world output along ``chain`` (list by depth), or None where a stage fails or is refused."""
+def _compose(chain: Chain, cam_phase: float, overrides: dict[Chain, dict[str, Any]], q: Array) -> list[Array] | None:
+    """Every stage's world output along ``chain`` (by depth) for motor angles ``q`` (rad), as
+    :class:`ToyMechanism` composes it; None where a stage's parameters are refused or it fails at a sample."""
     outs = []
-    world = q + cam_phase
-    first = True
+    world = q + cam_phase  # the cam's rotation drives the first stage
     for d in range(1, len(chain) + 1):
         r = realise(chain[d - 1])
-        u = _to_base(r, world) if not first else _to_base(r, q + cam_phase)
-        first = False
+        u = _to_base(r, world)
         try:
             P = _stage_params(r.number, overrides.get(chain[:d], {}), u)
             check_params(r.number, P)
@@ -220,7 +219,7 @@ def _compose(chain: Chain, cam_phase: float, overrides: dict[Chain, dict[str, An
             return None
         world = _to_world(r, res.out)
         outs.append(world)
-    return outs  # type: ignore[return-value]
+    return outs
 
 
 def _span(out: Array) -> float:
