@@ -403,7 +403,7 @@ def effector_ranges(toy: ToyMechanism, samples: int = SAMPLES) -> dict[str, tupl
         if motion[0] == "O":
             val = float(np.ptp(np.unwrap(pose[:, 2])))
         else:
-            axis = {"xy": "xy", "xz": "xz", "yz": "yz"}[plane].index(motion[1])
+            axis = plane.index(motion[1])  # the piece's plane names its pose's two coordinates
             val = float(np.ptp(pose[:, axis]))
         out[name] = (motion, val)
     return out
