@@ -354,6 +354,7 @@ def build_parser() -> argparse.ArgumentParser:
     ex.set_defaults(func=_cmd_export)
 
     __import__("planar.cli_toy", fromlist=["add_parser"]).add_parser(sub)
+    __import__("planar.cli_design", fromlist=["add_parser"]).add_parser(sub)
 
     c = sub.add_parser("catalog", help="write the motion table of a built-in mechanism")
     c.add_argument("mechanism", help="catalog name, e.g. jansen, kangaroo, slider-crank")

@@ -281,6 +281,20 @@ class ChainSpec(_Strict):
     (``planar chains`` lists them), e.g. ``["Rz->OzT", "OzT->Oz"]``."""
 
 
+class ToyStageSpec(_Strict):
+    """One stage of a toy given its own parameters or a name: ``[[mechanism.stages]]`` with ``cam``,
+    ``chain`` (the stage's prefix) and ``params`` (as an elemental's), e.g. what ``planar design`` writes."""
+
+    cam: Literal["left", "right"]
+    """The cam whose tree holds the stage, ``"left"`` or ``"right"``."""
+    chain: Annotated[list[str], Field(min_length=1)]
+    """The patterns from the motor to this stage (a prefix of one of the cam's chains), e.g. ``["Rz->Tx"]``."""
+    params: dict[str, Union[Real, list[Real]]] = {}
+    """The stage mechanism's parameters overriding its defaults (angles in the scene's angle unit)."""
+    name: str | None = None
+    """A name for the stage's end effector: a point at its follower's origin (trails, motion tables)."""
+
+
 class ToySpec(_Strict):
     """A wind-up toy: chains on the motor's left and right cams (see ``gallery/horse.toml``)."""
 
@@ -292,6 +306,8 @@ class ToySpec(_Strict):
     """Chains on the right cam, e.g. ``[["Rz->OzT", "OzT->Ty"], ["Rz->OzT", "OzT->Oz"]]``."""
     phase: Real = math.pi
     """The right cam's lead over the left (scene's angle unit), e.g. ``180`` with ``angle_unit = "deg"``."""
+    stages: list[ToyStageSpec] = []
+    """Stages with their own parameters or end-effector names (``[[mechanism.stages]]``)."""
 
     @model_validator(mode="after")
     def _some(self) -> "ToySpec":
@@ -885,7 +901,28 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, A
             cams["left"] = [tuple(c) for c in m.left]
         if m.right:
             cams["right"] = [tuple(c) for c in m.right]
-        return ToyMechanism(cams, phase=_angle(spec, m.phase), rate=rate, name=spec.name or "toy")
+        from .windup import ELEMENTAL
+        from .windup.table import realise
+
+        overrides: dict[Any, dict[str, Any]] = {}
+        names: dict[tuple[str, tuple[str, ...]], str] = {}
+        for i, sg in enumerate(m.stages):
+            key = (sg.cam, tuple(sg.chain))
+            if not any(tuple(c[:len(key[1])]) == key[1] for c in cams.get(sg.cam, [])):
+                raise InputError(f"mechanism.stages[{i}].chain", sg.chain, f"a prefix of a chain on the {sg.cam} cam")
+            angle_params = ELEMENTAL[realise(sg.chain[-1]).number].angle_params
+            kw = {}
+            for k, v in sg.params.items():
+                val = tuple(v) if isinstance(v, list) else v
+                if k in angle_params:
+                    val = tuple(_angle(spec, x) for x in val) if isinstance(val, tuple) else _angle(spec, val)
+                kw[k] = val
+            if kw:
+                overrides[key] = kw
+            if sg.name is not None:
+                names[key] = sg.name
+        return ToyMechanism(cams, phase=_angle(spec, m.phase), rate=rate, name=spec.name or "toy",
+                            overrides=overrides, names=names)
     if isinstance(m, CamSpec):
         return _build_cam(spec, m, rate, phase)
     try:

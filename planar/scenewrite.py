@@ -10,8 +10,7 @@
 saved is what runs);
 :func:`write_scene` writes a scene's keys as TOML (``Scene.save``).  Angles
 are written in radians.  What a scene file cannot say is refused with a
-one-line :class:`~planar.errors.InputError`, never dropped: a toy with
-per-stage parameter overrides, a linkage with a custom part width or pin
+one-line :class:`~planar.errors.InputError`, never dropped: a linkage with a custom part width or pin
 diameter, a node kind without scene keys.
 """
 
@@ -94,11 +93,20 @@ def mechanism_table(mech: "Mechanism") -> dict[str, Any]:
         table: dict[str, Any] = {"type": "toy", "phase": mech.phase}
         for cam, chains in mech.cams.items():
             table[cam] = [list(c) for c in chains]
-        rebuilt = ToyMechanism(mech.cams, phase=mech.phase, rate=mech.driver.rate, name=mech.name)
+        given = getattr(mech, "stage_overrides", {})
+        rebuilt = ToyMechanism(mech.cams, phase=mech.phase, rate=mech.driver.rate, name=mech.name,
+                               overrides=given)
         for a, b in zip(mech.stages, rebuilt.stages):
             if a.mech.params != b.mech.params:
                 raise InputError(f"{mech.name}.stage {' '.join(a.key)}", a.mech.params,
-                                 "a stage at its default parameters (a scene file cannot override a toy's stage)")
+                                 "a stage whose parameters the toy recorded (ToyMechanism overrides)")
+        stages: dict[tuple[str, tuple[str, ...]], dict[str, Any]] = {}
+        for (cam, key), kw in given.items():
+            stages[(cam, key)] = {"cam": cam, "chain": list(key), "params": {k: _f(v) for k, v in kw.items()}}
+        for (cam, key), n in getattr(mech, "names", {}).items():
+            stages.setdefault((cam, key), {"cam": cam, "chain": list(key)})["name"] = n
+        if stages:
+            table["stages"] = list(stages.values())
         return table
     raise InputError("mechanism", type(mech).__name__,
                      "a FourBar, SliderCrank, Linkage, ElementalMechanism or ToyMechanism (those a scene describes)")

@@ -321,6 +321,14 @@ class ToyAssembly(Mechanism):
                     body = "+".join(group)
                 piece_of[full] = piece
                 body_of[full] = body
+        # a named end effector's follower that is a piece of its own takes the effector's name
+        label_of = {(st.cam, st.key): st.label for st in toy.stages}
+        rename = {f"{label_of[k]}.follower": n for k, n in getattr(toy, "names", {}).items()}
+        for full, n in rename.items():
+            if piece_of.get(full) == full:
+                piece_of[full] = n
+                if body_of.get(full) == full:
+                    body_of[full] = n
         # each piece's frame: world for frames, else its first member's frame
         members: dict[str, list[tuple[str, XForm]]] = {}
         for full, piece in piece_of.items():
@@ -377,12 +385,15 @@ class ToyAssembly(Mechanism):
             if name == main_cam:
                 continue
             ph = toy.cam_phase[self.placed[i].stage.cam] - toy.cam_phase[self.placed[min(cam_name)].stage.cam]
+            # a root stage turned by its realisation (Rz->Ty is #1 turned a quarter) turns its cam as much
+            ph = float(wrap_angle(np.array([ph + self.placed[i].place[2] - self.placed[min(cam_name)].place[2]]))[0])
             self.keyed[name] = float(ph)
             joints.append(KeyedShaft(f"{name}.key", main_cam, name, (0.0, 0.0), (0.0, 0.0), float(ph), size))
         self.main_cam = main_cam
         d = toy.driver
         driver = Driver(main_cam, "rotation", origin=(0.0, 0.0), rate=d.rate, phase=d.phase)
-        points = {k: (piece_of[v[0]], _xf_point(xf[v[0]], v[1])) for k, v in toy.points.items()}
+        named = set(rename.values()) & set(piece_of.values())  # effector pieces carry the name themselves
+        points = {k: (piece_of[v[0]], _xf_point(xf[v[0]], v[1])) for k, v in toy.points.items() if k not in named}
         super().__init__(f"{toy.name} (assembled)", parts, joints, driver, points)
         self.spatial = False
 

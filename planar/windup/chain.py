@@ -97,7 +97,10 @@ class ToyMechanism(Mechanism):
 
     ``cams`` maps ``"left"``/``"right"`` to the chains hanging on that cam;
     ``phase`` (rad) is the right cam's lead.  ``overrides`` maps a pattern
-    prefix (a chain tuple) to parameter overrides of that stage's mechanism.
+    prefix (a chain tuple), or ``(cam, prefix)`` for one cam's stage only, to
+    parameter overrides of that stage's mechanism.  ``names`` maps
+    ``(cam, prefix)`` to a name for that stage's end effector: a named point at
+    its follower's origin (trails, motion tables).
     """
 
     def __init__(
@@ -106,8 +109,9 @@ class ToyMechanism(Mechanism):
         phase: float = math.pi,
         name: str = "toy",
         rate: float = 2 * math.pi,
-        overrides: Mapping[Chain, Mapping[str, Any]] | None = None,
+        overrides: Mapping[Any, Mapping[str, Any]] | None = None,
         samples: int = 721,
+        names: Mapping[tuple[str, Chain], str] | None = None,
     ) -> None:
         if not cams:
             raise InputError(f"{name}.cams", cams, "at least one cam with a chain")
@@ -118,6 +122,8 @@ class ToyMechanism(Mechanism):
         self.phase = float(check_finite(f"{name}.phase", phase))
         self.cam_phase = {"left": 0.0, "right": self.phase}
         overrides = dict(overrides or {})
+        #: the parameter overrides given, by ``(cam, prefix)`` (what a scene file's ``stages`` record)
+        self.stage_overrides: dict[tuple[str, Chain], dict[str, Any]] = {}
         self.stages: list[_Stage] = []
         index: dict[tuple[str, Chain], int] = {}
         q = np.linspace(0.0, 2 * math.pi, samples)
@@ -134,7 +140,9 @@ class ToyMechanism(Mechanism):
                         u = _to_base(r, q + self.cam_phase[cam])
                     else:
                         u = _to_base(r, world_out[parent])
-                    kw = dict(overrides.get(key, {}))
+                    kw = dict(overrides.get((cam, key)) or overrides.get(key) or {})
+                    if kw:
+                        self.stage_overrides[(cam, key)] = dict(kw)
                     mech = self._build_stage(r, u, kw, name, key)
                     st = mech.forward(u)
                     world_out[len(self.stages)] = _to_world(r, st.out)
@@ -151,6 +159,11 @@ class ToyMechanism(Mechanism):
             for chain in chains:
                 leaf = self.stages[index[(cam, chain)]]
                 points[f"{cam}:{chain[-1].split('->')[1]}@{leaf.label}"] = (f"{leaf.label}.follower", (0.0, 0.0))
+        self.names = {(cam, tuple(c)): str(n) for (cam, c), n in (names or {}).items()}
+        for (cam, c), n in self.names.items():
+            if (cam, c) not in index:
+                raise InputError(f"{name}.names", n, f"a stage of the toy ({cam} {' '.join(c)} is none)")
+            points[n] = (f"{self.stages[index[(cam, c)]].label}.follower", (0.0, 0.0))
         self.end_effectors = {cam: [index[(cam, c)] for c in chains] for cam, chains in self.cams.items()}
         super().__init__(name, parts, joints, driver, points)
 

@@ -1,0 +1,103 @@
+"""``planar design REQUEST.toml -o toy.toml``: a wind-up toy from requested end-effector motions.
+
+Enumerates chains, merges them into trees, ranks by the paper's cost, sizes
+the cheapest tree that works and writes it as a toy scene (renders
+assembled, simulates with ``planar toy``, exports).  Prints the tree, its
+cost, each effector's requested and measured range, the layers and any
+same-layer collision.  Exit status 2 for bad input or an unreachable request
+(one line naming the effector and what its chains reach; nothing written);
+3 when the written toy fails its own check (a range off by more than 1 %, a
+same-layer collision).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+EXIT_MISMATCH = 3
+
+
+def _cmd_design(args: argparse.Namespace) -> int:
+    import tomllib
+
+    from .pipeline import scene_from_mechanism
+    from .windup.design import TOLERANCE, design_toy, load_request
+
+    from .errors import InputError
+
+    out = Path(args.output)
+    parent = out.parent if str(out.parent) else Path(".")
+    if not parent.is_dir() or out.is_dir() or out.suffix != ".toml":
+        raise InputError("--output", args.output, "a .toml file name in an existing directory")
+    if out.exists() and out.resolve() == Path(args.request).resolve():
+        raise InputError("--output", args.output, "a file other than the request")
+    effectors = load_request(args.request)
+    with open(args.request, "rb") as fh:
+        name = tomllib.load(fh).get("name") or Path(args.request).stem
+    if not isinstance(name, str):
+        raise InputError(f"{args.request}: name", name, "a string")
+    d = design_toy(effectors, name=name, max_length=args.max_length)
+    scene = scene_from_mechanism(d.toy, name=name, driver={"speed": 0.5, "samples_per_cycle": 36},
+                                 render={"width": 360, "height": 270}, fabrication={"unit_mm": 100.0})
+    scene.save(args.output)
+    rep = d.report()
+    rep["output"] = str(args.output)
+    bad = [e for e in rep["effectors"] if e["error"] > TOLERANCE]
+    ok = not bad and not d.collisions and not d.clashes
+    if args.json:
+        print(json.dumps(rep, indent=2, sort_keys=True, default=float))
+    else:
+        trees = "; ".join(f"{cam}: " + ", ".join(" ".join(c) for c in chains) for cam, chains in rep["cams"].items())
+        lead = f"; right cam {math.degrees(d.toy.phase):.0f} deg ahead" if len(d.toy.cams) == 2 else ""
+        print(f"{name}: cost {d.cost:g} ({d.toy.mechanism_count} mechanisms), {trees}{lead}; "
+              f"{d.tried} of {d.candidates} trees sized")
+        for r in d.rejected:
+            print(f"  passed over (its pieces collide): {r}")
+        for e in rep["effectors"]:
+            unit = "deg" if e["motion"][0] == "O" else "units"
+            flag = "[ok]" if e["error"] <= TOLERANCE else "[FAIL]"
+            print(f"  {e['name']} ({e['motion']}, {e['cam']} cam): requested {e['requested']:g} {unit}, "
+                  f"measured {e['achieved']:.6g} {unit} ({100 * e['error']:.2g} %) {flag}; "
+                  f"{e['sized']['stage']}: {e['sized']['parameter']} = {e['sized']['value']:.6g}")
+        n_layers = len(set(d.layers.values()))
+        pl = d.placement
+        b = d.before
+        if pl is not None and pl.variables:
+            if b["export_refused"]:
+                print(f"  before placement: {d.before_reason}")
+            else:
+                print(f"  before placement: {b['layers']} layers, {b['collisions']} same-layer collisions, "
+                      f"{b['pin_clashes']} pins through pieces")
+            if pl.kept:
+                print(f"  placement ({', '.join(pl.variables)}; {pl.evaluations} layouts annealed, "
+                      f"{pl.checked} checked against the export): footprint {pl.footprint[0]:.3g} -> "
+                      f"{pl.footprint[1]:.3g} units^2, overlap of unjoined pieces {pl.overlap[0]:.3g} -> "
+                      f"{pl.overlap[1]:.3g}")
+            else:
+                print(f"  placement ({', '.join(pl.variables)}; {pl.evaluations} layouts annealed): none of the "
+                      f"{pl.checked} best kept (each added a collision, pin clash or layer, or none improved)")
+        else:
+            print("  placement: no stage of this tree can move without changing a motion")
+        print(f"  {len(d.layers)} pieces in {n_layers} layers (the export's plan); same-layer collisions over 24 "
+              f"poses: {len(d.collisions)}, pins through pieces: {len(d.clashes)} "
+              + ("[ok]" if not (d.collisions or d.clashes) else "[FAIL] " + ", ".join(
+                  [f"{a}/{b} {ov:.3g} mm^2" for a, b, ov in d.collisions] + d.clashes)))
+        print(f"  wrote {args.output} ({sum(d.seconds.values()):.2f} s)")
+    return 0 if ok else EXIT_MISMATCH
+
+
+def add_parser(sub: Any) -> None:
+    """Register ``planar design``."""
+    d = sub.add_parser("design", help="a wind-up toy from requested end-effector motions (writes a toy scene)",
+                       description="Design a wind-up toy from a request file of [[effector]] tables (name, motion "
+                                   "Ox Oy Oz Tx Ty Tz OzT, range in degrees for O/OzT or model units for T, "
+                                   "optional cam left/right and phase in cycles).")
+    d.add_argument("request", help="request file (TOML, [[effector]] tables)")
+    d.add_argument("-o", "--output", required=True, help="toy scene file to write (TOML)")
+    d.add_argument("--json", action="store_true", help="print a JSON report")
+    d.add_argument("--max-length", type=int, default=3, help="longest chain considered (default 3)")
+    d.set_defaults(func=_cmd_design)

@@ -1,0 +1,782 @@
+"""Toy design from requested motions: the paper's pipeline, end to end (``planar design``).
+
+A request lists end effectors (``[[effector]]``: ``name``, ``motion``,
+``range``, optional ``cam`` and ``phase``).  :func:`design_toy`
+
+1. **enumerates** every chain from the motor to each effector's motion (up to
+   three stages, :func:`~planar.windup.table.enumerate_chains`);
+2. **merges** one chain per effector into trees on the two cams (chains on one
+   cam share their common prefix: one stage each), respecting a requested
+   ``cam`` and putting effectors with different ``phase`` on different cams;
+3. **ranks** the trees by the paper's cost (:func:`~planar.windup.chain.tree_cost`:
+   mechanisms + 2 x mean chain length), cheapest first, skipping trees with a
+   chain that cannot reach its effector's range (each chain's reachable range
+   is scanned once, lazily, its sized stage's parameter varied);
+4. **sizes** the cheapest tree that works: each effector's last stage's design
+   parameter (:data:`~planar.windup.sizing.DESIGN_PARAMETER`; its parent's for a
+   #10, whose stroke follows its driver's travel) is solved with
+   :func:`scipy.optimize.brentq` so that the effector's range, composed
+   through the tree (its parent's actual output, not a standalone law), is the
+   request; stages are sized parents first;
+5. **places** the stages (:func:`place_stages`): a toy's stages sit where the
+   assembly puts them (a child's driver on its parent's follower, the roots on
+   the motor axis); the free variables are the follower positions that change
+   no motion (#1's slider, #9's pivot: ``F_o``), annealed toward a small
+   footprint and little overlap of unjoined pieces; the result is kept only if
+   it adds no collision, pin clash or layer;
+6. **checks** the result independently: each effector's range is measured on
+   the assembled toy's piece poses, and the export's own layer plan
+   (:func:`planar.fabexport.build`) is checked with shapely for pieces of one
+   layer overlapping at any of 24 sampled poses and for pins running through
+   a piece.  A tree that fails is passed over for the next cheapest (up to
+   ``max_fabricated``); if all fail, the cheapest is returned with its
+   failures (``planar design`` exits 3).
+
+Units: ranges of O motions (and the rotation of OzT) in degrees, of T
+motions in model units (one unit is 100 mm when cut); phases in cycles.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InputError, PlanarError
+from .chain import Chain, ToyMechanism, _to_base, _to_world, tree_cost
+from .mechanisms import ELEMENTAL, check_params, params_for
+from .sizing import DESIGN_PARAMETER
+from .table import MOTION_TYPES, enumerate_chains, realise
+
+__all__ = ["Effector", "Design", "load_request", "design_toy", "effector_ranges", "layer_collisions"]
+
+Array = NDArray[np.float64]
+CAMS = ("left", "right")
+#: samples of one motor turn used for sizing and for the checks
+SAMPLES = 721
+#: design-parameter values scanned per sized stage before root finding
+SCAN = 97
+#: relative range tolerance the check demands (the request says 1 %)
+TOLERANCE = 0.01
+
+
+@dataclass(frozen=True)
+class Effector:
+    """One requested end effector: ``range`` in degrees (O, OzT's rotation) or model units (T);
+    ``phase`` in cycles (only differences between cams matter)."""
+
+    name: str
+    motion: str
+    range: float
+    cam: str | None = None
+    phase: float = 0.0
+
+    @property
+    def target(self) -> float:
+        """The range in the kinematics' units (radians or model units)."""
+        return math.radians(self.range) if self.motion[0] == "O" else self.range
+
+    def unit(self, value: float) -> str:
+        """``value`` (kinematics units) in the request's units, with the unit."""
+        return f"{math.degrees(value):.4g} deg" if self.motion[0] == "O" else f"{value:.4g} units"
+
+
+@dataclass
+class Design:
+    """A designed toy: the sized mechanism, which tree, its cost and the checks' figures."""
+
+    toy: ToyMechanism
+    effectors: list[Effector]
+    assignment: list[tuple[str, Chain]]
+    cost: float
+    ranges: dict[str, float]  # measured in the assembled toy, request units
+    candidates: int  # trees considered (after the reachability filter)
+    tried: int  # trees sized before one worked
+    sizing: dict[str, tuple[str, str, float]]  # effector -> (stage chain, parameter, value)
+    layers: dict[str, int] = field(default_factory=dict)
+    collisions: list[tuple[str, str, float]] = field(default_factory=list)
+    seconds: dict[str, float] = field(default_factory=dict)
+    placement: "Placement | None" = None
+    layers_before: int | None = None  # layers of the toy before placement
+    clashes: list[str] = field(default_factory=list)  # pins crossing a piece between their layers
+    rejected: list[str] = field(default_factory=list)  # cheaper trees whose fabrication collided
+    before: dict[str, int] = field(default_factory=dict)  # layers, collisions, pin clashes before placement
+    before_reason: str = ""  # why the export refused the pieces before placement, if it did
+
+    def report(self) -> dict[str, Any]:
+        return {
+            "toy": self.toy.name,
+            "cost": self.cost,
+            "mechanisms": self.toy.mechanism_count,
+            "cams": {cam: [list(c) for c in chains] for cam, chains in self.toy.cams.items()},
+            "phase_deg": math.degrees(self.toy.phase),
+            "effectors": [{"name": e.name, "motion": e.motion, "cam": cam, "chain": list(chain),
+                           "requested": e.range, "achieved": self.ranges[e.name],
+                           "error": abs(self.ranges[e.name] - e.range) / e.range,
+                           "sized": {"stage": self.sizing[e.name][0], "parameter": self.sizing[e.name][1],
+                                     "value": self.sizing[e.name][2]}}
+                          for e, (cam, chain) in zip(self.effectors, self.assignment)],
+            "trees_considered": self.candidates,
+            "trees_sized": self.tried,
+            "layers": self.layers,
+            "layer_count": len(set(self.layers.values())),
+            "before_placement": self.before,
+            "placement": None if self.placement is None else {
+                "variables": self.placement.variables, "objective": list(self.placement.objective),
+                "footprint": list(self.placement.footprint), "overlap": list(self.placement.overlap),
+                "evaluations": self.placement.evaluations, "rejected": self.placement.rejected,
+                "kept": self.placement.kept, "checked": self.placement.checked},
+            "collisions": [{"a": a, "b": b, "overlap": ov} for a, b, ov in self.collisions],
+            "pin_clashes": self.clashes,
+            "rejected_trees": self.rejected,
+            "seconds": self.seconds,
+        }
+
+
+# ----------------------------------------------------------------------------- the request
+
+
+def load_request(path: str | Path) -> list[Effector]:
+    """Read a request file (TOML ``[[effector]]`` tables); bad input is an :class:`InputError` naming the field."""
+    p = str(path)
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except OSError as e:
+        raise InputError(p, p, f"a readable request file ({e.strerror})") from None
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(p, p, f"TOML ({e})") from None
+    extra = sorted(set(data) - {"effector", "name"})
+    if extra:
+        raise InputError(f"{p}: {extra[0]}", data[extra[0]], "only [[effector]] tables and a toy name")
+    rows = data.get("effector")
+    if not isinstance(rows, list) or not rows or not all(isinstance(r, dict) for r in rows):
+        raise InputError(f"{p}: effector", rows, "one or more [[effector]] tables")
+    out = []
+    for i, r in enumerate(rows):
+        where = f"{p}: effector[{i}]"
+        bad = sorted(set(r) - {"name", "motion", "range", "cam", "phase"})
+        if bad:
+            raise InputError(f"{where}.{bad[0]}", r[bad[0]], "one of name, motion, range, cam, phase")
+        name = r.get("name")
+        if not isinstance(name, str) or not name.strip() or any(c in name for c in ".:+") or name == "frame":
+            raise InputError(f"{where}.name", name, "a name without '.', ':' or '+', not 'frame' (the effector's piece)")
+        motion = r.get("motion")
+        if motion not in MOTION_TYPES:
+            raise InputError(f"{where}.motion", motion, f"one of {', '.join(MOTION_TYPES)}")
+        rng = r.get("range")
+        if isinstance(rng, bool) or not isinstance(rng, (int, float)) or not math.isfinite(rng) or rng <= 0:
+            raise InputError(f"{where}.range", rng, "a positive number (degrees for O and OzT, model units for T)")
+        cam = r.get("cam")
+        if cam is not None and cam not in CAMS:
+            raise InputError(f"{where}.cam", cam, "'left' or 'right'")
+        ph = r.get("phase", 0.0)
+        if isinstance(ph, bool) or not isinstance(ph, (int, float)) or not math.isfinite(ph):
+            raise InputError(f"{where}.phase", ph, "a number of cycles")
+        out.append(Effector(name, str(motion), float(rng), cam, float(ph)))
+    names = [e.name for e in out]
+    dup = next((n for n in names if names.count(n) > 1), None)
+    if dup is not None:
+        raise InputError(f"{p}: effector.name", dup, "distinct effector names")
+    return out
+
+
+# ----------------------------------------------------------------------------- composition and sizing
+
+
+def _stage_params(number: int, kw: dict[str, Any], u: Array) -> Any:
+    """The parameters :class:`ToyMechanism` builds a stage with (its oscillating drivers' amplitude from ``u``)."""
+    kw = dict(kw)
+    if u.ndim == 1 and ELEMENTAL[number].motions[0] != "Rz" and "amplitude" not in kw:
+        amp = float(np.max(np.abs(u)))
+        if amp > 0:
+            kw["amplitude"] = amp
+    return params_for(number, **kw)
+
+
+def _compose(chain: Chain, cam_phase: float, overrides: dict[Chain, dict[str, Any]], q: Array) -> list[Array] | None:
+    """Every stage's world output along ``chain`` (by depth) for motor angles ``q`` (rad), as
+    :class:`ToyMechanism` composes it; None where a stage's parameters are refused or it fails at a sample."""
+    outs = []
+    world = q + cam_phase  # the cam's rotation drives the first stage
+    for d in range(1, len(chain) + 1):
+        r = realise(chain[d - 1])
+        u = _to_base(r, world)
+        try:
+            P = _stage_params(r.number, overrides.get(chain[:d], {}), u)
+            check_params(r.number, P)
+        except InputError:
+            return None
+        res = ELEMENTAL[r.number].forward(P, u)
+        if not np.all(res.valid):
+            return None
+        world = _to_world(r, res.out)
+        outs.append(world)
+    return outs
+
+
+def _span(out: Array) -> float:
+    """Peak-to-peak of an effector motion (the rotation of OzT)."""
+    return float(np.ptp(out[:, 2] if out.ndim == 2 else out))
+
+
+def _sized_depth(chain: Chain) -> int:
+    """Which stage (depth, 1-based) sizes the effector: the last, or its parent for a #10 in a chain."""
+    if len(chain) > 1 and realise(chain[-1]).number == 10:
+        return len(chain) - 1
+    return len(chain)
+
+
+@dataclass
+class _Scan:
+    values: Array
+    spans: Array  # NaN where invalid
+
+    def reachable(self) -> tuple[float, float] | None:
+        ok = np.isfinite(self.spans)
+        return (float(self.spans[ok].min()), float(self.spans[ok].max())) if ok.any() else None
+
+
+def _setter(number: int, base_kw: dict[str, Any], name: str, comp: int | None):
+    default = getattr(params_for(number), name)
+
+    def kw(v: float) -> dict[str, Any]:
+        out = dict(base_kw)
+        if comp is None:
+            out[name] = float(v)
+        else:
+            cur = list(out.get(name, default))
+            cur[comp] = float(v)
+            out[name] = tuple(cur)
+        return out
+    return kw, float(default if comp is None else default[comp])
+
+
+def _span_fn(chain: Chain, depth: int, cam_phase: float, overrides: dict[Chain, dict[str, Any]], q: Array):
+    number = realise(chain[depth - 1]).number
+    name, comp, bracket, _ = DESIGN_PARAMETER[number]
+    kw_of, current = _setter(number, overrides.get(chain[:depth], {}), name, comp)
+
+    def f(v: float) -> float:
+        ov = dict(overrides)
+        ov[chain[:depth]] = kw_of(v)
+        outs = _compose(chain, cam_phase, ov, q)
+        return float("nan") if outs is None else _span(outs[-1])
+    return f, kw_of, name, bracket, current
+
+
+def _scan(f, bracket: tuple[float, float], cache: dict | None = None, key: Any = None) -> _Scan:
+    if cache is not None and key in cache:
+        return cache[key]
+    v = np.linspace(bracket[0], bracket[1], SCAN)
+    sc = _Scan(v, np.array([f(x) for x in v]))
+    if cache is not None:
+        cache[key] = sc
+    return sc
+
+
+def _scan_key(chain: Chain, depth: int, overrides: dict[Chain, dict[str, Any]]) -> Any:
+    """What a scan depends on: the chain, the sized stage and the overrides along the chain (a cam's phase
+    only shifts the cycle)."""
+    return (chain, depth, tuple((k, tuple(sorted((n, repr(v)) for n, v in overrides[k].items())))
+                                for k in (chain[:d] for d in range(1, len(chain) + 1)) if k in overrides))
+
+
+def _solve(f, sc: _Scan, target: float, current: float) -> float | None:
+    """The parameter value nearest ``current`` whose span is ``target`` (brentq between scan neighbours)."""
+    from scipy.optimize import brentq
+
+    d = sc.spans - target
+    roots = []
+    for k in range(sc.values.size - 1):
+        a, b = d[k], d[k + 1]
+        if not (np.isfinite(a) and np.isfinite(b)):
+            continue
+        if a == 0:
+            roots.append(float(sc.values[k]))
+        elif a * b < 0:
+            try:
+                roots.append(float(brentq(lambda v: f(v) - target, sc.values[k], sc.values[k + 1],
+                                          xtol=1e-14, rtol=1e-13)))
+            except ValueError:  # an invalid sliver between the scan values
+                continue
+    roots = [r for r in roots if np.isfinite(f(r))]
+    return min(roots, key=lambda r: abs(r - current)) if roots else None
+
+
+# ----------------------------------------------------------------------------- trees
+
+
+def _candidates(effectors: list[Effector], options: list[list[Chain]], limit: int = 500_000
+                ) -> list[tuple[float, int, list[tuple[str, Chain]]]]:
+    """Every assignment of one chain and one cam per effector, cheapest first (cost, then enumeration order)."""
+    cams = [[e.cam] if e.cam else list(CAMS) for e in effectors]
+    n = math.prod(len(o) for o in options) * math.prod(len(c) for c in cams)
+    if n > limit:
+        raise InputError("request", [e.name for e in effectors],
+                         f"fewer chain and cam combinations than {limit:,} (this request has {n:,})")
+    out = []
+    k = 0
+    for combo in itertools.product(*options):
+        for sides in itertools.product(*cams):
+            k += 1
+            pairs = list(zip(sides, combo))
+            if len(set(pairs)) < len(pairs):
+                continue  # two effectors cannot be one stage's follower
+            ok = True
+            for cam in CAMS:  # one cam turns its effectors at one phase
+                ph = {round(e.phase % 1.0, 12) for e, s in zip(effectors, sides) if s == cam}
+                if len(ph) > 1:
+                    ok = False
+            if not ok:
+                continue
+            tree: dict[str, list[Chain]] = {}
+            for s, c in pairs:
+                tree.setdefault(s, []).append(c)
+            out.append((tree_cost(tree), k, pairs))
+    out.sort(key=lambda x: (x[0], x[1]))
+    return out
+
+
+def _size_tree(effectors: list[Effector], pairs: list[tuple[str, Chain]], phase: float, q: Array,
+               cache: dict) -> tuple[dict[tuple[str, Chain], dict[str, Any]], dict[str, tuple[str, str, float]]] | None:
+    """Sized overrides (by ``(cam, prefix)``) for one tree, or None when some effector cannot be sized in it."""
+    cam_phase = {"left": 0.0, "right": phase}
+    per_cam: dict[str, dict[Chain, dict[str, Any]]] = {cam: {} for cam in CAMS}
+    fixed: set[tuple[str, Chain]] = set()
+    sizing: dict[str, tuple[str, str, float]] = {}
+    order = sorted(range(len(effectors)), key=lambda i: (_sized_depth(pairs[i][1]), len(pairs[i][1]), i))
+    for i in order:
+        e, (cam, chain) = effectors[i], pairs[i]
+        depth = _sized_depth(chain)
+        key = (cam, chain[:depth])
+        if key in fixed:
+            return None  # another effector already sized this stage
+        f, kw_of, name, bracket, current = _span_fn(chain, depth, cam_phase[cam], per_cam[cam], q)
+        sc = _scan(f, bracket, cache, _scan_key(chain, depth, per_cam[cam]))
+        v = _solve(f, sc, e.target, current)
+        if v is None:
+            return None
+        per_cam[cam][chain[:depth]] = kw_of(v)
+        fixed.add(key)
+        sizing[e.name] = (" ".join(chain[:depth]), name, v)
+    overrides = {(cam, k): kw for cam, d in per_cam.items() for k, kw in d.items()}
+    return overrides, sizing
+
+
+def _toy_phase(effectors: list[Effector], pairs: list[tuple[str, Chain]]) -> float:
+    ph = {cam: e.phase for e, (cam, _) in zip(effectors, pairs)}
+    if "left" in ph and "right" in ph:
+        return float(2 * math.pi * ((ph["right"] - ph["left"]) % 1.0))
+    return 0.0 if "left" in ph else float(2 * math.pi * (ph["right"] % 1.0))
+
+
+# ----------------------------------------------------------------------------- checks
+
+
+def effector_ranges(toy: ToyMechanism, samples: int = SAMPLES) -> dict[str, tuple[str, float]]:
+    """Each named effector's range measured on the assembled toy's piece poses: ``name -> (motion, range)``.
+
+    The range is the peak-to-peak of the piece's pose track (its angle for O
+    and OzT, rad; its coordinate along the axis for T, model units) over one
+    cycle, read from the assembly's solved motion (not from the sizing).
+    """
+    from .assembly import toy_assembly
+
+    asm = toy_assembly(toy)
+    m = asm.run(samples_per_cycle=samples)
+    if not np.all(m.valid):
+        raise InputError(toy.name, "motion", "a toy valid over its whole cycle")
+    out = {}
+    for (_cam, chain), name in toy.names.items():
+        motion = chain[-1].split("->")[1]
+        piece = name if any(p.name == name for p in asm.parts) else asm.points[name][0]
+        pose = np.asarray(m.poses[piece])
+        plane = next(p.plane for p in asm.parts if p.name == piece)
+        if motion[0] == "O":
+            val = float(np.ptp(np.unwrap(pose[:, 2])))
+        else:
+            axis = plane.index(motion[1])  # the piece's plane names its pose's two coordinates
+            val = float(np.ptp(pose[:, axis]))
+        out[name] = (motion, val)
+    return out
+
+
+def layer_collisions(toy: ToyMechanism, samples: int = 24, unit_mm: float = 100.0
+                     ) -> tuple[dict[str, int], list[tuple[str, str, float]], list[str]]:
+    """The toy's fabrication (what ``planar export`` cuts) checked for collisions over ``samples`` poses.
+
+    Returns ``(layers, collisions, pin clashes)``: the export's layer of every
+    piece; every pair of pieces on one layer (same plane) whose cut material
+    (outline minus holes and slots, mm) overlaps at some sampled pose by more
+    than the fabrication's tolerance (``planar.assembly.OVERLAP_MM2``, 0.5 mm^2),
+    with the worst overlap (mm^2); and the export's pin clashes (a pin whose
+    path crosses a piece on a layer between its ends), or the export's refusal
+    of the pieces (no layers) as the one clash.
+    """
+    from shapely import affinity
+
+    from ..assembly import OVERLAP_MM2
+    from ..fabexport import build
+    from ..fabparts import FabSettings
+    from ..pipeline import scene_from_mechanism
+    from .assembly import toy_assembly
+
+    scene = scene_from_mechanism(toy, fabrication={"unit_mm": unit_mm})
+    try:
+        fab = build(scene, FabSettings.from_spec(scene.spec.fabrication, None, None))
+    except PlanarError as e:  # the export refuses these pieces (e.g. no material left between two cuts)
+        return {}, [], [f"the export refuses it: {e}"]
+    plan = fab.assembly
+    layers = {k: (v if v is not None else 0) for k, v in plan.layers.items()}
+    clashes = [f"pin {pp.letter} ({', '.join(pp.joints)}) through {q}" for pp in plan.pins for q in pp.clashes]
+    asm = toy_assembly(toy)
+    m = asm.run(samples_per_cycle=samples)
+    ok = np.flatnonzero(m.valid)
+    plane = {p.name: p.plane for p in asm.parts}
+
+    def placed(name: str, k: int) -> Any:
+        x, y, a = m.poses[name][k]
+        c, s = math.cos(a), math.sin(a)
+        return affinity.affine_transform(fab.own[name], [c, -s, s, c, x * unit_mm, y * unit_mm])
+
+    found = []
+    names = [p.name for p in asm.parts]
+    for a, b in itertools.combinations(names, 2):
+        if plane[a] != plane[b] or layers.get(a) != layers.get(b):
+            continue
+        worst = max(placed(a, int(k)).intersection(placed(b, int(k))).area for k in ok)
+        if worst > OVERLAP_MM2:
+            found.append((a, b, float(worst)))
+    return layers, found, clashes
+
+
+# ----------------------------------------------------------------------------- placement
+
+#: stages whose follower can move relative to the driver without changing any motion (the slider of #1,
+#: the pivot of #9): ``F_o``'s in-plane components are the placement variables (checked again at run time)
+PLACEABLE = {1: "F_o", 9: "F_o"}
+#: annealing: iterations, step (model units), box around the default position (model units), overlap weight
+ANNEAL_STEPS = 24
+ANNEAL_STEP = 0.08
+ANNEAL_BOX = 0.4
+OVERLAP_WEIGHT = 10.0
+#: outline simplification in the placement objective (model units)
+SIMPLIFY = 0.003
+#: how many of the best annealed layouts are checked against the fabrication
+PLACEMENT_OPTIONS = 2
+#: a pin's radius in the placement's clash penalty (model units: 1.5 mm)
+PIN_RADIUS = 0.015
+
+
+@dataclass
+class Placement:
+    """What the annealing did: variables, objective and footprint before and after, evaluations."""
+
+    variables: list[str]
+    objective: tuple[float, float]
+    footprint: tuple[float, float]
+    overlap: tuple[float, float]
+    evaluations: int
+    rejected: int
+    seconds: float
+    kept: bool = True  # False when no annealed layout passed the fabrication check (the start is kept)
+    checked: int = 0  # annealed layouts checked against the fabrication
+
+
+def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
+    """``(footprint, overlap)``: the convex hull area of every xy piece's swept region over one cycle, and the
+    summed swept overlap of xy pieces no joint connects (pairs that must go on different layers); units^2."""
+    import shapely
+    from shapely import affinity
+
+    from ..assembly import pin_stacks
+    from ..fabjoints import joint_pins
+    from .assembly import ToyAssembly
+
+    asm = ToyAssembly(toy)
+    m = asm.run(samples_per_cycle=samples)
+    joined = {frozenset((j.a, j.b)) for j in asm.joints}
+    swept = {}
+    for p in asm.parts:
+        if p.plane != "xy":
+            continue
+        pose = np.asarray(m.poses[p.name])
+        c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+        shape = p.outline.simplify(SIMPLIFY)  # 0.3 mm: the objective need not follow every facet of a cam
+        swept[p.name] = shapely.union_all([affinity.affine_transform(shape, [c[k], -s[k], s[k], c[k],
+                                                                            pose[k, 0], pose[k, 1]])
+                                           for k in range(len(pose))])
+    footprint = float(shapely.union_all(list(swept.values())).convex_hull.area)
+    overlap = 0.0
+    names = [n for n in swept if n != "frame"]
+    for a, b in itertools.combinations(names, 2):
+        if frozenset((a, b)) not in joined:
+            overlap += float(swept[a].intersection(swept[b]).area)
+    # pins crossing pieces they do not join (the fabrication would need them on layers outside the pin)
+    pins, _ = joint_pins(asm)
+    for stack in pin_stacks(pins):
+        on = {n for i in stack for n in pins[i].parts}
+        pin = pins[stack[0]]
+        a = pin.parts[0]
+        if a not in swept:
+            continue
+        pose = np.asarray(m.poses[a])
+        c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+        x, y = pin.at[0]
+        path = np.c_[pose[:, 0] + c * x - s * y, pose[:, 1] + s * x + c * y]
+        geom = shapely.buffer(shapely.points(path[0]) if np.ptp(path, axis=0).max() < 1e-9
+                              else shapely.linestrings(path), PIN_RADIUS)
+        for n in names:
+            if n not in on:
+                overlap += float(swept[n].intersection(geom).area)
+    return footprint, overlap
+
+
+def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, overrides: dict[tuple[str, Chain], dict[str, Any]],
+                 names: dict[tuple[str, Chain], str], seed: int = 0
+                 ) -> tuple[list[tuple[dict[tuple[str, Chain], dict[str, Any]], tuple[float, float, float]]], Placement]:
+    """Anneal the placement variables (:data:`PLACEABLE`) to a compact toy whose pieces overlap little.
+
+    Returns the best ``PLACEMENT_OPTIONS`` distinct layouts the annealing
+    accepted that improve on the start (overrides and ``(objective,
+    footprint, overlap)``, best first) and what it did; the caller checks
+    them against the fabrication in turn.
+
+    Objective: footprint + ``OVERLAP_WEIGHT`` x overlap (:func:`_layout_score`).
+    A move that changes any stage's motion (compared on 181 samples to 1e-9)
+    or that the toy cannot be built with is rejected.  Simulated annealing
+    with a fixed seed (same request, same toy), ``ANNEAL_STEPS`` moves.
+    """
+    t0 = time.perf_counter()
+    q = np.linspace(0.0, 2 * math.pi, 181)
+    stages = []
+    for cam, chains in cams.items():
+        seen = set()
+        for c in chains:
+            for d in range(1, len(c) + 1):
+                key = c[:d]
+                if key in seen:
+                    continue
+                seen.add(key)
+                number = realise(key[-1]).number
+                if number in PLACEABLE:
+                    stages.append((cam, key, PLACEABLE[number], getattr(params_for(number), PLACEABLE[number])))
+
+    def build(x: Array) -> ToyMechanism | None:
+        ov = {k: dict(v) for k, v in overrides.items()}
+        for i, (cam, key, pname, default) in enumerate(stages):
+            cur = list(ov.get((cam, key), {}).get(pname, default))
+            cur[0], cur[1] = float(x[2 * i]), float(x[2 * i + 1])
+            ov.setdefault((cam, key), {})[pname] = tuple(cur)
+        try:
+            return ToyMechanism(cams, phase=phase, name=name, overrides=ov, names=names)
+        except InputError:
+            return None
+
+    base = ToyMechanism(cams, phase=phase, name=name, overrides=overrides, names=names)
+    ref, _ = base.world_motion(q)
+    ref = {k: v.copy() for k, v in ref.items()}
+
+    def score(x: Array) -> tuple[float, float, float, ToyMechanism | None]:
+        toy = build(x)
+        if toy is None:
+            return math.inf, math.inf, math.inf, None
+        outs, checks = toy.world_motion(q)
+        if not all(np.all(ok) for ok, _, _ in checks) or any(
+                not np.allclose(outs[k], ref[k], rtol=0, atol=1e-9) for k in ref):
+            return math.inf, math.inf, math.inf, None
+        try:
+            fp, ovl = _layout_score(toy)
+        except InputError:
+            return math.inf, math.inf, math.inf, None
+        return fp + OVERLAP_WEIGHT * ovl, fp, ovl, toy
+
+    x0 = np.array([v for _, _, _, d in stages for v in (d[0], d[1])], float)
+    # the sized overrides may already hold the variables
+    for i, (cam, key, pname, _) in enumerate(stages):
+        if pname in overrides.get((cam, key), {}):
+            x0[2 * i:2 * i + 2] = overrides[(cam, key)][pname][:2]
+    f0, fp0, ov0, _ = score(x0)
+    if not stages or not math.isfinite(f0):
+        return [], Placement([], (f0, f0), (fp0, fp0), (ov0, ov0), 1, 0, time.perf_counter() - t0, kept=False)
+    rng = np.random.default_rng(seed)
+    lo, hi = x0 - ANNEAL_BOX, x0 + ANNEAL_BOX
+    x, fx = x0.copy(), f0
+    states: list[tuple[float, float, float, Array]] = []  # accepted layouts better than the start
+    temp0 = 0.05 * f0
+    evals, rejected = 1, 0
+    for k in range(ANNEAL_STEPS):
+        temp = temp0 * (1 - k / ANNEAL_STEPS) + 1e-12
+        y = np.clip(x + rng.normal(0.0, ANNEAL_STEP, x.size), lo, hi)
+        fy, fpy, ovy, _ = score(y)
+        evals += 1
+        if not math.isfinite(fy):
+            rejected += 1
+            continue
+        if fy <= fx or rng.random() < math.exp(-(fy - fx) / temp):
+            x, fx = y, fy
+            if fy < f0 and all(np.abs(y - st[3]).max() > 1e-9 for st in states):
+                states.append((fy, fpy, ovy, y.copy()))
+    labels = [f"{cam} {' '.join(key)}: {pname}" for cam, key, pname, _ in stages]
+    options = []
+    for f, fp, ov, xs in sorted(states, key=lambda t: t[0])[:PLACEMENT_OPTIONS]:
+        out = {k: dict(v) for k, v in overrides.items()}
+        for i, (cam, key, pname, default) in enumerate(stages):
+            cur = list(out.get((cam, key), {}).get(pname, default))
+            cur[0], cur[1] = float(xs[2 * i]), float(xs[2 * i + 1])
+            out.setdefault((cam, key), {})[pname] = tuple(cur)
+        options.append((out, (f, fp, ov)))
+    return options, Placement(labels, (f0, f0), (fp0, fp0), (ov0, ov0), evals, rejected,
+                              time.perf_counter() - t0, kept=False)
+
+
+# ----------------------------------------------------------------------------- the pipeline
+
+
+def design_toy(effectors: list[Effector], name: str = "designed toy", max_length: int = 3,
+               max_trees: int = 200, place: bool = True, max_fabricated: int = 4) -> Design:
+    """Design a toy for ``effectors`` (see the module docstring); an unreachable request is an
+    :class:`InputError` naming the effector and the ranges its chains reach."""
+    t0 = time.perf_counter()
+    q = np.linspace(0.0, 2 * math.pi, SAMPLES)
+    cache: dict[Any, _Scan] = {}
+
+    def reach(c: Chain) -> tuple[float, float] | None:
+        """The ranges the chain reaches alone (its sized stage's parameter scanned; every other at its default)."""
+        f, _, _, bracket, _ = _span_fn(c, _sized_depth(c), 0.0, {}, q)
+        return _scan(f, bracket, cache, _scan_key(c, _sized_depth(c), {})).reachable()
+
+    built: dict[Chain, str | None] = {}
+
+    def refused(c: Chain) -> str | None:
+        """Why the assembly cannot build the chain alone (a stage turned out of its plane), or None."""
+        if c not in built:
+            from .assembly import toy_assembly
+
+            try:
+                toy_assembly(ToyMechanism({"left": [c]}, name="chain"))
+                built[c] = None
+            except InputError as err:
+                built[c] = str(err)
+        return built[c]
+
+    def reaches(e: Effector, c: Chain) -> bool:
+        r = reach(c)
+        return r is not None and r[0] * (1 - 1e-6) <= e.target <= r[1] * (1 + 0.02)  # scan maxima run low
+
+    def can(e: Effector, c: Chain) -> bool:
+        return reaches(e, c) and refused(c) is None
+
+    phases = sorted({round(e.phase % 1.0, 12) for e in effectors})
+    if len(phases) > 2:
+        raise InputError("effector phases", phases, "at most two distinct phases (one per cam)")
+    for cam in CAMS:
+        on = sorted({round(e.phase % 1.0, 12) for e in effectors if e.cam == cam})
+        if len(on) > 1:
+            raise InputError(f"effector phases on the {cam} cam", on, "one phase per cam")
+    options = [enumerate_chains(e.motion, max_length)[e.motion] for e in effectors]
+    for e, opts in zip(effectors, options):
+        if not opts:
+            raise InputError(f"effector {e.name!r} ({e.motion}) chain length", max_length,
+                             f"enough stages for a chain from the motor to {e.motion} (--max-length)")
+    cands = _candidates(effectors, options)
+    t_enum = time.perf_counter() - t0
+    tried = fabricated = 0
+    rejected: list[str] = []
+    first: Design | None = None
+    for cost, _, pairs in cands:
+        if tried >= max_trees:
+            break
+        if not all(can(e, c) for e, (_, c) in zip(effectors, pairs)):
+            continue
+        tried += 1
+        phase = _toy_phase(effectors, pairs)
+        sized = _size_tree(effectors, pairs, phase, q, cache)
+        if sized is None:
+            continue
+        overrides, sizing = sized
+        cams: dict[str, list[Chain]] = {}
+        for cam, c in pairs:
+            if c not in cams.setdefault(cam, []):
+                cams[cam].append(c)
+        names = {(cam, c): e.name for e, (cam, c) in zip(effectors, pairs)}
+        try:
+            toy = ToyMechanism({k: v for k, v in cams.items()}, phase=phase, name=name, overrides=overrides,
+                               names=names)
+            from .assembly import toy_assembly
+
+            toy_assembly(toy)
+        except InputError:
+            continue  # a tree the assembly refuses (a mirrored or turned out-of-plane stage)
+        t_size = time.perf_counter() - t0 - t_enum
+        t1 = time.perf_counter()
+        placement = None
+        checked = layer_collisions(toy)
+        layers_before = len(set(checked[0].values()))
+        checked_before = checked
+        before = {"layers": layers_before, "collisions": len(checked[1]), "pin_clashes": len(checked[2]),
+                  "export_refused": int(not checked[0])}
+
+        def bad(c: tuple[dict[str, int], list, list]) -> tuple[int, int, int]:
+            return len(c[1]), len(c[2]), len(set(c[0].values()))
+        if place:
+            layouts, placement = place_stages(cams, phase, name, overrides, names)
+            for placed, (f, fp, ov) in layouts:
+                moved = ToyMechanism(cams, phase=phase, name=name, overrides=placed, names=names)
+                after = layer_collisions(moved)
+                placement.checked += 1
+                # keep a placement only where it adds no collision, no pin clash and no layer
+                if bad(after) <= bad(checked):
+                    toy, checked = moved, after
+                    placement.kept = True
+                    placement.objective = (placement.objective[0], f)
+                    placement.footprint = (placement.footprint[0], fp)
+                    placement.overlap = (placement.overlap[0], ov)
+                    break
+        fabricated += 1
+        measured = effector_ranges(toy)
+        ranges = {}
+        for e in effectors:
+            _, val = measured[e.name]
+            ranges[e.name] = math.degrees(val) if e.motion[0] == "O" else val
+        layers, collisions, clashes = checked
+        secs = {"enumerate": t_enum, "rank_and_size": t_size, "place_and_check": time.perf_counter() - t1}
+        d = Design(toy, effectors, pairs, cost, ranges, len(cands), tried, sizing, layers, collisions, secs,
+                   placement, layers_before, clashes, rejected, before,
+                   before_reason=checked_before[2][0] if before["export_refused"] else "")
+        if not collisions and not clashes:
+            return d
+        # a tree whose pieces collide or whose pins cross pieces: try the next cheapest (a few)
+        rejected.append(f"cost {cost:g} " + "; ".join(f"{cam}: {' '.join(c)}" for cam, c in pairs) + ": "
+                        + ", ".join([f"{a}/{b} collide" for a, b, _ in collisions] + clashes))
+        if first is None:
+            first = d
+        if fabricated >= max_fabricated:
+            break
+    if first is not None:
+        return first  # every tree tried collides: the cheapest, its failures reported
+    for e, opts in zip(effectors, options):
+        if any(reaches(e, c) for c in opts) and not any(can(e, c) for c in opts):
+            why = next(refused(c) for c in opts if reaches(e, c))
+            raise InputError(f"effector {e.name!r} ({e.motion})", e.motion,
+                             f"a motion with a chain the toy assembly can build (every {e.motion} chain up to "
+                             f"{max_length} stages reaching {e.range:g} is refused, e.g. {why})")
+        if not any(can(e, c) for c in opts):
+            spans = [r for r in (reach(c) for c in opts) if r is not None]
+            if spans:
+                lo, hi = min(s[0] for s in spans), max(s[1] for s in spans)
+                where = f"between about {e.unit(lo)} and {e.unit(hi)}"
+            else:
+                where = "none"
+            raise InputError(f"effector {e.name!r} ({e.motion}) range", e.range,
+                             f"a range its chains up to {max_length} stages reach ({where})")
+    raise InputError("request", [e.name for e in effectors],
+                     f"a tree that can be sized and assembled (none of the {tried} cheapest that could reach the ranges)")
