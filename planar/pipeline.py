@@ -339,7 +339,7 @@ DEMO_SCENES: dict[str, dict] = {
                       "right": [["Rz->OzT", "OzT->Ty"], ["Rz->OzT", "OzT->Oz"]], "phase": 180},
         "driver": {"speed": 0.5, "samples_per_cycle": 48},
         "render": {"width": 480, "height": 360},
-        "fabrication": {"unit_mm": 100.0},
+        "fabrication": {"unit_mm": 100.0, "sheet_mm": [400.0, 300.0]},  # one frame spans every pivot
     },
     "kangaroo-leg": {
         "name": "kangaroo-leg",
@@ -381,7 +381,9 @@ def run_demo(output: str | Path) -> Iterator[str]:
             line += f"; peak motor torque {np.abs(tau).max():.3f} (force x unit) for a 10 N foot push"
         dxf = out / f"{name}.dxf"
         fab = export_scene(scene, dxf=dxf)
-        line += f"; {len(fab.layout.parts)} parts -> {', '.join(map(str, fab.written))}"
+        rings = sum(pp.spacers for pp in fab.assembly.pins)
+        line += (f"; {len(fab.layout.parts) - rings} parts{f' + {rings} spacer rings' if rings else ''} on "
+                 f"{fab.layout.sheets} sheet(s) -> {', '.join(map(str, fab.written))}")
         yield line
         for extra in DEMO_EXTRAS:
             extra(scene, out)
