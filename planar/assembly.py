@@ -166,7 +166,18 @@ def plan_assembly(mech: Any, material: dict[str, Any], pins: list[PinSpec], cont
         x, y = ct.parts
         # a cam running in a hole or on an edge of the same sheet shares its layer; one whose material
         # overlaps the other's (a tab reaching through a window) touches it from another layer
-        if ct.coplanar and plane[x] == plane[y] and worst_overlap(x, y) <= OVERLAP_MM2:
+        if ct.coplanar and plane[x] == plane[y]:
+            worst = worst_overlap(x, y)
+            if worst > OVERLAP_MM2 and ct.through:
+                continue  # a tab reaching through a window: it touches from another layer
+            if worst > OVERLAP_MM2:
+                # a flat part drives only what lies in its own layer: a cam (or roller, or gear) whose material
+                # overlaps its follower's cannot share the follower's layer, and on another it drives nothing
+                from .fabjoints import FabricationError
+
+                raise FabricationError(
+                    f"joint {ct.joint!r}: {x} must touch {y} in one layer, but their material overlaps by "
+                    f"{worst:.1f} mm^2 over the cycle (a larger window or slot, or a smaller cam, clears it)")
             ra, rb = find(x), find(y)
             if ra != rb:
                 root[max(ra, rb, key=names.index)] = min(ra, rb, key=names.index)

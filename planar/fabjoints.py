@@ -44,9 +44,13 @@ class PinSpec:
 
 @dataclass(frozen=True)
 class Contact:
+    """Two parts joined by touching: ``coplanar`` ones share a layer; ``through``: one may instead reach
+    through the other from another layer (#8's tab standing in its window)."""
+
     joint: str
     parts: tuple[str, str]
     coplanar: bool
+    through: bool = False
 
 
 def _hole_at(part: Part, p: tuple[float, float]) -> Hole | None:
@@ -99,7 +103,7 @@ def _slide(mech: Mechanism, j: Slide) -> tuple[list[PinSpec], list[Contact]]:
 
 @PIN_RULES.register(CamOnLine)
 def _cam_on_line(mech: Mechanism, j: CamOnLine) -> tuple[list[PinSpec], list[Contact]]:
-    return [], [Contact(j.name, (j.a, j.b), True)]
+    return [], [Contact(j.name, (j.a, j.b), True, through=True)]
 
 
 def register_contact(kind: type, coplanar: bool) -> None:

@@ -304,9 +304,18 @@ class ElementalMechanism(Mechanism):
         return [ground, drv, follower], joints
 
     def _cam_driver(self) -> Part:
-        """The round cam of #1-#3: a disc of radius D_jr about D_jc, turning on an axle at D_o."""
+        """The round cam of #1-#3: a disc of radius D_jr about D_jc, turning on an axle at D_o.
+
+        An eccentric disc holds its axle's boss (``|D_jc - D_o| + 2 D_ar <= D_jr``) and runs in its follower's
+        window in one layer.  A larger eccentricity makes it a crank whose boss would sweep across the
+        window's rim: then the disc's centre carries a pin hole, and a pin in the follower's slot joins them
+        across layers (a Scotch yoke), which is how it is cut (``planar.fabjoints``)."""
         P = self.world
-        return Part("driver", ((*_sub(P.D_jc, P.D_o), P.D_jr), (0.0, 0.0, 2 * P.D_ar)), (Hole((0.0, 0.0), 2 * P.D_ar),))
+        c = _sub(P.D_jc, P.D_o)
+        feats: tuple[Feature, ...] = (Hole((0.0, 0.0), 2 * P.D_ar),)
+        if float(np.hypot(*c)) + 2 * P.D_ar > P.D_jr:
+            feats += (Hole(c, 2 * P.D_ar),)
+        return Part("driver", ((*c, P.D_jr), (0.0, 0.0, 2 * P.D_ar)), feats)
 
     def _slotted_driver(self, slot: Slot) -> Part:
         """The oscillating arm of #4/#5: an axle at its origin and ``slot`` (parallel to x) for the follower's pin."""
