@@ -65,16 +65,6 @@ class SliderCrankSpec(_Strict):
     polygons: list[PolygonSpec] = []
 
 
-_NODE_FIELDS = {
-    "fixed": ("at",),
-    "crank": ("centre", "radius"),
-    "actuator": ("origin",),
-    "rrr": ("a", "ra", "b", "rb"),
-    "rrp": ("a", "ra", "p", "q"),
-    "rigid": ("a", "b", "local"),
-}
-
-
 class NodeSpec(_Strict):
     """A joint centre of a general linkage; which fields it needs depends on ``kind``."""
 
@@ -98,7 +88,10 @@ class NodeSpec(_Strict):
 
     @model_validator(mode="after")
     def _needs(self) -> "NodeSpec":
-        missing = [f for f in _NODE_FIELDS[self.kind] if getattr(self, f) is None]
+        from .linkages import NODE_KINDS
+
+        # the kind's own scene keys; those with a default here (phase, axis, branch, offset) are never None
+        missing = [f for f in NODE_KINDS[self.kind].scene_fields if getattr(self, f) is None]
         if missing:
             raise ValueError(f"a {self.kind!r} node needs {', '.join(missing)}")
         return self

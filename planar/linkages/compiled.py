@@ -74,9 +74,11 @@ _PI_HI, _PI_LO = 3.14159265358979311600e00, 1.22464679914735317720e-16
 _TAN_PI8 = 0.41421356237309503  # tan(pi/8)
 
 _JIT: dict[str, Any] = {"cache": True, "nogil": True, "error_model": "numpy"}
+#: the polynomial kernels may fuse multiply-adds (they differ from the C library by rounding anyway)
+_JIT_POLY: dict[str, Any] = {**_JIT, "fastmath": {"contract"}}
 
 
-@njit(**_JIT)
+@njit(**_JIT_POLY)
 def _sincos(a: float) -> tuple[float, float]:
     """``(sin a, cos a)`` for ``|a| <= SINCOS_MAX``, branch-free."""
     n = math.floor(a * _INVPIO2 + 0.5)
@@ -93,7 +95,7 @@ def _sincos(a: float) -> tuple[float, float]:
     return sa, ca
 
 
-@njit(**_JIT)
+@njit(**_JIT_POLY)
 def _atan2(y: float, x: float) -> float:
     """``atan2(y, x)`` in ``[-pi, pi]``, signs of zeros as the C library's, branch-free."""
     ax, ay = abs(x), abs(y)
