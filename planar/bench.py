@@ -97,7 +97,7 @@ def _spread(rates: list[float]) -> dict[str, float]:
 def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
     """One linkage: planar's public ``solve`` vs pylinkage ``step_fast``, interleaved repeats."""
     from .catalog import get
-    from .linkages.chunked import threads_default
+    from .linkages.chunked import solver_for, threads_default
 
     mech: Any = get(name)
     step = 2 * math.pi / 3600
@@ -113,7 +113,9 @@ def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
     q_peer = np.arctan2(ca[:, 1], ca[:, 0]) - crank.phase
     ours = mech.node_positions(q_peer)
     diff = max(float(np.max(np.abs(ours[nd] - traj[:, i]))) for i, nd in enumerate(names))
-    motion = mech.solve(q_peer)
+    t0 = time.perf_counter()
+    motion = mech.solve(q_peer)  # the first call: numba import and kernel load (or compile) included
+    first_call = time.perf_counter() - t0
     diff_points = max(float(np.max(np.abs(motion.points[p] - traj[:, names.index(nd)])))
                       for p, nd in mech.point_nodes.items())
 
@@ -154,6 +156,8 @@ def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
         "all_valid": valid,
         "agrees": diff <= AGREEMENT and diff_points <= AGREEMENT and valid,
         "threads": threads_default(),
+        "kernels": solver_for(mech, n),
+        "first_call_s": first_call,
     }
 
 
@@ -171,7 +175,11 @@ def bench_kinematics(n: int = 1_000_000, repeats: int = 5) -> dict[str, Any]:
     (``max_abs_diff_vs_peer``, model units); ``ok`` is false (and the
     command's exit status 1) unless every joint agrees within
     :data:`AGREEMENT` and every sample is valid.  The top-level ``ratio`` is
-    the smaller of the two linkages' ratios.
+    the smaller of the two linkages' ratios.  Per case, ``kernels`` names the
+    kernels ``solve`` took for ``n`` samples (``"compiled"``: numba,
+    ``"numpy"``) and ``first_call_s`` the first solve's time in the process
+    (importing numba and loading, or compiling, the kernels), which the timed
+    repeats do not include.
     """
     if n < 1 or repeats < 1:
         raise PlanarError("planar bench kinematics needs n >= 1 and repeats >= 1")
@@ -197,7 +205,8 @@ def format_kinematics(r: dict[str, Any]) -> str:
         lines += [
             f"  {c['linkage']} ({c['nodes']} nodes, {c['parts']} parts)",
             (f"    planar solve ({c['threads']} threads) {p['median'] / 1e6:8.2f} M samples/s "
-             f"({p['min'] / 1e6:.2f}-{p['max'] / 1e6:.2f})"),
+             f"({p['min'] / 1e6:.2f}-{p['max'] / 1e6:.2f}), {c['kernels']} kernels "
+             f"(first call {c['first_call_s']:.2f} s)"),
             (f"    pylinkage step_fast        {q['median'] / 1e6:8.2f} M samples/s "
              f"({q['min'] / 1e6:.2f}-{q['max'] / 1e6:.2f})"),
             f"    ratio                      {c['ratio']:8.2f}  (per repeat {k['min']:.2f}-{k['max']:.2f})",

@@ -50,7 +50,7 @@ if TYPE_CHECKING:
     from .dyads import Linkage, NodeKind
 
 __all__ = ["CHUNK", "JIT_CHUNK", "JIT_MIN", "KERNELS", "Solved", "fast_solve", "jit_available", "plan_for",
-           "threads_default"]
+           "solver_for", "threads_default"]
 
 Array = NDArray[np.float64]
 Mask = NDArray[np.bool_]
@@ -570,6 +570,15 @@ def jit_available() -> bool:
     return True
 
 
+def solver_for(lk: Linkage, n: int) -> str:
+    """Which kernels :meth:`Linkage.solve` takes for ``n`` samples where no branch may switch:
+    ``"compiled"``, ``"numpy"`` or ``"reference"`` (a node kind without a chunk kernel)."""
+    plan = lk._fast_plan()
+    if plan is None:
+        return "reference"
+    return "compiled" if _use_jit(None, n) and _program(plan) is not None else "numpy"
+
+
 def _use_jit(jit: bool | None, n: int) -> bool:
     if jit is None:
         return n >= JIT_MIN and jit_available()
@@ -606,11 +615,12 @@ def _solve_compiled(lk: Linkage, plan: _Plan, prog: Any, q: Array, tols: list[fl
     tol = np.asarray(tols, dtype=float)
     ranges = _cuts(n, chunk, nthreads) if n else []
     fails = np.zeros((len(ranges), len(plan.checks)), dtype=np.int64)
+    bad_chunks = np.zeros(-(-n // chunk), dtype=bool)
 
     def run(t: int) -> bool:
         a, b = ranges[t]
         return bool(solve_range(q, a, b, chunk, prog.kinds, prog.refs, prog.par, tol, prog.check_row,
-                                prog.links, prog.pts, prog.pl, block, pblock, oks, fails[t]))
+                                prog.links, prog.pts, prog.pl, block, pblock, oks, fails[t], bad_chunks))
 
     if len(ranges) > 1:
         switched = [f.result() for f in [_pool().submit(run, t) for t in range(len(ranges))]]
@@ -620,6 +630,7 @@ def _solve_compiled(lk: Linkage, plan: _Plan, prog: Any, q: Array, tols: list[fl
         return None
     checks: list[tuple[Mask, str, str]] | None = None
     if fails.any():
+        oks[:, ~np.repeat(bad_chunks, chunk)[:n]] = True  # chunks where every sample closes
         checks = [(oks[row], node, why) for row, (_, node, why) in enumerate(plan.checks)]
     return _finish(lk, poses, checks, points)
 

@@ -332,7 +332,8 @@ def _k_point(x, y, m, pl, out):
 
 
 @njit(**_JIT)
-def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts, pl, poses, points, oks, fails):
+def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts, pl, poses, points, oks, fails,
+                bad_chunks):
     """Solve samples ``lo:hi`` chunk by chunk; returns whether a branch may switch (then stops early).
 
     ``kinds[i]``, ``refs[i]``, ``par[i]``: node ``i``'s kind code, referenced
@@ -341,7 +342,9 @@ def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts,
     ``links`` ``(m, 3)``: origin, direction from, direction to of each moving
     part, written to ``poses[j]`` ``(n, 3)``; ``pts`` the node of each named
     point (``points[j]`` ``(n, 2)``); ``pl``: placement ``x, y, angle, cos,
-    sin``.  ``fails[row]`` counts the samples of this range that fail.
+    sin``.  ``fails[row]`` counts the samples of this range that fail;
+    ``oks[row]`` is written only for the chunks where a sample fails (marked in
+    ``bad_chunks``, indexed by sample // chunk).
     """
     nn = kinds.shape[0]
     W = chunk + 3
@@ -357,6 +360,7 @@ def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts,
         first = max(3, off)
         m = j - i
         qw = q[ws:j]
+        bad = 0
         for nd in range(nn):
             k = kinds[nd]
             r = refs[nd]
@@ -364,7 +368,8 @@ def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts,
             xo, yo, ok = X[nd], Y[nd], OK[nd]
             nf = 0
             if k == FIXED:
-                _k_fixed(p, L, xo, yo)
+                if i == lo:  # a fixed node's rows never change
+                    _k_fixed(p, W, xo, yo)
             elif k == CRANK:
                 _k_crank(p, qw, L, X[r[0]], Y[r[0]], xo, yo)
             elif k == ACTUATOR:
@@ -377,15 +382,22 @@ def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts,
                 nf = _k_rigid(p, L, X[r[0]], Y[r[0]], X[r[1]], Y[r[1]], xo, yo, ok)
             if (k == RRR or k == RRP) and _may_switch(xo, yo, ok, sep, tols[nd], qw, first, L):
                 return True
-            row = check_row[nd]
-            if row >= 0:
+            if nf and check_row[nd] >= 0:
                 okw = ok[off:]
-                if nf:
-                    for t in range(m):
-                        fails[row] += not okw[t]
-                o = oks[row, i:j]
+                cnt = 0
                 for t in range(m):
-                    o[t] = okw[t]
+                    cnt += not okw[t]
+                fails[check_row[nd]] += cnt
+                bad += cnt
+        if bad:  # validity rows only for chunks where a sample fails
+            bad_chunks[i // chunk] = True
+            for nd in range(nn):
+                row = check_row[nd]
+                if row >= 0:
+                    okw = OK[nd, off:]
+                    o = oks[row, i:j]
+                    for t in range(m):
+                        o[t] = okw[t]
         for li in range(links.shape[0]):
             o, a, b = links[li, 0], links[li, 1], links[li, 2]
             _k_pose(X[o, off:], Y[o, off:], X[a, off:], Y[a, off:], X[b, off:], Y[b, off:], m, pl,
