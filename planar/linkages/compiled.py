@@ -133,13 +133,12 @@ def _k_crank(par, q, L, xc, yc, xo, yo):
     r, phase = par[0], par[1]
     big = 0
     for i in range(L):
-        big += abs(q[i] + phase) > SINCOS_MAX
-    if big == 0:
-        for i in range(L):
-            s, c = _sincos(q[i] + phase)
-            xo[i] = r * c + xc[i]
-            yo[i] = r * s + yc[i]
-    else:
+        a = q[i] + phase
+        big += abs(a) > SINCOS_MAX
+        s, c = _sincos(a)  # finite (and unused) beyond SINCOS_MAX
+        xo[i] = r * c + xc[i]
+        yo[i] = r * s + yc[i]
+    if big:
         for i in range(L):
             a = q[i] + phase
             xo[i] = r * math.cos(a) + xc[i]
@@ -229,7 +228,13 @@ def _k_rigid(par, L, xa, ya, xb, yb, xo, yo, ok):
         ey = yb[i] - ya[i]
         en = math.sqrt(ex * ex + ey * ey)
         fails += en <= 0.0
-    if fails:  # coincident nodes or an underflow: as the reference (hypot)
+        inv = 1.0 / en
+        ex *= inv
+        ey *= inv
+        ok[i] = True
+        xo[i] = (ex * u - ey * v) + xa[i]
+        yo[i] = (ey * u + ex * v) + ya[i]
+    if fails:  # coincident nodes or an underflow: again, as the reference (hypot)
         fails = 0
         for i in range(L):
             ex = xb[i] - xa[i]
@@ -243,17 +248,7 @@ def _k_rigid(par, L, xa, ya, xb, yb, xo, yo, ok):
             ey *= inv
             xo[i] = (ex * u - ey * v) + xa[i]
             yo[i] = (ey * u + ex * v) + ya[i]
-        return fails
-    for i in range(L):
-        ex = xb[i] - xa[i]
-        ey = yb[i] - ya[i]
-        inv = 1.0 / math.sqrt(ex * ex + ey * ey)
-        ex *= inv
-        ey *= inv
-        ok[i] = True
-        xo[i] = (ex * u - ey * v) + xa[i]
-        yo[i] = (ey * u + ex * v) + ya[i]
-    return 0
+    return fails
 
 
 @njit(**_JIT)
