@@ -288,28 +288,20 @@ def _may_switch(x, y, ok, sep, tol, q, first, L):
 
 
 @njit(**_JIT)
-def _k_pose(xo, yo, xa, ya, xb, yb, m, pl, P, ang):
-    """Pose rows ``P[:m]`` from node windows of length ``m``: origin, ``atan2`` of ``a -> b``, placement.
-
-    The angles go to the scratch row ``ang`` first (a vectorised loop), then all three columns
-    are written in one interleaved pass.
-    """
+def _k_pose(xo, yo, xa, ya, xb, yb, m, pl, P):
+    """Pose rows ``P[:m]`` from node windows of length ``m``: origin, ``atan2`` of ``a -> b``, placement."""
     px, py, pa, c, s = pl[0], pl[1], pl[2], pl[3], pl[4]
     F = P.ravel()
     if pa == 0.0 and px == 0.0 and py == 0.0:
         for i in range(m):
-            ang[i] = _atan2(yb[i] - ya[i], xb[i] - xa[i])
-        for i in range(m):
             F[3 * i] = xo[i]
             F[3 * i + 1] = yo[i]
-            F[3 * i + 2] = ang[i]
+            F[3 * i + 2] = _atan2(yb[i] - ya[i], xb[i] - xa[i])
     else:
-        for i in range(m):
-            ang[i] = _atan2(yb[i] - ya[i], xb[i] - xa[i]) + pa
         for i in range(m):
             F[3 * i] = (px + xo[i] * c) - yo[i] * s
             F[3 * i + 1] = (py + xo[i] * s) + yo[i] * c
-            F[3 * i + 2] = ang[i]
+            F[3 * i + 2] = _atan2(yb[i] - ya[i], xb[i] - xa[i]) + pa
 
 
 @njit(**_JIT)
@@ -395,8 +387,7 @@ def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts,
                         o[t] = okw[t]
         for li in range(links.shape[0]):
             o, a, b = links[li, 0], links[li, 1], links[li, 2]
-            _k_pose(X[o, off:], Y[o, off:], X[a, off:], Y[a, off:], X[b, off:], Y[b, off:], m, pl,
-                    poses[li, i:j], sep)
+            _k_pose(X[o, off:], Y[o, off:], X[a, off:], Y[a, off:], X[b, off:], Y[b, off:], m, pl, poses[li, i:j])
         for pi in range(pts.shape[0]):
             _k_point(X[pts[pi], off:], Y[pts[pi], off:], m, pl, points[pi, i:j])
     return False
