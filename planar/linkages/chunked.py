@@ -38,7 +38,8 @@ import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from itertools import pairwise
+from itertools import count, pairwise
+from threading import Lock
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -559,6 +560,8 @@ def _finish(lk: Linkage, poses: dict[str, Array], checks: list[tuple[Mask, str, 
 JIT_MIN = 20_000
 #: samples per chunk of the compiled kernels
 JIT_CHUNK = 2048
+#: ranges of chunks per thread the compiled path hands out (balancing threads slowed by other load)
+JIT_RANGES_PER_THREAD = 4
 def jit_available() -> bool:
     """Whether the compiled kernels can be used (numba installed and ``PLANAR_JIT`` is not ``0``)."""
     if os.environ.get("PLANAR_JIT", "1") == "0":
@@ -613,19 +616,30 @@ def _solve_compiled(lk: Linkage, plan: _Plan, prog: Any, q: Array, tols: list[fl
     points = {name: pblock[i] for i, (name, _) in enumerate(plan.points)}
     oks = np.empty((len(plan.checks), n), dtype=bool)
     tol = np.asarray(tols, dtype=float)
-    ranges = _cuts(n, chunk, nthreads) if n else []
+    # more ranges than threads, taken in turn by each thread: a thread slowed by other work on
+    # the machine leaves its share to the others (the result does not depend on the ranges)
+    ranges = _cuts(n, chunk, nthreads * JIT_RANGES_PER_THREAD if nthreads > 1 else 1) if n else []
     fails = np.zeros((len(ranges), len(plan.checks)), dtype=np.int64)
     bad_chunks = np.zeros(-(-n // chunk), dtype=bool)
+    switched = [False] * len(ranges)
+    taken, lock = count(), Lock()
 
-    def run(t: int) -> bool:
-        a, b = ranges[t]
-        return bool(solve_range(q, a, b, chunk, prog.kinds, prog.refs, prog.par, tol, prog.check_row,
-                                prog.links, prog.pts, prog.pl, block, pblock, oks, fails[t], bad_chunks))
+    def work() -> None:
+        while True:
+            with lock:
+                t = next(taken)
+            if t >= len(ranges) or any(switched):
+                return
+            a, b = ranges[t]
+            switched[t] = bool(solve_range(q, a, b, chunk, prog.kinds, prog.refs, prog.par, tol, prog.check_row,
+                                           prog.links, prog.pts, prog.pl, block, pblock, oks, fails[t], bad_chunks))
 
-    if len(ranges) > 1:
-        switched = [f.result() for f in [_pool().submit(run, t) for t in range(len(ranges))]]
+    workers = min(nthreads, len(ranges))
+    if workers > 1:
+        for f in [_pool().submit(work) for _ in range(workers)]:
+            f.result()
     else:
-        switched = [run(t) for t in range(len(ranges))]
+        work()
     if any(switched):
         return None
     checks: list[tuple[Mask, str, str]] | None = None
