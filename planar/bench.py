@@ -97,7 +97,7 @@ def _spread(rates: list[float]) -> dict[str, float]:
 def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
     """One linkage: planar's public ``solve`` vs pylinkage ``step_fast``, interleaved repeats."""
     from .catalog import get
-    from .linkages.chunked import threads_default
+    from .linkages.chunked import solver_for, threads_default
 
     mech: Any = get(name)
     step = 2 * math.pi / 3600
@@ -113,7 +113,9 @@ def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
     q_peer = np.arctan2(ca[:, 1], ca[:, 0]) - crank.phase
     ours = mech.node_positions(q_peer)
     diff = max(float(np.max(np.abs(ours[nd] - traj[:, i]))) for i, nd in enumerate(names))
-    motion = mech.solve(q_peer)
+    t0 = time.perf_counter()
+    motion = mech.solve(q_peer)  # the first call: numba import and kernel load (or compile) included
+    first_call = time.perf_counter() - t0
     diff_points = max(float(np.max(np.abs(motion.points[p] - traj[:, names.index(nd)])))
                       for p, nd in mech.point_nodes.items())
 
@@ -121,21 +123,25 @@ def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
     mech.solve(q[:m])
     planar_rates: list[float] = []
     peer_rates: list[float] = []
+    planar_cpu: list[float] = []
+    peer_cpu: list[float] = []
     valid = True
     for r in range(repeats):
         peer = _pylinkage_of(mech, step)
 
         def run_planar() -> None:
             nonlocal valid
-            t0 = time.perf_counter()
+            c0, t0 = time.process_time(), time.perf_counter()
             mo = mech.solve(q)
             planar_rates.append(n / (time.perf_counter() - t0))
+            planar_cpu.append(time.process_time() - c0)
             valid = valid and bool(mo.valid.all())
 
         def run_peer(peer: Any = peer) -> None:
-            t0 = time.perf_counter()
+            c0, t0 = time.process_time(), time.perf_counter()
             peer.step_fast(iterations=n)
             peer_rates.append(n / (time.perf_counter() - t0))
+            peer_cpu.append(time.process_time() - c0)
 
         for fn in ((run_planar, run_peer) if r % 2 == 0 else (run_peer, run_planar)):
             fn()
@@ -148,12 +154,18 @@ def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
         "peer_samples_per_s": _spread(peer_rates),
         "ratio": float(np.median(planar_rates) / np.median(peer_rates)),
         "ratio_per_repeat": _spread(ratios),
+        # processor time (all threads of the process): the work each does, less sensitive to other load
+        "planar_cpu_s": _spread(planar_cpu),
+        "peer_cpu_s": _spread(peer_cpu),
+        "cpu_ratio": float(np.median(peer_cpu) / np.median(planar_cpu)) if np.median(planar_cpu) > 0 else math.inf,
         "max_abs_diff_vs_peer": diff,
         "max_abs_diff_points_vs_peer": diff_points,
         "size": float(mech.size),
         "all_valid": valid,
         "agrees": diff <= AGREEMENT and diff_points <= AGREEMENT and valid,
         "threads": threads_default(),
+        "kernels": solver_for(mech, n),
+        "first_call_s": first_call,
     }
 
 
@@ -171,7 +183,14 @@ def bench_kinematics(n: int = 1_000_000, repeats: int = 5) -> dict[str, Any]:
     (``max_abs_diff_vs_peer``, model units); ``ok`` is false (and the
     command's exit status 1) unless every joint agrees within
     :data:`AGREEMENT` and every sample is valid.  The top-level ``ratio`` is
-    the smaller of the two linkages' ratios.
+    the smaller of the two linkages' ratios.  Per case, ``kernels`` names the
+    kernels ``solve`` took for ``n`` samples (``"compiled"``: numba,
+    ``"numpy"``) and ``first_call_s`` the first solve's time in the process
+    (importing numba and loading, or compiling, the kernels), which the timed
+    repeats do not include; ``planar_cpu_s``/``peer_cpu_s`` the processor time
+    of each call (all of planar's threads together) and ``cpu_ratio`` the
+    ratio of their medians, the work each does, which other load on the machine
+    disturbs less than the wall-clock ``ratio``.
     """
     if n < 1 or repeats < 1:
         raise PlanarError("planar bench kinematics needs n >= 1 and repeats >= 1")
@@ -197,10 +216,13 @@ def format_kinematics(r: dict[str, Any]) -> str:
         lines += [
             f"  {c['linkage']} ({c['nodes']} nodes, {c['parts']} parts)",
             (f"    planar solve ({c['threads']} threads) {p['median'] / 1e6:8.2f} M samples/s "
-             f"({p['min'] / 1e6:.2f}-{p['max'] / 1e6:.2f})"),
+             f"({p['min'] / 1e6:.2f}-{p['max'] / 1e6:.2f}), {c['kernels']} kernels "
+             f"(first call {c['first_call_s']:.2f} s)"),
             (f"    pylinkage step_fast        {q['median'] / 1e6:8.2f} M samples/s "
              f"({q['min'] / 1e6:.2f}-{q['max'] / 1e6:.2f})"),
             f"    ratio                      {c['ratio']:8.2f}  (per repeat {k['min']:.2f}-{k['max']:.2f})",
+            (f"    processor time             {c['planar_cpu_s']['median'] * 1e3:8.1f} ms vs "
+             f"{c['peer_cpu_s']['median'] * 1e3:.1f} ms: ratio {c['cpu_ratio']:.2f}"),
             f"    max |planar - peer|        {c['max_abs_diff_vs_peer']:8.1e}  (size {c['size']:.3g})"
             + ("" if c["agrees"] else f"  DISAGREES (more than {AGREEMENT:g}, or invalid samples)"),
         ]

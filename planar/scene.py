@@ -119,19 +119,6 @@ class SliderCrankSpec(_Strict):
     """Polygons fixed to parts, swept in drawings."""
 
 
-_NODE_FIELDS = {
-    "fixed": ("at",),
-    "crank": ("centre", "radius"),
-    "actuator": ("origin",),
-    "rrr": ("a", "ra", "b", "rb"),
-    "rrp": ("a", "ra", "p", "q"),
-    "rigid": ("a", "b", "local"),
-    "geared": ("centre", "radius", "mesh", "ratio"),
-    "driven": ("centre", "radius"),
-    "triad": ("a", "ra", "local", "at"),
-}
-
-
 class NodeSpec(_Strict):
     """A joint centre of a general linkage, placed in closed form from nodes declared before it.
 
@@ -218,7 +205,11 @@ class NodeSpec(_Strict):
 
     @model_validator(mode="after")
     def _needs(self) -> "NodeSpec":
-        missing = [f for f in _NODE_FIELDS[self.kind] if getattr(self, f) is None]
+        from .linkages import NODE_KINDS
+
+        # the kind's own scene keys; those with a default here (phase, axis, branch, offset) are never None
+        kind = NODE_KINDS[self.kind]
+        missing = [f for f in getattr(kind, "required_fields", kind.scene_fields) if getattr(self, f) is None]
         if missing:
             raise ValueError(f"a {self.kind!r} node needs {', '.join(missing)}")
         return self

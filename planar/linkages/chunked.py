@@ -40,8 +40,9 @@ import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from itertools import pairwise
-from typing import TYPE_CHECKING
+from itertools import count, pairwise
+from threading import Lock
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -51,7 +52,8 @@ from ..geometry import CONCENTRIC, TANGENCY_RTOL, line_circle, poses_apply
 if TYPE_CHECKING:
     from .dyads import Linkage, NodeKind
 
-__all__ = ["CHUNK", "KERNELS", "Solved", "fast_solve", "plan_for", "threads_default"]
+__all__ = ["CHUNK", "JIT_CHUNK", "JIT_MIN", "KERNELS", "Solved", "fast_solve", "jit_available", "plan_for",
+           "solver_for", "threads_default"]
 
 Array = NDArray[np.float64]
 Mask = NDArray[np.bool_]
@@ -65,6 +67,8 @@ Solved = tuple[dict[str, Array], "list[tuple[Mask, str, str]] | None", "dict[str
 
 #: samples per chunk: the working set of a chunk stays in the L2 cache
 CHUNK = 8192
+#: a plan's program not built yet
+_NO_PROGRAM: object = object()
 #: samples at the start of a chunk recomputed from the previous chunk (branch screen history)
 _OVERLAP = 3
 
@@ -279,6 +283,7 @@ class _Plan:
     placement: tuple[float, float, float]
     bound: list[float]  # a bound on |coordinate| of each node, for q = 0 (actuators add |q|)
     grows: list[bool]  # node moves with |q| (downstream of an actuator)
+    program: Any = None  # the compiled program (planar.linkages.compiled), built on first use
 
 
 #: per node kind: (node, bound from its refs, grows from its refs, bounds, grows, index) -> (bound, grows),
@@ -322,7 +327,7 @@ def plan_for(lk: Linkage) -> _Plan | None:
         grows.append(g)
     return _Plan(list(lk.nodes), kernels, checks, links,
                  [(p, index[n]) for p, n in lk.point_nodes.items()],
-                 (lk.placement[0], lk.placement[1], lk.placement[2]), bound, grows)
+                 (lk.placement[0], lk.placement[1], lk.placement[2]), bound, grows, _NO_PROGRAM)
 
 
 # ------------------------------------------------------------------ solving
@@ -482,13 +487,18 @@ def _place(x: Coord, y: Coord, ox: Array, oy: Array, placed: bool, px: float, py
     oy += m
 
 
-def fast_solve(lk: Linkage, q: Array, threads: int | None = None, chunk: int = CHUNK) -> Solved | None:
+def fast_solve(lk: Linkage, q: Array, threads: int | None = None, chunk: int | None = None,
+               jit: bool | None = None) -> Solved | None:
     """``(poses, checks, points)`` for driver values ``q`` by the chunked path, or ``None``.
 
     ``None``: a node kind has no kernel, or a branch may switch by continuity
     somewhere (the caller then solves by the reference path).  ``checks`` is
     ``None`` when every sample closes, else the reference's
-    ``[(mask, node, why)]``.
+    ``[(mask, node, why)]``.  ``jit``: ``True`` the compiled kernels
+    (:mod:`planar.linkages.compiled`, needs numba), ``False`` the numpy
+    kernels, ``None`` the compiled ones for at least :data:`JIT_MIN` samples
+    when numba is installed and ``PLANAR_JIT`` is not ``0``.  ``chunk``:
+    samples per chunk (default :data:`CHUNK`, compiled :data:`JIT_CHUNK`).
     """
     plan = lk._fast_plan()
     if plan is None:
@@ -496,21 +506,23 @@ def fast_solve(lk: Linkage, q: Array, threads: int | None = None, chunk: int = C
     n = q.shape[0]
     qmax = float(np.abs(q).max()) if n and any(plan.grows) else 0.0
     tols = [1e-9 * (1.0 + b + (qmax if g else 0.0)) for b, g in zip(plan.bound, plan.grows)]
+    nthreads = threads if threads is not None else threads_default()
+    prog = _program(plan) if _use_jit(jit, n) else None
+    if prog is not None:
+        return _solve_compiled(lk, plan, prog, q, tols, nthreads, chunk or JIT_CHUNK)
+    chunk = chunk or CHUNK
     poses: dict[str, Array] = {}
     px, py, pa = plan.placement
     for name, o, _, _ in plan.links:
         if o < 0:
-            poses[name] = np.zeros((n, 3)) if not (px or py or pa) else np.tile(np.array([px, py, pa]), (n, 1))
+            poses[name] = _ground_pose(n, plan.placement)
         else:
             poses[name] = np.empty((n, 3))
     points = {name: np.empty((n, 2)) for name, _ in plan.points}
-    nthreads = threads if threads is not None else threads_default()
     nchunks = -(-n // chunk) if n else 0
     if nthreads > 1 and nchunks >= 2:
-        nthreads = min(nthreads, nchunks)
-        cuts = [chunk * (nchunks * t // nthreads) for t in range(nthreads)] + [n]
         futs = [_pool().submit(_solve_range, plan, q, a, b, chunk, poses, points, tols)
-                for a, b in pairwise(cuts)]
+                for a, b in _cuts(n, chunk, nthreads)]
         results = [r for f in futs for r in f.result()]
     else:
         results = _solve_range(plan, q, 0, n, chunk, poses, points, tols)
@@ -526,13 +538,128 @@ def fast_solve(lk: Linkage, q: Array, threads: int | None = None, chunk: int = C
                 if m is not None:
                     full[a:b] = m
             checks.append((full, node, why))
-        # where a sample fails a frame may degenerate (two nodes meet): there the named points
-        # are taken through the part's pose, as the reference does
+    return _finish(lk, poses, checks, points)
+
+
+def _ground_pose(n: int, placement: tuple[float, float, float]) -> Array:
+    px, py, pa = placement
+    return np.zeros((n, 3)) if not (px or py or pa) else np.tile(np.array([px, py, pa]), (n, 1))
+
+
+def _cuts(n: int, chunk: int, nthreads: int) -> list[tuple[int, int]]:
+    """``nthreads`` (at most one per chunk) ranges of whole chunks covering ``0:n``."""
+    nchunks = -(-n // chunk)
+    nthreads = min(nthreads, nchunks)
+    cuts = [chunk * (nchunks * t // nthreads) for t in range(nthreads)] + [n]
+    return list(pairwise(cuts))
+
+
+def _finish(lk: Linkage, poses: dict[str, Array], checks: list[tuple[Mask, str, str]] | None,
+            points: dict[str, Array]) -> Solved:
+    """Where a sample fails a frame may degenerate (two nodes meet): there the named points
+    are taken through the part's pose, as the reference does."""
+    if checks is not None:
         bad = ~np.logical_and.reduce([m for m, _, _ in checks])
         if bad.any():
             for name, (part, xy) in lk.points.items():
                 points[name][bad] = poses_apply(poses[part][bad], xy)
     return poses, checks, points
+
+
+# ------------------------------------------------------------------ the compiled path
+
+#: smallest batch the compiled kernels take by default (below it the numpy path is as quick
+#: as importing numba and loading the kernels once)
+JIT_MIN = 20_000
+#: samples per chunk of the compiled kernels
+JIT_CHUNK = 2048
+#: ranges of chunks per thread the compiled path hands out (balancing threads slowed by other load)
+JIT_RANGES_PER_THREAD = 4
+def jit_available() -> bool:
+    """Whether the compiled kernels can be used (numba installed and ``PLANAR_JIT`` is not ``0``)."""
+    if os.environ.get("PLANAR_JIT", "1") == "0":
+        return False
+    try:
+        import numba  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def solver_for(lk: Linkage, n: int) -> str:
+    """Which kernels :meth:`Linkage.solve` takes for ``n`` samples where no branch may switch:
+    ``"compiled"``, ``"numpy"`` or ``"reference"`` (a node kind without a chunk kernel)."""
+    plan = lk._fast_plan()
+    if plan is None:
+        return "reference"
+    return "compiled" if _use_jit(None, n) and _program(plan) is not None else "numpy"
+
+
+def _use_jit(jit: bool | None, n: int) -> bool:
+    if jit is None:
+        return n >= JIT_MIN and jit_available()
+    return jit
+
+
+def _program(plan: _Plan) -> Any:
+    """The plan's compiled program (built once), or ``None`` when a node kind has no encoder."""
+    if plan.program is _NO_PROGRAM:
+        from .compiled import program_for
+
+        plan.program = program_for(plan)
+    return plan.program
+
+
+def _solve_compiled(lk: Linkage, plan: _Plan, prog: Any, q: Array, tols: list[float], nthreads: int,
+                    chunk: int) -> Solved | None:
+    from .compiled import solve_range
+
+    n = q.shape[0]
+    q = np.ascontiguousarray(q, dtype=float)
+    poses: dict[str, Array] = {}
+    block = np.empty((prog.links.shape[0], n, 3))
+    m = 0
+    for name, o, _, _ in plan.links:
+        if o < 0:
+            poses[name] = _ground_pose(n, plan.placement)
+        else:
+            poses[name] = block[m]
+            m += 1
+    pblock = np.empty((prog.pts.shape[0], n, 2))
+    points = {name: pblock[i] for i, (name, _) in enumerate(plan.points)}
+    oks = np.empty((len(plan.checks), n), dtype=bool)
+    tol = np.asarray(tols, dtype=float)
+    # more ranges than threads, taken in turn by each thread: a thread slowed by other work on
+    # the machine leaves its share to the others (the result does not depend on the ranges)
+    ranges = _cuts(n, chunk, nthreads * JIT_RANGES_PER_THREAD if nthreads > 1 else 1) if n else []
+    fails = np.zeros((len(ranges), len(plan.checks)), dtype=np.int64)
+    bad_chunks = np.zeros(-(-n // chunk), dtype=bool)
+    switched = [False] * len(ranges)
+    taken, lock = count(), Lock()
+
+    def work() -> None:
+        while True:
+            with lock:
+                t = next(taken)
+            if t >= len(ranges) or any(switched):
+                return
+            a, b = ranges[t]
+            switched[t] = bool(solve_range(q, a, b, chunk, prog.kinds, prog.refs, prog.par, tol, prog.check_row,
+                                           prog.links, prog.pts, prog.pl, block, pblock, oks, fails[t], bad_chunks))
+
+    workers = min(nthreads, len(ranges))
+    if workers > 1:
+        for f in [_pool().submit(work) for _ in range(workers)]:
+            f.result()
+    else:
+        work()
+    if any(switched):
+        return None
+    checks: list[tuple[Mask, str, str]] | None = None
+    if fails.any():
+        oks[:, ~np.repeat(bad_chunks, chunk)[:n]] = True  # chunks where every sample closes
+        checks = [(oks[row], node, why) for row, (_, node, why) in enumerate(plan.checks)]
+    return _finish(lk, poses, checks, points)
 
 
 def _chunk_bounds(n: int, chunk: int) -> list[tuple[int, int]]:

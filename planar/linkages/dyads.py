@@ -820,13 +820,15 @@ class Linkage(Mechanism):
         back = np.cumsum(steps)  # distances before q[0], nearest first
         return q0 - direction * back[::-1]
 
-    def solve_nodes(self, q: Array) -> tuple[dict[str, Array], list[tuple[Mask, str, str]]]:
+    def solve_nodes(self, q: Array, lead: Array | None = None) -> tuple[dict[str, Array], list[tuple[Mask, str, str]]]:
         """World positions ``(N, 2)`` of every node (before placement) and validity checks.
 
         The samples are a path in their order (see the module's note on branches).
+        ``lead``: :meth:`_lead_in` of ``q`` when the caller has it already.
         """
         q = np.asarray(q, dtype=float)
-        lead = self._lead_in(q)
+        if lead is None:
+            lead = self._lead_in(q)
         if lead.size == 0:
             return self._solve_nodes(q, self.nodes)
         k = lead.shape[0]
@@ -870,14 +872,13 @@ class Linkage(Mechanism):
         plan: _Plan | None = self.__dict__["_plan"]
         return plan
 
-    def _declared_branches_hold(self, q: Array) -> bool:
-        """Whether the branch carried from :attr:`branch_reference` is the declared one at ``q[0]``.
+    def _declared_branches_hold(self, q: Array, lead: Array) -> bool:
+        """Whether the branch carried from :attr:`branch_reference` along ``lead`` is the declared one at ``q[0]``.
 
         The chunked path starts every dyad on its declared branch; where the
         lead-in from the reference arrives on the other one (a change-point
         four-bar starting past a flat position), the reference path is used.
         """
-        lead = self._lead_in(q)
         if lead.size == 0:
             return True
         k = lead.shape[0]
@@ -891,16 +892,21 @@ class Linkage(Mechanism):
         return True
 
     def _solve_points(self, q: Array) -> Solved:
-        """The chunked, threaded path (:mod:`planar.linkages.chunked`), else the reference path."""
-        # kinds without a chunk kernel (gears, driven inputs, triads): no plan, straight to the reference path
-        usable = q.ndim == 1 and self._fast_plan() is not None
-        fast = fast_solve(self, q) if usable and self._declared_branches_hold(q) else None
-        if fast is not None:
-            return fast
-        return super()._solve_points(q)
+        """The chunked, threaded path (:mod:`planar.linkages.chunked`), else the reference path.
 
-    def _solve_poses(self, q: Array):
-        pos, checks = self.solve_nodes(q)
+        Kinds without a chunk kernel (gears, driven inputs, triads) have no plan and go straight to the
+        reference path. The lead-in is built once and, on falling back, handed to the reference solve.
+        """
+        lead = self._lead_in(q) if q.ndim == 1 else None
+        if lead is not None and self._fast_plan() is not None and self._declared_branches_hold(q, lead):
+            fast = fast_solve(self, q)
+            if fast is not None:
+                return fast
+        poses, checks = self._solve_poses(q, lead)
+        return poses, checks, None
+
+    def _solve_poses(self, q: Array, lead: Array | None = None):
+        pos, checks = self.solve_nodes(q, lead)
         poses = self._link_poses(pos, q.shape[0])
         if any(self.placement):
             pl = np.asarray(self.placement)

@@ -222,6 +222,8 @@ class Triad(NodeKind):
 
     kind: ClassVar[str] = "triad"
     scene_fields: ClassVar[tuple[str, ...]] = ("a", "ra", "local", "at", "members")
+    #: the keys every triad node gives (``members`` only the first of the three)
+    required_fields: ClassVar[tuple[str, ...]] = ("a", "ra", "local", "at")
     #: declares its branch at driver value 0 (the linkage leads a path in from there)
     continued: ClassVar[bool] = True
     name: str

@@ -1,0 +1,443 @@
+"""Compiled (numba) chunk kernels behind :meth:`Linkage.solve` for large batches.
+
+The same solve as :mod:`planar.linkages.chunked` (same chunks with a
+three-sample overlap, same branch screen, same validity), with every node
+kind's arithmetic fused into one compiled loop over a chunk instead of one
+numpy pass per operation, and every part's pose and named point written in
+the same pass.  One function (:func:`solve_range`) is compiled once for every
+linkage: the linkage is handed to it as a small program (a kind code, up to
+three referenced nodes and up to six numbers per node, see :data:`ENCODERS`),
+so a new linkage costs no compilation; ``cache=True`` keeps the machine code
+between processes.
+
+Arithmetic: circle-circle, line-circle, rigid points and placement are the
+numpy path's expressions in the numpy path's order (no fast-math, no fused
+multiply-add), so validity is decided by the same comparisons.  Two
+functions differ from numpy's by rounding only: the crank's cosine and sine
+(fdlibm's polynomial kernels after a three-part Cody-Waite reduction, for
+``|angle| <= 2**19 pi / 2``, else the C library's) and ``atan2`` (fdlibm's
+``atan`` polynomial after an exact-quadrant reduction); both are within a few
+units in the last place, and branch-free, so the compiler vectorises them.
+
+The kernels release the GIL (``nogil``): :func:`planar.linkages.chunked.fast_solve`
+runs one range of chunks per thread of its pool, as the numpy path does.
+Importing this module needs numba; :mod:`planar.linkages.chunked` imports it
+only when a batch is large enough to use it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numba import njit
+
+from ..geometry import TANGENCY_RTOL
+
+if TYPE_CHECKING:
+    from .chunked import _Plan
+
+__all__ = ["ENCODERS", "Program", "program_for", "solve_range"]
+
+FIXED, CRANK, ACTUATOR, RRR, RRP, RIGID = range(6)
+#: kinds whose node has two roots (the branch screen runs on them)
+TWO_ROOT = (RRR, RRP)
+#: kinds whose node can fail to close (a validity row each)
+CHECKED = (RRR, RRP, RIGID)
+
+_RTOL = TANGENCY_RTOL
+_TINY = float(np.finfo(float).tiny)
+
+# Cody-Waite pi/2 in three parts of 33 bits (fdlibm's pio2_1, pio2_2, pio2_2t): exact products
+# n * part for |n| < 2**20
+_INVPIO2 = 6.36619772367581382433e-01
+_PIO2_1 = 1.57079632673412561417e00
+_PIO2_2 = 6.07710050630396597660e-11
+_PIO2_2T = 2.02226624879595063154e-21
+#: largest |angle| the polynomial sine and cosine take (beyond: the C library's)
+SINCOS_MAX = 2.0**19 * math.pi / 2
+_S1, _S2, _S3 = -1.66666666666666324348e-01, 8.33333333332248946124e-03, -1.98412698298579493134e-04
+_S4, _S5, _S6 = 2.75573137070700676789e-06, -2.50507602534068634195e-08, 1.58969099521155010221e-10
+_C1, _C2, _C3 = 4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015872894767294178e-05
+_C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.13596475577881948265e-11
+# fdlibm atan: polynomial for |x| < 7/16, pi/4 split in a high and a low part
+_AT = (3.33333333333329318027e-01, -1.99999999998764832476e-01, 1.42857142725034663711e-01,
+       -1.11111104054623557880e-01, 9.09088713343650656196e-02, -7.69187620504482999495e-02,
+       6.66107313738753120669e-02, -5.83357013379057348645e-02, 4.97687799461593236017e-02,
+       -3.65315727442169155270e-02, 1.62858201153657823623e-02)
+_AT0, _AT1, _AT2, _AT3, _AT4, _AT5, _AT6, _AT7, _AT8, _AT9, _AT10 = _AT
+_PIO4_HI, _PIO4_LO = 7.85398163397448278999e-01, 3.06161699786838301793e-17
+_PIO2_HI, _PIO2_LO = 1.57079632679489655800e00, 6.12323399573676603587e-17
+_PI_HI, _PI_LO = 3.14159265358979311600e00, 1.22464679914735317720e-16
+_TAN_PI8 = 0.41421356237309503  # tan(pi/8)
+
+_JIT: dict[str, Any] = {"cache": True, "nogil": True, "error_model": "numpy"}
+#: the polynomial kernels may fuse multiply-adds (they differ from the C library by rounding anyway)
+_JIT_POLY: dict[str, Any] = {**_JIT, "fastmath": {"contract"}}
+
+
+@njit(**_JIT_POLY)
+def _sincos(a: float) -> tuple[float, float]:
+    """``(sin a, cos a)`` for ``|a| <= SINCOS_MAX``, branch-free."""
+    n = math.floor(a * _INVPIO2 + 0.5)
+    r = ((a - n * _PIO2_1) - n * _PIO2_2) - n * _PIO2_2T
+    z = r * r
+    s = r + z * r * (_S1 + z * (_S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))))
+    c = 1.0 - (0.5 * z - z * z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6))))))
+    m = n - 4.0 * math.floor(n * 0.25)  # quadrant 0..3
+    odd = (m == 1.0) | (m == 3.0)
+    sa = c if odd else s
+    ca = s if odd else c
+    sa = -sa if m >= 2.0 else sa
+    ca = -ca if (m == 1.0) | (m == 2.0) else ca
+    return sa, ca
+
+
+@njit(**_JIT_POLY)
+def _atan2(y: float, x: float) -> float:
+    """``atan2(y, x)`` in ``[-pi, pi]``, signs of zeros as the C library's, branch-free."""
+    ax, ay = abs(x), abs(y)
+    swap = ay > ax
+    num = ax if swap else ay
+    den = ay if swap else ax
+    big = num > _TAN_PI8 * den
+    top = num - den if big else num
+    bot = num + den if big else den
+    bot = 1.0 if bot == 0.0 else bot  # atan2(0, 0)
+    t = top / bot  # |t| <= tan(pi/8) < 7/16
+    z = t * t
+    w = z * z
+    s1 = z * (_AT0 + w * (_AT2 + w * (_AT4 + w * (_AT6 + w * (_AT8 + w * _AT10)))))
+    s2 = w * (_AT1 + w * (_AT3 + w * (_AT5 + w * (_AT7 + w * _AT9))))
+    r = (_PIO4_HI - ((t * (s1 + s2) - _PIO4_LO) - t)) if big else (t - t * (s1 + s2))
+    r = (_PIO2_HI - r) + _PIO2_LO if swap else r
+    r = (_PI_HI - r) + _PI_LO if math.copysign(1.0, x) < 0.0 else r
+    return math.copysign(r, y)
+
+
+# ------------------------------------------------------------------ node kinds on one chunk window
+
+
+@njit(**_JIT)
+def _k_fixed(par, L, xo, yo):
+    x, y = par[0], par[1]
+    for i in range(L):
+        xo[i] = x
+        yo[i] = y
+
+
+@njit(**_JIT)
+def _k_crank(par, q, L, xc, yc, xo, yo):
+    r, phase = par[0], par[1]
+    big = 0
+    for i in range(L):
+        a = q[i] + phase
+        big += abs(a) > SINCOS_MAX
+        s, c = _sincos(a)  # finite (and unused) beyond SINCOS_MAX
+        xo[i] = r * c + xc[i]
+        yo[i] = r * s + yc[i]
+    if big:
+        for i in range(L):
+            a = q[i] + phase
+            xo[i] = r * math.cos(a) + xc[i]
+            yo[i] = r * math.sin(a) + yc[i]
+
+
+@njit(**_JIT)
+def _k_actuator(par, q, L, xs, ys, xo, yo):
+    ux, uy, off = par[0], par[1], par[2]
+    for i in range(L):
+        s = q[i] + off
+        xo[i] = s * ux + xs[i]
+        yo[i] = s * uy + ys[i]
+
+
+@njit(**_JIT)
+def _k_rrr(par, L, xa, ya, xb, yb, xo, yo, ok, sep):
+    """Circle-circle as the numpy path (``chunked._rrr``); returns the number of samples that fail."""
+    ra, rb, branch = par[0], par[1], par[2]
+    s = ra + rb
+    f = ra - rb
+    s2, f2 = s * s, f * f
+    hb = 0.5 * branch
+    hr = 0.5 * (ra * ra - rb * rb)
+    fails = 0
+    for i in range(L):
+        dx = xb[i] - xa[i]
+        dy = yb[i] - ya[i]
+        d2 = dx * dx + dy * dy
+        prod = (s2 - d2) * (d2 - f2)
+        scale = max(s2, d2)
+        good = (prod >= -_RTOL * scale * scale) & (d2 > 0.0)
+        ok[i] = good
+        fails += not good
+        d2 = 1.0 if d2 <= 0.0 else d2
+        prod = max(prod, 0.0)
+        inv = 1.0 / d2
+        t = math.sqrt(prod) * inv * hb
+        sep[i] = prod * inv
+        fr = inv * hr + 0.5
+        xo[i] = (fr * dx + xa[i]) - t * dy
+        yo[i] = (fr * dy + ya[i]) + t * dx
+    return fails
+
+
+@njit(**_JIT)
+def _k_rrp(par, L, xa, ya, xp, yp, xq, yq, xo, yo, ok, sep):
+    """Line-circle as :func:`planar.geometry.line_circle` (the numpy path's ``chunked._rrp``)."""
+    ra, branch, off = par[0], par[1], par[2]
+    fails = 0
+    for i in range(L):
+        ux = xq[i] - xp[i]
+        uy = yq[i] - yp[i]
+        un = math.hypot(ux, uy)
+        ok_u = un > 0.0
+        un = un if ok_u else 1.0
+        bx = xp[i] + off * -uy / un
+        by = yp[i] + off * ux / un
+        ex = ux / un
+        ey = uy / un
+        wx = xa[i] - bx
+        wy = ya[i] - by
+        s0 = wx * ex + wy * ey
+        e = ex * wy - ey * wx
+        h2 = (ra - e) * (ra + e)
+        scale = max(ra * ra, e * e)
+        good = (h2 >= -_RTOL * max(scale, _TINY)) & ok_u
+        ok[i] = good
+        fails += not good
+        h = math.sqrt(max(h2, 0.0))
+        sk = s0 + branch * h
+        so = s0 + -branch * h
+        kx, ky = bx + sk * ex, by + sk * ey
+        ox, oy = bx + so * ex, by + so * ey
+        xo[i] = kx
+        yo[i] = ky
+        sep[i] = (kx - ox) ** 2 + (ky - oy) ** 2
+    return fails
+
+
+@njit(**_JIT)
+def _k_rigid(par, L, xa, ya, xb, yb, xo, yo, ok):
+    u, v = par[0], par[1]
+    fails = 0
+    for i in range(L):
+        ex = xb[i] - xa[i]
+        ey = yb[i] - ya[i]
+        en = math.sqrt(ex * ex + ey * ey)
+        fails += en <= 0.0
+        inv = 1.0 / en
+        ex *= inv
+        ey *= inv
+        ok[i] = True
+        xo[i] = (ex * u - ey * v) + xa[i]
+        yo[i] = (ey * u + ex * v) + ya[i]
+    if fails:  # coincident nodes or an underflow: again, as the reference (hypot)
+        fails = 0
+        for i in range(L):
+            ex = xb[i] - xa[i]
+            ey = yb[i] - ya[i]
+            en = math.hypot(ex, ey)
+            good = en > 0.0
+            ok[i] = good
+            fails += not good
+            inv = 1.0 / (en if good else 1.0)
+            ex *= inv
+            ey *= inv
+            xo[i] = (ex * u - ey * v) + xa[i]
+            yo[i] = (ey * u + ex * v) + ya[i]
+    return fails
+
+
+@njit(**_JIT)
+def _may_switch(x, y, ok, sep, tol, q, first, L):
+    """``chunked._may_switch`` on one window: a vectorised count, then the path test where it is not zero.
+
+    (Indices are offsets from slices, never ``k - 1``: a possibly negative index costs numba a
+    wraparound test that stops the loop from being vectorised.)
+    """
+    t2 = tol * tol
+    m = L - first
+    x0, x1, x2, x3 = x[first:], x[first - 1:], x[first - 2:], x[first - 3:]
+    y0, y1, y2, y3 = y[first:], y[first - 1:], y[first - 2:], y[first - 3:]
+    o0, o1, o2, o3 = ok[first:], ok[first - 1:], ok[first - 2:], ok[first - 3:]
+    s = sep[first:]
+    cand = 0
+    for k in range(m):
+        ex = x0[k] - 3.0 * x1[k] + 3.0 * x2[k] - x3[k]
+        ey = y0[k] - 3.0 * y1[k] + 3.0 * y2[k] - y3[k]
+        hist = o1[k] & o2[k] & o3[k]
+        cand += o0[k] & ((4.0 * (ex * ex + ey * ey) + t2 >= s[k]) | (not hist))
+    if cand == 0:
+        return False
+    q0, q1, q2, q3 = q[first:], q[first - 1:], q[first - 2:], q[first - 3:]
+    for k in range(m):
+        ex = x0[k] - 3.0 * x1[k] + 3.0 * x2[k] - x3[k]
+        ey = y0[k] - 3.0 * y1[k] + 3.0 * y2[k] - y3[k]
+        hist = o1[k] & o2[k] & o3[k]
+        if o0[k] and ((not hist) or 4.0 * (ex * ex + ey * ey) + t2 >= s[k]):
+            # chunked._path_ok: the three driver steps into sample k share a sign, within 1.5x
+            a, b, c = q2[k] - q3[k], q1[k] - q2[k], q0[k] - q1[k]
+            same = ((a > 0) & (b > 0) & (c > 0)) | ((a < 0) & (b < 0) & (c < 0))
+            a, b, c = abs(a), abs(b), abs(c)
+            if same and max(a, max(b, c)) <= 1.5 * min(a, min(b, c)):
+                return True
+    return False
+
+
+@njit(**_JIT)
+def _k_pose(xo, yo, xa, ya, xb, yb, m, pl, P):
+    """Pose rows ``P[:m]`` from node windows of length ``m``: origin, ``atan2`` of ``a -> b``, placement."""
+    px, py, pa, c, s = pl[0], pl[1], pl[2], pl[3], pl[4]
+    F = P.ravel()
+    if pa == 0.0 and px == 0.0 and py == 0.0:
+        for i in range(m):
+            F[3 * i] = xo[i]
+            F[3 * i + 1] = yo[i]
+            F[3 * i + 2] = _atan2(yb[i] - ya[i], xb[i] - xa[i])
+    else:
+        for i in range(m):
+            F[3 * i] = (px + xo[i] * c) - yo[i] * s
+            F[3 * i + 1] = (py + xo[i] * s) + yo[i] * c
+            F[3 * i + 2] = _atan2(yb[i] - ya[i], xb[i] - xa[i]) + pa
+
+
+@njit(**_JIT)
+def _k_point(x, y, m, pl, out):
+    px, py, pa, c, s = pl[0], pl[1], pl[2], pl[3], pl[4]
+    F = out.ravel()
+    if pa == 0.0 and px == 0.0 and py == 0.0:
+        for i in range(m):
+            F[2 * i] = x[i]
+            F[2 * i + 1] = y[i]
+    else:
+        for i in range(m):
+            F[2 * i] = (px + x[i] * c) - y[i] * s
+            F[2 * i + 1] = (py + x[i] * s) + y[i] * c
+
+
+@njit(**_JIT)
+def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts, pl, poses, points, oks, fails,
+                bad_chunks):
+    """Solve samples ``lo:hi`` chunk by chunk; returns whether a branch may switch (then stops early).
+
+    ``kinds[i]``, ``refs[i]``, ``par[i]``: node ``i``'s kind code, referenced
+    nodes and numbers (:data:`ENCODERS`); ``tols[i]`` its branch-screen
+    tolerance; ``check_row[i]`` its row in ``oks`` (-1: it cannot fail).
+    ``links`` ``(m, 3)``: origin, direction from, direction to of each moving
+    part, written to ``poses[j]`` ``(n, 3)``; ``pts`` the node of each named
+    point (``points[j]`` ``(n, 2)``); ``pl``: placement ``x, y, angle, cos,
+    sin``.  ``fails[row]`` counts the samples of this range that fail;
+    ``oks[row]`` is written only for the chunks where a sample fails (marked in
+    ``bad_chunks``, indexed by sample // chunk).
+    """
+    nn = kinds.shape[0]
+    W = chunk + 3
+    X = np.empty((nn, W))
+    Y = np.empty((nn, W))
+    OK = np.ones((nn, W), dtype=np.bool_)
+    sep = np.empty(W)
+    for i in range(lo, hi, chunk):
+        j = min(i + chunk, hi)
+        ws = max(0, i - 3)
+        off = i - ws
+        L = j - ws
+        first = max(3, off)
+        m = j - i
+        qw = q[ws:j]
+        bad = 0
+        for nd in range(nn):
+            k = kinds[nd]
+            r = refs[nd]
+            p = par[nd]
+            xo, yo, ok = X[nd], Y[nd], OK[nd]
+            nf = 0
+            if k == FIXED:
+                if i == lo:  # a fixed node's rows never change
+                    _k_fixed(p, W, xo, yo)
+            elif k == CRANK:
+                _k_crank(p, qw, L, X[r[0]], Y[r[0]], xo, yo)
+            elif k == ACTUATOR:
+                _k_actuator(p, qw, L, X[r[0]], Y[r[0]], xo, yo)
+            elif k == RRR:
+                nf = _k_rrr(p, L, X[r[0]], Y[r[0]], X[r[1]], Y[r[1]], xo, yo, ok, sep)
+            elif k == RRP:
+                nf = _k_rrp(p, L, X[r[0]], Y[r[0]], X[r[1]], Y[r[1]], X[r[2]], Y[r[2]], xo, yo, ok, sep)
+            else:
+                nf = _k_rigid(p, L, X[r[0]], Y[r[0]], X[r[1]], Y[r[1]], xo, yo, ok)
+            if (k == RRR or k == RRP) and _may_switch(xo, yo, ok, sep, tols[nd], qw, first, L):
+                return True
+            if nf and check_row[nd] >= 0:
+                okw = ok[off:]
+                cnt = 0
+                for t in range(m):
+                    cnt += not okw[t]
+                fails[check_row[nd]] += cnt
+                bad += cnt
+        if bad:  # validity rows only for chunks where a sample fails
+            bad_chunks[i // chunk] = True
+            for nd in range(nn):
+                row = check_row[nd]
+                if row >= 0:
+                    okw = OK[nd, off:]
+                    o = oks[row, i:j]
+                    for t in range(m):
+                        o[t] = okw[t]
+        for li in range(links.shape[0]):
+            o, a, b = links[li, 0], links[li, 1], links[li, 2]
+            _k_pose(X[o, off:], Y[o, off:], X[a, off:], Y[a, off:], X[b, off:], Y[b, off:], m, pl, poses[li, i:j])
+        for pi in range(pts.shape[0]):
+            _k_point(X[pts[pi], off:], Y[pts[pi], off:], m, pl, points[pi, i:j])
+    return False
+
+
+# ------------------------------------------------------------------ programs
+
+#: per node kind name: ``encode(node, index) -> (code, refs, numbers)``; a kind without an
+#: encoder is solved by the numpy path
+ENCODERS: dict[str, Callable[[Any, dict[str, int]], tuple[int, tuple[int, ...], tuple[float, ...]]]] = {
+    "fixed": lambda nd, ix: (FIXED, (), (float(nd.xy[0]), float(nd.xy[1]))),
+    "crank": lambda nd, ix: (CRANK, (ix[nd.centre],), (float(nd.radius), float(nd.phase))),
+    "actuator": lambda nd, ix: (ACTUATOR, (ix[nd.origin],),
+                                (float(nd.unit_axis[0]), float(nd.unit_axis[1]), float(nd.offset))),
+    "rrr": lambda nd, ix: (RRR, (ix[nd.a], ix[nd.b]), (float(nd.ra), float(nd.rb), float(nd.branch))),
+    "rrp": lambda nd, ix: (RRP, (ix[nd.a], ix[nd.p], ix[nd.q]), (float(nd.ra), float(nd.branch), float(nd.offset))),
+    "rigid": lambda nd, ix: (RIGID, (ix[nd.a], ix[nd.b]), (float(nd.local[0]), float(nd.local[1]))),
+}
+
+
+class Program:
+    """A linkage's plan as arrays for :func:`solve_range`."""
+
+    def __init__(self, kinds, refs, par, check_row, links, pts, pl) -> None:
+        self.kinds, self.refs, self.par, self.check_row = kinds, refs, par, check_row
+        self.links, self.pts, self.pl = links, pts, pl
+
+
+def program_for(plan: _Plan) -> Program | None:
+    """The program of a plan, or ``None`` when a node kind has no encoder."""
+    index = {nd.name: i for i, nd in enumerate(plan.nodes)}
+    nn = len(plan.nodes)
+    kinds = np.zeros(nn, np.int64)
+    refs = np.zeros((nn, 3), np.int64)
+    par = np.zeros((nn, 6))
+    for i, nd in enumerate(plan.nodes):
+        enc = ENCODERS.get(type(nd).kind)
+        if enc is None:
+            return None
+        code, rr, pp = enc(nd, index)
+        kinds[i] = code
+        refs[i, : len(rr)] = rr
+        par[i, : len(pp)] = pp
+    check_row = np.full(nn, -1, np.int64)
+    for row, (i, _, _) in enumerate(plan.checks):
+        check_row[i] = row
+    if sorted(i for i, _, _ in plan.checks) != [i for i in range(nn) if kinds[i] in CHECKED]:
+        return None  # the reference checks other nodes than the kernels report: keep the numpy path
+    links = np.array([(o, a, b) for _, o, a, b in plan.links if o >= 0], np.int64).reshape(-1, 3)
+    pts = np.array([i for _, i in plan.points], np.int64)
+    px, py, pa = plan.placement
+    pl = np.array([px, py, pa, float(np.cos(pa)), float(np.sin(pa))])  # as the numpy path
+    return Program(kinds, refs, par, check_row, links, pts, pl)
