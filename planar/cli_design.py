@@ -35,11 +35,21 @@ def _cmd_design(args: argparse.Namespace) -> int:
         raise InputError("--output", args.output, "a .toml file name in an existing directory")
     if out.exists() and out.resolve() == Path(args.request).resolve():
         raise InputError("--output", args.output, "a file other than the request")
+    from .limits import check_count
+
+    if args.max_length < 1:
+        raise InputError("--max-length", args.max_length, "a chain length of at least 1")
+    check_count("chain", "--max-length", args.max_length, "stages in a chain")
     effectors = load_request(args.request)
     with open(args.request, "rb") as fh:
         name = tomllib.load(fh).get("name") or Path(args.request).stem
-    if not isinstance(name, str):
-        raise InputError(f"{args.request}: name", name, "a string")
+    import re
+
+    from .scene import _NAME
+
+    if not isinstance(name, str) or not re.match(_NAME, name) or len(name) > 80:
+        raise InputError(f"{args.request}: name", name, "a string of at most 80 characters without commas, double "
+                         "quotes or control characters")
     d = design_toy(effectors, name=name, max_length=args.max_length)
     scene = scene_from_mechanism(d.toy, name=name, driver={"speed": 0.5, "samples_per_cycle": 36},
                                  render={"width": 360, "height": 270}, fabrication={"unit_mm": 100.0})

@@ -13,7 +13,11 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     from .scene import load_scene
 
     what = [w.strip() for w in args.what.split(",") if w.strip()] if args.what else None
-    charts = write_plot(load_scene(args.scene), args.output, what, args.samples)
+    from .pipeline import numeric_guard
+
+    scene = load_scene(args.scene)
+    with numeric_guard(scene, "the charts"):
+        charts = write_plot(scene, args.output, what, args.samples)
     print(f"wrote {args.output}: {', '.join(charts)}")
     return 0
 

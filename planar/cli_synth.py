@@ -81,7 +81,12 @@ def _cmd_path(args: argparse.Namespace) -> int:
 
     if not args.max_ratio > 1:
         raise InputError("--max-ratio", args.max_ratio, "a ratio greater than 1")
+    if args.seed < 0:
+        raise InputError("--seed", args.seed, "a seed of 0 or more")
     targets, theta = read_path_targets(args.target, args.points)
+    if len(targets) > MAX_TARGETS:
+        raise InputError(args.target, f"{len(targets)} targets", f"at most {MAX_TARGETS} targets (a path is "
+                         "matched at each; thin the file or use --points for an SVG)")
     if theta is not None and args.deg:
         theta = np.radians(theta)
     cons = Constraints(full_turn=True, max_ratio=args.max_ratio, region=_region(args.pivots))
@@ -171,6 +176,10 @@ def _cmd_motion(args: argparse.Namespace) -> int:
     report = {"command": "synth motion", "poses": len(poses), "angle_offset": d.angle_offset, **d.to_dict()}
     return _finish(args, f"four-bar ({d.grashof}, {d.circuit}) through {len(poses)} poses, position error "
                    f"{d.checks['max_position_error']:.3g}", text, report, d.ok, failing)
+
+
+#: most target points ``synth path`` takes (the search evaluates every candidate at each)
+MAX_TARGETS = 500
 
 
 def add_parser(sub: Any) -> None:

@@ -322,6 +322,8 @@ def derivative_columns(mech: "Mechanism", motion: "Motion", effects: Any = None)
     names += ["torque", "torque.loads"]
     cols += [tau, tau_l]
     good = der.valid & ok
+    for c in cols:  # a final finite check: a sample whose rates or torque overflowed is not valid
+        good &= np.isfinite(c)
     cols = [np.where(good, c, np.nan) for c in cols]
     names.append("rates_valid")
     cols.append(good.astype(float))

@@ -54,6 +54,8 @@ Array = NDArray[np.float64]
 
 def check_finite(field_name: str, value: ArrayLike) -> NDArray[np.float64]:
     """Return ``value`` as a float array or raise :class:`InputError` on NaN/inf (or what is not numbers)."""
+    if np.iscomplexobj(value):  # numpy would drop the imaginary part with only a warning
+        raise InputError(field_name, "complex numbers", "real numbers")
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError, OverflowError):
@@ -64,7 +66,9 @@ def check_finite(field_name: str, value: ArrayLike) -> NDArray[np.float64]:
 
 
 def check_positive(field_name: str, value: float) -> float:
-    """Return ``value`` as float or raise :class:`InputError` unless finite and > 0."""
+    """Return ``value`` as float or raise :class:`InputError` unless a finite number > 0 (not a bool or a string)."""
+    if isinstance(value, (bool, str, bytes)) or isinstance(value, np.bool_):
+        raise InputError(field_name, value, "a positive number")
     try:
         v = float(value)
     except (TypeError, ValueError):

@@ -8,6 +8,7 @@ functions that need them, so ``import planar.pipeline`` stays light.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 from collections.abc import Callable, Iterator
@@ -131,7 +132,6 @@ def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, p
         if not video_available():
             raise InputError("-o", str(out), f"the video extra for {suffix} output: pip install 'planar[video]' "
                                              "(imageio-ffmpeg), or write a .gif")
-    from shapely.errors import GEOSException
 
     from .limits import check_count
 
@@ -152,7 +152,7 @@ def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, p
     if overlay is not None:
         overlay = resample(overlay, plan.times())
     polys = {n: scene.polygons[n] for n in scene.spec.render.sweep}
-    try:
+    with numeric_guard(scene, "the animation"):
         r = Renderer(scene.mechanism, motion, scene_style(scene), overlay=overlay, polygons=polys, trail_motion=fine)
         if suffix == ".gif":
             from exporters.gif import indexer, write_gif
@@ -162,9 +162,6 @@ def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, p
         from exporters.video import write_video
 
         return write_video(out, r.frames(progress=progress), plan.fps)
-    except GEOSException as e:  # part outlines of extreme sizes (a coupler point at 1e305) defeat GEOS
-        raise InputError(f"{scene.path}: mechanism", f"parts up to {scene.mechanism.size:.4g} units across",
-                         f"part sizes the outline geometry can draw (shapely: {' '.join(str(e).split())})") from None
 
 
 def build_gallery(source: str | Path, output: str | Path | None = None,
@@ -189,6 +186,33 @@ def build_gallery(source: str | Path, output: str | Path | None = None,
 # --------------------------------------------------------------------------- motion tables
 
 
+@contextlib.contextmanager
+def numeric_guard(scene: Scene, doing: str) -> Iterator[None]:
+    """Turn a numerical library's failure on a scene of extreme sizes (shapely's GEOS, a singular matrix in
+    matplotlib, an overflow) into one line naming the scene, its size and what was being done."""
+    import numpy as np
+
+    from .errors import PlanarError
+
+    try:
+        yield
+    except PlanarError:
+        raise
+    except (np.linalg.LinAlgError, OverflowError, FloatingPointError, ValueError) as e:
+        if type(e).__module__.startswith("planar"):
+            raise
+        raise InputError(f"{scene.path}: mechanism", f"parts up to {scene.mechanism.size:.4g} units across",
+                         f"numbers (sizes, loads, densities) at which {doing} can be computed ({type(e).__name__}: "
+                         f"{' '.join(str(e).split())})"
+                         ) from None
+    except Exception as e:
+        if type(e).__name__ != "GEOSException":
+            raise
+        raise InputError(f"{scene.path}: mechanism", f"parts up to {scene.mechanism.size:.4g} units across",
+                         f"numbers (sizes, loads, densities) at which {doing} can be computed (shapely: "
+                         f"{' '.join(str(e).split())})") from None
+
+
 def write_scene_motion(scene: Scene, out: str | Path, derivatives: bool = False) -> Motion:
     """Write the scene's analytic motion table (CSV) to ``out``; returns the motion.
 
@@ -203,6 +227,8 @@ def write_scene_motion(scene: Scene, out: str | Path, derivatives: bool = False)
 
     from .fileio import atomic_write, motion_columns, write_motion_csv
 
+    if Path(out).suffix.lower() != ".csv":
+        raise InputError("output", str(out), "a .csv file (the motion table is CSV)")
     motion = scene.motion()
     if not derivatives:
         write_motion_csv(out, scene.mechanism, motion)
@@ -210,7 +236,8 @@ def write_scene_motion(scene: Scene, out: str | Path, derivatives: bool = False)
     from .derivatives import derivative_columns
 
     names, table = motion_columns(scene.mechanism, motion)
-    extra_names, extra = derivative_columns(scene.mechanism, motion, scene.effects)
+    with numeric_guard(scene, "the rates and motor torque"):
+        extra_names, extra = derivative_columns(scene.mechanism, motion, scene.effects)
     names = names[:-1] + extra_names + names[-1:]
     table = np.column_stack([table[:, :-1], *extra, table[:, -1]])
     buf = io.StringIO()

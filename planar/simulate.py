@@ -496,6 +496,11 @@ class _Rebuild:
                 self.true_mass[p.name] = (m, cog, inertia)
                 if p.name in self.overrides:
                     m, cog, inertia, _ = self.overrides[p.name]
+                if not (math.isfinite(m) and m > 0 and math.isfinite(inertia) and inertia > 0):
+                    # Chipmunk aborts the process on a mass it cannot use: say which part and why, first
+                    raise SimulationError(f"part {p.name!r}: mass {m:.4g} and moment {inertia:.4g} from [effects] "
+                                          f"density {d:.4g}: expected a positive, finite mass and moment (a density "
+                                          "or size this large or small leaves float64)")
                 body = pymunk.Body(m, inertia)
                 masses.append(m)
                 # The body's frame is put at the part's centre of gravity (``center_of_gravity``

@@ -166,8 +166,10 @@ def load_request(path: str | Path) -> list[Effector]:
         if bad:
             raise InputError(f"{where}.{bad[0]}", r[bad[0]], "one of name, motion, range, cam, phase")
         name = r.get("name")
-        if not isinstance(name, str) or not name.strip() or any(c in name for c in ".:+") or name == "frame":
-            raise InputError(f"{where}.name", name, "a name without '.', ':' or '+', not 'frame' (the effector's piece)")
+        if not isinstance(name, str) or not name.strip() or any(c in name for c in '.:+,"') or name == "frame" \
+                or any(ord(c) < 32 or ord(c) == 127 for c in name):
+            raise InputError(f"{where}.name", name, "a name without '.', ':', '+', ',', '\"' or control characters, "
+                             "not 'frame' (the effector's piece)")
         motion = r.get("motion")
         if motion not in MOTION_TYPES:
             raise InputError(f"{where}.motion", motion, f"one of {', '.join(MOTION_TYPES)}")
