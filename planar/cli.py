@@ -200,6 +200,9 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         _positive(option, v)
     _positive("--substeps", args.substeps, integer=True)
     _positive("--iterations", args.iterations, integer=True)
+    for option, v, cap in (("--substeps", args.substeps, 100_000), ("--iterations", args.iterations, 100_000)):
+        if v is not None and v > cap:  # checked before pymunk allocates steps x samples
+            raise InputError(option, v, f"at most {cap:,} (more gains nothing in float64 and runs for hours)")
     if args.step_drift is not None and not (math.isfinite(args.step_drift) and args.step_drift >= 0):
         raise InputError("--step-drift", args.step_drift, "a drift fraction >= 0 (0 keeps --substeps fixed)")
     if args.error_bias is not None and not (0 <= args.error_bias <= 1):

@@ -51,8 +51,11 @@ def _cmd_design(args: argparse.Namespace) -> int:
         raise InputError(f"{args.request}: name", name, "a string of at most 80 characters without commas, double "
                          "quotes or control characters")
     d = design_toy(effectors, name=name, max_length=args.max_length)
+    # a #8 stage's tab is held on its face by gravity along +x (README, "Wind-up toys"): the toy stands that way
+    effects = {"gravity": [9.81, 0.0]} if any(st.realisation.number == 8 for st in d.toy.stages) else {}
     scene = scene_from_mechanism(d.toy, name=name, driver={"speed": 0.5, "samples_per_cycle": 36},
-                                 render={"width": 360, "height": 270}, fabrication={"unit_mm": 100.0})
+                                 render={"width": 360, "height": 270}, fabrication={"unit_mm": 100.0},
+                                 effects=effects)
     scene.save(args.output)
     rep = d.report()
     rep["output"] = str(args.output)
