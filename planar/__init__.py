@@ -1,14 +1,33 @@
 """planar: 2D rigid-body mechanisms with exact (closed-form) kinematics.
 
-``import planar`` stays light: numpy only.  shapely, pymunk, ezdxf and imageio
-are imported by the modules that use them.
+``import planar`` is light: the errors only.  The model's names
+(``planar.Mechanism`` ...) load numpy on first use; shapely, pymunk, ezdxf and
+imageio are imported by the modules that use them.  So the ``planar`` command
+holds nothing heavy until its interrupt handling is in place (a Ctrl-C while
+numpy loads is one line, not a traceback).
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
 from .errors import AssemblyError, InputError, LimitError, PlanarError, SceneError
-from .model import Driver, Mechanism, Motion, Part, joint_residuals
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .model import Driver, Mechanism, Motion, Part, joint_residuals
 
 __all__ = [
     "AssemblyError", "InputError", "LimitError", "PlanarError", "SceneError",
     "Driver", "Mechanism", "Motion", "Part", "joint_residuals",
 ]
 __version__ = "0.1.0"
+
+_MODEL_NAMES = ("Driver", "Mechanism", "Motion", "Part", "joint_residuals")
+
+
+def __getattr__(name: str) -> Any:
+    if name in _MODEL_NAMES:
+        from . import model
+
+        return getattr(model, name)
+    raise AttributeError(f"module 'planar' has no attribute {name!r}")

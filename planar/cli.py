@@ -184,6 +184,8 @@ def _cmd_schema(args: argparse.Namespace) -> int:
             fh.write(text)
         print(f"wrote {args.output}")
     else:
+        if sys.stdout is None:  # standard output closed (planar schema >&-)
+            raise InputError("standard output", "closed", "an open standard output, or -o FILE")
         sys.stdout.write(text)
     return 0
 

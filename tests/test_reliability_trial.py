@@ -97,3 +97,24 @@ def test_python_api_refuses_bools_strings_complex_and_a_wrong_suffix(tmp_path):
     with pytest.raises(PlanarError, match="csv"):
         write_mechanism_motion(FourBar(4, 1, 4, 3), tmp_path / "m.gif")
     assert not (tmp_path / "m.gif").exists()
+
+
+def test_ctrl_c_while_numpy_loads_is_one_line(tmp_path):
+    # `import planar.cli` no longer loads numpy, so the command's interrupt handling covers numpy's import
+    import subprocess
+    import sys
+
+    code = "import sys, planar.cli; print('numpy' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "False"
+
+
+def test_schema_to_a_closed_stdout(tmp_path):
+    import subprocess
+    import sys
+
+    r = subprocess.run([sys.executable, "-m", "planar", "schema"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                       text=True, check=False)
+    assert r.returncode == 0
+    r = subprocess.run(f"{sys.executable} -m planar schema >&-", shell=True, stderr=subprocess.PIPE, text=True)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "standard output" in r.stderr
