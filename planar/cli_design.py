@@ -60,7 +60,20 @@ def _cmd_design(args: argparse.Namespace) -> int:
     rep = d.report()
     rep["output"] = str(args.output)
     bad = [e for e in rep["effectors"] if e["error"] > TOLERANCE]
-    ok = not bad and not d.collisions and not d.clashes
+    # the toy as it will run: coupled pymunk physics, the motor the only driver, its torque against inverse
+    # dynamics (as `planar toy` checks it), at the scene's speed
+    from .windup.toy_physics import simulate_toy
+
+    motion = scene.motion()
+    assert motion.t is not None
+    speed = scene.mechanism.driver.rate / (2 * math.pi)
+    phys = simulate_toy(scene.mechanism, motion.t, scene.effects, speeds=[speed])
+    tq = phys.torque
+    ok_physics = tq["failure"] is None and tq["max_rel_diff"] <= 0.01
+    lets_go = sorted(k for k, v in phys.liftoff.items() if v["liftoff_speed"] is not None and v["liftoff_speed"] <= speed)
+    rep["physics"] = {"torque_rel_diff": tq["max_rel_diff"], "failure": tq["failure"], "lets_go": lets_go,
+                      "not_simulated": [s.stage for s in phys.not_simulated], "ok": ok_physics and not lets_go}
+    ok = not bad and not d.collisions and not d.clashes and ok_physics and not lets_go
     if args.json:
         print(json.dumps(rep, indent=2, sort_keys=True, default=float))
     else:
@@ -99,6 +112,11 @@ def _cmd_design(args: argparse.Namespace) -> int:
               f"poses: {len(d.collisions)}, pins through pieces: {len(d.clashes)} "
               + ("[ok]" if not (d.collisions or d.clashes) else "[FAIL] " + ", ".join(
                   [f"{a}/{b} {ov:.3g} mm^2" for a, b, ov in d.collisions] + d.clashes)))
+        print(f"  physics (as planar toy): motor torque vs inverse dynamics {tq['max_rel_diff']:.2g} of the peak"
+              + (f"; {tq['failure']}" if tq["failure"] else "")
+              + (f"; lets go at {speed:g} cycles/s: {', '.join(lets_go)}" if lets_go else "")
+              + (f"; not simulated: {', '.join(s.stage for s in phys.not_simulated)}" if phys.not_simulated else "")
+              + (" [ok]" if ok_physics and not lets_go else " [FAIL]"))
         print(f"  wrote {args.output} ({sum(d.seconds.values()):.2f} s)")
     return 0 if ok else EXIT_MISMATCH
 
