@@ -198,7 +198,8 @@ def plan_assembly(mech: Any, material: dict[str, Any], pins: list[PinSpec], cont
                 adj[x].add(y)
                 adj[y].add(x)
         node_pins = [(i, [find(p) for p in sp]) for i, sp in enumerate(stack_parts) if plane[sp[0]] == pl]
-        assign, _ = _best_layers(nodes, adj, node_pins, crossing, group, find)
+        grounds = [r for r in nodes if any(p.ground for p in mech.parts if p.name in group[r])]
+        assign, _ = _best_layers(nodes, adj, node_pins, crossing, group, find, grounds[0] if grounds else None)
         used = sorted(set(assign.values()))
         assign = {r: used.index(v) for r, v in assign.items()}
         n_layers[pl] = len(used)
@@ -237,9 +238,10 @@ def _score(pins_q: list, a: dict[str, int]) -> tuple[int, int, int]:
     return clash, spacers, spread
 
 
-def _search(order: list[str], adj: dict, k: int,
-            score: Callable[[dict[str, int]], tuple[int, int, int]]) -> tuple[tuple[int, int, int], dict[str, int]] | None:
-    """Best assignment of ``k`` layers to ``order`` (neighbours in ``adj`` apart), depth first with bounds."""
+def _search(order: list[str], adj: dict, k: int, score: Callable[[dict[str, int]], tuple[int, int, int]],
+            fixed: dict[str, int] | None = None) -> tuple[tuple[int, int, int], dict[str, int]] | None:
+    """Best assignment of ``k`` layers to ``order`` (neighbours in ``adj`` apart), depth first with bounds;
+    ``fixed`` nodes take only their given layer."""
     best: list = [None]
     count = [0]
     assign: dict[str, int] = {}
@@ -256,7 +258,7 @@ def _search(order: list[str], adj: dict, k: int,
             return
         r = order[idx]
         used = {assign[n] for n in adj[r] if n in assign}
-        for c in range(k):
+        for c in ([fixed[r]] if fixed and r in fixed else range(k)):
             if c not in used:
                 assign[r] = c
                 dfs(idx + 1)
@@ -266,8 +268,10 @@ def _search(order: list[str], adj: dict, k: int,
     return best[0]
 
 
-def _best_layers(nodes, adj, node_pins, crossing, group, find) -> tuple[dict[str, int], int]:
+def _best_layers(nodes, adj, node_pins, crossing, group, find, bottom: str | None = None) -> tuple[dict[str, int], int]:
     """Fewest layers (exact), then no pin clashes, then fewest spacers; first found wins ties.
+
+    ``bottom``: a node held at layer 0 (the ground plate: the motor sits under it, so nothing may be below).
 
     Depth-first over layer assignments with branch and bound: the score of a
     partial assignment (pins whose ends and crossed parts are all placed) only
@@ -280,7 +284,7 @@ def _best_layers(nodes, adj, node_pins, crossing, group, find) -> tuple[dict[str
     for k in range(1, len(nodes) + 1):
         if chromatic and k > chromatic + 2:  # two more layers did not clear the clashes
             break
-        best = _search(order, adj, k, functools.partial(_score, pins_q))
+        best = _search(order, adj, k, functools.partial(_score, pins_q), None if bottom is None else {bottom: 0})
         if best is None:
             continue
         chromatic = chromatic or k
@@ -289,5 +293,6 @@ def _best_layers(nodes, adj, node_pins, crossing, group, find) -> tuple[dict[str
         if best[0][0] == 0:
             break
     if chosen is None:
-        return {r: i for i, r in enumerate(nodes)}, len(nodes)
+        first = sorted(nodes, key=lambda r: r != bottom)
+        return {r: i for i, r in enumerate(first)}, len(nodes)
     return chosen[1], chosen[2]

@@ -174,6 +174,11 @@ def test_every_gallery_scene_exports_checked_files(tmp_path, path):
                                                             math.cos(q[2]), q[0] * s.unit_mm, q[1] * s.unit_mm])
                       for n, q in ((a_name, motion.poses[a_name][i]), (b_name, motion.poses[b_name][i]))]
             assert ga.intersection(gb).area < 1.0, (a_name, b_name, i)
+    # the motor sits under the ground plate: no part of the ground's plane lies below it
+    for g in fab.grounds:
+        if asm.layers.get(g) is not None:
+            same_plane = [n for n, v in asm.layers.items() if v is not None and asm.plane[n] == asm.plane[g]]
+            assert asm.layers[g] == min(asm.layers[n] for n in same_plane), (g, asm.layers)
     # BOM: pins as long as the layers they span plus heads
     import csv
 
