@@ -125,7 +125,7 @@ class Design:
                           for e, (cam, chain) in zip(self.effectors, self.assignment)],
             "trees_considered": self.candidates,
             "trees_sized": self.tried,
-            "layers": self.layers,
+            "layers": {k: v + 1 for k, v in self.layers.items()},  # numbered from 1, as in the BOM
             "layer_count": len(set(self.layers.values())),
             "before_placement": self.before,
             "placement": None if self.placement is None else {
