@@ -43,7 +43,7 @@ def _cmd_toy(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
     toy = scene.mechanism
     if not isinstance(toy, ToyMechanism):
-        raise InputError(f"{args.scene}: mechanism.type", type(toy).__name__, "a toy scene (type = \"toy\")")
+        raise InputError(f"{args.scene}: mechanism.type", scene.spec.mechanism.type, "a toy scene (type = \"toy\")")
     asm = toy_assembly(toy)
     res = assembly_residual(asm)
     worst = max(res.values(), default=0.0) / asm.size
