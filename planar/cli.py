@@ -123,25 +123,17 @@ def _cmd_chains(args: argparse.Namespace) -> int:
 
 
 def _cmd_render(args: argparse.Namespace) -> int:
-    from .pipeline import overlay_motion, render_scene
+    from .pipeline import ANIMATION_SUFFIXES, animation_plan, overlay_motion, render_scene
     from .scene import load_scene
-
-    from .pipeline import ANIMATION_SUFFIXES
 
     _outputs(args, (args.scene,), ("-o", "output", ANIMATION_SUFFIXES))
     scene = load_scene(args.scene)
     overlay = overlay_motion(scene) if args.overlay else None
-    from .pipeline import animation_plan
-
-    plan = animation_plan(scene, args.output, args.fps)
-    if plan.note():
-        print(f"note: {plan.note()}")
-    m = scene.motion()
-    bad = ~m.valid
-    if bad.any():  # drawn (tinted red, the joint ringed), and said
-        print(f"note: {int(bad.sum())} of {len(m)} samples cannot be assembled and are drawn tinted red; first: "
-              f"{m.reason(int(bad.argmax()))}")
-    n = render_scene(scene, args.output, overlay=overlay, fps=args.fps)
+    notes: list[str] = []
+    n = render_scene(scene, args.output, overlay=overlay, fps=args.fps, notes=notes)
+    for note in notes:
+        print(f"note: {note}")
+    plan = animation_plan(scene, args.output, args.fps)  # arithmetic only: what render_scene drew
     print(f"wrote {args.output}: {n} frames, {plan.fps:.3g} frames/s, a cycle plays {plan.cycle_play_s:.3g} s")
     return 0
 

@@ -109,7 +109,7 @@ def animation_plan(scene: Scene, out: str | Path, fps: float | None = None) -> "
 
 
 def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, progress: bool = True,
-                 fps: float | None = None) -> int:
+                 fps: float | None = None, notes: list[str] | None = None) -> int:
     """Render a scene's analytic motion (and optionally an overlay motion) to ``out``; returns the frame count.
 
     The format follows the suffix: ``.gif`` (streamed, reproducible), ``.mp4``
@@ -117,7 +117,9 @@ def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, p
     plays for what the scene's ``speed`` says, within one frame delay
     (:func:`planar.animation.plan_frames`); ``fps`` (or the scene's
     ``[render] fps``) sets the frame rate.  The overlay, a simulated motion
-    with sample times, is interpolated to the frame instants.
+    with sample times, is interpolated to the frame instants.  ``notes``, if
+    given, receives what a user should hear: a cycle that plays slower than
+    its speed, samples that cannot be assembled (drawn tinted red).
     """
     from .animation import animation_motion, resample
     from .errors import InputError
@@ -149,6 +151,13 @@ def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, p
                          f"a frame delay a GIF can hold (at most {GIF_MAX_DELAY_MS / 1000:g} s; this needs "
                          f"{plan.delay_ms / 1000:.4g} s): a higher speed or frame rate")
     motion, fine = animation_motion(scene, plan)
+    if notes is not None:
+        if plan.note():
+            notes.append(plan.note())
+        bad = ~fine.valid
+        if bad.any():
+            notes.append(f"{int(bad.sum())} of the {len(fine)} samples drawn from cannot be assembled and are drawn "
+                         f"tinted red; first: {fine.reason(int(bad.argmax()))}")
     if overlay is not None:
         overlay = resample(overlay, plan.times())
     polys = {n: scene.polygons[n] for n in scene.spec.render.sweep}

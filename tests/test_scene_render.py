@@ -153,7 +153,9 @@ def test_render_marks_invalid_samples(tmp_path):
     m = scene.motion()
     assert m.valid.any() and not m.valid.all()
     out = tmp_path / "inv.gif"
-    render_scene(scene, out, progress=False)
+    notes: list[str] = []
+    render_scene(scene, out, progress=False, notes=notes)
+    assert any("cannot be assembled" in n for n in notes)  # and the command says so
     _, frames, _ = _gif_frames(out)
     from planar.animation import animation_motion, plan_frames, scene_duration
 
