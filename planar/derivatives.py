@@ -244,16 +244,10 @@ def _rates_and_coefficients(mech: "Mechanism", motion: "Motion"
 
 def _torque(mech: "Mechanism", motion: "Motion", rates: dict[str, PartRates], coef: dict[str, PartRates],
             effects: Any, t_rest: float | None, densities: dict[str, float] | None) -> Array:
-    from .dynamics import part_mass_table
+    from .dynamics import gravity_and_damping, part_mass_table
 
     assert motion.t is not None
-    g = np.zeros(2)
-    lam = 0.0
-    if effects is not None:
-        if effects.gravity is not None:
-            g = np.asarray(effects.gravity, float)
-        if effects.damping is not None:
-            lam = -math.log(float(effects.damping))
+    g, lam = gravity_and_damping(effects)
     tau = np.zeros(len(motion))
     for name, (mass, cog, inertia) in part_mass_table(mech, effects, densities).items():
         if mass == 0.0 and inertia == 0.0:

@@ -29,9 +29,22 @@ from numpy.typing import NDArray
 
 from .geometry import poses_apply
 
-__all__ = ["inverse_dynamics_torque", "mass_properties", "part_mass_table"]
+__all__ = ["gravity_and_damping", "inverse_dynamics_torque", "mass_properties", "part_mass_table"]
 
 Array = NDArray[np.float64]
+
+
+def gravity_and_damping(effects: Any) -> tuple[Array, float]:
+    """The scene's gravity ``(gx, gy)`` (zero if none) and its damping as a rate ``lam = -ln(damping)`` (1/s:
+    pymunk keeps ``damping`` of every velocity per second, so the drag force is ``lam m v``; 0 if none)."""
+    g = np.zeros(2)
+    lam = 0.0
+    if effects is not None:
+        if effects.gravity is not None:
+            g = np.asarray(effects.gravity, float)
+        if effects.damping is not None:
+            lam = -math.log(float(effects.damping))
+    return g, lam
 
 
 def _ring_moments(xy: Array) -> tuple[float, float, float, float]:
@@ -102,13 +115,7 @@ def inverse_dynamics_torque(mech: Any, t: Array, effects: Any = None, densities:
     m0 = mech.solve(drv.value(t))
     mp = mech.solve(drv.value(t + h))
     mm = mech.solve(drv.value(t - h))
-    g = np.zeros(2)
-    lam = 0.0
-    if effects is not None:
-        if effects.gravity is not None:
-            g = np.asarray(effects.gravity, float)
-        if effects.damping is not None:
-            lam = -math.log(float(effects.damping))
+    g, lam = gravity_and_damping(effects)
     tau = np.zeros(t.size)
     for name, (mass, cog, inertia) in part_mass_table(mech, effects, densities).items():
         c = np.asarray(cog, float)
