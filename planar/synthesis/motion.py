@@ -35,6 +35,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError, PlanarError
+from .designs import Checked, PlacedFourBar
 
 __all__ = ["MotionDesign", "burmester", "circle_point_curve", "burmester_points", "dyad_rows"]
 
@@ -158,7 +159,7 @@ def burmester_points(poses: Array, grid: int = 60, reach: float = 4.0) -> tuple[
 
 
 @dataclass
-class MotionDesign:
+class MotionDesign(Checked, PlacedFourBar):
     ground: float
     crank: float
     coupler: float
@@ -173,16 +174,6 @@ class MotionDesign:
     grashof: str
     candidates: int
     checks: dict[str, Any] = field(default_factory=dict)
-
-    @property
-    def ok(self) -> bool:
-        return all(bool(v) for k, v in self.checks.items() if k.startswith("ok_"))
-
-    def fourbar(self, **kw: Any):
-        from ..linkages import FourBar
-
-        return FourBar(self.ground, self.crank, self.coupler, self.rocker, coupler_point=self.coupler_point,
-                       circuit=self.circuit, placement=self.placement, **kw)  # type: ignore[arg-type]
 
     def to_dict(self) -> dict[str, Any]:
         return {"type": "fourbar", "ground": self.ground, "crank": self.crank, "coupler": self.coupler,

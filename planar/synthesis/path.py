@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from .designs import Checked, PlacedFourBar
 from .search import Constraints, search_fourbar
 
 __all__ = ["FourBarDesign", "synthesise_path"]
@@ -29,7 +30,7 @@ Array = NDArray[np.float64]
 
 
 @dataclass
-class FourBarDesign:
+class FourBarDesign(Checked, PlacedFourBar):
     """A synthesised four-bar and how well it does (see the module for the checks)."""
 
     ground: float
@@ -45,18 +46,6 @@ class FourBarDesign:
     timed: bool
     seconds: float
     checks: dict[str, Any] = field(default_factory=dict)
-
-    @property
-    def ok(self) -> bool:
-        """Every check passed."""
-        return all(bool(v) for k, v in self.checks.items() if k.startswith("ok_"))
-
-    def fourbar(self, **kw: Any):
-        """The design as a :class:`planar.linkages.FourBar`."""
-        from ..linkages import FourBar
-
-        return FourBar(self.ground, self.crank, self.coupler, self.rocker, coupler_point=self.coupler_point,
-                       circuit=self.circuit, placement=self.placement, **kw)  # type: ignore[arg-type]
 
     def to_dict(self) -> dict[str, Any]:
         return {

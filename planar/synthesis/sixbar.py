@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from .designs import Checked
 from .kernel import coupler_points
 from .search import GRASHOF_MARGIN, Constraints, violation
 
@@ -129,7 +130,7 @@ class _Objective:
 
 
 @dataclass
-class SixBarDesign:
+class SixBarDesign(Checked):
     topology: str
     params: Array              # the 17 columns (see the module)
     theta: Array
@@ -138,10 +139,6 @@ class SixBarDesign:
     sse: float
     seconds: float
     checks: dict[str, Any] = field(default_factory=dict)
-
-    @property
-    def ok(self) -> bool:
-        return all(bool(v) for k, v in self.checks.items() if k.startswith("ok_"))
 
     def nodes(self) -> list[dict[str, Any]]:
         """The linkage's nodes as scene tables (world coordinates, radians)."""
