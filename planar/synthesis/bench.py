@@ -62,9 +62,6 @@ PROBLEMS: dict[str, dict[str, Any]] = {
 
 def _from_pylinkage(sol: Any, targets: Array, theta: Array | None) -> FourBarDesign | None:
     """A pylinkage FourBarSolution as planar's design, scored like planar's (None if it cannot close)."""
-    from .kernel import coupler_points
-    from .search import PathObjective, _nearest_theta
-
     A, D = np.asarray(sol.ground_pivot_a, float), np.asarray(sol.ground_pivot_d, float)
     B, C = np.asarray(sol.crank_pivot_b, float), np.asarray(sol.coupler_pivot_c, float)
     P = np.asarray(sol.coupler_point if sol.coupler_point is not None else B, float)
@@ -75,17 +72,31 @@ def _from_pylinkage(sol: Any, targets: Array, theta: Array | None) -> FourBarDes
     e1 = D - B
     circ = 1.0 if e1[0] * (C - B)[1] - e1[1] * (C - B)[0] > 0 else -1.0
     row = np.array([np.hypot(*g), sol.crank_length, sol.coupler_length, sol.rocker_length, u, v, A[0], A[1],
-                    math.atan2(g[1], g[0]), circ])
+                    math.atan2(g[1], g[0])])
+    return score_params(row, circ, targets, theta)
+
+
+def score_params(p: Array, circuit: float, targets: Array, theta: Array | None) -> FourBarDesign | None:
+    """planar's design of the four-bar ``p`` (planar's 9 parameters, circuit sign), scored by planar's solver.
+
+    Timed: at ``theta``; untimed: at the crank angles nearest each target (7200 per turn).  None if the
+    lengths cannot close.
+    """
+    from .kernel import coupler_points
+    from .search import PathObjective, _nearest_theta
+
+    row = np.append(np.asarray(p, float)[:9], 1.0 if circuit >= 0 else -1.0)
+    circ = row[9]
     L = row[:4]
-    if L.max() >= L.sum() - L.max():
+    if L.min() <= 0 or L.max() >= L.sum() - L.max():
         return None
     if theta is None:
         th = _nearest_theta(PathObjective(targets, None, Constraints(full_turn=False, max_ratio=1e12)), row, 7200)
     else:
         th = np.asarray(theta, float)
-    d = FourBarDesign(float(row[0]), float(row[1]), float(row[2]), float(row[3]), (u, v),
-                      "open" if circ > 0 else "crossed", (float(A[0]), float(A[1]), float(row[8])), th, float("nan"),
-                      targets, theta is not None, 0.0)
+    d = FourBarDesign(float(row[0]), float(row[1]), float(row[2]), float(row[3]), (float(row[4]), float(row[5])),
+                      "open" if circ > 0 else "crossed", (float(row[6]), float(row[7]), float(row[8])), th,
+                      float("nan"), targets, theta is not None, 0.0)
     try:
         x, y, _ = coupler_points(row[None, :9], th[None, :], np.array([circ]))
         check_design(d, np.column_stack([x[0], y[0]]))
