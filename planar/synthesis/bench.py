@@ -60,8 +60,10 @@ SEARCHED = (
     "searched (2026-11-22) with the session's search tool: its web-page corpus holds later papers that "
     "benchmark these cases (Sleesongsom & Bureerat, Comput. Intell. Neurosci. 2018, 5462563; Appl. Sci. 2022, "
     "12(15), 7368; Yao et al., individual repairing method; Winyangkul et al., Biomimetics 2026, 11(3), 160; "
-    "Buskiewicz, J. Theor. Appl. Mech. 56(1) (2018) 43-55; Sedano et al., Math. Probl. Eng. 2012, 151590) but "
-    "returns only each page's opening passage, never a results table; the public-code index has no file with "
+    "Buskiewicz, J. Theor. Appl. Mech. 56(1) (2018) 43-55; Sedano et al., Math. Probl. Eng. 2012, 151590; "
+    "Kafash & Nahvi, Mech. Mach. Theory 115 (2017) 18-34) but returns only each page's opening passage, never a "
+    "results table, and no page of Acharyya & Mandal 2009, Ebrahimi & Payvandy or Lin 2010; the public-code index "
+    "has no file with "
     "the case-2 coordinates (2.759, 3.363, 3.943) or with Kunjur, Krishnamurty or Acharyya in this context; "
     "jmejia8/eca-four-bar-mechanisms (testTrajectories.jl, case 4) holds the six line points, no error"
 )
