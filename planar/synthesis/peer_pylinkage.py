@@ -171,7 +171,7 @@ def optimise(targets: Array, theta: Array | None, budget: str = "normal") -> dic
     polished_sse = swarm_sse = fine.sse(x[:9], circ) if fine is not peer else swarm_sse
     if math.isfinite(swarm_sse):
         x0 = [x[1], x[2], x[3], float(np.hypot(x[4], x[5])), math.atan2(x[5], x[4])]
-        pol = minimize_linkage(polish_fitness, peer.linkage, x0=x0, order_relation=min, method="Nelder-Mead",
+        pol = minimize_linkage(polish_fitness, fine.linkage, x0=x0, order_relation=min, method="Nelder-Mead",
                                maxiter=b["polish"], verbose=False)
         polished_sse = float(pol.scores["score"][0])
         if polished_sse < swarm_sse:
