@@ -5,8 +5,11 @@
   and a ``SimpleMotor`` on the first cam is the only driver
   (:func:`planar.simulate.simulate`, ``mode="motor"``).  The pieces of #8
   stages (xz) join the same space, each tied to its body's xy piece by its x
-  (:class:`SharedX`).  The motor's signed torque is compared with inverse
-  dynamics (:func:`planar.simulate.torque_comparison`).
+  (:class:`SharedX`), and so do the yz followers of #6/#9: each in a space of
+  its own stepped in lockstep, its contact's load put on its driver every step
+  (:func:`_skew_load`).  The motor's signed torque is compared with inverse
+  dynamics (:func:`planar.simulate.torque_comparison`), which takes every
+  piece's gravity in its plane (:func:`planar.dynamics.plane_gravity`).
 * **#8 in xz** (:func:`contact_hold`): its own 2D space.  The window plate is
   a kinematic body following the slider's x; the tab pivots on the frame and
   touches the window's edge through a pair of collision shapes (a thick segment
@@ -16,7 +19,7 @@
   gap exceeds ``1e-3`` of the size; :func:`liftoff_speed` scans speeds, and
   :func:`hold_margin` gives the speed at which inverse dynamics says the
   contact force changes sign (an independent prediction).
-* **#6 and #9** (:func:`skew_stage`): rebuilt in the follower's plane (yz).
+* **#6 and #9 alone** (:func:`skew_stage`): rebuilt in the follower's plane (yz).
   The driver's edge meets that plane in a point moving along a line (a
   kinematic body); the pin holds it at the skew-line distance, whose in-plane
   value ``r sqrt(cos^2 a + sin^2 a cos^2 phi) / cos phi`` follows the pin's
@@ -449,18 +452,23 @@ class ToyPhysics:
         return [s for s in self.stages if not s.simulated]
 
 
-def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, speeds: Any = None) -> ToyPhysics:
+def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, speeds: Any = None,
+                 densities: dict[str, float] | None = None) -> ToyPhysics:
     """The toy's coupled motor run with its torque against inverse dynamics, and every stage's own physics.
 
     ``t``: output times (s) at the toy's speed.  The coupled run holds the xy
     pieces and, when the scene names gravity, the xz pieces of #8 stages (tied
     to their body's xy piece by :class:`SharedX`; one 2D space, gravity
     ``(gx, gy)`` acting along (x, z) on them: x stays x, the toy's y is the
-    stage's z); the yz followers of #6/#9 are not in it (their load on the
-    slider is not in the motor torque).  Each #8 stage also runs alone,
-    one-sided, scanned over ``speeds`` (cycles/s) for lift-off; #6/#9 are rebuilt
-    in their follower's plane.  A stage that cannot be simulated is reported
-    with the reason.
+    stage's z) and the yz followers of #6/#9 (co-simulated in their plane,
+    gravity ``(gy, 0)``, their load on their driver: :func:`_skew_load`), so
+    the motor torque and the inverse dynamics it is compared with both carry
+    every stage.  ``densities``: per piece (assembly part name), overriding the
+    scene's density in the coupled run and its inverse dynamics (e.g. a
+    heavier follower).  Each #8 stage also runs alone, one-sided, scanned over
+    ``speeds`` (cycles/s) for lift-off; #6/#9 are also rebuilt alone in their
+    follower's plane.  A stage that cannot be simulated is reported with the
+    reason.
     """
     from ..simulate import SimSettings, torque_comparison
 
@@ -472,7 +480,8 @@ def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, 
     flat = coupled_mechanism(asm, xz=has_xz and g != (0.0, 0.0))
     # 128 substeps, 80 iterations: measured, the motor torque's start transient at 32 substeps is 4 % of the peak
     # for the Bunny (its #8 tab coupled), 0.7 % at 64 and 1e-6 at 128 (Horse 2.6e-3, 2.6e-4, 2.9e-5)
-    tq = torque_comparison(flat, np.asarray(t, float), effects, settings or SimSettings(substeps=128, iterations=80))
+    tq = torque_comparison(flat, np.asarray(t, float), effects, settings or SimSettings(substeps=128, iterations=80),
+                           densities=densities)
     tq["pieces"] = [p.name for p in flat.parts]
     speed = toy.driver.rate / (2 * math.pi)
     out = ToyPhysics(tq)
@@ -507,8 +516,9 @@ def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, 
                 + f"; inverse dynamics predicts {crit:.3g} cycles/s")))
         elif st.mech.spatial:
             err, why = skew_stage(st.mech, speed, drive=drive)
-            out.stages.append(StageReport(label, pat, why is None,
-                                          why or f"rebuilt in the follower's plane: {err:.2g} of the size"))
+            out.stages.append(StageReport(label, pat, why is None, (
+                f"in the motor run, co-simulated in its plane (yz); alone, rebuilt in the follower's plane: "
+                f"{err:.2g} of the size") if why is None else why))
         else:
             out.stages.append(StageReport(label, pat, True, "in the motor's plane (coupled)"))
     return out
@@ -561,7 +571,8 @@ def _skew_load(rb: Any, j: SkewContact, effects: Any) -> list[Any]:
       before; alone, it set the motor's solver oscillating once the
       follower's reflected inertia ``I_p (da/dq)^2`` neared the driver's (the
       Bunny's ear at 10x its density).  The driver therefore carries that
-      inertia as added mass (along its motion) and moment, and gets back what
+      inertia as added mass and moment (its own, scaled to match along its
+      motion), and gets back what
       they resist for the velocity change the follower was moved with (and
       what gravity and damping do to them): the inertial load acts on the
       velocity the solver finds, and nothing is counted twice.
@@ -603,7 +614,7 @@ def _skew_load(rb: Any, j: SkewContact, effects: Any) -> list[Any]:
     m0, i0 = drv.mass, drv.moment
     hq = 1e-6 * max(rb.mech.size, 1e-12)
     prev: list[tuple[float, float, float]] = []
-    dirn = [1.0, 0.0]
+    scale = [0.0]
     failed: list[str] = []
 
     def touching(q: tuple[float, float, float], a: float) -> float:
@@ -660,15 +671,16 @@ def _skew_load(rb: Any, j: SkewContact, effects: Any) -> list[Any]:
         drv.apply_force_at_world_point((-mc * jq[0], -mc * jq[1]), (q[0], q[1]))
         # Alone, that force, one step behind the driver's motion, sets the motor's solver oscillating once
         # the follower's reflected inertia I_p (da/dq)^2 is near the driver's (the Bunny's ear at 10x its
-        # density).  So the driver carries that inertia as added mass (along its motion) and moment, and gets
+        # density).  So the driver carries that inertia as added mass and moment, and gets
         # back what the added inertia resists for the velocity change this step's follower was moved with
         # (vc - the previous step's), and what gravity and damping would do to it: the follower's inertial
         # load then acts on the velocity the solver finds (implicit), and nothing is counted twice.
-        sp = math.hypot(vp[0], vp[1])
-        if sp > 0.0:
-            dirn[:] = [vp[0] / sp, vp[1] / sp]
-        ma = ip * (jq[0] * dirn[0] + jq[1] * dirn[1]) ** 2
-        ia = ip * jq[2] ** 2
+        # the added inertia: the driver's own, scaled so that along its motion it is the reflected one
+        # (I_p (da/dq . qdot)^2 = s (m |v_G|^2 + I w^2)); kept while the driver stands still
+        own = m0 * (vc[0] ** 2 + vc[1] ** 2) + i0 * w * w
+        if own > 0.0:
+            scale[0] = ip * (jq[0] * vp[0] + jq[1] * vp[1] + jq[2] * vp[2]) ** 2 / own
+        ma, ia = scale[0] * m0, scale[0] * i0
         drv.mass, drv.moment = m0 + ma, i0 + ia
         pv = prev[0] if prev else vc
         prev[:] = [vc]
