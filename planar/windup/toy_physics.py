@@ -667,6 +667,8 @@ def _skew_load(rb: Any, j: SkewContact, effects: Any) -> list[Any]:
 
         mc = mom(v1, w1) - yz.damping * mom(v0, w0) - m * (gx * yz.gravity[1] - gy * yz.gravity[0])
         jq = jacobian(fol.angle, q)
+        if drv.body_type != pymunk.Body.DYNAMIC:
+            return  # an imposed driver (kinematic mode): nothing to load
         # the contact's generalized force on the driver: Q = -M da/dq (a force at its origin and a torque)
         drv.apply_force_at_world_point((-mc * jq[0], -mc * jq[1]), (q[0], q[1]))
         # Alone, that force, one step behind the driver's motion, sets the motor's solver oscillating once
