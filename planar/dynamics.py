@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 
 from .geometry import poses_apply
 
-__all__ = ["gravity_and_damping", "inverse_dynamics_torque", "mass_properties", "part_mass_table"]
+__all__ = ["gravity_and_damping", "inverse_dynamics_torque", "mass_properties", "part_mass_table", "plane_gravity"]
 
 Array = NDArray[np.float64]
 
@@ -45,6 +45,20 @@ def gravity_and_damping(effects: Any) -> tuple[Array, float]:
         if effects.damping is not None:
             lam = -math.log(float(effects.damping))
     return g, lam
+
+
+def plane_gravity(plane: str, g: Any) -> Array:
+    """The scene's gravity ``(gx, gy)`` as it acts on a part moving in ``plane`` (that plane's two axes).
+
+    ``"xy"`` and ``"xz"`` take it as given (an xz piece of a toy feels ``gx``
+    along x and ``gy`` along its second axis, as the coupled toy run has done
+    since #8 joined it); ``"yz"`` (the followers of wind-up #6/#9) feels
+    ``(gy, 0)``: the toy's y stays y, the scene names no z, and ``gx`` runs
+    along the plane's normal, where it does no work on a piece turning about
+    an x-parallel axis.
+    """
+    g = np.asarray(g, float)
+    return np.array([g[1], 0.0]) if plane == "yz" else g
 
 
 def _ring_moments(xy: Array) -> tuple[float, float, float, float]:
@@ -118,6 +132,7 @@ def inverse_dynamics_torque(mech: Any, t: Array, effects: Any = None, densities:
     g, lam = gravity_and_damping(effects)
     tau = np.zeros(t.size)
     for name, (mass, cog, inertia) in part_mass_table(mech, effects, densities).items():
+        gp = plane_gravity(getattr(mech.part(name), "plane", "xy"), g)
         c = np.asarray(cog, float)
         X0, Xp, Xm = (poses_apply(m.poses[name], c) for m in (m0, mp, mm))
         v = (Xp - Xm) / (2 * h)                    # d X_G / dt
@@ -127,7 +142,7 @@ def inverse_dynamics_torque(mech: Any, t: Array, effects: Any = None, densities:
         om = (fwd + back) / (2 * h)
         al = (fwd - back) / (h * h)
         # power balance divided by the driver rate: tau w = sum (m a - m g + lam m v) . v + I (alpha + lam om) om
-        tau += (mass * ((a - g + lam * v) * v).sum(-1) + inertia * (al + lam * om) * om) / w
+        tau += (mass * ((a - gp + lam * v) * v).sum(-1) + inertia * (al + lam * om) * om) / w
     if effects is not None:
         for load in effects.loads:
             vp = (mp.points[load.point] - mm.points[load.point]) / (2 * h)
