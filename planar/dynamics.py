@@ -50,15 +50,20 @@ def gravity_and_damping(effects: Any) -> tuple[Array, float]:
 def plane_gravity(plane: str, g: Any) -> Array:
     """The scene's gravity ``(gx, gy)`` as it acts on a part moving in ``plane`` (that plane's two axes).
 
-    ``"xy"`` and ``"xz"`` take it as given (an xz piece of a toy feels ``gx``
-    along x and ``gy`` along its second axis, as the coupled toy run has done
-    since #8 joined it); ``"yz"`` (the followers of wind-up #6/#9) feels
-    ``(gy, 0)``: the toy's y stays y, the scene names no z, and ``gx`` runs
-    along the plane's normal, where it does no work on a piece turning about
-    an x-parallel axis.
+    A toy's gravity is the 3D vector ``(gx, gy, 0)`` in the toy's frame (the
+    scene names no z).  ``"xy"`` takes it as given; ``"xz"`` (the pieces of
+    wind-up #8) feels ``(gx, 0)``: ``gy`` runs along the plane's normal, the
+    axis the piece turns about, where it does no work; ``"yz"`` (the followers
+    of #6/#9) feels ``(gy, 0)``: ``gx`` is that plane's normal.  (Until
+    2026-11-22 an xz piece took ``gy`` along z, so a toy lying with gravity
+    along -y had its #8 tabs held by a gravity that cannot reach them.)
     """
     g = np.asarray(g, float)
-    return np.array([g[1], 0.0]) if plane == "yz" else g
+    if plane == "yz":
+        return np.array([g[1], 0.0])
+    if plane == "xz":
+        return np.array([g[0], 0.0])
+    return g
 
 
 def _ring_moments(xy: Array) -> tuple[float, float, float, float]:

@@ -458,9 +458,9 @@ def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, 
 
     ``t``: output times (s) at the toy's speed.  The coupled run holds the xy
     pieces and, when the scene names gravity, the xz pieces of #8 stages (tied
-    to their body's xy piece by :class:`SharedX`; one 2D space, gravity
-    ``(gx, gy)`` acting along (x, z) on them: x stays x, the toy's y is the
-    stage's z) and the yz followers of #6/#9 (co-simulated in their plane,
+    to their body's xy piece by :class:`SharedX`; one 2D space, the toy's
+    gravity ``(gx, gy, 0)`` acting on them as ``(gx, 0)`` along (x, z):
+    :func:`planar.dynamics.plane_gravity`) and the yz followers of #6/#9 (co-simulated in their plane,
     gravity ``(gy, 0)``, their load on their driver: :func:`_skew_load`), so
     the motor torque and the inverse dynamics it is compared with both carry
     every stage.  ``densities``: per piece (assembly part name), overriding the
@@ -472,8 +472,12 @@ def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, 
     """
     from ..simulate import SimSettings, torque_comparison
 
+    from ..dynamics import plane_gravity
+
     asm = toy_assembly(toy)
-    g = _hold_gravity(effects)
+    g3 = _hold_gravity(effects)
+    gxz = plane_gravity("xz", g3)
+    g = (float(gxz[0]), float(gxz[1]))  # what an #8 stage's pieces (xz) feel of the toy's gravity (gx, gy, 0)
     has_xz = any(p.plane == "xz" and not p.ground for p in asm.parts)
     # the motor turns the xy pieces and, through the bodies they share, the xz stages (whose contact needs what
     # holds it: without gravity or a spring they are left out of the coupled run)
@@ -496,8 +500,11 @@ def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, 
         drive: StageDrive = (toy.driver, stage_u)  # the stage as the toy drives it
         if num == 8:
             if g == (0.0, 0.0):
-                out.stages.append(StageReport(label, pat, False, "#8: its contact is held by gravity or a spring in "
-                                              "its plane; the scene names none"))
+                out.stages.append(StageReport(label, pat, False, (
+                    "#8: its contact is held by gravity or a spring in its plane (xz); " + (
+                        "the scene names none" if g3 == (0.0, 0.0) else
+                        f"the scene's gravity ({g3[0]:g}, {g3[1]:g}) has no x component, and its y is normal to "
+                        "the xz plane"))))
                 continue
             crit = hold_margin(st.mech, g, getattr(effects, "density", 1.0), drive=drive)
             sc = list(speeds) if speeds is not None else [speed * f for f in (1.0, 2.0, 4.0, 8.0)]
