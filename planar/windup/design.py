@@ -109,6 +109,7 @@ class Design:
     rejected: list[str] = field(default_factory=list)  # cheaper trees whose fabrication collided
     before: dict[str, int] = field(default_factory=dict)  # layers, collisions, pin clashes before placement
     before_reason: str = ""  # why the export refused the pieces before placement, if it did
+    physics: dict[str, Any] | None = None  # :func:`physics_check` of the written toy (None: not run)
 
     def report(self) -> dict[str, Any]:
         return {
@@ -136,6 +137,7 @@ class Design:
             "collisions": [{"a": a, "b": b, "overlap": ov} for a, b, ov in self.collisions],
             "pin_clashes": self.clashes,
             "rejected_trees": self.rejected,
+            "physics": self.physics,
             "seconds": self.seconds,
         }
 
@@ -320,6 +322,8 @@ def _candidates(effectors: list[Effector], options: list[list[Chain]], limit: in
                 ) -> list[tuple[float, int, list[tuple[str, Chain]]]]:
     """Every assignment of one chain and one cam per effector, cheapest first (cost, then enumeration order)."""
     cams = [[e.cam] if e.cam else list(CAMS) for e in effectors]
+    if not any(e.cam for e in effectors):
+        cams[0] = [CAMS[0]]  # with no cam named, a tree and its mirror image (cams swapped) are one design
     n = math.prod(len(o) for o in options) * math.prod(len(c) for c in cams)
     if n > limit:
         raise InputError("request", [e.name for e in effectors],
@@ -460,13 +464,93 @@ def layer_collisions(toy: ToyMechanism, samples: int = 24, unit_mm: float = 100.
     return layers, found, clashes
 
 
+#: the written toy's scene tables: half a cycle a second, 36 frames a cycle, a small GIF, 100 mm a unit
+SCENE_TABLES: dict[str, Any] = {"driver": {"speed": 0.5, "samples_per_cycle": 36},
+                                "render": {"width": 360, "height": 270}, "fabrication": {"unit_mm": 100.0}}
+#: the motor torque's largest allowed difference from inverse dynamics, fraction of its peak (as ``planar toy``)
+TORQUE_TOLERANCE = 0.01
+
+
+def design_scene(toy: ToyMechanism, name: str) -> Any:
+    """The scene ``planar design`` writes for ``toy``.  A #8 stage's tab is held on its face by gravity along
+    +x (README, "Wind-up toys"): a toy with one is written standing that way, so its tab is held and simulated."""
+    from ..pipeline import scene_from_mechanism
+
+    effects = {"gravity": [9.81, 0.0]} if any(st.realisation.number == 8 for st in toy.stages) else {}
+    return scene_from_mechanism(toy, name=name, effects=effects, **SCENE_TABLES)
+
+
+def physics_check(scene: Any) -> dict[str, Any]:
+    """Run the scene's toy as ``planar toy`` does and judge it: a dict with ``ok`` and the figures.
+
+    Coupled pymunk physics, the motor the only driver, its torque against
+    inverse dynamics at the scene's speed (``torque_rel_diff``, fraction of
+    the peak; ``failure``), each #8 tab's lift-off (``lets_go``: stages whose
+    tab lets go at that speed) and every stage the physics did not simulate,
+    or simulated with a result it does not accept (``not_simulated``: stage
+    label, pattern, the effector it ends, the reason).  ``ok`` is false for
+    any of them; a physics run that refuses the toy (a :class:`PlanarError`)
+    is ``failure``.
+    """
+    from .toy_physics import simulate_toy
+
+    toy = scene.mechanism
+    speed = toy.driver.rate / (2 * math.pi)
+    effector = {st.label: toy.names.get((st.cam, st.key)) for st in toy.stages}
+    try:
+        motion = scene.motion()
+        phys = simulate_toy(toy, motion.t, scene.effects, speeds=[speed])
+    except PlanarError as e:
+        return {"ok": False, "torque_rel_diff": None, "failure": f"the physics refuses the toy: {e}",
+                "lets_go": [], "not_simulated": [], "stages": [], "speed": speed}
+    tq = phys.torque
+    lets_go = sorted(k for k, v in phys.liftoff.items()
+                     if v["liftoff_speed"] is not None and v["liftoff_speed"] <= speed)
+    missing = [{"stage": s.stage, "pattern": s.pattern, "effector": effector.get(s.stage), "reason": s.detail}
+               for s in phys.not_simulated]
+    ok = tq["failure"] is None and tq["max_rel_diff"] <= TORQUE_TOLERANCE and not lets_go and not missing
+    return {"ok": bool(ok), "torque_rel_diff": float(tq["max_rel_diff"]), "failure": tq["failure"],
+            "lets_go": lets_go, "not_simulated": missing, "speed": speed,
+            "stages": [{"stage": s.stage, "pattern": s.pattern, "simulated": s.simulated, "detail": s.detail}
+                       for s in phys.stages]}
+
+
+def physics_failures(phys: dict[str, Any]) -> list[str]:
+    """One line per reason the physics check failed (empty when it passed)."""
+    out = []
+    if phys["failure"]:
+        out.append(str(phys["failure"]))
+    elif phys["torque_rel_diff"] is not None and phys["torque_rel_diff"] > TORQUE_TOLERANCE:
+        out.append(f"motor torque strays {phys['torque_rel_diff']:.2g} of its peak from inverse dynamics "
+                   f"(more than {TORQUE_TOLERANCE:g})")
+    for k in phys["lets_go"]:
+        out.append(f"stage {k}'s tab lets go at {phys['speed']:g} cycles/s")
+    for m in phys["not_simulated"]:
+        who = f" (effector {m['effector']!r})" if m["effector"] else ""
+        out.append(f"stage {m['stage']} {m['pattern']}{who} not simulated: {m['reason']}")
+    return out
+
+
 # ----------------------------------------------------------------------------- placement
 
-#: stages whose follower can move relative to the driver without changing any motion (the slider of #1,
-#: the pivot of #9): ``F_o``'s in-plane components are the placement variables (checked again at run time)
-PLACEABLE = {1: "F_o", 9: "F_o"}
+#: candidate placement moves of a stage, tried on every stage: a name and the parameters it shifts together
+#: (``+1``/``-1``), one component at a time.  A move is a placement variable of a stage only where it leaves
+#: the stage's motion on its real input unchanged (to 1e-9, :func:`placement_variables`) and changes its
+#: parts: e.g. #1's and #9's follower (``F_o``), #4's and #10's follower origin about its pin (``F_o`` with
+#: ``F_jc`` back), #7's driver pin and follower pivot together, #8's pivot with its tab.
+MOVES: tuple[tuple[str, dict[str, int]], ...] = (
+    ("F_o", {"F_o": 1}),
+    ("F_jc", {"F_jc": 1}),
+    ("D_jc", {"D_jc": 1}),
+    ("S_c", {"S_c": 1}),
+    ("F_o-F_jc", {"F_o": 1, "F_jc": -1}),
+    ("F_o-S_c", {"F_o": 1, "S_c": -1}),
+    ("F_o+D_jc", {"F_o": 1, "D_jc": 1}),
+)
+#: the shifts (model units) a move is tried at before it is taken as a placement variable
+MOVE_PROBES = (-0.2, -0.05, 0.05, 0.2)
 #: annealing: iterations, step (model units), box around the default position (model units), overlap weight
-ANNEAL_STEPS = 24
+ANNEAL_STEPS = 48
 ANNEAL_STEP = 0.08
 ANNEAL_BOX = 0.4
 OVERLAP_WEIGHT = 10.0
@@ -476,6 +560,15 @@ SIMPLIFY = 0.003
 PLACEMENT_OPTIONS = 2
 #: a pin's radius in the placement's clash penalty (model units: 1.5 mm)
 PIN_RADIUS = 0.015
+#: the pieces' crowding in the placement objective (model units at 100 mm a unit, the export's defaults): the
+#: least wall between cuts with the clearance (2 mm), the motor's shaft clearance and screws (9 mm apart)
+WALL = 0.02
+MOTOR_SHAFT_R = 0.023
+MOTOR_SCREW_X = 0.045
+MOTOR_SCREW_R = 0.012
+#: crowding counts this many times its area in the overlap (the export refuses a crowded piece, while
+#: overlapping pieces may still go on different layers)
+CROWDING_WEIGHT = 20.0
 
 
 @dataclass
@@ -494,33 +587,43 @@ class Placement:
 
 
 def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
-    """``(footprint, overlap)``: the convex hull area of every xy piece's swept region over one cycle, and the
-    summed swept overlap of xy pieces no joint connects (pairs that must go on different layers); units^2."""
+    """``(footprint, overlap)`` of the toy's pieces over one cycle (``samples`` poses), units^2.
+
+    Footprint: the convex hull area of every piece's swept region, summed over
+    the planes the pieces move in (xy, and xz/yz for #8, #6, #9).  Overlap:
+    the swept overlap of pieces of one plane that no joint connects (pairs
+    that must go on different layers), plus the area pins sweep through pieces
+    of their plane they do not hold, plus the pieces' crowding (a piece's cuts,
+    each grown by half a wall, overlapping one another, or the frame's the
+    motor's screws: what the export refuses as too little material),
+    ``CROWDING_WEIGHT`` x its area.
+    """
     import shapely
     from shapely import affinity
 
     from ..assembly import pin_stacks
     from ..fabjoints import joint_pins
+    from ..outlines import feature_shape
     from .assembly import ToyAssembly
 
     asm = ToyAssembly(toy)
     m = asm.run(samples_per_cycle=samples)
     joined = {frozenset((j.a, j.b)) for j in asm.joints}
+    plane = {p.name: p.plane for p in asm.parts}
     swept = {}
     for p in asm.parts:
-        if p.plane != "xy":
-            continue
         pose = np.asarray(m.poses[p.name])
         c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
         shape = p.outline.simplify(SIMPLIFY)  # 0.3 mm: the objective need not follow every facet of a cam
         swept[p.name] = shapely.union_all([affinity.affine_transform(shape, [c[k], -s[k], s[k], c[k],
                                                                             pose[k, 0], pose[k, 1]])
                                            for k in range(len(pose))])
-    footprint = float(shapely.union_all(list(swept.values())).convex_hull.area)
+    footprint = sum(float(shapely.union_all([g for n, g in swept.items() if plane[n] == pl]).convex_hull.area)
+                    for pl in sorted(set(plane.values())))
     overlap = 0.0
-    names = [n for n in swept if n != "frame"]
+    names = [n for n in swept if not asm.part(n).ground]
     for a, b in itertools.combinations(names, 2):
-        if frozenset((a, b)) not in joined:
+        if plane[a] == plane[b] and frozenset((a, b)) not in joined:
             overlap += float(swept[a].intersection(swept[b]).area)
     # pins crossing pieces they do not join (the fabrication would need them on layers outside the pin)
     pins, _ = joint_pins(asm)
@@ -537,15 +640,113 @@ def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
         geom = shapely.buffer(shapely.points(path[0]) if np.ptp(path, axis=0).max() < 1e-9
                               else shapely.linestrings(path), PIN_RADIUS)
         for n in names:
-            if n not in on:
+            if n not in on and plane[n] == plane[a]:
                 overlap += float(swept[n].intersection(geom).area)
+    # a piece's cuts too close to one another, the frame's to the motor (each piece in its own frame)
+    for p in asm.parts:
+        cuts = [feature_shape(f, WALL / 2) for f in p.features
+                if not (p.ground and p.plane == "xy" and getattr(f, "centre", None) is not None
+                        and np.hypot(*f.centre) < 1e-9)]
+        if p.ground and p.plane == "xy":
+            cuts += [shapely.Point(sx * MOTOR_SCREW_X, 0.0).buffer(MOTOR_SCREW_R + WALL / 2) for sx in (-1, 1)]
+            cuts.append(shapely.Point(0.0, 0.0).buffer(MOTOR_SHAFT_R + WALL / 2))
+        for g, h in itertools.combinations(cuts, 2):
+            if not (g.contains(h) or h.contains(g)):
+                overlap += CROWDING_WEIGHT * float(g.intersection(h).area)
     return footprint, overlap
+
+
+@dataclass(frozen=True)
+class PlacementVariable:
+    """One placement variable: a stage (``cam``, ``key``), a move of :data:`MOVES` and the component it shifts."""
+
+    cam: str
+    key: Chain
+    move: str
+    shifts: tuple[tuple[str, int], ...]
+    comp: int
+
+    @property
+    def label(self) -> str:
+        return f"{self.cam} {' '.join(self.key)}: {self.move}[{'xyz'[self.comp]}]"
+
+
+def _shifted(kw: dict[str, Any], number: int, var: PlacementVariable, dx: float) -> dict[str, Any]:
+    """``kw`` with ``var``'s move applied by ``dx`` (model units)."""
+    out = dict(kw)
+    defaults = params_for(number)
+    for pname, sign in var.shifts:
+        cur = list(out.get(pname, getattr(defaults, pname)))
+        cur[var.comp] = float(cur[var.comp]) + sign * dx
+        out[pname] = tuple(cur)
+    return out
+
+
+def _geometry(mech: Any) -> Any:
+    """What a stage's placement changes: its parts' hulls, cuts and outlines, and its follower's rest pose."""
+    out = np.zeros((1, 3)) if mech.motion_out == "OzT" else np.zeros(1)
+    return ([(p.hull, p.features, p.polygon) for p in mech.parts], np.round(mech._follower_pose(out), 12).tolist())
+
+
+def placement_variables(toy: ToyMechanism, samples: int = 181) -> list[PlacementVariable]:
+    """Every stage's moves (:data:`MOVES`, one component each) that change its parts but not its motion.
+
+    A move qualifies when, at every shift of :data:`MOVE_PROBES`, the stage's
+    parameters are accepted, its follower's motion on the input the toy
+    gives it (``samples`` of a cycle) is unchanged to 1e-9 and valid, and its
+    parts or its follower's rest pose (where its children sit) change.
+    """
+    q = np.linspace(0.0, 2 * math.pi, samples)
+    toy.world_motion(q)
+    bases = toy._last_bases
+    found: list[PlacementVariable] = []
+    for st in toy.stages:
+        number = st.realisation.number
+        u, res = bases[st.index]
+        kw = dict(toy.stage_overrides.get((st.cam, st.key), {}))
+        try:  # the stage rebuilt on the same samples (its slots' lengths follow the input it is built for)
+            geo0 = _geometry(ToyMechanism._build_stage(st.realisation, u, dict(kw), toy.name, st.key))
+        except InputError:
+            continue
+        defaults = params_for(number)
+        for move, shifts in MOVES:
+            if not all(hasattr(defaults, n) for n in shifts):
+                continue
+            width = min(len(getattr(defaults, n)) for n in shifts)
+            for comp in range(width):
+                var = PlacementVariable(st.cam, st.key, move, tuple(shifts.items()), comp)
+                ok = True
+                moved = False
+                for dx in MOVE_PROBES:
+                    kw2 = _shifted(kw, number, var, dx)
+                    try:
+                        P = _stage_params(number, kw2, u)
+                        check_params(number, P)
+                        r2 = ELEMENTAL[number].forward(P, u)
+                        mech = ToyMechanism._build_stage(st.realisation, u, dict(kw2), toy.name, st.key)
+                    except InputError:
+                        ok = False
+                        break
+                    if not np.all(r2.valid) or not np.allclose(r2.out, res.out, rtol=0, atol=1e-9):
+                        ok = False
+                        break
+                    moved = moved or _geometry(mech) != geo0
+                if ok and moved:
+                    found.append(var)
+    # one move per stage and component where several do the same (F_o alone and F_o with D_jc on a #1):
+    # the first in MOVES order is kept
+    out: list[PlacementVariable] = []
+    for v in found:
+        if not any(o.cam == v.cam and o.key == v.key and o.comp == v.comp and
+                   dict(o.shifts).keys() <= dict(v.shifts).keys() for o in out):
+            out.append(v)
+    return out
 
 
 def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, overrides: dict[tuple[str, Chain], dict[str, Any]],
                  names: dict[tuple[str, Chain], str], seed: int = 0
                  ) -> tuple[list[tuple[dict[tuple[str, Chain], dict[str, Any]], tuple[float, float, float]]], Placement]:
-    """Anneal the placement variables (:data:`PLACEABLE`) to a compact toy whose pieces overlap little.
+    """Anneal the placement variables (:func:`placement_variables`) to a compact toy whose pieces overlap little.
 
     Returns the best ``PLACEMENT_OPTIONS`` distinct layouts the annealing
     accepted that improve on the start (overrides and ``(objective,
@@ -555,35 +756,28 @@ def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, override
     Objective: footprint + ``OVERLAP_WEIGHT`` x overlap (:func:`_layout_score`).
     A move that changes any stage's motion (compared on 181 samples to 1e-9)
     or that the toy cannot be built with is rejected.  Simulated annealing
-    with a fixed seed (same request, same toy), ``ANNEAL_STEPS`` moves.
+    with a fixed seed (same request, same toy), ``ANNEAL_STEPS`` moves, each
+    shifting a random subset of the variables.
     """
     t0 = time.perf_counter()
     q = np.linspace(0.0, 2 * math.pi, 181)
-    stages = []
-    for cam, chains in cams.items():
-        seen = set()
-        for c in chains:
-            for d in range(1, len(c) + 1):
-                key = c[:d]
-                if key in seen:
-                    continue
-                seen.add(key)
-                number = realise(key[-1]).number
-                if number in PLACEABLE:
-                    stages.append((cam, key, PLACEABLE[number], getattr(params_for(number), PLACEABLE[number])))
+    base = ToyMechanism(cams, phase=phase, name=name, overrides=overrides, names=names)
+    variables = placement_variables(base)
+    number = {(st.cam, st.key): st.realisation.number for st in base.stages}
+
+    def layout(x: Array) -> dict[tuple[str, Chain], dict[str, Any]]:
+        ov = {k: dict(v) for k, v in overrides.items()}
+        for v, dx in zip(variables, x):
+            if dx != 0.0:
+                ov[(v.cam, v.key)] = _shifted(ov.get((v.cam, v.key), {}), number[(v.cam, v.key)], v, float(dx))
+        return ov
 
     def build(x: Array) -> ToyMechanism | None:
-        ov = {k: dict(v) for k, v in overrides.items()}
-        for i, (cam, key, pname, default) in enumerate(stages):
-            cur = list(ov.get((cam, key), {}).get(pname, default))
-            cur[0], cur[1] = float(x[2 * i]), float(x[2 * i + 1])
-            ov.setdefault((cam, key), {})[pname] = tuple(cur)
         try:
-            return ToyMechanism(cams, phase=phase, name=name, overrides=ov, names=names)
+            return ToyMechanism(cams, phase=phase, name=name, overrides=layout(x), names=names)
         except InputError:
             return None
 
-    base = ToyMechanism(cams, phase=phase, name=name, overrides=overrides, names=names)
     ref, _ = base.world_motion(q)
     ref = {k: v.copy() for k, v in ref.items()}
 
@@ -601,23 +795,23 @@ def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, override
             return math.inf, math.inf, math.inf, None
         return fp + OVERLAP_WEIGHT * ovl, fp, ovl, toy
 
-    x0 = np.array([v for _, _, _, d in stages for v in (d[0], d[1])], float)
-    # the sized overrides may already hold the variables
-    for i, (cam, key, pname, _) in enumerate(stages):
-        if pname in overrides.get((cam, key), {}):
-            x0[2 * i:2 * i + 2] = overrides[(cam, key)][pname][:2]
+    labels = [v.label for v in variables]
+    x0 = np.zeros(len(variables))
     f0, fp0, ov0, _ = score(x0)
-    if not stages or not math.isfinite(f0):
-        return [], Placement([], (f0, f0), (fp0, fp0), (ov0, ov0), 1, 0, time.perf_counter() - t0, kept=False)
+    if not variables or not math.isfinite(f0):
+        return [], Placement(labels, (f0, f0), (fp0, fp0), (ov0, ov0), 1, 0, time.perf_counter() - t0, kept=False)
     rng = np.random.default_rng(seed)
     lo, hi = x0 - ANNEAL_BOX, x0 + ANNEAL_BOX
     x, fx = x0.copy(), f0
     states: list[tuple[float, float, float, Array]] = []  # accepted layouts better than the start
     temp0 = 0.05 * f0
     evals, rejected = 1, 0
+    p_move = max(1.0 / len(variables), 0.3)
     for k in range(ANNEAL_STEPS):
         temp = temp0 * (1 - k / ANNEAL_STEPS) + 1e-12
-        y = np.clip(x + rng.normal(0.0, ANNEAL_STEP, x.size), lo, hi)
+        mask = rng.random(x.size) < p_move
+        mask[rng.integers(x.size)] = True
+        y = np.clip(x + mask * rng.normal(0.0, ANNEAL_STEP, x.size), lo, hi)
         fy, fpy, ovy, _ = score(y)
         evals += 1
         if not math.isfinite(fy):
@@ -627,15 +821,7 @@ def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, override
             x, fx = y, fy
             if fy < f0 and all(np.abs(y - st[3]).max() > 1e-9 for st in states):
                 states.append((fy, fpy, ovy, y.copy()))
-    labels = [f"{cam} {' '.join(key)}: {pname}" for cam, key, pname, _ in stages]
-    options = []
-    for f, fp, ov, xs in sorted(states, key=lambda t: t[0])[:PLACEMENT_OPTIONS]:
-        out = {k: dict(v) for k, v in overrides.items()}
-        for i, (cam, key, pname, default) in enumerate(stages):
-            cur = list(out.get((cam, key), {}).get(pname, default))
-            cur[0], cur[1] = float(xs[2 * i]), float(xs[2 * i + 1])
-            out.setdefault((cam, key), {})[pname] = tuple(cur)
-        options.append((out, (f, fp, ov)))
+    options = [(layout(xs), (f, fp, ov)) for f, fp, ov, xs in sorted(states, key=lambda t: t[0])[:PLACEMENT_OPTIONS]]
     return options, Placement(labels, (f0, f0), (fp0, fp0), (ov0, ov0), evals, rejected,
                               time.perf_counter() - t0, kept=False)
 
@@ -644,7 +830,7 @@ def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, override
 
 
 def design_toy(effectors: list[Effector], name: str = "designed toy", max_length: int = 3,
-               max_trees: int = 200, place: bool = True, max_fabricated: int = 4) -> Design:
+               max_trees: int = 200, place: bool = True, max_fabricated: int = 4, physics: bool = True) -> Design:
     """Design a toy for ``effectors`` (see the module docstring); an unreachable request is an
     :class:`InputError` naming the effector and the ranges its chains reach."""
     t0 = time.perf_counter()
@@ -744,6 +930,13 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
                     placement.overlap = (placement.overlap[0], ov)
                     break
         fabricated += 1
+        # the sized parameter as written (a placement may move it along with another: #4's pin with its origin)
+        for e, (cam, _chain) in zip(effectors, pairs):
+            stage, pname, _ = sizing[e.name]
+            key = tuple(stage.split(" "))
+            number, comp = realise(key[-1]).number, DESIGN_PARAMETER[realise(key[-1]).number][1]
+            val = toy.stage_overrides.get((cam, key), {}).get(pname, getattr(params_for(number), pname))
+            sizing[e.name] = (stage, pname, float(val if comp is None else val[comp]))
         measured = effector_ranges(toy)
         ranges = {}
         for e in effectors:
@@ -754,11 +947,17 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
         d = Design(toy, effectors, pairs, cost, ranges, len(cands), tried, sizing, layers, collisions, secs,
                    placement, layers_before, clashes, rejected, before,
                    before_reason=checked_before[2][0] if before["export_refused"] else "")
-        if not collisions and not clashes:
+        problems = [f"{a}/{b} collide" for a, b, _ in collisions] + clashes
+        if not problems and physics:
+            t2 = time.perf_counter()
+            d.physics = physics_check(design_scene(toy, name))
+            secs["physics"] = time.perf_counter() - t2
+            problems = physics_failures(d.physics)
+        if not problems:
             return d
-        # a tree whose pieces collide or whose pins cross pieces: try the next cheapest (a few)
+        # a tree whose pieces collide, whose pins cross pieces or whose physics fails: try the next cheapest
         rejected.append(f"cost {cost:g} " + "; ".join(f"{cam}: {' '.join(c)}" for cam, c in pairs) + ": "
-                        + ", ".join([f"{a}/{b} collide" for a, b, _ in collisions] + clashes))
+                        + ", ".join(problems))
         if first is None:
             first = d
         if fabricated >= max_fabricated:
