@@ -568,7 +568,7 @@ MOTOR_SCREW_X = 0.045
 MOTOR_SCREW_R = 0.012
 #: crowding counts this many times its area in the overlap (the export refuses a crowded piece, while
 #: overlapping pieces may still go on different layers)
-CROWDING_WEIGHT = 20.0
+CROWDING_WEIGHT = 1000.0
 
 
 @dataclass
@@ -603,6 +603,7 @@ def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
 
     from ..assembly import pin_stacks
     from ..fabjoints import joint_pins
+    from ..model import Hole
     from ..outlines import feature_shape
     from .assembly import ToyAssembly
 
@@ -645,8 +646,7 @@ def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
     # a piece's cuts too close to one another, the frame's to the motor (each piece in its own frame)
     for p in asm.parts:
         cuts = [feature_shape(f, WALL / 2) for f in p.features
-                if not (p.ground and p.plane == "xy" and getattr(f, "centre", None) is not None
-                        and np.hypot(*f.centre) < 1e-9)]
+                if not (p.ground and p.plane == "xy" and isinstance(f, Hole) and np.hypot(*f.centre) < 1e-9)]
         if p.ground and p.plane == "xy":
             cuts += [shapely.Point(sx * MOTOR_SCREW_X, 0.0).buffer(MOTOR_SCREW_R + WALL / 2) for sx in (-1, 1)]
             cuts.append(shapely.Point(0.0, 0.0).buffer(MOTOR_SHAFT_R + WALL / 2))
@@ -826,6 +826,61 @@ def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, override
                               time.perf_counter() - t0, kept=False)
 
 
+#: cam-in-window stages (#1-#3): their motion follows the eccentricity alone, not the disc's radius
+DISC_CAMS = (1, 2, 3)
+#: material kept round the axle's boss when a cam is grown into a disc (model units: 1 mm)
+DISC_MARGIN = 0.01
+
+
+def _disc_cams(cams: dict[str, list[Chain]], phase: float, name: str,
+               overrides: dict[tuple[str, Chain], dict[str, Any]], names: dict[tuple[str, Chain], str]
+               ) -> dict[tuple[str, Chain], dict[str, Any]] | None:
+    """``overrides`` with every #1-#3 cam that would be a crank (its axle's boss leaving the disc,
+    ``|D_jc| + 2 D_ar > D_jr``) grown into a disc holding the boss, or None when none is; None too when the
+    grown toy moves differently (compared on 181 samples to 1e-9) or cannot be built.
+
+    A crank is cut as a pin in a pin-wide slot across layers, so its follower covers the motor shaft and
+    must lie outside the cams' layers; a disc runs in its follower's window in one layer."""
+    toy = ToyMechanism(cams, phase=phase, name=name, overrides=overrides, names=names)
+    out = {k: dict(v) for k, v in overrides.items()}
+    grown = False
+    for st in toy.stages:
+        if st.realisation.number not in DISC_CAMS:
+            continue
+        P = st.mech.params
+        e = float(np.hypot(P.D_jc[0], P.D_jc[1]))
+        if e + 2 * P.D_ar > P.D_jr:
+            out.setdefault((st.cam, st.key), {})["D_jr"] = e + 2 * P.D_ar + DISC_MARGIN
+            grown = True
+    if not grown:
+        return None
+    q = np.linspace(0.0, 2 * math.pi, 181)
+    try:
+        disc = ToyMechanism(cams, phase=phase, name=name, overrides=out, names=names)
+    except InputError:
+        return None
+    ref, _ = toy.world_motion(q)
+    got, checks = disc.world_motion(q)
+    if not all(np.all(ok) for ok, _, _ in checks) or any(
+            not np.allclose(got[k], ref[k], rtol=0, atol=1e-9) for k in ref):
+        return None
+    return out
+
+
+def _variants(cams: dict[str, list[Chain]], phase: float, name: str,
+              overrides: dict[tuple[str, Chain], dict[str, Any]], names: dict[tuple[str, Chain], str]
+              ) -> list[tuple[str, dict[tuple[str, Chain], dict[str, Any]]]]:
+    """The sized tree as sized, then (when it has cranks) with its cams grown into discs (:func:`_disc_cams`)."""
+    out: list[tuple[str, dict[tuple[str, Chain], dict[str, Any]]]] = [("", overrides)]
+    try:
+        disc = _disc_cams(cams, phase, name, overrides, names)
+    except InputError:
+        disc = None
+    if disc is not None:
+        out.append(("its cams grown into discs", disc))
+    return out
+
+
 # ----------------------------------------------------------------------------- the pipeline
 
 
@@ -896,70 +951,74 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
             if c not in cams.setdefault(cam, []):
                 cams[cam].append(c)
         names = {(cam, c): e.name for e, (cam, c) in zip(effectors, pairs)}
-        try:
-            toy = ToyMechanism({k: v for k, v in cams.items()}, phase=phase, name=name, overrides=overrides,
-                               names=names)
-            from .assembly import toy_assembly
+        made = False
+        for how, variant in _variants(cams, phase, name, overrides, names):
+            try:
+                toy = ToyMechanism({k: v for k, v in cams.items()}, phase=phase, name=name, overrides=variant,
+                                   names=names)
+                from .assembly import toy_assembly
 
-            toy_assembly(toy)
-        except InputError:
-            continue  # a tree the assembly refuses (a mirrored or turned out-of-plane stage)
-        t_size = time.perf_counter() - t0 - t_enum
-        t1 = time.perf_counter()
-        placement = None
-        checked = layer_collisions(toy)
-        layers_before = len(set(checked[0].values()))
-        checked_before = checked
-        before = {"layers": layers_before, "collisions": len(checked[1]), "pin_clashes": len(checked[2]),
-                  "export_refused": int(not checked[0])}
+                toy_assembly(toy)
+            except InputError:
+                continue  # a tree the assembly refuses (a mirrored or turned out-of-plane stage)
+            t_size = time.perf_counter() - t0 - t_enum
+            t1 = time.perf_counter()
+            placement = None
+            checked = layer_collisions(toy)
+            layers_before = len(set(checked[0].values()))
+            checked_before = checked
+            before = {"layers": layers_before, "collisions": len(checked[1]), "pin_clashes": len(checked[2]),
+                      "export_refused": int(not checked[0])}
 
-        def bad(c: tuple[dict[str, int], list, list]) -> tuple[int, int, int]:
-            return len(c[1]), len(c[2]), len(set(c[0].values()))
-        if place:
-            layouts, placement = place_stages(cams, phase, name, overrides, names)
-            for placed, (f, fp, ov) in layouts:
-                moved = ToyMechanism(cams, phase=phase, name=name, overrides=placed, names=names)
-                after = layer_collisions(moved)
-                placement.checked += 1
-                # keep a placement only where it adds no collision, no pin clash and no layer
-                if bad(after) <= bad(checked):
-                    toy, checked = moved, after
-                    placement.kept = True
-                    placement.objective = (placement.objective[0], f)
-                    placement.footprint = (placement.footprint[0], fp)
-                    placement.overlap = (placement.overlap[0], ov)
-                    break
-        fabricated += 1
-        # the sized parameter as written (a placement may move it along with another: #4's pin with its origin)
-        for e, (cam, _chain) in zip(effectors, pairs):
-            stage, pname, _ = sizing[e.name]
-            key = tuple(stage.split(" "))
-            number, comp = realise(key[-1]).number, DESIGN_PARAMETER[realise(key[-1]).number][1]
-            val = toy.stage_overrides.get((cam, key), {}).get(pname, getattr(params_for(number), pname))
-            sizing[e.name] = (stage, pname, float(val if comp is None else val[comp]))
-        measured = effector_ranges(toy)
-        ranges = {}
-        for e in effectors:
-            _, val = measured[e.name]
-            ranges[e.name] = math.degrees(val) if e.motion[0] == "O" else val
-        layers, collisions, clashes = checked
-        secs = {"enumerate": t_enum, "rank_and_size": t_size, "place_and_check": time.perf_counter() - t1}
-        d = Design(toy, effectors, pairs, cost, ranges, len(cands), tried, sizing, layers, collisions, secs,
-                   placement, layers_before, clashes, rejected, before,
-                   before_reason=checked_before[2][0] if before["export_refused"] else "")
-        problems = [f"{a}/{b} collide" for a, b, _ in collisions] + clashes
-        if not problems and physics:
-            t2 = time.perf_counter()
-            d.physics = physics_check(design_scene(toy, name))
-            secs["physics"] = time.perf_counter() - t2
-            problems = physics_failures(d.physics)
-        if not problems:
-            return d
-        # a tree whose pieces collide, whose pins cross pieces or whose physics fails: try the next cheapest
-        rejected.append(f"cost {cost:g} " + "; ".join(f"{cam}: {' '.join(c)}" for cam, c in pairs) + ": "
-                        + ", ".join(problems))
-        if first is None:
-            first = d
+            def bad(c: tuple[dict[str, int], list, list]) -> tuple[int, int, int, int]:
+                """An export that refuses the pieces (no layers) first, then collisions, pin clashes, layers."""
+                return int(not c[0]), len(c[1]), len(c[2]), len(set(c[0].values()))
+            if place:
+                layouts, placement = place_stages(cams, phase, name, variant, names)
+                for placed, (f, fp, ov) in layouts:
+                    moved = ToyMechanism(cams, phase=phase, name=name, overrides=placed, names=names)
+                    after = layer_collisions(moved)
+                    placement.checked += 1
+                    # keep a placement only where it adds no collision, no pin clash and no layer
+                    if bad(after) <= bad(checked):
+                        toy, checked = moved, after
+                        placement.kept = True
+                        placement.objective = (placement.objective[0], f)
+                        placement.footprint = (placement.footprint[0], fp)
+                        placement.overlap = (placement.overlap[0], ov)
+                        break
+                made = True
+            # the sized parameter as written (a placement may move it along with another: #4's pin with its origin)
+            for e, (cam, _chain) in zip(effectors, pairs):
+                stage, pname, _ = sizing[e.name]
+                key = tuple(stage.split(" "))
+                number, comp = realise(key[-1]).number, DESIGN_PARAMETER[realise(key[-1]).number][1]
+                val = toy.stage_overrides.get((cam, key), {}).get(pname, getattr(params_for(number), pname))
+                sizing[e.name] = (stage, pname, float(val if comp is None else val[comp]))
+            measured = effector_ranges(toy)
+            ranges = {}
+            for e in effectors:
+                _, val = measured[e.name]
+                ranges[e.name] = math.degrees(val) if e.motion[0] == "O" else val
+            layers, collisions, clashes = checked
+            secs = {"enumerate": t_enum, "rank_and_size": t_size, "place_and_check": time.perf_counter() - t1}
+            d = Design(toy, effectors, pairs, cost, ranges, len(cands), tried, sizing, layers, collisions, secs,
+                       placement, layers_before, clashes, rejected, before,
+                       before_reason=checked_before[2][0] if before["export_refused"] else "")
+            problems = [f"{a}/{b} collide" for a, b, _ in collisions] + clashes
+            if not problems and physics:
+                t2 = time.perf_counter()
+                d.physics = physics_check(design_scene(toy, name))
+                secs["physics"] = time.perf_counter() - t2
+                problems = physics_failures(d.physics)
+            if not problems:
+                return d
+            # a tree whose pieces collide, whose pins cross pieces or whose physics fails: try the next cheapest
+            rejected.append(f"cost {cost:g} " + "; ".join(f"{cam}: {' '.join(c)}" for cam, c in pairs)
+                            + (f" ({how})" if how else "") + ": " + ", ".join(problems))
+            if first is None:
+                first = d
+        fabricated += made
         if fabricated >= max_fabricated:
             break
     if first is not None:
