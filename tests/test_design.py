@@ -145,19 +145,19 @@ def test_bunny_request_renders_exports_and_runs(tmp_path: Path, capsys) -> None:
 
 
 def test_a_request_no_gallery_scene_has(tmp_path: Path, capsys) -> None:
-    """A slider (Tx) on the left cam and a rocker (Oz) on the right, a quarter turn ahead."""
-    rows = [{"name": "tail", "motion": "Tx", "range": 0.3, "cam": "left"},
-            {"name": "head", "motion": "Oz", "range": 30.0, "cam": "right", "phase": 0.25}]
+    """A lift (Ty) on the left cam and a rocker (Oz) on the right, a quarter turn ahead (issue 15: Ty + Oz)."""
+    rows = [{"name": "lift", "motion": "Ty", "range": 0.1, "cam": "left"},
+            {"name": "head", "motion": "Oz", "range": 25.0, "cam": "right", "phase": 0.25}]
     out, _ = _design(tmp_path, rows, capsys)
     _check(out, rows)
     toy = load_scene(out).mechanism
     assert toy.phase == pytest.approx(math.pi / 2)
     # each effector's follower is a piece of its own here: the piece takes the effector's name
-    assert {"tail", "head"} <= {p.name for p in toy_assembly(toy).parts}
-    # the named effectors are points of the scene's motion: the tail's point moves 0.3
+    assert {"lift", "head"} <= {p.name for p in toy_assembly(toy).parts}
+    # the named effectors are points of the scene's motion: the lift's point moves 0.1
     m = load_scene(out).motion()
     # (a straight stroke: the extent of its path, whichever way the stage is turned in the motion table)
-    assert float(np.hypot(*np.ptp(m.points["tail"], axis=0))) == pytest.approx(0.3, rel=0.01)
+    assert float(np.hypot(*np.ptp(m.points["lift"], axis=0))) == pytest.approx(0.1, rel=0.01)
 
 
 def test_unreachable_and_bad_requests_are_refused(tmp_path: Path, capsys) -> None:

@@ -550,7 +550,7 @@ MOVES: tuple[tuple[str, dict[str, int]], ...] = (
 #: the shifts (model units) a move is tried at before it is taken as a placement variable
 MOVE_PROBES = (-0.2, -0.05, 0.05, 0.2)
 #: annealing: iterations, step (model units), box around the default position (model units), overlap weight
-ANNEAL_STEPS = 48
+ANNEAL_STEPS = 40
 ANNEAL_STEP = 0.08
 ANNEAL_BOX = 0.4
 OVERLAP_WEIGHT = 10.0
@@ -614,6 +614,8 @@ def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
     swept = {}
     for p in asm.parts:
         pose = np.asarray(m.poses[p.name])
+        if p.ground:
+            pose = pose[:1]  # a frame does not move
         c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
         shape = p.outline.simplify(SIMPLIFY)  # 0.3 mm: the objective need not follow every facet of a cam
         swept[p.name] = shapely.union_all([affinity.affine_transform(shape, [c[k], -s[k], s[k], c[k],
