@@ -7,7 +7,9 @@ cost, each effector's requested and measured range, the layers and any
 same-layer collision.  Exit status 2 for bad input or an unreachable request
 (one line naming the effector and what its chains reach; nothing written);
 3 when the written toy fails its own check (a range off by more than 1 %, a
-same-layer collision).
+same-layer collision, a pin through a piece, an export that refuses it, a
+motor torque off inverse dynamics by more than 1 %, a #8 tab letting go, or a
+stage the physics did not simulate: each named with its reason).
 """
 
 from __future__ import annotations

@@ -20,16 +20,20 @@ A request lists end effectors (``[[effector]]``: ``name``, ``motion``,
    request; stages are sized parents first;
 5. **places** the stages (:func:`place_stages`): a toy's stages sit where the
    assembly puts them (a child's driver on its parent's follower, the roots on
-   the motor axis); the free variables are the follower positions that change
-   no motion (#1's slider, #9's pivot: ``F_o``), annealed toward a small
-   footprint and little overlap of unjoined pieces; the result is kept only if
-   it adds no collision, pin clash or layer;
+   the motor axis); the free variables are each stage's joint moves that
+   change no motion (:func:`placement_variables`: found per stage on its real
+   input among :data:`MOVES`, e.g. #1's slider, #4's follower origin about its
+   pin, #7's pin and pivot together), annealed toward a small footprint and
+   little overlap of unjoined pieces or crowding of cuts; the result is kept
+   only if it adds no export refusal, collision, pin clash or layer;
 6. **checks** the result independently: each effector's range is measured on
    the assembled toy's piece poses, and the export's own layer plan
    (:func:`planar.fabexport.build`) is checked with shapely for pieces of one
    layer overlapping at any of 24 sampled poses and for pins running through
-   a piece.  A tree that fails is passed over for the next cheapest (up to
-   ``max_fabricated``); if all fail, the cheapest is returned with its
+   a piece; then the toy's physics (:func:`physics_check`, as ``planar toy``).
+   A tree that fails is tried again with its cranks grown into disc cams
+   (:func:`_disc_cams`, same motion), then passed over for the next cheapest
+   (up to ``max_fabricated``); if all fail, the cheapest is returned with its
    failures (``planar design`` exits 3).
 
 Units: ranges of O motions (and the rotation of OzT) in degrees, of T
