@@ -113,3 +113,33 @@ def test_a_stage_left_unsimulated_fails_by_name(tmp_path, capsys, monkeypatch) -
 
     phys = physics_check(load_scene(out))
     assert not phys["ok"] and [m["stage"] for m in phys["not_simulated"]] == [miss[0]["stage"]]
+
+
+def test_two_tracks_on_one_circle_are_cut_once() -> None:
+    """Two #3 stages on two cams put their tracks on one circle of the frame, one within the other's angles
+    (an OzT on each cam): the export cuts the longer once (their polygons' chords differ, so a polygon
+    containment test missed it and the frame was refused); a track off that circle is still refused."""
+    from planar.fabjoints import FabricationError
+    from planar.fabparts import FabSettings, part_cuts
+    from planar.model import ArcSlot, Part
+
+    s = FabSettings(unit_mm=100.0)
+    big = ArcSlot(centre=(0.5, -0.5), radius=0.2236, angle0=0.28, angle1=1.72, width=0.15)
+    small = ArcSlot(centre=(0.5, -0.5), radius=0.2236, angle0=0.366, angle1=1.696, width=0.15)
+    cut = part_cuts(Part("frame", ((0.5, -0.5, 0.4),), (big, small), ground=True), s, 1)
+    assert len(cut.inner) == 1
+    off = ArcSlot(centre=(0.5, -0.5), radius=0.26, angle0=0.366, angle1=1.696, width=0.15)
+    with pytest.raises(FabricationError):
+        part_cuts(Part("frame", ((0.5, -0.5, 0.4),), (big, off), ground=True), s, 1)
+
+
+def test_two_effectors_that_would_be_one_follower_are_refused_by_name(tmp_path, capsys) -> None:
+    """Two OzT effectors on the left cam: OzT has one chain (Rz->OzT), so both would be one stage's follower."""
+    req = tmp_path / "r.toml"
+    req.write_text('[[effector]]\nname = "walk"\nmotion = "OzT"\nrange = 8.0\ncam = "left"\n'
+                   '[[effector]]\nname = "step"\nmotion = "OzT"\nrange = 6.0\ncam = "left"\n')
+    out = tmp_path / "toy.toml"
+    rc = main(["design", str(req), "-o", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1 and not out.exists()
+    assert "'walk' and 'step'" in err and "Rz->OzT" in err and "different cams" in err

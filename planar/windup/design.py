@@ -355,6 +355,24 @@ def _candidates(effectors: list[Effector], options: list[list[Chain]], limit: in
     return out
 
 
+def _no_tree(effectors: list[Effector], options: list[list[Chain]]) -> tuple[str, Any, str]:
+    """Why no assignment of chains and cams exists (the fields of an :class:`InputError`): two effectors that
+    would be one stage's follower (one chain each, one cam), or the cams' phases."""
+    cams = [[e.cam] if e.cam else list(CAMS) for e in effectors]
+    for i, j in itertools.combinations(range(len(effectors)), 2):
+        a, b = effectors[i], effectors[j]
+        shared = set(options[i]) & set(options[j])
+        if shared and set(options[i]) == shared == set(options[j]) and set(cams[i]) == set(cams[j]) \
+                and len(cams[i]) * len(options[i]) == 1:
+            chain = " ".join(next(iter(shared)))
+            return (f"effectors {a.name!r} and {b.name!r} ({a.motion}, {b.motion})", f"{cams[i][0]} cam",
+                    f"effectors with a follower each: their only chain, {chain}, on one cam is one stage "
+                    "(put them on different cams, or ask for different motions)")
+    return ("request", [e.name for e in effectors],
+            "an assignment of one chain and one cam per effector (two effectors cannot be one stage's follower, "
+            "and one cam turns its effectors at one phase)")
+
+
 def _size_tree(effectors: list[Effector], pairs: list[tuple[str, Chain]], phase: float, q: Array,
                cache: dict) -> tuple[dict[tuple[str, Chain], dict[str, Any]], dict[str, tuple[str, str, float]]] | None:
     """Sized overrides (by ``(cam, prefix)``) for one tree, or None when some effector cannot be sized in it."""
@@ -937,6 +955,8 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
             raise InputError(f"effector {e.name!r} ({e.motion}) chain length", max_length,
                              f"enough stages for a chain from the motor to {e.motion} (--max-length)")
     cands = _candidates(effectors, options)
+    if not cands:
+        raise InputError(*_no_tree(effectors, options))
     t_enum = time.perf_counter() - t0
     tried = fabricated = 0
     rejected: list[str] = []
