@@ -608,6 +608,22 @@ class Placement:
     checked: int = 0  # annealed layouts checked against the fabrication
 
 
+def _posed(shape: Any, pose: Array) -> Any:
+    """``shape`` (own frame) placed at every pose of ``pose`` (k x 3: x, y, angle in rad): k geometries,
+    transformed in one array expression (every copy has the same coordinates, in order)."""
+    import shapely
+
+    n = int(shapely.get_num_coordinates(shape))
+    geoms = np.empty(len(pose), dtype=object)
+    geoms[:] = [shape] * len(pose)
+    P = np.repeat(pose, n, axis=0)
+    c, s = np.cos(P[:, 2]), np.sin(P[:, 2])
+
+    def move(xy: Array) -> Array:
+        return np.column_stack([P[:, 0] + c * xy[:, 0] - s * xy[:, 1], P[:, 1] + s * xy[:, 0] + c * xy[:, 1]])
+    return shapely.transform(geoms, move)
+
+
 def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
     """``(footprint, overlap)`` of the toy's pieces over one cycle (``samples`` poses), units^2.
 
@@ -621,7 +637,6 @@ def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
     ``CROWDING_WEIGHT`` x its area.
     """
     import shapely
-    from shapely import affinity
 
     from ..assembly import pin_stacks
     from ..fabjoints import joint_pins
@@ -638,11 +653,8 @@ def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
         pose = np.asarray(m.poses[p.name])
         if p.ground:
             pose = pose[:1]  # a frame does not move
-        c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
         shape = p.outline.simplify(SIMPLIFY)  # 0.3 mm: the objective need not follow every facet of a cam
-        swept[p.name] = shapely.union_all([affinity.affine_transform(shape, [c[k], -s[k], s[k], c[k],
-                                                                            pose[k, 0], pose[k, 1]])
-                                           for k in range(len(pose))])
+        swept[p.name] = shapely.union_all(_posed(shape, pose))
     footprint = sum(float(shapely.union_all([g for n, g in swept.items() if plane[n] == pl]).convex_hull.area)
                     for pl in sorted(set(plane.values())))
     overlap = 0.0
