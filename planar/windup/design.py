@@ -923,7 +923,13 @@ def _variants(cams: dict[str, list[Chain]], phase: float, name: str,
 def design_toy(effectors: list[Effector], name: str = "designed toy", max_length: int = 3,
                max_trees: int = 200, place: bool = True, max_fabricated: int = 4, physics: bool = True) -> Design:
     """Design a toy for ``effectors`` (see the module docstring); an unreachable request is an
-    :class:`InputError` naming the effector and the ranges its chains reach."""
+    :class:`InputError` naming the effector and the ranges its chains reach.
+
+    ``place``: anneal the placement; ``max_fabricated``: trees checked against the export (and the physics)
+    before giving up; ``physics``: run :func:`physics_check` on a tree that passes the export's check and
+    pass it over when it fails (``Design.physics`` holds the verdict).  Seconds per step in ``Design.seconds``
+    (``rank_and_size`` counts every tree tried before the one returned).
+    """
     t0 = time.perf_counter()
     q = np.linspace(0.0, 2 * math.pi, SAMPLES)
     cache: dict[Any, _Scan] = {}
