@@ -116,7 +116,11 @@ def add_parser(sub: Any) -> None:
     d = sub.add_parser("design", help="a wind-up toy from requested end-effector motions (writes a toy scene)",
                        description="Design a wind-up toy from a request file of [[effector]] tables (name, motion "
                                    "Ox Oy Oz Tx Ty Tz OzT, range in degrees for O/OzT or model units for T, "
-                                   "optional cam left/right and phase in cycles).")
+                                   "optional cam left/right and phase in cycles). Exit status 2 for bad input "
+                                   "or a range no chain reaches (nothing written); 3 when the toy written fails a "
+                                   "check (a range off by more than 1 %, a same-layer collision, a pin through a "
+                                   "piece, the export refusing it, or its physics: motor torque, a #8 tab letting "
+                                   "go, a stage not simulated), each failure named.")
     d.add_argument("request", help="request file (TOML, [[effector]] tables)")
     d.add_argument("-o", "--output", required=True, help="toy scene file to write (TOML)")
     d.add_argument("--json", action="store_true", help="print a JSON report")
