@@ -193,3 +193,8 @@ def test_a_tree_whose_physics_fails_is_passed_over(tmp_path, capsys) -> None:
     passed = [ln for ln in out.splitlines() if "passed over" in ln]
     assert rc == 0 and passed and "Rz->Tx Tx->Oz Oz->Oz: motor torque strays" in passed[0]
     assert main(["toy", str(tmp_path / "toy.toml"), "--speeds", "0.5"]) == 0  # the toy command agrees
+    # the tree written (Rz->Ty Ty->Oz Oz->Oz) is placed by its #7's pin and pivot too, not only its slider: the
+    # nod still swings 110 degrees on the assembled pieces and no two pieces of one layer overlap
+    placed = next(ln for ln in out.splitlines() if "placement (" in ln)
+    assert "Ty->Oz: F_o+D_jc" in placed and "footprint" in placed
+    _check(tmp_path / "toy.toml", [{"name": "head", "range": 110.0}])
