@@ -148,8 +148,9 @@ def _cmd_motion(args: argparse.Namespace) -> int:
     print(f"wrote {args.output}: {len(motion)} samples, {int(motion.valid.sum())} valid")
     if args.derivatives:
         from .derivatives import rates_method
+        from .pipeline import table_motion
 
-        print(f"rates: {rates_method(scene.mechanism)}")
+        print(f"rates: {rates_method(table_motion(scene.mechanism, motion)[0])}")
     return 0
 
 

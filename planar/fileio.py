@@ -151,13 +151,19 @@ def check_name(field: str, name: str) -> str:
     return str(name)
 
 
+#: the two axes of a part's plane, as its columns are named (a wind-up toy's pieces move in xy, xz or yz)
+PLANE_AXES = {"xy": ("x", "y"), "xz": ("x", "z"), "yz": ("y", "z")}
+
+
 def motion_columns(mech: Mechanism, motion: Motion) -> tuple[list[str], np.ndarray]:
     """Column names and an ``(N, k)`` float table for a motion.
 
     Columns: ``t``, ``driver`` (and ``driver.<node>`` per input node of a
     linkage with several), then ``<part>.x, <part>.y, <part>.angle`` for
     every part, ``<point>.x, <point>.y`` for every named point, and ``valid``
-    (1 or 0).  Model units and radians.
+    (1 or 0).  Model units and radians.  A part moving in another plane
+    (a toy's xz or yz piece) names its plane's axes: ``<part>.x, <part>.z``
+    or ``<part>.y, <part>.z`` (its angle about the plane's normal).
     """
     n = len(motion)
     t = motion.t if motion.t is not None else np.arange(n, dtype=float)
@@ -169,10 +175,14 @@ def motion_columns(mech: Mechanism, motion: Motion) -> tuple[list[str], np.ndarr
         cols.append(value)
     for p in mech.parts:
         pose = motion.poses[p.name]
-        names += [f"{p.name}.x", f"{p.name}.y", f"{p.name}.angle"]
+        u, v = PLANE_AXES[getattr(p, "plane", "xy")]
+        names += [f"{p.name}.{u}", f"{p.name}.{v}", f"{p.name}.angle"]
         cols += [pose[:, 0], pose[:, 1], pose[:, 2]]
+    points = getattr(mech, "points", {})
     for pname, xy in motion.points.items():
-        names += [f"{pname}.x", f"{pname}.y"]
+        part = points[pname][0] if pname in points else None
+        u, v = PLANE_AXES[getattr(mech.part(part), "plane", "xy")] if part is not None else ("x", "y")
+        names += [f"{pname}.{u}", f"{pname}.{v}"]
         cols += [xy[:, 0], xy[:, 1]]
     names.append("valid")
     cols.append(motion.valid.astype(float))

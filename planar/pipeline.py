@@ -238,15 +238,15 @@ def write_scene_motion(scene: Scene, out: str | Path, derivatives: bool = False)
 
     if Path(out).suffix.lower() != ".csv":
         raise InputError("output", str(out), "a .csv file (the motion table is CSV)")
-    motion = scene.motion()
+    mech, motion = table_motion(scene.mechanism, scene.motion())
     if not derivatives:
-        write_motion_csv(out, scene.mechanism, motion)
+        write_motion_csv(out, mech, motion)
         return motion
     from .derivatives import derivative_columns
 
-    names, table = motion_columns(scene.mechanism, motion)
+    names, table = motion_columns(mech, motion)
     with numeric_guard(scene, "the rates and motor torque"):
-        extra_names, extra = derivative_columns(scene.mechanism, motion, scene.effects)
+        extra_names, extra = derivative_columns(mech, motion, scene.effects)
     names = names[:-1] + extra_names + names[-1:]
     table = np.column_stack([table[:, :-1], *extra, table[:, -1]])
     buf = io.StringIO()
@@ -262,10 +262,27 @@ def write_catalog_motion(name: str, out: str | Path, samples: int = 360) -> Moti
     from .catalog import get
     from .fileio import write_motion_csv
 
-    mech = get(name)
-    motion = mech.run(samples_per_cycle=samples)
+    mech, motion = table_motion(get(name), None, samples)
     write_motion_csv(out, mech, motion)
     return motion
+
+
+def table_motion(mech: Mechanism, motion: Motion | None, samples: int = 360) -> tuple[Mechanism, Motion]:
+    """The mechanism and motion a motion table reports: ``mech`` and ``motion`` (or one cycle of
+    ``samples`` samples), except for a wind-up toy, whose table is its assembly in the toy's frame
+    (:class:`planar.windup.assembly.ToyAssembly`: every piece in its own plane, a Ty effector moving
+    along y) rather than the stages' panels the toy's own motion lays side by side."""
+    if motion is None:
+        motion = mech.run(samples_per_cycle=samples)
+    import sys
+
+    chain = sys.modules.get("planar.windup.chain")  # not imported: ``mech`` is no toy
+    if chain is None or not isinstance(mech, chain.ToyMechanism):
+        return mech, motion
+    from .windup.assembly import toy_assembly
+
+    asm = toy_assembly(mech)
+    return asm, asm.solve(motion.driver, t=motion.t)
 
 
 # --------------------------------------------------------------------------- fabrication

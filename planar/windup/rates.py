@@ -310,6 +310,33 @@ def toy_rates(toy: Any, q: Array, qd: Array, qdd: Array) -> tuple[dict[str, tupl
     return parts, valid
 
 
+def assembly_rates(asm: Any, q: Array, qd: Array, qdd: Array) -> tuple[dict[str, tuple[Array, ...]], Mask]:
+    """Rates of every piece of a toy's assembly (:class:`~planar.windup.assembly.ToyAssembly`, the toy's
+    frame): each piece is a stage part (its first member) at the stage's place, then offset on its body.
+
+    The place is a turn by ``a`` about z and a shift for an xy stage, a shift for xz and yz
+    (:func:`planar.windup.assembly._world_track`): the stage part's velocity and acceleration turn by
+    ``a``, its angular rates do not change; the piece's origin is a point of that body
+    (:func:`planar.derivatives.point_rates`)."""
+    from ..derivatives import PartRates, point_rates
+
+    raw, ok = toy_rates(asm.toy, q, qd, qdd)
+    stage_poses = asm.stage_poses(q)
+    pieces, _ = asm._solve_poses(q)
+    out: dict[str, tuple[Array, ...]] = {}
+    for piece, members in asm.members.items():
+        full = members[0][0]
+        v, a, om, al = (np.asarray(x, float) for x in raw[full])
+        if asm._stage_part(full).plane == "xy":
+            ang = asm.placed[int(full.split(".")[0][1:])].place[2]
+            c, s_ = np.cos(ang), np.sin(ang)
+            v = np.column_stack([c * v[:, 0] - s_ * v[:, 1], s_ * v[:, 0] + c * v[:, 1]])
+            a = np.column_stack([c * a[:, 0] - s_ * a[:, 1], s_ * a[:, 0] + c * a[:, 1]])
+        pv, pa = point_rates(stage_poses[full], PartRates(v, a, om, al), pieces[piece][:, :2])
+        out[piece] = (pv, pa, om, al)
+    return out, ok
+
+
 def windup_rates(mech: "Mechanism", q: Array, qd: Array, qdd: Array
                  ) -> tuple[dict[str, tuple[Array, ...]], Mask, str]:
     """Part rates ``(v, a, omega, alpha)`` of an elemental mechanism or a toy (see the module's note), with the
@@ -322,5 +349,11 @@ def windup_rates(mech: "Mechanism", q: Array, qd: Array, qdd: Array
     if isinstance(mech, ToyMechanism):
         raw, ok = toy_rates(mech, q, qd, qdd)
         return raw, ok, "wind-up closed forms differentiated analytically, composed through the toy's stages"
+    from .assembly import ToyAssembly
+
+    if isinstance(mech, ToyAssembly):
+        raw, ok = assembly_rates(mech, q, qd, qdd)
+        return raw, ok, ("wind-up closed forms differentiated analytically, composed through the toy's stages, "
+                         "turned to each piece's place")
     raise UnsupportedError(f"rates (velocities, accelerations, torque): no closed-form derivatives for "
                            f"{type(mech).__name__} {mech.name!r}")

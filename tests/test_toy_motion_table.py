@@ -1,0 +1,63 @@
+"""A toy's motion table is its assembly in the toy's frame (a Ty effector moves along y), with rates that
+agree with central differences of the positions."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from planar.cli import main
+from planar.derivatives import mechanism_rates
+from planar.scene import load_scene
+from planar.windup.assembly import toy_assembly
+
+GALLERY = Path(__file__).resolve().parents[1] / "gallery"
+
+
+def _table(path: Path) -> dict[str, np.ndarray]:
+    rows = list(csv.reader(path.open()))
+    data = np.array(rows[1:], float)
+    return {name: data[:, i] for i, name in enumerate(rows[0])}
+
+
+def test_a_turned_ty_stage_moves_along_y_in_the_table(tmp_path: Path) -> None:
+    out = tmp_path / "horse.csv"
+    assert main(["motion", str(GALLERY / "horse.toml"), "-o", str(out)]) == 0
+    col = _table(out)
+    # the Horse's right cam drives a Ty leg through a turned #-stage: in the toy's frame it moves along y only
+    assert np.ptp(col["right:Ty@s3.y"]) > 0.04
+    assert np.ptp(col["right:Ty@s3.x"]) < 1e-12
+    # the table's pieces are the assembly's (one frame, merged bodies), not the stages' panels
+    assert "frame.x" in col and "s0.ground.x" not in col
+
+
+def test_pieces_in_other_planes_name_their_axes(tmp_path: Path) -> None:
+    out = tmp_path / "bunny.csv"
+    assert main(["motion", str(GALLERY / "bunny.toml"), "-o", str(out)]) == 0
+    col = _table(out)
+    assert {"s1.follower.y", "s1.follower.z", "s2.follower.x", "s2.follower.z"} <= set(col)
+    assert "s1.follower.x" not in col and "s2.follower.y" not in col
+
+
+@pytest.mark.parametrize("scene", ["horse.toml", "bunny.toml"])
+def test_assembly_rates_agree_with_central_differences(scene: str) -> None:
+    toy = load_scene(GALLERY / scene).mechanism
+    asm = toy_assembly(toy)
+    w = toy.driver.rate
+    t = np.linspace(0.1, 0.9, 17) * toy.driver.period
+    h = 1e-5 * toy.driver.period
+    q = toy.driver.value(t)
+    rates, valid, method = mechanism_rates(asm, q, w, 0.0)
+    assert valid.all() and "turned to each piece's place" in method
+    p0, pp, pm = (asm.solve(toy.driver.value(x)).poses for x in (t, t + h, t - h))
+    size = asm.size
+    for piece, r in rates.items():
+        v = (pp[piece][:, :2] - pm[piece][:, :2]) / (2 * h)
+        a = (pp[piece][:, :2] - 2 * p0[piece][:, :2] + pm[piece][:, :2]) / (h * h)
+        dang = np.angle(np.exp(1j * (pp[piece][:, 2] - pm[piece][:, 2])))
+        np.testing.assert_allclose(r.v, v, atol=1e-6 * size * abs(w), err_msg=piece)
+        np.testing.assert_allclose(r.omega, dang / (2 * h), atol=1e-6 * abs(w), err_msg=piece)
+        np.testing.assert_allclose(r.a, a, atol=2e-3 * size * w * w, err_msg=piece)
