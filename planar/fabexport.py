@@ -41,6 +41,8 @@ class Fabrication:
     grounds: list[str] = field(default_factory=list)
     #: files written by :func:`write_outputs`
     written: list[Path] = field(default_factory=list)
+    #: tab-and-slot joints of pieces standing perpendicular to the xy stack (:mod:`planar.fabtabs`)
+    joins: list[Any] = field(default_factory=list)
 
 
 def _shaft_pin(mech: Any, pins) -> Any:
@@ -56,14 +58,16 @@ def _shaft_pin(mech: Any, pins) -> Any:
 
 def _fab_mechanism(mech: Any) -> Any:
     """The mechanism whose parts are cut: a wind-up toy is cut as its assembly (merged parts, one frame,
-    cams keyed to the shaft; :mod:`planar.windup.assembly`), anything else as it is."""
+    cams keyed to the shaft; :mod:`planar.windup.assembly`), anything else as it is; pieces standing
+    perpendicular to the xy stack get brackets and lose repeated guides (:func:`planar.fabtabs.fab_view`)."""
+    from .fabtabs import fab_view
     from .windup.chain import ToyMechanism
 
     if isinstance(mech, ToyMechanism):
         from .windup.assembly import toy_assembly
 
-        return toy_assembly(mech)
-    return mech
+        return fab_view(toy_assembly(mech))
+    return fab_view(mech)
 
 
 def _phase_mark(pc: PartCut, at: tuple[float, float], flat: float, phase: float) -> None:
@@ -84,6 +88,8 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
     s = settings
     if not (0 <= s.kerf <= 2):
         raise InputError("kerf", s.kerf, "a kerf between 0 and 2 mm")
+    from .fabtabs import plan_tabs, slot_features
+
     mech = _fab_mechanism(scene.mechanism)
     keyed: dict[str, float] = dict(getattr(mech, "keyed", {}))
     pins, contacts = joint_pins(mech)
@@ -105,27 +111,64 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
                 if pin.kinds[side] == "hole" and pin is not shaft and key not in marked:
                     marked.add(key)
                     letters[pin.parts[side]].append((pin.at[side], letter(k)))
-    cuts: list[PartCut] = []
-    for n, part in enumerate(mech.parts, start=1):
-        drive_at = motor_at = None
-        if shaft is not None and part.name in shaft.parts:
-            k = shaft.parts.index(part.name)
-            if part.name == mech.driver.part:
-                drive_at = shaft.at[k]
-            else:
-                motor_at = shaft.at[k]
-        flat = math.pi / 2
-        if shaft is not None and part.name in keyed:  # a toy's cam: a D on the shaft, turned by its phase
-            drive_at, flat = (0.0, 0.0), math.pi / 2 - keyed[part.name]
-        pc = part_cuts(part, s, n, {i for (pn, i) in pinned if pn == part.name}, drive_at, motor_at,
-                       mounting=part.ground and part.plane == "xy", letters=letters[part.name], drive_flat=flat)
-        if drive_at is not None and part.name in keyed:
-            _phase_mark(pc, (drive_at[0] * s.unit_mm, drive_at[1] * s.unit_mm), flat, keyed[part.name])
-        notes.extend(pc.notes)
-        cuts.append(pc)
-    material = {pc.name: nominal_material(pc.outer, pc.inner, s.kerf / 2) for pc in cuts}
-    asm = plan_assembly(mech, material, pins, contacts, s.unit_mm, s.thickness_mm, s.pin_mm, s.pin_head,
-                        shaft.joint if shaft is not None else None)
+
+    def cut_all(joins: list[Any]) -> tuple[list[PartCut], list[str]]:
+        slots = slot_features(joins)
+        tab_of = {jn.piece: jn for jn in joins}
+        cuts: list[PartCut] = []
+        part_notes: list[str] = []
+        for n, part in enumerate(mech.parts, start=1):
+            drive_at = motor_at = None
+            if shaft is not None and part.name in shaft.parts:
+                k = shaft.parts.index(part.name)
+                if part.name == mech.driver.part:
+                    drive_at = shaft.at[k]
+                else:
+                    motor_at = shaft.at[k]
+            flat = math.pi / 2
+            if shaft is not None and part.name in keyed:  # a toy's cam: a D on the shaft, turned by its phase
+                drive_at, flat = (0.0, 0.0), math.pi / 2 - keyed[part.name]
+            pc = part_cuts(part, s, n, {i for (pn, i) in pinned if pn == part.name}, drive_at, motor_at,
+                           mounting=part.ground and part.plane == "xy", letters=letters[part.name],
+                           drive_flat=flat, extra=slots.get(part.name, ()), tabs=tab_of.get(part.name))
+            if drive_at is not None and part.name in keyed:
+                _phase_mark(pc, (drive_at[0] * s.unit_mm, drive_at[1] * s.unit_mm), flat, keyed[part.name])
+            part_notes.extend(pc.notes)
+            cuts.append(pc)
+        return cuts, part_notes
+
+    def plan(cuts: list[PartCut]) -> tuple[dict[str, Any], Assembly]:
+        material = {pc.name: nominal_material(pc.outer, pc.inner, s.kerf / 2) for pc in cuts}
+        return material, plan_assembly(mech, material, pins, contacts, s.unit_mm, s.thickness_mm, s.pin_mm,
+                                       s.pin_head, shaft.joint if shaft is not None else None)
+
+    cuts, part_notes = cut_all([])
+    material, asm = plan(cuts)
+    joins = plan_tabs(mech, asm.layers, material, s)
+    if joins:  # cut again with the tabs and slots, and check the layers the planes' positions came from
+        cuts, part_notes = cut_all(joins)
+        material, asm2 = plan(cuts)
+        moved = [n for n in asm.layers if asm.plane.get(n) != "xy" and asm.layers[n] != asm2.layers.get(n)]
+        if moved:
+            from .fabjoints import FabricationError
+
+            raise FabricationError(f"part {moved[0]!r}: its layer changed once its tabs were cut; the tab joints "
+                                   "were planned for the old layers")
+        asm = asm2
+        tabs = {jn.piece: jn for jn in joins}
+        for pc in cuts:
+            if pc.name in tabs:
+                jn = tabs[pc.name]
+                pc.notes.append(f"{pc.name}: {len(jn.spans)} tab(s) {jn.letter}, {jn.tab_width:g} x "
+                                f"{s.thickness_mm:g} mm, into the slots {jn.letter} of {jn.base}")
+                part_notes.append(pc.notes[-1])
+            for jn in joins:
+                if jn.base == pc.name:
+                    pc.notes.append(f"{pc.name}: {len(jn.slots)} slot(s) {jn.letter} "
+                                    f"{jn.slot_size[0]:g} x {jn.slot_size[1]:g} mm for the tabs of {jn.piece}")
+                    part_notes.append(pc.notes[-1])
+        _engrave_joins(cuts, joins, s)
+    notes.extend(part_notes)
     notes.extend(asm.notes)
     for pc in cuts:
         pc.layer = asm.layers.get(pc.name)
@@ -139,7 +182,32 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
                                 nominal_holes=[((0.0, 0.0), ri)]))
     layout = nest(cuts, s.sheet, s.spacing, s.margin, s.kerf, s.unit_mm)
     return Fabrication(scene.name, s, layout, asm, notes, shaft.joint if shaft is not None else None, material,
-                       [p.name for p in mech.parts if p.ground and p.plane == "xy"])
+                       [p.name for p in mech.parts if p.ground and p.plane == "xy"], joins=joins)
+
+
+def _engrave_joins(cuts: list[PartCut], joins: list[Any], s: FabSettings) -> None:
+    """Engrave each joint's letter beside its slots (where it fits) and once on the tabbed piece by its edge."""
+    from .fabparts import letter_marks
+
+    by_name = {pc.name: pc for pc in cuts}
+    for jn in joins:
+        base = by_name[jn.base]
+        mat = nominal_material(base.outer, base.inner, s.kerf / 2)
+        for e in base.engrave:
+            from shapely.geometry import LineString
+
+            mat = mat.difference(LineString(e).buffer(0.5))
+        base.engrave.extend(letter_marks(mat, [(c, jn.slot_size[0] / 2, jn.letter) for c, _ in jn.slots],
+                                         max(s.min_label, 1.5)))
+        piece = by_name[jn.piece]
+        mat = nominal_material(piece.outer, piece.inner, s.kerf / 2)
+        for e in piece.engrave:
+            from shapely.geometry import LineString
+
+            mat = mat.difference(LineString(e).buffer(0.5))
+        mid = jn.tabs[0].centroid
+        piece.engrave.extend(letter_marks(mat, [((float(mid.x), float(mid.y)), s.thickness_mm, jn.letter)],
+                                          max(s.min_label, 1.5)))
 
 
 def sheet_paths(path: str | os.PathLike, sheets: int) -> list[Path]:

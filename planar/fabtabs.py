@@ -1,0 +1,453 @@
+"""Tab-and-slot joints for pieces standing perpendicular to the toy's plane (xz, yz).
+
+A wind-up toy's #8 stage moves in xz and its #6/#9 followers in yz; each of
+those pieces is cut flat and must be joined to the xy stack it belongs to.
+The joint is the usual laser-cut tab and slot (Boxes.py's finger joint on one
+side, through-slots on the other):
+
+* **rigid pieces**: a perpendicular piece that is one rigid body with an xy
+  piece (``ToyAssembly.bodies``: the #8 window plate with the slider, the
+  xz frame with the frame) is cut flat along the model's xy plane (``z = 0``
+  of its plane's coordinates, where the #8 driver slides), keeping its side of
+  it, and gets tabs ``thickness_mm`` long standing out of that edge; the xy
+  piece gets a rectangular through-slot for each tab on the line where the
+  two planes meet (``thickness_mm + clearance_mm`` wide, the tab's width +
+  ``clearance_mm`` long: the fit allowance holes get).  Tabs are ``2 x
+  thickness`` wide with ``2 x thickness`` gaps (Boxes.py's default finger
+  and space), as many as fit where both pieces have material with
+  ``min_wall_mm`` round each slot and clear of every other cut; at least two
+  per joint.  A hull-outlined xy piece (the frame) grows to hold its slots;
+  an explicit outline (the merged slider) must already have room.
+* **plane positions**: a plane's pieces stand in its layer order, one sheet
+  thickness apart (``y = y0 + (layer + 1/2) t`` for xz).  The model fixes no
+  y for xz pieces, so ``y0`` is the nearest position (0.5 mm steps from the
+  model's ``y = 0``) where every xz joint fits.  A yz piece stays at its x
+  (``Part.offset``: the #6/#9 pin must meet the driver's edge there); its
+  bracket stands one layer beside it.
+* **brackets**: a moving perpendicular piece that no pin holds (the #6/#9
+  follower, whose axle the model leaves in the air) gets a bracket: a frame
+  piece in its plane with a hole on the axle (the piece's stationary hole)
+  and a base on the xy plane, tab-joined to the frame like any frame piece.
+  A #8 tab is held by the xz frame already (pin through both), so the xz
+  frame is its bracket.
+* **repeated guides**: a slide between two perpendicular pieces that are both
+  joined to the xy stack repeats the xy slide of their bodies (the #8 side
+  view of the slider's own guide): it is not cut (no slot, no pin holes).
+
+Refused (``FabricationError``, exit 3): a perpendicular piece whose body
+turns or leaves its plane's line while joined, one that does not reach the
+xy plane, one with a moving axle, or a joint with room for fewer than two
+tabs.  Sizes in millimetres; the tabs' and slots' positions in each piece's
+own frame (``TabJoin``) are what the tests read back from the files.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .fabjoints import FabricationError
+from .fabparts import Feature
+from .model import Hole, Part, Pivot, Slide
+
+__all__ = ["FabView", "TabJoin", "fab_view", "plan_tabs", "slot_features"]
+
+PLANES = ("xz", "yz")
+MIN_TABS = 2
+
+
+@dataclass
+class TabJoin:
+    """Tabs of ``piece`` (perpendicular) in slots of ``base`` (xy), lettered ``letter`` (``T1``, ...).
+
+    ``at``: the piece's plane (mm; world y for xz, x for yz); ``side``: +1 when the piece lies on the
+    model's +z side of the xy plane; ``edge``: the world z (mm) where it stands on the xy piece's face;
+    ``spans``: each tab's ends along the line where the planes meet (world
+    x for xz, y for yz, mm); ``slots``: each slot's centre (base frame, mm) and the slot's long-axis angle.
+    """
+
+    letter: str
+    piece: str
+    base: str
+    plane: str
+    at: float
+    side: int
+    #: the edge the piece stands on: world z (mm) of its plane; its tabs run from there ``thickness`` away from it
+    edge: float
+    spans: list[tuple[float, float]]
+    tab_width: float
+    slot_size: tuple[float, float]
+    slots: list[tuple[tuple[float, float], float]] = field(default_factory=list)
+    #: the piece's own-frame outline change: keep this half-plane polygon, add these tab rectangles (mm)
+    keep: Any = None
+    tabs: list[Any] = field(default_factory=list)
+
+
+class FabView:
+    """A mechanism as fabrication cuts it: repeated perpendicular guides dropped, brackets added.
+
+    Everything else (driver, notes, keyed cams, poses) is the wrapped mechanism's; a bracket stands still.
+    """
+
+    def __init__(self, mech: Any, parts: list[Part], joints: list[Any], extra: list[str], notes: list[str]) -> None:
+        self._mech = mech
+        self.parts = tuple(parts)
+        self.joints = tuple(joints)
+        self.extra = extra
+        self.notes = list(getattr(mech, "notes", [])) + notes
+        self.bodies: dict[str, list[str]] = {k: list(v) for k, v in getattr(mech, "bodies", {}).items()}
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._mech, name)
+
+    def part(self, name: str) -> Part:
+        for p in self.parts:
+            if p.name == name:
+                return p
+        return self._mech.part(name)
+
+    def run(self, *args: Any, **kw: Any) -> Any:
+        m = self._mech.run(*args, **kw)
+        for n in self.extra:
+            m.poses[n] = np.zeros((len(m), 3))
+        return m
+
+
+def _bodies(mech: Any) -> dict[str, list[str]]:
+    """Rigid bodies -> pieces (a toy assembly's own; else each part alone, every ground one body)."""
+    got = getattr(mech, "bodies", None)
+    if got:
+        return {k: list(v) for k, v in got.items()}
+    out: dict[str, list[str]] = {}
+    for p in mech.parts:
+        out.setdefault("frame" if p.ground else p.name, []).append(p.name)
+    return out
+
+
+def _joined(mech: Any, bodies: dict[str, list[str]]) -> dict[str, str]:
+    """Perpendicular piece -> the xy piece of its body it is tab-joined to."""
+    plane = {p.name: p.plane for p in mech.parts}
+    out: dict[str, str] = {}
+    for pieces in bodies.values():
+        xy = [n for n in pieces if plane.get(n) == "xy"]
+        for n in pieces:
+            if plane.get(n) in PLANES and xy:
+                if len(xy) > 1:
+                    raise FabricationError(f"part {n!r}: its body has {len(xy)} xy pieces ({', '.join(xy)}); "
+                                           "no rule says which one its tabs go into")
+                out[n] = xy[0]
+    return out
+
+
+def fab_view(mech: Any, samples: int = 48) -> Any:
+    """``mech`` as it is cut (see the module docstring); ``mech`` itself when nothing stands perpendicular."""
+    from .windup.assembly import _without_cuts_of
+
+    parts = list(mech.parts)
+    if not any(p.plane in PLANES for p in parts) or not any(p.plane == "xy" for p in parts):
+        return mech
+    bodies = _bodies(mech)
+    joined = _joined(mech, bodies)
+    body_of = {n: b for b, ps in bodies.items() for n in ps}
+    plane = {p.name: p.plane for p in parts}
+    # repeated guides: a perpendicular slide between two joined pieces repeats their bodies' xy slide
+    joints, dropped = [], []
+    for j in mech.joints:
+        if isinstance(j, Slide) and plane.get(j.a) in PLANES and j.a in joined and j.b in joined:
+            dropped.append(j)
+        else:
+            joints.append(j)
+    notes: list[str] = []
+    if dropped:
+        parts, removed = _without_cuts_of(parts, dropped, joints)
+        for j in dropped:
+            notes.append(f"{j.b}: its slide {j.name!r} in {j.a} is not cut: both pieces stand on the xy stack, "
+                         f"whose own slide guides them ({body_of.get(j.b, j.b)} on {body_of.get(j.a, j.a)})")
+    # brackets for perpendicular pieces that no pin holds
+    held = set(joined)
+    for j in joints:
+        if isinstance(j, Pivot) and plane.get(j.a) == plane.get(j.b) and plane.get(j.a) in PLANES:
+            held |= {j.a, j.b}
+    loose = [p for p in parts if p.plane in PLANES and p.name not in held]
+    extra: list[str] = []
+    if loose:
+        motion = mech.run(samples_per_cycle=samples)
+        ok = np.flatnonzero(motion.valid)
+        ok = ok if ok.size else np.arange(len(motion))
+        for p in loose:
+            bracket, pivot = _bracket(p, np.asarray(motion.poses[p.name], float)[ok])
+            parts.append(bracket)
+            joints.append(pivot)
+            extra.append(bracket.name)
+            notes.append(f"{bracket.name}: a bracket on the frame holding the axle of {p.name} (pin joint "
+                         f"{pivot.name!r}); nothing in the model holds it")
+    view = FabView(mech, parts, joints, extra, notes)
+    frame = next((b for b, ps in bodies.items() if any(n in ps for n in (q.name for q in mech.parts if q.ground))),
+                 "frame")
+    view.bodies = {**bodies, frame: bodies.get(frame, []) + extra}
+    return view
+
+
+def _bracket(p: Part, poses: np.ndarray) -> tuple[Part, Pivot]:
+    """A frame piece in ``p``'s plane holding ``p``'s stationary hole (its axle), its base on ``z = 0``."""
+    best = None
+    for f in p.features:
+        if not isinstance(f, Hole):
+            continue
+        c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+        w = np.c_[poses[:, 0] + c * f.centre[0] - s * f.centre[1], poses[:, 1] + s * f.centre[0] + c * f.centre[1]]
+        if float(np.ptp(w, axis=0).max()) < 1e-9 * max(1.0, float(np.abs(w).max())):
+            best = (f, (float(w[0, 0]), float(w[0, 1])))
+            break
+    if best is None:
+        raise FabricationError(f"part {p.name!r} ({p.plane}): no pin holds it and it turns about no fixed hole; "
+                               "no bracket can hold it")
+    f, (u, z) = best
+    if abs(z) < 2 * f.diameter:
+        raise FabricationError(f"part {p.name!r} ({p.plane}): its axle lies on the xy plane (z = {z:.3g}); "
+                               "no room for a bracket standing on the frame")
+    boss = 1.5 * f.diameter
+    base = max(boss, 0.5 * abs(z))
+    name = f"frame.{p.plane}.{p.name}"
+    part = Part(name, ((u, z, boss), (u - base, 0.0, boss), (u + base, 0.0, boss)), (Hole((u, z), f.diameter),),
+                ground=True, plane=p.plane, offset=p.offset)
+    return part, Pivot(f"{name}.axle", name, p.name, anchor_a=(u, z), anchor_b=(float(f.centre[0]), float(f.centre[1])))
+
+
+# ------------------------------------------------------------------------------------------------ planning
+
+
+def _world(poly: Any, pose: tuple[float, float, float]) -> Any:
+    from shapely import affinity
+
+    x, y, a = pose
+    c, s = math.cos(a), math.sin(a)
+    return affinity.affine_transform(poly, [c, -s, s, c, x, y])
+
+
+def _local(poly: Any, pose: tuple[float, float, float]) -> Any:
+    from shapely import affinity
+
+    x, y, a = pose
+    c, s = math.cos(a), math.sin(a)
+    # inverse of p -> R p + t: R^T (p - t)
+    return affinity.affine_transform(poly, [c, s, -s, c, -(c * x + s * y), -(-s * x + c * y)])
+
+
+def _intervals(geom: Any) -> list[tuple[float, float]]:
+    """The x-extents of the pieces of a line's intersection (sorted)."""
+    if geom.is_empty:
+        return []
+    parts = getattr(geom, "geoms", [geom])
+    out = []
+    for g in parts:
+        if g.geom_type == "LineString" and g.length > 0:
+            xs = np.asarray(g.coords)[:, 0]
+            out.append((float(xs.min()), float(xs.max())))
+    return sorted(out)
+
+
+def _and(a: list[tuple[float, float]], b: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    out = []
+    for a0, a1 in a:
+        for b0, b1 in b:
+            lo, hi = max(a0, b0), min(a1, b1)
+            if hi > lo:
+                out.append((lo, hi))
+    return sorted(out)
+
+
+def _along(region: Any, level: float, half: float, lo: float, hi: float) -> list[tuple[float, float]]:
+    """Where a strip ``level +- half`` (in the second coordinate) lies inside ``region``, as x intervals."""
+    from shapely.geometry import LineString
+
+    got: list[tuple[float, float]] | None = None
+    for dy in (-half, -half / 2, 0.0, half / 2, half):
+        iv = _intervals(region.intersection(LineString([(lo, level + dy), (hi, level + dy)])))
+        got = iv if got is None else _and(got, iv)
+    return got or []
+
+
+def _place(intervals: list[tuple[float, float]], w: float, g: float) -> list[float]:
+    """Tab centres: as many ``w`` wide, ``g`` apart as fit in each interval, centred in it."""
+    out: list[float] = []
+    for lo, hi in intervals:
+        n = int(math.floor((hi - lo + g) / (w + g) + 1e-9))
+        if n <= 0:
+            continue
+        span = n * w + (n - 1) * g
+        x0 = (lo + hi - span) / 2 + w / 2
+        out += [x0 + k * (w + g) for k in range(n)]
+    return out
+
+
+def _static_pose(track: np.ndarray, what: str, keep: tuple[int, ...]) -> None:
+    """Refuse a track whose coordinates ``keep`` (indices into x, y, angle) change over the cycle."""
+    spread = np.ptp(track[:, list(keep)], axis=0)
+    if float(spread.max()) > 1e-6:
+        raise FabricationError(f"{what}: it moves across the line where it meets the xy stack (by up to "
+                               f"{float(spread.max()):.3g}) over the cycle; it cannot be tab-joined")
+
+
+def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any], s: Any,
+              samples: int = 48) -> list[TabJoin]:
+    """Tab joints of every perpendicular piece that is rigid with an xy piece (see the module docstring).
+
+    ``layers``: each piece's layer in its plane; ``material``: each piece's nominal material (mm, own frame).
+    """
+    from shapely.geometry import Polygon, box
+
+    parts = {p.name: p for p in mech.parts}
+    if not any(p.plane in PLANES for p in parts.values()) or not any(p.plane == "xy" for p in parts.values()):
+        return []
+    bodies = _bodies(mech)
+    joined = _joined(mech, bodies)
+    if not joined:
+        return []
+    u = s.unit_mm
+    t = s.thickness_mm
+    motion = mech.run(samples_per_cycle=samples)
+    ok = np.flatnonzero(motion.valid)
+    ok = ok if ok.size else np.arange(len(motion))
+    track = {n: np.asarray(motion.poses[n], float)[ok] * [u, u, 1.0] for n in parts}
+    pose: dict[str, tuple[float, float, float]] = {
+        n: (float(track[n][0, 0]), float(track[n][0, 1]), float(track[n][0, 2])) for n in parts}
+    for n, q in joined.items():
+        pl = parts[n].plane
+        k = 1 if pl == "xz" else 0  # the xy coordinate across the perpendicular plane (y for xz, x for yz)
+        _static_pose(track[n], f"part {n!r} ({pl})", (1, 2))
+        _static_pose(track[q], f"part {q!r}, the xy piece {n!r} stands on", (k, 2))
+        shift = track[n][:, 0] - track[q][:, 1 - k]
+        if float(np.ptp(shift)) > 1e-6:
+            raise FabricationError(f"part {n!r} ({pl}) does not move with {q!r} along the line where they meet; "
+                                   "it cannot be tab-joined")
+    w, g = 2 * t, 2 * t
+    hw = (t + s.clearance) / 2
+    wall = s.min_wall
+    out: list[TabJoin] = []
+    for pl in PLANES:
+        mine = [n for n in joined if parts[n].plane == pl]
+        if not mine:
+            continue
+        # each piece's edge: where its material (world, its plane) meets z = 0, and the side it lies on
+        edges: dict[str, tuple[int, float, list[tuple[float, float]], Any]] = {}
+        for n in mine:
+            mat = _world(material[n], pose[n])
+            side = 1 if mat.centroid.y > 0 else -1
+            x0, z0, x1, z1 = mat.bounds
+            # the edge: the model's xy plane (z = 0), or past it as far as the piece's own cuts need for a wall
+            cuts = [Polygon(r) for r in mat.interiors]
+            ze = 0.0
+            if cuts:
+                ze = min(0.0, min(c.bounds[1] for c in cuts) - wall) if side > 0 else \
+                    max(0.0, max(c.bounds[3] for c in cuts) + wall)
+            if (side > 0 and z0 > ze + 1e-6) or (side < 0 and z1 < ze - 1e-6):
+                raise FabricationError(f"part {n!r} ({pl}): it does not reach the xy plane (z = {ze:.3g} mm), where "
+                                       f"it would stand on {joined[n]!r}")
+            keep = box(x0 - 1, ze, x1 + 1, z1 + 1) if side > 0 else box(x0 - 1, z0 - 1, x1 + 1, ze)
+            root = mat.intersection(keep)
+            # the tab's root: solid material for a wall's depth behind the edge
+            iv = _along(root, ze + side * wall / 2, wall / 2 - 1e-3, x0 - 1, x1 + 1)
+            edges[n] = (side, ze, iv, keep)
+        # where each xy piece has room for a slot on a line (its frame: through its pose)
+        def room(n: str, at: float, pl: str = pl) -> list[tuple[float, float]]:
+            from shapely.geometry import LineString
+
+            q = joined[n]
+            qm = material[q]
+            hull_part = parts[q].polygon is None and s.widen
+            holes = [Polygon(r) for r in qm.interiors] if qm.geom_type == "Polygon" else \
+                [Polygon(r) for g_ in qm.geoms for r in g_.interiors]
+            if hull_part:
+                big = box(*qm.buffer(10 * (t + wall) + 50).bounds)
+                region = big
+            else:
+                region = qm.buffer(-wall)
+                region = Polygon(region.exterior) if region.geom_type == "Polygon" else region
+            for h in holes:
+                region = region.difference(h.buffer(wall))
+            # the line where the planes meet, in the xy piece's frame, as a strip of half-width hw
+            lo, hi = -1e4, 1e4
+            if pl == "xz":
+                line = LineString([(lo, at), (hi, at)])
+            else:
+                line = LineString([(at, lo), (at, hi)])
+            local = _local(line, pose[q])
+            (a0, b0), (a1, b1) = np.asarray(local.coords)
+            ang = math.atan2(b1 - b0, a1 - a0)
+            # turn the xy piece's frame so the line runs along x at height `level`
+            from shapely import affinity
+
+            turned = affinity.rotate(region, -ang, origin=(0, 0), use_radians=True)
+            p0 = affinity.rotate(local, -ang, origin=(0, 0), use_radians=True)
+            level = float(np.asarray(p0.coords)[0, 1])
+            iv = _along(turned, level, hw, -1e4, 1e4)
+            # back to the world coordinate along the line: world u = along-line coordinate + offset
+            xs = np.asarray(p0.coords)[:, 0]
+            offset = lo - float(xs[0])  # world u of turned-x = x + offset (the line runs lo -> hi)
+            return [(a + offset, b + offset) for a, b in iv]
+
+        def base_y(y0: float, mine: list[str] = mine) -> dict[str, float]:
+            return {n: y0 + ((layers.get(n) or 0) + 0.5) * t for n in mine}
+
+        if pl == "yz":  # the yz pieces stay at their x: each bracket stands beside its piece
+            ats = {}
+            for n in mine:
+                ref = n
+                if n.startswith("frame.yz.") and n[len("frame.yz."):] in parts:
+                    ref = n[len("frame.yz."):]
+                ats[n] = parts[ref].offset * u + ((layers.get(n) or 0) - (layers.get(ref) or 0)) * t
+            candidates = [ats]
+        else:
+            steps = [0.0] + [sgn * 0.5 * k for k in range(1, 401) for sgn in (1, -1)]
+            candidates = [base_y(y0) for y0 in steps]
+        chosen = None
+        for ats in candidates:
+            plan = {}
+            for n in mine:
+                side, ze, iv, keep = edges[n]
+                centres = _place(_and(iv, room(n, ats[n])), w, g)
+                if len(centres) < MIN_TABS:
+                    break
+                plan[n] = centres
+            else:
+                chosen = (ats, plan)
+                break
+        if chosen is None:
+            n = mine[0]
+            raise FabricationError(f"part {n!r} ({pl}): no line where it meets {joined[n]!r} has room for "
+                                   f"{MIN_TABS} tabs {w:g} mm wide with {wall:g} mm of material round their slots; "
+                                   "it cannot be tab-joined (a larger unit_mm or a thinner sheet)")
+        ats, plan = chosen
+        for n in mine:
+            side, ze, _, keep = edges[n]
+            q = joined[n]
+            spans = [(c - w / 2, c + w / 2) for c in plan[n]]
+            tabs = [box(a, ze - t, b, ze + 0.01) if side > 0 else box(a, ze - 0.01, b, ze + t) for a, b in spans]
+            slots = []
+            for c in plan[n]:
+                wc = (c, ats[n]) if pl == "xz" else (ats[n], c)
+                qx, qy, qa = pose[q]
+                cs, sn = math.cos(qa), math.sin(qa)
+                dx, dy = wc[0] - qx, wc[1] - qy
+                centre = (cs * dx + sn * dy, -sn * dx + cs * dy)
+                along = (0.0 if pl == "xz" else math.pi / 2) - qa
+                slots.append((centre, along))
+            out.append(TabJoin(f"T{len(out) + 1}", n, q, pl, float(ats[n]), side, ze, spans, w,
+                               (w + s.clearance, t + s.clearance), slots, _local(keep, pose[n]),
+                               [_local(tb, pose[n]) for tb in tabs]))
+    return out
+
+
+def slot_features(joins: list[TabJoin]) -> dict[str, list[Feature]]:
+    """The xy pieces' through-slots as fabrication features (mm, own frame)."""
+    out: dict[str, list[Feature]] = {}
+    for jn in joins:
+        L, W = jn.slot_size
+        for c, ang in jn.slots:
+            out.setdefault(jn.base, []).append(Feature("rect", f"tab slot {jn.letter}", c, W / 2, R=L / 2, t0=ang))
+    return out
+
