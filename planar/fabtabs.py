@@ -137,7 +137,7 @@ def _joined(mech: Any, bodies: dict[str, list[str]]) -> dict[str, str]:
             if plane.get(n) in PLANES and xy:
                 if len(xy) > 1:
                     raise FabricationError(f"part {n!r}: its body has {len(xy)} xy pieces ({', '.join(xy)}); "
-                                           "no rule says which one its tabs go into")
+                                           "no rule says which one its tabs go into, it cannot be tab-joined")
                 out[n] = xy[0]
     return out
 
@@ -204,11 +204,11 @@ def _bracket(p: Part, poses: np.ndarray) -> tuple[Part, Pivot]:
             break
     if best is None:
         raise FabricationError(f"part {p.name!r} ({p.plane}): no pin holds it and it turns about no fixed hole; "
-                               "no bracket can hold it")
+                               "no bracket can hold it, it cannot be tab-joined")
     f, (u, z) = best
     if abs(z) < 2 * f.diameter:
         raise FabricationError(f"part {p.name!r} ({p.plane}): its axle lies on the xy plane (z = {z:.3g}); "
-                               "no room for a bracket standing on the frame")
+                               "no room for a bracket standing on the frame, it cannot be tab-joined")
     boss = 1.5 * f.diameter
     base = max(boss, 0.5 * abs(z))
     name = f"frame.{p.plane}.{p.name}"
@@ -328,25 +328,38 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
     hw = (t + s.clearance) / 2
     wall = s.min_wall
     out: list[TabJoin] = []
+    # the stack along z: layer k of the xy plane between z0 + k t and z0 + (k + 1) t (mm); a piece below the
+    # stack (the model's -z side, where the #8 plates and the #6/#9 axles hang) stands on its xy piece's lower
+    # face, one above on its upper face.  z0 = 0 (the model's xy plane is the stack's lower face) unless a
+    # piece's own cuts need it moved for min_wall below the piece's edge.
+    world = {n: _world(material[n], pose[n]) for n in joined}
+    sides = {n: 1 if world[n].centroid.y > 0 else -1 for n in joined}
+    face = {n: ((layers.get(joined[n]) or 0) + (1 if sides[n] > 0 else 0)) * t for n in joined}
+    lo_b, hi_b = [-math.inf], [math.inf]
+    for n in joined:
+        cuts = [Polygon(r) for r in world[n].interiors]
+        if cuts and sides[n] < 0:
+            lo_b.append(max(c.bounds[3] for c in cuts) + wall - face[n])
+        elif cuts:
+            hi_b.append(min(c.bounds[1] for c in cuts) - wall - face[n])
+    if max(lo_b) > min(hi_b):
+        raise FabricationError("the pieces standing perpendicular to the xy stack need it both higher and lower "
+                               "for their cuts' walls; they cannot be tab-joined")
+    z_stack = min(max(0.0, max(lo_b)), min(hi_b))
     for pl in PLANES:
         mine = [n for n in joined if parts[n].plane == pl]
         if not mine:
             continue
-        # each piece's edge: where its material (world, its plane) meets z = 0, and the side it lies on
+        # each piece's edge: the face of its xy piece's layer, and the side it lies on
         edges: dict[str, tuple[int, float, list[tuple[float, float]], Any]] = {}
         for n in mine:
-            mat = _world(material[n], pose[n])
-            side = 1 if mat.centroid.y > 0 else -1
+            mat = world[n]
+            side = sides[n]
             x0, z0, x1, z1 = mat.bounds
-            # the edge: the model's xy plane (z = 0), or past it as far as the piece's own cuts need for a wall
-            cuts = [Polygon(r) for r in mat.interiors]
-            ze = 0.0
-            if cuts:
-                ze = min(0.0, min(c.bounds[1] for c in cuts) - wall) if side > 0 else \
-                    max(0.0, max(c.bounds[3] for c in cuts) + wall)
+            ze = z_stack + face[n]
             if (side > 0 and z0 > ze + 1e-6) or (side < 0 and z1 < ze - 1e-6):
-                raise FabricationError(f"part {n!r} ({pl}): it does not reach the xy plane (z = {ze:.3g} mm), where "
-                                       f"it would stand on {joined[n]!r}")
+                raise FabricationError(f"part {n!r} ({pl}): it does not reach the face of {joined[n]!r} (z = "
+                                       f"{ze:.3g} mm), where it would stand on it; it cannot be tab-joined")
             keep = box(x0 - 1, ze, x1 + 1, z1 + 1) if side > 0 else box(x0 - 1, z0 - 1, x1 + 1, ze)
             root = mat.intersection(keep)
             # the tab's root: solid material for a wall's depth behind the edge
@@ -405,19 +418,21 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
             steps = [0.0] + [sgn * 0.5 * k for k in range(1, 401) for sgn in (1, -1)]
             candidates = [base_y(y0) for y0 in steps]
         chosen = None
+        failed: str | None = None
         for ats in candidates:
             plan = {}
             for n in mine:
                 side, ze, iv, keep = edges[n]
                 centres = _place(_and(iv, room(n, ats[n])), w, g)
                 if len(centres) < MIN_TABS:
+                    failed = failed or n  # the first piece that failed at the model's own position
                     break
                 plan[n] = centres
             else:
                 chosen = (ats, plan)
                 break
         if chosen is None:
-            n = mine[0]
+            n = failed or mine[0]
             raise FabricationError(f"part {n!r} ({pl}): no line where it meets {joined[n]!r} has room for "
                                    f"{MIN_TABS} tabs {w:g} mm wide with {wall:g} mm of material round their slots; "
                                    "it cannot be tab-joined (a larger unit_mm or a thinner sheet)")
