@@ -43,6 +43,8 @@ class Fabrication:
     written: list[Path] = field(default_factory=list)
     #: tab-and-slot joints of pieces standing perpendicular to the xy stack (:mod:`planar.fabtabs`)
     joins: list[Any] = field(default_factory=list)
+    #: where the xy stack's lower face lies along the model's z (mm), for the pieces standing perpendicular
+    stack_z: float = 0.0
 
 
 def _shaft_pin(mech: Any, pins) -> Any:
@@ -88,7 +90,7 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
     s = settings
     if not (0 <= s.kerf <= 2):
         raise InputError("kerf", s.kerf, "a kerf between 0 and 2 mm")
-    from .fabtabs import plan_tabs, slot_features
+    from .fabtabs import plan_tabs, slot_features, travel_slots
 
     mech = _fab_mechanism(scene.mechanism)
     keyed: dict[str, float] = dict(getattr(mech, "keyed", {}))
@@ -112,8 +114,10 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
                     marked.add(key)
                     letters[pin.parts[side]].append((pin.at[side], letter(k)))
 
-    def cut_all(joins: list[Any]) -> tuple[list[PartCut], list[str]]:
+    def cut_all(joins: list[Any], travel: dict[str, list[Any]]) -> tuple[list[PartCut], list[str]]:
         slots = slot_features(joins)
+        for k_, v_ in travel.items():
+            slots[k_] = slots.get(k_, []) + v_
         tab_of = {jn.piece: jn for jn in joins}
         cuts: list[PartCut] = []
         part_notes: list[str] = []
@@ -142,12 +146,26 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
         return material, plan_assembly(mech, material, pins, contacts, s.unit_mm, s.thickness_mm, s.pin_mm,
                                        s.pin_head, shaft.joint if shaft is not None else None)
 
-    cuts, part_notes = cut_all([])
+    cuts, part_notes = cut_all([], {})
     material, asm = plan(cuts)
-    joins = plan_tabs(mech, asm.layers, material, s)
-    if joins:  # cut again with the tabs and slots, and check the layers the planes' positions came from
-        cuts, part_notes = cut_all(joins)
-        material, asm2 = plan(cuts)
+    tab_plan = plan_tabs(mech, asm.layers, material, s)
+    joins = tab_plan.joins
+    if joins or tab_plan.planes:  # cut again with the tabs and slots, then with travel slots until none is missing
+        travel: dict[str, list[Any]] = {}
+        for _ in range(4):
+            cuts, part_notes = cut_all(joins, travel)
+            material, asm2 = plan(cuts)
+            more, more_notes = travel_slots(mech, asm2.layers, material, s, tab_plan)
+            if not more:
+                break
+            for k_, v_ in more.items():
+                travel[k_] = travel.get(k_, []) + v_
+            notes.extend(more_notes)
+        else:
+            from .fabjoints import FabricationError
+
+            raise FabricationError(f"{', '.join(more)}: still in the way of the pieces standing perpendicular after "
+                                   "4 rounds of travel slots")
         moved = [n for n in asm.layers if asm.plane.get(n) != "xy" and asm.layers[n] != asm2.layers.get(n)]
         if moved:
             from .fabjoints import FabricationError
@@ -182,7 +200,8 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
                                 nominal_holes=[((0.0, 0.0), ri)]))
     layout = nest(cuts, s.sheet, s.spacing, s.margin, s.kerf, s.unit_mm)
     return Fabrication(scene.name, s, layout, asm, notes, shaft.joint if shaft is not None else None, material,
-                       [p.name for p in mech.parts if p.ground and p.plane == "xy"], joins=joins)
+                       [p.name for p in mech.parts if p.ground and p.plane == "xy"], joins=joins,
+                       stack_z=tab_plan.z_stack)
 
 
 def _engrave_joins(cuts: list[PartCut], joins: list[Any], s: FabSettings) -> None:

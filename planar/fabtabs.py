@@ -53,7 +53,7 @@ from .fabjoints import FabricationError
 from .fabparts import Feature
 from .model import Hole, Part, Pivot, Slide
 
-__all__ = ["FabView", "TabJoin", "fab_view", "plan_tabs", "slot_features"]
+__all__ = ["FabView", "TabJoin", "TabPlan", "fab_view", "plan_tabs", "slot_features", "travel_slots"]
 
 PLANES = ("xz", "yz")
 MIN_TABS = 2
@@ -210,7 +210,10 @@ def _bracket(p: Part, poses: np.ndarray) -> tuple[Part, Pivot]:
         raise FabricationError(f"part {p.name!r} ({p.plane}): its axle lies on the xy plane (z = {z:.3g}); "
                                "no room for a bracket standing on the frame, it cannot be tab-joined")
     boss = 1.5 * f.diameter
-    base = max(boss, 0.5 * abs(z))
+    # the base reaches past the piece's own way through the stack on both sides, room for a tab beyond it
+    c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+    reach = max(float(np.abs(poses[:, 0] + c * x - s * y - u).max()) + r for x, y, r in p.hull)
+    base = max(boss, 0.5 * abs(z), reach + 2 * boss)
     name = f"frame.{p.plane}.{p.name}"
     part = Part(name, ((u, z, boss), (u - base, 0.0, boss), (u + base, 0.0, boss)), (Hole((u, z), f.diameter),),
                 ground=True, plane=p.plane, offset=p.offset)
@@ -292,21 +295,39 @@ def _static_pose(track: np.ndarray, what: str, keep: tuple[int, ...]) -> None:
                                f"{float(spread.max()):.3g}) over the cycle; it cannot be tab-joined")
 
 
+@dataclass
+class TabPlan:
+    """The tab joints, the travel slots (xy piece -> cuts, mm) letting perpendicular pieces pass through other
+    layers, what was done (notes), and the stack's lower face along the model's z (mm)."""
+
+    joins: list[TabJoin] = field(default_factory=list)
+    travel: dict[str, list[Feature]] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+    z_stack: float = 0.0
+    #: every perpendicular piece's plane position (mm: y for xz, x for yz)
+    planes: dict[str, float] = field(default_factory=dict)
+    #: pose tracks over the cycle (mm, mm, rad) and each piece's shape as cut (own frame, mm)
+    track: dict[str, Any] = field(default_factory=dict)
+    shape: dict[str, Any] = field(default_factory=dict)
+
+
 def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any], s: Any,
-              samples: int = 48) -> list[TabJoin]:
-    """Tab joints of every perpendicular piece that is rigid with an xy piece (see the module docstring).
+              samples: int = 48) -> TabPlan:
+    """Tab joints of every perpendicular piece that is rigid with an xy piece, and travel slots for every
+    perpendicular piece passing through another xy layer (see the module docstring).
 
     ``layers``: each piece's layer in its plane; ``material``: each piece's nominal material (mm, own frame).
     """
-    from shapely.geometry import Polygon, box
+    import shapely
+    from shapely.geometry import LineString, Polygon, box
 
     parts = {p.name: p for p in mech.parts}
     if not any(p.plane in PLANES for p in parts.values()) or not any(p.plane == "xy" for p in parts.values()):
-        return []
+        return TabPlan()
     bodies = _bodies(mech)
     joined = _joined(mech, bodies)
     if not joined:
-        return []
+        return TabPlan()
     u = s.unit_mm
     t = s.thickness_mm
     motion = mech.run(samples_per_cycle=samples)
@@ -327,12 +348,14 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
     w, g = 2 * t, 2 * t
     hw = (t + s.clearance) / 2
     wall = s.min_wall
-    out: list[TabJoin] = []
-    # the stack along z: layer k of the xy plane between z0 + k t and z0 + (k + 1) t (mm); a piece below the
-    # stack (the model's -z side, where the #8 plates and the #6/#9 axles hang) stands on its xy piece's lower
-    # face, one above on its upper face.  z0 = 0 (the model's xy plane is the stack's lower face) unless a
-    # piece's own cuts need it moved for min_wall below the piece's edge.
-    world = {n: _world(material[n], pose[n]) for n in joined}
+    perp = [n for n, p in parts.items() if p.plane in PLANES]
+    xy = [n for n, p in parts.items() if p.plane == "xy"]
+    # the stack along z: layer k of the xy plane between z0 + k t and z0 + (k + 1) t (mm).  The model's xy
+    # plane (z = 0: where the #8 driver slides and the #6/#9 pin meets its driver's edge) is the mid-plane of
+    # the layer the perpendicular stages ride on, as near as the pieces' cuts allow: a piece below the stack
+    # (the model's -z side, where the #8 plates and the #6/#9 axles hang) stands on its xy piece's lower face,
+    # one above on its upper face, and keeps min_wall between its edge and its own cuts.
+    world = {n: _world(material[n], pose[n]) for n in perp}
     sides = {n: 1 if world[n].centroid.y > 0 else -1 for n in joined}
     face = {n: ((layers.get(joined[n]) or 0) + (1 if sides[n] > 0 else 0)) * t for n in joined}
     lo_b, hi_b = [-math.inf], [math.inf]
@@ -345,7 +368,34 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
     if max(lo_b) > min(hi_b):
         raise FabricationError("the pieces standing perpendicular to the xy stack need it both higher and lower "
                                "for their cuts' walls; they cannot be tab-joined")
-    z_stack = min(max(0.0, max(lo_b)), min(hi_b))
+    riders = {joined[n] for n in joined if not parts[n].ground}
+    riders |= {j.a for j in mech.joints if getattr(j, "b", None) in perp and getattr(j, "a", None) in xy}
+    ride = [layers.get(n) or 0 for n in sorted(riders)] or [0]
+    target = -(float(np.mean(ride)) + 0.5) * t
+    z_stack = min(max(target, max(lo_b)), min(hi_b))
+
+    def band(r: str) -> Any:
+        lz = (layers.get(r) or 0) * t + z_stack
+        return box(-1e5, lz + 0.01, 1e5, lz + t - 0.01)
+
+    def footprint(n: str, at: float, r: str) -> Any:
+        """Where piece ``n`` (its plane at ``at``, mm) passes through ``r``'s layer over the cycle, ``r``'s frame."""
+        bd = band(r)
+        mat = shape[n].simplify(0.05)
+        strips = []
+        for k in range(len(ok)):
+            got = _world(mat, tuple(track[n][k])).intersection(bd)
+            if got.area <= 1e-6:
+                continue
+            a, _, b, _ = got.bounds
+            strip = box(a, at - t / 2, b, at + t / 2) if parts[n].plane == "xz" else box(at - t / 2, a, at + t / 2, b)
+            strips.append(_local(strip, tuple(track[r][k])))
+        return shapely.union_all(strips) if strips else Polygon()
+
+    shape = dict(material)  # each piece as cut (a tab-joined one: cut flat along its edge, tabs added)
+    # pieces whose plane is fixed already (a yz piece at its x) keep their way through the layers clear
+    fixed_at = {n: parts[n].offset * u for n in perp if parts[n].plane == "yz" and n not in joined}
+    out: list[TabJoin] = []
     for pl in PLANES:
         mine = [n for n in joined if parts[n].plane == pl]
         if not mine:
@@ -365,42 +415,45 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
             # the tab's root: solid material for a wall's depth behind the edge
             iv = _along(root, ze + side * wall / 2, wall / 2 - 1e-3, x0 - 1, x1 + 1)
             edges[n] = (side, ze, iv, keep)
-        # where each xy piece has room for a slot on a line (its frame: through its pose)
-        def room(n: str, at: float, pl: str = pl) -> list[tuple[float, float]]:
-            from shapely.geometry import LineString
+        keepout = {q: shapely.union_all([footprint(m, a, q) for m, a in fixed_at.items()]).buffer(s.clearance)
+                   for q in set(joined.values())}
 
-            q = joined[n]
+        # where each xy piece has room for a slot on a line (its frame: through its pose)
+        regions: dict[str, Any] = {}
+        for q in {joined[n] for n in mine}:
             qm = material[q]
-            hull_part = parts[q].polygon is None and s.widen
             holes = [Polygon(r) for r in qm.interiors] if qm.geom_type == "Polygon" else \
                 [Polygon(r) for g_ in qm.geoms for r in g_.interiors]
-            if hull_part:
-                big = box(*qm.buffer(10 * (t + wall) + 50).bounds)
-                region = big
+            if not keepout[q].is_empty:
+                holes.append(keepout[q])
+            if parts[q].polygon is None and s.widen:  # a hull grows to hold its slots: only its cuts matter
+                region = box(*qm.buffer(10 * (t + wall) + 50).bounds)
             else:
                 region = qm.buffer(-wall)
                 region = Polygon(region.exterior) if region.geom_type == "Polygon" else region
-            for h in holes:
-                region = region.difference(h.buffer(wall))
+            regions[q] = region.difference(shapely.union_all([h.buffer(wall) for h in holes])) if holes else region
+        turned_of: dict[str, Any] = {}
+
+        def room(n: str, at: float, pl: str = pl, regions: dict[str, Any] = regions,
+                 turned_of: dict[str, Any] = turned_of) -> list[tuple[float, float]]:
+            from shapely import affinity
+
+            q = joined[n]
             # the line where the planes meet, in the xy piece's frame, as a strip of half-width hw
             lo, hi = -1e4, 1e4
-            if pl == "xz":
-                line = LineString([(lo, at), (hi, at)])
-            else:
-                line = LineString([(at, lo), (at, hi)])
+            line = LineString([(lo, at), (hi, at)]) if pl == "xz" else LineString([(at, lo), (at, hi)])
             local = _local(line, pose[q])
             (a0, b0), (a1, b1) = np.asarray(local.coords)
             ang = math.atan2(b1 - b0, a1 - a0)
             # turn the xy piece's frame so the line runs along x at height `level`
-            from shapely import affinity
-
-            turned = affinity.rotate(region, -ang, origin=(0, 0), use_radians=True)
+            if q not in turned_of:
+                turned_of[q] = affinity.rotate(regions[q], -ang, origin=(0, 0), use_radians=True)
+            turned = turned_of[q]
             p0 = affinity.rotate(local, -ang, origin=(0, 0), use_radians=True)
             level = float(np.asarray(p0.coords)[0, 1])
             iv = _along(turned, level, hw, -1e4, 1e4)
-            # back to the world coordinate along the line: world u = along-line coordinate + offset
-            xs = np.asarray(p0.coords)[:, 0]
-            offset = lo - float(xs[0])  # world u of turned-x = x + offset (the line runs lo -> hi)
+            # back to the world coordinate along the line (the line runs lo -> hi)
+            offset = lo - float(np.asarray(p0.coords)[0, 0])
             return [(a + offset, b + offset) for a, b in iv]
 
         def base_y(y0: float, mine: list[str] = mine) -> dict[str, float]:
@@ -409,9 +462,7 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
         if pl == "yz":  # the yz pieces stay at their x: each bracket stands beside its piece
             ats = {}
             for n in mine:
-                ref = n
-                if n.startswith("frame.yz.") and n[len("frame.yz."):] in parts:
-                    ref = n[len("frame.yz."):]
+                ref = n[len("frame.yz."):] if n.startswith("frame.yz.") and n[len("frame.yz."):] in parts else n
                 ats[n] = parts[ref].offset * u + ((layers.get(n) or 0) - (layers.get(ref) or 0)) * t
             candidates = [ats]
         else:
@@ -437,7 +488,12 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
                                    f"{MIN_TABS} tabs {w:g} mm wide with {wall:g} mm of material round their slots; "
                                    "it cannot be tab-joined (a larger unit_mm or a thinner sheet)")
         ats, plan = chosen
+        if pl == "xz":  # every xz piece's plane, joined or not, in the layer order
+            y0 = next(ats[n] - ((layers.get(n) or 0) + 0.5) * t for n in mine)
+            fixed_at.update({n: y0 + ((layers.get(n) or 0) + 0.5) * t for n in perp
+                             if parts[n].plane == "xz" and n not in joined})
         for n in mine:
+            fixed_at[n] = ats[n]
             side, ze, _, keep = edges[n]
             q = joined[n]
             spans = [(c - w / 2, c + w / 2) for c in plan[n]]
@@ -451,10 +507,68 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
                 centre = (cs * dx + sn * dy, -sn * dx + cs * dy)
                 along = (0.0 if pl == "xz" else math.pi / 2) - qa
                 slots.append((centre, along))
-            out.append(TabJoin(f"T{len(out) + 1}", n, q, pl, float(ats[n]), side, ze, spans, w,
-                               (w + s.clearance, t + s.clearance), slots, _local(keep, pose[n]),
-                               [_local(tb, pose[n]) for tb in tabs]))
-    return out
+            jn = TabJoin(f"T{len(out) + 1}", n, q, pl, float(ats[n]), side, ze, spans, w,
+                         (w + s.clearance, t + s.clearance), slots, _local(keep, pose[n]),
+                         [_local(tb, pose[n]) for tb in tabs])
+            out.append(jn)
+            shape[n] = shapely.union_all([material[n].intersection(jn.keep)] + jn.tabs)
+    return TabPlan(out, {}, [], z_stack, fixed_at, track, shape)
+
+
+def travel_slots(mech: Any, layers: dict[str, int | None], material: dict[str, Any], s: Any,
+                 plan: TabPlan) -> tuple[dict[str, list[Feature]], list[str]]:
+    """Travel slots (xy piece -> cuts, mm) for perpendicular pieces that pass through another xy piece's layer
+    where it has material (``material``: as cut so far), and a note for each; pieces joined by a joint
+    (the #6/#9 pin on its driver's edge) touch by design and get none."""
+    import shapely
+    from shapely.geometry import Polygon, box
+
+    parts = {p.name: p for p in mech.parts}
+    t = s.thickness_mm
+    joined = {jn.piece: jn.base for jn in plan.joins}
+    touching = {frozenset((j.a, j.b)) for j in mech.joints}
+    track = plan.track
+
+    def footprint(n: str, at: float, r: str) -> Any:
+        lz = (layers.get(r) or 0) * t + plan.z_stack
+        bd = box(-1e5, lz + 0.01, 1e5, lz + t - 0.01)
+        mat = plan.shape[n].simplify(0.05)
+        strips = []
+        for k in range(len(track[n])):
+            got = _world(mat, tuple(track[n][k])).intersection(bd)
+            if got.area <= 1e-6:
+                continue
+            a, _, b, _ = got.bounds
+            strip = box(a, at - t / 2, b, at + t / 2) if parts[n].plane == "xz" else box(at - t / 2, a, at + t / 2, b)
+            strips.append(_local(strip, tuple(track[r][k])))
+        return shapely.union_all(strips) if strips else Polygon()
+
+    out: dict[str, list[Feature]] = {}
+    notes: list[str] = []
+    for n, at in plan.planes.items():
+        for r in (q for q, p in parts.items() if p.plane == "xy"):
+            if r == joined.get(n) or frozenset((n, r)) in touching:
+                continue  # its tabs go through their own slots; a contact touches on purpose
+            foot = footprint(n, at, r)
+            if foot.is_empty or foot.intersection(material[r]).area <= 0.5:
+                continue
+            rect = foot.buffer(s.clearance, join_style="mitre").minimum_rotated_rectangle
+            length, width, ang = _rect_sides(rect)
+            c = rect.centroid
+            out.setdefault(r, []).append(
+                Feature("rect", f"travel slot for {n}", (float(c.x), float(c.y)), width / 2, R=length / 2, t0=ang))
+            notes.append(f"{r}: a travel slot {length:.1f} x {width:.1f} mm for {n} ({parts[n].plane}), which "
+                         "passes through its layer")
+    return out, notes
+
+
+def _rect_sides(rect: Any) -> tuple[float, float, float]:
+    """A rectangle's long side, short side and the long side's angle (rad)."""
+    xy = np.asarray(rect.exterior.coords)[:4]
+    e1, e2 = xy[1] - xy[0], xy[2] - xy[1]
+    a, b = float(np.hypot(*e1)), float(np.hypot(*e2))
+    long = e1 if a >= b else e2
+    return max(a, b), min(a, b), math.atan2(long[1], long[0])
 
 
 def slot_features(joins: list[TabJoin]) -> dict[str, list[Feature]]:
