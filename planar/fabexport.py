@@ -45,6 +45,8 @@ class Fabrication:
     joins: list[Any] = field(default_factory=list)
     #: where the xy stack's lower face lies along the model's z (mm), for the pieces standing perpendicular
     stack_z: float = 0.0
+    #: each perpendicular piece's plane position (mm: world y for xz, x for yz)
+    planes: dict[str, float] = field(default_factory=dict)
 
 
 def _shaft_pin(mech: Any, pins) -> Any:
@@ -201,7 +203,7 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
     layout = nest(cuts, s.sheet, s.spacing, s.margin, s.kerf, s.unit_mm)
     return Fabrication(scene.name, s, layout, asm, notes, shaft.joint if shaft is not None else None, material,
                        [p.name for p in mech.parts if p.ground and p.plane == "xy"], joins=joins,
-                       stack_z=tab_plan.z_stack)
+                       stack_z=tab_plan.z_stack, planes=dict(tab_plan.planes))
 
 
 def _engrave_joins(cuts: list[PartCut], joins: list[Any], s: FabSettings) -> None:

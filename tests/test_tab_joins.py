@@ -31,9 +31,12 @@ def bunny(tmp_path_factory):
     scene = load_scene(GALLERY / "bunny.toml")
     fab = build(scene, FabSettings.from_spec(scene.spec.fabrication))
     write_outputs(fab, dxf=tmp / "b.dxf", svg=tmp / "b.svg", bom=tmp / "b.csv")
-    motion = _fab_mechanism(scene.mechanism).run(samples_per_cycle=24)
+    mech = _fab_mechanism(scene.mechanism)
+    motion = mech.run(samples_per_cycle=24)
     k = int(np.flatnonzero(motion.valid)[0])
     pose = {n: motion.poses[n][k] for n in motion.poses}
+    fab.test_motion = motion  # type: ignore[attr-defined]
+    fab.test_mech = mech  # type: ignore[attr-defined]
     return fab, tmp, pose
 
 
@@ -181,3 +184,50 @@ def test_no_joint_without_an_xy_stack():
     scene = load_scene(GALLERY / "windup-08.toml")
     fab = build(scene, FabSettings.from_spec(scene.spec.fabrication))
     assert fab.joins == []
+
+
+def test_pieces_standing_perpendicular_pass_through_other_layers_clear(bunny):
+    """Swept through the cycle, each perpendicular piece (the file's outline) meets no other xy piece's material
+    (the file's outline less its cuts) in that piece's layer: travel slots let the #8 plate and the #9 pin by."""
+    fab, tmp, _ = bunny
+    s = fab.settings
+    u, t = s.unit_mm, s.thickness_mm
+    polys = dxf_cut_polygons(tmp / "b.dxf")
+    by = {pc.name: pc for pc in fab.layout.parts}
+    m, mech = fab.test_motion, fab.test_mech
+    ok = np.flatnonzero(m.valid)
+    plane = {p.name: p.plane for p in mech.parts}
+    touching = {frozenset((j.a, j.b)) for j in mech.joints}
+    base = {jn.piece: jn.base for jn in fab.joins}
+    solid = {}
+    for name, pc in by.items():
+        if plane.get(name) == "xy":
+            outer, inner = _part_contours(polys, pc)
+            solid[name] = outer.difference(shapely_union(inner))
+    assert set(fab.planes) >= {"s2.driver", "s1.follower", "frame.xz", "s2.follower"}
+    crossed = set()
+    for n, at in fab.planes.items():
+        outer, _ = _part_contours(polys, by[n])
+        for r, mat in solid.items():
+            if base.get(n) == r or frozenset((n, r)) in touching:
+                continue
+            lz = fab.stack_z + fab.assembly.layers[r] * t
+            band = box(-1e5, lz + s.kerf, 1e5, lz + t - s.kerf)  # the file's outlines are grown by half the kerf
+            for k in ok:
+                got = _pose(outer, m.poses[n][k], u).intersection(band)
+                if got.area <= 1e-6:
+                    continue
+                crossed.add((n, r))
+                a, _, b, _ = got.bounds
+                strip = box(a, at - t / 2, b, at + t / 2) if plane[n] == "xz" else box(at - t / 2, a, at + t / 2, b)
+                q = m.poses[r][k]
+                here = _pose(mat, q, u)
+                assert here.intersection(strip).area < 0.5, (n, r, int(k))
+    # the #8 window plate passes through the frame's layer, and the #9 pin too: both had to be let by
+    assert {("s2.driver", "frame"), ("s1.follower", "frame")} <= crossed
+
+
+def shapely_union(polys):
+    import shapely
+
+    return shapely.union_all(polys)
