@@ -168,7 +168,7 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
 
             raise FabricationError(f"{', '.join(more)}: still in the way of the pieces standing perpendicular after "
                                    "4 rounds of travel slots")
-        moved = [n for n in asm.layers if asm.plane.get(n) != "xy" and asm.layers[n] != asm2.layers.get(n)]
+        moved = [n for n in asm.layers if asm.layers[n] != asm2.layers.get(n)]
         if moved:
             from .fabjoints import FabricationError
 

@@ -169,13 +169,14 @@ def test_walls_nesting_and_bom(bunny):
 
 
 def test_a_joint_without_room_is_refused(tmp_path, capsys):
-    text = (GALLERY / "bunny.toml").read_text().replace("unit_mm = 100.0", "unit_mm = 100.0\nthickness_mm = 12.0")
+    # #9's bracket on a 9 mm sheet: its tabs would be 18 mm wide, no room for two beside the pin's way
+    text = (GALLERY / "windup-09.toml").read_text().replace("unit_mm = 100.0", "unit_mm = 100.0\nthickness_mm = 9.0")
     scene = tmp_path / "thick.toml"
     scene.write_text(text)
     out = tmp_path / "p.dxf"
     assert main(["export", str(scene), "-o", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "cannot be tab-joined" in err[0], err
+    assert len(err) == 1 and "cannot be tab-joined" in err[0] and "frame.yz.follower" in err[0], err
     assert not out.exists()
 
 
