@@ -92,7 +92,7 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
     s = settings
     if not (0 <= s.kerf <= 2):
         raise InputError("kerf", s.kerf, "a kerf between 0 and 2 mm")
-    from .fabtabs import plan_tabs, slot_features, travel_slots
+    from .fabtabs import merge_travel, plan_tabs, slot_features, travel_slots
 
     mech = _fab_mechanism(scene.mechanism)
     keyed: dict[str, float] = dict(getattr(mech, "keyed", {}))
@@ -149,31 +149,45 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
                                        s.pin_head, shaft.joint if shaft is not None else None)
 
     cuts, part_notes = cut_all([], {})
-    material, asm = plan(cuts)
-    tab_plan = plan_tabs(mech, asm.layers, material, s)
+    material0, asm = plan(cuts)
+    material = material0
+    tab_plan = plan_tabs(mech, asm.layers, material0, s)
     joins = tab_plan.joins
-    if joins or tab_plan.planes:  # cut again with the tabs and slots, then with travel slots until none is missing
-        travel: dict[str, list[Any]] = {}
-        for _ in range(4):
-            cuts, part_notes = cut_all(joins, travel)
-            material, asm2 = plan(cuts)
-            more, more_notes = travel_slots(mech, asm2.layers, material, s, tab_plan)
-            if not more:
+    more_notes: list[str] = []
+    if joins or tab_plan.planes:
+        # cut again with the tabs and slots, then with travel slots until none is missing; the tabs' faces
+        # follow the layers, so a plan whose cuts move a layer is planned again for the new layers
+        layers_used = asm.layers
+        done = False
+        for _ in range(3):
+            travel: dict[str, list[Any]] = {}
+            travel_notes: list[str] = []
+            for _ in range(4):
+                cuts, part_notes = cut_all(joins, travel)
+                material, asm2 = plan(cuts)
+                if asm2.layers != layers_used:
+                    break
+                more, more_notes = travel_slots(mech, asm2.layers, material, s, tab_plan)
+                if not more:
+                    done = True
+                    break
+                for k_, v_ in more.items():
+                    travel[k_] = merge_travel(travel.get(k_, []) + v_, s.min_wall)
+                travel_notes.extend(more_notes)
+            if done or asm2.layers == layers_used:
                 break
-            for k_, v_ in more.items():
-                travel[k_] = travel.get(k_, []) + v_
-            notes.extend(more_notes)
-        else:
+            layers_used = asm2.layers
+            tab_plan = plan_tabs(mech, layers_used, material0, s)
+            joins = tab_plan.joins
+        if not done:
             from .fabjoints import FabricationError
 
-            raise FabricationError(f"{', '.join(more)}: still in the way of the pieces standing perpendicular after "
-                                   "4 rounds of travel slots")
-        moved = [n for n in asm.layers if asm.layers[n] != asm2.layers.get(n)]
-        if moved:
-            from .fabjoints import FabricationError
-
-            raise FabricationError(f"part {moved[0]!r}: its layer changed once its tabs were cut; the tab joints "
-                                   "were planned for the old layers")
+            moved = [n for n in asm2.layers if asm2.layers[n] != layers_used.get(n)]
+            raise FabricationError(
+                f"part {moved[0]!r}: its layer keeps changing as the tab joints are cut; they cannot be planned"
+                if moved else "the pieces standing perpendicular are still in the way of other layers after 4 "
+                "rounds of travel slots; they cannot be tab-joined")
+        notes.extend(travel_notes)
         asm = asm2
         tabs = {jn.piece: jn for jn in joins}
         for pc in cuts:

@@ -7,38 +7,53 @@ side, through-slots on the other):
 
 * **rigid pieces**: a perpendicular piece that is one rigid body with an xy
   piece (``ToyAssembly.bodies``: the #8 window plate with the slider, the
-  xz frame with the frame) is cut flat along the model's xy plane (``z = 0``
-  of its plane's coordinates, where the #8 driver slides), keeping its side of
-  it, and gets tabs ``thickness_mm`` long standing out of that edge; the xy
-  piece gets a rectangular through-slot for each tab on the line where the
-  two planes meet (``thickness_mm + clearance_mm`` wide, the tab's width +
-  ``clearance_mm`` long: the fit allowance holes get).  Tabs are ``2 x
-  thickness`` wide with ``2 x thickness`` gaps (Boxes.py's default finger
-  and space), as many as fit where both pieces have material with
-  ``min_wall_mm`` round each slot and clear of every other cut; at least two
-  per joint.  A hull-outlined xy piece (the frame) grows to hold its slots;
-  an explicit outline (the merged slider) must already have room.
+  xz frame with the frame) is cut flat where it meets that piece's layer face,
+  keeping its side, and gets tabs ``thickness_mm`` long standing out of that
+  edge through the layer; the xy piece gets a rectangular through-slot for
+  each tab on the line where the two planes meet (``thickness_mm +
+  clearance_mm`` wide, the tab's width + ``clearance_mm`` long: the fit
+  allowance holes get).  Tabs are ``2 x thickness`` wide with ``2 x
+  thickness`` gaps (Boxes.py's default finger and space), as many as fit
+  where both pieces have material with ``min_wall_mm`` round each slot and
+  clear of every other cut; at least two per joint.  A hull-outlined xy piece
+  (the frame) grows to hold its slots; an explicit outline (the merged slider)
+  must already have room.
+* **the stack along z**: xy layer k lies between ``z0 + k t`` and ``z0 + (k + 1) t``
+  (mm) of the model's z.  The model's xy plane (``z = 0``: where the #8 driver
+  slides, where the #6/#9 pin meets its driver's edge) is the mid-plane of the
+  layer the perpendicular stages ride on, as near as the pieces' own cuts
+  allow (each keeps ``min_wall_mm`` between its edge and its cuts).  Pieces
+  on the model's -z side hang below the stack from their xy piece's lower
+  face; pieces on the +z side stand on its upper face.
 * **plane positions**: a plane's pieces stand in its layer order, one sheet
   thickness apart (``y = y0 + (layer + 1/2) t`` for xz).  The model fixes no
   y for xz pieces, so ``y0`` is the nearest position (0.5 mm steps from the
-  model's ``y = 0``) where every xz joint fits.  A yz piece stays at its x
+  model's ``y = 0``, up to 60 mm) where every xz joint has room and every
+  travel slot (below) keeps its walls.  A yz piece stays at its x
   (``Part.offset``: the #6/#9 pin must meet the driver's edge there); its
-  bracket stands one layer beside it.
+  bracket stands in its layer beside it.
 * **brackets**: a moving perpendicular piece that no pin holds (the #6/#9
   follower, whose axle the model leaves in the air) gets a bracket: a frame
   piece in its plane with a hole on the axle (the piece's stationary hole)
-  and a base on the xy plane, tab-joined to the frame like any frame piece.
-  A #8 tab is held by the xz frame already (pin through both), so the xz
-  frame is its bracket.
+  and a base reaching past the piece's way through the stack, tab-joined to
+  the frame like any frame piece (its tabs clear of that way).  A #8 tab is
+  held by the xz frame already (pin through both), so the xz frame is its
+  bracket.
 * **repeated guides**: a slide between two perpendicular pieces that are both
   joined to the xy stack repeats the xy slide of their bodies (the #8 side
   view of the slider's own guide): it is not cut (no slot, no pin holes).
+* **travel slots**: a perpendicular piece passing through another xy piece's
+  layer where that piece has material gets a rectangular travel slot there
+  (its way over the cycle, ``clearance_mm`` round it; ways closer than
+  ``min_wall_mm`` are one slot).  Pieces joined by a joint (the #6/#9 pin on
+  its driver's edge) touch by design and get none.
 
-Refused (``FabricationError``, exit 3): a perpendicular piece whose body
-turns or leaves its plane's line while joined, one that does not reach the
-xy plane, one with a moving axle, or a joint with room for fewer than two
-tabs.  Sizes in millimetres; the tabs' and slots' positions in each piece's
-own frame (``TabJoin``) are what the tests read back from the files.
+Refused (``FabricationError``, exit 2, one line): a perpendicular piece whose
+xy piece turns or moves across the line where they meet, one that does not
+reach its xy piece's face, one with a moving axle, a joint with room for fewer
+than two tabs, travel slots running into other cuts.  Sizes in millimetres;
+the tabs' and slots' positions (``TabJoin``) are what the tests read back from
+the files.
 """
 
 from __future__ import annotations
@@ -53,7 +68,7 @@ from .fabjoints import FabricationError
 from .fabparts import Feature
 from .model import Hole, Part, Pivot, Slide
 
-__all__ = ["FabView", "TabJoin", "TabPlan", "fab_view", "plan_tabs", "slot_features", "travel_slots"]
+__all__ = ["FabView", "TabJoin", "TabPlan", "fab_view", "merge_travel", "plan_tabs", "slot_features", "travel_slots"]
 
 PLANES = ("xz", "yz")
 MIN_TABS = 2
@@ -350,6 +365,7 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
     wall = s.min_wall
     perp = [n for n, p in parts.items() if p.plane in PLANES]
     xy = [n for n, p in parts.items() if p.plane == "xy"]
+    touching = {frozenset((j.a, j.b)) for j in mech.joints}
     # the stack along z: layer k of the xy plane between z0 + k t and z0 + (k + 1) t (mm).  The model's xy
     # plane (z = 0: where the #8 driver slides and the #6/#9 pin meets its driver's edge) is the mid-plane of
     # the layer the perpendicular stages ride on, as near as the pieces' cuts allow: a piece below the stack
@@ -466,10 +482,61 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
                 ats[n] = parts[ref].offset * u + ((layers.get(n) or 0) - (layers.get(ref) or 0)) * t
             candidates = [ats]
         else:
-            steps = [0.0] + [sgn * 0.5 * k for k in range(1, 401) for sgn in (1, -1)]
+            steps = [0.0] + [sgn * 0.5 * k for k in range(1, 121) for sgn in (1, -1)]  # up to 60 mm either way
             candidates = [base_y(y0) for y0 in steps]
+        # an xz plane's way through the other layers (each piece's body, cut flat, within each xy layer's band
+        # at each sample): where it must cut a travel slot, the slot must keep its walls too
+        ways: dict[tuple[str, str], list[tuple[int, float, float]]] = {}
+        if pl == "xz":
+            for n in (m for m in perp if parts[m].plane == "xz"):
+                body = material[n].intersection(_local(edges[n][3], pose[n])) if n in edges else material[n]
+                body = body.simplify(0.05)
+                for r in xy:
+                    if r == joined.get(n) or frozenset((n, r)) in touching:
+                        continue
+                    bd = band(r)
+                    got = [(k, _world(body, tuple(track[n][k])).intersection(bd)) for k in range(len(ok))]
+                    hits = [(k, g_.bounds[0], g_.bounds[2]) for k, g_ in got if g_.area > 1e-6]
+                    if hits:
+                        ways[(n, r)] = hits
+        walls_of = {r: [Polygon(h) for h in material[r].interiors] for r in xy if material[r].geom_type == "Polygon"}
+
+        def clear_way(y_of: dict[str, float], plan: dict[str, list[float]],
+                      ways: dict[tuple[str, str], list[tuple[int, float, float]]] = ways,
+                      walls_of: dict[str, list[Any]] = walls_of) -> bool:
+            slots_of: dict[str, list[Any]] = {}
+            for m, cs in plan.items():
+                slots_of.setdefault(joined[m], []).extend(
+                    _local(box(c - w / 2, y_of[m] - hw, c + w / 2, y_of[m] + hw), pose[joined[m]]) for c in cs)
+            rects: dict[str, list[Any]] = {}
+            for (n, r), hits in ways.items():
+                at = y_of[n]
+                foot = shapely.union_all([_local(box(a, at - t / 2, b, at + t / 2), tuple(track[r][k]))
+                                          for k, a, b in hits])
+                # a hull piece grows round its slots: its material is then at least their hull's
+                hull = parts[r].polygon is None and s.widen
+                where = shapely.union_all([material[r]] + [q.buffer(wall) for q in slots_of.get(r, [])]).convex_hull \
+                    if hull else material[r]
+                if foot.intersection(where).area <= 0.5:
+                    continue
+                rects.setdefault(r, []).append(foot.buffer(s.clearance, join_style="mitre").minimum_rotated_rectangle)
+            for r, rs in rects.items():
+                # side by side, two ways are one travel slot (merge_travel)
+                rs = [g_.minimum_rotated_rectangle for g_ in
+                      getattr(shapely.union_all([q.buffer(wall / 2) for q in rs]), "geoms",
+                              [shapely.union_all([q.buffer(wall / 2) for q in rs])])]
+                for rect in rs:
+                    if any(rect.distance(h) < wall for h in walls_of.get(r, [])):
+                        return False
+                    if parts[r].polygon is not None and not material[r].buffer(-wall).convex_hull.contains(rect):
+                        return False
+                    if any(q.distance(rect) < wall for q in slots_of.get(r, [])):
+                        return False
+            return True
+
         chosen = None
         failed: str | None = None
+        blocked = False
         for ats in candidates:
             plan = {}
             for n in mine:
@@ -480,8 +547,19 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
                     break
                 plan[n] = centres
             else:
+                if pl == "xz" and ways:
+                    y0 = next(ats[n] - ((layers.get(n) or 0) + 0.5) * t for n in mine)
+                    y_of = {m: y0 + ((layers.get(m) or 0) + 0.5) * t for m in perp if parts[m].plane == "xz"}
+                    if not clear_way(y_of, plan):
+                        blocked = True
+                        continue
                 chosen = (ats, plan)
                 break
+        if chosen is None and blocked:
+            raise FabricationError(f"parts {', '.join(repr(n) for n in mine)} ({pl}): wherever their tabs have room, "
+                                   "the travel slots the pieces of this plane need through the other layers would run "
+                                   f"into other cuts (less than {wall:g} mm between); they cannot be tab-joined "
+                                   "(a larger unit_mm or a thinner sheet)")
         if chosen is None:
             n = failed or mine[0]
             raise FabricationError(f"part {n!r} ({pl}): no line where it meets {joined[n]!r} has room for "
@@ -560,6 +638,32 @@ def travel_slots(mech: Any, layers: dict[str, int | None], material: dict[str, A
             notes.append(f"{r}: a travel slot {length:.1f} x {width:.1f} mm for {n} ({parts[n].plane}), which "
                          "passes through its layer")
     return out, notes
+
+
+def merge_travel(feats: list[Feature], wall: float) -> list[Feature]:
+    """Travel slots closer than ``wall`` to each other (two perpendicular pieces side by side) as one slot:
+    the smallest rectangle round both."""
+    from .fabrication import cut_polygon
+
+    out = list(feats)
+    merged = True
+    while merged:
+        merged = False
+        for i in range(len(out)):
+            for j in range(i + 1, len(out)):
+                a, b = cut_polygon(out[i].cut(0.0)), cut_polygon(out[j].cut(0.0))
+                if a.distance(b) < wall:
+                    rect = a.union(b).minimum_rotated_rectangle
+                    length, width, ang = _rect_sides(rect)
+                    c = rect.centroid
+                    what = out[i].what + " and " + out[j].what.removeprefix("travel slot for ")
+                    out[i] = Feature("rect", what, (float(c.x), float(c.y)), width / 2, R=length / 2, t0=ang)
+                    del out[j]
+                    merged = True
+                    break
+            if merged:
+                break
+    return out
 
 
 def _rect_sides(rect: Any) -> tuple[float, float, float]:
