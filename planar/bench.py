@@ -122,6 +122,7 @@ def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
     _pylinkage_of(mech, step).step_fast(iterations=16)  # numba compile (cached) outside the timing
     mech.solve(q[:m])
     planar_rates: list[float] = []
+    fresh_rates: list[float] = []
     peer_rates: list[float] = []
     planar_cpu: list[float] = []
     peer_cpu: list[float] = []
@@ -137,13 +138,27 @@ def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
             planar_cpu.append(time.process_time() - c0)
             valid = valid and bool(mo.valid.all())
 
+        def run_fresh() -> None:
+            # the same call with output recycling off (planar.buffers): every block is new memory
+            old = os.environ.get("PLANAR_RECYCLE")
+            os.environ["PLANAR_RECYCLE"] = "0"
+            try:
+                t0 = time.perf_counter()
+                mech.solve(q)
+                fresh_rates.append(n / (time.perf_counter() - t0))
+            finally:
+                if old is None:
+                    del os.environ["PLANAR_RECYCLE"]
+                else:
+                    os.environ["PLANAR_RECYCLE"] = old
+
         def run_peer(peer: Any = peer) -> None:
             c0, t0 = time.process_time(), time.perf_counter()
             peer.step_fast(iterations=n)
             peer_rates.append(n / (time.perf_counter() - t0))
             peer_cpu.append(time.process_time() - c0)
 
-        for fn in ((run_planar, run_peer) if r % 2 == 0 else (run_peer, run_planar)):
+        for fn in ((run_planar, run_peer, run_fresh) if r % 2 == 0 else (run_fresh, run_peer, run_planar)):
             fn()
     ratios = [a / b for a, b in zip(planar_rates, peer_rates)]
     return {
@@ -154,6 +169,9 @@ def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
         "peer_samples_per_s": _spread(peer_rates),
         "ratio": float(np.median(planar_rates) / np.median(peer_rates)),
         "ratio_per_repeat": _spread(ratios),
+        # the same solve writing into new memory every call (PLANAR_RECYCLE=0), what a single call costs
+        "planar_new_memory_samples_per_s": _spread(fresh_rates),
+        "ratio_new_memory": float(np.median(fresh_rates) / np.median(peer_rates)),
         # processor time (all threads of the process): the work each does, less sensitive to other load
         "planar_cpu_s": _spread(planar_cpu),
         "peer_cpu_s": _spread(peer_cpu),
@@ -190,7 +208,12 @@ def bench_kinematics(n: int = 1_000_000, repeats: int = 5) -> dict[str, Any]:
     repeats do not include; ``planar_cpu_s``/``peer_cpu_s`` the processor time
     of each call (all of planar's threads together) and ``cpu_ratio`` the
     ratio of their medians, the work each does, which other load on the machine
-    disturbs less than the wall-clock ``ratio``.
+    disturbs less than the wall-clock ``ratio``.  ``solve`` writes into the
+    output blocks of results the caller has dropped
+    (:mod:`planar.buffers`), as each timed call drops the last;
+    ``planar_new_memory_samples_per_s`` and ``ratio_new_memory`` time the
+    same call with that off (``PLANAR_RECYCLE=0``, new pages every call),
+    interleaved with the others.
     """
     if n < 1 or repeats < 1:
         raise PlanarError("planar bench kinematics needs n >= 1 and repeats >= 1")
@@ -221,6 +244,8 @@ def format_kinematics(r: dict[str, Any]) -> str:
             (f"    pylinkage step_fast        {q['median'] / 1e6:8.2f} M samples/s "
              f"({q['min'] / 1e6:.2f}-{q['max'] / 1e6:.2f})"),
             f"    ratio                      {c['ratio']:8.2f}  (per repeat {k['min']:.2f}-{k['max']:.2f})",
+            (f"    planar, new memory per call {c['planar_new_memory_samples_per_s']['median'] / 1e6:7.2f} M samples/s "
+             f"(PLANAR_RECYCLE=0): ratio {c['ratio_new_memory']:.2f}"),
             (f"    processor time             {c['planar_cpu_s']['median'] * 1e3:8.1f} ms vs "
              f"{c['peer_cpu_s']['median'] * 1e3:.1f} ms: ratio {c['cpu_ratio']:.2f}"),
             f"    max |planar - peer|        {c['max_abs_diff_vs_peer']:8.1e}  (size {c['size']:.3g})"

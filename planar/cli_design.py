@@ -7,7 +7,9 @@ cost, each effector's requested and measured range, the layers and any
 same-layer collision.  Exit status 2 for bad input or an unreachable request
 (one line naming the effector and what its chains reach; nothing written);
 3 when the written toy fails its own check (a range off by more than 1 %, a
-same-layer collision).
+same-layer collision, a pin through a piece, an export that refuses it, a
+motor torque off inverse dynamics by more than 1 %, a #8 tab letting go, or a
+stage the physics did not simulate: each named with its reason).
 """
 
 from __future__ import annotations
@@ -24,8 +26,7 @@ EXIT_MISMATCH = 3
 def _cmd_design(args: argparse.Namespace) -> int:
     import tomllib
 
-    from .pipeline import scene_from_mechanism
-    from .windup.design import TOLERANCE, design_toy, load_request
+    from .windup.design import TOLERANCE, design_scene, design_toy, load_request, physics_check, physics_failures
 
     from .errors import InputError
 
@@ -51,29 +52,17 @@ def _cmd_design(args: argparse.Namespace) -> int:
         raise InputError(f"{args.request}: name", name, "a string of at most 80 characters without commas, double "
                          "quotes or control characters")
     d = design_toy(effectors, name=name, max_length=args.max_length)
-    # a #8 stage's tab is held on its face by gravity along +x (README, "Wind-up toys"): the toy stands that way
-    effects = {"gravity": [9.81, 0.0]} if any(st.realisation.number == 8 for st in d.toy.stages) else {}
-    scene = scene_from_mechanism(d.toy, name=name, driver={"speed": 0.5, "samples_per_cycle": 36},
-                                 render={"width": 360, "height": 270}, fabrication={"unit_mm": 100.0},
-                                 effects=effects)
+    scene = design_scene(d.toy, name)
     scene.save(args.output)
+    # the toy as it will run (as `planar toy` checks it): the design has run it unless the tree failed before
+    phys = d.physics if d.physics is not None else physics_check(scene)
     rep = d.report()
+    rep["physics"] = phys
     rep["output"] = str(args.output)
     bad = [e for e in rep["effectors"] if e["error"] > TOLERANCE]
-    # the toy as it will run: coupled pymunk physics, the motor the only driver, its torque against inverse
-    # dynamics (as `planar toy` checks it), at the scene's speed
-    from .windup.toy_physics import simulate_toy
-
-    motion = scene.motion()
-    assert motion.t is not None
-    speed = scene.mechanism.driver.rate / (2 * math.pi)
-    phys = simulate_toy(scene.mechanism, motion.t, scene.effects, speeds=[speed])
-    tq = phys.torque
-    ok_physics = tq["failure"] is None and tq["max_rel_diff"] <= 0.01
-    lets_go = sorted(k for k, v in phys.liftoff.items() if v["liftoff_speed"] is not None and v["liftoff_speed"] <= speed)
-    rep["physics"] = {"torque_rel_diff": tq["max_rel_diff"], "failure": tq["failure"], "lets_go": lets_go,
-                      "not_simulated": [s.stage for s in phys.not_simulated], "ok": ok_physics and not lets_go}
-    ok = not bad and not d.collisions and not d.clashes and ok_physics and not lets_go
+    failures = physics_failures(phys)
+    ok = not bad and not d.collisions and not d.clashes and phys["ok"]
+    rep["ok"] = ok
     if args.json:
         print(json.dumps(rep, indent=2, sort_keys=True, default=float))
     else:
@@ -82,7 +71,7 @@ def _cmd_design(args: argparse.Namespace) -> int:
         print(f"{name}: cost {d.cost:g} ({d.toy.mechanism_count} mechanisms), {trees}{lead}; "
               f"{d.tried} of {d.candidates} trees sized")
         for r in d.rejected:
-            print(f"  passed over (its pieces collide): {r}")
+            print(f"  passed over (it failed a check): {r}")
         for e in rep["effectors"]:
             unit = "deg" if e["motion"][0] == "O" else "units"
             flag = "[ok]" if e["error"] <= TOLERANCE else "[FAIL]"
@@ -112,11 +101,12 @@ def _cmd_design(args: argparse.Namespace) -> int:
               f"poses: {len(d.collisions)}, pins through pieces: {len(d.clashes)} "
               + ("[ok]" if not (d.collisions or d.clashes) else "[FAIL] " + ", ".join(
                   [f"{a}/{b} {ov:.3g} mm^2" for a, b, ov in d.collisions] + d.clashes)))
-        print(f"  physics (as planar toy): motor torque vs inverse dynamics {tq['max_rel_diff']:.2g} of the peak"
-              + (f"; {tq['failure']}" if tq["failure"] else "")
-              + (f"; lets go at {speed:g} cycles/s: {', '.join(lets_go)}" if lets_go else "")
-              + (f"; not simulated: {', '.join(s.stage for s in phys.not_simulated)}" if phys.not_simulated else "")
-              + (" [ok]" if ok_physics and not lets_go else " [FAIL]"))
+        tq = phys["torque_rel_diff"]
+        print("  physics (as planar toy): " + (f"motor torque vs inverse dynamics {tq:.2g} of the peak"
+                                               if tq is not None else "not run")
+              + (" [ok]" if phys["ok"] else " [FAIL]"))
+        for why in failures:
+            print(f"    {why}")
         print(f"  wrote {args.output} ({sum(d.seconds.values()):.2f} s)")
     return 0 if ok else EXIT_MISMATCH
 
@@ -126,7 +116,11 @@ def add_parser(sub: Any) -> None:
     d = sub.add_parser("design", help="a wind-up toy from requested end-effector motions (writes a toy scene)",
                        description="Design a wind-up toy from a request file of [[effector]] tables (name, motion "
                                    "Ox Oy Oz Tx Ty Tz OzT, range in degrees for O/OzT or model units for T, "
-                                   "optional cam left/right and phase in cycles).")
+                                   "optional cam left/right and phase in cycles). Exit status 2 for bad input "
+                                   "or a range no chain reaches (nothing written); 3 when the toy written fails a "
+                                   "check (a range off by more than 1 %, a same-layer collision, a pin through a "
+                                   "piece, the export refusing it, or its physics: motor torque, a #8 tab letting "
+                                   "go, a stage not simulated), each failure named.")
     d.add_argument("request", help="request file (TOML, [[effector]] tables)")
     d.add_argument("-o", "--output", required=True, help="toy scene file to write (TOML)")
     d.add_argument("--json", action="store_true", help="print a JSON report")

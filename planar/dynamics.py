@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 
 from .geometry import poses_apply
 
-__all__ = ["gravity_and_damping", "inverse_dynamics_torque", "mass_properties", "part_mass_table"]
+__all__ = ["gravity_and_damping", "inverse_dynamics_torque", "mass_properties", "part_mass_table", "plane_gravity"]
 
 Array = NDArray[np.float64]
 
@@ -45,6 +45,25 @@ def gravity_and_damping(effects: Any) -> tuple[Array, float]:
         if effects.damping is not None:
             lam = -math.log(float(effects.damping))
     return g, lam
+
+
+def plane_gravity(plane: str, g: Any) -> Array:
+    """The scene's gravity ``(gx, gy)`` as it acts on a part moving in ``plane`` (that plane's two axes).
+
+    A toy's gravity is the 3D vector ``(gx, gy, 0)`` in the toy's frame (the
+    scene names no z).  ``"xy"`` takes it as given; ``"xz"`` (the pieces of
+    wind-up #8) feels ``(gx, 0)``: ``gy`` runs along the plane's normal, the
+    axis the piece turns about, where it does no work; ``"yz"`` (the followers
+    of #6/#9) feels ``(gy, 0)``: ``gx`` is that plane's normal.  (Until
+    2026-11-22 an xz piece took ``gy`` along z, so a toy lying with gravity
+    along -y had its #8 tabs held by a gravity that cannot reach them.)
+    """
+    g = np.asarray(g, float)
+    if plane == "yz":
+        return np.array([g[1], 0.0])
+    if plane == "xz":
+        return np.array([g[0], 0.0])
+    return g
 
 
 def _ring_moments(xy: Array) -> tuple[float, float, float, float]:
@@ -118,6 +137,7 @@ def inverse_dynamics_torque(mech: Any, t: Array, effects: Any = None, densities:
     g, lam = gravity_and_damping(effects)
     tau = np.zeros(t.size)
     for name, (mass, cog, inertia) in part_mass_table(mech, effects, densities).items():
+        gp = plane_gravity(getattr(mech.part(name), "plane", "xy"), g)
         c = np.asarray(cog, float)
         X0, Xp, Xm = (poses_apply(m.poses[name], c) for m in (m0, mp, mm))
         v = (Xp - Xm) / (2 * h)                    # d X_G / dt
@@ -127,7 +147,7 @@ def inverse_dynamics_torque(mech: Any, t: Array, effects: Any = None, densities:
         om = (fwd + back) / (2 * h)
         al = (fwd - back) / (h * h)
         # power balance divided by the driver rate: tau w = sum (m a - m g + lam m v) . v + I (alpha + lam om) om
-        tau += (mass * ((a - g + lam * v) * v).sum(-1) + inertia * (al + lam * om) * om) / w
+        tau += (mass * ((a - gp + lam * v) * v).sum(-1) + inertia * (al + lam * om) * om) / w
     if effects is not None:
         for load in effects.loads:
             vp = (mp.points[load.point] - mm.points[load.point]) / (2 * h)

@@ -263,7 +263,7 @@ def _drop_contained(feats: list[Feature]) -> list[Feature]:
     keep = []
     for i, p in enumerate(polys):
         inside = any(j != i and (polys[j].buffer(1e-6).contains(p) and (polys[j].area > p.area or j < i)
-                                 or _same_guide(feats[i], feats[j], j < i))
+                                 or _same_guide(feats[i], feats[j], j < i) or _same_arc(feats[i], feats[j], j < i))
                      for j in range(len(polys)))
         if not inside:
             keep.append(feats[i])
@@ -289,6 +289,24 @@ def _same_guide(f: Feature, g: Feature, g_first: bool, tol: float = 1e-6) -> boo
         return False
     flen = float(np.hypot(*(np.asarray(f.b) - np.asarray(f.a))))
     return L > flen + tol or (abs(L - flen) <= tol and g_first)
+
+
+def _same_arc(f: Feature, g: Feature, g_first: bool, tol: float = 1e-6) -> bool:
+    """Whether arc slot ``f`` lies on arc slot ``g`` (one centre and radius, no wider, within ``g``'s angles):
+    one track, cut once as ``g`` (two toy stages' tracks on one frame; their polygons' chords differ, so the
+    polygon test above misses it)."""
+    if f.kind != "arc" or g.kind != "arc" or f is g:
+        return False
+    if math.dist(f.a, g.a) > tol or abs(f.R - g.R) > tol or f.r > g.r + tol:
+        return False
+    start = (f.t0 - g.t0) % (2 * math.pi)
+    if start > 2 * math.pi - tol / max(g.R, tol):
+        start -= 2 * math.pi
+    end, span = start + (f.t1 - f.t0), g.t1 - g.t0
+    if start < -tol / max(g.R, tol) or end > span + tol / max(g.R, tol):
+        return False
+    same = abs(start) <= tol / max(g.R, tol) and abs(end - span) <= tol / max(g.R, tol) and abs(f.r - g.r) <= tol
+    return not same or g_first
 
 
 def _closest_cuts(feats: Sequence[Feature]) -> tuple[float, Feature | None, Feature | None]:

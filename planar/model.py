@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Literal, Mapping, Protocol, Seq
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .buffers import block as new_block
 from .errors import InputError
 from .geometry import poses_apply
 
@@ -46,6 +47,7 @@ __all__ = [
     "joint_residuals",
     "check_positive",
     "check_finite",
+    "FinitePoses",
 ]
 
 Vec = tuple[float, float]
@@ -60,9 +62,16 @@ def check_finite(field_name: str, value: ArrayLike) -> NDArray[np.float64]:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError, OverflowError):
         raise InputError(field_name, value, "numbers (a number or an array of them)") from None
-    if not np.all(np.isfinite(arr)):
+    # a sum is finite only if every term is (NaN and inf propagate); a finite array whose sum
+    # overflows is looked at element by element
+    if not np.isfinite(arr.sum()) and not np.all(np.isfinite(arr)):
         raise InputError(field_name, value, "finite numbers")
     return arr
+
+
+class FinitePoses(dict[str, "NDArray[np.float64]"]):
+    """Poses from a solver that screened every number it wrote (poses and named points) and found
+    them finite: :meth:`Mechanism.solve` skips its own finite screen for them."""
 
 
 def check_positive(field_name: str, value: float) -> float:
@@ -595,7 +604,9 @@ class Mechanism:
 
     def solve(self, q: ArrayLike, t: ArrayLike | None = None) -> Motion:
         """Solve all samples at once for driver values ``q`` (scalar or array)."""
-        qa = np.atleast_1d(check_finite(f"{self.name}.driver value", q)).astype(float)
+        qin = np.atleast_1d(check_finite(f"{self.name}.driver value", q))
+        qa = new_block(qin.shape)  # the motion's own copy (recycled memory for a large batch)
+        np.copyto(qa, qin)
         if qa.ndim != 1:  # an OzT driver's path is a function of its 1-D driver value too
             raise InputError(f"{self.name}.solve(q)", f"an array of shape {qa.shape}",
                              "a scalar or a 1-D array of driver values")
@@ -609,7 +620,7 @@ class Mechanism:
             pts = {name: poses_apply(poses[part], xy) for name, (part, xy) in self.points.items()}
         # the final finite check: a sample whose numbers overflowed float64 is never valid (and holds 0, not NaN)
         finite = np.ones(n, dtype=bool)
-        for arr in (*poses.values(), *pts.values()):
+        for arr in () if isinstance(poses, FinitePoses) else (*poses.values(), *pts.values()):
             if not np.isfinite(arr.sum()):  # a cheap screen (a sum of finite numbers may overflow: then look closer)
                 finite &= np.isfinite(arr).reshape(n, -1).all(axis=1)
         if not finite.all():

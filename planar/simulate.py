@@ -507,6 +507,19 @@ class _Rebuild:
                 # stays (0, 0)): with an offset centre of gravity pymunk 7.3's GrooveJoint lets the
                 # pin leave its groove, so part-frame anchors are shifted by ``cog`` instead.
                 self.cog[p.name] = cog
+            plane = getattr(p, "plane", "xy")
+            if plane != "xy" and body.body_type == pymunk.Body.DYNAMIC and effects is not None \
+                    and effects.gravity is not None:
+                # a toy's piece in another plane feels the part of the toy's gravity in its plane
+                from .dynamics import plane_gravity
+
+                gp = plane_gravity(plane, effects.gravity) * dt * dt
+                own = (float(gp[0]), float(gp[1]))
+
+                def _velocity(b: Any, _g: Any, damping: float, step: float, own: tuple[float, float] = own) -> None:
+                    pymunk.Body.update_velocity(b, own, damping, step)
+
+                body.velocity_func = _velocity
             c, s_ = math.cos(pose0[2]), math.sin(pose0[2])
             cx, cy = self.cog[p.name]
             body.position = (float(pose0[0] + c * cx - s_ * cy), float(pose0[1] + s_ * cx + c * cy))

@@ -166,6 +166,9 @@ def test_bench_synthesis_quick_timed_problem():
     assert c["planar"]["ok"] and c["planar"]["sse_min"] < 1e-3
     assert "pylinkage" in c["pylinkage"]["call"] and c["published_best_error"]
     assert r["kernel_candidates_per_s"]["median"] > 0
+    o = c["pylinkage_optimisers"]   # timed: pylinkage's own sse and planar's, at the same crank angles
+    assert o["ok"] and o["sse_min"] == pytest.approx(o["pylinkage_sse_of_best"], rel=1e-9)
+    assert c["pylinkage_four_targets"]["solutions"] > 0
 
 
 @pytest.mark.parametrize("topology", ["stephenson", "watt"])

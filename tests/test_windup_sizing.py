@@ -62,10 +62,11 @@ def test_every_mechanism_sizes_within_a_second(k):
     base = motion_range(elemental(k))
     size_for_range(k, base)  # warm-up (imports)
     for factor in (0.9, 1.1):
-        t0 = time.perf_counter()
+        # processor time, not wall time: other work on a shared CI machine does not count against it
+        t0 = time.process_time()
         s = size_for_range(k, factor * base)
-        dt = time.perf_counter() - t0
-        assert dt < 1.0, f"#{k}: {dt:.2f} s"
+        dt = time.process_time() - t0
+        assert dt < 1.0, f"#{k}: {dt:.2f} s of processor time"
         assert s.achieved == pytest.approx(factor * base, rel=1e-9)
         assert motion_range(s.mechanism) == pytest.approx(factor * base, rel=1e-9)
     # the default value lies inside the default bracket, so the default range is reachable

@@ -612,40 +612,48 @@ def _program(plan: _Plan) -> Any:
 
 def _solve_compiled(lk: Linkage, plan: _Plan, prog: Any, q: Array, tols: list[float], nthreads: int,
                     chunk: int) -> Solved | None:
+    from ..model import FinitePoses
+    from ..buffers import block as new_block
     from .compiled import solve_range
 
     n = q.shape[0]
     q = np.ascontiguousarray(q, dtype=float)
     poses: dict[str, Array] = {}
-    block = np.empty((prog.links.shape[0], n, 3))
+    block = new_block((prog.links.shape[0], n, 3))
     m = 0
+    ground_row = np.array(plan.placement, dtype=float)
+    grounds: list[Array] = []  # filled by the threads, range by range
     for name, o, _, _ in plan.links:
         if o < 0:
-            poses[name] = _ground_pose(n, plan.placement)
+            poses[name] = new_block((n, 3))
+            grounds.append(poses[name])
         else:
             poses[name] = block[m]
             m += 1
-    pblock = np.empty((prog.pts.shape[0], n, 2))
+    pblock = new_block((prog.pts.shape[0], n, 2))
     points = {name: pblock[i] for i, (name, _) in enumerate(plan.points)}
-    oks = np.empty((len(plan.checks), n), dtype=bool)
+    oks = new_block((len(plan.checks), n), bool)
     tol = np.asarray(tols, dtype=float)
     # more ranges than threads, taken in turn by each thread: a thread slowed by other work on
     # the machine leaves its share to the others (the result does not depend on the ranges)
     ranges = _cuts(n, chunk, nthreads * JIT_RANGES_PER_THREAD if nthreads > 1 else 1) if n else []
     fails = np.zeros((len(ranges), len(plan.checks)), dtype=np.int64)
     bad_chunks = np.zeros(-(-n // chunk), dtype=bool)
-    switched = [False] * len(ranges)
+    # per range: -1 where a branch may switch, else its count of non-finite pose and point rows
+    found = [0] * len(ranges)
     taken, lock = count(), Lock()
 
     def work() -> None:
         while True:
             with lock:
                 t = next(taken)
-            if t >= len(ranges) or any(switched):
+            if t >= len(ranges) or min(found) < 0:
                 return
             a, b = ranges[t]
-            switched[t] = bool(solve_range(q, a, b, chunk, prog.kinds, prog.refs, prog.par, tol, prog.check_row,
-                                           prog.links, prog.pts, prog.pl, block, pblock, oks, fails[t], bad_chunks))
+            found[t] = int(solve_range(q, a, b, chunk, prog.kinds, prog.refs, prog.par, tol, prog.check_row,
+                                       prog.links, prog.pts, prog.pl, block, pblock, oks, fails[t], bad_chunks))
+            for g in grounds:
+                g[a:b] = ground_row
 
     workers = min(nthreads, len(ranges))
     if workers > 1:
@@ -653,8 +661,10 @@ def _solve_compiled(lk: Linkage, plan: _Plan, prog: Any, q: Array, tols: list[fl
             f.result()
     else:
         work()
-    if any(switched):
+    if min(found, default=0) < 0:
         return None
+    if not any(found):
+        poses = FinitePoses(poses)
     checks: list[tuple[Mask, str, str]] | None = None
     if fails.any():
         oks[:, ~np.repeat(bad_chunks, chunk)[:n]] = True  # chunks where every sample closes

@@ -289,39 +289,60 @@ def _may_switch(x, y, ok, sep, tol, q, first, L):
 
 @njit(**_JIT)
 def _k_pose(xo, yo, xa, ya, xb, yb, m, pl, P):
-    """Pose rows ``P[:m]`` from node windows of length ``m``: origin, ``atan2`` of ``a -> b``, placement."""
+    """Pose rows ``P[:m]`` from node windows of length ``m``: origin, ``atan2`` of ``a -> b``, placement.
+
+    Returns how many rows hold a non-finite number (counted as they are written: the
+    caller's finite screen needs no second pass over the output)."""
     px, py, pa, c, s = pl[0], pl[1], pl[2], pl[3], pl[4]
     F = P.ravel()
+    bad = 0
     if pa == 0.0 and px == 0.0 and py == 0.0:
         for i in range(m):
-            F[3 * i] = xo[i]
-            F[3 * i + 1] = yo[i]
-            F[3 * i + 2] = _atan2(yb[i] - ya[i], xb[i] - xa[i])
+            u, v = xo[i], yo[i]
+            w = _atan2(yb[i] - ya[i], xb[i] - xa[i])
+            F[3 * i] = u
+            F[3 * i + 1] = v
+            F[3 * i + 2] = w
+            bad += not math.isfinite(u + v + w)
     else:
         for i in range(m):
-            F[3 * i] = (px + xo[i] * c) - yo[i] * s
-            F[3 * i + 1] = (py + xo[i] * s) + yo[i] * c
-            F[3 * i + 2] = _atan2(yb[i] - ya[i], xb[i] - xa[i]) + pa
+            u = (px + xo[i] * c) - yo[i] * s
+            v = (py + xo[i] * s) + yo[i] * c
+            w = _atan2(yb[i] - ya[i], xb[i] - xa[i]) + pa
+            F[3 * i] = u
+            F[3 * i + 1] = v
+            F[3 * i + 2] = w
+            bad += not math.isfinite(u + v + w)
+    return bad
 
 
 @njit(**_JIT)
 def _k_point(x, y, m, pl, out):
+    """Named point rows ``out[:m]``; returns how many hold a non-finite number."""
     px, py, pa, c, s = pl[0], pl[1], pl[2], pl[3], pl[4]
     F = out.ravel()
+    bad = 0
     if pa == 0.0 and px == 0.0 and py == 0.0:
         for i in range(m):
-            F[2 * i] = x[i]
-            F[2 * i + 1] = y[i]
+            u, v = x[i], y[i]
+            F[2 * i] = u
+            F[2 * i + 1] = v
+            bad += not math.isfinite(u + v)
     else:
         for i in range(m):
-            F[2 * i] = (px + x[i] * c) - y[i] * s
-            F[2 * i + 1] = (py + x[i] * s) + y[i] * c
+            u = (px + x[i] * c) - y[i] * s
+            v = (py + x[i] * s) + y[i] * c
+            F[2 * i] = u
+            F[2 * i + 1] = v
+            bad += not math.isfinite(u + v)
+    return bad
 
 
 @njit(**_JIT)
 def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts, pl, poses, points, oks, fails,
                 bad_chunks):
-    """Solve samples ``lo:hi`` chunk by chunk; returns whether a branch may switch (then stops early).
+    """Solve samples ``lo:hi`` chunk by chunk; returns -1 where a branch may switch (then it stops
+    early), else the number of pose and point rows holding a non-finite number.
 
     ``kinds[i]``, ``refs[i]``, ``par[i]``: node ``i``'s kind code, referenced
     nodes and numbers (:data:`ENCODERS`); ``tols[i]`` its branch-screen
@@ -339,6 +360,7 @@ def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts,
     Y = np.empty((nn, W))
     OK = np.ones((nn, W), dtype=np.bool_)
     sep = np.empty(W)
+    nonfinite = 0
     for i in range(lo, hi, chunk):
         j = min(i + chunk, hi)
         ws = max(0, i - 3)
@@ -368,7 +390,7 @@ def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts,
             else:
                 nf = _k_rigid(p, L, X[r[0]], Y[r[0]], X[r[1]], Y[r[1]], xo, yo, ok)
             if (k == RRR or k == RRP) and _may_switch(xo, yo, ok, sep, tols[nd], qw, first, L):
-                return True
+                return -1
             if nf and check_row[nd] >= 0:
                 okw = ok[off:]
                 cnt = 0
@@ -387,10 +409,11 @@ def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts,
                         o[t] = okw[t]
         for li in range(links.shape[0]):
             o, a, b = links[li, 0], links[li, 1], links[li, 2]
-            _k_pose(X[o, off:], Y[o, off:], X[a, off:], Y[a, off:], X[b, off:], Y[b, off:], m, pl, poses[li, i:j])
+            nonfinite += _k_pose(X[o, off:], Y[o, off:], X[a, off:], Y[a, off:], X[b, off:], Y[b, off:], m, pl,
+                                 poses[li, i:j])
         for pi in range(pts.shape[0]):
-            _k_point(X[pts[pi], off:], Y[pts[pi], off:], m, pl, points[pi, i:j])
-    return False
+            nonfinite += _k_point(X[pts[pi], off:], Y[pts[pi], off:], m, pl, points[pi, i:j])
+    return nonfinite
 
 
 # ------------------------------------------------------------------ programs

@@ -20,16 +20,20 @@ A request lists end effectors (``[[effector]]``: ``name``, ``motion``,
    request; stages are sized parents first;
 5. **places** the stages (:func:`place_stages`): a toy's stages sit where the
    assembly puts them (a child's driver on its parent's follower, the roots on
-   the motor axis); the free variables are the follower positions that change
-   no motion (#1's slider, #9's pivot: ``F_o``), annealed toward a small
-   footprint and little overlap of unjoined pieces; the result is kept only if
-   it adds no collision, pin clash or layer;
+   the motor axis); the free variables are each stage's joint moves that
+   change no motion (:func:`placement_variables`: found per stage on its real
+   input among :data:`MOVES`, e.g. #1's slider, #4's follower origin about its
+   pin, #7's pin and pivot together), annealed toward a small footprint and
+   little overlap of unjoined pieces or crowding of cuts; the result is kept
+   only if it adds no export refusal, collision, pin clash or layer;
 6. **checks** the result independently: each effector's range is measured on
    the assembled toy's piece poses, and the export's own layer plan
    (:func:`planar.fabexport.build`) is checked with shapely for pieces of one
    layer overlapping at any of 24 sampled poses and for pins running through
-   a piece.  A tree that fails is passed over for the next cheapest (up to
-   ``max_fabricated``); if all fail, the cheapest is returned with its
+   a piece; then the toy's physics (:func:`physics_check`, as ``planar toy``).
+   A tree that fails is tried again with its cranks grown into disc cams
+   (:func:`_disc_cams`, same motion), then passed over for the next cheapest
+   (up to ``max_fabricated``); if all fail, the cheapest is returned with its
    failures (``planar design`` exits 3).
 
 Units: ranges of O motions (and the rotation of OzT) in degrees, of T
@@ -109,6 +113,7 @@ class Design:
     rejected: list[str] = field(default_factory=list)  # cheaper trees whose fabrication collided
     before: dict[str, int] = field(default_factory=dict)  # layers, collisions, pin clashes before placement
     before_reason: str = ""  # why the export refused the pieces before placement, if it did
+    physics: dict[str, Any] | None = None  # :func:`physics_check` of the written toy (None: not run)
 
     def report(self) -> dict[str, Any]:
         return {
@@ -136,6 +141,7 @@ class Design:
             "collisions": [{"a": a, "b": b, "overlap": ov} for a, b, ov in self.collisions],
             "pin_clashes": self.clashes,
             "rejected_trees": self.rejected,
+            "physics": self.physics,
             "seconds": self.seconds,
         }
 
@@ -320,6 +326,8 @@ def _candidates(effectors: list[Effector], options: list[list[Chain]], limit: in
                 ) -> list[tuple[float, int, list[tuple[str, Chain]]]]:
     """Every assignment of one chain and one cam per effector, cheapest first (cost, then enumeration order)."""
     cams = [[e.cam] if e.cam else list(CAMS) for e in effectors]
+    if not any(e.cam for e in effectors):
+        cams[0] = [CAMS[0]]  # with no cam named, a tree and its mirror image (cams swapped) are one design
     n = math.prod(len(o) for o in options) * math.prod(len(c) for c in cams)
     if n > limit:
         raise InputError("request", [e.name for e in effectors],
@@ -345,6 +353,24 @@ def _candidates(effectors: list[Effector], options: list[list[Chain]], limit: in
             out.append((tree_cost(tree), k, pairs))
     out.sort(key=lambda x: (x[0], x[1]))
     return out
+
+
+def _no_tree(effectors: list[Effector], options: list[list[Chain]]) -> tuple[str, Any, str]:
+    """Why no assignment of chains and cams exists (the fields of an :class:`InputError`): two effectors that
+    would be one stage's follower (one chain each, one cam), or the cams' phases."""
+    cams = [[e.cam] if e.cam else list(CAMS) for e in effectors]
+    for i, j in itertools.combinations(range(len(effectors)), 2):
+        a, b = effectors[i], effectors[j]
+        shared = set(options[i]) & set(options[j])
+        if shared and set(options[i]) == shared == set(options[j]) and set(cams[i]) == set(cams[j]) \
+                and len(cams[i]) * len(options[i]) == 1:
+            chain = " ".join(next(iter(shared)))
+            return (f"effectors {a.name!r} and {b.name!r} ({a.motion}, {b.motion})", f"{cams[i][0]} cam",
+                    f"effectors with a follower each: their only chain, {chain}, on one cam is one stage "
+                    "(put them on different cams, or ask for different motions)")
+    return ("request", [e.name for e in effectors],
+            "an assignment of one chain and one cam per effector (two effectors cannot be one stage's follower, "
+            "and one cam turns its effectors at one phase)")
 
 
 def _size_tree(effectors: list[Effector], pairs: list[tuple[str, Chain]], phase: float, q: Array,
@@ -460,13 +486,93 @@ def layer_collisions(toy: ToyMechanism, samples: int = 24, unit_mm: float = 100.
     return layers, found, clashes
 
 
+#: the written toy's scene tables: half a cycle a second, 36 frames a cycle, a small GIF, 100 mm a unit
+SCENE_TABLES: dict[str, Any] = {"driver": {"speed": 0.5, "samples_per_cycle": 36},
+                                "render": {"width": 360, "height": 270}, "fabrication": {"unit_mm": 100.0}}
+#: the motor torque's largest allowed difference from inverse dynamics, fraction of its peak (as ``planar toy``)
+TORQUE_TOLERANCE = 0.01
+
+
+def design_scene(toy: ToyMechanism, name: str) -> Any:
+    """The scene ``planar design`` writes for ``toy``.  A #8 stage's tab is held on its face by gravity along
+    +x (README, "Wind-up toys"): a toy with one is written standing that way, so its tab is held and simulated."""
+    from ..pipeline import scene_from_mechanism
+
+    effects = {"gravity": [9.81, 0.0]} if any(st.realisation.number == 8 for st in toy.stages) else {}
+    return scene_from_mechanism(toy, name=name, effects=effects, **SCENE_TABLES)
+
+
+def physics_check(scene: Any) -> dict[str, Any]:
+    """Run the scene's toy as ``planar toy`` does and judge it: a dict with ``ok`` and the figures.
+
+    Coupled pymunk physics, the motor the only driver, its torque against
+    inverse dynamics at the scene's speed (``torque_rel_diff``, fraction of
+    the peak; ``failure``), each #8 tab's lift-off (``lets_go``: stages whose
+    tab lets go at that speed) and every stage the physics did not simulate,
+    or simulated with a result it does not accept (``not_simulated``: stage
+    label, pattern, the effector it ends, the reason).  ``ok`` is false for
+    any of them; a physics run that refuses the toy (a :class:`PlanarError`)
+    is ``failure``.
+    """
+    from .toy_physics import simulate_toy
+
+    toy = scene.mechanism
+    speed = toy.driver.rate / (2 * math.pi)
+    effector = {st.label: toy.names.get((st.cam, st.key)) for st in toy.stages}
+    try:
+        motion = scene.motion()
+        phys = simulate_toy(toy, motion.t, scene.effects, speeds=[speed])
+    except PlanarError as e:
+        return {"ok": False, "torque_rel_diff": None, "failure": f"the physics refuses the toy: {e}",
+                "lets_go": [], "not_simulated": [], "stages": [], "speed": speed}
+    tq = phys.torque
+    lets_go = sorted(k for k, v in phys.liftoff.items()
+                     if v["liftoff_speed"] is not None and v["liftoff_speed"] <= speed)
+    missing = [{"stage": s.stage, "pattern": s.pattern, "effector": effector.get(s.stage), "reason": s.detail}
+               for s in phys.not_simulated]
+    ok = tq["failure"] is None and tq["max_rel_diff"] <= TORQUE_TOLERANCE and not lets_go and not missing
+    return {"ok": bool(ok), "torque_rel_diff": float(tq["max_rel_diff"]), "failure": tq["failure"],
+            "lets_go": lets_go, "not_simulated": missing, "speed": speed,
+            "stages": [{"stage": s.stage, "pattern": s.pattern, "simulated": s.simulated, "detail": s.detail}
+                       for s in phys.stages]}
+
+
+def physics_failures(phys: dict[str, Any]) -> list[str]:
+    """One line per reason the physics check failed (empty when it passed)."""
+    out = []
+    if phys["failure"]:
+        out.append(str(phys["failure"]))
+    elif phys["torque_rel_diff"] is not None and phys["torque_rel_diff"] > TORQUE_TOLERANCE:
+        out.append(f"motor torque strays {phys['torque_rel_diff']:.2g} of its peak from inverse dynamics "
+                   f"(more than {TORQUE_TOLERANCE:g})")
+    for k in phys["lets_go"]:
+        out.append(f"stage {k}'s tab lets go at {phys['speed']:g} cycles/s")
+    for m in phys["not_simulated"]:
+        who = f" (effector {m['effector']!r})" if m["effector"] else ""
+        out.append(f"stage {m['stage']} {m['pattern']}{who} not simulated: {m['reason']}")
+    return out
+
+
 # ----------------------------------------------------------------------------- placement
 
-#: stages whose follower can move relative to the driver without changing any motion (the slider of #1,
-#: the pivot of #9): ``F_o``'s in-plane components are the placement variables (checked again at run time)
-PLACEABLE = {1: "F_o", 9: "F_o"}
+#: candidate placement moves of a stage, tried on every stage: a name and the parameters it shifts together
+#: (``+1``/``-1``), one component at a time.  A move is a placement variable of a stage only where it leaves
+#: the stage's motion on its real input unchanged (to 1e-9, :func:`placement_variables`) and changes its
+#: parts: e.g. #1's and #9's follower (``F_o``), #4's and #10's follower origin about its pin (``F_o`` with
+#: ``F_jc`` back), #7's driver pin and follower pivot together, #8's pivot with its tab.
+MOVES: tuple[tuple[str, dict[str, int]], ...] = (
+    ("F_o", {"F_o": 1}),
+    ("F_jc", {"F_jc": 1}),
+    ("D_jc", {"D_jc": 1}),
+    ("S_c", {"S_c": 1}),
+    ("F_o-F_jc", {"F_o": 1, "F_jc": -1}),
+    ("F_o-S_c", {"F_o": 1, "S_c": -1}),
+    ("F_o+D_jc", {"F_o": 1, "D_jc": 1}),
+)
+#: the shifts (model units) a move is tried at before it is taken as a placement variable
+MOVE_PROBES = (-0.2, -0.05, 0.05, 0.2)
 #: annealing: iterations, step (model units), box around the default position (model units), overlap weight
-ANNEAL_STEPS = 24
+ANNEAL_STEPS = 40
 ANNEAL_STEP = 0.08
 ANNEAL_BOX = 0.4
 OVERLAP_WEIGHT = 10.0
@@ -476,6 +582,15 @@ SIMPLIFY = 0.003
 PLACEMENT_OPTIONS = 2
 #: a pin's radius in the placement's clash penalty (model units: 1.5 mm)
 PIN_RADIUS = 0.015
+#: the pieces' crowding in the placement objective (model units at 100 mm a unit, the export's defaults): the
+#: least wall between cuts with the clearance (2 mm), the motor's shaft clearance and screws (9 mm apart)
+WALL = 0.02
+MOTOR_SHAFT_R = 0.023
+MOTOR_SCREW_X = 0.045
+MOTOR_SCREW_R = 0.012
+#: crowding counts this many times its area in the overlap (the export refuses a crowded piece, while
+#: overlapping pieces may still go on different layers)
+CROWDING_WEIGHT = 1000.0
 
 
 @dataclass
@@ -493,34 +608,59 @@ class Placement:
     checked: int = 0  # annealed layouts checked against the fabrication
 
 
-def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
-    """``(footprint, overlap)``: the convex hull area of every xy piece's swept region over one cycle, and the
-    summed swept overlap of xy pieces no joint connects (pairs that must go on different layers); units^2."""
+def _posed(shape: Any, pose: Array) -> Any:
+    """``shape`` (own frame) placed at every pose of ``pose`` (k x 3: x, y, angle in rad): k geometries,
+    transformed in one array expression (every copy has the same coordinates, in order)."""
     import shapely
-    from shapely import affinity
+
+    n = int(shapely.get_num_coordinates(shape))
+    geoms = np.empty(len(pose), dtype=object)
+    geoms[:] = [shape] * len(pose)
+    P = np.repeat(pose, n, axis=0)
+    c, s = np.cos(P[:, 2]), np.sin(P[:, 2])
+
+    def move(xy: Array) -> Array:
+        return np.column_stack([P[:, 0] + c * xy[:, 0] - s * xy[:, 1], P[:, 1] + s * xy[:, 0] + c * xy[:, 1]])
+    return shapely.transform(geoms, move)
+
+
+def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
+    """``(footprint, overlap)`` of the toy's pieces over one cycle (``samples`` poses), units^2.
+
+    Footprint: the convex hull area of every piece's swept region, summed over
+    the planes the pieces move in (xy, and xz/yz for #8, #6, #9).  Overlap:
+    the swept overlap of pieces of one plane that no joint connects (pairs
+    that must go on different layers), plus the area pins sweep through pieces
+    of their plane they do not hold, plus the pieces' crowding (a piece's cuts,
+    each grown by half a wall, overlapping one another, or the frame's the
+    motor's screws: what the export refuses as too little material),
+    ``CROWDING_WEIGHT`` x its area.
+    """
+    import shapely
 
     from ..assembly import pin_stacks
     from ..fabjoints import joint_pins
+    from ..model import Hole
+    from ..outlines import feature_shape
     from .assembly import ToyAssembly
 
     asm = ToyAssembly(toy)
     m = asm.run(samples_per_cycle=samples)
     joined = {frozenset((j.a, j.b)) for j in asm.joints}
+    plane = {p.name: p.plane for p in asm.parts}
     swept = {}
     for p in asm.parts:
-        if p.plane != "xy":
-            continue
         pose = np.asarray(m.poses[p.name])
-        c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+        if p.ground:
+            pose = pose[:1]  # a frame does not move
         shape = p.outline.simplify(SIMPLIFY)  # 0.3 mm: the objective need not follow every facet of a cam
-        swept[p.name] = shapely.union_all([affinity.affine_transform(shape, [c[k], -s[k], s[k], c[k],
-                                                                            pose[k, 0], pose[k, 1]])
-                                           for k in range(len(pose))])
-    footprint = float(shapely.union_all(list(swept.values())).convex_hull.area)
+        swept[p.name] = shapely.union_all(_posed(shape, pose))
+    footprint = sum(float(shapely.union_all([g for n, g in swept.items() if plane[n] == pl]).convex_hull.area)
+                    for pl in sorted(set(plane.values())))
     overlap = 0.0
-    names = [n for n in swept if n != "frame"]
+    names = [n for n in swept if not asm.part(n).ground]
     for a, b in itertools.combinations(names, 2):
-        if frozenset((a, b)) not in joined:
+        if plane[a] == plane[b] and frozenset((a, b)) not in joined:
             overlap += float(swept[a].intersection(swept[b]).area)
     # pins crossing pieces they do not join (the fabrication would need them on layers outside the pin)
     pins, _ = joint_pins(asm)
@@ -537,15 +677,112 @@ def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
         geom = shapely.buffer(shapely.points(path[0]) if np.ptp(path, axis=0).max() < 1e-9
                               else shapely.linestrings(path), PIN_RADIUS)
         for n in names:
-            if n not in on:
+            if n not in on and plane[n] == plane[a]:
                 overlap += float(swept[n].intersection(geom).area)
+    # a piece's cuts too close to one another, the frame's to the motor (each piece in its own frame)
+    for p in asm.parts:
+        cuts = [feature_shape(f, WALL / 2) for f in p.features
+                if not (p.ground and p.plane == "xy" and isinstance(f, Hole) and np.hypot(*f.centre) < 1e-9)]
+        if p.ground and p.plane == "xy":
+            cuts += [shapely.Point(sx * MOTOR_SCREW_X, 0.0).buffer(MOTOR_SCREW_R + WALL / 2) for sx in (-1, 1)]
+            cuts.append(shapely.Point(0.0, 0.0).buffer(MOTOR_SHAFT_R + WALL / 2))
+        for g, h in itertools.combinations(cuts, 2):
+            if not (g.contains(h) or h.contains(g)):
+                overlap += CROWDING_WEIGHT * float(g.intersection(h).area)
     return footprint, overlap
+
+
+@dataclass(frozen=True)
+class PlacementVariable:
+    """One placement variable: a stage (``cam``, ``key``), a move of :data:`MOVES` and the component it shifts."""
+
+    cam: str
+    key: Chain
+    move: str
+    shifts: tuple[tuple[str, int], ...]
+    comp: int
+
+    @property
+    def label(self) -> str:
+        return f"{self.cam} {' '.join(self.key)}: {self.move}[{'xyz'[self.comp]}]"
+
+
+def _shifted(kw: dict[str, Any], number: int, var: PlacementVariable, dx: float) -> dict[str, Any]:
+    """``kw`` with ``var``'s move applied by ``dx`` (model units)."""
+    out = dict(kw)
+    defaults = params_for(number)
+    for pname, sign in var.shifts:
+        cur = list(out.get(pname, getattr(defaults, pname)))
+        cur[var.comp] = float(cur[var.comp]) + sign * dx
+        out[pname] = tuple(cur)
+    return out
+
+
+def _geometry(mech: Any) -> Any:
+    """What a stage's placement changes: its parts' hulls, cuts and outlines, and its follower's rest pose."""
+    out = np.zeros((1, 3)) if mech.motion_out == "OzT" else np.zeros(1)
+    return ([(p.hull, p.features, p.polygon) for p in mech.parts], np.round(mech._follower_pose(out), 12).tolist())
+
+
+def placement_variables(toy: ToyMechanism, samples: int = 181) -> list[PlacementVariable]:
+    """Every stage's moves (:data:`MOVES`, one component each) that change its parts but not its motion.
+
+    A move qualifies when, at every shift of :data:`MOVE_PROBES`, the stage's
+    parameters are accepted, its follower's motion on the input the toy
+    gives it (``samples`` of a cycle) is unchanged to 1e-9 and valid, and its
+    parts or its follower's rest pose (where its children sit) change.
+    """
+    q = np.linspace(0.0, 2 * math.pi, samples)
+    toy.world_motion(q)
+    bases = toy._last_bases
+    found: list[PlacementVariable] = []
+    for st in toy.stages:
+        number = st.realisation.number
+        u, res = bases[st.index]
+        kw = dict(toy.stage_overrides.get((st.cam, st.key), {}))
+        try:  # the stage rebuilt on the same samples (its slots' lengths follow the input it is built for)
+            geo0 = _geometry(ToyMechanism._build_stage(st.realisation, u, dict(kw), toy.name, st.key))
+        except InputError:
+            continue
+        defaults = params_for(number)
+        for move, shifts in MOVES:
+            if not all(hasattr(defaults, n) for n in shifts):
+                continue
+            width = min(len(getattr(defaults, n)) for n in shifts)
+            for comp in range(width):
+                var = PlacementVariable(st.cam, st.key, move, tuple(shifts.items()), comp)
+                ok = True
+                moved = False
+                for dx in MOVE_PROBES:
+                    kw2 = _shifted(kw, number, var, dx)
+                    try:
+                        P = _stage_params(number, kw2, u)
+                        check_params(number, P)
+                        r2 = ELEMENTAL[number].forward(P, u)
+                        mech = ToyMechanism._build_stage(st.realisation, u, dict(kw2), toy.name, st.key)
+                    except InputError:
+                        ok = False
+                        break
+                    if not np.all(r2.valid) or not np.allclose(r2.out, res.out, rtol=0, atol=1e-9):
+                        ok = False
+                        break
+                    moved = moved or _geometry(mech) != geo0
+                if ok and moved:
+                    found.append(var)
+    # one move per stage and component where several do the same (F_o alone and F_o with D_jc on a #1):
+    # the first in MOVES order is kept
+    out: list[PlacementVariable] = []
+    for v in found:
+        if not any(o.cam == v.cam and o.key == v.key and o.comp == v.comp and
+                   dict(o.shifts).keys() <= dict(v.shifts).keys() for o in out):
+            out.append(v)
+    return out
 
 
 def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, overrides: dict[tuple[str, Chain], dict[str, Any]],
                  names: dict[tuple[str, Chain], str], seed: int = 0
                  ) -> tuple[list[tuple[dict[tuple[str, Chain], dict[str, Any]], tuple[float, float, float]]], Placement]:
-    """Anneal the placement variables (:data:`PLACEABLE`) to a compact toy whose pieces overlap little.
+    """Anneal the placement variables (:func:`placement_variables`) to a compact toy whose pieces overlap little.
 
     Returns the best ``PLACEMENT_OPTIONS`` distinct layouts the annealing
     accepted that improve on the start (overrides and ``(objective,
@@ -555,35 +792,28 @@ def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, override
     Objective: footprint + ``OVERLAP_WEIGHT`` x overlap (:func:`_layout_score`).
     A move that changes any stage's motion (compared on 181 samples to 1e-9)
     or that the toy cannot be built with is rejected.  Simulated annealing
-    with a fixed seed (same request, same toy), ``ANNEAL_STEPS`` moves.
+    with a fixed seed (same request, same toy), ``ANNEAL_STEPS`` moves, each
+    shifting a random subset of the variables.
     """
     t0 = time.perf_counter()
     q = np.linspace(0.0, 2 * math.pi, 181)
-    stages = []
-    for cam, chains in cams.items():
-        seen = set()
-        for c in chains:
-            for d in range(1, len(c) + 1):
-                key = c[:d]
-                if key in seen:
-                    continue
-                seen.add(key)
-                number = realise(key[-1]).number
-                if number in PLACEABLE:
-                    stages.append((cam, key, PLACEABLE[number], getattr(params_for(number), PLACEABLE[number])))
+    base = ToyMechanism(cams, phase=phase, name=name, overrides=overrides, names=names)
+    variables = placement_variables(base)
+    number = {(st.cam, st.key): st.realisation.number for st in base.stages}
+
+    def layout(x: Array) -> dict[tuple[str, Chain], dict[str, Any]]:
+        ov = {k: dict(v) for k, v in overrides.items()}
+        for v, dx in zip(variables, x):
+            if dx != 0.0:
+                ov[(v.cam, v.key)] = _shifted(ov.get((v.cam, v.key), {}), number[(v.cam, v.key)], v, float(dx))
+        return ov
 
     def build(x: Array) -> ToyMechanism | None:
-        ov = {k: dict(v) for k, v in overrides.items()}
-        for i, (cam, key, pname, default) in enumerate(stages):
-            cur = list(ov.get((cam, key), {}).get(pname, default))
-            cur[0], cur[1] = float(x[2 * i]), float(x[2 * i + 1])
-            ov.setdefault((cam, key), {})[pname] = tuple(cur)
         try:
-            return ToyMechanism(cams, phase=phase, name=name, overrides=ov, names=names)
+            return ToyMechanism(cams, phase=phase, name=name, overrides=layout(x), names=names)
         except InputError:
             return None
 
-    base = ToyMechanism(cams, phase=phase, name=name, overrides=overrides, names=names)
     ref, _ = base.world_motion(q)
     ref = {k: v.copy() for k, v in ref.items()}
 
@@ -601,23 +831,23 @@ def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, override
             return math.inf, math.inf, math.inf, None
         return fp + OVERLAP_WEIGHT * ovl, fp, ovl, toy
 
-    x0 = np.array([v for _, _, _, d in stages for v in (d[0], d[1])], float)
-    # the sized overrides may already hold the variables
-    for i, (cam, key, pname, _) in enumerate(stages):
-        if pname in overrides.get((cam, key), {}):
-            x0[2 * i:2 * i + 2] = overrides[(cam, key)][pname][:2]
+    labels = [v.label for v in variables]
+    x0 = np.zeros(len(variables))
     f0, fp0, ov0, _ = score(x0)
-    if not stages or not math.isfinite(f0):
-        return [], Placement([], (f0, f0), (fp0, fp0), (ov0, ov0), 1, 0, time.perf_counter() - t0, kept=False)
+    if not variables or not math.isfinite(f0):
+        return [], Placement(labels, (f0, f0), (fp0, fp0), (ov0, ov0), 1, 0, time.perf_counter() - t0, kept=False)
     rng = np.random.default_rng(seed)
     lo, hi = x0 - ANNEAL_BOX, x0 + ANNEAL_BOX
     x, fx = x0.copy(), f0
     states: list[tuple[float, float, float, Array]] = []  # accepted layouts better than the start
     temp0 = 0.05 * f0
     evals, rejected = 1, 0
+    p_move = max(1.0 / len(variables), 0.3)
     for k in range(ANNEAL_STEPS):
         temp = temp0 * (1 - k / ANNEAL_STEPS) + 1e-12
-        y = np.clip(x + rng.normal(0.0, ANNEAL_STEP, x.size), lo, hi)
+        mask = rng.random(x.size) < p_move
+        mask[rng.integers(x.size)] = True
+        y = np.clip(x + mask * rng.normal(0.0, ANNEAL_STEP, x.size), lo, hi)
         fy, fpy, ovy, _ = score(y)
         evals += 1
         if not math.isfinite(fy):
@@ -627,26 +857,79 @@ def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, override
             x, fx = y, fy
             if fy < f0 and all(np.abs(y - st[3]).max() > 1e-9 for st in states):
                 states.append((fy, fpy, ovy, y.copy()))
-    labels = [f"{cam} {' '.join(key)}: {pname}" for cam, key, pname, _ in stages]
-    options = []
-    for f, fp, ov, xs in sorted(states, key=lambda t: t[0])[:PLACEMENT_OPTIONS]:
-        out = {k: dict(v) for k, v in overrides.items()}
-        for i, (cam, key, pname, default) in enumerate(stages):
-            cur = list(out.get((cam, key), {}).get(pname, default))
-            cur[0], cur[1] = float(xs[2 * i]), float(xs[2 * i + 1])
-            out.setdefault((cam, key), {})[pname] = tuple(cur)
-        options.append((out, (f, fp, ov)))
+    options = [(layout(xs), (f, fp, ov)) for f, fp, ov, xs in sorted(states, key=lambda t: t[0])[:PLACEMENT_OPTIONS]]
     return options, Placement(labels, (f0, f0), (fp0, fp0), (ov0, ov0), evals, rejected,
                               time.perf_counter() - t0, kept=False)
+
+
+#: cam-in-window stages (#1-#3): their motion follows the eccentricity alone, not the disc's radius
+DISC_CAMS = (1, 2, 3)
+#: material kept round the axle's boss when a cam is grown into a disc (model units: 1 mm)
+DISC_MARGIN = 0.01
+
+
+def _disc_cams(cams: dict[str, list[Chain]], phase: float, name: str,
+               overrides: dict[tuple[str, Chain], dict[str, Any]], names: dict[tuple[str, Chain], str]
+               ) -> dict[tuple[str, Chain], dict[str, Any]] | None:
+    """``overrides`` with every #1-#3 cam that would be a crank (its axle's boss leaving the disc,
+    ``|D_jc| + 2 D_ar > D_jr``) grown into a disc holding the boss, or None when none is; None too when the
+    grown toy moves differently (compared on 181 samples to 1e-9) or cannot be built.
+
+    A crank is cut as a pin in a pin-wide slot across layers, so its follower covers the motor shaft and
+    must lie outside the cams' layers; a disc runs in its follower's window in one layer."""
+    toy = ToyMechanism(cams, phase=phase, name=name, overrides=overrides, names=names)
+    out = {k: dict(v) for k, v in overrides.items()}
+    grown = False
+    for st in toy.stages:
+        if st.realisation.number not in DISC_CAMS:
+            continue
+        P = st.mech.params
+        e = float(np.hypot(P.D_jc[0], P.D_jc[1]))
+        if e + 2 * P.D_ar > P.D_jr:
+            out.setdefault((st.cam, st.key), {})["D_jr"] = e + 2 * P.D_ar + DISC_MARGIN
+            grown = True
+    if not grown:
+        return None
+    q = np.linspace(0.0, 2 * math.pi, 181)
+    try:
+        disc = ToyMechanism(cams, phase=phase, name=name, overrides=out, names=names)
+    except InputError:
+        return None
+    ref, _ = toy.world_motion(q)
+    got, checks = disc.world_motion(q)
+    if not all(np.all(ok) for ok, _, _ in checks) or any(
+            not np.allclose(got[k], ref[k], rtol=0, atol=1e-9) for k in ref):
+        return None
+    return out
+
+
+def _variants(cams: dict[str, list[Chain]], phase: float, name: str,
+              overrides: dict[tuple[str, Chain], dict[str, Any]], names: dict[tuple[str, Chain], str]
+              ) -> list[tuple[str, dict[tuple[str, Chain], dict[str, Any]]]]:
+    """The sized tree as sized, then (when it has cranks) with its cams grown into discs (:func:`_disc_cams`)."""
+    out: list[tuple[str, dict[tuple[str, Chain], dict[str, Any]]]] = [("", overrides)]
+    try:
+        disc = _disc_cams(cams, phase, name, overrides, names)
+    except InputError:
+        disc = None
+    if disc is not None:
+        out.append(("its cams grown into discs", disc))
+    return out
 
 
 # ----------------------------------------------------------------------------- the pipeline
 
 
 def design_toy(effectors: list[Effector], name: str = "designed toy", max_length: int = 3,
-               max_trees: int = 200, place: bool = True, max_fabricated: int = 4) -> Design:
+               max_trees: int = 200, place: bool = True, max_fabricated: int = 4, physics: bool = True) -> Design:
     """Design a toy for ``effectors`` (see the module docstring); an unreachable request is an
-    :class:`InputError` naming the effector and the ranges its chains reach."""
+    :class:`InputError` naming the effector and the ranges its chains reach.
+
+    ``place``: anneal the placement; ``max_fabricated``: trees checked against the export (and the physics)
+    before giving up; ``physics``: run :func:`physics_check` on a tree that passes the export's check and
+    pass it over when it fails (``Design.physics`` holds the verdict).  Seconds per step in ``Design.seconds``
+    (``rank_and_size`` counts every tree tried before the one returned).
+    """
     t0 = time.perf_counter()
     q = np.linspace(0.0, 2 * math.pi, SAMPLES)
     cache: dict[Any, _Scan] = {}
@@ -690,6 +973,8 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
             raise InputError(f"effector {e.name!r} ({e.motion}) chain length", max_length,
                              f"enough stages for a chain from the motor to {e.motion} (--max-length)")
     cands = _candidates(effectors, options)
+    if not cands:
+        raise InputError(*_no_tree(effectors, options))
     t_enum = time.perf_counter() - t0
     tried = fabricated = 0
     rejected: list[str] = []
@@ -710,57 +995,74 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
             if c not in cams.setdefault(cam, []):
                 cams[cam].append(c)
         names = {(cam, c): e.name for e, (cam, c) in zip(effectors, pairs)}
-        try:
-            toy = ToyMechanism({k: v for k, v in cams.items()}, phase=phase, name=name, overrides=overrides,
-                               names=names)
-            from .assembly import toy_assembly
+        made = False
+        for how, variant in _variants(cams, phase, name, overrides, names):
+            try:
+                toy = ToyMechanism({k: v for k, v in cams.items()}, phase=phase, name=name, overrides=variant,
+                                   names=names)
+                from .assembly import toy_assembly
 
-            toy_assembly(toy)
-        except InputError:
-            continue  # a tree the assembly refuses (a mirrored or turned out-of-plane stage)
-        t_size = time.perf_counter() - t0 - t_enum
-        t1 = time.perf_counter()
-        placement = None
-        checked = layer_collisions(toy)
-        layers_before = len(set(checked[0].values()))
-        checked_before = checked
-        before = {"layers": layers_before, "collisions": len(checked[1]), "pin_clashes": len(checked[2]),
-                  "export_refused": int(not checked[0])}
+                toy_assembly(toy)
+            except InputError:
+                continue  # a tree the assembly refuses (a mirrored or turned out-of-plane stage)
+            t_size = time.perf_counter() - t0 - t_enum
+            t1 = time.perf_counter()
+            placement = None
+            checked = layer_collisions(toy)
+            layers_before = len(set(checked[0].values()))
+            checked_before = checked
+            before = {"layers": layers_before, "collisions": len(checked[1]), "pin_clashes": len(checked[2]),
+                      "export_refused": int(not checked[0])}
 
-        def bad(c: tuple[dict[str, int], list, list]) -> tuple[int, int, int]:
-            return len(c[1]), len(c[2]), len(set(c[0].values()))
-        if place:
-            layouts, placement = place_stages(cams, phase, name, overrides, names)
-            for placed, (f, fp, ov) in layouts:
-                moved = ToyMechanism(cams, phase=phase, name=name, overrides=placed, names=names)
-                after = layer_collisions(moved)
-                placement.checked += 1
-                # keep a placement only where it adds no collision, no pin clash and no layer
-                if bad(after) <= bad(checked):
-                    toy, checked = moved, after
-                    placement.kept = True
-                    placement.objective = (placement.objective[0], f)
-                    placement.footprint = (placement.footprint[0], fp)
-                    placement.overlap = (placement.overlap[0], ov)
-                    break
-        fabricated += 1
-        measured = effector_ranges(toy)
-        ranges = {}
-        for e in effectors:
-            _, val = measured[e.name]
-            ranges[e.name] = math.degrees(val) if e.motion[0] == "O" else val
-        layers, collisions, clashes = checked
-        secs = {"enumerate": t_enum, "rank_and_size": t_size, "place_and_check": time.perf_counter() - t1}
-        d = Design(toy, effectors, pairs, cost, ranges, len(cands), tried, sizing, layers, collisions, secs,
-                   placement, layers_before, clashes, rejected, before,
-                   before_reason=checked_before[2][0] if before["export_refused"] else "")
-        if not collisions and not clashes:
-            return d
-        # a tree whose pieces collide or whose pins cross pieces: try the next cheapest (a few)
-        rejected.append(f"cost {cost:g} " + "; ".join(f"{cam}: {' '.join(c)}" for cam, c in pairs) + ": "
-                        + ", ".join([f"{a}/{b} collide" for a, b, _ in collisions] + clashes))
-        if first is None:
-            first = d
+            def bad(c: tuple[dict[str, int], list, list]) -> tuple[int, int, int, int]:
+                """An export that refuses the pieces (no layers) first, then collisions, pin clashes, layers."""
+                return int(not c[0]), len(c[1]), len(c[2]), len(set(c[0].values()))
+            if place:
+                layouts, placement = place_stages(cams, phase, name, variant, names)
+                for placed, (f, fp, ov) in layouts:
+                    moved = ToyMechanism(cams, phase=phase, name=name, overrides=placed, names=names)
+                    after = layer_collisions(moved)
+                    placement.checked += 1
+                    # keep a placement only where it adds no collision, no pin clash and no layer
+                    if bad(after) <= bad(checked):
+                        toy, checked = moved, after
+                        placement.kept = True
+                        placement.objective = (placement.objective[0], f)
+                        placement.footprint = (placement.footprint[0], fp)
+                        placement.overlap = (placement.overlap[0], ov)
+                        break
+                made = True
+            # the sized parameter as written (a placement may move it along with another: #4's pin with its origin)
+            for e, (cam, _chain) in zip(effectors, pairs):
+                stage, pname, _ = sizing[e.name]
+                key = tuple(stage.split(" "))
+                number, comp = realise(key[-1]).number, DESIGN_PARAMETER[realise(key[-1]).number][1]
+                val = toy.stage_overrides.get((cam, key), {}).get(pname, getattr(params_for(number), pname))
+                sizing[e.name] = (stage, pname, float(val if comp is None else val[comp]))
+            measured = effector_ranges(toy)
+            ranges = {}
+            for e in effectors:
+                _, val = measured[e.name]
+                ranges[e.name] = math.degrees(val) if e.motion[0] == "O" else val
+            layers, collisions, clashes = checked
+            secs = {"enumerate": t_enum, "rank_and_size": t_size, "place_and_check": time.perf_counter() - t1}
+            d = Design(toy, effectors, pairs, cost, ranges, len(cands), tried, sizing, layers, collisions, secs,
+                       placement, layers_before, clashes, rejected, before,
+                       before_reason=checked_before[2][0] if before["export_refused"] else "")
+            problems = [f"{a}/{b} collide" for a, b, _ in collisions] + clashes
+            if not problems and physics:
+                t2 = time.perf_counter()
+                d.physics = physics_check(design_scene(toy, name))
+                secs["physics"] = time.perf_counter() - t2
+                problems = physics_failures(d.physics)
+            if not problems:
+                return d
+            # a tree whose pieces collide, whose pins cross pieces or whose physics fails: try the next cheapest
+            rejected.append(f"cost {cost:g} " + "; ".join(f"{cam}: {' '.join(c)}" for cam, c in pairs)
+                            + (f" ({how})" if how else "") + ": " + ", ".join(problems))
+            if first is None:
+                first = d
+        fabricated += made
         if fabricated >= max_fabricated:
             break
     if first is not None:

@@ -5,8 +5,11 @@
   and a ``SimpleMotor`` on the first cam is the only driver
   (:func:`planar.simulate.simulate`, ``mode="motor"``).  The pieces of #8
   stages (xz) join the same space, each tied to its body's xy piece by its x
-  (:class:`SharedX`).  The motor's signed torque is compared with inverse
-  dynamics (:func:`planar.simulate.torque_comparison`).
+  (:class:`SharedX`), and so do the yz followers of #6/#9: each in a space of
+  its own stepped in lockstep, its contact's load put on its driver every step
+  (:func:`_skew_load`).  The motor's signed torque is compared with inverse
+  dynamics (:func:`planar.simulate.torque_comparison`), which takes every
+  piece's gravity in its plane (:func:`planar.dynamics.plane_gravity`).
 * **#8 in xz** (:func:`contact_hold`): its own 2D space.  The window plate is
   a kinematic body following the slider's x; the tab pivots on the frame and
   touches the window's edge through a pair of collision shapes (a thick segment
@@ -16,7 +19,7 @@
   gap exceeds ``1e-3`` of the size; :func:`liftoff_speed` scans speeds, and
   :func:`hold_margin` gives the speed at which inverse dynamics says the
   contact force changes sign (an independent prediction).
-* **#6 and #9** (:func:`skew_stage`): rebuilt in the follower's plane (yz).
+* **#6 and #9 alone** (:func:`skew_stage`): rebuilt in the follower's plane (yz).
   The driver's edge meets that plane in a point moving along a line (a
   kinematic body); the pin holds it at the skew-line distance, whose in-plane
   value ``r sqrt(cos^2 a + sin^2 a cos^2 phi) / cos phi`` follows the pin's
@@ -32,6 +35,7 @@ simulated and what was not (with the reason) instead of refusing the toy.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from typing import Any, Callable, ClassVar
 
@@ -99,11 +103,17 @@ class SharedX:
 
 
 class _CoupledView(Mechanism):
-    """The assembly's xy and xz pieces in one 2D space, each xz piece tied to its body's xy piece by x."""
+    """The assembly's pieces in one motor run: xy, the yz followers of #6/#9 and (``xz``) the #8 pieces.
 
-    def __init__(self, asm: ToyAssembly) -> None:
+    Each xz piece is tied to its body's xy piece by x (:class:`SharedX`); each
+    yz follower keeps its stage's :class:`~planar.windup.mechanisms.SkewContact`
+    with the driver's edge (rebuilt by co-simulation, see :func:`_skew_load`).
+    """
+
+    def __init__(self, asm: ToyAssembly, xz: bool = True) -> None:
         self.asm = asm
-        parts = [p for p in asm.parts if p.plane in ("xy", "xz")]
+        planes = ("xy", "yz", "xz") if xz else ("xy", "yz")
+        parts = [p for p in asm.parts if p.plane in planes]
         names = {p.name for p in parts}
         joints: list[Any] = [j for j in asm.joints if j.a in names and j.b in names]
         plane = {p.name: p.plane for p in parts}
@@ -126,10 +136,10 @@ class _CoupledView(Mechanism):
         return {p.name: poses[p.name] for p in self.parts}, checks
 
 
-def coupled_mechanism(asm: ToyAssembly) -> Mechanism:
-    """The assembly's xy and xz pieces as one mechanism (the motor's load includes the xz stages); yz pieces
-    (#6/#9 followers) are left out (``left_out``)."""
-    return _CoupledView(asm)
+def coupled_mechanism(asm: ToyAssembly, xz: bool = True) -> Mechanism:
+    """The assembly's xy pieces, the yz followers of #6/#9 and (``xz``) the #8 pieces as one mechanism: the
+    motor's load includes every stage; pieces left out are named in ``left_out``."""
+    return _CoupledView(asm, xz)
 
 
 def _register() -> None:
@@ -140,8 +150,7 @@ def _register() -> None:
         """A groove along the second axis through ``a``'s origin holding ``b``'s anchor (a pin body)."""
         return rb._groove(j.a, rb._local(j.a, (0.0, -j.reach)), rb._local(j.a, (0.0, j.reach)), j.b, j.anchor)
 
-
-_register()
+    REBUILDERS.register(SkewContact)(_skew_load)
 
 
 # ---------------------------------------------------------------------------- driving one stage
@@ -443,30 +452,40 @@ class ToyPhysics:
         return [s for s in self.stages if not s.simulated]
 
 
-def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, speeds: Any = None) -> ToyPhysics:
+def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, speeds: Any = None,
+                 densities: dict[str, float] | None = None) -> ToyPhysics:
     """The toy's coupled motor run with its torque against inverse dynamics, and every stage's own physics.
 
     ``t``: output times (s) at the toy's speed.  The coupled run holds the xy
     pieces and, when the scene names gravity, the xz pieces of #8 stages (tied
-    to their body's xy piece by :class:`SharedX`; one 2D space, gravity
-    ``(gx, gy)`` acting along (x, z) on them: x stays x, the toy's y is the
-    stage's z); the yz followers of #6/#9 are not in it (their load on the
-    slider is not in the motor torque).  Each #8 stage also runs alone,
-    one-sided, scanned over ``speeds`` (cycles/s) for lift-off; #6/#9 are rebuilt
-    in their follower's plane.  A stage that cannot be simulated is reported
-    with the reason.
+    to their body's xy piece by :class:`SharedX`; one 2D space, the toy's
+    gravity ``(gx, gy, 0)`` acting on them as ``(gx, 0)`` along (x, z):
+    :func:`planar.dynamics.plane_gravity`) and the yz followers of #6/#9 (co-simulated in their plane,
+    gravity ``(gy, 0)``, their load on their driver: :func:`_skew_load`), so
+    the motor torque and the inverse dynamics it is compared with both carry
+    every stage.  ``densities``: per piece (assembly part name), overriding the
+    scene's density in the coupled run and its inverse dynamics (e.g. a
+    heavier follower).  Each #8 stage also runs alone, one-sided, scanned over
+    ``speeds`` (cycles/s) for lift-off; #6/#9 are also rebuilt alone in their
+    follower's plane.  A stage that cannot be simulated is reported with the
+    reason.
     """
     from ..simulate import SimSettings, torque_comparison
 
+    from ..dynamics import plane_gravity
+
     asm = toy_assembly(toy)
-    g = _hold_gravity(effects)
+    g3 = _hold_gravity(effects)
+    gxz = plane_gravity("xz", g3)
+    g = (float(gxz[0]), float(gxz[1]))  # what an #8 stage's pieces (xz) feel of the toy's gravity (gx, gy, 0)
     has_xz = any(p.plane == "xz" and not p.ground for p in asm.parts)
     # the motor turns the xy pieces and, through the bodies they share, the xz stages (whose contact needs what
     # holds it: without gravity or a spring they are left out of the coupled run)
-    flat = coupled_mechanism(asm) if has_xz and g != (0.0, 0.0) else plane_mechanism(asm, "xy")
+    flat = coupled_mechanism(asm, xz=has_xz and g != (0.0, 0.0))
     # 128 substeps, 80 iterations: measured, the motor torque's start transient at 32 substeps is 4 % of the peak
     # for the Bunny (its #8 tab coupled), 0.7 % at 64 and 1e-6 at 128 (Horse 2.6e-3, 2.6e-4, 2.9e-5)
-    tq = torque_comparison(flat, np.asarray(t, float), effects, settings or SimSettings(substeps=128, iterations=80))
+    tq = torque_comparison(flat, np.asarray(t, float), effects, settings or SimSettings(substeps=128, iterations=80),
+                           densities=densities)
     tq["pieces"] = [p.name for p in flat.parts]
     speed = toy.driver.rate / (2 * math.pi)
     out = ToyPhysics(tq)
@@ -481,8 +500,11 @@ def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, 
         drive: StageDrive = (toy.driver, stage_u)  # the stage as the toy drives it
         if num == 8:
             if g == (0.0, 0.0):
-                out.stages.append(StageReport(label, pat, False, "#8: its contact is held by gravity or a spring in "
-                                              "its plane; the scene names none"))
+                out.stages.append(StageReport(label, pat, False, (
+                    "#8: its contact is held by gravity or a spring in its plane (xz); " + (
+                        "the scene names none" if g3 == (0.0, 0.0) else
+                        f"the scene's gravity ({g3[0]:g}, {g3[1]:g}) has no x component, and its y is normal to "
+                        "the xz plane"))))
                 continue
             crit = hold_margin(st.mech, g, getattr(effects, "density", 1.0), drive=drive)
             sc = list(speeds) if speeds is not None else [speed * f for f in (1.0, 2.0, 4.0, 8.0)]
@@ -501,8 +523,196 @@ def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, 
                 + f"; inverse dynamics predicts {crit:.3g} cycles/s")))
         elif st.mech.spatial:
             err, why = skew_stage(st.mech, speed, drive=drive)
-            out.stages.append(StageReport(label, pat, why is None,
-                                          why or f"rebuilt in the follower's plane: {err:.2g} of the size"))
+            out.stages.append(StageReport(label, pat, why is None, (
+                f"in the motor run, co-simulated in its plane (yz); alone, rebuilt in the follower's plane: "
+                f"{err:.2g} of the size") if why is None else why))
         else:
             out.stages.append(StageReport(label, pat, True, "in the motor's plane (coupled)"))
     return out
+
+
+# ---------------------------------------------------------------------------- #6, #9 in the motor run
+
+
+def _skew_gap(j: SkewContact, pivot: tuple[float, float], a: float, q: tuple[float, float, float]) -> float:
+    """Signed distance (model units) between the driver's edge (driver origin pose ``q`` in xy) and the pin's
+    axis (through ``(pin_x, pivot)``, tilted ``a`` in yz): the skew lines' common normal, as
+    :meth:`SkewContact.residual` measures it, with its sign kept (it stays +-``radius`` in contact)."""
+    c, s = math.cos(q[2]), math.sin(q[2])
+    e0x = q[0] + c * j.edge_point[0] - s * j.edge_point[1]
+    e0y = q[1] + s * j.edge_point[0] + c * j.edge_point[1]
+    ex = c * j.edge_dir[0] - s * j.edge_dir[1]
+    ey = s * j.edge_dir[0] + c * j.edge_dir[1]
+    ca, sa = math.cos(a), math.sin(a)
+    n = (-ca * ey, ca * ex, sa * ex)  # (0, -sin a, cos a) x (ex, ey, 0)
+    d = (e0x - j.pin_x, e0y - pivot[0], j.plane_z - pivot[1])
+    return (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]) / math.sqrt(n[0] ** 2 + n[1] ** 2 + n[2] ** 2)
+
+
+def _skew_load(rb: Any, j: SkewContact, effects: Any) -> list[Any]:
+    """#6/#9 in the motor run: the yz follower co-simulated in a 2D space of its own, in lockstep.
+
+    The follower's body (made by the rebuild, mass from its outline) moves to a
+    space of its own (the follower's plane: gravity
+    :func:`~planar.dynamics.plane_gravity` ``"yz"``, the run's damping and step
+    scaling) on its pivot.  Each step of the motor's space, before it solves (a
+    ``pre_solve`` on a constraint that applies nothing), that space steps once:
+
+    * **the contact's kinematics**: the tilt ``a`` at which the pin touches the
+      driver's edge is solved (Newton) from the skew lines' exact distance
+      (:func:`_skew_gap`: the pin's tilt-dependent reach in the plane is in
+      it), for the driver as pymunk has it now (the follower is put there) and
+      moved on by its velocity (a motor on the follower turns it there within
+      the step: one velocity row, which pymunk solves exactly; a
+      ``GrooveJoint`` holding the edge's trace point, as :func:`skew_stage`
+      has it, was measured turning the Bunny's ear 19 % too fast, its pin kept
+      in the groove only by the position correction);
+    * **the load**: the contact's moment ``M`` on the follower about its pivot
+      over the step is read from pymunk (the change of its angular momentum
+      about the pivot, less gravity's and the damping's share), and the driver
+      gets the contact's generalized force ``Q = -M da/dq`` (virtual work of a
+      frictionless contact: ``Q dq + M da = 0``; ``da/dq`` from the skew
+      distance by central differences at the current poses), a force at its
+      origin and a torque, within the step, so the motor holds it;
+    * **stability**: that force follows the driver's velocity of the step
+      before; alone, it set the motor's solver oscillating once the
+      follower's reflected inertia ``I_p (da/dq)^2`` neared the driver's (the
+      Bunny's ear at 10x its density).  The driver therefore carries that
+      inertia as added mass and moment (its own, scaled to match along its
+      motion), and gets back what
+      they resist for the velocity change the follower was moved with (and
+      what gravity and damping do to them): the inertial load acts on the
+      velocity the solver finds, and nothing is counted twice.
+    """
+    import pymunk
+
+    from ..dynamics import gravity_and_damping, plane_gravity
+    from ..simulate import SimulationError
+
+    drv, fol = rb.bodies[j.a], rb.bodies[j.b]
+    if fol.body_type != pymunk.Body.DYNAMIC or drv.space is None:
+        raise SimulationError(f"joint {j.name!r}: the follower {j.b!r} must move under the solver, driven by "
+                              f"{j.a!r} in the motor's space")
+    main = drv.space
+    main.remove(fol)
+    dt = rb.dt
+    yz = pymunk.Space()
+    yz.iterations = main.iterations
+    g, _ = gravity_and_damping(effects)
+    gp = plane_gravity("yz", g)
+    yz.gravity = (float(gp[0]) * dt * dt, float(gp[1]) * dt * dt)
+    yz.damping = main.damping
+    fcog, dcog = rb.cog[j.b], rb.cog[j.a]
+    here = fol.local_to_world((-fcog[0], -fcog[1]))
+    pivot = (float(here[0]), float(here[1]))  # the follower frame's origin: on its pivot axis
+
+    def driver_pose() -> tuple[float, float, float]:
+        a = drv.angle
+        c, s = math.cos(a), math.sin(a)
+        return (drv.position.x - (c * dcog[0] - s * dcog[1]), drv.position.y - (s * dcog[0] + c * dcog[1]), a)
+
+    gap0 = _skew_gap(j, pivot, fol.angle, driver_pose())  # +-radius: the side the edge touches
+    turn = pymunk.SimpleMotor(yz.static_body, fol, 0.0)  # Chipmunk drives w_fol - w_static = -rate
+    hold = pymunk.PivotJoint(yz.static_body, fol, pivot, (-fcog[0], -fcog[1]))
+    hold.error_bias = 1.0 - rb.correction
+    yz.add(fol, turn, hold)
+    m, ic = fol.mass, fol.moment
+    ip = ic + m * float((fcog[0] ** 2 + fcog[1] ** 2))  # the follower's moment about its pivot
+    m0, i0 = drv.mass, drv.moment
+    hq = 1e-6 * max(rb.mech.size, 1e-12)
+    prev: list[tuple[float, float, float]] = []
+    scale = [0.0]
+    failed: list[str] = []
+
+    def touching(q: tuple[float, float, float], a: float) -> float:
+        """The tilt near ``a`` at which the pin touches the edge of a driver at pose ``q`` (Newton)."""
+        for _ in range(8):
+            f = _skew_gap(j, pivot, a, q) - gap0
+            d = (_skew_gap(j, pivot, a + 1e-7, q) - _skew_gap(j, pivot, a - 1e-7, q)) / 2e-7
+            step_ = f / d
+            a -= step_
+            if abs(step_) < 1e-14:
+                break
+        return a
+
+    def jacobian(a: float, q: tuple[float, float, float]) -> list[float]:
+        """``da/dq`` for the driver origin's ``(x, y, angle)``: the contact keeps the skew gap constant."""
+        ga = (_skew_gap(j, pivot, a + 1e-6, q) - _skew_gap(j, pivot, a - 1e-6, q)) / 2e-6
+        out = []
+        for k, h in ((0, hq), (1, hq), (2, 1e-6)):
+            qp, qm = list(q), list(q)
+            qp[k] += h
+            qm[k] -= h
+            gq = (_skew_gap(j, pivot, a, (qp[0], qp[1], qp[2])) - _skew_gap(j, pivot, a, (qm[0], qm[1], qm[2])))
+            out.append(-gq / (2 * h) / ga)
+        return out
+
+    def step(_c: Any, _space: Any) -> None:
+        q = driver_pose()
+        w = drv.angular_velocity
+        c, s = math.cos(q[2]), math.sin(q[2])
+        rx, ry = -(c * dcog[0] - s * dcog[1]), -(s * dcog[0] + c * dcog[1])  # origin - centre of gravity
+        vc = (drv.velocity.x, drv.velocity.y, w)  # centre of gravity's velocity (per step), angular velocity
+        vp = (vc[0] - w * ry, vc[1] + w * rx, w)  # the driver origin's velocity: taken as the step's
+        # the follower touching the driver as it is now (pymunk moves positions first: it is put where its
+        # velocity takes it there), and turned to where it touches the driver moved on by its velocity
+        af = touching(q, fol.angle + fol.angular_velocity)
+        ca, sa = math.cos(af), math.sin(af)
+        fol.angle = af - fol.angular_velocity
+        fol.position = (pivot[0] + ca * fcog[0] - sa * fcog[1] - fol.velocity.x,
+                        pivot[1] + sa * fcog[0] + ca * fcog[1] - fol.velocity.y)
+        a1 = touching((q[0] + vp[0], q[1] + vp[1], q[2] + vp[2]), af + fol.angular_velocity)
+        turn.rate = -(a1 - af)
+        v0, w0 = fol.velocity, fol.angular_velocity
+        yz.step(1.0)
+        # the contact's moment on the follower about its pivot over the step (angular momentum change)
+        gx, gy = fol.position.x - pivot[0], fol.position.y - pivot[1]
+        v1, w1 = fol.velocity, fol.angular_velocity
+
+        def mom(v: Any, w_: float) -> float:
+            return ic * w_ + m * (gx * v[1] - gy * v[0])
+
+        mc = mom(v1, w1) - yz.damping * mom(v0, w0) - m * (gx * yz.gravity[1] - gy * yz.gravity[0])
+        jq = jacobian(fol.angle, q)
+        if drv.body_type != pymunk.Body.DYNAMIC:
+            return  # an imposed driver (kinematic mode): nothing to load
+        # the contact's generalized force on the driver: Q = -M da/dq (a force at its origin and a torque)
+        drv.apply_force_at_world_point((-mc * jq[0], -mc * jq[1]), (q[0], q[1]))
+        # Alone, that force, one step behind the driver's motion, sets the motor's solver oscillating once
+        # the follower's reflected inertia I_p (da/dq)^2 is near the driver's (the Bunny's ear at 10x its
+        # density).  So the driver carries that inertia as added mass and moment, and gets
+        # back what the added inertia resists for the velocity change this step's follower was moved with
+        # (vc - the previous step's), and what gravity and damping would do to it: the follower's inertial
+        # load then acts on the velocity the solver finds (implicit), and nothing is counted twice.
+        # the added inertia: the driver's own, scaled so that along its motion it is the reflected one
+        # (I_p (da/dq . qdot)^2 = s (m |v_G|^2 + I w^2)); kept while the driver stands still
+        own = m0 * (vc[0] ** 2 + vc[1] ** 2) + i0 * w * w
+        if own > 0.0:
+            scale[0] = ip * (jq[0] * vp[0] + jq[1] * vp[1] + jq[2] * vp[2]) ** 2 / own
+        ma, ia = scale[0] * m0, scale[0] * i0
+        drv.mass, drv.moment = m0 + ma, i0 + ia
+        pv = prev[0] if prev else vc
+        prev[:] = [vc]
+        d = main.damping
+        drv.force = drv.force + (ma * (vc[0] - pv[0] + (1.0 - d) * vc[0] - main.gravity[0]),
+                                 ma * (vc[1] - pv[1] + (1.0 - d) * vc[1] - main.gravity[1]))
+        drv.torque = drv.torque - mc * jq[2] + ia * (vc[2] - pv[2] + (1.0 - d) * vc[2])
+
+    def guarded(c_: Any, space_: Any) -> None:
+        # pymunk prints and drops an exception raised in a callback: warn once and make the run fail instead
+        # (a NaN velocity: the pose check stops the run there and reports it)
+        try:
+            step(c_, space_)
+        except Exception as exc:  # noqa: BLE001 - reported through the run's failure
+            if not failed:
+                warnings.warn(f"{j.name}: the co-simulated follower {j.b!r} failed: {exc}", stacklevel=1)
+            failed.append(str(exc))
+            drv.velocity = (math.nan, math.nan)
+
+    hook = pymunk.SimpleMotor(main.static_body, drv, 0.0)
+    hook.max_force = 0.0  # applies nothing: its pre_solve steps the follower's space
+    hook.pre_solve = guarded
+    return [hook]
+
+
+_register()
