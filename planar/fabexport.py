@@ -10,6 +10,7 @@ With several sheets, ``parts.dxf`` becomes ``parts-1.dxf``, ``parts-2.dxf``
 
 from __future__ import annotations
 
+import copy
 import math
 import os
 from dataclasses import dataclass, field
@@ -116,6 +117,8 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
                     marked.add(key)
                     letters[pin.parts[side]].append((pin.at[side], letter(k)))
 
+    cut_cache: dict[Any, PartCut] = {}
+
     def cut_all(joins: list[Any], travel: dict[str, list[Any]]) -> tuple[list[PartCut], list[str]]:
         slots = slot_features(joins)
         for k_, v_ in travel.items():
@@ -134,9 +137,14 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
             flat = math.pi / 2
             if shaft is not None and part.name in keyed:  # a toy's cam: a D on the shaft, turned by its phase
                 drive_at, flat = (0.0, 0.0), math.pi / 2 - keyed[part.name]
-            pc = part_cuts(part, s, n, {i for (pn, i) in pinned if pn == part.name}, drive_at, motor_at,
-                           mounting=part.ground and part.plane == "xy", letters=letters[part.name],
-                           drive_flat=flat, extra=slots.get(part.name, ()), tabs=tab_of.get(part.name))
+            extra = tuple(slots.get(part.name, ()))
+            tab = tab_of.get(part.name)
+            key = (part.name, extra, None if tab is None else (tab.letter, tab.edge, tuple(tab.spans)))
+            if key not in cut_cache:  # a part that no tab, slot or travel slot changed is cut once
+                cut_cache[key] = part_cuts(part, s, n, {i for (pn, i) in pinned if pn == part.name}, drive_at,
+                                           motor_at, mounting=part.ground and part.plane == "xy",
+                                           letters=letters[part.name], drive_flat=flat, extra=extra, tabs=tab)
+            pc = copy.deepcopy(cut_cache[key])
             if drive_at is not None and part.name in keyed:
                 _phase_mark(pc, (drive_at[0] * s.unit_mm, drive_at[1] * s.unit_mm), flat, keyed[part.name])
             part_notes.extend(pc.notes)
