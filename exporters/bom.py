@@ -1,6 +1,8 @@
 """Bill of materials (CSV): parts with layer and sheet, pins with diameter and length, spacers, motor, screws.
 
-Columns: ``item, id, qty, layer, sheet, size_mm, joins, notes``.  Layers and
+Columns: ``item, id, qty, layer, sheet, size_mm, joins, notes``.  A ``tabs`` row
+per tab-and-slot joint (``planar.fabtabs``): its letter, the number of tabs,
+a tab's ``width x length``, ``piece -> xy piece`` and which slots they go into.  Layers and
 sheets count from 1; ``size_mm`` is the part's bounding box as laid out, a pin's
 ``d x length``, a spacer's ``ID x OD x thickness``.  Fixed formatting, rows
 in mechanism order: the same input gives the same bytes.
@@ -55,6 +57,12 @@ def bom_text(fab: Any) -> str:
             od = 2 * max((c.radius for c in [p.outer for p in sp] if hasattr(c, "radius")), default=0.0) - s.kerf
             w.writerow(["spacer", pp.letter, pp.spacers, "", "+".join(str(p.sheet + 1) for p in sp),
                         f"{ri:g} x {od:g} x {s.thickness_mm:g}", joins, "cut from the sheet; on the pin between its layers"])
+    for jn in getattr(fab, "joins", []):  # tab-and-slot joints of pieces standing perpendicular (planar.fabtabs)
+        lo, hi = jn.slot_size
+        w.writerow(["tabs", jn.letter, len(jn.spans), "", "", f"{jn.tab_width:g} x {s.thickness_mm:g}",
+                    f"{jn.piece} -> {jn.base}",
+                    f"the {len(jn.spans)} tabs {jn.letter} of {jn.piece} ({jn.plane}) into the {len(jn.slots)} slots "
+                    f"{jn.letter} ({lo:g} x {hi:g} mm) of {jn.base}; glue them"])
     grounds = [p for p in lay.parts if asm.layers.get(p.name) is not None and p.name in fab.grounds]
     if grounds:
         w.writerow(["mounting screw", "", 2 * len(grounds), "", "", f"M{s.mounting_hole_mm - 0.2:g}", "",

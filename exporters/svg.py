@@ -198,4 +198,8 @@ def _legend(fab: Any) -> list[str]:
         sp = f", {pp.spacers} spacer(s)" if pp.spacers else ""
         joins = " + ".join(pp.parts)
         lines.append(f"{pp.letter}: {what}, {joins}, layers {lo + 1}-{hi + 1}{sp}")
+    for jn in getattr(fab, "joins", []):  # tab-and-slot joints (planar.fabtabs)
+        lines.append(f"{jn.letter}: the {len(jn.spans)} tabs of {jn.piece} ({jn.plane}) into the slots {jn.letter} of "
+                     f"{jn.base} (layer {(asm.layers.get(jn.base) or 0) + 1}), standing {'below' if jn.side < 0 else 'above'}"
+                     " it; glue")
     return lines

@@ -346,7 +346,7 @@ def build_parser() -> argparse.ArgumentParser:
     ex.add_argument("--kerf", type=float, default=None, help="beam width in mm (default: the scene's kerf_mm)")
     ex.add_argument("--sheet", default=None, help="sheet size WIDTHxHEIGHT in mm (default: the scene's)")
     ex.add_argument("--preview", default=None, help="PNG preview of each sheet (photo-like)")
-    ex.add_argument("--bom", default=None, help="bill of materials (CSV): parts, layers, pins, spacers")
+    ex.add_argument("--bom", default=None, help="bill of materials (CSV): parts, layers, pins, spacers, tab joints")
     ex.add_argument("--assembly", default=None, help="assembly drawing (SVG): parts in place, layers, letters")
     ex.add_argument("--kerf-test", default=None, help="a kerf calibration piece (.dxf or .svg)")
     ex.set_defaults(func=_cmd_export)

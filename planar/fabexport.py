@@ -10,6 +10,7 @@ With several sheets, ``parts.dxf`` becomes ``parts-1.dxf``, ``parts-2.dxf``
 
 from __future__ import annotations
 
+import copy
 import math
 import os
 from dataclasses import dataclass, field
@@ -41,6 +42,12 @@ class Fabrication:
     grounds: list[str] = field(default_factory=list)
     #: files written by :func:`write_outputs`
     written: list[Path] = field(default_factory=list)
+    #: tab-and-slot joints of pieces standing perpendicular to the xy stack (:mod:`planar.fabtabs`)
+    joins: list[Any] = field(default_factory=list)
+    #: where the xy stack's lower face lies along the model's z (mm), for the pieces standing perpendicular
+    stack_z: float = 0.0
+    #: each perpendicular piece's plane position (mm: world y for xz, x for yz)
+    planes: dict[str, float] = field(default_factory=dict)
 
 
 def _shaft_pin(mech: Any, pins) -> Any:
@@ -56,14 +63,16 @@ def _shaft_pin(mech: Any, pins) -> Any:
 
 def _fab_mechanism(mech: Any) -> Any:
     """The mechanism whose parts are cut: a wind-up toy is cut as its assembly (merged parts, one frame,
-    cams keyed to the shaft; :mod:`planar.windup.assembly`), anything else as it is."""
+    cams keyed to the shaft; :mod:`planar.windup.assembly`), anything else as it is; pieces standing
+    perpendicular to the xy stack get brackets and lose repeated guides (:func:`planar.fabtabs.fab_view`)."""
+    from .fabtabs import fab_view
     from .windup.chain import ToyMechanism
 
     if isinstance(mech, ToyMechanism):
         from .windup.assembly import toy_assembly
 
-        return toy_assembly(mech)
-    return mech
+        return fab_view(toy_assembly(mech))
+    return fab_view(mech)
 
 
 def _phase_mark(pc: PartCut, at: tuple[float, float], flat: float, phase: float) -> None:
@@ -84,6 +93,8 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
     s = settings
     if not (0 <= s.kerf <= 2):
         raise InputError("kerf", s.kerf, "a kerf between 0 and 2 mm")
+    from .fabtabs import merge_travel, plan_tabs, slot_features, travel_slots
+
     mech = _fab_mechanism(scene.mechanism)
     keyed: dict[str, float] = dict(getattr(mech, "keyed", {}))
     pins, contacts = joint_pins(mech)
@@ -105,27 +116,101 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
                 if pin.kinds[side] == "hole" and pin is not shaft and key not in marked:
                     marked.add(key)
                     letters[pin.parts[side]].append((pin.at[side], letter(k)))
-    cuts: list[PartCut] = []
-    for n, part in enumerate(mech.parts, start=1):
-        drive_at = motor_at = None
-        if shaft is not None and part.name in shaft.parts:
-            k = shaft.parts.index(part.name)
-            if part.name == mech.driver.part:
-                drive_at = shaft.at[k]
-            else:
-                motor_at = shaft.at[k]
-        flat = math.pi / 2
-        if shaft is not None and part.name in keyed:  # a toy's cam: a D on the shaft, turned by its phase
-            drive_at, flat = (0.0, 0.0), math.pi / 2 - keyed[part.name]
-        pc = part_cuts(part, s, n, {i for (pn, i) in pinned if pn == part.name}, drive_at, motor_at,
-                       mounting=part.ground and part.plane == "xy", letters=letters[part.name], drive_flat=flat)
-        if drive_at is not None and part.name in keyed:
-            _phase_mark(pc, (drive_at[0] * s.unit_mm, drive_at[1] * s.unit_mm), flat, keyed[part.name])
-        notes.extend(pc.notes)
-        cuts.append(pc)
-    material = {pc.name: nominal_material(pc.outer, pc.inner, s.kerf / 2) for pc in cuts}
-    asm = plan_assembly(mech, material, pins, contacts, s.unit_mm, s.thickness_mm, s.pin_mm, s.pin_head,
-                        shaft.joint if shaft is not None else None)
+
+    cut_cache: dict[Any, PartCut] = {}
+
+    def cut_all(joins: list[Any], travel: dict[str, list[Any]]) -> tuple[list[PartCut], list[str]]:
+        slots = slot_features(joins)
+        for k_, v_ in travel.items():
+            slots[k_] = slots.get(k_, []) + v_
+        tab_of = {jn.piece: jn for jn in joins}
+        cuts: list[PartCut] = []
+        part_notes: list[str] = []
+        for n, part in enumerate(mech.parts, start=1):
+            drive_at = motor_at = None
+            if shaft is not None and part.name in shaft.parts:
+                k = shaft.parts.index(part.name)
+                if part.name == mech.driver.part:
+                    drive_at = shaft.at[k]
+                else:
+                    motor_at = shaft.at[k]
+            flat = math.pi / 2
+            if shaft is not None and part.name in keyed:  # a toy's cam: a D on the shaft, turned by its phase
+                drive_at, flat = (0.0, 0.0), math.pi / 2 - keyed[part.name]
+            extra = tuple(slots.get(part.name, ()))
+            tab = tab_of.get(part.name)
+            key = (part.name, extra, None if tab is None else (tab.letter, tab.edge, tuple(tab.spans)))
+            if key not in cut_cache:  # a part that no tab, slot or travel slot changed is cut once
+                cut_cache[key] = part_cuts(part, s, n, {i for (pn, i) in pinned if pn == part.name}, drive_at,
+                                           motor_at, mounting=part.ground and part.plane == "xy",
+                                           letters=letters[part.name], drive_flat=flat, extra=extra, tabs=tab)
+            pc = copy.deepcopy(cut_cache[key])
+            if drive_at is not None and part.name in keyed:
+                _phase_mark(pc, (drive_at[0] * s.unit_mm, drive_at[1] * s.unit_mm), flat, keyed[part.name])
+            part_notes.extend(pc.notes)
+            cuts.append(pc)
+        return cuts, part_notes
+
+    def plan(cuts: list[PartCut]) -> tuple[dict[str, Any], Assembly]:
+        material = {pc.name: nominal_material(pc.outer, pc.inner, s.kerf / 2) for pc in cuts}
+        return material, plan_assembly(mech, material, pins, contacts, s.unit_mm, s.thickness_mm, s.pin_mm,
+                                       s.pin_head, shaft.joint if shaft is not None else None)
+
+    cuts, part_notes = cut_all([], {})
+    material0, asm = plan(cuts)
+    material = material0
+    tab_plan = plan_tabs(mech, asm.layers, material0, s)
+    joins = tab_plan.joins
+    more_notes: list[str] = []
+    if joins or tab_plan.planes:
+        # cut again with the tabs and slots, then with travel slots until none is missing; the tabs' faces
+        # follow the layers, so a plan whose cuts move a layer is planned again for the new layers
+        layers_used = asm.layers
+        done = False
+        for _ in range(3):
+            travel: dict[str, list[Any]] = {}
+            travel_notes: list[str] = []
+            for _ in range(4):
+                cuts, part_notes = cut_all(joins, travel)
+                material, asm2 = plan(cuts)
+                if asm2.layers != layers_used:
+                    break
+                more, more_notes = travel_slots(mech, asm2.layers, material, s, tab_plan)
+                if not more:
+                    done = True
+                    break
+                for k_, v_ in more.items():
+                    travel[k_] = merge_travel(travel.get(k_, []) + v_, s.min_wall)
+                travel_notes.extend(more_notes)
+            if done or asm2.layers == layers_used:
+                break
+            layers_used = asm2.layers
+            tab_plan = plan_tabs(mech, layers_used, material0, s)
+            joins = tab_plan.joins
+        if not done:
+            from .fabjoints import FabricationError
+
+            moved = [n for n in asm2.layers if asm2.layers[n] != layers_used.get(n)]
+            raise FabricationError(
+                f"part {moved[0]!r}: its layer keeps changing as the tab joints are cut; they cannot be planned"
+                if moved else "the pieces standing perpendicular are still in the way of other layers after 4 "
+                "rounds of travel slots; they cannot be tab-joined")
+        notes.extend(travel_notes)
+        asm = asm2
+        tabs = {jn.piece: jn for jn in joins}
+        for pc in cuts:
+            if pc.name in tabs:
+                jn = tabs[pc.name]
+                pc.notes.append(f"{pc.name}: {len(jn.spans)} tab(s) {jn.letter}, {jn.tab_width:g} x "
+                                f"{s.thickness_mm:g} mm, into the slots {jn.letter} of {jn.base}")
+                part_notes.append(pc.notes[-1])
+            for jn in joins:
+                if jn.base == pc.name:
+                    pc.notes.append(f"{pc.name}: {len(jn.slots)} slot(s) {jn.letter} "
+                                    f"{jn.slot_size[0]:g} x {jn.slot_size[1]:g} mm for the tabs of {jn.piece}")
+                    part_notes.append(pc.notes[-1])
+        _engrave_joins(cuts, joins, s)
+    notes.extend(part_notes)
     notes.extend(asm.notes)
     for pc in cuts:
         pc.layer = asm.layers.get(pc.name)
@@ -139,7 +224,33 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
                                 nominal_holes=[((0.0, 0.0), ri)]))
     layout = nest(cuts, s.sheet, s.spacing, s.margin, s.kerf, s.unit_mm)
     return Fabrication(scene.name, s, layout, asm, notes, shaft.joint if shaft is not None else None, material,
-                       [p.name for p in mech.parts if p.ground and p.plane == "xy"])
+                       [p.name for p in mech.parts if p.ground and p.plane == "xy"], joins=joins,
+                       stack_z=tab_plan.z_stack, planes=dict(tab_plan.planes))
+
+
+def _engrave_joins(cuts: list[PartCut], joins: list[Any], s: FabSettings) -> None:
+    """Engrave each joint's letter beside its slots (where it fits) and once on the tabbed piece by its edge."""
+    from .fabparts import letter_marks
+
+    by_name = {pc.name: pc for pc in cuts}
+    for jn in joins:
+        base = by_name[jn.base]
+        mat = nominal_material(base.outer, base.inner, s.kerf / 2)
+        for e in base.engrave:
+            from shapely.geometry import LineString
+
+            mat = mat.difference(LineString(e).buffer(0.5))
+        base.engrave.extend(letter_marks(mat, [(c, jn.slot_size[0] / 2, jn.letter) for c, _ in jn.slots],
+                                         max(s.min_label, 1.5)))
+        piece = by_name[jn.piece]
+        mat = nominal_material(piece.outer, piece.inner, s.kerf / 2)
+        for e in piece.engrave:
+            from shapely.geometry import LineString
+
+            mat = mat.difference(LineString(e).buffer(0.5))
+        mid = jn.tabs[0].centroid
+        piece.engrave.extend(letter_marks(mat, [((float(mid.x), float(mid.y)), s.thickness_mm, jn.letter)],
+                                          max(s.min_label, 1.5)))
 
 
 def sheet_paths(path: str | os.PathLike, sheets: int) -> list[Path]:

@@ -44,6 +44,7 @@ from .fabrication import (
     cut_polygon,
     d_hole,
     hull_of_circles,
+    rectangle,
     stadium,
 )
 from .model import ArcSlot, Hole, Part, Slot
@@ -100,7 +101,8 @@ class Feature:
 
     ``kind``: ``"hole"`` (``a`` = centre, ``r``), ``"slot"`` (``a``, ``b`` ends of the centre line,
     ``r`` half-width), ``"arc"`` (``a`` = centre, ``R``, angles ``t0 < t1``, ``r`` half-width),
-    ``"d"`` (``a`` = centre, ``r``, ``flat`` from the centre along ``t0``).
+    ``"d"`` (``a`` = centre, ``r``, ``flat`` from the centre along ``t0``), ``"rect"`` (a tab's
+    through-slot: ``a`` = centre, ``R`` half its length along ``t0``, ``r`` half its width).
     """
 
     kind: str
@@ -122,6 +124,8 @@ class Feature:
             return stadium(self.a, self.b, r)
         if self.kind == "arc":
             return arc_slot(self.a, self.R, self.t0, self.t1, r)
+        if self.kind == "rect":
+            return rectangle(self.a, self.R - k2, r, self.t0)
         return d_hole(self.a, r, self.flat - k2, self.t0)
 
     def wall_circles(self, wall: float) -> list[tuple[float, float, float]]:
@@ -130,6 +134,10 @@ class Feature:
             return [(self.a[0], self.a[1], self.r + wall)]
         if self.kind == "slot":
             return [(self.a[0], self.a[1], self.r + wall), (self.b[0], self.b[1], self.r + wall)]
+        if self.kind == "rect":
+            c, s = math.cos(self.t0), math.sin(self.t0)
+            return [(self.a[0] + c * x - s * y, self.a[1] + s * x + c * y, wall)
+                    for x in (-self.R, self.R) for y in (-self.r, self.r)]
         # along the arc: chords between neighbours sag by at most 0.02 mm, made up by a larger radius
         sag = 0.02
         dmax = 2 * math.acos(max(-1.0, 1 - sag / max(self.R, 1e-9)))
@@ -413,16 +421,18 @@ def letter_marks(material, holes: list[tuple[tuple[float, float], float, str]], 
 def part_cuts(part: Part, s: FabSettings, number: int, pinned: set[int] = frozenset(),  # type: ignore[assignment]
               drive_at: tuple[float, float] | None = None, motor_at: tuple[float, float] | None = None,
               mounting: bool = False, letters: Sequence[tuple[tuple[float, float], str]] = (),
-              drive_flat: float = math.pi / 2) -> PartCut:
+              drive_flat: float = math.pi / 2, extra: Sequence[Feature] = (), tabs: Any = None) -> PartCut:
     """A part's cuts in mm in its own frame, kerf applied, checked (see the module docstring).
 
     ``pinned``: indices of the part's features a pin goes through; ``drive_at`` / ``motor_at``: the
     motor axis (model units, own frame) on the driven part / the plate holding the motor;
     ``letters``: hole letters at pin positions (model units, own frame); ``drive_flat``: direction
-    (rad, own frame) of the D-hole's flat (a toy's cams are keyed to one shaft at their phase).
+    (rad, own frame) of the D-hole's flat (a toy's cams are keyed to one shaft at their phase);
+    ``extra``: more cuts in mm (a perpendicular piece's tab slots); ``tabs``: a
+    :class:`~planar.fabtabs.TabJoin` whose piece this is (cut flat along its edge, tabs added).
     """
     k2 = s.kerf / 2.0
-    feats = _features(part, s, set(pinned), drive_at, motor_at, drive_flat)
+    feats = _features(part, s, set(pinned), drive_at, motor_at, drive_flat) + list(extra)
     for f in feats:
         if f.r - k2 <= 0 or (f.kind == "d" and f.flat - k2 <= -(f.r - k2)):
             raise FabricationError(f"part {part.name!r}: {f.what} {2 * f.r:.2f} mm wide is not wider than the "
@@ -440,6 +450,8 @@ def part_cuts(part: Part, s: FabSettings, number: int, pinned: set[int] = frozen
             f"min_wall_mm {s.min_wall:g} (a larger unit_mm, a smaller pin_diameter_mm or a smaller min_wall_mm)")
     nominal_outer, notes = _outer(part, s, feats, 0.0)
     outer = nominal_outer if k2 == 0 else _outer(part, s, feats, k2)[0]
+    if tabs is not None:
+        nominal_outer, outer = _with_tabs(part.name, cut_polygon(nominal_outer), tabs, k2)
     outer_poly = cut_polygon(nominal_outer)
     wall = _min_wall(outer_poly, feats)
     if wall < s.min_wall - WALL_TOL:
@@ -471,6 +483,23 @@ def part_cuts(part: Part, s: FabSettings, number: int, pinned: set[int] = frozen
     nominal = [(f.a, f.r) for f in feats if f.kind == "hole"]
     return PartCut(part.name, outer, [f.cut(k2) for f in feats], engrave, text, height,
                    nominal_holes=nominal, notes=notes)
+
+
+def _with_tabs(name: str, poly: Any, jn: Any, k2: float) -> tuple[Contour, Contour]:
+    """The outline cut flat along a tab joint's edge with its tabs added: nominal and grown by ``k2``."""
+    import shapely
+
+    got = shapely.union_all([poly.intersection(jn.keep)] + list(jn.tabs)).simplify(1e-4)
+    if got.geom_type != "Polygon" or len(got.interiors):
+        raise FabricationError(f"part {name!r}: cut flat along the xy plane it stands on, it falls apart "
+                               f"({got.geom_type}); it cannot be tab-joined")
+
+    def contour(p: Any) -> Contour:
+        p = shapely.geometry.polygon.orient(p, 1.0)
+        return Contour([(float(x), float(y), 0.0) for x, y in list(p.exterior.coords)[:-1]])
+
+    grown = got.buffer(k2, join_style="mitre") if k2 else got
+    return contour(got), contour(grown)
 
 
 def nominal_material(pc_outer: Cut, inner: Sequence[Cut], k2: float = 0.0):

@@ -38,6 +38,7 @@ __all__ = [
     "cut_polygon",
     "d_hole",
     "hull_of_circles",
+    "rectangle",
     "stadium",
 ]
 
@@ -91,11 +92,15 @@ class PartCut:
     notes: list[str] = field(default_factory=list)
     #: assembly layer (0 = bottom) or None for a part standing in another plane
     layer: int | None = None
+    #: where the part lies from its own frame: ``(angle, dx, dy)``, a point p goes to R(angle) p + (dx, dy)
+    placed: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def transformed(self, angle: float, dx: float, dy: float) -> PartCut:
         c, s = math.cos(angle), math.sin(angle)
         rot = np.array([[c, -s], [s, c]])
+        a0, x0, y0 = self.placed
         return replace(self, outer=self.outer.transformed(angle, dx, dy),
+                       placed=(a0 + angle, c * x0 - s * y0 + dx, s * x0 + c * y0 + dy),
                        inner=[k.transformed(angle, dx, dy) for k in self.inner],
                        engrave=[np.asarray(e) @ rot.T + (dx, dy) for e in self.engrave],
                        nominal_holes=[((c * x - s * y + dx, s * x + c * y + dy), r) for (x, y), r in self.nominal_holes],
@@ -270,6 +275,14 @@ def stadium(p0, p1, h: float) -> Cut:
     a, b = p0 - h * nrm, p1 - h * nrm
     c, dd = p1 + h * nrm, p0 + h * nrm
     return Contour([(a[0], a[1], 0.0), (b[0], b[1], 1.0), (c[0], c[1], 0.0), (dd[0], dd[1], 1.0)])
+
+
+def rectangle(centre, half_length: float, half_width: float, angle: float) -> Contour:
+    """A rectangle (a tab's through-slot) about ``centre``, its long axis along ``angle`` (rad), counter-clockwise."""
+    c, s = math.cos(angle), math.sin(angle)
+    cx, cy = centre
+    pts = [(-half_length, -half_width), (half_length, -half_width), (half_length, half_width), (-half_length, half_width)]
+    return Contour([(cx + c * x - s * y, cy + s * x + c * y, 0.0) for x, y in pts])
 
 
 def arc_slot(centre, R: float, a0: float, a1: float, h: float) -> Cut:

@@ -69,7 +69,8 @@ def _same_layer_overlaps(path: Path) -> tuple[list, list]:
     names = sorted(fab.own)
     for i, a in enumerate(names):
         for b in names[i + 1:]:
-            if planes[a] != planes[b] or fab.assembly.layers[a] != fab.assembly.layers[b]:
+            if a not in planes or b not in planes or planes[a] != planes[b] \
+                    or fab.assembly.layers[a] != fab.assembly.layers[b]:  # a bracket (planar.fabtabs) stands still
                 continue
             for k in range(len(m)):
                 pa, pb = m.poses[a][k], m.poses[b][k]
