@@ -26,7 +26,8 @@ EXIT_MISMATCH = 3
 def _cmd_design(args: argparse.Namespace) -> int:
     import tomllib
 
-    from .windup.design import TOLERANCE, design_scene, design_toy, load_request, physics_check, physics_failures
+    from .windup.design import (TOLERANCE, TORQUE_TOLERANCE, design_scene, design_toy, load_request, physics_check,
+                                physics_failures)
 
     from .errors import InputError
 
@@ -51,7 +52,7 @@ def _cmd_design(args: argparse.Namespace) -> int:
     if not isinstance(name, str) or not re.match(_NAME, name) or len(name) > 80:
         raise InputError(f"{args.request}: name", name, "a string of at most 80 characters without commas, double "
                          "quotes or control characters")
-    d = design_toy(effectors, name=name, max_length=args.max_length)
+    d = design_toy(effectors, name=name, max_length=args.max_length, source=str(args.request))
     scene = design_scene(d.toy, name)
     scene.save(args.output)
     # the toy as it will run (as `planar toy` checks it): the design has run it unless the tree failed before
@@ -72,6 +73,8 @@ def _cmd_design(args: argparse.Namespace) -> int:
               f"{d.tried} of {d.candidates} trees sized")
         for r in d.rejected:
             print(f"  passed over (it failed a check): {r}")
+        if d.variant:
+            print(f"  written: the tree as sized with {d.variant} (the same motion)")
         for e in rep["effectors"]:
             unit = "deg" if e["motion"][0] == "O" else "units"
             flag = "[ok]" if e["error"] <= TOLERANCE else "[FAIL]"
@@ -92,21 +95,34 @@ def _cmd_design(args: argparse.Namespace) -> int:
                       f"{pl.checked} checked against the export): footprint {pl.footprint[0]:.3g} -> "
                       f"{pl.footprint[1]:.3g} units^2, overlap of unjoined pieces {pl.overlap[0]:.3g} -> "
                       f"{pl.overlap[1]:.3g}")
-            else:
+            elif pl.checked:
                 print(f"  placement ({', '.join(pl.variables)}; {pl.evaluations} layouts annealed): none of the "
-                      f"{pl.checked} best kept (each added a collision, pin clash or layer, or none improved)")
+                      f"{pl.checked} best kept (each added a collision, pin clash or layer); the start kept")
+            else:
+                print(f"  placement ({', '.join(pl.variables)}; {pl.evaluations} layouts annealed): no layout "
+                      "improved on the start; the start kept")
         else:
             print("  placement: no stage of this tree can move without changing a motion")
-        print(f"  {len(d.layers)} pieces in {n_layers} layers (the export's plan); same-layer collisions over 24 "
-              f"poses: {len(d.collisions)}, pins through pieces: {len(d.clashes)} "
-              + ("[ok]" if not (d.collisions or d.clashes) else "[FAIL] " + ", ".join(
-                  [f"{a}/{b} {ov:.3g} mm^2" for a, b, ov in d.collisions] + d.clashes)))
+        if d.export_refused:
+            why = d.export_refused.removeprefix("the export refuses it: ")
+            print(f"  export: it refuses the pieces [FAIL]: {why} (no layer plan, so no collision or pin check)")
+        else:
+            print(f"  {len(d.layers)} pieces in {n_layers} layers (the export's plan); same-layer collisions over "
+                  f"24 poses: {len(d.collisions)}, pins through pieces: {len(d.clashes)} "
+                  + ("[ok]" if not (d.collisions or d.clashes) else "[FAIL] " + ", ".join(
+                      [f"{a}/{b} {ov:.3g} mm^2" for a, b, ov in d.collisions] + d.clashes)))
         tq = phys["torque_rel_diff"]
-        print("  physics (as planar toy): " + (f"motor torque vs inverse dynamics {tq:.2g} of the peak"
-                                               if tq is not None else "not run")
-              + (" [ok]" if phys["ok"] else " [FAIL]"))
+        if tq is None:
+            print("  physics (as planar toy): not run [FAIL]")
+        else:
+            tq_ok = tq <= TORQUE_TOLERANCE and not phys["failure"]
+            print(f"  physics (as planar toy): motor torque vs inverse dynamics {tq:.2g} of the peak "
+                  f"(limit {TORQUE_TOLERANCE:g}) " + ("[ok]" if tq_ok else "[FAIL]"))
         for why in failures:
-            print(f"    {why}")
+            print(f"    [FAIL] {why}")
+        if d.gravity_x:
+            print(f"  gravity along +x in the written toy (it holds the tab of #8 stage {', '.join(d.gravity_x)} on "
+                  "its face): stand the real toy with the drawing's +x axis pointing down")
         print(f"  wrote {args.output} ({sum(d.seconds.values()):.2f} s)")
     return 0 if ok else EXIT_MISMATCH
 

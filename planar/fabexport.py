@@ -66,8 +66,9 @@ def _fab_mechanism(mech: Any) -> Any:
     return mech
 
 
-def _phase_mark(pc: PartCut, at: tuple[float, float], flat: float, phase: float) -> None:
-    """Engrave a keyed cam's phase: a tick from its shaft hole along the D's flat and the phase in degrees."""
+def _phase_mark(pc: PartCut, at: tuple[float, float], flat: float, phase: float, turn: float = 0.0) -> None:
+    """Engrave a keyed cam's key angle: a tick from its shaft hole along the D's flat and the angle in degrees
+    (``phase``, rad: the cam's phase plus ``turn``, its root stage's own turn; the note names both)."""
     import numpy as np
 
     from .strokefont import text_strokes
@@ -76,7 +77,10 @@ def _phase_mark(pc: PartCut, at: tuple[float, float], flat: float, phase: float)
     pc.engrave.append(np.array([(at[0] + 2.5 * c, at[1] + 2.5 * s), (at[0] + 5.0 * c, at[1] + 5.0 * s)]))
     deg = f"{math.degrees(phase) % 360:.0f}"
     pc.engrave.extend(text_strokes(deg, 1.5, (at[0] - 3.5 * c, at[1] - 3.5 * s), flat - math.pi / 2))
-    pc.notes.append(f"{pc.name}: keyed to the motor shaft at {deg} degrees (engraved tick along the D's flat)")
+    own = f"{math.degrees(turn) % 360:.0f}"
+    cam = f"{math.degrees(phase - turn) % 360:.0f}"
+    why = f" = cam phase {cam} + the stage's own turn {own}" if own != "0" else ""
+    pc.notes.append(f"{pc.name}: keyed to the motor shaft at {deg} degrees{why} (engraved tick along the D's flat)")
 
 
 def build(scene: Any, settings: FabSettings) -> Fabrication:
@@ -120,7 +124,8 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
         pc = part_cuts(part, s, n, {i for (pn, i) in pinned if pn == part.name}, drive_at, motor_at,
                        mounting=part.ground and part.plane == "xy", letters=letters[part.name], drive_flat=flat)
         if drive_at is not None and part.name in keyed:
-            _phase_mark(pc, (drive_at[0] * s.unit_mm, drive_at[1] * s.unit_mm), flat, keyed[part.name])
+            _phase_mark(pc, (drive_at[0] * s.unit_mm, drive_at[1] * s.unit_mm), flat, keyed[part.name],
+                        dict(getattr(mech, "key_turn", {})).get(part.name, 0.0))
         notes.extend(pc.notes)
         cuts.append(pc)
     material = {pc.name: nominal_material(pc.outer, pc.inner, s.kerf / 2) for pc in cuts}
