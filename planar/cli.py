@@ -258,6 +258,8 @@ def _cmd_export(args: argparse.Namespace) -> int:
                        args.kerf_test)
     for note in fab.notes:
         print(f"note: {note}")
+    for w in fab.warnings:  # a toy's motion the cut parts will not make (the design exits 3 for it; cut anyway)
+        print(f"warning: {w}")
     print(f"{summary(fab)} -> {', '.join(map(str, fab.written)) or 'nothing written'}")
     return 0
 

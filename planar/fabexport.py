@@ -41,6 +41,9 @@ class Fabrication:
     grounds: list[str] = field(default_factory=list)
     #: files written by :func:`write_outputs`
     written: list[Path] = field(default_factory=list)
+    #: motions the cut parts will not make (a toy's cam throw or effector stroke under a few times the fit's
+    #: play: :func:`planar.windup.fitcheck.small_motions`), one line each
+    warnings: list[str] = field(default_factory=list)
 
 
 def _shaft_pin(mech: Any, pins) -> Any:
@@ -143,8 +146,13 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
             cuts.append(PartCut(f"spacer {pp.letter}{j + 1}", Circle((0.0, 0.0), ro + k2), [Circle((0.0, 0.0), ri - k2)],
                                 nominal_holes=[((0.0, 0.0), ri)]))
     layout = nest(cuts, s.sheet, s.spacing, s.margin, s.kerf, s.unit_mm)
+    warnings: list[str] = []
+    if mech is not scene.mechanism:  # a toy: its motions against the fit's play
+        from .windup.fitcheck import small_motion_text, small_motions
+
+        warnings = [small_motion_text(m, s) for m in small_motions(scene.mechanism, s)]
     return Fabrication(scene.name, s, layout, asm, notes, shaft.joint if shaft is not None else None, material,
-                       [p.name for p in mech.parts if p.ground and p.plane == "xy"])
+                       [p.name for p in mech.parts if p.ground and p.plane == "xy"], warnings=warnings)
 
 
 def sheet_paths(path: str | os.PathLike, sheets: int) -> list[Path]:
