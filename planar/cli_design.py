@@ -8,8 +8,9 @@ same-layer collision.  Exit status 2 for bad input or an unreachable request
 (one line naming the effector and what its chains reach; nothing written);
 3 when the written toy fails its own check (a range off by more than 1 %, a
 same-layer collision, a pin through a piece, an export that refuses it, a
-motor torque off inverse dynamics by more than 1 %, a #8 tab letting go, or a
-stage the physics did not simulate: each named with its reason).
+motor torque off inverse dynamics by more than 1 %, a #8 tab letting go, a
+stage the physics did not simulate, or a cam throw or effector stroke under 3
+times the fit's play (:mod:`planar.windup.fitcheck`): each named with its reason).
 """
 
 from __future__ import annotations
@@ -149,11 +150,13 @@ def add_parser(sub: Any) -> None:
     d = sub.add_parser("design", help="a wind-up toy from requested end-effector motions (writes a toy scene)",
                        description="Design a wind-up toy from a request file of [[effector]] tables (name, motion "
                                    "Ox Oy Oz Tx Ty Tz OzT, range in degrees for O/OzT or model units for T, "
-                                   "optional cam left/right and phase in cycles). Exit status 2 for bad input "
-                                   "or a range no chain reaches (nothing written); 3 when the toy written fails a "
-                                   "check (a range off by more than 1 %, a same-layer collision, a pin through a "
-                                   "piece, the export refusing it, or its physics: motor torque, a #8 tab letting "
-                                   "go, a stage not simulated), each failure named.")
+                                   "optional cam left/right and phase in cycles, 0 <= phase < 1: a quarter turn is "
+                                   "0.25). Exit status 2 for bad input or a range no buildable chain reaches "
+                                   "(one line naming the file, effector and value; nothing written); 3 when the toy "
+                                   "written fails a check (a range off by more than 1 %, a same-layer collision, a "
+                                   "pin through a piece, the export refusing it, its physics: motor torque, a #8 "
+                                   "tab letting go, a stage not simulated; or a cam throw or effector stroke under "
+                                   "3 times the fit's play, which the cut parts will not make), each failure named.")
     d.add_argument("request", help="request file (TOML, [[effector]] tables)")
     d.add_argument("-o", "--output", required=True, help="toy scene file to write (TOML)")
     d.add_argument("--json", action="store_true", help="print a JSON report")
