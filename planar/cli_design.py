@@ -87,8 +87,11 @@ def summary_lines(d: Any, rep: dict[str, Any], phys: dict[str, Any], name: str, 
     lead = f"; right cam {math.degrees(d.toy.phase):.0f} deg ahead" if len(d.toy.cams) == 2 else ""
     out.append(f"{name}: cost {d.cost:g} ({d.toy.mechanism_count} mechanisms), {trees}{lead}; "
                f"{d.tried} of {d.candidates} trees sized")
-    for r in d.rejected:
-        out.append(f"  passed over (it failed a check): {r}")
+    for k, r in enumerate(d.rejected):
+        if k == 0 and d.fallback:
+            out.append(f"  written although it failed a check (no tree tried passed; the cheapest): {r}")
+        else:
+            out.append(f"  passed over (it failed a check): {r}")
     if d.variant:
         out.append(f"  written: the tree as sized with {d.variant} (the same motion)")
     for e in rep["effectors"]:

@@ -126,6 +126,11 @@ def test_the_summary_says_which_check_failed() -> None:
     # a #8 stage: the toy is written with gravity along +x, and the summary says how to stand it
     assert any("gravity along +x" in ln and "s1" in ln and "pointing down" in ln for ln in lines)
     assert rep["gravity"] == [9.81, 0.0]
+    # when every tree tried failed, the one written is not said to be passed over
+    d = _fake_design(phys, rejected=["cost 6 left: Rz->Tx Tx->Oy: torque"], fallback=True)
+    lines = summary_lines(d, d.report(), phys, "t", "t.toml")
+    assert not any("passed over" in ln for ln in lines)
+    assert any(ln.startswith("  written although it failed a check") for ln in lines)
 
 
 def test_a_motion_lost_in_the_fit_fails_the_design_and_warns_the_export(tmp_path, capsys) -> None:

@@ -115,6 +115,7 @@ class Design:
     before_reason: str = ""  # why the export refused the pieces before placement, if it did
     physics: dict[str, Any] | None = None  # :func:`physics_check` of the written toy (None: not run)
     variant: str = ""  # how the tree differs from the tree as sized ("its cams grown into discs"), or ""
+    fallback: bool = False  # every tree tried failed: this is the cheapest (``rejected[0]``), written with its failures
 
     @property
     def export_refused(self) -> str:
@@ -153,6 +154,7 @@ class Design:
             "pin_clashes": [] if self.export_refused else self.clashes,
             "export_refused": self.export_refused or None,
             "variant": self.variant or None,
+            "fallback": self.fallback,
             "gravity": [9.81, 0.0] if self.gravity_x else None,
             "rejected_trees": self.rejected,
             "physics": self.physics,
@@ -1109,6 +1111,7 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
         if fabricated >= max_fabricated:
             break
     if first is not None:
+        first.fallback = True
         return first  # every tree tried collides: the cheapest, its failures reported
     for e, opts in zip(effectors, options):
         spans = [r for r in (reach(c) for c in opts if refused(c) is None) if r is not None]
