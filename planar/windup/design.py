@@ -11,7 +11,9 @@ A request lists end effectors (``[[effector]]``: ``name``, ``motion``,
 3. **ranks** the trees by the paper's cost (:func:`~planar.windup.chain.tree_cost`:
    mechanisms + 2 x mean chain length), cheapest first, skipping trees with a
    chain that cannot reach its effector's range (each chain's reachable range
-   is scanned once, lazily, its sized stage's parameter varied);
+   is scanned once, lazily, its sized stage's parameter varied) or that the toy
+   assembly cannot build (a mirrored stage, a stage turned out of its plane);
+   an unreachable range is refused naming the reach of the buildable chains;
 4. **sizes** the cheapest tree that works: each effector's last stage's design
    parameter (:data:`~planar.windup.sizing.DESIGN_PARAMETER`; its parent's for a
    #10, whose stroke follows its driver's travel) is solved with
@@ -74,7 +76,7 @@ TOLERANCE = 0.01
 @dataclass(frozen=True)
 class Effector:
     """One requested end effector: ``range`` in degrees (O, OzT's rotation) or model units (T);
-    ``phase`` in cycles (only differences between cams matter)."""
+    ``phase`` in cycles, ``0 <= phase < 1`` (only differences between cams matter)."""
 
     name: str
     motion: str
