@@ -259,6 +259,8 @@ def _cmd_export(args: argparse.Namespace) -> int:
                        args.kerf_test)
     for note in fab.notes:
         print(f"note: {note}")
+    for w in fab.warnings:  # a toy's motion the cut parts will not make (the design exits 3 for it; cut anyway)
+        print(f"warning: {w}")
     print(f"{summary(fab)} -> {', '.join(map(str, fab.written)) or 'nothing written'}")
     return 0
 
@@ -268,7 +270,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = _Parser(prog="planar", description="2D rigid-body mechanisms: exact kinematics and more.",
                 epilog="Exit status: 0 success, 2 a user error (one line naming the file, field or option), "
-                       "3 a failed check (compare), 1 an internal error (run with --debug for the traceback). "
+                       "3 a result that failed its own check (compare, toy, design, synth; each failure named, "
+                       "design and synth still write their result), 1 an internal error (run with --debug for the traceback). "
                        "Limits on work (PLANAR_MAX_SAMPLES, PLANAR_MAX_FRAMES, PLANAR_MAX_CHAIN, "
                        "PLANAR_MAX_MEMORY): see the README.")
     p.add_argument("--debug", action="store_true", help="show the Python traceback of an error")

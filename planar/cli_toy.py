@@ -18,6 +18,15 @@ from typing import Any
 EXIT_MISMATCH = 3
 
 
+
+def _key_text(cam: str, angle: float, turn: float) -> str:
+    """A cam's key angle (rad) in degrees, split into the cam's phase and its stage's own turn when it has one."""
+    own = round(math.degrees(turn)) % 360
+    if not own:
+        return f"{cam} {math.degrees(angle) % 360:.0f} deg"
+    return (f"{cam} {math.degrees(angle) % 360:.0f} deg (cam phase {math.degrees(angle - turn) % 360:.0f} + "
+            f"the stage's own turn {own})")
+
 def _speeds(text: str) -> list[float]:
     from .errors import InputError
 
@@ -63,6 +72,7 @@ def _cmd_toy(args: argparse.Namespace) -> int:
         "pieces": {p.name: p.plane for p in asm.parts},
         "bodies": asm.bodies,
         "keyed": {k: math.degrees(v) for k, v in asm.keyed.items()},
+        "key_turn": {k: math.degrees(v) for k, v in getattr(asm, "key_turn", {}).items()},
         "worst_joint_residual": worst,
         "torque": {k: tq[k] for k in ("peak", "max_rel_diff", "samples_compared", "failure", "pose_error", "pieces")},
         "stages": [{"stage": s.stage, "pattern": s.pattern, "simulated": s.simulated, "detail": s.detail}
@@ -80,7 +90,7 @@ def _cmd_toy(args: argparse.Namespace) -> int:
             planes[p.plane] = planes.get(p.plane, 0) + 1
         print(f"{toy.name}: {len(asm.parts)} pieces ({', '.join(f'{k} {v}' for k, v in planes.items())}), "
               f"{len(asm.bodies)} rigid bodies; cams keyed at "
-              + ", ".join(f"{k} {math.degrees(v):.0f} deg" for k, v in asm.keyed.items())
+              + ", ".join(_key_text(k, v, getattr(asm, "key_turn", {}).get(k, 0.0)) for k, v in asm.keyed.items())
               + f"; worst joint residual on the merged pieces {worst:.2g} of the size "
               + ("[ok]" if ok_joints else "[FAIL]"))
         fail = f"; {tq['failure']}" if tq["failure"] else ""

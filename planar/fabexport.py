@@ -48,6 +48,9 @@ class Fabrication:
     stack_z: float = 0.0
     #: each perpendicular piece's plane position (mm: world y for xz, x for yz)
     planes: dict[str, float] = field(default_factory=dict)
+    #: motions the cut parts will not make (a toy's cam throw or effector stroke under a few times the fit's
+    #: play: :func:`planar.windup.fitcheck.small_motions`), one line each
+    warnings: list[str] = field(default_factory=list)
 
 
 def _shaft_pin(mech: Any, pins) -> Any:
@@ -75,8 +78,9 @@ def _fab_mechanism(mech: Any) -> Any:
     return fab_view(mech)
 
 
-def _phase_mark(pc: PartCut, at: tuple[float, float], flat: float, phase: float) -> None:
-    """Engrave a keyed cam's phase: a tick from its shaft hole along the D's flat and the phase in degrees."""
+def _phase_mark(pc: PartCut, at: tuple[float, float], flat: float, phase: float, turn: float = 0.0) -> None:
+    """Engrave a keyed cam's key angle: a tick from its shaft hole along the D's flat and the angle in degrees
+    (``phase``, rad: the cam's phase plus ``turn``, its root stage's own turn; the note names both)."""
     import numpy as np
 
     from .strokefont import text_strokes
@@ -85,7 +89,10 @@ def _phase_mark(pc: PartCut, at: tuple[float, float], flat: float, phase: float)
     pc.engrave.append(np.array([(at[0] + 2.5 * c, at[1] + 2.5 * s), (at[0] + 5.0 * c, at[1] + 5.0 * s)]))
     deg = f"{math.degrees(phase) % 360:.0f}"
     pc.engrave.extend(text_strokes(deg, 1.5, (at[0] - 3.5 * c, at[1] - 3.5 * s), flat - math.pi / 2))
-    pc.notes.append(f"{pc.name}: keyed to the motor shaft at {deg} degrees (engraved tick along the D's flat)")
+    own = f"{math.degrees(turn) % 360:.0f}"
+    cam = f"{math.degrees(phase - turn) % 360:.0f}"
+    why = f" = cam phase {cam} + the stage's own turn {own}" if own != "0" else ""
+    pc.notes.append(f"{pc.name}: keyed to the motor shaft at {deg} degrees{why} (engraved tick along the D's flat)")
 
 
 def build(scene: Any, settings: FabSettings) -> Fabrication:
@@ -146,7 +153,8 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
                                            letters=letters[part.name], drive_flat=flat, extra=extra, tabs=tab)
             pc = copy.deepcopy(cut_cache[key])
             if drive_at is not None and part.name in keyed:
-                _phase_mark(pc, (drive_at[0] * s.unit_mm, drive_at[1] * s.unit_mm), flat, keyed[part.name])
+                _phase_mark(pc, (drive_at[0] * s.unit_mm, drive_at[1] * s.unit_mm), flat, keyed[part.name],
+                            dict(getattr(mech, "key_turn", {})).get(part.name, 0.0))
             part_notes.extend(pc.notes)
             cuts.append(pc)
         return cuts, part_notes
@@ -223,9 +231,16 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
             cuts.append(PartCut(f"spacer {pp.letter}{j + 1}", Circle((0.0, 0.0), ro + k2), [Circle((0.0, 0.0), ri - k2)],
                                 nominal_holes=[((0.0, 0.0), ri)]))
     layout = nest(cuts, s.sheet, s.spacing, s.margin, s.kerf, s.unit_mm)
+    warnings: list[str] = []
+    from .windup.chain import ToyMechanism
+
+    if isinstance(scene.mechanism, ToyMechanism):  # a toy: its motions against the fit's play
+        from .windup.fitcheck import small_motion_text, small_motions
+
+        warnings = [small_motion_text(m, s) for m in small_motions(scene.mechanism, s)]
     return Fabrication(scene.name, s, layout, asm, notes, shaft.joint if shaft is not None else None, material,
                        [p.name for p in mech.parts if p.ground and p.plane == "xy"], joins=joins,
-                       stack_z=tab_plan.z_stack, planes=dict(tab_plan.planes))
+                       stack_z=tab_plan.z_stack, planes=dict(tab_plan.planes), warnings=warnings)
 
 
 def _engrave_joins(cuts: list[PartCut], joins: list[Any], s: FabSettings) -> None:

@@ -166,21 +166,21 @@ def test_unreachable_and_bad_requests_are_refused(tmp_path: Path, capsys) -> Non
     # OzT has one chain (Rz->OzT, #3): its rotation reaches about 13 degrees
     rc = main(["design", str(_request(tmp_path, [{"name": "head", "motion": "OzT", "range": 30.0}])), "-o", str(out)])
     err = capsys.readouterr().err.strip()
-    assert rc == 2 and len(err.splitlines()) == 1 and "'head'" in err and "between" in err and not out.exists()
+    assert rc == 2 and len(err.splitlines()) == 1 and "'head'" in err and "reach" in err and not out.exists()
     # the reach it names is the landed inverse sizing's (planar.windup.sizing) for #3's rotation
     import re
 
     from planar.windup.sizing import reachable_ranges
 
     hi = max(h for _, h in reachable_ranges(3))
-    named = float(re.search(r"and ([0-9.]+) deg", err).group(1))
+    named = float(re.search(r"to ([0-9.]+) deg", err).group(1))
     assert named == pytest.approx(math.degrees(hi), rel=0.01)
     rc = main(["design", str(_request(tmp_path, [{"name": "a", "motion": "Tz", "range": 0.1}])), "-o", str(out)])
     err = capsys.readouterr().err.strip()
     assert rc == 2 and len(err.splitlines()) == 1 and "'a' (Tz)" in err and not out.exists()
     rc = main(["design", str(_request(tmp_path, [{"name": "head", "motion": "Rz", "range": 3.0}])), "-o", str(out)])
     err = capsys.readouterr().err.strip()
-    assert rc == 2 and "effector[0].motion" in err and not out.exists()
+    assert rc == 2 and "effector 'head'.motion" in err and not out.exists()
 
 
 def test_a_tree_whose_physics_fails_is_passed_over(tmp_path, capsys) -> None:

@@ -366,6 +366,9 @@ class ToyAssembly(Mechanism):
         joints: list[Any] = []
         main_cam = cam_name[min(cam_name)]
         self.keyed: dict[str, float] = {main_cam: 0.0}
+        #: each keyed cam's own part of its key angle (rad): its root stage's turn relative to the first cam's
+        #: (``keyed`` = cam phase difference + this; a Ty cam is #1 turned a quarter)
+        self.key_turn: dict[str, float] = {main_cam: 0.0}
         for p in self.placed:
             for j in p.stage.mech.joints:
                 a, b = f"{p.label}.{j.a}", f"{p.label}.{j.b}"
@@ -386,7 +389,9 @@ class ToyAssembly(Mechanism):
                 continue
             ph = toy.cam_phase[self.placed[i].stage.cam] - toy.cam_phase[self.placed[min(cam_name)].stage.cam]
             # a root stage turned by its realisation (Rz->Ty is #1 turned a quarter) turns its cam as much
-            ph = float(wrap_angle(np.array([ph + self.placed[i].place[2] - self.placed[min(cam_name)].place[2]]))[0])
+            turn = self.placed[i].place[2] - self.placed[min(cam_name)].place[2]
+            self.key_turn[name] = float(wrap_angle(np.array([turn]))[0])
+            ph = float(wrap_angle(np.array([ph + turn]))[0])
             self.keyed[name] = float(ph)
             joints.append(KeyedShaft(f"{name}.key", main_cam, name, (0.0, 0.0), (0.0, 0.0), float(ph), size))
         self.main_cam = main_cam

@@ -11,7 +11,9 @@ A request lists end effectors (``[[effector]]``: ``name``, ``motion``,
 3. **ranks** the trees by the paper's cost (:func:`~planar.windup.chain.tree_cost`:
    mechanisms + 2 x mean chain length), cheapest first, skipping trees with a
    chain that cannot reach its effector's range (each chain's reachable range
-   is scanned once, lazily, its sized stage's parameter varied);
+   is scanned once, lazily, its sized stage's parameter varied) or that the toy
+   assembly cannot build (a mirrored stage, a stage turned out of its plane);
+   an unreachable range is refused naming the reach of the buildable chains;
 4. **sizes** the cheapest tree that works: each effector's last stage's design
    parameter (:data:`~planar.windup.sizing.DESIGN_PARAMETER`; its parent's for a
    #10, whose stroke follows its driver's travel) is solved with
@@ -74,7 +76,7 @@ TOLERANCE = 0.01
 @dataclass(frozen=True)
 class Effector:
     """One requested end effector: ``range`` in degrees (O, OzT's rotation) or model units (T);
-    ``phase`` in cycles (only differences between cams matter)."""
+    ``phase`` in cycles, ``0 <= phase < 1`` (only differences between cams matter)."""
 
     name: str
     motion: str
@@ -114,6 +116,18 @@ class Design:
     before: dict[str, int] = field(default_factory=dict)  # layers, collisions, pin clashes before placement
     before_reason: str = ""  # why the export refused the pieces before placement, if it did
     physics: dict[str, Any] | None = None  # :func:`physics_check` of the written toy (None: not run)
+    variant: str = ""  # how the tree differs from the tree as sized ("its cams grown into discs"), or ""
+    fallback: bool = False  # every tree tried failed: this is the cheapest (``rejected[0]``), written with its failures
+
+    @property
+    def export_refused(self) -> str:
+        """Why the export refuses the toy's pieces ("" when it cuts them; then ``clashes`` are pins only)."""
+        return self.clashes[0] if not self.layers and self.clashes else ""
+
+    @property
+    def gravity_x(self) -> list[str]:
+        """The #8 stages for which the toy is written with gravity along +x (:func:`design_scene`)."""
+        return [st.label for st in self.toy.stages if st.realisation.number == 8]
 
     def report(self) -> dict[str, Any]:
         return {
@@ -139,7 +153,11 @@ class Design:
                 "evaluations": self.placement.evaluations, "rejected": self.placement.rejected,
                 "kept": self.placement.kept, "checked": self.placement.checked},
             "collisions": [{"a": a, "b": b, "overlap": ov} for a, b, ov in self.collisions],
-            "pin_clashes": self.clashes,
+            "pin_clashes": [] if self.export_refused else self.clashes,
+            "export_refused": self.export_refused or None,
+            "variant": self.variant or None,
+            "fallback": self.fallback,
+            "gravity": [9.81, 0.0] if self.gravity_x else None,
             "rejected_trees": self.rejected,
             "physics": self.physics,
             "seconds": self.seconds,
@@ -171,7 +189,12 @@ def load_request(path: str | Path) -> list[Effector]:
         bad = sorted(set(r) - {"name", "motion", "range", "cam", "phase"})
         if bad:
             raise InputError(f"{where}.{bad[0]}", r[bad[0]], "one of name, motion, range, cam, phase")
+        for req in ("name", "motion", "range"):
+            if req not in r:
+                raise InputError(f"{where}.{req}", None, f"a {req} (the field is required)")
         name = r.get("name")
+        if isinstance(name, str) and name.strip():
+            where = f"{p}: effector {name!r}"
         if not isinstance(name, str) or not name.strip() or any(c in name for c in '.:+,"') or name == "frame" \
                 or any(ord(c) < 32 or ord(c) == 127 for c in name):
             raise InputError(f"{where}.name", name, "a name without '.', ':', '+', ',', '\"' or control characters, "
@@ -187,13 +210,25 @@ def load_request(path: str | Path) -> list[Effector]:
             raise InputError(f"{where}.cam", cam, "'left' or 'right'")
         ph = r.get("phase", 0.0)
         if isinstance(ph, bool) or not isinstance(ph, (int, float)) or not math.isfinite(ph):
-            raise InputError(f"{where}.phase", ph, "a number of cycles")
+            raise InputError(f"{where}.phase", ph, "a number of cycles (0 <= phase < 1)")
+        if not 0 <= ph < 1:
+            raise InputError(f"{where}.phase", ph, _phase_hint(float(ph)))
         out.append(Effector(name, str(motion), float(rng), cam, float(ph)))
     names = [e.name for e in out]
     dup = next((n for n in names if names.count(n) > 1), None)
     if dup is not None:
         raise InputError(f"{p}: effector.name", dup, "distinct effector names")
     return out
+
+
+def _phase_hint(ph: float) -> str:
+    """What a phase outside [0, 1) should have been: cycles, with a guess at what was meant."""
+    text = "a phase in cycles (0 <= phase < 1; a quarter turn is 0.25)"
+    if 1 <= ph <= 360 and (ph >= 5 or ph == int(ph)):
+        return text + f"; if {ph:g} is degrees, write phase = {ph / 360:.6g} (degrees / 360)"
+    if 1 <= ph < 5:
+        return text + f"; whole turns make no difference: {ph:g} cycles is phase = {ph % 1:.6g}"
+    return text
 
 
 # ----------------------------------------------------------------------------- composition and sizing
@@ -921,9 +956,12 @@ def _variants(cams: dict[str, list[Chain]], phase: float, name: str,
 
 
 def design_toy(effectors: list[Effector], name: str = "designed toy", max_length: int = 3,
-               max_trees: int = 200, place: bool = True, max_fabricated: int = 4, physics: bool = True) -> Design:
+               max_trees: int = 200, place: bool = True, max_fabricated: int = 4, physics: bool = True,
+               source: str = "") -> Design:
     """Design a toy for ``effectors`` (see the module docstring); an unreachable request is an
-    :class:`InputError` naming the effector and the ranges its chains reach.
+    :class:`InputError` naming ``source`` (the request file), the effector, its range and the ranges the
+    chains the toy assembly can build reach (chains it refuses, e.g. a stage turned out of its plane, are
+    left out of that reach and named when they alone would reach the range).
 
     ``place``: anneal the placement; ``max_fabricated``: trees checked against the export (and the physics)
     before giving up; ``physics``: run :func:`physics_check` on a tree that passes the export's check and
@@ -960,24 +998,28 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
     def can(e: Effector, c: Chain) -> bool:
         return reaches(e, c) and refused(c) is None
 
+    at = f"{source}: " if source else ""
+
     phases = sorted({round(e.phase % 1.0, 12) for e in effectors})
     if len(phases) > 2:
-        raise InputError("effector phases", phases, "at most two distinct phases (one per cam)")
+        raise InputError(f"{at}effector phases", phases, "at most two distinct phases (one per cam)")
     for cam in CAMS:
         on = sorted({round(e.phase % 1.0, 12) for e in effectors if e.cam == cam})
         if len(on) > 1:
-            raise InputError(f"effector phases on the {cam} cam", on, "one phase per cam")
+            raise InputError(f"{at}effector phases on the {cam} cam", on, "one phase per cam")
     options = [enumerate_chains(e.motion, max_length)[e.motion] for e in effectors]
     for e, opts in zip(effectors, options):
         if not opts:
-            raise InputError(f"effector {e.name!r} ({e.motion}) chain length", max_length,
+            raise InputError(f"{at}effector {e.name!r} ({e.motion}) chain length", max_length,
                              f"enough stages for a chain from the motor to {e.motion} (--max-length)")
     cands = _candidates(effectors, options)
     if not cands:
-        raise InputError(*_no_tree(effectors, options))
+        where, value, expected = _no_tree(effectors, options)
+        raise InputError(at + where, value, expected)
     t_enum = time.perf_counter() - t0
     tried = fabricated = 0
     rejected: list[str] = []
+    why_not: list[str] = []  # why each tree that could reach the ranges was not built
     first: Design | None = None
     for cost, _, pairs in cands:
         if tried >= max_trees:
@@ -988,6 +1030,8 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
         phase = _toy_phase(effectors, pairs)
         sized = _size_tree(effectors, pairs, phase, q, cache)
         if sized is None:
+            why_not.append("; ".join(f"{cam}: {' '.join(c)}" for cam, c in pairs) + ": no parameter value gives "
+                           "every requested range")
             continue
         overrides, sizing = sized
         cams: dict[str, list[Chain]] = {}
@@ -1003,8 +1047,11 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
                 from .assembly import toy_assembly
 
                 toy_assembly(toy)
-            except InputError:
-                continue  # a tree the assembly refuses (a mirrored or turned out-of-plane stage)
+            except InputError as err:  # a tree the assembly refuses (a mirrored or turned out-of-plane stage)
+                why_not.append("; ".join(f"{cam}: {' '.join(c)}" for cam, c in pairs)
+                               + (f" ({how})" if how else "") + f": the toy assembly cannot build it (it would "
+                               f"{_reasons([str(err)])})")
+                continue
             t_size = time.perf_counter() - t0 - t_enum
             t1 = time.perf_counter()
             placement = None
@@ -1048,7 +1095,7 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
             secs = {"enumerate": t_enum, "rank_and_size": t_size, "place_and_check": time.perf_counter() - t1}
             d = Design(toy, effectors, pairs, cost, ranges, len(cands), tried, sizing, layers, collisions, secs,
                        placement, layers_before, clashes, rejected, before,
-                       before_reason=checked_before[2][0] if before["export_refused"] else "")
+                       before_reason=checked_before[2][0] if before["export_refused"] else "", variant=how)
             problems = [f"{a}/{b} collide" for a, b, _ in collisions] + clashes
             if not problems and physics:
                 t2 = time.perf_counter()
@@ -1066,21 +1113,52 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
         if fabricated >= max_fabricated:
             break
     if first is not None:
+        first.fallback = True
         return first  # every tree tried collides: the cheapest, its failures reported
     for e, opts in zip(effectors, options):
-        if any(reaches(e, c) for c in opts) and not any(can(e, c) for c in opts):
-            why = next(refused(c) for c in opts if reaches(e, c))
-            raise InputError(f"effector {e.name!r} ({e.motion})", e.motion,
-                             f"a motion with a chain the toy assembly can build (every {e.motion} chain up to "
-                             f"{max_length} stages reaching {e.range:g} is refused, e.g. {why})")
-        if not any(can(e, c) for c in opts):
-            spans = [r for r in (reach(c) for c in opts) if r is not None]
-            if spans:
-                lo, hi = min(s[0] for s in spans), max(s[1] for s in spans)
-                where = f"between about {e.unit(lo)} and {e.unit(hi)}"
-            else:
-                where = "none"
-            raise InputError(f"effector {e.name!r} ({e.motion}) range", e.range,
-                             f"a range its chains up to {max_length} stages reach ({where})")
-    raise InputError("request", [e.name for e in effectors],
-                     f"a tree that can be sized and assembled (none of the {tried} cheapest that could reach the ranges)")
+        spans = [r for r in (reach(c) for c in opts if refused(c) is None) if r is not None]
+        lo = min((r[0] for r in spans), default=math.nan)
+        hi = max((r[1] for r in spans), default=math.nan)
+        if spans and lo * (1 - 1e-6) <= e.target <= hi:
+            continue  # its buildable chains reach the range: the trees failed for another reason
+        where = f"reach about {e.unit(lo)} to {e.unit(hi)}" if spans else "reach no range (none can be built)"
+        value = f"{e.range:g} {'deg' if e.motion[0] == 'O' else 'units'}"
+        turned = [c for c in opts if refused(c) is not None and reaches(e, c)]
+        if turned:
+            why = _reasons([str(refused(c)) for c in turned])
+            listed = ", ".join(" ".join(c) for c in turned[:3]) + (f" and {len(turned) - 3} more" if len(turned) > 3
+                                                                    else "")
+            raise InputError(f"{at}effector {e.name!r} ({e.motion}) range", e.range,
+                             f"a range the toy assembly can build: the chains that reach {value} ({listed}) "
+                             f"{why}, which planar's toy assembly cannot build; buildable chains up to "
+                             f"{max_length} stages {where}")
+        raise InputError(f"{at}effector {e.name!r} ({e.motion}) range", e.range,
+                         f"a range buildable chains reach (buildable chains up to {max_length} stages {where})")
+    reason = why_not[0] if why_not else "none could be sized"
+    raise InputError(f"{at}request", [e.name for e in effectors],
+                     f"a tree that can be sized and assembled (none of the {tried} cheapest that could reach the "
+                     f"ranges; the cheapest: {reason})")
+
+
+def _assembly_reason(err: str) -> tuple[str, str]:
+    """Why the toy assembly refuses a chain or tree, in a user's terms, and the stage it names (from its
+    :class:`InputError`)."""
+    stage = err.split(" = ")[0].split(".stage ", 1)[-1].split(" ")[-1] if ".stage " in err else ""
+    if "not turned" in err:
+        return "need a stage turned out of its plane", stage
+    if "mirrored" in err:
+        return "need a mirrored stage", stage
+    if "follower moves in xy" in err:
+        return "need a stage driven by a follower moving out of the toy's plane", stage
+    return f"need what the assembly refuses ({err})", ""
+
+
+def _reasons(errs: list[str]) -> str:
+    """:func:`_assembly_reason` of several refusals, one clause per reason with its stages."""
+    by: dict[str, list[str]] = {}
+    for e in errs:
+        why, stage = _assembly_reason(e)
+        if stage and stage not in by.setdefault(why, []):
+            by[why].append(stage)
+    parts = [why + (f" ({', '.join(stages)})" if stages else "") for why, stages in sorted(by.items())]
+    return " or ".join(parts).replace(" or need ", " or ")
