@@ -317,9 +317,7 @@ def assembly_rates(asm: Any, q: Array, qd: Array, qdd: Array) -> tuple[dict[str,
     The place is a turn by ``a`` about z and a shift for an xy stage, a shift for xz and yz
     (:func:`planar.windup.assembly._world_track`): the stage part's velocity and acceleration turn by
     ``a``, its angular rates do not change; the piece's origin is a point of that body
-    (:func:`planar.derivatives.point_rates`)."""
-    from ..derivatives import PartRates, point_rates
-
+    (``v + omega x r``, ``a + alpha x r - omega^2 r``, ``r`` from the stage part's origin to the piece's)."""
     raw, ok = toy_rates(asm.toy, q, qd, qdd)
     stage_poses = asm.stage_poses(q)
     pieces, _ = asm._solve_poses(q)
@@ -332,7 +330,10 @@ def assembly_rates(asm: Any, q: Array, qd: Array, qdd: Array) -> tuple[dict[str,
             c, s_ = np.cos(ang), np.sin(ang)
             v = np.column_stack([c * v[:, 0] - s_ * v[:, 1], s_ * v[:, 0] + c * v[:, 1]])
             a = np.column_stack([c * a[:, 0] - s_ * a[:, 1], s_ * a[:, 0] + c * a[:, 1]])
-        pv, pa = point_rates(stage_poses[full], PartRates(v, a, om, al), pieces[piece][:, :2])
+        r = pieces[piece][:, :2] - stage_poses[full][:, :2]
+        om, al = np.broadcast_to(om, q.shape), np.broadcast_to(al, q.shape)
+        pv = np.column_stack([v[:, 0] - om * r[:, 1], v[:, 1] + om * r[:, 0]])
+        pa = np.column_stack([a[:, 0] - al * r[:, 1] - om * om * r[:, 0], a[:, 1] + al * r[:, 0] - om * om * r[:, 1]])
         out[piece] = (pv, pa, om, al)
     return out, ok
 
