@@ -29,6 +29,8 @@ from .designs import Checked
 __all__ = ["FunctionDesign", "check_function", "freudenstein_fit", "synthesise_function"]
 
 Array = NDArray[np.float64]
+#: a closed-form design this close (rad) at every pair is kept without a search
+EXACT = 1e-9
 
 
 def _wrap(a: Array) -> Array:
@@ -173,8 +175,8 @@ def synthesise_function(phi: Array, psi: Array, ground: float = 1.0, cons: Any =
                         tolerance: float = 0.01) -> tuple[FunctionDesign | None, str]:
     """The four-bar that follows ``psi`` at ``phi`` on one circuit, checked; or ``None`` and why none is valid.
 
-    Freudenstein's closed form is kept when it is valid and no less accurate
-    than the search's best (:mod:`.function_search`); ``cons`` is a
+    Freudenstein's closed form is kept when it is valid and exact (``EXACT``)
+    or no less accurate than the search's best (:mod:`.function_search`); ``cons`` is a
     :class:`.function_search.FunctionConstraints` (default: fixed offsets,
     link ratio 10).
     """
@@ -198,14 +200,15 @@ def synthesise_function(phi: Array, psi: Array, ground: float = 1.0, cons: Any =
             closed = freudenstein_fit(phi, psi, ground)
         except InputError as exc:                           # no real four-bar at these offsets: search
             note = f"Freudenstein's closed form gives no four-bar ({exc.value})"
-    r = search_function(phi, psi, cons)
     if closed is not None:
         x = _normalised(closed)[None, :]
         circ = np.array([1.0 if closed.circuit == "open" else -1.0])
         e, ok = output_errors(x, circ, phi, psi)
         cerr = float(np.abs(e).max()) if ok.all() else np.inf
         v = violations(x, phi, cons)[0]
-        if v.sum() == 0 and cerr <= r.max_error + 1e-12:
+    r = None if closed is not None and v.sum() == 0 and cerr <= EXACT else search_function(phi, psi, cons)
+    if closed is not None:
+        if v.sum() == 0 and (r is None or cerr <= r.max_error + 1e-12):
             check_function(closed, cons, tolerance)
             return closed, ""
         lengths = np.array([closed.ground, closed.crank, closed.coupler, closed.rocker])
@@ -216,6 +219,7 @@ def synthesise_function(phi: Array, psi: Array, ground: float = 1.0, cons: Any =
         note = (f"Freudenstein's closed form ({closed.grashof}, {closed.circuit}, error "
                 f"{cerr if np.isfinite(cerr) else float(closed.max_error):.3g} rad at the pairs) "
                 + ("was less accurate than the search's" if not why else "is no valid four-bar: " + ", ".join(why)))
+    assert r is not None
     if r.x is None:
         return None, r.reason + (f"; {note}" if note else "")
     d = _design(r.x, r.circuit, phi, psi, ground, cons.free_offsets)
