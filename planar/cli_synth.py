@@ -157,6 +157,10 @@ def _cmd_function(args: argparse.Namespace) -> int:
         raise InputError("--tolerance", args.tolerance, "a positive angle in radians")
     t = read_table(args.pairs, ("input", "output"), min_rows=3)
     phi, psi = t["input"], t["output"]
+    if len(np.unique(phi)) < len(phi):
+        raise InputError(f"{args.pairs}: input", phi.tolist(), "a different input angle in every row")
+    if len(np.unique(psi)) < 2:
+        raise InputError(f"{args.pairs}: output", psi.tolist(), "output angles that change")
     if args.deg:
         phi, psi = np.radians(phi), np.radians(psi)
     cons = FunctionConstraints(free_offsets=args.free_offsets, full_turn=args.full_turn, max_ratio=args.max_ratio,

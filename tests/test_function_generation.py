@@ -171,3 +171,11 @@ def test_cli_function_bad_options(tmp_path, capsys, argv, field):
     assert main(["synth", "function", str(pairs), "-o", str(out), "--deg", *argv]) == 2
     err = capsys.readouterr().err
     assert field in err and err.count("\n") == 1 and not out.exists()
+
+
+def test_cli_function_repeated_input_names_file_and_column(tmp_path, capsys):
+    pairs = _pairs_csv(tmp_path / "p.csv", [10, 10, 70], [60, 75, 95])
+    out = tmp_path / "f.toml"
+    assert main(["synth", "function", str(pairs), "-o", str(out), "--deg"]) == 2
+    err = capsys.readouterr().err
+    assert "p.csv: input = [10.0, 10.0, 70.0]" in err and err.count("\n") == 1 and not out.exists()
