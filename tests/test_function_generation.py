@@ -24,30 +24,34 @@ def _wrap(a):
     return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
 
 
-def _loop_closure_outputs(d, guess):
-    """Rocker angles (world) at the requested inputs by scipy's root finder on the vector loop
-    ``a e^{i th} + b e^{i th3} - c e^{i th4} - d = 0`` in the ground line's frame, started at ``guess``
-    (world rocker angles); also the side of ``C`` (its circuit sign, FourBar's convention)."""
+def _loop_closure_outputs(d):
+    """World rocker angles at the requested inputs by scipy's root finder on the vector loop
+    ``a e^{i th} + b e^{i th3} - c e^{i th4} - d = 0`` in the ground line's frame: started from 8 rocker
+    angles round the circle, the roots found are sorted by the side of ``C`` (left of the directed
+    diagonal ``B -> O4``: FourBar's open circuit), and the one on the design's circuit is returned."""
     a, b, c, g = d.crank, d.coupler, d.rocker, d.ground
-    out, side = [], []
-    for th, t4 in zip(d.phi + d.input_offset, np.asarray(guess) - d.ground_angle):
+    want = 1 if d.circuit == "open" else -1
+    out = []
+    for th in d.phi + d.input_offset:
         Bx, By = a * np.cos(th), a * np.sin(th)
-        Cx, Cy = g + c * np.cos(t4), c * np.sin(t4)
-        t3 = np.arctan2(Cy - By, Cx - Bx)
 
         def f(v, th=th):
             t3, t4 = v
             return [a * np.cos(th) + b * np.cos(t3) - c * np.cos(t4) - g,
                     a * np.sin(th) + b * np.sin(t3) - c * np.sin(t4)]
 
-        sol, info, ier, _ = fsolve(f, [t3, t4], full_output=True, xtol=1e-13)
-        assert ier == 1 and np.abs(f(sol)).max() < 1e-10
-        t3, t4 = sol
-        # C left of the directed diagonal B -> O4: open (+1)
-        Cx, Cy = g + c * np.cos(t4), c * np.sin(t4)
-        side.append(np.sign((g - Bx) * (Cy - By) - (0 - By) * (Cx - Bx)))
-        out.append(t4 + d.ground_angle)
-    return np.array(out), np.array(side)
+        roots = []
+        for t4 in np.linspace(0, 2 * np.pi, 8, endpoint=False):
+            Cx, Cy = g + c * np.cos(t4), c * np.sin(t4)
+            sol, _, ier, _ = fsolve(f, [np.arctan2(Cy - By, Cx - Bx), t4], full_output=True, xtol=1e-13)
+            if ier == 1 and np.abs(f(sol)).max() < 1e-10:
+                Cx, Cy = g + c * np.cos(sol[1]), c * np.sin(sol[1])
+                if np.sign((g - Bx) * (Cy - By) - (0 - By) * (Cx - Bx)) == want:
+                    roots.append(float(sol[1]))
+        assert roots, "no root on the design's circuit"
+        assert np.ptp(np.unwrap(roots)) < 1e-7           # one root on each circuit
+        out.append(roots[0] + d.ground_angle)
+    return np.array(out)
 
 
 def _pairs_csv(path, phi, psi):
@@ -97,11 +101,9 @@ def test_known_fourbar_recovered_with_free_offsets_and_root_finder_agrees():
     assert d.max_error < 1e-7
     assert np.allclose([d.crank, d.coupler, d.rocker], [3.0, 1.6, 3.5], atol=1e-5)
     assert abs(_wrap(d.input_offset + 0.7)) < 1e-6 and abs(_wrap(d.output_offset - 1.1)) < 1e-6
-    # scipy's root finder, started at the requested output, lands on the reported error and circuit
+    # scipy's root finder, on the design's circuit, gives the reported errors
     want = d.psi + d.output_offset + d.ground_angle
-    got, side = _loop_closure_outputs(d, want)
-    assert np.abs(_wrap(got - want) - d.output_error).max() < 1e-9
-    assert (side == (1 if d.circuit == "open" else -1)).all()
+    assert np.abs(_wrap(_loop_closure_outputs(d) - want) - d.output_error).max() < 1e-9
 
 
 def test_cli_finds_valid_linkage_where_closed_form_is_not_one(tmp_path, capsys):
@@ -122,6 +124,11 @@ def test_cli_finds_valid_linkage_where_closed_form_is_not_one(tmp_path, capsys):
     world = m.poses["rocker"][:, 2]
     want = np.radians(psi) + r["output_offset_rad"] + r["ground_angle"]
     assert np.abs(_wrap(world - want) - r["output_error_rad"]).max() < 1e-9
+    # and so does scipy's root finder on the loop-closure equations of the written lengths
+    d, _ = synthesise_function(np.radians(phi), np.radians(psi))
+    assert d is not None and [d.crank, d.coupler, d.rocker, d.circuit] == [r["crank"], r["coupler"], r["rocker"],
+                                                                         r["circuit"]]
+    assert np.abs(_wrap(_loop_closure_outputs(d) - want) - r["output_error_rad"]).max() < 1e-9
 
 
 def test_cli_free_offsets_three_pairs_exact_with_good_transmission(tmp_path, capsys):
