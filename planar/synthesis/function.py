@@ -216,8 +216,8 @@ def synthesise_function(phi: Array, psi: Array, ground: float = 1.0, cons: Any =
             "does not move over the inputs' arc on one circuit" + (
                 "" if cons.min_transmission == 0 else f" with {np.degrees(cons.min_transmission):g} deg transmission"),
             "its crank cannot turn fully", f"link ratio {lengths.max() / lengths.min():.3g} > {cons.max_ratio:g}")) if bad]
-        note = (f"Freudenstein's closed form ({closed.grashof}, {closed.circuit}, error "
-                f"{cerr if np.isfinite(cerr) else float(closed.max_error):.3g} rad at the pairs) "
+        how = f"error {cerr:.3g} rad at the pairs" if np.isfinite(cerr) else "some pairs not on its circuit"
+        note = (f"Freudenstein's closed form ({closed.grashof}, {closed.circuit}, {how}) "
                 + ("was less accurate than the search's" if not why else "is no valid four-bar: " + ", ".join(why)))
     assert r is not None
     if r.x is None:
