@@ -170,7 +170,7 @@ def _cmd_function(args: argparse.Namespace) -> int:
     if d is None:                                       # nothing valid to write
         if args.json:
             print(json.dumps({"command": "synth function", "pairs": len(phi), "ok": False, "reason": why,
-                              "hint": hint}, indent=2))
+                              **({"hint": hint} if hint else {})}, indent=2))
         else:
             print(f"check failed: {why}; nothing written" + (f"\n{hint}" if hint else ""))
         return EXIT_CHECK
@@ -264,7 +264,8 @@ def add_parser(sub: Any) -> None:
     f.add_argument("--full-turn", action="store_true", help="the crank must turn fully (Grashof crank)")
     f.add_argument("--max-ratio", type=float, default=10.0, help="longest / shortest link at most this (10)")
     f.add_argument("--min-transmission", type=float, default=0.0,
-                   help="transmission angle kept this far from a toggle over the motion, degrees (0)")
+                   help="keep the transmission angle at least this far from 0 and 180 (a toggle) over the "
+                        "motion, degrees (0)")
     f.add_argument("--json", action="store_true", help="print the design and its errors as JSON")
     f.set_defaults(func=_cmd_function)
 

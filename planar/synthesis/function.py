@@ -214,7 +214,8 @@ def synthesise_function(phi: Array, psi: Array, ground: float = 1.0, cons: Any =
         lengths = np.array([closed.ground, closed.crank, closed.coupler, closed.rocker])
         why = [text for bad, text in zip(v > 0, (
             "does not move over the inputs' arc on one circuit" + (
-                "" if cons.min_transmission == 0 else f" with {np.degrees(cons.min_transmission):g} deg transmission"),
+                "" if cons.min_transmission == 0 else
+                f" keeping the transmission angle {np.degrees(cons.min_transmission):g} deg from a toggle"),
             "its crank cannot turn fully", f"link ratio {lengths.max() / lengths.min():.3g} > {cons.max_ratio:g}")) if bad]
         how = f"error {cerr:.3g} rad at the pairs" if np.isfinite(cerr) else "some pairs not on its circuit"
         note = (f"Freudenstein's closed form ({closed.grashof}, {closed.circuit}, {how}) "
