@@ -157,6 +157,8 @@ def _cmd_function(args: argparse.Namespace) -> int:
         raise InputError("--tolerance", args.tolerance, "a positive angle in radians")
     t = read_table(args.pairs, ("input", "output"), min_rows=3)
     phi, psi = t["input"], t["output"]
+    if len(phi) > MAX_PAIRS:
+        raise InputError(str(args.pairs), f"{len(phi)} pairs", f"at most {MAX_PAIRS} pairs")
     if len(np.unique(phi)) < len(phi):
         raise InputError(f"{args.pairs}: input", phi.tolist(), "a different input angle in every row")
     if len(np.unique(psi)) < 2:
@@ -226,6 +228,8 @@ def _cmd_motion(args: argparse.Namespace) -> int:
 
 #: most target points ``synth path`` takes (the search evaluates every candidate at each)
 MAX_TARGETS = 500
+#: most pairs ``synth function`` takes (2000 pairs: about 4.5 s, 150 MB)
+MAX_PAIRS = 5000
 
 
 def add_parser(sub: Any) -> None:
