@@ -150,11 +150,18 @@ def test_cli_full_turn_is_a_grashof_crank(tmp_path, capsys):
     _, psi, _ = fb.angles(phi)
     pairs = _pairs_csv(tmp_path / "p.csv", phi + 1.0, psi + 2.0)     # other zeros than the linkage's
     out = tmp_path / "f.toml"
-    assert main(["synth", "function", str(pairs), "-o", str(out), "--json", "--free-offsets", "--full-turn"]) == 0
+    assert main(["synth", "function", str(pairs), "-o", str(out), "--json", "--free-offsets", "--full-turn",
+                 "--min-transmission", "30"]) == 0
     r = json.loads(capsys.readouterr().out)
     assert r["grashof"] in ("crank-rocker", "double-crank") and r["checks"]["crank_turns_fully"]
     assert r["max_output_error_rad"] < 1e-6
-    assert load_scene(out).motion().valid.all()
+    scene = load_scene(out)
+    assert scene.motion().valid.all()
+    # over the whole turn, the angle between coupler and rocker (from the solved part poses) keeps 30 deg
+    m = scene.mechanism.solve(np.linspace(0, 2 * np.pi, 720, endpoint=False))
+    assert m.valid.all()
+    rel = m.poses["coupler"][:, 2] - m.poses["rocker"][:, 2]
+    assert np.degrees(np.arccos(np.abs(np.cos(rel)))).min() >= 30 - 1e-6
 
 
 def test_nothing_valid_exits_3_names_the_constraint_writes_nothing(tmp_path, capsys):

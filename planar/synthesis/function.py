@@ -155,6 +155,9 @@ def check_function(d: FunctionDesign, cons: Any, tolerance: float, dense: int = 
     d.output_error = (rocker[at] - rocker[at[i0]]) - (want - want[i0]) + e0
     mu = fb.transmission_angle(t)
     margin = float(np.minimum(mu, np.pi - mu).min())
+    if cons.full_turn:                                    # the linkage passes the whole turn: its margin too
+        mu = fb.transmission_angle(np.linspace(0.0, 2 * np.pi, 721))
+        margin_turn = float(np.minimum(mu, np.pi - mu).min())
     lengths = np.array([d.ground, d.crank, d.coupler, d.rocker])
     ratio = float(lengths.max() / lengths.min())
     full = fb.input_range() == [(0.0, 2 * np.pi)]
@@ -162,13 +165,15 @@ def check_function(d: FunctionDesign, cons: Any, tolerance: float, dense: int = 
         "ok_assembles_over_arc": bool(m.valid.all()),
         "ok_output_error": bool(np.isfinite(d.max_error) and d.max_error <= tolerance),
         "ok_link_ratio": ratio <= cons.max_ratio * (1 + 1e-9),
-        "ok_transmission": margin >= cons.min_transmission - 1e-9,
+        "ok_transmission": min(margin, margin_turn if cons.full_turn else margin) >= cons.min_transmission - 1e-9,
         "ok_full_turn": bool(full) or not cons.full_turn,
         "input_arc_deg": float(np.degrees(th.max() - th.min())),
         "min_transmission_deg": float(np.degrees(margin)),
         "link_ratio": ratio,
         "crank_turns_fully": bool(full),
     }
+    if cons.full_turn:
+        d.checks["min_transmission_full_turn_deg"] = float(np.degrees(margin_turn))
 
 
 def synthesise_function(phi: Array, psi: Array, ground: float = 1.0, cons: Any = None,
