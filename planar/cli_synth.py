@@ -124,32 +124,80 @@ def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | N
                    text, report, d.ok, failing)
 
 
+def _plus(v: float) -> str:
+    return f"{'-' if v < 0 else '+'} {abs(v):.9g}"
+
+
+def _free_hint(phi: np.ndarray, psi: np.ndarray, args: argparse.Namespace, cons: Any) -> str:
+    """What ``--free-offsets`` would give, for a request that fails with the angles as given."""
+    import dataclasses
+
+    from .synthesis.function import synthesise_function
+
+    d, _ = synthesise_function(phi, psi, args.ground, dataclasses.replace(cons, free_offsets=True), args.tolerance)
+    if d is None or not d.ok:
+        return ""
+    return (f"with --free-offsets (only the pairs' differences kept) a valid four-bar has error {d.max_error:.3g} rad, "
+            f"input zero at {math.degrees(d.input_offset):.6g} deg, output zero at "
+            f"{math.degrees(d.output_offset):.6g} deg from the ground line")
+
+
 def _cmd_function(args: argparse.Namespace) -> int:
     _check_output(args, args.pairs)
-    from .synthesis.function import freudenstein_fit
+    from .synthesis.function import synthesise_function
+    from .synthesis.function_search import FunctionConstraints
     from .synthesis.scene_out import fourbar_scene_text
     from .synthesis.targets import read_table
 
+    if not (args.max_ratio > 1 and math.isfinite(args.max_ratio)):
+        raise InputError("--max-ratio", args.max_ratio, "a finite ratio greater than 1")
+    if not 0 <= args.min_transmission < 90:
+        raise InputError("--min-transmission", args.min_transmission, "degrees from 0 up to (not including) 90")
+    if not (args.tolerance > 0 and math.isfinite(args.tolerance)):
+        raise InputError("--tolerance", args.tolerance, "a positive angle in radians")
     t = read_table(args.pairs, ("input", "output"), min_rows=3)
     phi, psi = t["input"], t["output"]
+    if len(phi) > MAX_PAIRS:
+        raise InputError(str(args.pairs), f"{len(phi)} pairs", f"at most {MAX_PAIRS} pairs")
+    if len(np.unique(phi)) < len(phi):
+        raise InputError(f"{args.pairs}: input", phi.tolist(), "a different input angle in every row")
+    if len(np.unique(psi)) < 2:
+        raise InputError(f"{args.pairs}: output", psi.tolist(), "output angles that change")
     if args.deg:
         phi, psi = np.radians(phi), np.radians(psi)
-    d = freudenstein_fit(phi, psi, args.ground)
-    fb = d.fourbar()
-    amp, centre = _rocking(fb, phi - d.ground_angle)
-    tol = args.tolerance
-    exact = len(phi) == 3
-    ok = bool(np.isfinite(d.max_error)) and (d.max_error <= (1e-9 if exact else tol))
-    failing = [] if ok else [f"output angle error {d.max_error:.3g} rad (limit {1e-9 if exact else tol:g})"]
+    cons = FunctionConstraints(free_offsets=args.free_offsets, full_turn=args.full_turn, max_ratio=args.max_ratio,
+                               min_transmission=math.radians(args.min_transmission))
+    d, why = synthesise_function(phi, psi, args.ground, cons, args.tolerance)
+    hint = "" if (d is not None and d.ok) or args.free_offsets else _free_hint(phi, psi, args, cons)
+    if d is None:                                       # nothing valid to write
+        if args.json:
+            print(json.dumps({"command": "synth function", "pairs": len(phi), "ok": False, "reason": why,
+                              **({"hint": hint} if hint else {})}, indent=2))
+        else:
+            print(f"check failed: {why}; nothing written" + (f"\n{hint}" if hint else ""))
+        return EXIT_CHECK
+    th = d.phi + d.input_offset                         # crank angles from the ground line
+    amp, centre = (None, 0.0) if d.checks["crank_turns_fully"] else (
+        max(0.5 * float(np.ptp(th)), 1e-6), 0.5 * float(th.max() + th.min()))
+    failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]
+    if not d.checks["ok_output_error"]:
+        failing[failing.index("output error")] = (
+            f"output angle error {d.max_error:.3g} rad (limit {args.tolerance:g}) on the best valid four-bar"
+            + (f"; {d.note}" if d.note else "") + (f"; {hint}" if hint else ""))
+    offs = (f"crank angle from the ground line = input {_plus(d.input_offset)} rad, "
+            f"rocker angle = output {_plus(d.output_offset)} rad")
     text = fourbar_scene_text(
         "synth-function", d.ground, d.crank, d.coupler, d.rocker, (0.5 * d.coupler, 0.0), d.circuit,
         (0.0, 0.0, d.ground_angle),
-        comments=[f"planar synth function {args.pairs}: {len(phi)} pairs, max output error {d.max_error:.3g} rad",
-                  "crank and rocker angles are the pairs' minus the placement angle (from the ground line)"],
+        comments=[f"planar synth function {args.pairs}: {len(phi)} pairs, max output error {d.max_error:.3g} rad "
+                  f"({d.method})", offs + " (the placement turns both by its angle)"],
         amplitude=amp, centre=centre)
-    report = {"command": "synth function", "pairs": len(phi), **d.to_dict()}
-    return _finish(args, f"four-bar ({d.grashof}, {d.circuit}), max output angle error {d.max_error:.3g} rad",
-                   text, report, ok, failing)
+    report = {"command": "synth function", "pairs": len(phi), **d.to_dict(), **({"hint": hint} if hint else {})}
+    shift = "" if not args.free_offsets else (f"; input zero at {math.degrees(d.input_offset):.6g} deg, output zero "
+                                               f"at {math.degrees(d.output_offset):.6g} deg from the ground line")
+    return _finish(args, f"four-bar ({d.grashof}, {d.circuit}, {d.method}), max output angle error {d.max_error:.3g} "
+                   f"rad, transmission angle >= {d.checks['min_transmission_deg']:.3g} deg{shift}",
+                   text, report, d.ok, failing)
 
 
 def _cmd_motion(args: argparse.Namespace) -> int:
@@ -180,6 +228,8 @@ def _cmd_motion(args: argparse.Namespace) -> int:
 
 #: most target points ``synth path`` takes (the search evaluates every candidate at each)
 MAX_TARGETS = 500
+#: most pairs ``synth function`` takes (2000 pairs: about 4.5 s, 150 MB)
+MAX_PAIRS = 5000
 
 
 def add_parser(sub: Any) -> None:
@@ -205,12 +255,21 @@ def add_parser(sub: Any) -> None:
     p.set_defaults(func=_cmd_path)
 
     f = ss.add_parser("function", help="input/output angle pairs (Freudenstein): CSV input,output")
-    f.add_argument("pairs", help="CSV with columns input,output (crank and rocker angles from the ground line)")
+    f.add_argument("pairs", help="CSV with columns input,output (crank and rocker angles from the ground line, "
+                   "the crank turning from the smallest input to the largest)")
     f.add_argument("-o", "--output", required=True, help="scene file (TOML) to write")
     f.add_argument("--ground", type=float, default=1.0, help="ground link length (sets the scale; 1)")
     f.add_argument("--deg", action="store_true", help="angles in degrees")
     f.add_argument("--tolerance", type=float, default=0.01,
-                   help="more than 3 pairs: largest output angle error accepted, rad (0.01)")
+                   help="largest output angle error accepted on the chosen circuit, rad (0.01)")
+    f.add_argument("--free-offsets", action="store_true",
+                   help="only the pairs' differences matter: the synthesis chooses where input and output "
+                        "angles are zero (reported)")
+    f.add_argument("--full-turn", action="store_true", help="the crank must turn fully (Grashof crank)")
+    f.add_argument("--max-ratio", type=float, default=10.0, help="longest / shortest link at most this (10)")
+    f.add_argument("--min-transmission", type=float, default=0.0,
+                   help="keep the transmission angle at least this far from 0 and 180 (a toggle) over the "
+                        "motion, degrees (0)")
     f.add_argument("--json", action="store_true", help="print the design and its errors as JSON")
     f.set_defaults(func=_cmd_function)
 
