@@ -144,8 +144,11 @@ def _cmd_motion(args: argparse.Namespace) -> int:
 
     _outputs(args, (args.scene,), ("-o", "output", (".csv",)))
     scene = load_scene(args.scene)
-    motion = write_scene_motion(scene, args.output, derivatives=args.derivatives)
+    notes: list[str] = []
+    motion = write_scene_motion(scene, args.output, derivatives=args.derivatives, notes=notes)
     print(f"wrote {args.output}: {len(motion)} samples, {int(motion.valid.sum())} valid")
+    for note in notes:
+        print(f"note: {note}")
     if args.derivatives:
         from .derivatives import rates_method
         from .pipeline import table_motion

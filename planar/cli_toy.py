@@ -97,7 +97,8 @@ def _cmd_toy(args: argparse.Namespace) -> int:
         out_of_run = sorted({p.name for p in asm.parts} - set(tq["pieces"]))
         print(f"motor on the cam shaft, the only driver, turning {len(tq['pieces'])} pieces"
               + (f" (not {', '.join(out_of_run)})" if out_of_run else "")
-              + f": torque peak {tq['peak']:.4g}, pymunk vs inverse dynamics {tq['max_rel_diff']:.2g} of the peak "
+              + f": torque peak {tq['peak']:.4g} (model units: density x unit^4/s^2; see README, Conventions)"
+              + f", pymunk vs inverse dynamics {tq['max_rel_diff']:.2g} of the peak "
               f"over {tq['samples_compared']} samples, pose error {tq['pose_error']:.2g} of the size{fail} "
               + ("[ok]" if ok_torque else "[FAIL]"))
         for s in phys.stages:

@@ -244,14 +244,15 @@ def _rates_and_coefficients(mech: "Mechanism", motion: "Motion"
 
 def _torque(mech: "Mechanism", motion: "Motion", rates: dict[str, PartRates], coef: dict[str, PartRates],
             effects: Any, t_rest: float | None, densities: dict[str, float] | None) -> Array:
-    from .dynamics import gravity_and_damping, part_mass_table
+    from .dynamics import gravity_and_damping, part_mass_table, plane_gravity
 
     assert motion.t is not None
-    g, lam = gravity_and_damping(effects)
+    g3, lam = gravity_and_damping(effects)
     tau = np.zeros(len(motion))
     for name, (mass, cog, inertia) in part_mass_table(mech, effects, densities).items():
         if mass == 0.0 and inertia == 0.0:
             continue
+        g = plane_gravity(getattr(mech.part(name), "plane", "xy"), g3)  # a toy's piece: gravity in its plane
         G = poses_apply(motion.poses[name], np.asarray(cog, float))
         vG, aG = point_rates(motion.poses[name], rates[name], G)
         cG, _ = point_rates(motion.poses[name], coef[name], G)

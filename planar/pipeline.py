@@ -222,8 +222,11 @@ def numeric_guard(scene: Scene, doing: str) -> Iterator[None]:
                          f"{' '.join(str(e).split())})") from None
 
 
-def write_scene_motion(scene: Scene, out: str | Path, derivatives: bool = False) -> Motion:
+def write_scene_motion(scene: Scene, out: str | Path, derivatives: bool = False,
+                       notes: list[str] | None = None) -> Motion:
     """Write the scene's analytic motion table (CSV) to ``out``; returns the motion.
+
+    ``notes``: where to add what the table is, when not the obvious (see :func:`table_motion`).
 
     ``derivatives``: add the rates of :func:`planar.derivatives.derivative_columns`
     (point velocities and accelerations, part omega and alpha, transmission
@@ -238,7 +241,7 @@ def write_scene_motion(scene: Scene, out: str | Path, derivatives: bool = False)
 
     if Path(out).suffix.lower() != ".csv":
         raise InputError("output", str(out), "a .csv file (the motion table is CSV)")
-    mech, motion = table_motion(scene.mechanism, scene.motion())
+    mech, motion = table_motion(scene.mechanism, scene.motion(), notes=notes)
     if not derivatives:
         write_motion_csv(out, mech, motion)
         return motion
@@ -262,16 +265,19 @@ def write_catalog_motion(name: str, out: str | Path, samples: int = 360) -> Moti
     from .catalog import get
     from .fileio import write_motion_csv
 
-    mech, motion = table_motion(get(name), None, samples)
+    mech, motion = table_motion(get(name), None, samples, notes=[])
     write_motion_csv(out, mech, motion)
     return motion
 
 
-def table_motion(mech: Mechanism, motion: Motion | None, samples: int = 360) -> tuple[Mechanism, Motion]:
+def table_motion(mech: Mechanism, motion: Motion | None, samples: int = 360,
+                 notes: list[str] | None = None) -> tuple[Mechanism, Motion]:
     """The mechanism and motion a motion table reports: ``mech`` and ``motion`` (or one cycle of
     ``samples`` samples), except for a wind-up toy, whose table is its assembly in the toy's frame
     (:class:`planar.windup.assembly.ToyAssembly`: every piece in its own plane, a Ty effector moving
-    along y) rather than the stages' panels the toy's own motion lays side by side."""
+    along y) rather than the stages' panels the toy's own motion lays side by side.  A toy the
+    assembly cannot build keeps its stages' panels (each stage in its own frame, side by side), and a
+    note saying so and why is added to ``notes``."""
     if motion is None:
         motion = mech.run(samples_per_cycle=samples)
     import sys
@@ -281,7 +287,13 @@ def table_motion(mech: Mechanism, motion: Motion | None, samples: int = 360) -> 
         return mech, motion
     from .windup.assembly import toy_assembly
 
-    asm = toy_assembly(mech)
+    try:
+        asm = toy_assembly(mech)
+    except InputError as e:
+        if notes is not None:
+            notes.append(f"{mech.name} cannot be assembled ({e}); the table has its stages' panels instead: "
+                         "each stage in its own frame, side by side, not the toy's frame")
+        return mech, motion
     return asm, asm.solve(motion.driver, t=motion.t)
 
 

@@ -125,7 +125,7 @@ def test_the_summary_says_which_check_failed() -> None:
     assert any("cams grown into discs" in ln for ln in lines) and "none of the 0" not in text
     # a #8 stage: the toy is written with gravity along +x, and the summary says how to stand it
     assert any("gravity along +x" in ln and "s1" in ln and "pointing down" in ln for ln in lines)
-    assert rep["gravity"] == [9.81, 0.0]
+    assert rep["gravity"] == [98.1, 0.0]  # Earth's gravity at 100 mm per model unit
     # when every tree tried failed, the one written is not said to be passed over
     d = _fake_design(phys, rejected=["cost 6 left: Rz->Tx Tx->Oy: torque"], fallback=True)
     lines = summary_lines(d, d.report(), phys, "t", "t.toml")

@@ -190,12 +190,14 @@ def _placements(toy: Any) -> list[_Placed]:
         ang = math.atan2(R[1, 0], R[0, 0])
         proper = abs(R[2, 2] - 1.0) < 1e-12 and abs(np.linalg.det(R[:2, :2]) - 1.0) < 1e-12
         if not proper:
-            raise InputError(f"{toy.name}.stage {' '.join(st.key)}", st.realisation.rotation,
+            raise InputError(f"{toy.name}.stage {' '.join(st.key)}",
+                             f"realised as #{st.realisation.number} mirrored or turned out of the xy plane",
                              "a stage turned about z only (a mirrored stage is not assembled)")
         plane = st.mech.part("driver").plane
         other = sorted({p.plane for p in st.mech.parts} - {"xy"})
         if other and abs(ang) > 1e-12:
-            raise InputError(f"{toy.name}.stage {' '.join(st.key)}", st.realisation.rotation,
+            raise InputError(f"{toy.name}.stage {' '.join(st.key)}",
+                             f"realised as #{st.realisation.number} turned {math.degrees(ang):g} deg about z",
                              f"a stage with parts moving in {', '.join(other)} that is not turned (a turned "
                              f"#{st.realisation.number} would move in another plane, which no part records)")
         d0 = _rest_pose(st, "driver")

@@ -157,7 +157,7 @@ class Design:
             "export_refused": self.export_refused or None,
             "variant": self.variant or None,
             "fallback": self.fallback,
-            "gravity": [9.81, 0.0] if self.gravity_x else None,
+            "gravity": [EARTH_GRAVITY, 0.0] if self.gravity_x else None,
             "rejected_trees": self.rejected,
             "physics": self.physics,
             "seconds": self.seconds,
@@ -524,6 +524,9 @@ def layer_collisions(toy: ToyMechanism, samples: int = 24, unit_mm: float = 100.
 #: the written toy's scene tables: half a cycle a second, 36 frames a cycle, a small GIF, 100 mm a unit
 SCENE_TABLES: dict[str, Any] = {"driver": {"speed": 0.5, "samples_per_cycle": 36},
                                 "render": {"width": 360, "height": 270}, "fabrication": {"unit_mm": 100.0}}
+#: Earth's gravity in the written scene's model units per s^2 (9810 mm/s^2 at its ``unit_mm``): physics runs in
+#: model units, so a toy cut at 100 mm per unit falls at 98.1 units/s^2
+EARTH_GRAVITY = 9810.0 / SCENE_TABLES["fabrication"]["unit_mm"]
 #: the motor torque's largest allowed difference from inverse dynamics, fraction of its peak (as ``planar toy``)
 TORQUE_TOLERANCE = 0.01
 
@@ -533,7 +536,7 @@ def design_scene(toy: ToyMechanism, name: str) -> Any:
     +x (README, "Wind-up toys"): a toy with one is written standing that way, so its tab is held and simulated."""
     from ..pipeline import scene_from_mechanism
 
-    effects = {"gravity": [9.81, 0.0]} if any(st.realisation.number == 8 for st in toy.stages) else {}
+    effects = {"gravity": [EARTH_GRAVITY, 0.0]} if any(st.realisation.number == 8 for st in toy.stages) else {}
     return scene_from_mechanism(toy, name=name, effects=effects, **SCENE_TABLES)
 
 
