@@ -114,11 +114,16 @@ def _cmd_chains(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps({k: [list(c) for c in v] for k, v in chains.items()}))
         return 0
+    from .windup.assembly import assembly_refusal
+
     for motion, cs in chains.items():
-        print(f"{motion}: {len(cs)} chains")
+        why = {c: assembly_refusal(c) for c in cs}
+        print(f"{motion}: {len(cs)} chains, {sum(w is None for w in why.values())} assemble")
         for c in cs:
             path = " -> ".join([c[0].split("->")[0]] + [p.split("->")[1] for p in c])
-            print(f"   {path:<28} chain = {json.dumps(list(c))}")  # the second column pastes into a scene
+            # the second column pastes into a scene; the third says whether render, export and toy can build it
+            print(f"   {path:<28} chain = {json.dumps(list(c)):<40} "
+                  + ("assembles" if why[c] is None else f"motion only: {why[c]}"))
     return 0
 
 

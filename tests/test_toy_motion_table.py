@@ -94,3 +94,17 @@ def test_a_toy_that_cannot_be_assembled_gets_its_panels_and_a_note(tmp_path: Pat
     text = capsys.readouterr().out
     assert "cannot be assembled" in text and "turned 90 deg about z" in text and "own frame" in text
     assert "s0.ground.x" in _table(out)  # the stages' panels
+
+
+def test_chains_says_which_chains_assemble(capsys) -> None:
+    assert main(["chains"]) == 0
+    out = capsys.readouterr().out
+    rows = [r for r in out.splitlines() if "chain = [" in r]
+    assert len(rows) == 77
+    assert sum(r.rstrip().endswith("assembles") for r in rows) == 39
+    (row,) = [r for r in rows if 'chain = ["Rz->Ty", "Ty->Ox"] ' in r]
+    assert "motion only: its stage Ty->Ox is realised as #8 turned 90 deg about z" in row
+    # the gallery's toys are built from chains the table marks as assembling
+    for chain in ('["Rz->Tx", "Tx->Ox"]', '["Rz->Tx", "Tx->Oy"]', '["Rz->OzT", "OzT->Ty"]'):
+        (r,) = [r for r in rows if f"chain = {chain} " in r]
+        assert r.rstrip().endswith("assembles")

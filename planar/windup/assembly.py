@@ -451,6 +451,21 @@ def toy_assembly(toy: Any) -> ToyAssembly:
     return got
 
 
+def assembly_refusal(chain: Any) -> str | None:
+    """Why a chain (a sequence of patterns) cannot be built as one toy, or ``None`` when it can."""
+    from ..errors import PlanarError
+    from .chain import chain_mechanism
+
+    try:
+        toy_assembly(chain_mechanism(tuple(chain)))
+    except InputError as e:
+        stage = e.field.split(".stage ", 1)[-1].split()[-1]
+        return f"its stage {stage} is {e.value}; needed: {e.expected}"
+    except PlanarError as e:
+        return str(e)
+    return None
+
+
 def assembly_residual(asm: ToyAssembly, samples: int = 73) -> dict[str, float]:
     """Largest residual of every joint of ``asm`` over one cycle (valid samples), model units."""
     m = asm.run(samples_per_cycle=samples)
