@@ -142,6 +142,10 @@ def summary_lines(d: Any, rep: dict[str, Any], phys: dict[str, Any], name: str, 
     if d.gravity_x:
         out.append(f"  gravity along +x in the written toy (it holds the tab of #8 stage {', '.join(d.gravity_x)} on "
                    "its face): stand the real toy with the drawing's +x axis pointing down")
+    if d.gravity_y:
+        out.append(f"  gravity along -y in the written toy (it holds the pin of #6/#9 stage {', '.join(d.gravity_y)} on "
+                   "its driver's edge): tilt the real toy so that the drawing's -y axis points down"
+                   + (" as well (+x and -y at 45 degrees)" if d.gravity_x else ""))
     for m in rep.get("small_motions", []):
         out.append(f"  [FAIL] {m['text']}")
     out.append(f"  wrote {output} ({sum(d.seconds.values()):.2f} s)")

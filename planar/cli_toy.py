@@ -5,7 +5,8 @@ residual on them, the motor torque of the coupled run against inverse
 dynamics, and every stage's fate (simulated, or why not; #8's lift-off).
 Exit status 3 when a check fails (joint residual, torque beyond
 ``--torque-threshold`` of its peak, a simulation failure, #8 letting go at
-the scene's speed); 2 for bad input.
+the scene's speed, a #6/#9 edge that would have to pull its pin at the
+scene's speed); 2 for bad input.
 """
 
 from __future__ import annotations
@@ -64,6 +65,8 @@ def _cmd_toy(args: argparse.Namespace) -> int:
     ok_torque = tq["failure"] is None and tq["max_rel_diff"] <= args.torque_threshold
     speed = toy.driver.rate / (2 * math.pi)
     lets_go = [k for k, v in phys.liftoff.items() if v["liftoff_speed"] is not None and v["liftoff_speed"] <= speed]
+    skew_go = [k for k, v in phys.skew.items() if not v["holds"]]
+    lets_go += skew_go
     # a stage left out of the physics leaves its load out of the motor torque: the toy's check fails
     unsimulated = [s.stage for s in phys.stages if not s.simulated]
     ok = ok_joints and ok_torque and not lets_go and not unsimulated
@@ -78,6 +81,7 @@ def _cmd_toy(args: argparse.Namespace) -> int:
         "stages": [{"stage": s.stage, "pattern": s.pattern, "simulated": s.simulated, "detail": s.detail}
                    for s in phys.stages],
         "liftoff": phys.liftoff,
+        "skew_hold": phys.skew,
         "notes": asm.notes,
         "not_simulated": unsimulated,
         "ok": ok,
@@ -104,7 +108,15 @@ def _cmd_toy(args: argparse.Namespace) -> int:
         for s in phys.stages:
             print(f"  {s.stage} {s.pattern}: {'simulated' if s.simulated else 'NOT simulated [FAIL]'}: {s.detail}")
         for k in lets_go:
-            print(f"  {k}: lets go at the scene's speed ({speed:g} cycles/s) [FAIL]")
+            if k in phys.skew:
+                v = phys.skew[k]
+                c = v["critical_speed"]
+                print(f"  {k}: the edge lets the pin go at the scene's speed ({speed:g} cycles/s): it would have to "
+                      f"pull from sample {v['sample']} (t = {v['time']:.4g} s); "
+                      + ("nothing holds the pin on it at any speed (no gravity or spring in its plane pushes it "
+                         "there)" if c == 0.0 else f"it holds only below {c:.3g} cycles/s") + " [FAIL]")
+            else:
+                print(f"  {k}: lets go at the scene's speed ({speed:g} cycles/s) [FAIL]")
     return 0 if ok else EXIT_MISMATCH
 
 

@@ -129,6 +129,11 @@ class Design:
         """The #8 stages for which the toy is written with gravity along +x (:func:`design_scene`)."""
         return [st.label for st in self.toy.stages if st.realisation.number == 8]
 
+    @property
+    def gravity_y(self) -> list[str]:
+        """The #6/#9 stages for which the toy is written with gravity along -y (:func:`design_scene`)."""
+        return [st.label for st in self.toy.stages if st.realisation.number in (6, 9)]
+
     def report(self) -> dict[str, Any]:
         return {
             "toy": self.toy.name,
@@ -157,7 +162,7 @@ class Design:
             "export_refused": self.export_refused or None,
             "variant": self.variant or None,
             "fallback": self.fallback,
-            "gravity": [EARTH_GRAVITY, 0.0] if self.gravity_x else None,
+            "gravity": design_gravity(self.toy),
             "rejected_trees": self.rejected,
             "physics": self.physics,
             "seconds": self.seconds,
@@ -531,12 +536,25 @@ EARTH_GRAVITY = 9810.0 / SCENE_TABLES["fabrication"]["unit_mm"]
 TORQUE_TOLERANCE = 0.01
 
 
+def design_gravity(toy: ToyMechanism) -> list[float] | None:
+    """The gravity ``planar design`` writes for ``toy`` (None: none).  A #8 stage's tab is held on its face by
+    gravity along +x (its plane xz), a #6/#9 follower's pin on its driver's edge by gravity along -y (its plane
+    yz; README, "Wind-up toys"): a toy with them is written standing that way.  The -y side is the one the
+    edge holds for the gallery's and the trial's followers; the physics check (:func:`physics_check`) says
+    where it is not."""
+    nums = {st.realisation.number for st in toy.stages}
+    g = [1.0 if 8 in nums else 0.0, -1.0 if nums & {6, 9} else 0.0]
+    norm = math.hypot(*g)
+    # Earth's gravity (EARTH_GRAVITY model units/s^2), tilted 45 degrees between +x and -y when both are needed
+    return [EARTH_GRAVITY * c / norm + 0.0 for c in g] if norm else None
+
+
 def design_scene(toy: ToyMechanism, name: str) -> Any:
-    """The scene ``planar design`` writes for ``toy``.  A #8 stage's tab is held on its face by gravity along
-    +x (README, "Wind-up toys"): a toy with one is written standing that way, so its tab is held and simulated."""
+    """The scene ``planar design`` writes for ``toy``, with :func:`design_gravity`."""
     from ..pipeline import scene_from_mechanism
 
-    effects = {"gravity": [EARTH_GRAVITY, 0.0]} if any(st.realisation.number == 8 for st in toy.stages) else {}
+    g = design_gravity(toy)
+    effects = {"gravity": g} if g is not None else {}
     return scene_from_mechanism(toy, name=name, effects=effects, **SCENE_TABLES)
 
 
@@ -562,15 +580,17 @@ def physics_check(scene: Any) -> dict[str, Any]:
         phys = simulate_toy(toy, motion.t, scene.effects, speeds=[speed])
     except PlanarError as e:
         return {"ok": False, "torque_rel_diff": None, "failure": f"the physics refuses the toy: {e}",
-                "lets_go": [], "not_simulated": [], "stages": [], "speed": speed}
+                "lets_go": [], "pin_lets_go": [], "not_simulated": [], "stages": [], "speed": speed}
     tq = phys.torque
     lets_go = sorted(k for k, v in phys.liftoff.items()
                      if v["liftoff_speed"] is not None and v["liftoff_speed"] <= speed)
+    pin_lets_go = sorted(k for k, v in phys.skew.items() if not v["holds"])  # #6/#9: the edge would have to pull
     missing = [{"stage": s.stage, "pattern": s.pattern, "effector": effector.get(s.stage), "reason": s.detail}
                for s in phys.not_simulated]
-    ok = tq["failure"] is None and tq["max_rel_diff"] <= TORQUE_TOLERANCE and not lets_go and not missing
+    ok = (tq["failure"] is None and tq["max_rel_diff"] <= TORQUE_TOLERANCE and not lets_go and not pin_lets_go
+          and not missing)
     return {"ok": bool(ok), "torque_rel_diff": float(tq["max_rel_diff"]), "failure": tq["failure"],
-            "lets_go": lets_go, "not_simulated": missing, "speed": speed,
+            "lets_go": lets_go, "pin_lets_go": pin_lets_go, "not_simulated": missing, "speed": speed,
             "stages": [{"stage": s.stage, "pattern": s.pattern, "simulated": s.simulated, "detail": s.detail}
                        for s in phys.stages]}
 
@@ -585,6 +605,8 @@ def physics_failures(phys: dict[str, Any]) -> list[str]:
                    f"(more than {TORQUE_TOLERANCE:g})")
     for k in phys["lets_go"]:
         out.append(f"stage {k}'s tab lets go at {phys['speed']:g} cycles/s")
+    for k in phys.get("pin_lets_go", []):
+        out.append(f"stage {k}'s pin leaves its driver's edge at {phys['speed']:g} cycles/s")
     for m in phys["not_simulated"]:
         who = f" (effector {m['effector']!r})" if m["effector"] else ""
         out.append(f"stage {m['stage']} {m['pattern']}{who} not simulated: {m['reason']}")

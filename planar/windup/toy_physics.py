@@ -48,7 +48,7 @@ from .assembly import ToyAssembly, toy_assembly
 from .mechanisms import SkewContact
 
 __all__ = ["ContactRun", "StageReport", "ToyPhysics", "contact_hold", "hold_margin", "liftoff_speed",
-           "plane_mechanism", "simulate_toy", "skew_stage"]
+           "plane_mechanism", "simulate_toy", "skew_hold", "skew_stage", "SkewHold"]
 
 Array = NDArray[np.float64]
 
@@ -349,8 +349,17 @@ def hold_margin(mech: Any, gravity: tuple[float, float], density: float = 1.0, s
 
 
 def skew_stage(mech: Any, speed: float, cycles: float = 1.0, samples_per_cycle: int = 72, substeps: int = 128,
-               density: float = 1.0, tolerance: float = 1e-3, drive: StageDrive | None = None) -> tuple[float, str | None]:
-    """Rebuild #6/#9 in its follower's plane (yz) and run it; ``(worst error / size, refusal or None)``."""
+               density: float = 1.0, tolerance: float = 1e-3, drive: StageDrive | None = None,
+               gravity: tuple[float, float] = (0.0, 0.0), record: list[tuple[float, float]] | None = None,
+               ) -> tuple[float, str | None]:
+    """Rebuild #6/#9 in its follower's plane (yz) and run it; ``(worst error / size, refusal or None)``.
+
+    ``gravity``: in the follower's plane (y, z).  The rebuilt contact is two-sided (a groove); ``record``,
+    when given, gets per step ``(time at the step's end s, the contact's moment on the follower about its
+    pivot)``, read from pymunk as the change of the follower's angular momentum about the pivot less
+    gravity's moment: where its sign is not the one the edge can push with (:func:`skew_hold`), the groove
+    pulled.
+    """
     import pymunk
 
     from ..dynamics import mass_properties
@@ -381,6 +390,11 @@ def skew_stage(mech: Any, speed: float, cycles: float = 1.0, samples_per_cycle: 
     c, s = math.cos(f0[2]), math.sin(f0[2])
     body.position = (f0[0] + c * cog[0] - s * cog[1], f0[1] + s * cog[0] + c * cog[1])
     body.angle = float(f0[2])
+    space.gravity = (float(gravity[0]), float(gravity[1]))
+    if record is not None:  # start on the path's velocity (else the groove's first step is a kick)
+        w0 = float(fpose[1, 2] - fpose[0, 2]) / (float(t[1] - t[0]) / substeps)
+        body.angular_velocity = w0
+        body.velocity = (-w0 * (body.position.y - f0[1]), w0 * (body.position.x - f0[0]))
     kin = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
     kin.position = (float(ty[0]), float(j.plane_z))
     # the pin's axis in the follower frame runs from the pivot (0, 0) along +y (the follower frame's "up")
@@ -415,7 +429,14 @@ def skew_stage(mech: Any, speed: float, cycles: float = 1.0, samples_per_cycle: 
             tx = ty[k] - dr * math.cos(a)
             tz = j.plane_z - dr * math.sin(a)
             kin.velocity = ((tx - kin.position.x) / dt, (tz - kin.position.y) / dt)
+            if record is not None:
+                ry, rz = body.position.x - f0[0], body.position.y - f0[1]
+                l0 = inertia * body.angular_velocity + m * (ry * body.velocity.y - rz * body.velocity.x)
             space.step(dt)
+            if record is not None:  # pymunk moves positions with the new velocities: the lever arm of the step
+                v = body.velocity
+                l1 = inertia * body.angular_velocity + m * (ry * v.y - rz * v.x)
+                record.append((float(sub_t[k]), (l1 - l0) / dt - m * (ry * gravity[1] - rz * gravity[0])))
         a = body.angle
         c, s = math.cos(a), math.sin(a)
         track[i] = (body.position.x - (c * cog[0] - s * cog[1]), body.position.y - (s * cog[0] + c * cog[1]), a)
@@ -427,6 +448,92 @@ def skew_stage(mech: Any, speed: float, cycles: float = 1.0, samples_per_cycle: 
                      f"(tolerance {tolerance:g})")
     return err, None
 
+
+# ---------------------------------------------------------------------------- #6, #9: can the edge hold the pin?
+
+
+@dataclass
+class SkewHold:
+    """What inverse dynamics says of a #6/#9 contact (the driver's edge can only push the follower's pin).
+
+    Moments about the follower's pivot, in its plane (yz; positive from +y towards +z, i.e. about +x),
+    model units at the run's density.
+    """
+
+    speed: float  # cycles/s, the speed the samples are taken at
+    t: Array  # s, one cycle of samples
+    moment: Array  # the moment the edge must exert on the follower, M = I_p phi'' - M_g
+    push: Array  # +-1: the sign of the moment the edge can exert (from the contact's geometry)
+    letgo: int | None  # the first sample where it would have to pull (sign(M) != push), None: it holds
+    critical_speed: float  # cycles/s above which it lets go (inf: never; 0: even at rest)
+    gravity: tuple[float, float]  # in the follower's plane (y, z)
+
+
+def _skew_gap_a(j: SkewContact, fpose: Array, dpose: Array, da: float = 0.0) -> Array:
+    """Signed distance between the driver's edge and the pin's axis, per sample, the pin turned by ``da``
+    (vectorised :func:`_skew_gap`; ``fpose``: the follower's (y, z, angle), its origin on the pivot axis)."""
+    c, s = np.cos(dpose[:, 2]), np.sin(dpose[:, 2])
+    e0 = poses_apply(dpose, j.edge_point)
+    ex = c * j.edge_dir[0] - s * j.edge_dir[1]
+    ey = s * j.edge_dir[0] + c * j.edge_dir[1]
+    a = fpose[:, 2] + da
+    ca, sa = np.cos(a), np.sin(a)
+    n = np.column_stack([-ca * ey, ca * ex, sa * ex])  # (0, -sin a, cos a) x (ex, ey, 0)
+    d = np.column_stack([e0[:, 0] - j.pin_x, e0[:, 1] - fpose[:, 0], np.full_like(a, j.plane_z) - fpose[:, 1]])
+    return (d * n).sum(1) / np.linalg.norm(n, axis=1)
+
+
+def _skew_terms(mech: Any, j: SkewContact, gravity: tuple[float, float], density: float, samples: int,
+                drive: StageDrive | None) -> tuple[Array, Array, Array, Array]:
+    """Over one cycle at 1 cycle/s (``samples`` per cycle): ``(t, I_p phi'', M_g, push)`` of :func:`skew_hold`."""
+    from ..dynamics import mass_properties
+
+    fol = mech.part(j.b)
+    m, cog, ic = mass_properties(fol, density)
+    ip = ic + m * float(cog[0] ** 2 + cog[1] ** 2)  # the follower's frame origin is on its pivot axis
+    one = _law(mech, drive, 1.0)
+    t1 = one.times(samples, 1.0)
+    h = 1e-4
+    ang = [_poses(mech, one.value(t1 + k * h), drive)[j.b][:, 2] for k in (-1, 0, 1)]
+    alpha1 = (ang[2] - 2 * ang[1] + ang[0]) / h**2  # rad/s^2 at 1 cycle/s
+    now = _poses(mech, one.value(t1), drive)
+    fp, dp = now[j.b], now[j.a]
+    r = poses_apply(fp, cog) - fp[:, :2]  # pivot to centre of gravity (y, z)
+    mg = m * (r[:, 0] * gravity[1] - r[:, 1] * gravity[0])
+    s0 = _skew_gap_a(j, fp, dp)
+    ds = (_skew_gap_a(j, fp, dp, 1e-7) - _skew_gap_a(j, fp, dp, -1e-7)) / 2e-7
+    return t1, ip * alpha1, mg, np.sign(np.sign(s0) * ds)
+
+
+def skew_hold(mech: Any, gravity: tuple[float, float], speed: float, density: float = 1.0,
+              samples_per_cycle: int = 72, drive: StageDrive | None = None, fine: int = 1440) -> SkewHold:
+    """Inverse dynamics of a #6/#9 follower: can the driver's edge, which only pushes, keep it on its path?
+
+    ``gravity``: in the follower's plane (y, z) (:func:`planar.dynamics.plane_gravity` ``"yz"``); ``speed``:
+    cycles/s, the moments are sampled ``samples_per_cycle`` times over its cycle.  About the pivot the
+    contact must exert ``M = I_p phi'' - M_g`` (``I_p`` the follower's moment about the pivot, ``M_g``
+    gravity's moment).  The contact keeps the edge at the pin's radius from its axis (``sigma s >= r``,
+    ``s`` the skew lines' signed distance, ``sigma`` its sign in contact), so its moment is
+    ``lambda sigma ds/dphi`` with ``lambda >= 0``: where ``M`` has the other sign it would have to pull, and
+    the pin leaves the edge.  ``phi''`` scales with the speed squared (the driver law's shape is fixed), so
+    the critical speed is ``sqrt(min over samples of push M_g / (-push I_p phi''_1))`` where the two oppose
+    (``fine`` samples per cycle).
+    """
+    j = next(j for j in mech.joints if isinstance(j, SkewContact))
+    _, ia, mg, push = _skew_terms(mech, j, gravity, density, fine, drive)
+    hold = push * (-mg)  # what the contact must give at rest, signed so that >= 0 is a push
+    grow = push * ia  # its growth per (cycle/s)^2
+    tol = 1e-9 * max(float(np.abs(mg).max()), float(np.abs(ia).max()), 1e-300)
+    if (hold < -tol).any():
+        crit = 0.0
+    else:
+        crit = float(np.sqrt(np.where(grow < -tol, np.maximum(hold, 0.0) / np.maximum(-grow, 1e-300), np.inf).min()))
+    t1, ia, mg, push = _skew_terms(mech, j, gravity, density, samples_per_cycle, drive)
+    moment = speed**2 * ia - mg
+    tol = 1e-9 * max(float(np.abs(mg).max()), float(np.abs(ia).max()) * speed**2, 1e-300)
+    bad = np.flatnonzero(push * moment < -tol)
+    return SkewHold(speed, t1 / speed, moment, push, int(bad[0]) if bad.size else None, crit,
+                    (float(gravity[0]), float(gravity[1])))
 
 # ---------------------------------------------------------------------------- the whole toy
 
@@ -446,6 +553,7 @@ class ToyPhysics:
     torque: dict[str, Any]
     stages: list[StageReport] = field(default_factory=list)
     liftoff: dict[str, Any] = field(default_factory=dict)
+    skew: dict[str, Any] = field(default_factory=dict)  # #6/#9: does the edge hold the pin (skew_hold, pymunk)
 
     @property
     def not_simulated(self) -> list[StageReport]:
@@ -522,13 +630,56 @@ def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, 
                 + (f"at {lift:g} cycles/s, sample {runs[-1].liftoff}" if lift is not None else "not seen in the scan")
                 + f"; inverse dynamics predicts {crit:.3g} cycles/s")))
         elif st.mech.spatial:
-            err, why = skew_stage(st.mech, speed, drive=drive)
-            out.stages.append(StageReport(label, pat, why is None, (
-                f"in the motor run, co-simulated in its plane (yz); alone, rebuilt in the follower's plane: "
-                f"{err:.2g} of the size") if why is None else why))
+            out.stages.append(_skew_report(st, toy, drive, effects, g3, speed, np.asarray(t, float), out))
         else:
             out.stages.append(StageReport(label, pat, True, "in the motor's plane (coupled)"))
     return out
+
+
+def _skew_report(st: Any, toy: Any, drive: StageDrive, effects: Any, g3: tuple[float, float], speed: float,
+                 t: Array, out: ToyPhysics) -> StageReport:
+    """#6/#9 in :func:`simulate_toy`: the rebuild alone (pymunk, with gravity) and whether the edge holds the pin."""
+    from ..dynamics import plane_gravity
+
+    label, pat, mech = st.label, st.realisation.pattern, st.mech
+    j = next(j for j in mech.joints if isinstance(j, SkewContact))
+    sprung = [f"{s.a}-{s.b}" for s in getattr(effects, "springs", ()) or () if mech.part(j.b).name in (s.a, s.b)]
+    if sprung:
+        return StageReport(label, pat, False, f"#{st.realisation.number}: a spring on the yz follower ({sprung[0]}) "
+                           "is not modelled in its hold check")
+    gp = plane_gravity("yz", g3)
+    g = (float(gp[0]), float(gp[1]))
+    per = max(int(round(1.0 / (speed * float(t[1] - t[0])))), 4) if t.size > 1 else 72
+    dens = float(getattr(effects, "density", 1.0) or 1.0)
+    hold = skew_hold(mech, g, speed, dens, per, drive)
+    rec: list[tuple[float, float]] = []
+    err, why = skew_stage(mech, speed, drive=drive, gravity=g, record=rec, density=dens)
+    tr, mr = (np.array(rec, float).T if rec else (np.zeros(0), np.zeros(0)))
+    keep = tr > tr[0] + 1.0 / (72 * speed) if tr.size else tr > 0  # its first sample interval: a start transient
+    tr, mr = tr[keep], mr[keep]
+    # pymunk's contact moment against the side the edge can push (the push sign at the nearest sample)
+    pk = hold.push[np.clip(np.rint(tr * speed * per).astype(int), 0, per - 1)] if tr.size else np.zeros(0)
+    pulls = np.flatnonzero(pk * mr < -1e-6 * max(float(np.abs(mr).max(initial=0.0)), 1e-300))
+    sim_t = float(tr[pulls[0]]) if pulls.size else None
+    held = hold.letgo is None
+    out.skew[label] = {"holds": held, "sample": hold.letgo, "time": None if held else float(hold.t[hold.letgo]),
+                       "critical_speed": hold.critical_speed, "gravity_yz": list(g),
+                       "moment_range": [float(hold.moment.min()), float(hold.moment.max())],
+                       "push_sign": float(hold.push[0]) if np.all(hold.push == hold.push[0]) else 0.0,
+                       "pymunk_pull_time": sim_t}
+    crit = hold.critical_speed
+    hold_txt = (f"#{st.realisation.number} edge on the pin (it can only push): {'holds' if held else 'lets go'} at "
+                f"{speed:g} cycles/s" + ("" if held else f" (first at sample {hold.letgo}, t = {hold.t[hold.letgo]:.4g} s)")
+                + "; inverse dynamics: lets go " + ("at any speed" if crit == 0.0 else "never" if math.isinf(crit)
+                                                   else f"above {crit:.3g} cycles/s")
+                + f" (gravity in its plane ({g[0]:g}, {g[1]:g}))"
+                + ("; the rebuild (pymunk, two-sided) pulls first at " + (f"t = {sim_t:.4g} s" if sim_t is not None
+                                                               else "no step")))
+    if why is not None:
+        return StageReport(label, pat, False, why + "; " + hold_txt)
+    return StageReport(label, pat, True, (
+        f"in the motor run, co-simulated in its plane (yz); alone, rebuilt in the follower's plane: "
+        f"{err:.2g} of the size; " + hold_txt))
 
 
 # ---------------------------------------------------------------------------- #6, #9 in the motor run
