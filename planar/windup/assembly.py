@@ -480,8 +480,8 @@ _register()
 def _without_cuts_of(parts: list[Part], dropped: list[Any], kept: list[Any], tol: float = 1e-9
                      ) -> tuple[list[Part], list[tuple[str, Any]]]:
     """``parts`` without the slots and pin holes of the ``dropped`` slides (features at their slot ends or at
-    their pin points), except where a ``kept`` joint has a pin at the same place (piece frames); and the
-    ``(piece, feature)`` pairs removed."""
+    their pin points), except that where a ``kept`` joint has a pin at the same place (piece frames) one hole
+    stays (the first there, the one the kept pin goes through); and the ``(piece, feature)`` pairs removed."""
     from ..features import Hole, Slot
 
     keep_pins: dict[str, list[tuple[float, float]]] = {}
@@ -502,11 +502,17 @@ def _without_cuts_of(parts: list[Part], dropped: list[Any], kept: list[Any], tol
     removed: list[tuple[str, Any]] = []
     for part in parts:
         feats = []
+        kept_at: list[tuple[float, float]] = []  # kept pins' places that already have their one hole
         for f in part.features:
-            if isinstance(f, Hole) and any(near(f.centre, q) for q in drop_pins.get(part.name, ())) \
-                    and not any(near(f.centre, q) for q in keep_pins.get(part.name, ())):
-                removed.append((part.name, f))
-                continue
+            if isinstance(f, Hole) and any(near(f.centre, q) for q in drop_pins.get(part.name, ())):
+                # a kept pin at the same place keeps ONE hole there (the first, the one fabjoints finds); any
+                # other hole there is the dropped slide's own (e.g. the Bunny's s1.driver 6 mm pin hole under
+                # s0's pin B): cut, it would be pinned to nothing and swallow the pin hole at its own size
+                at_kept = next((q for q in keep_pins.get(part.name, ()) if near(f.centre, q)), None)
+                if at_kept is None or any(near(at_kept, q) for q in kept_at):
+                    removed.append((part.name, f))
+                    continue
+                kept_at.append(at_kept)
             if isinstance(f, Slot) and any(near(f.start, a) and near(f.end, b) or near(f.start, b) and near(f.end, a)
                                            for a, b in drop_slots.get(part.name, ())):
                 removed.append((part.name, f))
