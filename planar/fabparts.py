@@ -275,6 +275,20 @@ def _drop_contained(feats: list[Feature]) -> list[Feature]:
     return keep
 
 
+def _pins_held(name: str, feats: list[Feature], kept: list[Feature]) -> list[Feature]:
+    """``kept``, after refusing a pin hole of ``feats`` that a larger cut swallowed (the pin would rattle in
+    it; the Bunny's pin B once sat in a 6.1 mm hole): only the same hole again may stand for it."""
+    for f in feats:
+        if f.kind == "hole" and f.what == "pin hole" and f not in kept and not any(
+                g.kind == "hole" and math.dist(g.a, f.a) < 1e-6 and abs(g.r - f.r) < 1e-9 for g in kept):
+            big = next((g for g in kept if cut_polygon(g.cut(0.0)).buffer(1e-6).contains(cut_polygon(f.cut(0.0)))),
+                       None)
+            what = f"its {big.what} {2 * big.r:.2f} mm wide" if big is not None else "another cut"
+            raise FabricationError(f"part {name!r}: its pin hole {2 * f.r:.2f} mm at ({f.a[0]:.1f}, {f.a[1]:.1f}) mm "
+                                   f"lies inside {what}; the pin would not be held")
+    return kept
+
+
 def _same_guide(f: Feature, g: Feature, g_first: bool, tol: float = 1e-6) -> bool:
     """Whether slot ``f`` runs on the line of slot ``g`` within ``g``'s ends (mm): one guide, cut once as ``g``.
 
@@ -446,7 +460,7 @@ def part_cuts(part: Part, s: FabSettings, number: int, pinned: set[int] = frozen
         base = [(x * s.unit_mm, y * s.unit_mm, r * s.unit_mm) for x, y, r in part.hull] + \
             [c for f in feats for c in f.wall_circles(s.min_wall)]
         feats = feats + _mounting_holes(base, s)
-    feats = _drop_contained(feats)
+    feats = _pins_held(part.name, feats, _drop_contained(feats))
     gap, fa, fb = _closest_cuts(feats)
     if fa is not None and fb is not None and gap < s.min_wall - WALL_TOL:
         raise FabricationError(

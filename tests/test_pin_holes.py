@@ -157,3 +157,19 @@ def test_widened_note_has_no_negative_wall(bunny):
     assert widened, fab.notes
     for n in widened:
         assert not re.search(r"-\d[\d.]* mm wall", n), n
+
+
+def test_a_pin_hole_swallowed_by_a_larger_hole_is_refused():
+    """Loud, not wrong: a part with a pin hole inside a larger hole (the old Bunny slider) is refused."""
+    from planar.fabjoints import FabricationError
+    from planar.fabparts import FabSettings, part_cuts
+    from planar.model import Hole, Part
+
+    part = Part("slider", ((0.0, 0.0, 1.0), (3.0, 0.0, 1.0)),
+                (Hole((0.0, 0.0), 0.3), Hole((2.0, 0.0), 0.3), Hole((0.0, 0.0), 0.6)))
+    s = FabSettings(unit_mm=10.0)
+    ok = part_cuts(part, s, 1, {0, 1, 2})  # all three pinned: the two at (0, 0) are one 3.1 mm hole
+    assert sorted(round(2 * r, 3) for _, r in ok.nominal_holes) == [3.1, 3.1]
+    with pytest.raises(FabricationError, match=r"'slider': its pin hole 3\.10 mm at \(0\.0, 0\.0\) mm lies inside "
+                                               r"its hole 6\.10 mm wide"):
+        part_cuts(part, s, 1, {0, 1})
