@@ -545,15 +545,15 @@ class FabricationSpec(_Strict):
     pin_head_mm: Annotated[float, Strict(), Field(ge=0, le=50)] = 1.5
     """Pin head allowance per end (pin length = thickness x layers + two heads)."""
     shaft_diameter_mm: Pos = 3.0
-    """Motor shaft diameter (the driven part's D hole is cut at this plus ``clearance_mm``)."""
+    """Motor shaft diameter (the driven part's D hole)."""
     shaft_flat_mm: Pos = 2.5
-    """Distance across the shaft's flat (the D is cut at this plus ``clearance_mm``)."""
+    """Distance across the shaft's flat (the D)."""
     motor_screw_mm: Pos = 1.7
     """Motor screw hole diameter."""
     motor_screw_spacing_mm: Pos = 9.0
     """Distance between the two motor screws, across the shaft (N20: 9)."""
     mounting_hole_mm: Pos = 3.2
-    """Diameter of the ground plates' mounting holes (on ears), as cut: no clearance added."""
+    """Diameter of the ground plates' mounting holes (on ears)."""
     # nesting and file conventions
     spacing_mm: Annotated[float, Strict(), Field(ge=0, le=100)] = 3.0
     """Gap between nested parts."""
