@@ -12,7 +12,7 @@ are the toy's rigid pieces:
 * **merged parts**: a stage's follower and its children's drivers are one part
   (``s0.follower+s1.driver``), in the follower's frame: the outline is the
   shapely union of the members' rounded hulls, and every member's holes and
-  slots are kept;
+  slots are kept (holes at one place are one hole, the first member's);
 * **one frame**: every stage's ground, moved to its place, is one part
   (``frame``) holding every fixed pivot, slot and the motor shaft;
 * **cams keyed to the shaft**: each root stage's driver is a cam
@@ -245,7 +245,13 @@ def _merge(name: str, members: list[tuple[Part, XForm]], plane: str, ground: boo
         hull += [(*_xf_point(m, (x, y)), r) for x, y, r in part.hull]
         for f in part.features:
             g = _xf_feature(m, f)
-            if g not in feats:  # two stages' identical holes (two tracks in one place) are one cut
+            # two stages' holes at one place of one rigid piece are one cut, the first member's: a follower's
+            # pivot hole and its child driver's axle hole are one axle (both pivots are one pin); a second,
+            # larger hole there would be pinned to nothing and swallow the pin's hole (#3 -> #1: 6.1 mm for a
+            # 3 mm pin on the frame)
+            if g not in feats and not (isinstance(g, Hole) and any(
+                    isinstance(h, Hole) and math.dist(h.centre, g.centre) <= 1e-9 * max(1.0, math.hypot(*g.centre))
+                    for h in feats)):
                 feats.append(g)
         c, s = math.cos(m[2]), math.sin(m[2])
         polys.append(affinity.affine_transform(_hull_poly(part), [c, -s, s, c, m[0], m[1]]))
