@@ -9,9 +9,11 @@ Sizes (millimetres):
 * slots run ``slot_end_margin_mm`` past each end of the pin's travel
   (straight slots along their axis, arc slots along their arc);
 * the driven part's hole on the motor axis is a D (``shaft_diameter_mm``,
-  ``shaft_flat_mm`` across the flat, no clearance: a push fit); the ground
+  ``shaft_flat_mm`` across the flat, each plus ``clearance_mm``: a snug fit
+  that still goes on a real shaft; the flat carries the torque); the ground
   plate holding the motor gets a shaft clearance hole, two motor screw holes
-  ``motor_screw_spacing_mm`` apart and two mounting holes.
+  ``motor_screw_spacing_mm`` apart and two mounting holes of
+  ``mounting_hole_mm`` as cut (the BOM lists the same size).
 
 Checks: every inner cut keeps ``min_wall_mm`` of material to the outline.  A
 rounded part (a hull of circles) that is too narrow is widened — a circle of
@@ -160,8 +162,9 @@ def _features(part: Part, s: FabSettings, pinned: set[int], drive_at: tuple[floa
                 if not s.shaft_flat_mm < s.shaft_mm:
                     raise FabricationError(f"fabrication.shaft_flat_mm: {s.shaft_flat_mm:g} mm across the flat must be "
                                            f"less than the shaft diameter {s.shaft_mm:g} mm")
-                out.append(Feature("d", f"motor shaft D-hole {s.shaft_mm:g} mm", c, s.shaft_mm / 2,
-                                   flat=s.shaft_flat_mm - s.shaft_mm / 2, t0=drive_flat))
+                # snug, not zero: the clearance on the diameter and across the flat (half of it each side)
+                out.append(Feature("d", f"motor shaft D-hole {s.shaft_mm:g} mm", c, (s.shaft_mm + s.clearance) / 2,
+                                   flat=s.shaft_flat_mm - s.shaft_mm / 2 + s.clearance / 2, t0=drive_flat))
                 continue
             if motor_at is not None and math.dist(f.centre, motor_at) < 1e-9 * max(1.0, u):
                 d = s.shaft_mm + 4 * s.clearance + 0.5
@@ -205,7 +208,7 @@ def _mounting_holes(circles: list[tuple[float, float, float]], s: FabSettings) -
         axis = np.array([1.0, 0.0])
     if axis[0] < 0 or (axis[0] == 0 and axis[1] < 0):
         axis = -axis
-    r = (s.mounting_hole_mm + s.clearance) / 2
+    r = s.mounting_hole_mm / 2  # the cut diameter itself (a clearance hole for its screw; the BOM says the same)
     out = []
     for sgn in (-1, 1):
         reach = float(((pts - c0) @ (sgn * axis) + rad).max())
@@ -234,7 +237,9 @@ def _outer(part: Part, s: FabSettings, feats: list[Feature], k2: float) -> tuple
         if not s.widen:
             raise FabricationError(f"part {part.name!r}: {wall:.3f} mm wall between a cut and the outline, less than "
                                    f"min_wall_mm {s.min_wall:g} (widen = false)")
-        notes.append(f"{part.name}: widened from a {wall:.3f} mm wall to {s.min_wall:g} mm "
+        # a negative wall is a cut reaching out of the part (e.g. a frame's travel slot past its plate)
+        was = f"a {wall:.3f} mm wall" if wall >= 0 else f"a cut reaching {-wall:.3f} mm out of the outline"
+        notes.append(f"{part.name}: widened from {was} to a {s.min_wall:g} mm wall "
                      f"(area {before.area:.0f} -> {after.area:.0f} mm^2)")
         base = base + extra
     if ears:
@@ -268,6 +273,20 @@ def _drop_contained(feats: list[Feature]) -> list[Feature]:
         if not inside:
             keep.append(feats[i])
     return keep
+
+
+def _pins_held(name: str, feats: list[Feature], kept: list[Feature]) -> list[Feature]:
+    """``kept``, after refusing a pin hole of ``feats`` that a larger cut swallowed (the pin would rattle in
+    it; the Bunny's pin B once sat in a 6.1 mm hole): only the same hole again may stand for it."""
+    for f in feats:
+        if f.kind == "hole" and f.what == "pin hole" and f not in kept and not any(
+                g.kind == "hole" and math.dist(g.a, f.a) < 1e-6 and abs(g.r - f.r) < 1e-9 for g in kept):
+            big = next((g for g in kept if cut_polygon(g.cut(0.0)).buffer(1e-6).contains(cut_polygon(f.cut(0.0)))),
+                       None)
+            what = f"its {big.what} {2 * big.r:.2f} mm wide" if big is not None else "another cut"
+            raise FabricationError(f"part {name!r}: its pin hole {2 * f.r:.2f} mm at ({f.a[0]:.1f}, {f.a[1]:.1f}) mm "
+                                   f"lies inside {what}; the pin would not be held")
+    return kept
 
 
 def _same_guide(f: Feature, g: Feature, g_first: bool, tol: float = 1e-6) -> bool:
@@ -441,7 +460,7 @@ def part_cuts(part: Part, s: FabSettings, number: int, pinned: set[int] = frozen
         base = [(x * s.unit_mm, y * s.unit_mm, r * s.unit_mm) for x, y, r in part.hull] + \
             [c for f in feats for c in f.wall_circles(s.min_wall)]
         feats = feats + _mounting_holes(base, s)
-    feats = _drop_contained(feats)
+    feats = _pins_held(part.name, feats, _drop_contained(feats))
     gap, fa, fb = _closest_cuts(feats)
     if fa is not None and fb is not None and gap < s.min_wall - WALL_TOL:
         raise FabricationError(

@@ -12,7 +12,7 @@ are the toy's rigid pieces:
 * **merged parts**: a stage's follower and its children's drivers are one part
   (``s0.follower+s1.driver``), in the follower's frame: the outline is the
   shapely union of the members' rounded hulls, and every member's holes and
-  slots are kept;
+  slots are kept (holes at one place are one hole, the first member's);
 * **one frame**: every stage's ground, moved to its place, is one part
   (``frame``) holding every fixed pivot, slot and the motor shaft;
 * **cams keyed to the shaft**: each root stage's driver is a cam
@@ -247,7 +247,13 @@ def _merge(name: str, members: list[tuple[Part, XForm]], plane: str, ground: boo
         hull += [(*_xf_point(m, (x, y)), r) for x, y, r in part.hull]
         for f in part.features:
             g = _xf_feature(m, f)
-            if g not in feats:  # two stages' identical holes (two tracks in one place) are one cut
+            # two stages' holes at one place of one rigid piece are one cut, the first member's: a follower's
+            # pivot hole and its child driver's axle hole are one axle (both pivots are one pin); a second,
+            # larger hole there would be pinned to nothing and swallow the pin's hole (#3 -> #1: 6.1 mm for a
+            # 3 mm pin on the frame)
+            if g not in feats and not (isinstance(g, Hole) and any(
+                    isinstance(h, Hole) and math.dist(h.centre, g.centre) <= 1e-9 * max(1.0, math.hypot(*g.centre))
+                    for h in feats)):
                 feats.append(g)
         c, s = math.cos(m[2]), math.sin(m[2])
         polys.append(affinity.affine_transform(_hull_poly(part), [c, -s, s, c, m[0], m[1]]))
@@ -497,8 +503,8 @@ _register()
 def _without_cuts_of(parts: list[Part], dropped: list[Any], kept: list[Any], tol: float = 1e-9
                      ) -> tuple[list[Part], list[tuple[str, Any]]]:
     """``parts`` without the slots and pin holes of the ``dropped`` slides (features at their slot ends or at
-    their pin points), except where a ``kept`` joint has a pin at the same place (piece frames); and the
-    ``(piece, feature)`` pairs removed."""
+    their pin points), except that where a ``kept`` joint has a pin at the same place (piece frames) one hole
+    stays (the first there, the one the kept pin goes through); and the ``(piece, feature)`` pairs removed."""
     from ..features import Hole, Slot
 
     keep_pins: dict[str, list[tuple[float, float]]] = {}
@@ -519,11 +525,17 @@ def _without_cuts_of(parts: list[Part], dropped: list[Any], kept: list[Any], tol
     removed: list[tuple[str, Any]] = []
     for part in parts:
         feats = []
+        kept_at: list[tuple[float, float]] = []  # kept pins' places that already have their one hole
         for f in part.features:
-            if isinstance(f, Hole) and any(near(f.centre, q) for q in drop_pins.get(part.name, ())) \
-                    and not any(near(f.centre, q) for q in keep_pins.get(part.name, ())):
-                removed.append((part.name, f))
-                continue
+            if isinstance(f, Hole) and any(near(f.centre, q) for q in drop_pins.get(part.name, ())):
+                # a kept pin at the same place keeps ONE hole there (the first, the one fabjoints finds); any
+                # other hole there is the dropped slide's own (e.g. the Bunny's s1.driver 6 mm pin hole under
+                # s0's pin B): cut, it would be pinned to nothing and swallow the pin hole at its own size
+                at_kept = next((q for q in keep_pins.get(part.name, ()) if near(f.centre, q)), None)
+                if at_kept is None or any(near(at_kept, q) for q in kept_at):
+                    removed.append((part.name, f))
+                    continue
+                kept_at.append(at_kept)
             if isinstance(f, Slot) and any(near(f.start, a) and near(f.end, b) or near(f.start, b) and near(f.end, a)
                                            for a, b in drop_slots.get(part.name, ())):
                 removed.append((part.name, f))
