@@ -170,12 +170,7 @@ def _cmd_function(args: argparse.Namespace) -> int:
     d, why = synthesise_function(phi, psi, args.ground, cons, args.tolerance)
     hint = "" if (d is not None and d.ok) or args.free_offsets else _free_hint(phi, psi, args, cons)
     if d is None:                                       # nothing valid to write
-        if args.json:
-            print(json.dumps({"command": "synth function", "pairs": len(phi), "ok": False, "reason": why,
-                              **({"hint": hint} if hint else {})}, indent=2))
-        else:
-            print(f"check failed: {why}; nothing written" + (f"\n{hint}" if hint else ""))
-        return EXIT_CHECK
+        return _no_design(args, "synth function", {"pairs": len(phi)}, why, hint)
     th = d.phi + d.input_offset                         # crank angles from the ground line
     amp, centre = (None, 0.0) if d.checks["crank_turns_fully"] else (
         max(0.5 * float(np.ptp(th)), 1e-6), 0.5 * float(th.max() + th.min()))
@@ -200,20 +195,54 @@ def _cmd_function(args: argparse.Namespace) -> int:
                    text, report, d.ok, failing)
 
 
+def _no_design(args: argparse.Namespace, command: str, count: dict[str, int], why: str, hint: str = "") -> int:
+    """No design meets the constraints: say why (JSON ``reason``), write nothing, exit 3."""
+    if args.json:
+        print(json.dumps({"command": command, **count, "ok": False, "reason": why,
+                          **({"hint": hint} if hint else {})}, indent=2))
+    else:
+        print(f"check failed: {why}; nothing written" + (f"\n{hint}" if hint else ""))
+    return EXIT_CHECK
+
+
+def _check_poses(name: str, poses: np.ndarray) -> None:
+    """Refuse poses Burmester synthesis cannot use: duplicates, or a body that never turns."""
+    L = max(float(np.hypot(*np.ptp(poses[:, :2], axis=0))), 1e-3)
+    ang = poses[:, 2]
+    for i in range(len(poses)):
+        for j in range(i + 1, len(poses)):
+            dth = abs((ang[j] - ang[i] + math.pi) % (2 * math.pi) - math.pi)
+            if math.hypot(*(poses[j, :2] - poses[i, :2])) <= 1e-9 * L and dth <= 1e-9:
+                raise InputError(name, f"rows {i + 1} and {j + 1}", "different poses (these two are the same "
+                                 "position and angle)")
+    turn = np.abs((ang - ang[0] + math.pi) % (2 * math.pi) - math.pi)
+    if turn.max() <= 1e-9:
+        raise InputError(f"{name}: angle", ang.tolist(), "a body that turns between poses (every angle is the "
+                         "same: a pure translation, which no Burmester four-bar's coupler makes except a "
+                         "parallelogram whose positions lie on one circle)")
+
+
 def _cmd_motion(args: argparse.Namespace) -> int:
     _check_output(args, args.poses)
-    from .synthesis.motion import burmester
+    from .synthesis.motion import NoMotionDesign, burmester
     from .synthesis.scene_out import fourbar_scene_text
     from .synthesis.targets import read_table
 
+    if not (args.max_ratio > 1 and math.isfinite(args.max_ratio)):
+        raise InputError("--max-ratio", args.max_ratio, "a finite ratio greater than 1")
     t = read_table(args.poses, ("x", "y", "angle"), min_rows=3)
     ang = np.radians(t["angle"]) if args.deg else t["angle"]
     poses = np.column_stack([t["x"], t["y"], ang])
     if len(poses) > 5:
         raise InputError(str(args.poses), f"{len(poses)} poses", "3, 4 or 5 poses (Burmester theory)")
-    d = burmester(poses, max_ratio=args.max_ratio)
+    _check_poses(str(args.poses), poses)
+    try:
+        d = burmester(poses, max_ratio=args.max_ratio)
+    except NoMotionDesign as e:
+        return _no_design(args, "synth motion", {"poses": len(poses)}, str(e))
     fb = d.fourbar()
-    amp, centre = _rocking(fb, d.theta)
+    amp, centre = (None, 0.0) if d.crank_range is None else (
+        max(0.5 * (d.crank_range[1] - d.crank_range[0]), 1e-6), 0.5 * (d.crank_range[0] + d.crank_range[1]))
     failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]
     text = fourbar_scene_text(
         "synth-motion", d.ground, d.crank, d.coupler, d.rocker, d.coupler_point, d.circuit, d.placement,
