@@ -240,7 +240,6 @@ def _cmd_motion(args: argparse.Namespace) -> int:
         d = burmester(poses, max_ratio=args.max_ratio)
     except NoMotionDesign as e:
         return _no_design(args, "synth motion", {"poses": len(poses)}, str(e))
-    fb = d.fourbar()
     amp, centre = (None, 0.0) if d.crank_range is None else (
         max(0.5 * (d.crank_range[1] - d.crank_range[0]), 1e-6), 0.5 * (d.crank_range[0] + d.crank_range[1]))
     failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]

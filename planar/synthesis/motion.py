@@ -20,10 +20,14 @@ the bilinear ``row_j(z) . (c, 1) = 0`` with
   the poses' extent) while fewer than 2 or an odd number are found.
 
 Two dyads make a four-bar: the first is the crank.  Pairs are chosen with the
-body at one circuit in every pose (no branch defect), the crank turning fully
-if any pair allows it, link ratio within ``max_ratio``, then the smallest
-ratio.  The result is checked by solving the four-bar with planar's solver at
-each pose's crank angle and comparing the coupler poses.
+body at one circuit in every pose (no branch defect), the poses met in the
+given order by the crank moving one way (no order defect, see
+:func:`crank_order`: exact assembly arcs of the crank, so no dead zone between
+poses), the crank turning fully if any pair allows it, link ratio within
+``max_ratio``, then the smallest ratio; :class:`NoMotionDesign` when no pair
+qualifies.  The result is checked by solving the four-bar with planar's solver
+at each pose's crank angle and comparing the coupler poses, and at 4096 crank
+angles over the swept range (all must assemble).
 """
 
 from __future__ import annotations
@@ -190,7 +194,8 @@ class NoMotionDesign(PlanarError):
     """No candidate four-bar meets the constraints (the CLI exits 3 and writes nothing)."""
 
 
-def crank_order(theta: Array, d: Array, a: Array, b: Array, r: Array) -> tuple[Array, Array, Array, Array]:
+def crank_order(theta: Array, d: Array, a: Array, b: Array, r: Array) -> tuple[NDArray[np.bool_], NDArray[np.bool_],
+                                                                              Array, Array]:
     """Whether the crank reaches the poses in order, and the crank's swept range.
 
     ``theta`` ``(P, n)``: crank angle (rad, from the ground line O2-O4) at each
