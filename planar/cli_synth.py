@@ -165,6 +165,10 @@ def _cmd_function(args: argparse.Namespace) -> int:
         raise InputError(f"{args.pairs}: output", psi.tolist(), "output angles that change")
     if args.deg:
         phi, psi = np.radians(phi), np.radians(psi)
+    for name, v in (("input", phi), ("output", psi)):
+        if np.ptp(v) > 2 * math.pi:
+            raise InputError(f"{args.pairs}: {name}", f"a span of {np.ptp(v):.6g} rad",
+                             "a span of at most 2 pi rad (one turn" + ("" if args.deg else "; --deg for degrees") + ")")
     cons = FunctionConstraints(free_offsets=args.free_offsets, full_turn=args.full_turn, max_ratio=args.max_ratio,
                                min_transmission=math.radians(args.min_transmission))
     d, why = synthesise_function(phi, psi, args.ground, cons, args.tolerance)
@@ -283,8 +287,9 @@ def add_parser(sub: Any) -> None:
     p.set_defaults(func=_cmd_path)
 
     f = ss.add_parser("function", help="input/output angle pairs (Freudenstein): CSV input,output")
-    f.add_argument("pairs", help="CSV with columns input,output (crank and rocker angles from the ground line, "
-                   "the crank turning from the smallest input to the largest)")
+    f.add_argument("pairs", help="CSV with columns input,output (crank and rocker angles counter-clockwise from "
+                   "the world +x axis, the crank pivot at the origin, the rocker pivot on the x axis, either side; "
+                   "the crank turning from the smallest input to the largest; each span at most one turn)")
     f.add_argument("-o", "--output", required=True, help="scene file (TOML) to write")
     f.add_argument("--ground", type=float, default=1.0, help="ground link length (sets the scale; 1)")
     f.add_argument("--deg", action="store_true", help="angles in degrees")
