@@ -165,9 +165,11 @@ def _cmd_function(args: argparse.Namespace) -> int:
         raise InputError(f"{args.pairs}: output", psi.tolist(), "output angles that change")
     if args.deg:
         phi, psi = np.radians(phi), np.radians(psi)
-    for name, v in (("input", phi), ("output", psi)):
-        if np.ptp(v) > 2 * math.pi:
-            raise InputError(f"{args.pairs}: {name}", f"a span of {np.ptp(v):.6g} rad",
+    from .synthesis.function import spans
+
+    for name, span in zip(("input", "output"), spans(phi, psi)):
+        if span > 2 * math.pi:
+            raise InputError(f"{args.pairs}: {name}", f"a span of {span:.6g} rad",
                              "a span of at most 2 pi rad (one turn" + ("" if args.deg else "; --deg for degrees") + ")")
     cons = FunctionConstraints(free_offsets=args.free_offsets, full_turn=args.full_turn, max_ratio=args.max_ratio,
                                min_transmission=math.radians(args.min_transmission))

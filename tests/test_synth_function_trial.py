@@ -57,6 +57,6 @@ def test_span_beyond_one_turn_refused(tmp_path, capsys):
     assert main(["synth", "function", str(pairs), "-o", str(out)]) == 2
     err = capsys.readouterr().err
     assert "input" in err and "2 pi" in err and len(err.strip().splitlines()) == 1 and not out.exists()
-    pairs.write_text("input,output\n0,0\n100,200\n200,370\n")
+    pairs.write_text("input,output\n0,0\n100,170\n200,340\n300,510\n")
     assert main(["synth", "function", str(pairs), "--deg", "-o", str(out)]) == 2
     assert "output" in capsys.readouterr().err and not out.exists()

@@ -37,6 +37,14 @@ def _wrap(a: Array) -> Array:
     return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
 
 
+def spans(phi: Array, psi: Array) -> tuple[float, float]:
+    """Input and output spans (rad): the inputs' as given (the crank turns from the smallest to the largest),
+    the outputs' unwrapped in the inputs' order (a step between neighbours taken as less than pi, as
+    :func:`check_function` compares them)."""
+    phi, psi = np.asarray(phi, float), np.asarray(psi, float)
+    return float(np.ptp(phi)), float(np.ptp(np.unwrap(psi[np.argsort(phi)])))
+
+
 @dataclass
 class FunctionDesign(Checked):
     ground: float
@@ -199,9 +207,9 @@ def synthesise_function(phi: Array, psi: Array, ground: float = 1.0, cons: Any =
         raise InputError("pairs", [float(v) for v in phi], "a different input angle in every pair")
     if len(np.unique(psi)) < 2:
         raise InputError("pairs", [float(v) for v in psi], "output angles that change")
-    for name, v in (("input", phi), ("output", psi)):
-        if np.ptp(v) > 2 * np.pi:
-            raise InputError(f"pairs: {name}", f"a span of {np.ptp(v):.6g} rad",
+    for name, span in zip(("input", "output"), spans(phi, psi)):
+        if span > 2 * np.pi:
+            raise InputError(f"pairs: {name}", f"a span of {span:.6g} rad",
                              "a span of at most 2 pi rad (one turn; --deg for degrees)")
     closed: FunctionDesign | None = None
     note = ""
