@@ -309,9 +309,12 @@ def add_parser(sub: Any) -> None:
     f.set_defaults(func=_cmd_function)
 
     m = ss.add_parser("motion", help="3, 4 or 5 poses of the coupler (Burmester): CSV x,y,angle")
-    m.add_argument("poses", help="CSV with columns x,y,angle (the guided body's origin and angle)")
+    m.add_argument("poses", help="CSV with columns x,y,angle (the guided body's origin and angle), 3 to 5 rows, "
+                   "reached in this order as the crank moves one way (exit 3, nothing written, when no four-bar "
+                   "does)")
     m.add_argument("-o", "--output", required=True, help="scene file (TOML) to write")
-    m.add_argument("--max-ratio", type=float, default=10.0, help="longest / shortest link at most this (10)")
+    m.add_argument("--max-ratio", type=float, default=10.0,
+                   help="longest / shortest link at most this, a finite number > 1 (10)")
     m.add_argument("--deg", action="store_true", help="angles in degrees")
     m.add_argument("--json", action="store_true", help="print the design and its checks as JSON")
     m.set_defaults(func=_cmd_motion)
