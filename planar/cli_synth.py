@@ -165,17 +165,18 @@ def _cmd_function(args: argparse.Namespace) -> int:
         raise InputError(f"{args.pairs}: output", psi.tolist(), "output angles that change")
     if args.deg:
         phi, psi = np.radians(phi), np.radians(psi)
+    from .synthesis.function import spans
+
+    for name, span in zip(("input", "output"), spans(phi, psi)):
+        if span > 2 * math.pi:
+            raise InputError(f"{args.pairs}: {name}", f"a span of {span:.6g} rad",
+                             "a span of at most 2 pi rad (one turn" + ("" if args.deg else "; --deg for degrees") + ")")
     cons = FunctionConstraints(free_offsets=args.free_offsets, full_turn=args.full_turn, max_ratio=args.max_ratio,
                                min_transmission=math.radians(args.min_transmission))
     d, why = synthesise_function(phi, psi, args.ground, cons, args.tolerance)
     hint = "" if (d is not None and d.ok) or args.free_offsets else _free_hint(phi, psi, args, cons)
     if d is None:                                       # nothing valid to write
-        if args.json:
-            print(json.dumps({"command": "synth function", "pairs": len(phi), "ok": False, "reason": why,
-                              **({"hint": hint} if hint else {})}, indent=2))
-        else:
-            print(f"check failed: {why}; nothing written" + (f"\n{hint}" if hint else ""))
-        return EXIT_CHECK
+        return _no_design(args, "synth function", {"pairs": len(phi)}, why, hint)
     th = d.phi + d.input_offset                         # crank angles from the ground line
     amp, centre = (None, 0.0) if d.checks["crank_turns_fully"] else (
         max(0.5 * float(np.ptp(th)), 1e-6), 0.5 * float(th.max() + th.min()))
@@ -200,20 +201,53 @@ def _cmd_function(args: argparse.Namespace) -> int:
                    text, report, d.ok, failing)
 
 
+def _no_design(args: argparse.Namespace, command: str, count: dict[str, int], why: str, hint: str = "") -> int:
+    """No design meets the constraints: say why (JSON ``reason``), write nothing, exit 3."""
+    if args.json:
+        print(json.dumps({"command": command, **count, "ok": False, "reason": why,
+                          **({"hint": hint} if hint else {})}, indent=2))
+    else:
+        print(f"check failed: {why}; nothing written" + (f"\n{hint}" if hint else ""))
+    return EXIT_CHECK
+
+
+def _check_poses(name: str, poses: np.ndarray) -> None:
+    """Refuse poses Burmester synthesis cannot use: duplicates, or a body that never turns."""
+    L = max(float(np.hypot(*np.ptp(poses[:, :2], axis=0))), 1e-3)
+    ang = poses[:, 2]
+    for i in range(len(poses)):
+        for j in range(i + 1, len(poses)):
+            dth = abs((ang[j] - ang[i] + math.pi) % (2 * math.pi) - math.pi)
+            if math.hypot(*(poses[j, :2] - poses[i, :2])) <= 1e-9 * L and dth <= 1e-9:
+                raise InputError(name, f"rows {i + 1} and {j + 1}", "different poses (these two are the same "
+                                 "position and angle)")
+    turn = np.abs((ang - ang[0] + math.pi) % (2 * math.pi) - math.pi)
+    if turn.max() <= 1e-9:
+        raise InputError(f"{name}: angle", ang.tolist(), "a body that turns between poses (every angle is the "
+                         "same: a pure translation, which no Burmester four-bar's coupler makes except a "
+                         "parallelogram whose positions lie on one circle)")
+
+
 def _cmd_motion(args: argparse.Namespace) -> int:
     _check_output(args, args.poses)
-    from .synthesis.motion import burmester
+    from .synthesis.motion import NoMotionDesign, burmester
     from .synthesis.scene_out import fourbar_scene_text
     from .synthesis.targets import read_table
 
+    if not (args.max_ratio > 1 and math.isfinite(args.max_ratio)):
+        raise InputError("--max-ratio", args.max_ratio, "a finite ratio greater than 1")
     t = read_table(args.poses, ("x", "y", "angle"), min_rows=3)
     ang = np.radians(t["angle"]) if args.deg else t["angle"]
     poses = np.column_stack([t["x"], t["y"], ang])
     if len(poses) > 5:
         raise InputError(str(args.poses), f"{len(poses)} poses", "3, 4 or 5 poses (Burmester theory)")
-    d = burmester(poses, max_ratio=args.max_ratio)
-    fb = d.fourbar()
-    amp, centre = _rocking(fb, d.theta)
+    _check_poses(str(args.poses), poses)
+    try:
+        d = burmester(poses, max_ratio=args.max_ratio)
+    except NoMotionDesign as e:
+        return _no_design(args, "synth motion", {"poses": len(poses)}, str(e))
+    amp, centre = (None, 0.0) if d.crank_range is None else (
+        max(0.5 * (d.crank_range[1] - d.crank_range[0]), 1e-6), 0.5 * (d.crank_range[0] + d.crank_range[1]))
     failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]
     text = fourbar_scene_text(
         "synth-motion", d.ground, d.crank, d.coupler, d.rocker, d.coupler_point, d.circuit, d.placement,
@@ -255,8 +289,9 @@ def add_parser(sub: Any) -> None:
     p.set_defaults(func=_cmd_path)
 
     f = ss.add_parser("function", help="input/output angle pairs (Freudenstein): CSV input,output")
-    f.add_argument("pairs", help="CSV with columns input,output (crank and rocker angles from the ground line, "
-                   "the crank turning from the smallest input to the largest)")
+    f.add_argument("pairs", help="CSV with columns input,output (crank and rocker angles counter-clockwise from "
+                   "the world +x axis, the crank pivot at the origin, the rocker pivot on the x axis, either side; "
+                   "the crank turning from the smallest input to the largest; each span at most one turn)")
     f.add_argument("-o", "--output", required=True, help="scene file (TOML) to write")
     f.add_argument("--ground", type=float, default=1.0, help="ground link length (sets the scale; 1)")
     f.add_argument("--deg", action="store_true", help="angles in degrees")
@@ -274,9 +309,12 @@ def add_parser(sub: Any) -> None:
     f.set_defaults(func=_cmd_function)
 
     m = ss.add_parser("motion", help="3, 4 or 5 poses of the coupler (Burmester): CSV x,y,angle")
-    m.add_argument("poses", help="CSV with columns x,y,angle (the guided body's origin and angle)")
+    m.add_argument("poses", help="CSV with columns x,y,angle (the guided body's origin and angle), 3 to 5 rows, "
+                   "reached in this order as the crank moves one way (exit 3, nothing written, when no four-bar "
+                   "does)")
     m.add_argument("-o", "--output", required=True, help="scene file (TOML) to write")
-    m.add_argument("--max-ratio", type=float, default=10.0, help="longest / shortest link at most this (10)")
+    m.add_argument("--max-ratio", type=float, default=10.0,
+                   help="longest / shortest link at most this, a finite number > 1 (10)")
     m.add_argument("--deg", action="store_true", help="angles in degrees")
     m.add_argument("--json", action="store_true", help="print the design and its checks as JSON")
     m.set_defaults(func=_cmd_motion)

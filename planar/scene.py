@@ -413,8 +413,9 @@ class DriverSpec(_Strict):
     """How many cycles to solve (default 1), e.g. ``2``; or give ``duration``."""
     duration: Pos | None = None
     """Seconds to solve instead of ``cycles``, e.g. ``3.0``."""
-    samples_per_cycle: Annotated[int, Strict(), Field(ge=4, le=100_000)] = 72
-    """Samples (and animation frames) per cycle, 4-100000, e.g. ``36``."""
+    samples_per_cycle: Annotated[int, Strict(), Field(ge=4)] = 72
+    """Samples (and animation frames) per cycle, at least 4, e.g. ``36``; samples x cycles at most
+    ``PLANAR_MAX_SAMPLES`` (:mod:`planar.limits`)."""
     phase: Real = 0.0
     """Input at t = 0 for a turning input, or the sine's phase for a rocking one (scene's angle unit)."""
     amplitude: Pos | None = None
@@ -668,6 +669,8 @@ class Scene:
         else:
             field_name, value = "driver.cycles", d.cycles
             cycles = d.cycles if d.cycles is not None else 1.0
+            if d.cycles is None:                          # one cycle: the per-cycle count is what asks
+                field_name, value = "driver.samples_per_cycle", d.samples_per_cycle
         total = d.samples_per_cycle * cycles
         where = f"{self.path}: {field_name}"
         n = check_count("samples", where, round(total) if math.isfinite(total) else total,

@@ -37,6 +37,14 @@ def _wrap(a: Array) -> Array:
     return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
 
 
+def spans(phi: Array, psi: Array) -> tuple[float, float]:
+    """Input and output spans (rad): the inputs' as given (the crank turns from the smallest to the largest),
+    the outputs' unwrapped in the inputs' order (a step between neighbours taken as less than pi, as
+    :func:`check_function` compares them)."""
+    phi, psi = np.asarray(phi, float), np.asarray(psi, float)
+    return float(np.ptp(phi)), float(np.ptp(np.unwrap(psi[np.argsort(phi)])))
+
+
 @dataclass
 class FunctionDesign(Checked):
     ground: float
@@ -111,7 +119,8 @@ def freudenstein_fit(phi: Array, psi: Array, ground: float = 1.0) -> FunctionDes
         if best is None or e < best[0]:
             best = (e, circuit, err)
     assert best is not None
-    return FunctionDesign(d, a, b, c, best[1], K, phi, psi, best[2], grashof_class(a, b, c, d), turn, -turn, -turn)
+    off = 0.0 - turn                     # never -0.0
+    return FunctionDesign(d, a, b, c, best[1], K, phi, psi, best[2], grashof_class(a, b, c, d), turn, off, off)
 
 
 def _normalised(d: FunctionDesign) -> Array:
@@ -126,9 +135,9 @@ def _design(x: Array, circuit: int, phi: Array, psi: Array, ground: float, free:
     a, b, c, A, B = (float(v) for v in x)
     K = np.array([1.0 / a, 1.0 / c, (a * a - b * b + c * c + 1.0) / (2.0 * a * c)])
     g = float(ground)
-    turn = 0.0 if free else float(-A)
+    turn = 0.0 if free else float(-A) + 0.0               # + 0.0: never -0.0
     return FunctionDesign(g, a * g, b * g, c * g, "open" if circuit > 0 else "crossed", K, phi, psi,
-                          np.full(len(phi), np.nan), grashof_class(a, b, c, 1.0), turn, A, B, "search")
+                          np.full(len(phi), np.nan), grashof_class(a, b, c, 1.0), turn, A + 0.0, B + 0.0, "search")
 
 
 def check_function(d: FunctionDesign, cons: Any, tolerance: float, dense: int = 361) -> None:
@@ -166,13 +175,13 @@ def check_function(d: FunctionDesign, cons: Any, tolerance: float, dense: int = 
         "ok_output_error": bool(np.isfinite(d.max_error) and d.max_error <= tolerance),
         "ok_link_ratio": ratio <= cons.max_ratio * (1 + 1e-9),
         "ok_transmission": min(margin, margin_turn if cons.full_turn else margin) >= cons.min_transmission - 1e-9,
-        "ok_full_turn": bool(full) or not cons.full_turn,
         "input_arc_deg": float(np.degrees(th.max() - th.min())),
         "min_transmission_deg": float(np.degrees(margin)),
         "link_ratio": ratio,
         "crank_turns_fully": bool(full),
     }
-    if cons.full_turn:
+    if cons.full_turn:                                    # only when asked (--full-turn)
+        d.checks["ok_full_turn"] = bool(full)
         d.checks["min_transmission_full_turn_deg"] = float(np.degrees(margin_turn))
 
 
@@ -198,6 +207,10 @@ def synthesise_function(phi: Array, psi: Array, ground: float = 1.0, cons: Any =
         raise InputError("pairs", [float(v) for v in phi], "a different input angle in every pair")
     if len(np.unique(psi)) < 2:
         raise InputError("pairs", [float(v) for v in psi], "output angles that change")
+    for name, span in zip(("input", "output"), spans(phi, psi)):
+        if span > 2 * np.pi:
+            raise InputError(f"pairs: {name}", f"a span of {span:.6g} rad",
+                             "a span of at most 2 pi rad (one turn; --deg for degrees)")
     closed: FunctionDesign | None = None
     note = ""
     if not cons.free_offsets:

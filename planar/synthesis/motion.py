@@ -20,10 +20,14 @@ the bilinear ``row_j(z) . (c, 1) = 0`` with
   the poses' extent) while fewer than 2 or an odd number are found.
 
 Two dyads make a four-bar: the first is the crank.  Pairs are chosen with the
-body at one circuit in every pose (no branch defect), the crank turning fully
-if any pair allows it, link ratio within ``max_ratio``, then the smallest
-ratio.  The result is checked by solving the four-bar with planar's solver at
-each pose's crank angle and comparing the coupler poses.
+body at one circuit in every pose (no branch defect), the poses met in the
+given order by the crank moving one way (no order defect, see
+:func:`crank_order`: exact assembly arcs of the crank, so no dead zone between
+poses), the crank turning fully if any pair allows it, link ratio within
+``max_ratio``, then the smallest ratio; :class:`NoMotionDesign` when no pair
+qualifies.  The result is checked by solving the four-bar with planar's solver
+at each pose's crank angle and comparing the coupler poses, and at 4096 crank
+angles over the swept range (all must assemble).
 """
 
 from __future__ import annotations
@@ -173,6 +177,8 @@ class MotionDesign(Checked, PlacedFourBar):
     dyads: Array                      # (2, 4): moving pivot (body frame), fixed pivot (world)
     grashof: str
     candidates: int
+    crank_range: tuple[float, float] | None = None   # swept crank angles (rad, unwrapped) of a rocking crank
+    in_order: bool = True                            # the crank meets the poses in the given order
     checks: dict[str, Any] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
@@ -180,12 +186,55 @@ class MotionDesign(Checked, PlacedFourBar):
                 "rocker": self.rocker, "coupler_point": list(self.coupler_point), "circuit": self.circuit,
                 "placement": list(self.placement), "theta": [float(t) for t in self.theta],
                 "grashof": self.grashof, "dyads": self.dyads.tolist(), "candidate_dyads": self.candidates,
+                "crank_range": None if self.crank_range is None else list(self.crank_range),
                 "ok": self.ok, "checks": self.checks}
+
+
+class NoMotionDesign(PlanarError):
+    """No candidate four-bar meets the constraints (the CLI exits 3 and writes nothing)."""
+
+
+def crank_order(theta: Array, d: Array, a: Array, b: Array, r: Array) -> tuple[NDArray[np.bool_], NDArray[np.bool_],
+                                                                              Array, Array]:
+    """Whether the crank reaches the poses in order, and the crank's swept range.
+
+    ``theta`` ``(P, n)``: crank angle (rad, from the ground line O2-O4) at each
+    pose; ``d, a, b, r`` ``(P,)``: ground, crank, coupler, rocker.  The crank
+    assembles where ``|b - r| <= |B - O4| <= b + r``, i.e. ``cmin <= cos theta
+    <= cmax`` (exact): the whole turn, or one or two arcs symmetric about the
+    ground line.  A crank that turns fully must meet the poses in their order
+    within one turn, forward or backward (cyclically); a crank confined to an
+    arc rocks, so all poses must lie on the same arc, in monotonic order along
+    it, and it sweeps only that arc (no toggle or dead zone between poses).
+    Returns ``(in_order, full, lo, hi)``: ``lo, hi`` the swept crank range
+    (unwrapped, rad; ``lo = hi = nan`` for a full turn).
+    """
+    two = 2.0 * np.pi
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cmin = (a ** 2 + d ** 2 - (b + r) ** 2) / (2 * a * d)
+        cmax = (a ** 2 + d ** 2 - (b - r) ** 2) / (2 * a * d)
+    full = (cmin <= -1.0) & (cmax >= 1.0)
+    fwd = np.mod(np.diff(theta, axis=1), two)
+    bwd = np.mod(-np.diff(theta, axis=1), two)
+    turn_ok = ((fwd > 0).all(1) & (fwd.sum(1) < two)) | ((bwd > 0).all(1) & (bwd.sum(1) < two))
+    around_pi = (cmin <= -1.0) & ~full                    # one arc centred on theta = pi
+    u = np.where(around_pi[:, None], np.mod(theta, two), (theta + np.pi) % two - np.pi)
+    # two arcs (neither limit outside [-1, 1]): the poses must share the sign of theta
+    two_arcs = (cmin > -1.0) & (cmax < 1.0)
+    same = (np.sign(u) == np.sign(u[:, :1])).all(1) | ~two_arcs
+    du = np.diff(u, axis=1)
+    mono = (du > 0).all(1) | (du < 0).all(1)
+    arc_ok = same & mono & ~full
+    lo = np.where(full, np.nan, u.min(1))
+    hi = np.where(full, np.nan, u.max(1))
+    return np.where(full, turn_ok, arc_ok), full, lo, hi
 
 
 def _choose(poses: Array, z: Array, c: Array, max_ratio: float) -> tuple[int, int, bool]:
     """The best ordered pair (crank dyad, rocker dyad) among candidate dyads (see the module)."""
     K = len(z)
+    if K < 2:
+        raise NoMotionDesign(f"only {K} dyad found for these {len(poses)} poses: a four-bar needs two")
     I, J = np.meshgrid(np.arange(K), np.arange(K), indexing="ij")
     I, J = I[I != J], J[I != J]
     R = _rot(poses[:, 2])
@@ -198,18 +247,25 @@ def _choose(poses: Array, z: Array, c: Array, max_ratio: float) -> tuple[int, in
     d = np.hypot(*(O4[:, 0] - O2[:, 0]).T)
     Lk = np.stack([d, a, b, r], 1)
     lo, hi = Lk.min(1), Lk.max(1)
-    pq = Lk.sum(1) - lo - hi
     L = _scale(poses)
     e1, e2 = O4 - B, C - B
     side = np.sign(e1[..., 0] * e2[..., 1] - e1[..., 1] * e2[..., 0])   # (P, n)
     one_circuit = (np.abs(side.sum(1)) == side.shape[1]) & (side[:, 0] != 0)
-    full = (lo + hi < pq - 1e-3 * Lk.sum(1)) & (np.minimum(d, a) < np.minimum(b, r))
+    g = O4[:, 0] - O2[:, 0]
+    theta = (np.arctan2(B[..., 1] - O2[..., 1], B[..., 0] - O2[..., 0])
+             - np.arctan2(g[:, 1], g[:, 0])[:, None])                 # crank angle from the ground line
+    in_order, full, _, _ = crank_order(theta, d, a, b, r)
     ratio = hi / np.maximum(lo, 1e-300)
     usable = one_circuit & (lo > 1e-3 * L) & (ratio <= max_ratio)
     if not usable.any():
-        raise PlanarError(f"poses: none of the {len(I)} pairs of the {K} dyads found takes the body through all "
-                          f"{len(poses)} poses on one circuit with links within the ratio {max_ratio:g} "
-                          "(a larger --max-ratio, or other poses)")
+        raise NoMotionDesign(f"none of the {len(I)} pairs of the {K} dyads found takes the body through all "
+                             f"{len(poses)} poses on one circuit with links within the ratio {max_ratio:g} "
+                             "(a larger --max-ratio, or other poses)")
+    if not (usable & in_order).any():
+        raise NoMotionDesign(f"order defect: each of the {int(usable.sum())} four-bars that reach all {len(poses)} "
+                             "poses on one circuit meets them out of the given order (or with a dead zone "
+                             "between them) as the crank moves in one direction (other poses, or their order)")
+    usable &= in_order
     pick = usable & full if (usable & full).any() else usable
     k = int(np.flatnonzero(pick)[np.argmin(ratio[pick])])
     return int(I[k]), int(J[k]), bool(full[k])
@@ -240,8 +296,9 @@ def burmester(poses: Array, max_ratio: float = 10.0, grid: int = 24) -> MotionDe
             if len(z) >= 2 and len(z) % 2 == 0:
                 break
         if len(z) < 2:
-            raise InputError("poses", "5 poses", f"poses with 2 or more Burmester points (these have {len(z)}: "
-                             "within 64 times the poses' extent: no four-bar takes the body through all five)")
+            raise NoMotionDesign(f"these 5 poses have {len(z)} Burmester points within 64 times their extent (2 or "
+                                 "4 are needed): no four-bar takes the body through all five (drop a pose, or move "
+                                 "one)")
     ok = np.isfinite(c).all(1)
     z, c = z[ok], c[ok]
     i, j, _ = _choose(poses, z, c, max_ratio)
@@ -267,14 +324,24 @@ def _design(poses: Array, zi: Array, ci: Array, zj: Array, cj: Array, candidates
     e1, e2 = cj - B[0], C[0] - B[0]
     circuit = "open" if e1[0] * e2[1] - e1[1] * e2[0] > 0 else "crossed"
     theta = np.arctan2(B[:, 1] - ci[1], B[:, 0] - ci[0]) - phi
+    ordered, full, lo, hi = crank_order(theta[None], *(np.array([v]) for v in (d, a, b, r)))
+    if not full[0]:                                   # a rocking crank: its angles as crank_order unwraps them
+        cmin = (a * a + d * d - (b + r) ** 2) / (2 * a * d)
+        theta = theta % (2 * np.pi) if cmin <= -1.0 else (theta + np.pi) % (2 * np.pi) - np.pi
     md = MotionDesign(d, a, b, r, local, off, circuit, (float(ci[0]), float(ci[1]), phi), theta, poses,
-                      np.array([[*zi, *ci], [*zj, *cj]]), grashof_class(a, b, r, d), candidates)
+                      np.array([[*zi, *ci], [*zj, *cj]]), grashof_class(a, b, r, d), candidates,
+                      None if full[0] else (float(lo[0]), float(hi[0])), bool(ordered[0]))
     check_motion(md)
     return md
 
 
-def check_motion(md: MotionDesign) -> None:
-    """Solve the four-bar at each pose's crank angle with planar's solver; compare the coupler poses."""
+def check_motion(md: MotionDesign, samples: int = 4096) -> None:
+    """Solve the four-bar at each pose's crank angle with planar's solver; compare the coupler poses.
+
+    Between poses the four-bar is solved again at ``samples`` crank angles
+    over the swept range (the whole turn, or the rocking arc): every one must
+    assemble on the design's circuit (no dead zone or toggle between poses).
+    """
     fb = md.fourbar()
     m = fb.solve(md.theta)
     pos = m.points["coupler_point"]
@@ -282,9 +349,14 @@ def check_motion(md: MotionDesign) -> None:
     L = _scale(md.poses)
     dp = np.hypot(*(pos - md.poses[:, :2]).T)
     da = np.abs((ang - md.poses[:, 2] + np.pi) % (2 * np.pi) - np.pi)
+    lo, hi = md.crank_range if md.crank_range is not None else (0.0, 2 * np.pi)
+    sweep = fb.solve(np.linspace(lo, hi, samples))
     md.checks = {
         "max_position_error": float(dp.max()) if m.valid.all() else float("inf"),
         "max_angle_error_rad": float(da.max()) if m.valid.all() else float("inf"),
         "ok_reaches_every_pose": bool(m.valid.all() and dp.max() <= 1e-6 * L and da.max() <= 1e-6),
-        "crank_turns_fully": md.grashof in ("crank-rocker", "double-crank"),
+        "ok_poses_in_order": md.in_order,
+        "ok_assembles_between_poses": bool(sweep.valid.all()),
+        "sweep_samples": samples,
+        "crank_turns_fully": md.crank_range is None,
     }
