@@ -2,7 +2,9 @@
 
 Exit status 0 when the design passes its own checks (solved again by
 planar's solver), 3 when it was written but fails one (the failing check is
-printed), 2 on bad input (one line, nothing written).
+printed), 2 on bad input (one line, nothing written).  ``path`` and
+``function`` exit 3 writing nothing, with the reason, when no valid design
+(one that keeps the constraints) is found.
 """
 
 from __future__ import annotations

@@ -7,7 +7,12 @@ solver, not the search kernel: the coupler point at the crank angles found
 the whole turn solved as a path (360 samples, branch continuity): every
 sample valid, and equal (to 1e-9 of the targets' extent) to the same angles
 solved as a shuffled batch, which keeps the declared circuit at every sample
-as the solve at the targets does: the circuit never switches.
+as the solve at the targets does: the circuit never switches.  Also checked:
+the constraints (:func:`planar.synthesis.search.constraint_failures`, each
+broken one named) and the accuracy, ``rms_error`` = RMS distance to the
+targets / their size (RMS distance from their centroid) at most
+``tolerance``.  The search runs on the targets moved to their centroid and
+divided by their size (the pivots box with them); the result is mapped back.
 """
 
 from __future__ import annotations
