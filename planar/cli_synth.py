@@ -317,10 +317,13 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--topology", choices=("stephenson", "watt"), default=None,
                    help="six-bar only: a dyad hung from the coupler (stephenson, the default) or from the rocker "
                         "(watt)")
-    p.add_argument("--json", action="store_true", help="print the design, sse and time_s as JSON")
+    p.add_argument("--json", action="store_true",
+                   help="print the design, sse, checks.rms_error and time_s as JSON (or ok false and the reason)")
     p.add_argument("--budget", choices=("quick", "normal", "thorough"), default="normal",
                    help="search effort (normal: about 1-4 s)")
-    p.add_argument("--max-ratio", type=float, default=10.0, help="longest / shortest link at most this (10)")
+    p.add_argument("--max-ratio", type=float, default=10.0,
+                   help="longest / shortest link at most this (10; six-bar: every side of every link, the "
+                        "ground's three included)")
     p.add_argument("--pivots", default=None,
                    help="ground pivots inside XMIN,YMIN,XMAX,YMAX (write --pivots=-1,... when XMIN is negative)")
     p.add_argument("--points", type=int, default=None, help="points sampled along an SVG target (12; SVG only)")
