@@ -105,10 +105,11 @@ def _path_failing(d: Any) -> list[str]:
 def _unusable(d: Any, kind: str, region: bool) -> str | None:
     """Why a design is no valid linkage at all (a constraint broken, or it misses a target's crank angle)."""
     if d.checks.get("constraint_failures"):
-        what = f"no {kind} keeping the constraints" + (" (both pivots in the --pivots box)" if region else "")
+        what = f"no {kind} keeping the constraints" + (" (every ground pivot in the --pivots box)" if region else "")
         return f"{what} reaches the targets; the best found: " + "; ".join(d.checks["constraint_failures"])
     if not math.isfinite(d.sse):
-        return f"no {kind} found that can be assembled at every target's crank angle"
+        return f"no {kind} found that can be assembled at every target's crank angle" + (
+            f" ({d.checks['error']})" if d.checks.get("error") else "")
     return None
 
 

@@ -23,12 +23,12 @@ def _csv(path, pts, theta=None, header="x,y"):
     return str(path)
 
 
-@pytest.mark.parametrize("seed", [0, 1])
-def test_unusable_pivots_box_is_exit_3_with_reason_nothing_written(tmp_path, capsys, seed):
+@pytest.mark.parametrize("seed, kind", [(0, "fourbar"), (1, "fourbar"), (0, "sixbar")])
+def test_unusable_pivots_box_is_exit_3_with_reason_nothing_written(tmp_path, capsys, seed, kind):
     src = _csv(tmp_path / "ell6.csv", ELL)
     out = tmp_path / "far.toml"
     assert main(["synth", "path", src, "--pivots=100,100,100.1,100.1", "-o", str(out), "--budget", "quick",
-                 "--seed", str(seed), "--json"]) == 3
+                 "--seed", str(seed), "--json", "--type", kind]) == 3
     rep = json.loads(capsys.readouterr().out)
     assert rep["ok"] is False and "--pivots box" in rep["reason"] and "outside" in rep["reason"]
     assert not out.exists()

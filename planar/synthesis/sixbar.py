@@ -398,11 +398,12 @@ def check_sixbar(d: SixBarDesign, cons: Constraints, scale: float, tolerance: fl
     """
     from ..errors import PlanarError
 
+    cf = sixbar_constraint_failures(d.params, cons, d.topology)
     try:
         lk = d.linkage()
     except PlanarError as e:
         d.sse = float("inf")
-        d.checks = {"ok_builds": False, "error": str(e)}
+        d.checks = {"ok_builds": False, "error": str(e), "ok_constraints": not cf, "constraint_failures": cf}
         return
     th = np.mod(d.theta, 2 * np.pi)
     order = np.argsort(th, kind="stable")
@@ -420,7 +421,6 @@ def check_sixbar(d: SixBarDesign, cons: Constraints, scale: float, tolerance: fl
     ranges = invalid_ranges(m[0] <= 0, dense) or invalid_ranges(~full.valid, turn)
     failures = [f"the linkage cannot be assembled for driver angles {a:.4g}..{b:.4g} rad (from the ground line "
                 "O2-O4)" for a, b in ranges]
-    cf = sixbar_constraint_failures(d.params, cons, d.topology)
     _, size = normalisation(d.targets)
     rms = math.sqrt(d.sse / len(d.targets)) / size if math.isfinite(d.sse) else float("inf")
     d.checks = {
