@@ -94,7 +94,9 @@ def test_bom_csv_is_read(tmp_path, capsys):
 
 def test_constraints_named_with_value_and_limit_and_rounding_passes():
     row = np.array([1.21 * 5 * (1 + 1.1e-9 / 2), 1.21, 4.0, 5.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-    assert constraint_failures(row, Constraints(max_ratio=5.0)) == []          # 5.0000000055: rounding
+    assert constraint_failures(row, Constraints(max_ratio=5.0)) == []          # ratio 5.0000000028: rounding
+    row[0] = 1.21 * 5 * (1 + 3e-9)
+    assert len(constraint_failures(row, Constraints(max_ratio=5.0))) == 1       # past the 1e-9 tolerance
     row[0] = 1.21 * 5.01
     (f,) = constraint_failures(row, Constraints(max_ratio=5.0))
     assert "link ratio 5.01" in f and "ground" in f and "crank" in f and "--max-ratio 5" in f
