@@ -2,7 +2,9 @@
 
 Exit status 0 when the design passes its own checks (solved again by
 planar's solver), 3 when it was written but fails one (the failing check is
-printed), 2 on bad input (one line, nothing written).
+printed), 2 on bad input (one line, nothing written).  ``path`` and
+``function`` exit 3 writing nothing, with the reason, when no valid design
+(one that keeps the constraints) is found.
 """
 
 from __future__ import annotations
@@ -72,28 +74,77 @@ def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, An
     return 0 if ok else EXIT_CHECK
 
 
+def _no_design(args: argparse.Namespace, n: int, reason: str) -> int:
+    """Nothing valid to write (as ``synth function``): exit 3, the reason, nothing written."""
+    if args.json:
+        print(json.dumps({"command": "synth path", "targets": n, "ok": False, "reason": reason}, indent=2))
+    else:
+        print(f"check failed: {reason}; nothing written")
+    return EXIT_CHECK
+
+
+def _path_failing(d: Any) -> list[str]:
+    """One line per failed check of a path design, naming what failed and by how much."""
+    out: list[str] = []
+    for k, v in d.checks.items():
+        if not k.startswith("ok_") or v:
+            continue
+        if k == "ok_constraints":
+            out += d.checks["constraint_failures"]
+        elif k == "ok_accuracy":
+            out.append(f"RMS distance to the targets {d.checks['rms_error']:.3g} of their size (RMS distance from "
+                       f"their centroid, {d.checks['size']:.6g}), over --tolerance {d.checks['tolerance']:g} "
+                       f"(sse {d.sse:.6g})")
+        elif k == "ok_valid_over_turn" and d.checks.get("failures"):
+            out += d.checks["failures"]
+        else:
+            out.append(k[3:].replace("_", " "))
+    return out
+
+
+def _unusable(d: Any, kind: str, region: bool) -> str | None:
+    """Why a design is no valid linkage at all (a constraint broken, or it misses a target's crank angle)."""
+    if d.checks.get("constraint_failures"):
+        what = f"no {kind} keeping the constraints" + (" (every ground pivot in the --pivots box)" if region else "")
+        return f"{what} reaches the targets; the best found: " + "; ".join(d.checks["constraint_failures"])
+    if not math.isfinite(d.sse):
+        return f"no {kind} found that can be assembled at every target's crank angle" + (
+            f" ({d.checks['error']})" if d.checks.get("error") else "")
+    return None
+
+
 def _cmd_path(args: argparse.Namespace) -> int:
     _check_output(args, args.target)
     from .synthesis.path import synthesise_path
     from .synthesis.scene_out import fourbar_scene_text
     from .synthesis.search import Constraints
-    from .synthesis.targets import read_path_targets
+    from .synthesis.targets import check_theta, normalisation, read_path_targets
 
-    if not args.max_ratio > 1:
-        raise InputError("--max-ratio", args.max_ratio, "a ratio greater than 1")
+    if not (args.max_ratio > 1 and math.isfinite(args.max_ratio)):
+        raise InputError("--max-ratio", args.max_ratio, "a finite ratio greater than 1")
     if args.seed < 0:
         raise InputError("--seed", args.seed, "a seed of 0 or more")
+    if not (args.tolerance > 0 and math.isfinite(args.tolerance)):
+        raise InputError("--tolerance", args.tolerance, "a positive fraction of the targets' size")
+    if args.topology is not None and args.type != "sixbar":
+        raise InputError("--topology", args.topology, "--topology only with --type sixbar")
     targets, theta = read_path_targets(args.target, args.points)
     if len(targets) > MAX_TARGETS:
         raise InputError(args.target, f"{len(targets)} targets", f"at most {MAX_TARGETS} targets (a path is "
                          "matched at each; thin the file or use --points for an SVG)")
-    if theta is not None and args.deg:
-        theta = np.radians(theta)
+    normalisation(targets, str(args.target))
+    if theta is not None:
+        if args.deg:
+            theta = np.radians(theta)
+        check_theta(theta, str(args.target), args.deg)
     cons = Constraints(full_turn=True, max_ratio=args.max_ratio, region=_region(args.pivots))
     if args.type == "sixbar":
         return _sixbar(args, targets, theta, cons)
-    d = synthesise_path(targets, theta, cons, budget=args.budget, seed=args.seed)
-    failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]
+    d = synthesise_path(targets, theta, cons, budget=args.budget, seed=args.seed, tolerance=args.tolerance)
+    why = _unusable(d, "four-bar", cons.region is not None)
+    if why is not None:
+        return _no_design(args, len(targets), why)
+    failing = _path_failing(d)
     fb = d.fourbar()
     amp, centre = _rocking(fb, d.theta)
     text = fourbar_scene_text(
@@ -103,16 +154,38 @@ def _cmd_path(args: argparse.Namespace) -> int:
                   "crank angle at each target (rad): " + ", ".join(f"{t:.6g}" for t in d.theta)],
         amplitude=amp, centre=centre)
     report = {"command": "synth path", "targets": len(targets), **d.to_dict()}
-    return _finish(args, f"four-bar ({fb.grashof}, {d.circuit}), sse {d.sse:.3g} over {len(targets)} targets "
-                   f"in {d.seconds:.2f} s", text, report, d.ok, failing)
+    return _finish_path(args, f"four-bar ({fb.grashof}, {d.circuit}), sse {d.sse:.3g} (RMS distance "
+                        f"{d.checks['rms_error']:.3g} of the targets' size) over {len(targets)} targets "
+                        f"in {d.seconds:.2f} s", text, report, d.ok, failing)
+
+
+def _finish_path(args: argparse.Namespace, what: str, text: str, report: dict[str, Any], ok: bool,
+                 failing: list[str]) -> int:
+    """:func:`_finish`, except that a scene planar cannot build is no design (nothing written, exit 3)."""
+    from .errors import PlanarError
+    from .scene import build_scene, parse_scene
+
+    try:
+        import tomllib
+
+        build_scene(parse_scene(tomllib.loads(text), str(args.output)), str(args.output))
+    except PlanarError as e:
+        msg = str(e).replace(f"{args.output}: ", "", 1)
+        return _no_design(args, report["targets"], f"the design found does not assemble as a scene ({msg})")
+    return _finish(args, what, text, report, ok, failing)
 
 
 def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | None, cons: Any) -> int:
     from .synthesis.scene_out import linkage_scene_text
     from .synthesis.sixbar import synthesise_sixbar
 
-    d = synthesise_sixbar(targets, theta, args.topology, cons, budget=args.budget, seed=args.seed)
-    failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]
+    topology = args.topology or "stephenson"
+    d = synthesise_sixbar(targets, theta, topology, cons, budget=args.budget, seed=args.seed,
+                          tolerance=args.tolerance)
+    why = _unusable(d, f"{topology} six-bar", cons.region is not None)
+    if why is not None:
+        return _no_design(args, len(targets), why)
+    failing = _path_failing(d)
     text = linkage_scene_text(
         f"synth-sixbar-{d.topology}", d.nodes(), d.links(), {"tracer": "T"},
         comments=[f"planar synth path {args.target} --type sixbar --topology {d.topology}: {len(targets)} targets, "
@@ -120,8 +193,9 @@ def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | N
                   "crank angle at each target (rad, from the ground line O2-O4): "
                   + ", ".join(f"{t:.6g}" for t in d.theta)])
     report = {"command": "synth path", "targets": len(targets), **d.to_dict()}
-    return _finish(args, f"{d.topology} six-bar, sse {d.sse:.3g} over {len(targets)} targets in {d.seconds:.2f} s",
-                   text, report, d.ok, failing)
+    return _finish_path(args, f"{d.topology} six-bar, sse {d.sse:.3g} (RMS distance {d.checks['rms_error']:.3g} of "
+                        f"the targets' size) over {len(targets)} targets in {d.seconds:.2f} s",
+                        text, report, d.ok, failing)
 
 
 def _plus(v: float) -> str:
@@ -275,16 +349,23 @@ def add_parser(sub: Any) -> None:
     p.add_argument("target", help="CSV with columns x,y and optional theta (crank angle), or an .svg file")
     p.add_argument("-o", "--output", required=True, help="scene file (TOML) to write")
     p.add_argument("--type", choices=("fourbar", "sixbar"), default="fourbar", help="linkage type (fourbar)")
-    p.add_argument("--topology", choices=("stephenson", "watt"), default="stephenson",
-                   help="six-bar: a dyad hung from the coupler (stephenson) or from the rocker (watt)")
-    p.add_argument("--json", action="store_true", help="print the design, sse and time_s as JSON")
+    p.add_argument("--topology", choices=("stephenson", "watt"), default=None,
+                   help="six-bar only: a dyad hung from the coupler (stephenson, the default) or from the rocker "
+                        "(watt)")
+    p.add_argument("--json", action="store_true",
+                   help="print the design, sse, checks.rms_error and time_s as JSON (or ok false and the reason)")
     p.add_argument("--budget", choices=("quick", "normal", "thorough"), default="normal",
                    help="search effort (normal: about 1-4 s)")
-    p.add_argument("--max-ratio", type=float, default=10.0, help="longest / shortest link at most this (10)")
+    p.add_argument("--max-ratio", type=float, default=10.0,
+                   help="longest / shortest link at most this (10; six-bar: every side of every link, the "
+                        "ground's three included)")
     p.add_argument("--pivots", default=None,
                    help="ground pivots inside XMIN,YMIN,XMAX,YMAX (write --pivots=-1,... when XMIN is negative)")
-    p.add_argument("--points", type=int, default=12, help="points sampled along an SVG target (12)")
+    p.add_argument("--points", type=int, default=None, help="points sampled along an SVG target (12; SVG only)")
     p.add_argument("--deg", action="store_true", help="the theta column is in degrees")
+    p.add_argument("--tolerance", type=float, default=0.01,
+                   help="largest RMS distance to the targets accepted, as a fraction of the targets' size (their "
+                        "RMS distance from their centroid); beyond it the design is written and exits 3 (0.01)")
     p.add_argument("--seed", type=int, default=0, help="random seed of the search (same seed, same result)")
     p.set_defaults(func=_cmd_path)
 

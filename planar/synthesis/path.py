@@ -7,11 +7,17 @@ solver, not the search kernel: the coupler point at the crank angles found
 the whole turn solved as a path (360 samples, branch continuity): every
 sample valid, and equal (to 1e-9 of the targets' extent) to the same angles
 solved as a shuffled batch, which keeps the declared circuit at every sample
-as the solve at the targets does: the circuit never switches.
+as the solve at the targets does: the circuit never switches.  Also checked:
+the constraints (:func:`planar.synthesis.search.constraint_failures`, each
+broken one named) and the accuracy, ``rms_error`` = RMS distance to the
+targets / their size (RMS distance from their centroid) at most
+``tolerance``.  The search runs on the targets moved to their centroid and
+divided by their size (the pivots box with them); the result is mapped back.
 """
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -21,11 +27,24 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from .designs import Checked, PlacedFourBar
-from .search import Constraints, search_fourbar
+from .search import Constraints, constraint_failures, search_fourbar
+from .targets import normalisation
 
 __all__ = ["FourBarDesign", "synthesise_path"]
 
 Array = NDArray[np.float64]
+
+#: default largest RMS distance to the targets, as a fraction of their size (RMS distance from the centroid)
+DEFAULT_TOLERANCE = 0.01
+
+
+def normalised(cons: Constraints, c: Array, s: float) -> Constraints:
+    """``cons`` for targets moved by ``-c`` and divided by ``s`` (the pivots box moves with them)."""
+    if cons.region is None:
+        return cons
+    x0, y0, x1, y1 = cons.region
+    return Constraints(cons.full_turn, cons.max_ratio,
+                       ((x0 - c[0]) / s, (y0 - c[1]) / s, (x1 - c[0]) / s, (y1 - c[1]) / s))
 
 
 
@@ -94,12 +113,14 @@ def synthesise_path(
     cons: Constraints | None = None,
     budget: str = "normal",
     seed: int = 0,
+    tolerance: float = DEFAULT_TOLERANCE,
 ) -> FourBarDesign:
     """A four-bar whose coupler point passes through (or nearest to) ``targets`` ``(N, 2)``.
 
     ``theta`` ``(N,)``: prescribed crank angles (radians from the ground
     line); ``None`` leaves them free.  ``budget``: ``"quick"`` (for tests),
-    ``"normal"`` or ``"thorough"``.  Raises :class:`InputError` for fewer
+    ``"normal"`` or ``"thorough"``.  ``tolerance``: the largest accepted RMS distance to the targets as
+    a fraction of their size (RMS distance from their centroid; check ``ok_accuracy``).  Raises :class:`InputError` for fewer
     than 3 targets or mismatched lengths.
     """
     cons = cons if cons is not None else Constraints()
@@ -116,9 +137,13 @@ def synthesise_path(
     if budget not in kw:
         raise InputError("budget", budget, f"one of {', '.join(kw)}")
     t0 = time.perf_counter()
-    r = search_fourbar(t, theta, cons, seed=seed, **kw[budget])  # type: ignore[arg-type]
+    # searched on the targets moved to their centroid and divided by their size, then mapped back
+    c, s = normalisation(t)
+    r = search_fourbar((t - c) / s, theta, normalised(cons, c, s), seed=seed, **kw[budget])  # type: ignore[arg-type]
     secs = time.perf_counter() - t0
-    p = r.params
+    p = r.params.copy()
+    p[:6] *= s
+    p[6:8] = p[6:8] * s + c
     d = FourBarDesign(float(p[0]), float(p[1]), float(p[2]), float(p[3]), (float(p[4]), float(p[5])),
                       "open" if r.circuit > 0 else "crossed", (float(p[6]), float(p[7]), float(p[8])),
                       np.asarray(r.theta, float), float("nan"), t, theta is not None, secs)
@@ -126,7 +151,12 @@ def synthesise_path(
 
     x, y, _ = coupler_points(p[None, :], d.theta[None, :], np.array([float(r.circuit)]))
     check_design(d, np.column_stack([x[0], y[0]]))
-    d.checks["ok_constraints"] = r.feasible
+    d.checks["constraint_failures"] = constraint_failures(p, cons)
+    d.checks["ok_constraints"] = not d.checks["constraint_failures"]
+    d.checks["size"] = s
+    d.checks["rms_error"] = (math.sqrt(d.sse / len(t)) / s) if math.isfinite(d.sse) else float("inf")
+    d.checks["ok_accuracy"] = bool(d.checks["rms_error"] <= tolerance)
+    d.checks["tolerance"] = tolerance
     d.checks["stages_s"] = r.stages
     d.checks["evaluations"] = r.evaluations
     return d

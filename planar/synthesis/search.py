@@ -33,9 +33,13 @@ from numpy.typing import NDArray
 
 from .kernel import N_PARAMS, coupler_points
 
-__all__ = ["Constraints", "PathObjective", "search_fourbar", "SearchResult", "violation"]
+__all__ = ["Constraints", "PathObjective", "search_fourbar", "SearchResult", "violation", "constraint_failures",
+           "region_failures", "REL_TOL"]
 
 Array = NDArray[np.float64]
+
+#: relative tolerance of the final constraint check (rounding-level overshoots pass)
+REL_TOL = 1e-9
 
 #: relative margin kept from a change-point (s + l = p + q) and from equal shortest links
 GRASHOF_MARGIN = 1e-3
@@ -66,7 +70,7 @@ def violation(X: Array, cons: Constraints, scale: float, margin: float = GRASHOF
         pq = total - lo - hi
         v += np.maximum(0.0, lo + hi - pq + margin * total)
         v += np.maximum(0.0, np.minimum(r1, r2) - np.minimum(X[:, 2], X[:, 3]) + margin * total)
-    v += np.maximum(0.0, hi - cons.max_ratio * lo)
+    v += np.maximum(0.0, hi - cons.max_ratio * (1.0 - margin) * lo)
     if cons.region is not None:
         x0, y0, x1, y1 = cons.region
         ox, oy = X[:, 6], X[:, 7]
@@ -74,6 +78,53 @@ def violation(X: Array, cons: Constraints, scale: float, margin: float = GRASHOF
         for px, py in ((ox, oy), (o4x, o4y)):
             v += np.maximum(0.0, x0 - px) + np.maximum(0.0, px - x1) + np.maximum(0.0, y0 - py) + np.maximum(0.0, py - y1)
     return v / scale
+
+
+def region_failures(pivots: dict[str, tuple[float, float]], cons: Constraints) -> list[str]:
+    """One line per ground pivot outside ``cons.region`` (to :data:`REL_TOL` of the box's size), naming it."""
+    if cons.region is None:
+        return []
+    x0, y0, x1, y1 = cons.region
+    tol = REL_TOL * max(x1 - x0, y1 - y0, abs(x0), abs(x1), abs(y0), abs(y1))
+    out = []
+    for name, (px, py) in pivots.items():
+        if not (x0 - tol <= px <= x1 + tol and y0 - tol <= py <= y1 + tol):
+            out.append(f"pivot {name} at ({px:.6g}, {py:.6g}) is outside the --pivots box "
+                       f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}")
+    return out
+
+
+def ratio_failures(links: dict[str, float], max_ratio: float) -> list[str]:
+    """The link ratio (longest / shortest of ``links``, names to lengths) over ``max_ratio`` (relative
+    tolerance :data:`REL_TOL`), as one line naming both links, or nothing."""
+    if not np.isfinite(max_ratio):
+        return []
+    lo = min(links, key=lambda k: links[k])
+    hi = max(links, key=lambda k: links[k])
+    if links[hi] <= max_ratio * links[lo] * (1.0 + REL_TOL):
+        return []
+    return [f"link ratio {links[hi] / links[lo]:.10g} (longest {hi} {links[hi]:.6g} / shortest {lo} "
+            f"{links[lo]:.6g}) is over --max-ratio {max_ratio:g}"]
+
+
+def constraint_failures(p: Array, cons: Constraints) -> list[str]:
+    """The constraints a four-bar (kernel row ``p``, world units) breaks, each named with its value and
+    limit (relative tolerance :data:`REL_TOL`); empty when it keeps them all."""
+    r1, r2, r3, r4 = (float(v) for v in p[:4])
+    out: list[str] = []
+    if cons.full_turn:
+        L = sorted((r1, r2, r3, r4))
+        tol = REL_TOL * sum(L)
+        if L[0] + L[3] > L[1] + L[2] + tol:
+            out.append(f"the crank turns fully: shortest + longest link {L[0] + L[3]:.10g} > the other two "
+                       f"{L[1] + L[2]:.10g} (not Grashof)")
+        elif min(r1, r2) > min(r3, r4) + tol:
+            out.append(f"the crank turns fully: neither crank {r2:.6g} nor ground {r1:.6g} is the shortest link "
+                       f"(coupler {r3:.6g}, rocker {r4:.6g})")
+    out += ratio_failures({"ground": r1, "crank": r2, "coupler": r3, "rocker": r4}, cons.max_ratio)
+    x0, y0, phi = (float(v) for v in p[6:9])
+    out += region_failures({"O2": (x0, y0), "O4": (x0 + r1 * np.cos(phi), y0 + r1 * np.sin(phi))}, cons)
+    return out
 
 
 @dataclass
@@ -279,5 +330,5 @@ def search_fourbar(
     stages["refine_s"] = time.perf_counter() - t2
     assert best is not None
     e, r, tt = best
-    feasible = bool(violation(r[None, :N_PARAMS], cons, obj.scale, margin=0.0)[0] <= 0)
+    feasible = not constraint_failures(r[:N_PARAMS], cons)
     return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), feasible, evals, stages)

@@ -23,6 +23,7 @@ changes branch), link ratio, pivot region.  Search and refinement as
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -33,7 +34,9 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from .designs import Checked
 from .kernel import coupler_points
+from .path import DEFAULT_TOLERANCE, normalised
 from .search import GRASHOF_MARGIN, Constraints, violation
+from .targets import normalisation
 
 __all__ = ["SixBarDesign", "synthesise_sixbar", "sixbar_points", "TOPOLOGIES"]
 
@@ -82,16 +85,44 @@ def sixbar_points(X: Array, theta: Array, topology: str) -> tuple[Array, Array, 
     return ex + tu * kx - tv * ky, ey + tu * ky + tv * kx, margin
 
 
-def _violation6(X: Array, cons: Constraints, scale: float, margin: float) -> Array:
+def link_lengths(X: Array, topology: str) -> dict[str, Array]:
+    """Every distance between two joints of one link ``(P,)`` each, named: the binary links, the three
+    sides of the ground (``O2``, ``O4``, ``O6``) and of the other ternary link (coupler ``B C E`` or rocker
+    ``O4 C E``)."""
+    r1, r2, r3, r4, eu, ev, x0, y0, phi = (X[:, k] for k in range(9))
+    o4x, o4y = x0 + r1 * np.cos(phi), y0 + r1 * np.sin(phi)
+    out = {"ground O2-O4": r1, "crank": r2, "coupler B-C": r3, "rocker O4-C": r4,
+           "ground O2-O6": np.hypot(X[:, 9] - x0, X[:, 10] - y0), "ground O4-O6": np.hypot(X[:, 9] - o4x, X[:, 10] - o4y),
+           "link5 E-F": X[:, 11], "link6 F-O6": X[:, 12]}
+    if topology == "stephenson":
+        out["coupler B-E"] = np.hypot(eu, ev)
+        out["coupler C-E"] = np.hypot(eu - r3, ev)
+    else:
+        out["rocker O4-E"] = np.hypot(eu, ev)
+        out["rocker C-E"] = np.hypot(eu - r4, ev)
+    return out
+
+
+def _violation6(X: Array, cons: Constraints, scale: float, margin: float, topology: str) -> Array:
     v = violation(X[:, :9], Constraints(cons.full_turn, np.inf, cons.region), scale, margin)
-    L = np.column_stack([X[:, :4], X[:, 11:13]])
-    v += np.maximum(0.0, L.max(1) - cons.max_ratio * L.min(1)) / scale
+    L = np.column_stack(list(link_lengths(X, topology).values()))
+    v += np.maximum(0.0, L.max(1) - cons.max_ratio * (1.0 - margin) * L.min(1)) / scale
     if cons.region is not None:
         x0, y0, x1, y1 = cons.region
         px, py = X[:, 9], X[:, 10]
         v += (np.maximum(0.0, x0 - px) + np.maximum(0.0, px - x1) + np.maximum(0.0, y0 - py)
               + np.maximum(0.0, py - y1)) / scale
     return v
+
+
+def sixbar_constraint_failures(row: Array, cons: Constraints, topology: str) -> list[str]:
+    """The constraints a six-bar (``row``, world units) breaks, each named with its value and limit."""
+    from .search import constraint_failures, ratio_failures, region_failures
+
+    out = [f for f in constraint_failures(row[:9], Constraints(cons.full_turn, np.inf, cons.region))]
+    out += ratio_failures({k: float(v[0]) for k, v in link_lengths(row[None, :], topology).items()}, cons.max_ratio)
+    out += region_failures({"O6": (float(row[9]), float(row[10]))}, cons)
+    return out
 
 
 @dataclass
@@ -125,7 +156,7 @@ class _Objective:
         else:
             err = ((x[:, S:] - tx) ** 2 + (y[:, S:] - ty) ** 2).sum(1)
         closes = np.maximum(0.0, DYAD_MARGIN - m[:, :S]).max(1)
-        v = _violation6(X, self.cons, self.scale, GRASHOF_MARGIN) + closes
+        v = _violation6(X, self.cons, self.scale, GRASHOF_MARGIN, self.topology) + closes
         return err + np.where(v > 0, self.penalty * (1.0 + v), 0.0)
 
 
@@ -207,7 +238,7 @@ def _refine(obj: _Objective, row: Array, lo: Array, hi: Array, max_nfev: int) ->
         allth = np.concatenate([np.broadcast_to(turn64, (len(Z), S)), th], axis=1)
         x, y, m = sixbar_points(X, np.ascontiguousarray(allth), obj.topology)
         r = np.concatenate([x[:, S:] - obj.targets[:, 0], y[:, S:] - obj.targets[:, 1]], axis=1)
-        v = _violation6(X, obj.cons, obj.scale, 2 * GRASHOF_MARGIN)
+        v = _violation6(X, obj.cons, obj.scale, 2 * GRASHOF_MARGIN, obj.topology)
         v = v + np.maximum(0.0, 2 * DYAD_MARGIN - m[:, :S]).max(1)
         return np.concatenate([r, (w * v)[:, None]], axis=1)
 
@@ -261,9 +292,10 @@ def _fourbar_seed(t: Array, th: Array | None, cons: Constraints, seed: int) -> A
 
 def synthesise_sixbar(targets: Array, theta: Array | None = None, topology: str = "stephenson",
                       cons: Constraints | None = None, budget: str | tuple[int, int, int, int] = "normal",
-                      seed: int = 0) -> SixBarDesign:
+                      seed: int = 0, tolerance: float = DEFAULT_TOLERANCE) -> SixBarDesign:
     """A six-bar (``topology`` ``"stephenson"`` or ``"watt"``) whose tracer passes through ``targets``.
 
+    ``tolerance``: as :func:`planar.synthesis.path.synthesise_path`'s.
     ``budget``: ``"quick"``, ``"normal"``, ``"thorough"`` or ``(random samples, DE generations, DE
     population per variable, refinement starts)``.
     """
@@ -288,6 +320,10 @@ def synthesise_sixbar(targets: Array, theta: Array | None = None, topology: str 
         raise InputError("budget", budget, f"one of {', '.join(kw)}")
     t0 = time.perf_counter()
     th = None if theta is None else np.asarray(theta, float)
+    # searched on the targets moved to their centroid and divided by their size, then mapped back
+    tw, cons_w = t, cons
+    c0, s0 = normalisation(tw)
+    t, cons = (tw - c0) / s0, normalised(cons_w, c0, s0)
     obj = _Objective(t, th, cons, topology)
     fb = default_bounds(t, cons, th is not None)            # 9 four-bar bounds + circuit
     L = obj.scale
@@ -326,8 +362,13 @@ def synthesise_sixbar(targets: Array, theta: Array | None = None, topology: str 
         if best is None or e < best[0]:
             best = (e, r, tt)
     assert best is not None
-    d = SixBarDesign(topology, best[1], best[2], t, th is not None, float("nan"), time.perf_counter() - t0)
-    check_sixbar(d, cons, obj.scale)
+    p = best[1].copy()
+    p[:6] *= s0
+    p[6:8] = p[6:8] * s0 + c0
+    p[9:11] = p[9:11] * s0 + c0
+    p[11:15] *= s0
+    d = SixBarDesign(topology, p, best[2], tw, th is not None, float("nan"), time.perf_counter() - t0)
+    check_sixbar(d, cons_w, float(max(np.hypot(*np.ptp(tw, axis=0)), 1e-300)), tolerance)
     return d
 
 
@@ -337,15 +378,32 @@ def _closes(row: Array, topology: str, n: int = 720) -> bool:
     return bool((m > 0).all())
 
 
-def check_sixbar(d: SixBarDesign, cons: Constraints, scale: float) -> None:
-    """sse and checks from planar's solver: the whole turn valid and on the search's branches."""
+def invalid_ranges(bad: NDArray[np.bool_], turn: Array) -> list[tuple[float, float]]:
+    """Driver ranges ``(first, last)`` (radians) of the runs of ``bad`` samples over the turn ``turn``."""
+    out: list[tuple[float, float]] = []
+    idx = np.flatnonzero(bad)
+    if len(idx) == 0:
+        return out
+    breaks = np.flatnonzero(np.diff(idx) > 1)
+    starts = np.concatenate([idx[:1], idx[breaks + 1]])
+    ends = np.concatenate([idx[breaks], idx[-1:]])
+    return [(float(turn[a]), float(turn[b])) for a, b in zip(starts, ends)]
+
+
+def check_sixbar(d: SixBarDesign, cons: Constraints, scale: float, tolerance: float = DEFAULT_TOLERANCE) -> None:
+    """sse and checks from planar's solver: the whole turn valid and on the search's branches.
+
+    Where the linkage cannot be assembled is found on 36,000 driver angles (the kernel, as the search's
+    dyad margin) and 360 (planar's solver); ``failures`` names the driver ranges.
+    """
     from ..errors import PlanarError
 
+    cf = sixbar_constraint_failures(d.params, cons, d.topology)
     try:
         lk = d.linkage()
     except PlanarError as e:
         d.sse = float("inf")
-        d.checks = {"ok_builds": False, "error": str(e)}
+        d.checks = {"ok_builds": False, "error": str(e), "ok_constraints": not cf, "constraint_failures": cf}
         return
     th = np.mod(d.theta, 2 * np.pi)
     order = np.argsort(th, kind="stable")
@@ -358,11 +416,24 @@ def check_sixbar(d: SixBarDesign, cons: Constraints, scale: float) -> None:
     x, y, _ = sixbar_points(d.params[None], d.theta, d.topology)
     kern = np.column_stack([x[0], y[0]])
     d.sse = float(np.sum((pts - d.targets) ** 2)) if at.valid.all() else float("inf")
-    v = _violation6(d.params[None], cons, scale, 0.0)[0]
+    dense = np.linspace(0.0, 2 * np.pi, 36_000, endpoint=False)
+    _, _, m = sixbar_points(d.params[None], dense, d.topology)
+    ranges = invalid_ranges(m[0] <= 0, dense) or invalid_ranges(~full.valid, turn)
+    failures = [f"the linkage cannot be assembled for driver angles {a:.4g}..{b:.4g} rad (from the ground line "
+                "O2-O4)" for a, b in ranges]
+    _, size = normalisation(d.targets)
+    rms = math.sqrt(d.sse / len(d.targets)) / size if math.isfinite(d.sse) else float("inf")
     d.checks = {
         "ok_builds": True,
-        "ok_valid_over_turn": bool(full.valid.all() and path.valid.all()),
+        "ok_valid_over_turn": bool(full.valid.all() and path.valid.all()) and not ranges,
+        "invalid_driver_ranges": ranges,
         "ok_same_branches_as_search": bool(at.valid.all()) and float(np.max(np.abs(pts - kern))) <= 1e-9 * scale,
-        "ok_constraints": bool(v <= 0),
+        "ok_constraints": not cf,
+        "constraint_failures": cf,
+        "failures": failures,
+        "size": size,
+        "rms_error": rms,
+        "tolerance": tolerance,
+        "ok_accuracy": bool(rms <= tolerance),
         "max_target_distance": float(np.max(np.hypot(*(pts - d.targets).T))) if at.valid.all() else float("inf"),
     }
