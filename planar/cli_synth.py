@@ -74,15 +74,6 @@ def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, An
     return 0 if ok else EXIT_CHECK
 
 
-def _no_design(args: argparse.Namespace, n: int, reason: str) -> int:
-    """Nothing valid to write (as ``synth function``): exit 3, the reason, nothing written."""
-    if args.json:
-        print(json.dumps({"command": "synth path", "targets": n, "ok": False, "reason": reason}, indent=2))
-    else:
-        print(f"check failed: {reason}; nothing written")
-    return EXIT_CHECK
-
-
 def _path_failing(d: Any) -> list[str]:
     """One line per failed check of a path design, naming what failed and by how much."""
     out: list[str] = []
@@ -143,7 +134,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
     d = synthesise_path(targets, theta, cons, budget=args.budget, seed=args.seed, tolerance=args.tolerance)
     why = _unusable(d, "four-bar", cons.region is not None)
     if why is not None:
-        return _no_design(args, len(targets), why)
+        return _no_design(args, "synth path", {"targets": len(targets)}, why)
     failing = _path_failing(d)
     fb = d.fourbar()
     amp, centre = _rocking(fb, d.theta)
@@ -171,7 +162,8 @@ def _finish_path(args: argparse.Namespace, what: str, text: str, report: dict[st
         build_scene(parse_scene(tomllib.loads(text), str(args.output)), str(args.output))
     except PlanarError as e:
         msg = str(e).replace(f"{args.output}: ", "", 1)
-        return _no_design(args, report["targets"], f"the design found does not assemble as a scene ({msg})")
+        return _no_design(args, "synth path", {"targets": report["targets"]},
+                              f"the design found does not assemble as a scene ({msg})")
     return _finish(args, what, text, report, ok, failing)
 
 
@@ -184,7 +176,7 @@ def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | N
                           tolerance=args.tolerance)
     why = _unusable(d, f"{topology} six-bar", cons.region is not None)
     if why is not None:
-        return _no_design(args, len(targets), why)
+        return _no_design(args, "synth path", {"targets": len(targets)}, why)
     failing = _path_failing(d)
     text = linkage_scene_text(
         f"synth-sixbar-{d.topology}", d.nodes(), d.links(), {"tracer": "T"},

@@ -226,7 +226,9 @@ def circle_circle(
     ok_d = d2 > CONCENTRIC * sum_ * sum_
     valid = (prod >= -rtol * scale * scale) & ok_d
     safe_d2 = np.where(ok_d, d2, 1.0)
-    a = 0.5 * (d2 + q1 * q1 - q2 * q2) / safe_d2  # fraction of d along c1->c2
+    # fraction of d along c1->c2; r1^2 - r2^2 as (r1 - r2)(r1 + r2): nearly equal radii round to their exact
+    # difference (as squares they cancel, and with nearly concentric centres the point was garbage; hypothesis)
+    a = 0.5 * (d2 + dif * sum_) / safe_d2
     h = 0.5 * np.sqrt(np.maximum(prod, 0.0)) / safe_d2  # half-chord / d
     hb = h * np.asarray(branch, float)
     x = c1[..., 0] + a * dx - hb * dy

@@ -134,3 +134,17 @@ def test_wrap_angle_range():
     w = g.wrap_angle(a)
     assert np.all(w > -np.pi) and np.all(w <= np.pi)
     np.testing.assert_allclose(np.cos(w), np.cos(a), atol=1e-12)
+
+
+def test_nearly_concentric_circles_with_nearly_equal_radii_meet_where_both_circles_are() -> None:
+    """Centres 5e-17 apart, radii one unit in the last place apart: the circles do meet (a 0.12-high chord
+    0.11 off the centres); as squares the radii cancelled and the point was 0.02 off both circles."""
+    from planar.geometry import circle_circle
+
+    c1 = np.array([0.2, 0.0])
+    c2 = np.array([0.2 * np.cos(2 * np.pi), 0.2 * np.sin(2 * np.pi)])  # 4.9e-17 from c1
+    r1, r2 = 0.2, 0.20000000000000004
+    for branch in (1.0, -1.0):
+        p, ok = circle_circle(c1, r1, c2, r2, branch)
+        assert bool(ok)
+        assert abs(np.hypot(*(p - c1)) - r1) < 1e-12 and abs(np.hypot(*(p - c2)) - r2) < 1e-12

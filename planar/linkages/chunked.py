@@ -197,7 +197,7 @@ def _rrr(node, pos, q, w, ox, oy) -> Placed:
     t *= d2
     t *= 0.5 * node.branch  # branch * h / d
     prod *= d2  # sep^2 = 4 h^2 = prod / d^2
-    d2 *= 0.5 * (ra * ra - rb * rb)
+    d2 *= 0.5 * (f * s)  # (ra^2 - rb^2) without cancellation (see geometry.circle_circle)
     d2 += 0.5  # fraction along a -> b
     if k != 1.0:
         dx /= k  # back to model units (exact)

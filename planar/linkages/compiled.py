@@ -162,7 +162,7 @@ def _k_rrr(par, L, xa, ya, xb, yb, xo, yo, ok, sep):
     f = ra - rb
     s2, f2 = s * s, f * f
     hb = 0.5 * branch
-    hr = 0.5 * (ra * ra - rb * rb)
+    hr = 0.5 * (f * s)  # (ra^2 - rb^2) without cancellation, as the numpy path
     fails = 0
     for i in range(L):
         dx = xb[i] - xa[i]
