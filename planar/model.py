@@ -615,13 +615,19 @@ class Mechanism:
                              f"one time per driver value (shape {qa.shape[:1]})")
         poses, checks, pts = self._solve_points(qa)
         n = qa.shape[0]
+        for p in self.parts:  # the ground never moves: its track is one row seen n times (read-only, no memory)
+            g = poses.get(p.name)
+            if p.ground and g is not None and n and g.ndim == 2 and g.strides[0] != 0:
+                poses[p.name] = np.broadcast_to(g[0].copy(), g.shape)
         table: list[tuple[str, str]] = []
         if pts is None:
             pts = {name: poses_apply(poses[part], xy) for name, (part, xy) in self.points.items()}
         # the final finite check: a sample whose numbers overflowed float64 is never valid (and holds 0, not NaN)
         finite = np.ones(n, dtype=bool)
         for arr in () if isinstance(poses, FinitePoses) else (*poses.values(), *pts.values()):
-            if not np.isfinite(arr.sum()):  # a cheap screen (a sum of finite numbers may overflow: then look closer)
+            if arr.ndim == 2 and arr.strides[0] == 0:  # one row seen n times (the ground)
+                finite &= bool(np.isfinite(arr[:1]).all())
+            elif not np.isfinite(arr.sum()):  # a cheap screen (a sum of finite numbers may overflow: look closer)
                 finite &= np.isfinite(arr).reshape(n, -1).all(axis=1)
         if not finite.all():
             checks = list(checks or []) + [(finite, "result", "a number overflowed float64 (non-finite result)")]

@@ -95,3 +95,20 @@ def test_compiled_path_marks_overflowing_samples_invalid_as_the_numpy_path(monke
         cx = np.cos(a) * 1.3e308 + np.sin(a) * 1.3e308 + slow.poses["coupler"][:, 0]
         cy = np.sin(a) * 1.3e308 - np.cos(a) * 1.3e308 + slow.poses["coupler"][:, 1]
     np.testing.assert_array_equal(~fast.valid, ~(np.isfinite(cx) & np.isfinite(cy)))
+
+
+@pytest.mark.parametrize("n", [50, N])  # the numpy (or reference) path and the compiled one
+def test_the_ground_pose_is_one_read_only_row(n: int) -> None:
+    """The ground never moves: every path returns its track as one row seen n times, read-only, at the
+    linkage's placement."""
+    from planar.linkages import Linkage
+
+    for mech in (get("jansen"), FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0))):
+        m = mech.solve(np.linspace(0.0, 2 * np.pi, n))
+        ground = next(p.name for p in mech.parts if p.ground)
+        g = m.poses[ground]
+        assert g.shape == (n, 3) and g.strides[0] == 0 and not g.flags.writeable
+        expect = np.array(mech.placement, float) if isinstance(mech, Linkage) else np.zeros(3)
+        np.testing.assert_array_equal(g, np.broadcast_to(expect, (n, 3)))
+        with pytest.raises(ValueError, match="read-only"):
+            g[0, 0] = 1.0

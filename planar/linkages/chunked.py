@@ -621,12 +621,9 @@ def _solve_compiled(lk: Linkage, plan: _Plan, prog: Any, q: Array, tols: list[fl
     poses: dict[str, Array] = {}
     block = new_block((prog.links.shape[0], n, 3))
     m = 0
-    ground_row = np.array(plan.placement, dtype=float)
-    grounds: list[Array] = []  # filled by the threads, range by range
     for name, o, _, _ in plan.links:
-        if o < 0:
-            poses[name] = new_block((n, 3))
-            grounds.append(poses[name])
+        if o < 0:  # the ground never moves: one row seen n times (read-only), as Mechanism.solve makes it
+            poses[name] = np.broadcast_to(np.array(plan.placement, dtype=float), (n, 3))
         else:
             poses[name] = block[m]
             m += 1
@@ -652,8 +649,6 @@ def _solve_compiled(lk: Linkage, plan: _Plan, prog: Any, q: Array, tols: list[fl
             a, b = ranges[t]
             found[t] = int(solve_range(q, a, b, chunk, prog.kinds, prog.refs, prog.par, tol, prog.check_row,
                                        prog.links, prog.pts, prog.pl, block, pblock, oks, fails[t], bad_chunks))
-            for g in grounds:
-                g[a:b] = ground_row
 
     workers = min(nthreads, len(ranges))
     if workers > 1:
