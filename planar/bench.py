@@ -119,8 +119,11 @@ def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
     diff_points = max(float(np.max(np.abs(motion.points[p] - traj[:, names.index(nd)])))
                       for p, nd in mech.point_nodes.items())
 
-    _pylinkage_of(mech, step).step_fast(iterations=16)  # numba compile (cached) outside the timing
-    mech.solve(q[:m])
+    # warm-up, outside the timing: pylinkage's numba compile (cached) and one call of the full size each (planar's
+    # first call of a size takes new memory, which its later calls recycle: the "new memory per call" rate below
+    # times that cost on every call)
+    _pylinkage_of(mech, step).step_fast(iterations=n)
+    mech.solve(q)
     planar_rates: list[float] = []
     fresh_rates: list[float] = []
     peer_rates: list[float] = []
@@ -187,7 +190,7 @@ def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
     }
 
 
-def bench_kinematics(n: int = 1_000_000, repeats: int = 5) -> dict[str, Any]:
+def bench_kinematics(n: int = 1_000_000, repeats: int = 7) -> dict[str, Any]:
     """Throughput of the public ``Mechanism.solve`` vs pylinkage's ``step_fast`` (numba) on the same linkages.
 
     For the four-bar (ground 4, crank 1, coupler 4, rocker 3, coupler point

@@ -293,7 +293,8 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("name", choices=sorted(BENCHMARKS))
     b.add_argument("--json", action="store_true", help="print a JSON object (with a 'ratio' key)")
     b.add_argument("-n", type=int, default=None, help="problem size (samples)")
-    b.add_argument("--repeats", type=int, default=None, help="timing repeats (best is kept)")
+    b.add_argument("--repeats", type=int, default=None,
+                   help="timing repeats (kinematics: 7 by default, interleaved with the peer; median and spread reported)")
     b.add_argument("-o", "--output", default="planar-bench-accuracy", help="accuracy: folder for the CSV and chart")
     b.add_argument("--quick", action="store_true",
                    help="accuracy: a small grid on three mechanisms; synthesis: one repeat, small budgets")
