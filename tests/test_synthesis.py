@@ -167,7 +167,9 @@ def test_bench_synthesis_quick_timed_problem():
     assert "pylinkage" in c["pylinkage"]["call"] and c["published_best_error"]
     assert r["kernel_candidates_per_s"]["median"] > 0
     o = c["pylinkage_optimisers"]   # timed: pylinkage's own sse and planar's, at the same crank angles
-    assert o["ok"] and o["sse_min"] == pytest.approx(o["pylinkage_sse_of_best"], rel=1e-9)
+    # (pylinkage's swarm is unseeded: whether its best also passes planar's design checks, e.g. the link-ratio
+    # bound, varies from run to run; the two scorings of the same linkage must agree every time)
+    assert np.isfinite(o["sse_min"]) and o["sse_min"] == pytest.approx(o["pylinkage_sse_of_best"], rel=1e-9)
     assert c["pylinkage_four_targets"]["solutions"] > 0
 
 
