@@ -206,7 +206,8 @@ def bench_kinematics(n: int = 1_000_000, repeats: int = 7) -> dict[str, Any]:
     :data:`AGREEMENT` and every sample is valid.  The top-level ``ratio`` is
     the smaller of the two linkages' ratios.  Per case, ``kernels`` names the
     kernels ``solve`` took for ``n`` samples (``"compiled"``: numba,
-    ``"numpy"``) and ``first_call_s`` the first solve's time in the process
+    ``"numpy"``) and ``first_call_s`` the first solve's time in the process (the agreement check's, up to
+    20,000 samples, not a full-size call)
     (importing numba and loading, or compiling, the kernels), which the timed
     repeats do not include; ``planar_cpu_s``/``peer_cpu_s`` the processor time
     of each call (all of planar's threads together) and ``cpu_ratio`` the
@@ -243,7 +244,8 @@ def format_kinematics(r: dict[str, Any]) -> str:
             f"  {c['linkage']} ({c['nodes']} nodes, {c['parts']} parts)",
             (f"    planar solve ({c['threads']} threads) {p['median'] / 1e6:8.2f} M samples/s "
              f"({p['min'] / 1e6:.2f}-{p['max'] / 1e6:.2f}), {c['kernels']} kernels "
-             f"(first call {c['first_call_s']:.2f} s)"),
+             f"(the process's first solve, up to 20,000 samples, numba import and kernel load included: "
+             f"{c['first_call_s']:.2f} s)"),
             (f"    pylinkage step_fast        {q['median'] / 1e6:8.2f} M samples/s "
              f"({q['min'] / 1e6:.2f}-{q['max'] / 1e6:.2f})"),
             f"    ratio                      {c['ratio']:8.2f}  (per repeat {k['min']:.2f}-{k['max']:.2f})",

@@ -13,9 +13,12 @@ keeps a reference to the block.  Every view numpy makes of the array (the
 result's per-part rows, a user's slice of them) references the block itself
 (numpy collapses the chain of bases), so the block's reference count is the
 pool's own references exactly when no view of it is alive anywhere: only then
-is it handed out again.  The pool keeps at most :data:`MAX_BYTES` of released
-blocks; :func:`release` drops them all.  Set ``PLANAR_RECYCLE=0`` to turn
-recycling off (every block is new).
+is it handed out again (a released block up to twice the size of a request
+serves it).  When a solve needs a new block, released blocks are dropped,
+oldest first, so that they and the new block stay within :data:`MAX_BYTES`
+(a block released after that counts at the next solve); :func:`release` drops
+them all.  Set ``PLANAR_RECYCLE=0`` to turn recycling off (every block is
+new).
 
 The reference count test needs CPython's reference counting; where it does
 not behave as measured at import (another interpreter, a free-threaded
@@ -64,7 +67,14 @@ _FREE = _measure()
 
 
 def _enabled() -> bool:
-    return _FREE > 0 and os.environ.get("PLANAR_RECYCLE", "1") != "0"
+    text = os.environ.get("PLANAR_RECYCLE", "").strip().lower()
+    if text in ("", "1", "true", "yes", "on"):
+        return _FREE > 0
+    if text in ("0", "false", "no", "off"):
+        return False
+    from .errors import InputError
+
+    raise InputError("PLANAR_RECYCLE", os.environ["PLANAR_RECYCLE"], "0 (off) or 1 (on: the default)")
 
 
 def block(shape: tuple[int, ...], dtype: Any = float) -> np.ndarray[Any, Any]:
@@ -74,24 +84,30 @@ def block(shape: tuple[int, ...], dtype: Any = float) -> np.ndarray[Any, Any]:
     if nbytes < MIN_BYTES or not _enabled():
         return np.empty(shape, dt)
     with _LOCK:
+        # the smallest released block that holds the request and wastes at most half of itself
+        best = -1
         for i in range(len(_POOL)):
-            if _POOL[i].nbytes == nbytes and _count(_POOL, i) == _FREE:
-                b = _POOL.pop(i)
-                _POOL.append(b)  # most recently used last
-                return b.view(dt).reshape(shape)  # a view: the pool's block stays referenced while it lives
+            size = _POOL[i].nbytes
+            if nbytes <= size <= 2 * nbytes and _count(_POOL, i) == _FREE \
+                    and (best < 0 or size < _POOL[best].nbytes):
+                best = i
+        if best >= 0:
+            b = _POOL.pop(best)
+            _POOL.append(b)  # most recently used last
+            return b[:nbytes].view(dt).reshape(shape)  # a view: the pool's block stays referenced while it lives
+        _trim(MAX_BYTES - nbytes)  # room for the new block within the cap, released blocks dropped oldest first
         new = np.empty(nbytes, np.uint8)
         _POOL.append(new)
-        _trim()
         return new.view(dt).reshape(shape)
 
 
-def _trim() -> None:
-    """Drop the oldest released blocks beyond :data:`MAX_BYTES` (blocks in use are never counted or dropped)."""
+def _trim(keep: int = MAX_BYTES) -> None:
+    """Drop the oldest released blocks beyond ``keep`` bytes (blocks in use are never counted or dropped)."""
     free = _free_indices()
     total = sum(_POOL[i].nbytes for i in free)
     drop = []
     for i in free:
-        if total <= MAX_BYTES:
+        if total <= keep:
             break
         total -= _POOL[i].nbytes
         drop.append(i)
@@ -111,7 +127,14 @@ def pooled_bytes() -> int:
 
 
 def release() -> None:
-    """Forget every released block (their memory goes back to the system); blocks in use are unaffected."""
+    """Forget every released block, blocks in use unaffected; their memory goes back to the allocator, and on
+    glibc the allocator is asked to return its free memory to the system (``malloc_trim``)."""
     with _LOCK:
         for i in reversed(_free_indices()):
             del _POOL[i]
+    try:
+        import ctypes
+
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):  # not glibc: the allocator keeps what it keeps
+        pass

@@ -604,6 +604,13 @@ class Mechanism:
 
     def solve(self, q: ArrayLike, t: ArrayLike | None = None) -> Motion:
         """Solve all samples at once for driver values ``q`` (scalar or array)."""
+        if isinstance(q, np.ma.MaskedArray) or np.asarray(q).dtype == bool:
+            raise InputError(f"{self.name}.solve(q)", f"a {'masked' if isinstance(q, np.ma.MaskedArray) else 'bool'}"
+                             " array", "plain driver values (a masked array: pass q[~q.mask] or q.filled(v))")
+        from .limits import check_count
+
+        check_count("samples", f"{self.name}.solve(q)", float(np.size(q)), "samples of one motion",
+                    shown=f"{np.size(q):,} driver values")
         qin = np.atleast_1d(check_finite(f"{self.name}.driver value", q))
         qa = new_block(qin.shape)  # the motion's own copy (recycled memory for a large batch)
         np.copyto(qa, qin)

@@ -112,3 +112,43 @@ def test_the_ground_pose_is_one_read_only_row(n: int) -> None:
         np.testing.assert_array_equal(g, np.broadcast_to(expect, (n, 3)))
         with pytest.raises(ValueError, match="read-only"):
             g[0, 0] = 1.0
+
+
+@needs_pool
+def test_released_blocks_stay_within_the_cap_when_a_solve_starts(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Solves of many sizes: the pool never holds more than MAX_BYTES of released blocks when a solve takes a new
+    block (a new user's 300 solves of random sizes reached 695 MiB against 512)."""
+    monkeypatch.setattr(buffers, "MAX_BYTES", 8 << 20)
+    leg = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0))
+    gc.collect()
+    buffers.release()
+    seen = []
+    for n in np.random.default_rng(0).integers(30_000, 100_000, 40):
+        m = leg.solve(np.linspace(0.0, 2 * np.pi, int(n)))
+        seen.append(buffers.pooled_bytes())  # released blocks, while this result is held
+        del m
+    assert max(seen) <= 8 << 20, max(seen)
+    buffers.release()
+
+
+def test_bad_settings_and_inputs_are_one_line_errors(monkeypatch: pytest.MonkeyPatch) -> None:
+    from planar.errors import InputError, LimitError
+
+    leg = FourBar(4.0, 1.0, 4.0, 3.0)
+    q = np.linspace(0.0, 1.0, N)
+    for var, bad in (("PLANAR_THREADS", "abc"), ("PLANAR_THREADS", "0"), ("PLANAR_RECYCLE", "maybe")):
+        monkeypatch.setenv(var, bad)
+        with pytest.raises(InputError, match=var):
+            leg.solve(q)
+        monkeypatch.delenv(var)
+    monkeypatch.setenv("PLANAR_RECYCLE", "off")
+    assert leg.solve(q).valid.all()
+    monkeypatch.delenv("PLANAR_RECYCLE")
+    monkeypatch.setenv("PLANAR_MAX_SAMPLES", "1000")
+    with pytest.raises(LimitError, match="PLANAR_MAX_SAMPLES"):
+        leg.solve(q)
+    monkeypatch.delenv("PLANAR_MAX_SAMPLES")
+    with pytest.raises(InputError, match="masked"):
+        leg.solve(np.ma.masked_greater(q, 0.5))
+    with pytest.raises(InputError, match="bool"):
+        leg.solve(q > 0.5)

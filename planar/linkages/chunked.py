@@ -355,8 +355,18 @@ def _pool() -> ThreadPoolExecutor:
 
 def threads_default() -> int:
     """Threads the fast solve uses: ``PLANAR_THREADS`` if set, else the number of cores."""
-    env = os.environ.get("PLANAR_THREADS")
-    return max(1, int(env)) if env else (os.cpu_count() or 1)
+    env = os.environ.get("PLANAR_THREADS", "").strip()
+    if not env:
+        return os.cpu_count() or 1
+    try:
+        n = int(env)
+    except ValueError:
+        n = 0
+    if n < 1:
+        from ..errors import InputError
+
+        raise InputError("PLANAR_THREADS", env, "a positive whole number of threads (unset: every core)")
+    return n
 
 
 def _path_ok(q: Array, k: NDArray[np.intp]) -> Mask:
