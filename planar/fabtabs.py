@@ -302,6 +302,26 @@ def _place(intervals: list[tuple[float, float]], w: float, g: float) -> list[flo
     return out
 
 
+def _layer_footprint(mat: Any, plane: str, at: float, track_n: np.ndarray, track_r: np.ndarray, band: Any,
+                     t: float) -> Any:
+    """Where a perpendicular piece (its cut outline ``mat``, its ``plane`` at ``at``, mm) passes through the layer
+    ``band`` (world, mm) over its pose ``track_n``: strips of thickness ``t``, in the frame of the xy piece whose
+    track is ``track_r``."""
+    import shapely
+    from shapely.geometry import Polygon, box
+
+    mat = mat.simplify(0.05)
+    strips = []
+    for k in range(len(track_n)):
+        got = _world(mat, tuple(track_n[k])).intersection(band)
+        if got.area <= 1e-6:
+            continue
+        a, _, b, _ = got.bounds
+        strip = box(a, at - t / 2, b, at + t / 2) if plane == "xz" else box(at - t / 2, a, at + t / 2, b)
+        strips.append(_local(strip, tuple(track_r[k])))
+    return shapely.union_all(strips) if strips else Polygon()
+
+
 def _static_pose(track: np.ndarray, what: str, keep: tuple[int, ...]) -> None:
     """Refuse a track whose coordinates ``keep`` (indices into x, y, angle) change over the cycle."""
     spread = np.ptp(track[:, list(keep)], axis=0)
@@ -396,17 +416,7 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
 
     def footprint(n: str, at: float, r: str) -> Any:
         """Where piece ``n`` (its plane at ``at``, mm) passes through ``r``'s layer over the cycle, ``r``'s frame."""
-        bd = band(r)
-        mat = shape[n].simplify(0.05)
-        strips = []
-        for k in range(len(ok)):
-            got = _world(mat, tuple(track[n][k])).intersection(bd)
-            if got.area <= 1e-6:
-                continue
-            a, _, b, _ = got.bounds
-            strip = box(a, at - t / 2, b, at + t / 2) if parts[n].plane == "xz" else box(at - t / 2, a, at + t / 2, b)
-            strips.append(_local(strip, tuple(track[r][k])))
-        return shapely.union_all(strips) if strips else Polygon()
+        return _layer_footprint(shape[n], parts[n].plane, at, track[n], track[r], band(r), t)
 
     shape = dict(material)  # each piece as cut (a tab-joined one: cut flat along its edge, tabs added)
     # pieces whose plane is fixed already (a yz piece at its x) keep their way through the layers clear
@@ -598,8 +608,7 @@ def travel_slots(mech: Any, layers: dict[str, int | None], material: dict[str, A
     """Travel slots (xy piece -> cuts, mm) for perpendicular pieces that pass through another xy piece's layer
     where it has material (``material``: as cut so far), and a note for each; pieces joined by a joint
     (the #6/#9 pin on its driver's edge) touch by design and get none."""
-    import shapely
-    from shapely.geometry import Polygon, box
+    from shapely.geometry import box
 
     parts = {p.name: p for p in mech.parts}
     t = s.thickness_mm
@@ -609,17 +618,8 @@ def travel_slots(mech: Any, layers: dict[str, int | None], material: dict[str, A
 
     def footprint(n: str, at: float, r: str) -> Any:
         lz = (layers.get(r) or 0) * t + plan.z_stack
-        bd = box(-1e5, lz + 0.01, 1e5, lz + t - 0.01)
-        mat = plan.shape[n].simplify(0.05)
-        strips = []
-        for k in range(len(track[n])):
-            got = _world(mat, tuple(track[n][k])).intersection(bd)
-            if got.area <= 1e-6:
-                continue
-            a, _, b, _ = got.bounds
-            strip = box(a, at - t / 2, b, at + t / 2) if parts[n].plane == "xz" else box(at - t / 2, a, at + t / 2, b)
-            strips.append(_local(strip, tuple(track[r][k])))
-        return shapely.union_all(strips) if strips else Polygon()
+        return _layer_footprint(plan.shape[n], parts[n].plane, at, track[n], track[r],
+                                box(-1e5, lz + 0.01, 1e5, lz + t - 0.01), t)
 
     out: dict[str, list[Feature]] = {}
     notes: list[str] = []
