@@ -84,16 +84,22 @@ class FunctionDesign(Checked):
                 **({"note": self.note} if self.note else {})}
 
 
-def freudenstein_fit(phi: Array, psi: Array, ground: float = 1.0) -> FunctionDesign:
-    """The four-bar whose output follows ``psi`` at inputs ``phi`` (radians; see the module)."""
-    from ..linkages import freudenstein_angles, grashof_class
-
+def _pairs(phi: Array, psi: Array, ground: float) -> tuple[Array, Array]:
+    """The (input, output) angles as float arrays, refused unless 3 or more pairs with a positive ground."""
     phi = np.asarray(phi, float)
     psi = np.asarray(psi, float)
     if len(phi) < 3 or len(phi) != len(psi):
         raise InputError("pairs", len(phi), "3 or more (input, output) angle pairs")
     if not ground > 0:
         raise InputError("--ground", ground, "a positive ground length")
+    return phi, psi
+
+
+def freudenstein_fit(phi: Array, psi: Array, ground: float = 1.0) -> FunctionDesign:
+    """The four-bar whose output follows ``psi`` at inputs ``phi`` (radians; see the module)."""
+    from ..linkages import freudenstein_angles, grashof_class
+
+    phi, psi = _pairs(phi, psi, ground)
     M = np.column_stack([np.cos(psi), -np.cos(phi), np.ones_like(phi)])
     rhs = np.cos(phi - psi)
     if np.linalg.matrix_rank(M) < 3:
@@ -197,12 +203,7 @@ def synthesise_function(phi: Array, psi: Array, ground: float = 1.0, cons: Any =
     from .function_search import FunctionConstraints, output_errors, search_function, violations
 
     cons = FunctionConstraints() if cons is None else cons
-    phi = np.asarray(phi, float)
-    psi = np.asarray(psi, float)
-    if len(phi) < 3 or len(phi) != len(psi):
-        raise InputError("pairs", len(phi), "3 or more (input, output) angle pairs")
-    if not ground > 0:
-        raise InputError("--ground", ground, "a positive ground length")
+    phi, psi = _pairs(phi, psi, ground)
     if len(np.unique(phi)) < len(phi):
         raise InputError("pairs", [float(v) for v in phi], "a different input angle in every pair")
     if len(np.unique(psi)) < 2:
