@@ -552,8 +552,8 @@ def fast_solve(lk: Linkage, q: Array, threads: int | None = None, chunk: int | N
 
 
 def _ground_pose(n: int, placement: tuple[float, float, float]) -> Array:
-    px, py, pa = placement
-    return np.zeros((n, 3)) if not (px or py or pa) else np.tile(np.array([px, py, pa]), (n, 1))
+    """The ground never moves: one row seen ``n`` times (read-only), as :meth:`Mechanism.solve` returns it."""
+    return np.broadcast_to(np.array(placement, dtype=float), (n, 3))
 
 
 def _cuts(n: int, chunk: int, nthreads: int) -> list[tuple[int, int]]:
@@ -632,8 +632,8 @@ def _solve_compiled(lk: Linkage, plan: _Plan, prog: Any, q: Array, tols: list[fl
     block = new_block((prog.links.shape[0], n, 3))
     m = 0
     for name, o, _, _ in plan.links:
-        if o < 0:  # the ground never moves: one row seen n times (read-only), as Mechanism.solve makes it
-            poses[name] = np.broadcast_to(np.array(plan.placement, dtype=float), (n, 3))
+        if o < 0:
+            poses[name] = _ground_pose(n, plan.placement)
         else:
             poses[name] = block[m]
             m += 1

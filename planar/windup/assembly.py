@@ -430,11 +430,15 @@ class ToyAssembly(Mechanism):
 
     def _solve_poses(self, q: Array):
         stage_poses, checks = self._stage_poses(q)
+        return self.piece_poses(stage_poses), checks
+
+    def piece_poses(self, stage_poses: Mapping[str, Array]) -> dict[str, Array]:
+        """Every piece's pose track from its first member's (a stage part's) track at its place."""
         poses: dict[str, Array] = {}
         for piece, mem in self.members.items():
             full, m = mem[0]
             poses[piece] = poses_compose(stage_poses[full], poses_invert(np.array(m)))
-        return poses, checks
+        return poses
 
     def stage_poses(self, q: Array) -> dict[str, Array]:
         """Every stage part's own pose track at its place (for drawing a stage's parts one by one)."""

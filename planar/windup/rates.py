@@ -320,7 +320,7 @@ def assembly_rates(asm: Any, q: Array, qd: Array, qdd: Array) -> tuple[dict[str,
     (``v + omega x r``, ``a + alpha x r - omega^2 r``, ``r`` from the stage part's origin to the piece's)."""
     raw, ok = toy_rates(asm.toy, q, qd, qdd)
     stage_poses = asm.stage_poses(q)
-    pieces, _ = asm._solve_poses(q)
+    pieces = asm.piece_poses(stage_poses)
     out: dict[str, tuple[Array, ...]] = {}
     for piece, members in asm.members.items():
         full = members[0][0]
