@@ -189,11 +189,6 @@ class ContactRun:
     liftoff_time: float | None = None
 
 
-def _hold_gravity(effects: Any) -> tuple[float, float]:
-    g = getattr(effects, "gravity", None)
-    return (0.0, 0.0) if g is None else (float(g[0]), float(g[1]))
-
-
 def contact_hold(mech: Any, speed: float, gravity: tuple[float, float], cycles: float = 1.0,
                  samples_per_cycle: int = 72, substeps: int = 64, density: float = 1.0,
                  tolerance: float = 1e-3, drive: StageDrive | None = None) -> ContactRun:
@@ -578,12 +573,12 @@ def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, 
     follower's plane.  A stage that cannot be simulated is reported with the
     reason.
     """
+    from ..dynamics import gravity_and_damping, plane_gravity
     from ..simulate import SimSettings, torque_comparison
 
-    from ..dynamics import plane_gravity
-
     asm = toy_assembly(toy)
-    g3 = _hold_gravity(effects)
+    gx, gy = (float(v) for v in gravity_and_damping(effects)[0])
+    g3 = (gx, gy)  # the toy's gravity (gx, gy, 0), zero when the scene names none
     gxz = plane_gravity("xz", g3)
     g = (float(gxz[0]), float(gxz[1]))  # what an #8 stage's pieces (xz) feel of the toy's gravity (gx, gy, 0)
     has_xz = any(p.plane == "xz" and not p.ground for p in asm.parts)
