@@ -1,7 +1,7 @@
 """Bill of materials (CSV): parts with layer and sheet, pins with diameter and length, spacers, motor, screws.
 
 Columns: ``item, id, qty, layer, sheet, size_mm, joins, notes``.  A ``tabs`` row
-per tab-and-slot joint (``planar.fabtabs``): its letter, the number of tabs,
+per tab-and-slot joint (``planar.fabrication.tabs``): its letter, the number of tabs,
 a tab's ``width x length``, ``piece -> xy piece`` and which slots they go into.  Layers and
 sheets count from 1; ``size_mm`` is the part's bounding box as laid out, a pin's
 ``d x length``, a spacer's ``ID x OD x thickness``.  Fixed formatting, rows
@@ -15,7 +15,7 @@ import io
 import math
 from typing import Any
 
-from planar.fabrication import cut_polygon
+from planar.fabrication.sheet import cut_polygon
 
 __all__ = ["bom_text"]
 
@@ -57,7 +57,7 @@ def bom_text(fab: Any) -> str:
             od = 2 * max((c.radius for c in [p.outer for p in sp] if hasattr(c, "radius")), default=0.0) - s.kerf
             w.writerow(["spacer", pp.letter, pp.spacers, "", "+".join(str(p.sheet + 1) for p in sp),
                         f"{ri:g} x {od:g} x {s.thickness_mm:g}", joins, "cut from the sheet; on the pin between its layers"])
-    for jn in getattr(fab, "joins", []):  # tab-and-slot joints of pieces standing perpendicular (planar.fabtabs)
+    for jn in getattr(fab, "joins", []):  # tab-and-slot joints of pieces standing perpendicular (planar.fabrication.tabs)
         lo, hi = jn.slot_size
         w.writerow(["tabs", jn.letter, len(jn.spans), "", "", f"{jn.tab_width:g} x {s.thickness_mm:g}",
                     f"{jn.piece} -> {jn.base}",

@@ -22,7 +22,7 @@ import os
 from collections.abc import Iterator
 from typing import Any
 
-from planar.fabrication import Circle, Layout
+from planar.fabrication.sheet import Circle, Layout
 from planar.fileio import atomic_write, check_name
 
 __all__ = ["LAYERS", "aci", "dxf_bytes", "preview_png", "write_dxf"]

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from planar.fabrication import Circle, Layout, bulge_points
+from planar.fabrication.sheet import Circle, Layout, bulge_points
 
 __all__ = ["sheet_png"]
 

@@ -23,7 +23,7 @@ import os
 from typing import Any
 from xml.sax.saxutils import escape
 
-from planar.fabrication import Circle, Contour, Layout
+from planar.fabrication.sheet import Circle, Contour, Layout
 from planar.fileio import atomic_write, check_name
 
 __all__ = ["assembly_svg_text", "svg_text", "write_svg"]
@@ -104,7 +104,7 @@ LAYER_FILLS = ("#c8a064", "#6aa0d8", "#e07a5f", "#81b29a", "#f2cc8f", "#9c89b8",
 
 
 def assembly_svg_text(fab: Any) -> str:
-    """The assembly drawing of a :class:`planar.fabexport.Fabrication` (see the module docstring)."""
+    """The assembly drawing of a :class:`planar.app.export.Fabrication` (see the module docstring)."""
     from shapely import affinity
 
     asm = fab.assembly
@@ -198,7 +198,7 @@ def _legend(fab: Any) -> list[str]:
         sp = f", {pp.spacers} spacer(s)" if pp.spacers else ""
         joins = " + ".join(pp.parts)
         lines.append(f"{pp.letter}: {what}, {joins}, layers {lo + 1}-{hi + 1}{sp}")
-    for jn in getattr(fab, "joins", []):  # tab-and-slot joints (planar.fabtabs)
+    for jn in getattr(fab, "joins", []):  # tab-and-slot joints (planar.fabrication.tabs)
         lines.append(f"{jn.letter}: the {len(jn.spans)} tabs of {jn.piece} ({jn.plane}) into the slots {jn.letter} of "
                      f"{jn.base} (layer {(asm.layers.get(jn.base) or 0) + 1}), standing {'below' if jn.side < 0 else 'above'}"
                      " it; glue")

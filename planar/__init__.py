@@ -11,10 +11,10 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from .errors import AssemblyError, InputError, LimitError, PlanarError, SceneError
+from planar.errors import AssemblyError, InputError, LimitError, PlanarError, SceneError
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .model import Driver, Mechanism, Motion, Part, joint_residuals
+    from planar.core.model import Driver, Mechanism, Motion, Part, joint_residuals
 
 __all__ = [
     "AssemblyError", "InputError", "LimitError", "PlanarError", "SceneError",
@@ -27,7 +27,6 @@ _MODEL_NAMES = ("Driver", "Mechanism", "Motion", "Part", "joint_residuals")
 
 def __getattr__(name: str) -> Any:
     if name in _MODEL_NAMES:
-        from . import model
-
+        from planar.core import model
         return getattr(model, name)
     raise AttributeError(f"module 'planar' has no attribute {name!r}")

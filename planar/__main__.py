@@ -1,7 +1,7 @@
 import sys
 
 try:
-    from .cli import main
+    from planar.cli.main import main
 except KeyboardInterrupt:  # Ctrl-C while importing
     print("planar: interrupted (no output written)", file=sys.stderr)
     sys.exit(130)

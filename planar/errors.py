@@ -49,7 +49,7 @@ class InputError(PlanarError, ValueError):
 
 
 class LimitError(InputError):
-    """A request needs more work or memory than a configured limit allows (see :mod:`planar.limits`)."""
+    """A request needs more work or memory than a configured limit allows (see :mod:`planar.core.limits`)."""
 
 
 class AssemblyError(PlanarError, ValueError):

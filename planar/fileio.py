@@ -18,12 +18,12 @@ import os
 import tempfile
 from collections.abc import Iterable, Sequence
 from pathlib import Path
-from typing import Any, IO, Iterator
+from typing import IO, Any, Iterator
 
 import numpy as np
 
-from .errors import InputError
-from .model import Mechanism, Motion
+from planar.core.model import Mechanism, Motion
+from planar.errors import InputError
 
 __all__ = ["atomic_write", "output_transaction", "check_output", "check_name", "motion_columns", "write_motion_csv"]
 

@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from planar import analysis
+from planar.analysis import statics as analysis
 from planar.errors import InputError, LimitError, PlanarError
 from planar.linkages import FourBar, SliderCrank
 from planar.windup import elemental

@@ -129,7 +129,7 @@ def test_the_cycle_finder_finds_a_lazy_cycle(tmp_path):
 
 def test_no_import_cycles_in_the_package():
     graph = import_graph(ROOT)
-    assert "planar.pipeline" in graph and "planar.features" in graph
+    assert "planar.app.pipeline" in graph and "planar.core.features" in graph
     assert find_cycle(graph) is None, " -> ".join(find_cycle(graph) or [])
 
 
@@ -153,7 +153,7 @@ def test_every_module_imports_on_its_own_in_a_fresh_interpreter():
     assert json.loads(r.stdout) == {}
 
 
-@pytest.mark.parametrize("module", ["planar", "planar.pipeline", "planar.cli"])
+@pytest.mark.parametrize("module", ["planar", "planar.app.pipeline", "planar.cli.main"])
 def test_light_imports(module):
     code = (f"import sys, json; import {module}; "
             f"print(json.dumps(sorted(m for m in {HEAVY!r} if m in sys.modules)))")

@@ -6,10 +6,10 @@
 :mod:`planar.cams.mechanism` (:class:`CamMechanism`).
 """
 
-from .joint import CamContact
-from .laws import LAWS, Program, Segment
-from .mechanism import CamMechanism
-from .profile import CamError, CamProfile, CamReport, FollowerGeometry
+from planar.cams.joint import CamContact
+from planar.cams.laws import LAWS, Program, Segment
+from planar.cams.mechanism import CamMechanism
+from planar.cams.profile import CamError, CamProfile, CamReport, FollowerGeometry
 
 __all__ = ["LAWS", "CamContact", "CamError", "CamMechanism", "CamProfile", "CamReport", "FollowerGeometry",
            "Program", "Segment"]

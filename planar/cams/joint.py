@@ -8,9 +8,9 @@ from typing import ClassVar, Mapping
 import numpy as np
 from numpy.typing import NDArray
 
-from ..geometry import poses_apply
-from ..model import Feature, joint_kind
-from .profile import CamProfile
+from planar.cams.profile import CamProfile
+from planar.core.geometry import poses_apply
+from planar.core.model import Feature, joint_kind
 
 __all__ = ["CamContact"]
 

@@ -29,7 +29,7 @@ from typing import Callable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import InputError
+from planar.errors import InputError
 
 __all__ = ["LAWS", "Law", "Segment", "Program"]
 

@@ -28,13 +28,13 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InputError
-from ..geometry import poses_apply
-from ..linkages import Link, Linkage
-from ..linkages.dyads import Actuator, Crank, Fixed, NodeKind
-from ..model import Driver, Mechanism, Part, Pivot
-from .joint import CamContact
-from .profile import CamError, CamProfile, CamReport
+from planar.cams.joint import CamContact
+from planar.cams.profile import CamError, CamProfile, CamReport
+from planar.core.geometry import poses_apply
+from planar.core.model import Driver, Mechanism, Part, Pivot
+from planar.errors import InputError
+from planar.linkages import Link, Linkage
+from planar.linkages.dyads import Actuator, Crank, Fixed, NodeKind
 
 __all__ = ["CamMechanism", "RESERVED"]
 

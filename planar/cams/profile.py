@@ -39,8 +39,8 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import InputError, PlanarError
-from .laws import TWO_PI, Program
+from planar.cams.laws import TWO_PI, Program
+from planar.errors import InputError, PlanarError
 
 __all__ = ["CamError", "CamProfile", "CamReport", "FollowerGeometry"]
 

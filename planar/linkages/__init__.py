@@ -1,10 +1,10 @@
 """Linkages: four-bar, slider-crank, and general pivot/slot linkages from dyads."""
 
-from .dyads import NODE_KINDS, RRP, RRR, Actuator, Crank, Fixed, Link, Linkage, NodeKind, Rigid, node_kind
-from .gears import Driven, Geared, GearMesh
-from .triads import Triad
-from .fourbar import FourBar, freudenstein_angles, grashof_class
-from .slidercrank import SliderCrank
+from planar.linkages.dyads import NODE_KINDS, RRP, RRR, Actuator, Crank, Fixed, Link, Linkage, NodeKind, Rigid, node_kind
+from planar.linkages.fourbar import FourBar, freudenstein_angles, grashof_class
+from planar.linkages.gears import Driven, Geared, GearMesh
+from planar.linkages.slidercrank import SliderCrank
+from planar.linkages.triads import Triad
 
 __all__ = [
     "NODE_KINDS", "NodeKind", "node_kind", "Actuator", "Crank", "Fixed", "Link", "Linkage", "RRP", "RRR", "Rigid",

@@ -35,22 +35,19 @@ Node kinds without a chunk kernel here (a kind registered elsewhere) make
 from __future__ import annotations
 
 import math
-
 import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from itertools import count, pairwise
 from threading import Lock
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..geometry import CONCENTRIC, TANGENCY_RTOL, line_circle, poses_apply
-
-if TYPE_CHECKING:
-    from .dyads import Linkage, NodeKind
+from planar.core.geometry import CONCENTRIC, TANGENCY_RTOL, line_circle, poses_apply
+from planar.linkages.plan import Linkage, NodeKind, _Plan
 
 __all__ = ["CHUNK", "JIT_CHUNK", "JIT_MIN", "KERNELS", "Solved", "fast_solve", "jit_available", "plan_for",
            "solver_for", "threads_default"]
@@ -161,7 +158,7 @@ def _actuator(node, pos, q, w, ox, oy) -> Placed:
 
 @_kernel("rrr")
 def _rrr(node, pos, q, w, ox, oy) -> Placed:
-    """Circle-circle as :func:`planar.geometry.circle_circle` (same validity, bit for bit)."""
+    """Circle-circle as :func:`planar.core.geometry.circle_circle` (same validity, bit for bit)."""
     ax, ay = pos[node.a]
     bx, by = pos[node.b]
     # scale-free: outside 1e-60..1e60, where fourth powers of lengths leave float64, lengths are taken
@@ -271,21 +268,6 @@ def _rigid(node, pos, q, w, ox, oy) -> Placed:
 # ------------------------------------------------------------------ the plan
 
 
-@dataclass
-class _Plan:
-    """What one linkage's fast solve needs, built once."""
-
-    nodes: list[NodeKind]
-    kernels: list[Kernel]
-    checks: list[tuple[int, str, str]]  # (node index, node, why) in solve order
-    links: list[tuple[str, int, int, int]]  # (link, origin, from, to); origin -1: the ground
-    points: list[tuple[str, int]]
-    placement: tuple[float, float, float]
-    bound: list[float]  # a bound on |coordinate| of each node, for q = 0 (actuators add |q|)
-    grows: list[bool]  # node moves with |q| (downstream of an actuator)
-    program: Any = None  # the compiled program (planar.linkages.compiled), built on first use
-
-
 #: per node kind: (node, bound from its refs, grows from its refs, bounds, grows, index) -> (bound, grows),
 #: a bound on the node's |coordinate| at q = 0 and whether it moves with |q| (downstream of an actuator)
 BOUNDS: dict[str, Callable[..., tuple[float, bool]]] = {
@@ -363,7 +345,7 @@ def threads_default() -> int:
     except ValueError:
         n = 0
     if n < 1:
-        from ..errors import InputError
+        from planar.errors import InputError
 
         raise InputError("PLANAR_THREADS", env, "a positive whole number of threads (unset: every core)")
     return n
@@ -481,7 +463,7 @@ def _tail(v: Coord, off: int) -> Coord:
 
 def _place(x: Coord, y: Coord, ox: Array, oy: Array, placed: bool, px: float, py: float, c: float, s: float,
            w: Scratch) -> None:
-    """``(ox, oy) = placement applied to (x, y)``, as :func:`planar.geometry.poses_compose`."""
+    """``(ox, oy) = placement applied to (x, y)``, as :func:`planar.core.geometry.poses_compose`."""
     if not placed:
         ox[...] = x
         oy[...] = y
@@ -614,7 +596,7 @@ def _use_jit(jit: bool | None, n: int) -> bool:
 def _program(plan: _Plan) -> Any:
     """The plan's compiled program (built once), or ``None`` when a node kind has no encoder."""
     if plan.program is _NO_PROGRAM:
-        from .compiled import program_for
+        from planar.linkages.compiled import program_for
 
         plan.program = program_for(plan)
     return plan.program
@@ -622,9 +604,9 @@ def _program(plan: _Plan) -> Any:
 
 def _solve_compiled(lk: Linkage, plan: _Plan, prog: Any, q: Array, tols: list[float], nthreads: int,
                     chunk: int) -> Solved | None:
-    from ..model import FinitePoses
-    from ..buffers import block as new_block
-    from .compiled import solve_range
+    from planar.core.buffers import block as new_block
+    from planar.core.model import FinitePoses
+    from planar.linkages.compiled import solve_range
 
     n = q.shape[0]
     q = np.ascontiguousarray(q, dtype=float)

@@ -29,15 +29,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numba import njit
 
-from ..geometry import TANGENCY_RTOL
-
-if TYPE_CHECKING:
-    from .chunked import _Plan
+from planar.core.geometry import TANGENCY_RTOL
+from planar.linkages.plan import _Plan
 
 __all__ = ["ENCODERS", "Program", "program_for", "solve_range"]
 
@@ -186,7 +184,7 @@ def _k_rrr(par, L, xa, ya, xb, yb, xo, yo, ok, sep):
 
 @njit(**_JIT)
 def _k_rrp(par, L, xa, ya, xp, yp, xq, yq, xo, yo, ok, sep):
-    """Line-circle as :func:`planar.geometry.line_circle` (the numpy path's ``chunked._rrp``)."""
+    """Line-circle as :func:`planar.core.geometry.line_circle` (the numpy path's ``chunked._rrp``)."""
     ra, branch, off = par[0], par[1], par[2]
     fails = 0
     for i in range(L):

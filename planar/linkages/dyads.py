@@ -59,19 +59,10 @@ from typing import ClassVar, Mapping, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import AssemblyError, InputError
-from ..geometry import circle_circle, line_circle, poses_apply, poses_compose, poses_invert
-from ..model import (
-    Driver,
-    Mechanism,
-    Part,
-    PinInSlot,
-    Pivot,
-    Slide,
-    check_finite,
-    check_positive,
-)
-from .chunked import Solved, _Plan, fast_solve, plan_for
+from planar.core.geometry import circle_circle, line_circle, poses_apply, poses_compose, poses_invert
+from planar.core.model import Driver, Mechanism, Part, PinInSlot, Pivot, Slide, check_finite, check_positive
+from planar.errors import AssemblyError, InputError
+from planar.linkages.chunked import Solved, _Plan, fast_solve, plan_for
 
 __all__ = ["Fixed", "Crank", "Actuator", "RRR", "RRP", "Rigid", "Link", "Linkage", "Node", "NodeKind",
            "NODE_KINDS", "node_kind", "carry_branch", "frame_rates"]
@@ -236,7 +227,7 @@ class NodeKind:
         false where the closure is singular (a toggle), as for :meth:`velocity`.
         A kind without one refuses rates (velocities, accelerations, torque) by name.
         """
-        from ..registry import UnsupportedError
+        from planar.core.registry import UnsupportedError
 
         raise UnsupportedError(f"rates (accelerations): node kind {self.kind!r} ({type(self).__name__}) "
                                "has no acceleration method")

@@ -22,9 +22,9 @@ from typing import Literal, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import InputError
-from ..model import check_finite, check_positive
-from .dyads import RRR, Crank, Fixed, Link, Linkage, Rigid
+from planar.core.model import check_finite, check_positive
+from planar.errors import InputError
+from planar.linkages.dyads import RRR, Crank, Fixed, Link, Linkage, Rigid
 
 __all__ = ["FourBar", "grashof_class", "freudenstein_angles"]
 

@@ -31,12 +31,12 @@ from typing import TYPE_CHECKING, Any, ClassVar, Mapping
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InputError
-from ..model import Driver, check_finite, check_positive, joint_kind
-from .dyads import Check, Crank, Fixed, Mask, NodeKind, _perp, frame_rates, node_kind
+from planar.core.model import Driver, check_finite, check_positive, joint_kind
+from planar.errors import InputError
+from planar.linkages.dyads import Check, Crank, Fixed, Mask, NodeKind, _perp, frame_rates, node_kind
 
 if TYPE_CHECKING:
-    from .dyads import Linkage
+    from planar.linkages.dyads import Linkage
 
 __all__ = ["Geared", "Driven", "GearMesh", "input_angle"]
 

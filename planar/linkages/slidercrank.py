@@ -2,7 +2,7 @@
 
 Closed form (line-circle dyad): the slider's x is
 ``r cos(theta) + branch * sqrt(l^2 - (r sin(theta) - e)^2)``, computed through
-:func:`planar.geometry.line_circle` (half-chord ``sqrt((l - h)(l + h))``, no
+:func:`planar.core.geometry.line_circle` (half-chord ``sqrt((l - h)(l + h))``, no
 cancellation).  ``branch=+1`` puts the slider on the +x side.
 """
 
@@ -12,9 +12,9 @@ from typing import Sequence
 
 import numpy as np
 
-from ..errors import InputError
-from ..model import check_finite, check_positive
-from .dyads import RRP, Crank, Fixed, Link, Linkage
+from planar.core.model import check_finite, check_positive
+from planar.errors import InputError
+from planar.linkages.dyads import RRP, Crank, Fixed, Link, Linkage
 
 __all__ = ["SliderCrank"]
 

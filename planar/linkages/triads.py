@@ -43,9 +43,9 @@ from typing import ClassVar, Mapping, cast
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InputError
-from ..model import check_finite, check_positive
-from .dyads import Check, Mask, NodeKind, Vec, node_kind
+from planar.core.model import check_finite, check_positive
+from planar.errors import InputError
+from planar.linkages.dyads import Check, Mask, NodeKind, Vec, node_kind
 
 __all__ = ["Triad", "solve_triad"]
 
@@ -297,7 +297,7 @@ class Triad(NodeKind):
             if self.name not in pos:
                 raise RuntimeError(f"triad node {self.name!r} solved before its group's first node")
             return pos[self.name], None
-        from .dyads import path_mask
+        from planar.linkages.dyads import path_mask
 
         S, L, u_ref, scale = self._data()
         K = np.stack([np.broadcast_to(pos[g.a], (q.shape[0], 2)) for g in self.group], 1)

@@ -5,6 +5,6 @@ See ``ERRATA.md`` beside this file for every correction to the supplement's
 equations and how it was verified.
 """
 
-from .mechanisms import ELEMENTAL, MOTIONS, ElementalMechanism, ElementalRecord, elemental, params_for
+from planar.windup.mechanisms import ELEMENTAL, MOTIONS, ElementalMechanism, ElementalRecord, elemental, params_for
 
 __all__ = ["ELEMENTAL", "MOTIONS", "ElementalMechanism", "ElementalRecord", "elemental", "params_for"]

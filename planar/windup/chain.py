@@ -24,11 +24,11 @@ from typing import Any, Callable, Iterable, Mapping, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InputError
-from ..model import CamOnLine, Driver, Mechanism, Part, PinInArcSlot, PinInSlot, Pivot, Slide, check_finite
-from ..registry import Registry
-from .mechanisms import ELEMENTAL, ElementalMechanism, SkewContact
-from .table import MOTION_TYPES, Realisation, enumerate_chains, realise
+from planar.core.model import CamOnLine, Driver, Mechanism, Part, PinInArcSlot, PinInSlot, Pivot, Slide, check_finite
+from planar.core.registry import Registry
+from planar.errors import InputError
+from planar.windup.mechanisms import ELEMENTAL, ElementalMechanism, SkewContact
+from planar.windup.table import MOTION_TYPES, Realisation, enumerate_chains, realise
 
 __all__ = ["ToyMechanism", "chain_mechanism", "tree_cost", "rank_trees", "horse", "bunny", "Chain"]
 

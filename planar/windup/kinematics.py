@@ -33,8 +33,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from ..geometry import circle_circle, line_circle, wrap_angle
-from . import params as P_
+from planar.core.geometry import circle_circle, line_circle, wrap_angle
+from planar.windup import params as P_
 
 __all__ = ["Stage", "rot", "cam_centre"] + [f"forward_{k}" for k in range(1, 12)]
 
@@ -139,7 +139,7 @@ def forward_3(P: P_.P3, theta: Array) -> Stage:
     must use ``r`` (the circle about ``s``); its ``p_x`` divides by
     ``m'_x = m_x - s_x`` (zero when the cam centre passes above ``s``) and its
     angles use ``atan`` of quotients.  Here: the stable circle-circle of
-    :func:`planar.geometry.circle_circle`, branch fixed at rest, ``atan2``.
+    :func:`planar.core.geometry.circle_circle`, branch fixed at rest, ``atan2``.
     """
     P = P_.in_world(P)  # D_jc, F_o: driver frame -> world
     m0 = _xy(P.D_jc)

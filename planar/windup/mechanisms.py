@@ -1,4 +1,4 @@
-"""The 11 elemental mechanisms as :class:`~planar.model.Mechanism` objects.
+"""The 11 elemental mechanisms as :class:`~planar.core.model.Mechanism` objects.
 
 Each has three parts, ``ground``, ``driver`` and ``follower``, with outlines
 built from its parameters (cam discs, windows, slots, pins, supports: the
@@ -26,13 +26,12 @@ from typing import Any, Callable, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InputError
-from ..geometry import poses_apply
-from ..model import (
+from planar.core.geometry import poses_apply
+from planar.core.model import (
     ArcSlot,
     CamOnLine,
-    Feature,
     Driver,
+    Feature,
     Hole,
     Mechanism,
     Part,
@@ -43,9 +42,10 @@ from ..model import (
     Slot,
     joint_kind,
 )
-from . import params as P_
-from . import kinematics as K
-from .kinematics import Stage
+from planar.errors import InputError
+from planar.windup import kinematics as K
+from planar.windup import params as P_
+from planar.windup.kinematics import Stage
 
 __all__ = ["ElementalMechanism", "ElementalRecord", "ELEMENTAL", "MOTIONS", "CONTACT_JOINT", "SkewContact",
            "elemental", "params_for", "register_elemental", "check_params", "standalone_driver",
@@ -309,7 +309,7 @@ class ElementalMechanism(Mechanism):
         An eccentric disc holds its axle's boss (``|D_jc - D_o| + 2 D_ar <= D_jr``) and runs in its follower's
         window in one layer.  A larger eccentricity makes it a crank whose boss would sweep across the
         window's rim: then the disc's centre carries a pin hole, and a pin in the follower's slot joins them
-        across layers (a Scotch yoke), which is how it is cut (``planar.fabjoints``)."""
+        across layers (a Scotch yoke), which is how it is cut (``planar.fabrication.joints``)."""
         P = self.world
         c = _sub(P.D_jc, P.D_o)
         feats: tuple[Feature, ...] = (Hole((0.0, 0.0), 2 * P.D_ar),)

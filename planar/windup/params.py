@@ -32,7 +32,7 @@ import math
 from dataclasses import dataclass, fields, replace
 from typing import Any, TypeVar
 
-from ..errors import InputError
+from planar.errors import InputError
 
 __all__ = ["in_world", "coerce", "check_shapes", "Params", "P1", "P2", "P3", "P4", "P5", "P6", "P7", "P8", "P9", "P10", "P11"]
 

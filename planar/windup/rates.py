@@ -29,13 +29,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..linkages.dyads import RRP, RRR, frame_rates
-from ..registry import UnsupportedError
-from . import params as P_
-from .mechanisms import ELEMENTAL, ElementalMechanism
+from planar.core.registry import UnsupportedError
+from planar.linkages.dyads import RRP, RRR, frame_rates
+from planar.windup import params as P_
+from planar.windup.mechanisms import ELEMENTAL, ElementalMechanism
 
 if TYPE_CHECKING:
-    from ..model import Mechanism
+    from planar.core.model import Mechanism
 
 __all__ = ["forward_rates", "driver_motion_rates", "elemental_rates", "windup_rates"]
 
@@ -261,7 +261,7 @@ _DRIVER_KIND = {"Rz": "Rz", "Oz": "Oz", "Tx": "x", "OzT": "free"}
 
 
 def _follower_kind(mech: ElementalMechanism) -> str:
-    from . import mechanisms as M
+    from planar.windup import mechanisms as M
 
     fp = mech.record.follower_pose
     table = {M._slide_x: "x", M._slide_y: "y", M._free: "free", M._pivot: "pivot", M._tilt_yz: "pivot",
@@ -289,7 +289,7 @@ def elemental_rates(mech: ElementalMechanism, q: Array, qd: Array, qdd: Array
 
 def toy_rates(toy: Any, q: Array, qd: Array, qdd: Array) -> tuple[dict[str, tuple[Array, ...]], Mask]:
     """Part rates of a :class:`~planar.windup.chain.ToyMechanism`: each stage's input is its parent's output."""
-    from .chain import _to_base, _to_world
+    from planar.windup.chain import _to_base, _to_world
 
     outs: dict[int, Jet] = {}
     valid = np.ones(q.shape, bool)
@@ -310,39 +310,11 @@ def toy_rates(toy: Any, q: Array, qd: Array, qdd: Array) -> tuple[dict[str, tupl
     return parts, valid
 
 
-def assembly_rates(asm: Any, q: Array, qd: Array, qdd: Array) -> tuple[dict[str, tuple[Array, ...]], Mask]:
-    """Rates of every piece of a toy's assembly (:class:`~planar.windup.assembly.ToyAssembly`, the toy's
-    frame): each piece is a stage part (its first member) at the stage's place, then offset on its body.
-
-    The place is a turn by ``a`` about z and a shift for an xy stage, a shift for xz and yz
-    (:func:`planar.windup.assembly._world_track`): the stage part's velocity and acceleration turn by
-    ``a``, its angular rates do not change; the piece's origin is a point of that body
-    (``v + omega x r``, ``a + alpha x r - omega^2 r``, ``r`` from the stage part's origin to the piece's)."""
-    raw, ok = toy_rates(asm.toy, q, qd, qdd)
-    stage_poses = asm.stage_poses(q)
-    pieces = asm.piece_poses(stage_poses)
-    out: dict[str, tuple[Array, ...]] = {}
-    for piece, members in asm.members.items():
-        full = members[0][0]
-        v, a, om, al = (np.asarray(x, float) for x in raw[full])
-        if asm._stage_part(full).plane == "xy":
-            ang = asm.placed[int(full.split(".")[0][1:])].place[2]
-            c, s_ = np.cos(ang), np.sin(ang)
-            v = np.column_stack([c * v[:, 0] - s_ * v[:, 1], s_ * v[:, 0] + c * v[:, 1]])
-            a = np.column_stack([c * a[:, 0] - s_ * a[:, 1], s_ * a[:, 0] + c * a[:, 1]])
-        r = pieces[piece][:, :2] - stage_poses[full][:, :2]
-        om, al = np.broadcast_to(om, q.shape), np.broadcast_to(al, q.shape)
-        pv = np.column_stack([v[:, 0] - om * r[:, 1], v[:, 1] + om * r[:, 0]])
-        pa = np.column_stack([a[:, 0] - al * r[:, 1] - om * om * r[:, 0], a[:, 1] + al * r[:, 0] - om * om * r[:, 1]])
-        out[piece] = (pv, pa, om, al)
-    return out, ok
-
-
 def windup_rates(mech: "Mechanism", q: Array, qd: Array, qdd: Array
                  ) -> tuple[dict[str, tuple[Array, ...]], Mask, str]:
     """Part rates ``(v, a, omega, alpha)`` of an elemental mechanism or a toy (see the module's note), with the
     validity and the method's name; other mechanisms are refused by name."""
-    from .chain import ToyMechanism
+    from planar.windup.chain import ToyMechanism
 
     if isinstance(mech, ElementalMechanism):
         raw, ok = elemental_rates(mech, q, qd, qdd)
@@ -350,11 +322,5 @@ def windup_rates(mech: "Mechanism", q: Array, qd: Array, qdd: Array
     if isinstance(mech, ToyMechanism):
         raw, ok = toy_rates(mech, q, qd, qdd)
         return raw, ok, "wind-up closed forms differentiated analytically, composed through the toy's stages"
-    from .assembly import ToyAssembly
-
-    if isinstance(mech, ToyAssembly):
-        raw, ok = assembly_rates(mech, q, qd, qdd)
-        return raw, ok, ("wind-up closed forms differentiated analytically, composed through the toy's stages, "
-                         "turned to each piece's place")
     raise UnsupportedError(f"rates (velocities, accelerations, torque): no closed-form derivatives for "
                            f"{type(mech).__name__} {mech.name!r}")

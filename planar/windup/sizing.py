@@ -32,15 +32,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
-from .mechanisms import (
-    ELEMENTAL,
-    ElementalMechanism,
-    check_params,
-    params_for,
-    standalone_driver,
-    standalone_motion,
-)
+from planar.errors import InputError
+from planar.windup.mechanisms import ELEMENTAL, ElementalMechanism, check_params, params_for, standalone_driver, standalone_motion
 
 __all__ = ["DESIGN_PARAMETER", "SCAN", "Sizing", "motion_range", "reachable_ranges", "size_for_range"]
 

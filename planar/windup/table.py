@@ -18,8 +18,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..errors import InputError
-from .mechanisms import MOTIONS
+from planar.errors import InputError
+from planar.windup.mechanisms import MOTIONS
 
 __all__ = ["TABLE", "OPTIONAL", "MOTION_TYPES", "Realisation", "realise", "patterns", "enumerate_chains",
            "chain_counts"]

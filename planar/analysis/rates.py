@@ -1,0 +1,334 @@
+"""Velocities and accelerations of every part and named point, and the motor torque they imply.
+
+Nothing here differences samples: each mechanism family supplies its rates
+from its closure equations differentiated in closed form
+(:func:`mechanism_rates`):
+
+* linkages (:class:`~planar.linkages.Linkage`, hence :class:`FourBar` and
+  :class:`SliderCrank`): every node kind's closure differentiated twice
+  (:meth:`~planar.linkages.NodeKind.acceleration`), solved as a 2x2 system per
+  sample;
+* wind-up mechanisms and toys: see :mod:`planar.windup.rates`.
+
+A part's rates are those of its pose track ``(x, y, angle)``: the velocity and
+acceleration of its frame's origin (world frame, model units per s and per
+s^2) and its angular velocity ``omega`` and acceleration ``alpha`` (rad/s,
+rad/s^2, counter-clockwise positive).  A point fixed to the part at world
+position ``P`` moves with ``v = v_O + omega perp(P - O)`` and
+``a = a_O + alpha perp(P - O) - omega^2 (P - O)``.
+
+The motor torque (:func:`motor_torque`) is the inverse dynamics of
+:mod:`planar.analysis.dynamics` (inertia, gravity, loads, springs, space damping) with
+these exact rates in place of its differences: by virtual work,
+``tau = sum_parts [m (a_G - g + lam v_G) . dX_G/dq + I (alpha + lam omega) dphi/dq]
++ sum_loads F . dX/dq + sum_springs f dL/dq`` with ``d/dq`` the velocity
+coefficients (the rates at unit driver speed), so it holds for a rocking
+driver too.  Force x model unit, the torque the motor applies to the driven
+part (force along the axis for a translating input).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from planar.core.geometry import poses_apply
+from planar.errors import InputError
+
+if TYPE_CHECKING:
+    from planar.core.model import Driver, Mechanism, Motion
+
+__all__ = ["PartRates", "Derivatives", "driver_rates", "rates_method", "mechanism_rates", "motion_derivatives", "motor_torque",
+           "point_rates", "transmission_angles", "derivative_columns"]
+
+Array = NDArray[np.float64]
+Mask = NDArray[np.bool_]
+
+
+@dataclass(frozen=True)
+class PartRates:
+    """Time derivatives of one part's pose track (world frame)."""
+
+    v: Array  # (N, 2) velocity of the frame's origin
+    a: Array  # (N, 2) its acceleration
+    omega: Array  # (N,) rad/s
+    alpha: Array  # (N,) rad/s^2
+
+
+@dataclass
+class Derivatives:
+    """Rates of a motion: per part, per named point, where defined, and how they were found."""
+
+    parts: dict[str, PartRates]
+    points: dict[str, tuple[Array, Array]]  # name -> (velocity (N, 2), acceleration (N, 2))
+    valid: Mask
+    method: str
+    transmission: dict[str, Array] = field(default_factory=dict)
+
+
+def _perp(v: Array) -> Array:
+    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
+
+
+def _rotate(v: Array, ang: float) -> Array:
+    if ang == 0.0:
+        return v
+    c, s = math.cos(ang), math.sin(ang)
+    return np.column_stack([c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1]])
+
+
+#: the last linkage node solve, ``(mechanism, digest of q, solve_nodes result)``: a motion table asks for
+#: rates at two driver speeds and the transmission angles of the same samples
+_LAST_SOLVE: list[tuple[Any, bytes, Any]] = []
+
+
+def _node_solve(mech: Any, q: Array) -> Any:
+    import hashlib
+
+    key = hashlib.blake2b(np.ascontiguousarray(q).tobytes(), digest_size=16).digest() + str(q.shape).encode()
+    if _LAST_SOLVE and _LAST_SOLVE[0][0] is mech and _LAST_SOLVE[0][1] == key:
+        return _LAST_SOLVE[0][2]
+    solved = mech.solve_nodes(q)
+    _LAST_SOLVE[:] = [(mech, key, solved)]
+    return solved
+
+
+def driver_rates(driver: "Driver", t: ArrayLike) -> tuple[Array, Array]:
+    """The driver's rate and its rate of change at times ``t`` (s): ``(dq/dt, d2q/dt2)``."""
+    tt = np.asarray(t, float)
+    if driver.amplitude is None:
+        return np.full_like(tt, driver.rate), np.zeros_like(tt)
+    arg = driver.rate * tt + driver.phase
+    return (driver.amplitude * driver.rate * np.cos(arg),
+            -driver.amplitude * driver.rate**2 * np.sin(arg))
+
+
+def mechanism_rates(mech: "Mechanism", q: ArrayLike, qd: ArrayLike = 1.0, qdd: ArrayLike = 0.0
+                    ) -> tuple[dict[str, PartRates], Mask, str]:
+    """Rates of every part for driver values ``q``, rates ``qd`` and ``qdd`` per sample.
+
+    Returns ``(parts, valid, method)``; ``method`` names how they were found.
+    A mechanism family with no closed-form rates raises
+    :class:`~planar.core.registry.UnsupportedError` naming it (never a difference).
+    """
+    from planar.linkages import Linkage
+
+    qa = np.atleast_1d(np.asarray(q, float))
+    qdv = np.broadcast_to(np.asarray(qd, float), qa.shape)
+    qddv = np.broadcast_to(np.asarray(qdd, float), qa.shape)
+    if isinstance(mech, Linkage):
+        pos, vel, acc, valid = mech.node_accelerations(qa, qdv, qddv, solved=_node_solve(mech, qa))
+        ang = mech.placement[2]
+        out = {}
+        for name, (v, a, om, al) in mech.link_rates(pos, vel, acc).items():
+            out[name] = PartRates(_rotate(v, ang), _rotate(a, ang), om, al)
+        return out, valid, "linkage closure equations differentiated twice (node kinds)"
+    from planar.cams.mechanism import CamMechanism
+
+    if isinstance(mech, CamMechanism):
+        return _cam_rates(mech, qa, qdv, qddv)
+    from planar.toys.assembly import ToyAssembly
+
+    if isinstance(mech, ToyAssembly):
+        from planar.toys.rates import assembly_rates
+
+        raw, valid = assembly_rates(mech, qa, qdv, qddv)
+        method = ("wind-up closed forms differentiated analytically, composed through the toy's stages, "
+                  "turned to each piece's place")
+        return {k: PartRates(*v) for k, v in raw.items()}, valid, method
+    from planar.windup.rates import windup_rates
+
+    raw, valid, method = windup_rates(mech, qa, qdv, qddv)
+    return {k: PartRates(*v) for k, v in raw.items()}, valid, method
+
+
+def _cam_rates(mech: Any, q: Array, qd: Array, qdd: Array) -> tuple[dict[str, PartRates], Mask, str]:
+    """A cam mechanism: the follower's coordinate ``s(theta)`` from the motion law (closed form, with ``s'``,
+    ``s''``) is the input of its linkage, by the chain rule ``ds/dt = s' qd``, ``d2s/dt2 = s'' qd^2 + s' qdd``;
+    the cam turns with the driver; a roller rolls without slip, its angle ``theta - L(theta) / r_roller``
+    (``L`` the pitch curve's arc length), so ``omega = qd (1 - |P'| / r)`` and
+    ``alpha = qdd (1 - |P'| / r) - qd^2 (P' . P'') / (|P'| r)``."""
+    prof = mech.profile
+    s, s1, s2 = prof.follower_output(q)
+    parts, valid, _ = mechanism_rates(mech.linkage, s, s1 * qd, s2 * qd * qd + s1 * qdd)
+    zero = np.zeros((q.shape[0], 2))
+    parts["cam"] = PartRates(zero, zero.copy(), np.array(qd, float), np.array(qdd, float))
+    if prof.follower.kind == "roller":
+        fol = mech.linkage.solve(s).poses["follower"]
+        from planar.core.geometry import poses_apply
+
+        c = poses_apply(fol, mech.tip_local)
+        vc, ac = point_rates(fol, parts["follower"], c)
+        _, P1, P2 = prof.pitch(q)
+        speed = np.hypot(P1[:, 0], P1[:, 1])
+        dspeed = np.einsum("ij,ij->i", P1, P2) / np.maximum(speed, 1e-300)
+        r = prof.rr
+        parts["roller"] = PartRates(vc, ac, qd * (1.0 - speed / r), qdd * (1.0 - speed / r) - qd * qd * dspeed / r)
+    return parts, valid, "cam motion law (closed form) through the linkage's closure equations, differentiated twice"
+
+
+def rates_method(mech: "Mechanism") -> str:
+    """How :func:`mechanism_rates` finds ``mech``'s rates (one line, for reports), from one sample."""
+    q = np.zeros(1)
+    return mechanism_rates(mech, mech.driver.value(q), 1.0, 0.0)[2]
+
+
+def point_rates(poses: ArrayLike, rates: PartRates, world_points: ArrayLike) -> tuple[Array, Array]:
+    """Velocity and acceleration ``(N, 2)`` of points fixed to a part, at world positions ``(N, 2)``."""
+    P, O = np.asarray(world_points, float), np.asarray(poses, float)
+    rx, ry = P[:, 0] - O[:, 0], P[:, 1] - O[:, 1]
+    om, al = rates.omega, rates.alpha
+    om2 = om * om
+    v = np.column_stack([rates.v[:, 0] - om * ry, rates.v[:, 1] + om * rx])
+    a = np.column_stack([rates.a[:, 0] - al * ry - om2 * rx, rates.a[:, 1] + al * rx - om2 * ry])
+    return v, a
+
+
+def transmission_angles(mech: "Mechanism", q: ArrayLike) -> dict[str, Array]:
+    """Transmission angle (rad, ``[0, pi]``) of every RRR dyad of a linkage, keyed by its node.
+
+    The angle between the two links meeting at the dyad's joint (a four-bar's
+    at ``C``: coupler and rocker); 90 degrees transmits best, near 0 or 180
+    the linkage toggles.  Only dyads whose two links are different parts (a
+    node fixed on a ternary link has none).  Empty for mechanisms without dyads.
+    """
+    from planar.linkages import RRR, Linkage
+
+    if not isinstance(mech, Linkage):
+        return {}
+    # a dyad whose two links are one part (a node on a ternary link) transmits nothing: no angle
+    rrr = [n for n in mech.nodes if isinstance(n, RRR)
+           and not any({n.name, n.a, n.b} <= set(lk.nodes) for lk in mech.links)]
+    if not rrr:
+        return {}
+    pos, _ = _node_solve(mech, np.atleast_1d(np.asarray(q, float)))
+    return {n.name: n.transmission(pos) for n in rrr}
+
+
+def motion_derivatives(mech: "Mechanism", motion: "Motion") -> Derivatives:
+    """Rates of a solved motion whose sample times ``motion.t`` are set (the driver's law gives the rates)."""
+    if motion.t is None:
+        raise InputError(f"{mech.name}.motion.t", None, "sample times (solve with t=..., or Mechanism.run)")
+    qd, qdd = driver_rates(mech.driver, motion.t)
+    parts, ok, method = mechanism_rates(mech, motion.driver, qd, qdd)
+    return _derivatives(mech, motion, parts, ok, method)
+
+
+def _derivatives(mech: "Mechanism", motion: "Motion", parts: dict[str, PartRates], ok: Mask,
+                 method: str = "") -> Derivatives:
+    points = {}
+    for name, (part, _) in mech.points.items():
+        points[name] = point_rates(motion.poses[part], parts[part], motion.points[name])
+    return Derivatives(parts, points, ok & motion.valid, method, transmission_angles(mech, motion.driver))
+
+
+def motor_torque(mech: "Mechanism", motion: "Motion", effects: Any = None, t_rest: float | None = None,
+                 densities: dict[str, float] | None = None) -> tuple[Array, Mask]:
+    """Inverse-dynamics motor torque per sample from exact rates (see the module's note).
+
+    ``effects``: an :class:`~planar.core.effects.Effects` (gravity, loads, springs,
+    damping, density) or ``None`` (inertia at density 1 only); ``t_rest``:
+    when a spring without a rest length has it (default the first sample);
+    ``densities``: per-part densities overriding ``effects.density``.
+    Returns ``(tau, valid)``.
+    """
+    rates, coef, ok = _rates_and_coefficients(mech, motion)
+    return _torque(mech, motion, rates, coef, effects, t_rest, densities), ok
+
+
+def _rates_and_coefficients(mech: "Mechanism", motion: "Motion"
+                            ) -> tuple[dict[str, PartRates], dict[str, PartRates], Mask]:
+    """Rates at the driver's law and at unit driver speed (the velocity coefficients ``d/dq``)."""
+    if motion.t is None:
+        raise InputError(f"{mech.name}.motion.t", None, "sample times (solve with t=..., or Mechanism.run)")
+    qd, qdd = driver_rates(mech.driver, motion.t)
+    rates, ok, _ = mechanism_rates(mech, motion.driver, qd, qdd)
+    coef, ok1, _ = mechanism_rates(mech, motion.driver, 1.0, 0.0)
+    return rates, coef, ok & ok1 & motion.valid
+
+
+def _torque(mech: "Mechanism", motion: "Motion", rates: dict[str, PartRates], coef: dict[str, PartRates],
+            effects: Any, t_rest: float | None, densities: dict[str, float] | None) -> Array:
+    from planar.analysis.dynamics import gravity_and_damping, part_mass_table, plane_gravity
+
+    assert motion.t is not None
+    g3, lam = gravity_and_damping(effects)
+    tau = np.zeros(len(motion))
+    for name, (mass, cog, inertia) in part_mass_table(mech, effects, densities).items():
+        if mass == 0.0 and inertia == 0.0:
+            continue
+        g = plane_gravity(getattr(mech.part(name), "plane", "xy"), g3)  # a toy's piece: gravity in its plane
+        G = poses_apply(motion.poses[name], np.asarray(cog, float))
+        vG, aG = point_rates(motion.poses[name], rates[name], G)
+        cG, _ = point_rates(motion.poses[name], coef[name], G)
+        r, c = rates[name], coef[name]
+        tau += mass * _dot(aG - g + lam * vG, cG) + inertia * (r.alpha + lam * r.omega) * c.omega
+    if effects is not None:
+        for load in effects.loads:
+            part, _ = mech.points[load.point]
+            cX, _ = point_rates(motion.poses[part], coef[part], motion.points[load.point])
+            tau += cX @ np.asarray(load.force, float)
+        i0 = 0 if t_rest is None else int(np.argmin(np.abs(motion.t - t_rest)))
+        for s in effects.springs:
+            pa = poses_apply(motion.poses[s.a], np.asarray(s.anchor_a, float))
+            pb = poses_apply(motion.poses[s.b], np.asarray(s.anchor_b, float))
+            va, _ = point_rates(motion.poses[s.a], rates[s.a], pa)
+            vb, _ = point_rates(motion.poses[s.b], rates[s.b], pb)
+            ca, _ = point_rates(motion.poses[s.a], coef[s.a], pa)
+            cb, _ = point_rates(motion.poses[s.b], coef[s.b], pb)
+            d = pb - pa
+            L = np.hypot(d[:, 0], d[:, 1])
+            Ls = np.where(L > 0, L, 1.0)
+            rest = float(L[i0]) if s.rest_length is None else s.rest_length
+            f = s.stiffness * (L - rest) + s.damping * _dot(d, vb - va) / Ls
+            tau += f * _dot(d, cb - ca) / Ls
+    return tau
+
+
+def _dot(a: Array, b: Array) -> Array:
+    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]
+
+
+def derivative_columns(mech: "Mechanism", motion: "Motion", effects: Any = None) -> tuple[list[str], list[Array]]:
+    """The ``--derivatives`` columns of a motion table.
+
+    ``<point>.vx .vy .ax .ay`` for every named point, ``<part>.omega .alpha``
+    for every part, ``<node>.transmission`` (rad) for every RRR dyad of a
+    linkage (a four-bar's is ``C.transmission``), ``torque`` (the inverse
+    dynamics of everything ``effects`` names, see :func:`motor_torque`) and
+    ``torque.loads`` (the loads alone, ideal: ``sum F . dX/dq``), and
+    ``rates_valid`` (0 where a rate is undefined: a toggle or an invalid
+    sample, whose rate cells are ``nan``).
+    """
+    from planar.core.effects import Effects
+
+    rates, coef, ok = _rates_and_coefficients(mech, motion)
+    der = _derivatives(mech, motion, rates, ok)
+    names: list[str] = []
+    cols: list[Array] = []
+    for pname, (v, a) in der.points.items():
+        names += [f"{pname}.vx", f"{pname}.vy", f"{pname}.ax", f"{pname}.ay"]
+        cols += [v[:, 0], v[:, 1], a[:, 0], a[:, 1]]
+    for p in mech.parts:
+        r = der.parts[p.name]
+        names += [f"{p.name}.omega", f"{p.name}.alpha"]
+        cols += [r.omega, r.alpha]
+    for node, ang in der.transmission.items():
+        names.append(f"{node}.transmission")
+        cols.append(ang)
+    tau = _torque(mech, motion, rates, coef, effects, None, None)
+    loads_only = Effects(loads=tuple(effects.loads)) if effects is not None else Effects()
+    tau_l = _torque(mech, motion, rates, coef, loads_only, None, {p.name: 0.0 for p in mech.parts})
+    names += ["torque", "torque.loads"]
+    cols += [tau, tau_l]
+    good = der.valid & ok
+    for c in cols:  # a final finite check: a sample whose rates or torque overflowed is not valid
+        good &= np.isfinite(c)
+    cols = [np.where(good, c, np.nan) for c in cols]
+    names.append("rates_valid")
+    cols.append(good.astype(float))
+    return names, cols

@@ -1,0 +1,85 @@
+"""``planar export``: every file of a :class:`~planar.fabrication.build.Fabrication` written at once.
+
+:func:`build` turns a scene into a :class:`Fabrication` (layout, assembly,
+notes); :func:`write_outputs` renders every requested file in memory and only
+then writes them (each to a temporary beside its target, all renamed at the
+end), so bad input or a failed check leaves no file written or clobbered.
+With several sheets, ``parts.dxf`` becomes ``parts-1.dxf``, ``parts-2.dxf``
+(same for SVG and the preview PNG).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from planar.errors import InputError
+from planar.fabrication.build import Fabrication, build, kerf_test_layout, sheet_paths, summary
+from planar.fabrication.parts import FabSettings
+
+__all__ = ["Fabrication", "build", "kerf_test_layout", "sheet_paths", "summary", "write_outputs"]
+
+
+def _commit(files: dict[Path, bytes]) -> None:
+    """Write every file to a temporary beside it, then rename them all; on any failure remove the temporaries.
+
+    Inside a command's :func:`planar.fileio.output_transaction` the renames wait for the whole command.
+    """
+    from planar.fileio import atomic_write, output_transaction
+
+    for target in files:
+        parent = target.parent if str(target.parent) else Path(".")
+        if not parent.is_dir():
+            raise InputError("output", str(target), f"a path in an existing directory ({parent} does not exist)")
+    with output_transaction():
+        for target, data in files.items():
+            with atomic_write(target, "wb") as fh:
+                fh.write(data)
+
+
+def write_outputs(fab: Fabrication | None, dxf=None, svg=None, preview=None, bom=None, assembly=None,
+                  kerf_test=None, settings: FabSettings | None = None) -> list[Path]:
+    """Render every requested output in memory, then write them all (see the module docstring)."""
+    from planar.app.formats import writer
+
+    dxf_bytes = writer("dxf").dxf_bytes
+    svg_text = writer("svg").svg_text
+
+    files: dict[Path, bytes] = {}
+    if fab is not None:
+        lay, s = fab.layout, fab.settings
+        meta = f"{fab.name}: {s.thickness_mm:g} mm sheet, kerf {s.kerf:g} mm"
+        if dxf is not None:
+            for k, p in enumerate(sheet_paths(dxf, lay.sheets)):
+                files[p] = dxf_bytes(lay, k, s, f"{meta}, sheet {k + 1} of {lay.sheets}")
+        if svg is not None:
+            for k, p in enumerate(sheet_paths(svg, lay.sheets)):
+                files[p] = svg_text(lay, k, s).encode()
+        if preview is not None:
+            sheet_png = writer("png").sheet_png
+
+            for k, p in enumerate(sheet_paths(preview, lay.sheets)):
+                files[p] = sheet_png(lay, k, s)
+        if bom is not None:
+            bom_text = writer("bom").bom_text
+
+            files[Path(bom)] = bom_text(fab).encode()
+        if assembly is not None:
+            assembly_svg_text = writer("svg").assembly_svg_text
+
+            files[Path(assembly)] = assembly_svg_text(fab).encode()
+    if kerf_test is not None:
+        s = settings or (fab.settings if fab is not None else FabSettings())
+        lay = kerf_test_layout(s)
+        p = Path(kerf_test)
+        if p.suffix.lower() == ".svg":
+            files[p] = svg_text(lay, 0, s).encode()
+        elif p.suffix.lower() == ".dxf":
+            files[p] = dxf_bytes(lay, 0, s, f"kerf test, kerf {s.kerf:g} mm")
+        else:
+            raise InputError("--kerf-test", str(p), "a .dxf or .svg file name")
+    if len({str(p.resolve()) for p in files}) != len(files):
+        raise InputError("output", ", ".join(map(str, files)), "distinct output files")
+    _commit(files)
+    return list(files)
+
+

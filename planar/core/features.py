@@ -1,0 +1,51 @@
+"""Features cut from a part (holes and slots), as exact geometry in the part's own frame.
+
+Lengths are model units; angles radians, counter-clockwise.  This module
+imports nothing from planar, so :mod:`planar.core.model` (which re-exports these
+classes) and :mod:`planar.core.outlines` (which turns them into shapely geometry)
+can both use it without importing each other.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+__all__ = ["ArcSlot", "Hole", "Slot"]
+
+Vec = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Hole:
+    """A round hole centred at ``centre``; ``diameter`` nominal.
+
+    ``role="pin"``: a pivot hole whose size fabrication takes from the pin
+    (the scene's pin diameter); ``"sized"``: the mechanism's own size (an
+    axle, a cam's round hole).
+    """
+
+    centre: Vec
+    diameter: float
+    role: str = "sized"
+
+
+@dataclass(frozen=True)
+class Slot:
+    """A straight slot (stadium): the pin's centre travels from ``start`` to ``end``."""
+
+    start: Vec
+    end: Vec
+    width: float
+    role: str = "sized"
+
+
+@dataclass(frozen=True)
+class ArcSlot:
+    """An arc slot about ``centre`` of mid-radius ``radius`` from ``angle0`` to ``angle1`` (CCW)."""
+
+    centre: Vec
+    radius: float
+    angle0: float
+    angle1: float
+    width: float
+    role: str = "sized"

@@ -1,0 +1,711 @@
+"""The mechanism model every consumer reads: parts, joints, driver, motion.
+
+A :class:`Mechanism` is declared once: rigid :class:`Part` objects (each with
+its outline in its own frame), joints between parts, and one :class:`Driver`.
+Its :meth:`Mechanism.solve` maps an array of driver values to a
+:class:`Motion` holding, for every part, an ``(N, 3)`` pose track
+``(x, y, angle)`` that maps the part's own frame to the world, a validity mask
+and, for every invalid sample, which joint failed and why.
+
+Units are model units (a scene says what one unit is in millimetres); angles
+are radians, counter-clockwise positive.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from typing import TYPE_CHECKING, Any, ClassVar, Literal, Mapping, Protocol, Sequence, TypeVar
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from planar.core.buffers import block as new_block
+from planar.core.geometry import poses_apply
+from planar.errors import InputError
+
+if TYPE_CHECKING:  # shapely is imported only when an outline is asked for
+    import shapely
+
+__all__ = [
+    "Hole",
+    "Slot",
+    "ArcSlot",
+    "Part",
+    "Pivot",
+    "PinInSlot",
+    "PinInArcSlot",
+    "Slide",
+    "CamOnLine",
+    "Joint",
+    "JointProtocol",
+    "JOINT_KINDS",
+    "joint_kind",
+    "Driver",
+    "Motion",
+    "Mechanism",
+    "joint_residuals",
+    "check_positive",
+    "check_finite",
+    "FinitePoses",
+]
+
+Vec = tuple[float, float]
+Array = NDArray[np.float64]
+
+
+def check_finite(field_name: str, value: ArrayLike) -> NDArray[np.float64]:
+    """Return ``value`` as a float array or raise :class:`InputError` on NaN/inf (or what is not numbers)."""
+    if np.iscomplexobj(value):  # numpy would drop the imaginary part with only a warning
+        raise InputError(field_name, "complex numbers", "real numbers")
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(field_name, value, "numbers (a number or an array of them)") from None
+    # a sum is finite only if every term is (NaN and inf propagate); a finite array whose sum
+    # overflows is looked at element by element
+    if not np.isfinite(arr.sum()) and not np.all(np.isfinite(arr)):
+        raise InputError(field_name, value, "finite numbers")
+    return arr
+
+
+class FinitePoses(dict[str, "NDArray[np.float64]"]):
+    """Poses from a solver that screened every number it wrote (poses and named points) and found
+    them finite: :meth:`Mechanism.solve` skips its own finite screen for them."""
+
+
+def check_positive(field_name: str, value: float) -> float:
+    """Return ``value`` as float or raise :class:`InputError` unless a finite number > 0 (not a bool or a string)."""
+    if isinstance(value, (bool, str, bytes)) or isinstance(value, np.bool_):
+        raise InputError(field_name, value, "a positive number")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(field_name, value, "a positive number") from None
+    if not np.isfinite(v) or v <= 0.0:
+        raise InputError(field_name, value, "a positive, finite length")
+    return v
+
+
+def _vec(v: ArrayLike) -> Vec:
+    a = np.asarray(v, dtype=float).reshape(2)
+    return (float(a[0]), float(a[1]))
+
+
+# --------------------------------------------------------------------------
+# Parts and their features (exact geometry, in the part's own frame)
+# --------------------------------------------------------------------------
+
+
+from planar.core.features import ArcSlot, Hole, Slot  # noqa: E402  (re-exported: defined in planar.core.features)
+
+Feature = Hole | Slot | ArcSlot
+
+
+@dataclass(frozen=True, eq=False)
+class Part:
+    """A rigid part.
+
+    ``hull`` lists circles ``(x, y, r)`` whose convex hull is the outer
+    profile (the paper's recipe: convex hull around the joints, rounded); it
+    is exact geometry (lines tangent to arcs) for fabrication.  ``features``
+    are holes and slots cut from it.  ``plane`` names the plane the part moves
+    in (``"xy"`` for planar parts; wind-up mechanism #8 moves in ``"xz"``).
+    """
+
+    name: str
+    hull: tuple[tuple[float, float, float], ...]
+    features: tuple[Feature, ...] = ()
+    ground: bool = False
+    plane: str = "xy"
+    #: position along the normal of ``plane`` (e.g. x for a part moving in "yz")
+    offset: float = 0.0
+    #: an explicit outer polygon (own frame) replacing the rounded hull, if given
+    polygon: tuple[Vec, ...] | None = None
+
+    @cached_property
+    def outline(self) -> "shapely.Polygon":
+        """The outline as a shapely polygon with holes and slots cut out."""
+        from planar.core.outlines import part_outline
+
+        return part_outline(self)
+
+    @property
+    def area(self) -> float:
+        """Area of the outline in model units squared."""
+        return float(self.outline.area)
+
+
+# --------------------------------------------------------------------------
+# Joints: every kind joins part ``a`` to part ``b`` and declares itself
+# --------------------------------------------------------------------------
+
+#: every joint kind, by name (filled by :func:`joint_kind`)
+JOINT_KINDS: dict[str, type] = {}
+
+J = TypeVar("J", bound=type)
+
+
+def joint_kind(cls: J) -> J:
+    """Class decorator: register ``cls`` as a joint kind (ezdxf's ``register_entity`` pattern).
+
+    A joint kind is a frozen dataclass with ``name``, the two parts it joins
+    ``a`` and ``b`` (part names; ``a`` carries the track, slot, face or edge,
+    ``b`` the pin, block or cam riding on it; for a pivot they are
+    symmetric), a class attribute ``kind``, and the methods of
+    :class:`JointProtocol`.  Registering a name twice is a :class:`TypeError`.
+    """
+    name = cls.__dict__.get("kind")
+    if not isinstance(name, str):
+        raise TypeError(f"joint kind {cls.__name__} needs a class attribute 'kind'")
+    if name in JOINT_KINDS:
+        raise TypeError(f"double registration for joint kind {name!r}")
+    for attr in ("residual", "features", "pins"):
+        if not callable(getattr(cls, attr, None)):
+            raise TypeError(f"joint kind {name!r} has no method {attr!r}")
+    JOINT_KINDS[name] = cls
+    return cls
+
+
+class JointProtocol(Protocol):
+    """What every joint kind states, one uniform way (pymunk's ``a`` and ``b``)."""
+
+    kind: ClassVar[str]
+    name: str
+    a: str
+    b: str
+
+    def residual(self, poses: Mapping[str, Array]) -> Array:
+        """How far the joint is from closing, per sample (model units, >= 0)."""
+        ...
+
+    def features(self) -> tuple[tuple[str, Feature], ...]:
+        """``(part, feature)``: the holes and slots this joint cuts into its parts (own frames)."""
+        ...
+
+    def pins(self) -> tuple[tuple[str, Vec], ...]:
+        """``(part, point)``: where the joint's pins sit (own frames), for drawing."""
+        ...
+
+
+Joint = JointProtocol
+
+
+def _pose(poses: Mapping[str, Array], part: str) -> Array:
+    return poses[part]
+
+
+def _point_line_distance(p: Array, a: Array, b: Array) -> Array:
+    """Signed distance of ``p`` from the line ``a -> b`` (left positive); ``(N,)``."""
+    d = b - a
+    n = np.hypot(d[..., 0], d[..., 1])
+    w = p - a
+    return (d[..., 0] * w[..., 1] - d[..., 1] * w[..., 0]) / n
+
+
+@joint_kind
+@dataclass(frozen=True)
+class Pivot:
+    """Revolute joint: point ``anchor_a`` of part ``a`` coincides with ``anchor_b`` of ``b``.
+
+    ``diameter`` (model units), when given, is the pin: the joint then puts a
+    pin hole on both parts; ``None`` leaves the holes to the part's builder.
+    """
+
+    kind: ClassVar[str] = "pivot"
+    name: str
+    a: str
+    b: str
+    anchor_a: Vec
+    anchor_b: Vec
+    diameter: float | None = None
+
+    def residual(self, poses: Mapping[str, Array]) -> Array:
+        """Distance between the two anchor points, per sample."""
+        pa = poses_apply(_pose(poses, self.a), self.anchor_a)
+        pb = poses_apply(_pose(poses, self.b), self.anchor_b)
+        return np.hypot(*(pa - pb).T)
+
+    def features(self) -> tuple[tuple[str, Feature], ...]:
+        if self.diameter is None:
+            return ()
+        return ((self.a, Hole(self.anchor_a, self.diameter, "pin")), (self.b, Hole(self.anchor_b, self.diameter, "pin")))
+
+    def pins(self) -> tuple[tuple[str, Vec], ...]:
+        return ((self.a, self.anchor_a),)
+
+
+@joint_kind
+@dataclass(frozen=True)
+class PinInSlot:
+    """A pin at ``pin`` on part ``b`` runs in a straight slot ``start -> end`` of part ``a``.
+
+    The residual is the pin's distance from the slot's centre line, plus how
+    far it has left the slot's length (so a slot that is too short shows).
+    ``width``, when given, is the slot's width (the pin's diameter): the joint
+    then cuts the slot in ``a`` and the pin hole in ``b``.
+    """
+
+    kind: ClassVar[str] = "pin-in-slot"
+    name: str
+    a: str
+    b: str
+    start: Vec
+    end: Vec
+    pin: Vec
+    width: float | None = None
+
+    def residual(self, poses: Mapping[str, Array]) -> Array:
+        p = poses_apply(_pose(poses, self.b), self.pin)
+        s0 = poses_apply(_pose(poses, self.a), self.start)
+        s1 = poses_apply(_pose(poses, self.a), self.end)
+        off = np.abs(_point_line_distance(p, s0, s1))
+        d = s1 - s0
+        L = np.hypot(d[..., 0], d[..., 1])
+        s = ((p - s0) * d).sum(-1) / L
+        beyond = np.maximum(0.0, np.maximum(-s, s - L))
+        return np.hypot(off, beyond)
+
+    def features(self) -> tuple[tuple[str, Feature], ...]:
+        if self.width is None:
+            return ()
+        return ((self.a, Slot(self.start, self.end, self.width, "pin")), (self.b, Hole(self.pin, self.width, "pin")))
+
+    def pins(self) -> tuple[tuple[str, Vec], ...]:
+        return ((self.b, self.pin),)
+
+
+@joint_kind
+@dataclass(frozen=True)
+class PinInArcSlot:
+    """A pin at ``pin`` on part ``b`` in an arc slot of part ``a`` (``centre``, mid-radius ``radius``).
+
+    Kinematically the same as a pivot on a link of length ``radius`` about
+    ``centre`` (reference file); the residual is ``| |pin - centre| - radius |``.
+    The arc slot itself is cut by the part's builder (it knows the travel).
+    """
+
+    kind: ClassVar[str] = "pin-in-arc-slot"
+    name: str
+    a: str
+    b: str
+    centre: Vec
+    radius: float
+    pin: Vec
+
+    def residual(self, poses: Mapping[str, Array]) -> Array:
+        p = poses_apply(_pose(poses, self.b), self.pin)
+        c = poses_apply(_pose(poses, self.a), self.centre)
+        return np.abs(np.hypot(*(p - c).T) - self.radius)
+
+    def features(self) -> tuple[tuple[str, Feature], ...]:
+        return ()
+
+    def pins(self) -> tuple[tuple[str, Vec], ...]:
+        return ((self.b, self.pin),)
+
+
+@joint_kind
+@dataclass(frozen=True)
+class Slide:
+    """Prismatic joint: part ``b`` translates along the line ``start -> end`` of part ``a`` without turning.
+
+    Realised as two pins of ``b`` (``anchor`` and ``anchor + axis``, with
+    ``axis`` a vector in ``b``'s frame) sliding in one straight slot
+    ``start -> end`` of ``a`` (the paper's support kind (h)).  The residual
+    is the larger of the two pins' distances from the slot line.  ``width``,
+    when given, is the slot's width: the joint then cuts the slot in ``a`` and
+    the two pin holes in ``b``.
+    """
+
+    kind: ClassVar[str] = "slide"
+    name: str
+    a: str
+    b: str
+    start: Vec
+    end: Vec
+    anchor: Vec
+    axis: Vec
+    width: float | None = None
+
+    def pin_points(self) -> tuple[Vec, Vec]:
+        """The two pins of ``b`` in its own frame: ``anchor`` and ``anchor + axis``."""
+        return self.anchor, (self.anchor[0] + self.axis[0], self.anchor[1] + self.axis[1])
+
+    def residual(self, poses: Mapping[str, Array]) -> Array:
+        q = _pose(poses, self.b)
+        p1, p2 = (poses_apply(q, p) for p in self.pin_points())
+        s0 = poses_apply(_pose(poses, self.a), self.start)
+        s1 = poses_apply(_pose(poses, self.a), self.end)
+        return np.maximum(np.abs(_point_line_distance(p1, s0, s1)), np.abs(_point_line_distance(p2, s0, s1)))
+
+    def features(self) -> tuple[tuple[str, Feature], ...]:
+        if self.width is None:
+            return ()
+        p1, p2 = self.pin_points()
+        return ((self.a, Slot(self.start, self.end, self.width, "pin")),
+                (self.b, Hole(p1, self.width, "pin")), (self.b, Hole(p2, self.width, "pin")))
+
+    def pins(self) -> tuple[tuple[str, Vec], ...]:
+        return tuple((self.b, p) for p in self.pin_points())
+
+
+@joint_kind
+@dataclass(frozen=True)
+class CamOnLine:
+    """A round cam (``centre``, ``radius`` on part ``b``) touching a flat face of part ``a``.
+
+    The face is the line ``start -> end`` on ``a``; the residual is
+    ``| distance(centre, line) - radius |``.
+    """
+
+    kind: ClassVar[str] = "cam-on-line"
+    name: str
+    a: str
+    b: str
+    start: Vec
+    end: Vec
+    centre: Vec
+    radius: float
+
+    def residual(self, poses: Mapping[str, Array]) -> Array:
+        c = poses_apply(_pose(poses, self.b), self.centre)
+        s0 = poses_apply(_pose(poses, self.a), self.start)
+        s1 = poses_apply(_pose(poses, self.a), self.end)
+        return np.abs(np.abs(_point_line_distance(c, s0, s1)) - self.radius)
+
+    def features(self) -> tuple[tuple[str, Feature], ...]:
+        return ()
+
+    def pins(self) -> tuple[tuple[str, Vec], ...]:
+        return ((self.b, self.centre),)
+
+
+# --------------------------------------------------------------------------
+# Driver
+# --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Driver:
+    """The single input of a mechanism.
+
+    ``kind`` is ``"rotation"`` (value in radians, counter-clockwise, about
+    ``origin`` of the ground) or ``"translation"`` (value in model units along
+    the unit ``axis``).  ``rate`` is the angular frequency in rad/s.  Over
+    time ``t`` (seconds) the driver value is
+
+    * full rotation (``amplitude is None``): ``phase + rate * t``; for
+      ``kind="path"`` this is the phase of a closed driver path (an OzT
+      driver's step) that the mechanism maps to a pose;
+    * oscillation: ``centre + amplitude * sin(rate * t + phase)``.
+    """
+
+    part: str
+    kind: Literal["rotation", "translation", "path"] = "rotation"
+    origin: Vec = (0.0, 0.0)
+    axis: Vec = (1.0, 0.0)
+    rate: float = 2.0 * np.pi
+    phase: float = 0.0
+    amplitude: float | None = None
+    centre: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.kind not in ("rotation", "translation", "path"):
+            raise InputError("driver.kind", self.kind, "'rotation', 'translation' or 'path'")
+        check_positive("driver.rate", self.rate)
+        if self.kind == "translation" and self.amplitude is None:
+            raise InputError("driver.amplitude", None, "a stroke amplitude for a translation driver")
+
+    @property
+    def period(self) -> float:
+        """Seconds per cycle."""
+        return 2.0 * np.pi / self.rate
+
+    def value(self, t: ArrayLike) -> Array:
+        """Driver value at times ``t`` (s)."""
+        t = np.asarray(t, dtype=float)
+        if self.amplitude is None:
+            return self.phase + self.rate * t
+        return self.centre + self.amplitude * np.sin(self.rate * t + self.phase)
+
+    def speed(self, t: ArrayLike) -> Array:
+        """Time derivative of :meth:`value` (rad/s or units/s)."""
+        t = np.asarray(t, dtype=float)
+        if self.amplitude is None:
+            return np.full_like(t, self.rate)
+        return self.amplitude * self.rate * np.cos(self.rate * t + self.phase)
+
+    def times(self, samples_per_cycle: int = 360, cycles: float = 1.0) -> Array:
+        """Sample times covering ``cycles`` periods, end point excluded."""
+        from planar.core.limits import sample_count
+
+        n = sample_count(samples_per_cycle, cycles)  # finite, positive and within PLANAR_MAX_SAMPLES
+        if n < 1:
+            raise InputError("samples_per_cycle", samples_per_cycle, "at least one sample")
+        return np.arange(n, dtype=np.float64) * (self.period / samples_per_cycle)
+
+
+# --------------------------------------------------------------------------
+# Motion
+# --------------------------------------------------------------------------
+
+
+@dataclass
+class Motion:
+    """Poses of every part over a batch of driver values.
+
+    ``poses[part]`` is ``(N, 3)``: ``x, y, angle`` of the part's frame in the
+    world.  ``valid`` is ``(N,)``.  ``fail_code[i]`` indexes ``fail_table``
+    (``-1`` where valid); each table entry is ``(joint, why)``.  Invalid
+    samples hold finite, nearest-real poses (never NaN) so they can be drawn
+    and marked.
+    """
+
+    driver: Array
+    poses: dict[str, Array]
+    valid: NDArray[np.bool_]
+    fail_code: NDArray[np.int16]
+    fail_table: list[tuple[str, str]] = field(default_factory=list)
+    points: dict[str, Array] = field(default_factory=dict)
+    t: Array | None = None
+
+    def __len__(self) -> int:
+        return int(self.driver.shape[0])
+
+    def reason(self, i: int) -> str:
+        """Why sample ``i`` is invalid (empty string when it is valid)."""
+        code = int(self.fail_code[i])
+        if code < 0:
+            return ""
+        joint, why = self.fail_table[code]
+        return f"joint {joint!r} cannot close at driver value {self.driver[i]:.6g}: {why}"
+
+    def failures(self) -> list[tuple[int, float, str, str]]:
+        """``(index, driver value, joint, why)`` for every invalid sample."""
+        idx = np.flatnonzero(~self.valid)
+        return [
+            (int(i), float(self.driver[i]), *self.fail_table[int(self.fail_code[i])]) for i in idx
+        ]
+
+    def take(self, index: ArrayLike) -> Motion:
+        """The samples ``index`` (an index array or boolean mask) as a new motion."""
+        idx = np.asarray(index)
+        return Motion(
+            driver=self.driver[idx],
+            poses={k: v[idx] for k, v in self.poses.items()},
+            valid=self.valid[idx],
+            fail_code=self.fail_code[idx],
+            fail_table=list(self.fail_table),
+            points={k: v[idx] for k, v in self.points.items()},
+            t=None if self.t is None else self.t[idx],
+        )
+
+    @property
+    def failed_joints(self) -> set[str]:
+        """Names of the joints that failed anywhere."""
+        codes = np.unique(self.fail_code[self.fail_code >= 0])
+        return {self.fail_table[int(c)][0] for c in codes}
+
+
+def merge_failures(
+    n: int, checks: Sequence[tuple[NDArray[np.bool_], str, str]]
+) -> tuple[NDArray[np.bool_], NDArray[np.int16], list[tuple[str, str]]]:
+    """Combine per-joint validity masks into (valid, fail_code, fail_table).
+
+    ``checks`` holds ``(valid_mask, joint, why)`` in solve order; a sample's
+    failure is attributed to the *first* joint that could not close.
+    """
+    valid = np.ones(n, dtype=bool)
+    code = np.full(n, -1, dtype=np.int16)
+    table: list[tuple[str, str]] = []
+    for mask, joint, why in checks:
+        bad = ~np.asarray(mask, dtype=bool) & valid
+        if bad.any():
+            code[bad] = len(table)
+            table.append((joint, why))
+            valid &= ~bad
+    return valid, code, table
+
+
+# --------------------------------------------------------------------------
+# Mechanism
+# --------------------------------------------------------------------------
+
+
+class Mechanism:
+    """Base class of every mechanism: parts, joints, a driver, named points.
+
+    Subclasses implement :meth:`_solve_poses`.  ``points`` maps a name (a
+    coupler point, a foot) to ``(part, (x, y))`` in that part's frame.
+    """
+
+    name: str
+    parts: tuple[Part, ...]
+    joints: tuple[JointProtocol, ...]
+    driver: Driver
+    points: dict[str, tuple[str, Vec]]
+
+    def __init__(
+        self,
+        name: str,
+        parts: Sequence[Part],
+        joints: Sequence[Any],
+        driver: Driver,
+        points: Mapping[str, tuple[str, Vec]] | None = None,
+    ) -> None:
+        self.name = name
+        self.parts = tuple(parts)
+        self.joints = tuple(joints)
+        self.driver = driver
+        self.points = dict(points or {})
+        names = [p.name for p in self.parts]
+        if len(set(names)) != len(names):
+            raise InputError(f"{name}.parts", names, "unique part names")
+        for pname, (part, _) in self.points.items():
+            if part not in names:
+                raise InputError(f"{name}.points.{pname}", part, f"one of the parts {names}")
+            if pname in names:
+                raise InputError(f"{name}.points", pname, "a point name that no part has (tables name columns by both)")
+        self._check_joints(names)
+        self.parts = _with_joint_features(self.parts, self.joints)
+
+    def _check_joints(self, names: list[str]) -> None:
+        """Every joint is of a registered kind and joins two existing parts."""
+        seen: set[str] = set()
+        for j in self.joints:
+            cls = type(j)
+            kname = cls.__dict__.get("kind")
+            if not isinstance(kname, str) or JOINT_KINDS.get(kname) is not cls:
+                raise InputError(f"{self.name}.joints.{getattr(j, 'name', '?')}", cls.__name__,
+                                 f"a registered joint kind, one of {sorted(JOINT_KINDS)}")
+            if j.name in seen:
+                raise InputError(f"{self.name}.joints", j.name, "unique joint names")
+            seen.add(j.name)
+            for side in ("a", "b"):
+                if getattr(j, side) not in names:
+                    raise InputError(f"{self.name}.joints.{j.name}.{side}", getattr(j, side),
+                                     f"one of the parts {names}")
+
+    # -- to implement ------------------------------------------------------
+    def _solve_poses(
+        self, q: Array
+    ) -> tuple[dict[str, Array], list[tuple[NDArray[np.bool_], str, str]]]:
+        """Poses for driver values ``q`` and the per-joint validity checks."""
+        raise NotImplementedError
+
+    # -- shared ------------------------------------------------------------
+    def part(self, name: str) -> Part:
+        """The part called ``name``."""
+        for p in self.parts:
+            if p.name == name:
+                return p
+        raise InputError(f"{self.name}.part", name, f"one of {[p.name for p in self.parts]}")
+
+    def solve(self, q: ArrayLike, t: ArrayLike | None = None) -> Motion:
+        """Solve all samples at once for driver values ``q`` (scalar or array)."""
+        if isinstance(q, np.ma.MaskedArray) or np.asarray(q).dtype == bool:
+            raise InputError(f"{self.name}.solve(q)", f"a {'masked' if isinstance(q, np.ma.MaskedArray) else 'bool'}"
+                             " array", "plain driver values (a masked array: pass q[~q.mask] or q.filled(v))")
+        from planar.core.limits import check_count
+
+        check_count("samples", f"{self.name}.solve(q)", float(np.size(q)), "samples of one motion",
+                    shown=f"{np.size(q):,} driver values")
+        qin = np.atleast_1d(check_finite(f"{self.name}.driver value", q))
+        qa = new_block(qin.shape)  # the motion's own copy (recycled memory for a large batch)
+        np.copyto(qa, qin)
+        if qa.ndim != 1:  # an OzT driver's path is a function of its 1-D driver value too
+            raise InputError(f"{self.name}.solve(q)", f"an array of shape {qa.shape}",
+                             "a scalar or a 1-D array of driver values")
+        if t is not None and np.shape(t) != qa.shape[:1]:
+            raise InputError(f"{self.name}.solve(t)", f"an array of shape {np.shape(t)}",
+                             f"one time per driver value (shape {qa.shape[:1]})")
+        poses, checks, pts = self._solve_points(qa)
+        n = qa.shape[0]
+        for p in self.parts:  # the ground never moves: its track is one row seen n times (read-only, no memory)
+            g = poses.get(p.name)
+            if p.ground and g is not None and n and g.ndim == 2 and g.strides[0] != 0:
+                poses[p.name] = np.broadcast_to(g[0].copy(), g.shape)
+        table: list[tuple[str, str]] = []
+        if pts is None:
+            pts = {name: poses_apply(poses[part], xy) for name, (part, xy) in self.points.items()}
+        # the final finite check: a sample whose numbers overflowed float64 is never valid (and holds 0, not NaN)
+        finite = np.ones(n, dtype=bool)
+        for arr in () if isinstance(poses, FinitePoses) else (*poses.values(), *pts.values()):
+            if arr.ndim == 2 and arr.strides[0] == 0:  # one row seen n times (the ground)
+                finite &= bool(np.isfinite(arr[:1]).all())
+            elif not np.isfinite(arr.sum()):  # a cheap screen (a sum of finite numbers may overflow: look closer)
+                finite &= np.isfinite(arr).reshape(n, -1).all(axis=1)
+        if not finite.all():
+            checks = list(checks or []) + [(finite, "result", "a number overflowed float64 (non-finite result)")]
+            poses = {k: np.nan_to_num(v, nan=0.0, posinf=0.0, neginf=0.0) for k, v in poses.items()}
+            pts = {k: np.nan_to_num(v, nan=0.0, posinf=0.0, neginf=0.0) for k, v in pts.items()}
+        if checks is None:  # every sample closes
+            valid, code = np.ones(n, dtype=bool), np.full(n, -1, dtype=np.int16)
+        else:
+            valid, code, table = merge_failures(n, checks)
+        return Motion(
+            driver=qa,
+            poses=poses,
+            valid=valid,
+            fail_code=code,
+            fail_table=table,
+            points=pts,
+            t=None if t is None else np.asarray(t, dtype=float),
+        )
+
+    def _solve_points(
+        self, q: Array
+    ) -> tuple[dict[str, Array], list[tuple[NDArray[np.bool_], str, str]] | None, dict[str, Array] | None]:
+        """Poses, validity checks (``None``: every sample closes) and named points (``None``: from the poses).
+
+        A subclass with a faster path than :meth:`_solve_poses` overrides this.
+        """
+        poses, checks = self._solve_poses(q)
+        return poses, checks, None
+
+    def run(self, samples_per_cycle: int = 360, cycles: float = 1.0) -> Motion:
+        """Solve over time with the driver's law (``cycles`` periods)."""
+        t = self.driver.times(samples_per_cycle, cycles)
+        return self.solve(self.driver.value(t), t=t)
+
+    @cached_property
+    def size(self) -> float:
+        """The mechanism's characteristic length, the denominator of every "error / size" figure.
+
+        Defined once, here: the largest diameter of any part, i.e. the
+        largest distance between two points of one part's hull,
+        ``max |c_i - c_j| + r_i + r_j`` over the hull circles ``(c, r)`` of
+        each part (its own frame, so it does not depend on the pose).  Model
+        units; 1.0 for a mechanism with no hulls.
+        """
+        best = 0.0
+        for p in self.parts:
+            if p.hull:
+                h = np.asarray(p.hull, dtype=float)
+                d = np.hypot(h[:, None, 0] - h[None, :, 0], h[:, None, 1] - h[None, :, 1])
+                best = max(best, float((d + h[:, None, 2] + h[None, :, 2]).max()))
+        return best or 1.0
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} {self.name!r}: {len(self.parts)} parts, {len(self.joints)} joints>"
+
+
+def _with_joint_features(parts: tuple[Part, ...], joints: Sequence[Any]) -> tuple[Part, ...]:
+    """``parts`` with every feature their joints declare added (once; a feature already there is kept)."""
+    extra: dict[str, list[Feature]] = {}
+    for j in joints:
+        for part, feat in j.features():
+            extra.setdefault(part, []).append(feat)
+    if not extra:
+        return parts
+    out = []
+    for p in parts:
+        add = [f for f in dict.fromkeys(extra.get(p.name, ())) if f not in p.features]
+        out.append(replace(p, features=p.features + tuple(add)) if add else p)
+    return tuple(out)
+
+
+def joint_residuals(mech: Mechanism, motion: Motion) -> dict[str, Array]:
+    """Residual (model units) of every joint of ``mech`` on every sample of ``motion``."""
+    return {j.name: np.asarray(j.residual(motion.poses)) for j in mech.joints}

@@ -1,0 +1,175 @@
+"""Animation timing: which instants become frames, and how long each frame shows.
+
+A GIF frame lasts a whole number of 10 ms ticks (at least 20 ms: browsers
+play shorter delays as 100 ms), so an animation plays at the scene's speed
+only if the frames are *resampled* to the frame rate, not one frame per
+motion sample.  :func:`plan_frames` picks the frames of one cycle so that a
+cycle plays within one frame delay of its period; :func:`animation_motion`
+solves the mechanism at those instants.
+
+The motion is solved on a grid at least as fine as the scene's own samples
+(the frames are every ``m``-th point of it), so a branch is carried by
+continuity exactly as in ``planar motion``; the trails are drawn from that
+fine grid.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from planar.core.model import Motion
+from planar.errors import InputError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from planar.scene.load import Scene
+
+__all__ = ["FramePlan", "plan_frames", "scene_duration", "animation_motion", "resample", "MAX_FRAMES",
+           "DEFAULT_DELAY_MS"]
+
+#: default frame delay: 25 frames per second
+DEFAULT_DELAY_MS = 40
+#: at least this many frames per cycle before the default falls back to 20 ms frames (50 per second)
+MIN_FRAMES_PER_CYCLE = 12
+#: fewest frames of one cycle (an explicit --fps giving fewer is refused; a cycle too fast for a GIF plays slower)
+MIN_FRAMES_ASKED = 4
+#: an animation longer than this many frames is refused before anything is drawn
+MAX_FRAMES = 20_000
+
+
+@dataclass(frozen=True)
+class FramePlan:
+    """Frames of an animation.
+
+    ``frames_per_cycle`` frames sample one driver period uniformly (the last
+    frame of a cycle is followed by the first of the next, so a one-cycle
+    animation loops without a seam); each shows for ``delay_ms``.  One cycle
+    plays for ``frames_per_cycle * delay_ms``, within ``delay_ms / 2`` of
+    ``period_s`` (the rounding to whole frames).
+    """
+
+    period_s: float
+    delay_ms: float
+    frames_per_cycle: int
+    frames: int
+
+    @property
+    def fps(self) -> float:
+        """Frames per second actually played."""
+        return 1000.0 / self.delay_ms
+
+    @property
+    def cycle_play_s(self) -> float:
+        """How long one cycle plays, seconds."""
+        return self.frames_per_cycle * self.delay_ms / 1000.0
+
+    @property
+    def slowdown(self) -> float:
+        """How much slower than the scene's speed the animation plays (1: at speed)."""
+        return self.cycle_play_s / self.period_s
+
+    def note(self) -> str:
+        """A one-line note when a cycle plays more than one frame delay away from its period, else ``""``."""
+        if abs(self.cycle_play_s - self.period_s) <= self.delay_ms / 1000.0:
+            return ""
+        return (f"a cycle of {self.period_s:.3g} s plays in {self.cycle_play_s:.3g} s ({self.slowdown:.3g}x slower: "
+                f"{self.frames_per_cycle} frames of {self.delay_ms:g} ms, the fewest that show the motion at the "
+                "fastest rate a GIF plays; an .mp4 plays it at speed)")
+
+    def times(self) -> np.ndarray:
+        """The motion time (s) of each frame."""
+        return np.arange(self.frames, dtype=np.float64) * (self.period_s / self.frames_per_cycle)
+
+
+def plan_frames(period_s: float, duration_s: float, fps: float | None = None, tick_ms: float | None = 10.0) -> FramePlan:
+    """The frames that play ``duration_s`` of motion (period ``period_s``) at the scene's speed.
+
+    ``fps``: frames per second asked for; the delay is ``1000 / fps`` rounded
+    to a whole number of ``tick_ms`` (GIF: 10 ms, at least 20 ms, so at most
+    50 frames per second; ``tick_ms=None``: video, any rate).  By default
+    25 frames per second, or 50 (video: 12 frames a cycle) when a cycle would
+    otherwise get fewer than 12 frames; a cycle gets at least 4 frames, so a
+    cycle faster than 80 ms plays slower in a GIF (:meth:`FramePlan.note`).
+    Raises :class:`InputError` for a rate a GIF cannot play, an ``fps`` that
+    gives fewer than 4 frames a cycle, or more than :data:`MAX_FRAMES` frames.
+    """
+    if not (math.isfinite(period_s) and period_s > 0):
+        raise InputError("speed", period_s, "a finite, positive speed (cycles per second)")
+    if not (math.isfinite(duration_s) and duration_s > 0):
+        raise InputError("duration", duration_s, "a finite, positive duration (or number of cycles)")
+    if fps is not None:
+        if not (math.isfinite(fps) and fps > 0):
+            raise InputError("--fps", fps, "a positive number of frames per second")
+        delay = 1000.0 / fps
+        if tick_ms is not None:
+            delay = round(delay / tick_ms) * tick_ms
+            if fps > 50 or delay < 20:
+                raise InputError("--fps", fps, "at most 50 frames per second in a GIF (browsers slow shorter "
+                                               "frame delays than 20 ms)")
+        if period_s * 1000.0 / delay < MIN_FRAMES_ASKED:
+            raise InputError("--fps", fps, f"at least {MIN_FRAMES_ASKED} frames per cycle: {MIN_FRAMES_ASKED / period_s:.3g} "
+                                           f"frames per second or more for a cycle of {period_s:.3g} s")
+    else:
+        delay = float(DEFAULT_DELAY_MS)
+        if 1000.0 * period_s / delay < MIN_FRAMES_PER_CYCLE:
+            delay = 20.0 if tick_ms is not None else 1000.0 * period_s / MIN_FRAMES_PER_CYCLE
+    per_cycle = max(MIN_FRAMES_ASKED, int(round(1000.0 * period_s / delay)))
+    frames = max(1, int(round(per_cycle * duration_s / period_s)))
+    from planar.core.limits import limit
+
+    if frames > limit("frames"):  # MAX_FRAMES unless PLANAR_MAX_FRAMES raises it
+        raise InputError("duration", duration_s, f"an animation of at most {limit('frames')} frames ({frames} asked "
+                                                 f"for at {1000.0 / delay:.3g} frames per second; shorten the duration, "
+                                                 "lower --fps or raise PLANAR_MAX_FRAMES)")
+    return FramePlan(float(period_s), float(delay), per_cycle, frames)
+
+
+def scene_duration(scene: Scene) -> float:
+    """Seconds of motion the scene asks for (``duration``, or ``cycles`` periods; one cycle by default)."""
+    d = scene.spec.driver
+    if d.duration is not None:
+        return float(d.duration)
+    return float(d.cycles if d.cycles is not None else 1.0) * scene.mechanism.driver.period
+
+
+def animation_motion(scene: Scene, plan: FramePlan) -> tuple[Motion, Motion]:
+    """``(frames, fine)``: the motion at the frames of ``plan`` and on the fine grid they are taken from.
+
+    The fine grid has at least the scene's ``samples_per_cycle`` per cycle and
+    holds every frame instant, so branch continuity is what the scene's own
+    motion has; the trails are drawn from it.
+    """
+    drv = scene.mechanism.driver
+    m = max(1, math.ceil(scene.spec.driver.samples_per_cycle / plan.frames_per_cycle))
+    t = np.arange(plan.frames * m, dtype=np.float64) * (plan.period_s / (plan.frames_per_cycle * m))
+    fine = scene.mechanism.solve(drv.value(t), t=t)
+    return fine.take(np.arange(plan.frames) * m), fine
+
+
+def resample(motion: Motion, t: np.ndarray) -> Motion:
+    """``motion`` (with times) interpolated linearly to the times ``t`` (angles unwrapped first).
+
+    For drawing a simulated motion over the analytic one at the frame
+    instants; a sample is valid if both neighbours are.
+    """
+    if motion.t is None:
+        raise InputError("motion.t", None, "a motion with sample times")
+    src = motion.t
+    t = np.asarray(t, dtype=np.float64)
+
+    def lerp(v: np.ndarray) -> np.ndarray:
+        return np.stack([np.interp(t, src, v[:, k]) for k in range(v.shape[1])], axis=1)
+
+    poses = {}
+    for k, v in motion.poses.items():
+        u = v.copy()
+        u[:, 2] = np.unwrap(u[:, 2])
+        poses[k] = lerp(u)
+    j = np.clip(np.searchsorted(src, t), 1, len(src) - 1)
+    valid = motion.valid[j] & motion.valid[j - 1]
+    code = np.where(valid, -1, np.maximum(motion.fail_code[j], motion.fail_code[j - 1])).astype(np.int16)
+    return Motion(driver=np.interp(t, src, motion.driver), poses=poses, valid=valid, fail_code=code,
+                  fail_table=list(motion.fail_table), points={k: lerp(v) for k, v in motion.points.items()}, t=t)

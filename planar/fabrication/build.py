@@ -1,0 +1,303 @@
+"""Everything cut for a scene, decided: parts checked, lettered, layered, tabbed and nested (no file written).
+
+:func:`build` turns a scene into a :class:`Fabrication`; :mod:`planar.app.export` writes it.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from planar.errors import InputError
+from planar.fabrication.joints import joint_pins, pin_features
+from planar.fabrication.layers import Assembly, letter, pin_stacks, plan_assembly
+from planar.fabrication.nesting import nest
+from planar.fabrication.parts import FabSettings, nominal_material, part_cuts
+from planar.fabrication.sheet import Circle, Layout, PartCut
+
+__all__ = ["Fabrication", "build", "kerf_test_layout", "sheet_paths", "summary"]
+
+
+@dataclass
+class Fabrication:
+    name: str
+    settings: FabSettings
+    layout: Layout
+    assembly: Assembly
+    notes: list[str] = field(default_factory=list)
+    #: the pin that is the motor shaft (joint name), if any
+    shaft: str | None = None
+    #: each part's material (outline minus cuts, mm) in its own frame
+    own: dict[str, Any] = field(default_factory=dict)
+    #: the ground plates (with mounting holes)
+    grounds: list[str] = field(default_factory=list)
+    #: files written by :func:`write_outputs`
+    written: list[Path] = field(default_factory=list)
+    #: tab-and-slot joints of pieces standing perpendicular to the xy stack (:mod:`planar.fabrication.tabs`)
+    joins: list[Any] = field(default_factory=list)
+    #: where the xy stack's lower face lies along the model's z (mm), for the pieces standing perpendicular
+    stack_z: float = 0.0
+    #: each perpendicular piece's plane position (mm: world y for xz, x for yz)
+    planes: dict[str, float] = field(default_factory=dict)
+    #: motions the cut parts will not make (a toy's cam throw or effector stroke under a few times the fit's
+    #: play: :func:`planar.toys.fitcheck.small_motions`), one line each
+    warnings: list[str] = field(default_factory=list)
+
+
+def _shaft_pin(mech: Any, pins) -> Any:
+    drv = mech.driver
+    if drv.kind != "rotation":
+        return None
+    ground = {p.name for p in mech.parts if p.ground}
+    for pin in pins:
+        if drv.part in pin.parts and (set(pin.parts) - {drv.part}) <= ground and pin.kinds == ("hole", "hole"):
+            return pin
+    return None
+
+
+def _fab_mechanism(mech: Any) -> Any:
+    """The mechanism whose parts are cut: a wind-up toy is cut as its assembly (merged parts, one frame,
+    cams keyed to the shaft; :mod:`planar.toys.assembly`), anything else as it is; pieces standing
+    perpendicular to the xy stack get brackets and lose repeated guides (:func:`planar.fabrication.tabs.fab_view`)."""
+    from planar.fabrication.tabs import fab_view
+    from planar.windup.chain import ToyMechanism
+
+    if isinstance(mech, ToyMechanism):
+        from planar.toys.assembly import toy_assembly
+
+        return fab_view(toy_assembly(mech))
+    return fab_view(mech)
+
+
+def _phase_mark(pc: PartCut, at: tuple[float, float], flat: float, phase: float, turn: float = 0.0) -> None:
+    """Engrave a keyed cam's key angle: a tick from its shaft hole along the D's flat and the angle in degrees
+    (``phase``, rad: the cam's phase plus ``turn``, its root stage's own turn; the note names both)."""
+    import numpy as np
+
+    from planar.fabrication.strokefont import text_strokes
+
+    c, s = math.cos(flat), math.sin(flat)
+    pc.engrave.append(np.array([(at[0] + 2.5 * c, at[1] + 2.5 * s), (at[0] + 5.0 * c, at[1] + 5.0 * s)]))
+    deg = f"{math.degrees(phase) % 360:.0f}"
+    pc.engrave.extend(text_strokes(deg, 1.5, (at[0] - 3.5 * c, at[1] - 3.5 * s), flat - math.pi / 2))
+    own = f"{math.degrees(turn) % 360:.0f}"
+    cam = f"{math.degrees(phase - turn) % 360:.0f}"
+    why = f" = cam phase {cam} + the stage's own turn {own}" if own != "0" else ""
+    pc.notes.append(f"{pc.name}: keyed to the motor shaft at {deg} degrees{why} (engraved tick along the D's flat)")
+
+
+def build(scene: Any, settings: FabSettings) -> Fabrication:
+    """Cut-ready, checked, layered and nested parts of ``scene`` (raises FabricationError/InputError)."""
+    s = settings
+    if not (0 <= s.kerf <= 2):
+        raise InputError("kerf", s.kerf, "a kerf between 0 and 2 mm")
+    from planar.fabrication.tabs import merge_travel, plan_tabs, slot_features, travel_slots
+
+    mech = _fab_mechanism(scene.mechanism)
+    keyed: dict[str, float] = dict(getattr(mech, "keyed", {}))
+    pins, contacts = joint_pins(mech)
+    pinned = pin_features(mech)
+    shaft = _shaft_pin(mech, pins)
+    notes: list[str] = list(getattr(mech, "design_notes", ()))  # what a mechanism reports of its own design
+    notes += list(getattr(mech, "notes", []))
+    if mech.driver.kind != "rotation":
+        notes.append(f"driver {mech.driver.part!r} is a {mech.driver.kind} drive: no motor shaft hole")
+    elif shaft is None:
+        notes.append(f"driver {mech.driver.part!r}: no pin to the ground on its axis, no motor shaft hole")
+    letters: dict[str, list[tuple[tuple[float, float], str]]] = {p.name: [] for p in mech.parts}
+    for k, stack in enumerate(pin_stacks(pins)):
+        marked: set[tuple[str, tuple[float, float]]] = set()
+        for i in stack:
+            pin = pins[i]
+            for side in (0, 1):
+                key = (pin.parts[side], pin.at[side])
+                if pin.kinds[side] == "hole" and pin is not shaft and key not in marked:
+                    marked.add(key)
+                    letters[pin.parts[side]].append((pin.at[side], letter(k)))
+
+    cut_cache: dict[Any, PartCut] = {}
+
+    def cut_all(joins: list[Any], travel: dict[str, list[Any]]) -> tuple[list[PartCut], list[str]]:
+        slots = slot_features(joins)
+        for k_, v_ in travel.items():
+            slots[k_] = slots.get(k_, []) + v_
+        tab_of = {jn.piece: jn for jn in joins}
+        cuts: list[PartCut] = []
+        part_notes: list[str] = []
+        for n, part in enumerate(mech.parts, start=1):
+            drive_at = motor_at = None
+            if shaft is not None and part.name in shaft.parts:
+                k = shaft.parts.index(part.name)
+                if part.name == mech.driver.part:
+                    drive_at = shaft.at[k]
+                else:
+                    motor_at = shaft.at[k]
+            flat = math.pi / 2
+            if shaft is not None and part.name in keyed:  # a toy's cam: a D on the shaft, turned by its phase
+                drive_at, flat = (0.0, 0.0), math.pi / 2 - keyed[part.name]
+            extra = tuple(slots.get(part.name, ()))
+            tab = tab_of.get(part.name)
+            key = (part.name, extra, None if tab is None else (tab.letter, tab.edge, tuple(tab.spans)))
+            if key not in cut_cache:  # a part that no tab, slot or travel slot changed is cut once
+                cut_cache[key] = part_cuts(part, s, n, {i for (pn, i) in pinned if pn == part.name}, drive_at,
+                                           motor_at, mounting=part.ground and part.plane == "xy",
+                                           letters=letters[part.name], drive_flat=flat, extra=extra, tabs=tab)
+            pc = copy.deepcopy(cut_cache[key])
+            if drive_at is not None and part.name in keyed:
+                _phase_mark(pc, (drive_at[0] * s.unit_mm, drive_at[1] * s.unit_mm), flat, keyed[part.name],
+                            dict(getattr(mech, "key_turn", {})).get(part.name, 0.0))
+            part_notes.extend(pc.notes)
+            cuts.append(pc)
+        return cuts, part_notes
+
+    def plan(cuts: list[PartCut]) -> tuple[dict[str, Any], Assembly]:
+        material = {pc.name: nominal_material(pc.outer, pc.inner, s.kerf / 2) for pc in cuts}
+        return material, plan_assembly(mech, material, pins, contacts, s.unit_mm, s.thickness_mm, s.pin_mm,
+                                       s.pin_head, shaft.joint if shaft is not None else None)
+
+    cuts, part_notes = cut_all([], {})
+    material0, asm = plan(cuts)
+    material = material0
+    tab_plan = plan_tabs(mech, asm.layers, material0, s)
+    joins = tab_plan.joins
+    more_notes: list[str] = []
+    if joins or tab_plan.planes:
+        # cut again with the tabs and slots, then with travel slots until none is missing; the tabs' faces
+        # follow the layers, so a plan whose cuts move a layer is planned again for the new layers
+        layers_used = asm.layers
+        done = False
+        for _ in range(3):
+            travel: dict[str, list[Any]] = {}
+            travel_notes: list[str] = []
+            for _ in range(4):
+                cuts, part_notes = cut_all(joins, travel)
+                material, asm2 = plan(cuts)
+                if asm2.layers != layers_used:
+                    break
+                more, more_notes = travel_slots(mech, asm2.layers, material, s, tab_plan)
+                if not more:
+                    done = True
+                    break
+                for k_, v_ in more.items():
+                    travel[k_] = merge_travel(travel.get(k_, []) + v_, s.min_wall)
+                travel_notes.extend(more_notes)
+            if done or asm2.layers == layers_used:
+                break
+            layers_used = asm2.layers
+            tab_plan = plan_tabs(mech, layers_used, material0, s)
+            joins = tab_plan.joins
+        if not done:
+            from planar.fabrication.joints import FabricationError
+
+            moved = [n for n in asm2.layers if asm2.layers[n] != layers_used.get(n)]
+            raise FabricationError(
+                f"part {moved[0]!r}: its layer keeps changing as the tab joints are cut; they cannot be planned"
+                if moved else "the pieces standing perpendicular are still in the way of other layers after 4 "
+                "rounds of travel slots; they cannot be tab-joined")
+        notes.extend(travel_notes)
+        asm = asm2
+        tabs = {jn.piece: jn for jn in joins}
+        for pc in cuts:
+            if pc.name in tabs:
+                jn = tabs[pc.name]
+                pc.notes.append(f"{pc.name}: {len(jn.spans)} tab(s) {jn.letter}, {jn.tab_width:g} x "
+                                f"{s.thickness_mm:g} mm, into the slots {jn.letter} of {jn.base}")
+                part_notes.append(pc.notes[-1])
+            for jn in joins:
+                if jn.base == pc.name:
+                    pc.notes.append(f"{pc.name}: {len(jn.slots)} slot(s) {jn.letter} "
+                                    f"{jn.slot_size[0]:g} x {jn.slot_size[1]:g} mm for the tabs of {jn.piece}")
+                    part_notes.append(pc.notes[-1])
+        _engrave_joins(cuts, joins, s)
+    notes.extend(part_notes)
+    notes.extend(asm.notes)
+    for pc in cuts:
+        pc.layer = asm.layers.get(pc.name)
+    # spacer rings, cut from the same sheet
+    k2 = s.kerf / 2
+    ri = (s.pin_mm + s.clearance) / 2
+    ro = max(ri + s.min_wall, s.min_part / 2)
+    for pp in asm.pins:
+        for j in range(pp.spacers):
+            cuts.append(PartCut(f"spacer {pp.letter}{j + 1}", Circle((0.0, 0.0), ro + k2), [Circle((0.0, 0.0), ri - k2)],
+                                nominal_holes=[((0.0, 0.0), ri)]))
+    layout = nest(cuts, s.sheet, s.spacing, s.margin, s.kerf, s.unit_mm)
+    warnings: list[str] = []
+    from planar.windup.chain import ToyMechanism
+
+    if isinstance(scene.mechanism, ToyMechanism):  # a toy: its motions against the fit's play
+        from planar.toys.fitcheck import small_motion_text, small_motions
+
+        warnings = [small_motion_text(m, s) for m in small_motions(scene.mechanism, s)]
+    return Fabrication(scene.name, s, layout, asm, notes, shaft.joint if shaft is not None else None, material,
+                       [p.name for p in mech.parts if p.ground and p.plane == "xy"], joins=joins,
+                       stack_z=tab_plan.z_stack, planes=dict(tab_plan.planes), warnings=warnings)
+
+
+def _engrave_joins(cuts: list[PartCut], joins: list[Any], s: FabSettings) -> None:
+    """Engrave each joint's letter beside its slots (where it fits) and once on the tabbed piece by its edge."""
+    from planar.fabrication.parts import letter_marks
+
+    by_name = {pc.name: pc for pc in cuts}
+    for jn in joins:
+        base = by_name[jn.base]
+        mat = nominal_material(base.outer, base.inner, s.kerf / 2)
+        for e in base.engrave:
+            from shapely.geometry import LineString
+
+            mat = mat.difference(LineString(e).buffer(0.5))
+        base.engrave.extend(letter_marks(mat, [(c, jn.slot_size[0] / 2, jn.letter) for c, _ in jn.slots],
+                                         max(s.min_label, 1.5)))
+        piece = by_name[jn.piece]
+        mat = nominal_material(piece.outer, piece.inner, s.kerf / 2)
+        for e in piece.engrave:
+            from shapely.geometry import LineString
+
+            mat = mat.difference(LineString(e).buffer(0.5))
+        mid = jn.tabs[0].centroid
+        piece.engrave.extend(letter_marks(mat, [((float(mid.x), float(mid.y)), s.thickness_mm, jn.letter)],
+                                          max(s.min_label, 1.5)))
+
+
+def sheet_paths(path: str | os.PathLike, sheets: int) -> list[Path]:
+    """``parts.dxf`` for one sheet; ``parts-1.dxf``, ``parts-2.dxf``, ... for several."""
+    p = Path(path)
+    if sheets == 1:
+        return [p]
+    return [p.with_name(f"{p.stem}-{k + 1}{p.suffix}") for k in range(sheets)]
+
+
+def kerf_test_layout(settings: FabSettings) -> Layout:
+    """A kerf calibration piece: a 20 mm square with a 10 mm hole, both kerf-compensated, the kerf engraved.
+
+    Measure the square and the hole after cutting: too small a square (or too large a hole) means the
+    real kerf is wider than ``kerf_mm`` by the difference.
+    """
+    from planar.fabrication.sheet import Contour
+    from planar.fabrication.strokefont import text_strokes
+
+    k2 = settings.kerf / 2
+    a = 10.0 + k2
+    outer = Contour([(-a, -a, 0.0), (a, -a, 0.0), (a, a, 0.0), (-a, a, 0.0)])
+    inner = [Circle((0.0, 3.0), 5.0 - k2)]
+    engrave = text_strokes(f"K {settings.kerf:.2f}", 2.0, (0.0, -5.5), 0.0)
+    engrave += text_strokes("20 / 10", 1.6, (0.0, -8.3), 0.0)
+    pc = PartCut("kerf test", outer, list(inner), engrave, f"K {settings.kerf:.2f}", 2.0, nominal_holes=[((0.0, 3.0), 5.0)])
+    return nest([pc], settings.sheet, settings.spacing, settings.margin, settings.kerf, settings.unit_mm)
+
+
+def summary(fab: Fabrication) -> str:
+    """One line: parts (and the spacer rings cut beside them), sheets, utilisation, layers, pins."""
+    lay, asm = fab.layout, fab.assembly
+    util = ", ".join(f"{u:.0%}" for u in lay.utilisation)
+    layers = max(asm.n_layers.values()) if asm.n_layers else 0
+    spacers = sum(p.spacers for p in asm.pins)
+    rings = f" + {spacers} spacer ring(s)" if spacers else ""
+    return (f"{len(lay.parts) - spacers} parts{rings} on {lay.sheets} sheet(s) of {lay.sheet_size[0]:g} x "
+            f"{lay.sheet_size[1]:g} mm (utilisation {util}), kerf {lay.kerf:g} mm, {layers} layer(s) of "
+            f"{fab.settings.thickness_mm:g} mm, {len(asm.pins)} pin(s)")
+

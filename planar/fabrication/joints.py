@@ -1,0 +1,168 @@
+"""What the joints mean for cutting and assembly: pins, contacts, which holes a pin goes through.
+
+A *pin* is a round pin through a hole of one part and a hole or slot of
+another (a pivot with holes on both sides, a pin in a straight or arc slot,
+each of a slide's two pins).  A *contact* joins two parts without a pin (a
+round cam in a hole, a cam on a flat face, a tilting pin on an edge): those
+parts must lie in one plane layer to touch.  Positions are in each part's own
+frame, model units.  Rules are found per joint kind in ``PIN_RULES``; a kind with
+no rule is an error naming it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Callable
+
+from planar.cams.joint import CamContact
+from planar.core.model import ArcSlot, CamOnLine, Hole, Mechanism, Part, PinInArcSlot, PinInSlot, Pivot, Slide, Slot
+from planar.core.registry import Registry
+from planar.errors import PlanarError
+from planar.linkages.gears import GearMesh
+from planar.toys.assembly import KeyedShaft
+from planar.windup.mechanisms import SkewContact
+
+__all__ = ["Contact", "FabricationError", "PIN_RULES", "PinSpec", "joint_pins", "pin_features", "register_contact"]
+
+TOL = 1e-7
+
+
+class FabricationError(PlanarError):
+    """A mechanism that cannot be made as asked (message: one line naming the part or joint)."""
+
+
+@dataclass(frozen=True)
+class PinSpec:
+    """A pin joining ``parts[0]`` (at ``at[0]``, own frame) and ``parts[1]`` (at ``at[1]``)."""
+
+    joint: str
+    parts: tuple[str, str]
+    at: tuple[tuple[float, float], tuple[float, float]]
+    #: "hole" or "slot" on each side
+    kinds: tuple[str, str]
+
+
+@dataclass(frozen=True)
+class Contact:
+    """Two parts joined by touching: ``coplanar`` ones share a layer; ``through``: one may instead reach
+    through the other from another layer (#8's tab standing in its window)."""
+
+    joint: str
+    parts: tuple[str, str]
+    coplanar: bool
+    through: bool = False
+
+
+def _hole_at(part: Part, p: tuple[float, float]) -> Hole | None:
+    for f in part.features:
+        if isinstance(f, Hole) and math.dist(f.centre, p) < TOL * max(1.0, abs(p[0]) + abs(p[1])):
+            return f
+    return None
+
+
+def _v(p: Any) -> tuple[float, float]:
+    return (float(p[0]), float(p[1]))
+
+
+def _close(a: Any, b: Any) -> bool:
+    return math.dist(a, b) < TOL * max(1.0, abs(a[0]) + abs(a[1]))
+
+
+#: pins and contacts of one joint, per joint kind: (mechanism, joint) -> (pins, contacts)
+PIN_RULES: Registry[Callable[[Mechanism, Any], tuple[list[PinSpec], list[Contact]]]] = Registry("fabrication")
+
+
+@PIN_RULES.register(Pivot)
+def _pivot(mech: Mechanism, j: Pivot) -> tuple[list[PinSpec], list[Contact]]:
+    if _hole_at(mech.part(j.a), j.anchor_a) and _hole_at(mech.part(j.b), j.anchor_b):
+        return [PinSpec(j.name, (j.a, j.b), (_v(j.anchor_a), _v(j.anchor_b)), ("hole", "hole"))], []
+    return [], [Contact(j.name, (j.a, j.b), True)]  # a round cam running in a hole: the disc is the pin
+
+
+@PIN_RULES.register(PinInSlot)
+def _pin_in_slot(mech: Mechanism, j: PinInSlot) -> tuple[list[PinSpec], list[Contact]]:
+    if _hole_at(mech.part(j.b), j.pin) is None:
+        # no hole at the "pin": the part's own round body runs in the slot (a wind-up eccentric cam in its
+        # follower's window), so nothing is pinned and the window keeps its own width
+        return [], [Contact(j.name, (j.a, j.b), True)]
+    return [PinSpec(j.name, (j.b, j.a), (_v(j.pin), _v(j.start)), ("hole", "slot"))], []
+
+
+@PIN_RULES.register(PinInArcSlot)
+def _pin_in_arc_slot(mech: Mechanism, j: PinInArcSlot) -> tuple[list[PinSpec], list[Contact]]:
+    on_arc = (float(j.centre[0] + j.radius), float(j.centre[1]))
+    return [PinSpec(j.name, (j.b, j.a), (_v(j.pin), on_arc), ("hole", "slot"))], []
+
+
+@PIN_RULES.register(Slide)
+def _slide(mech: Mechanism, j: Slide) -> tuple[list[PinSpec], list[Contact]]:
+    pts = j.pin_points()
+    return [PinSpec(f"{j.name}#{k + 1}", (j.b, j.a), (_v(p), _v(j.start)), ("hole", "slot"))
+            for k, p in enumerate(pts)], []
+
+
+@PIN_RULES.register(KeyedShaft)
+def _keyed_shaft(mech: Mechanism, j: KeyedShaft) -> tuple[list[PinSpec], list[Contact]]:
+    """The motor shaft: one pin through every cam keyed to it."""
+    return [PinSpec(j.name, (j.a, j.b), (j.anchor_a, j.anchor_b), ("hole", "hole"))], []
+
+
+@PIN_RULES.register(CamOnLine)
+def _cam_on_line(mech: Mechanism, j: CamOnLine) -> tuple[list[PinSpec], list[Contact]]:
+    return [], [Contact(j.name, (j.a, j.b), True, through=True)]
+
+
+def register_contact(kind: type, coplanar: bool) -> None:
+    """A joint kind that joins its parts by touching, without a pin (``coplanar``: in one layer)."""
+
+    def rule(mech: Mechanism, j: Any) -> tuple[list[PinSpec], list[Contact]]:
+        return [], [Contact(j.name, (j.a, j.b), coplanar)]
+
+    PIN_RULES.register(kind)(rule)
+
+
+register_contact(SkewContact, coplanar=False)  # a tilting pin on an edge: across layers
+register_contact(GearMesh, coplanar=True)  # two gears in mesh: one layer
+register_contact(CamContact, coplanar=True)  # a profile cam and its roller or follower: in one layer
+
+
+def joint_pins(mech: Mechanism) -> tuple[list[PinSpec], list[Contact]]:
+    """Pins and contacts of every joint, in joint order (a kind with no rule is an error naming it)."""
+    pins: list[PinSpec] = []
+    contacts: list[Contact] = []
+    for j in mech.joints:
+        p, c = PIN_RULES.get(j, f"joint {j.name!r}")(mech, j)
+        pins += p
+        contacts += c
+    return pins, contacts
+
+
+def pin_features(mech: Mechanism) -> set[tuple[str, int]]:
+    """``(part, feature index)`` of every hole or slot a pin goes through (cut at the scene's pin size)."""
+    out: set[tuple[str, int]] = set()
+    by_name = {p.name: p for p in mech.parts}
+    for j in mech.joints:
+        if isinstance(j, Pivot):
+            pa, pb = by_name[j.a], by_name[j.b]
+            ha, hb = _hole_at(pa, j.anchor_a), _hole_at(pb, j.anchor_b)
+            if ha and hb:
+                out.add((j.a, pa.features.index(ha)))
+                out.add((j.b, pb.features.index(hb)))
+        elif isinstance(j, (PinInSlot, PinInArcSlot, Slide)):
+            pin_part, slot_part = by_name[j.b], by_name[j.a]
+            anchors = list(j.pin_points()) if isinstance(j, Slide) else [j.pin]
+            if isinstance(j, PinInSlot) and _hole_at(pin_part, j.pin) is None:
+                continue  # a round body in a window, not a pin (see _pin_in_slot)
+            for p in anchors:
+                h = _hole_at(pin_part, p)
+                if h is not None:
+                    out.add((j.b, pin_part.features.index(h)))
+            for i, f in enumerate(slot_part.features):
+                if isinstance(j, PinInArcSlot):
+                    if isinstance(f, ArcSlot) and _close(f.centre, j.centre) \
+                            and abs(f.radius - j.radius) < TOL * max(1.0, j.radius):
+                        out.add((j.a, i))
+                elif isinstance(f, Slot) and _close(f.start, j.start) and _close(f.end, j.end):
+                    out.add((j.a, i))
+    return out

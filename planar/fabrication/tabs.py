@@ -1,0 +1,686 @@
+"""Tab-and-slot joints for pieces standing perpendicular to the toy's plane (xz, yz).
+
+A wind-up toy's #8 stage moves in xz and its #6/#9 followers in yz; each of
+those pieces is cut flat and must be joined to the xy stack it belongs to.
+The joint is the usual laser-cut tab and slot (Boxes.py's finger joint on one
+side, through-slots on the other):
+
+* **rigid pieces**: a perpendicular piece that is one rigid body with an xy
+  piece (``ToyAssembly.bodies``: the #8 window plate with the slider, the
+  xz frame with the frame) is cut flat where it meets that piece's layer face,
+  keeping its side, and gets tabs ``thickness_mm`` long standing out of that
+  edge through the layer; the xy piece gets a rectangular through-slot for
+  each tab on the line where the two planes meet (``thickness_mm +
+  clearance_mm`` wide, the tab's width + ``clearance_mm`` long: the fit
+  allowance holes get).  Tabs are ``2 x thickness`` wide with ``2 x
+  thickness`` gaps (Boxes.py's default finger and space), as many as fit
+  where both pieces have material with ``min_wall_mm`` round each slot and
+  clear of every other cut; at least two per joint.  A hull-outlined xy piece
+  (the frame) grows to hold its slots; an explicit outline (the merged slider)
+  must already have room.
+* **the stack along z**: xy layer k lies between ``z0 + k t`` and ``z0 + (k + 1) t``
+  (mm) of the model's z.  The model's xy plane (``z = 0``: where the #8 driver
+  slides, where the #6/#9 pin meets its driver's edge) is the mid-plane of the
+  layer the perpendicular stages ride on, as near as the pieces' own cuts
+  allow (each keeps ``min_wall_mm`` between its edge and its cuts).  Pieces
+  on the model's -z side hang below the stack from their xy piece's lower
+  face; pieces on the +z side stand on its upper face.
+* **plane positions**: a plane's pieces stand in its layer order, one sheet
+  thickness apart (``y = y0 + (layer + 1/2) t`` for xz).  The model fixes no
+  y for xz pieces, so ``y0`` is the nearest position (0.5 mm steps from the
+  model's ``y = 0``, up to 60 mm) where every xz joint has room and every
+  travel slot (below) keeps its walls.  A yz piece stays at its x
+  (``Part.offset``: the #6/#9 pin must meet the driver's edge there); its
+  bracket stands in its layer beside it.
+* **brackets**: a moving perpendicular piece that no pin holds (the #6/#9
+  follower, whose axle the model leaves in the air) gets a bracket: a frame
+  piece in its plane with a hole on the axle (the piece's stationary hole)
+  and a base reaching past the piece's way through the stack, tab-joined to
+  the frame like any frame piece (its tabs clear of that way).  A #8 tab is
+  held by the xz frame already (pin through both), so the xz frame is its
+  bracket.
+* **repeated guides**: a slide between two perpendicular pieces that are both
+  joined to the xy stack repeats the xy slide of their bodies (the #8 side
+  view of the slider's own guide): it is not cut (no slot, no pin holes).
+* **travel slots**: a perpendicular piece passing through another xy piece's
+  layer where that piece has material gets a rectangular travel slot there
+  (its way over the cycle, ``clearance_mm`` round it; ways closer than
+  ``min_wall_mm`` are one slot).  Pieces joined by a joint (the #6/#9 pin on
+  its driver's edge) touch by design and get none.
+
+Refused (``FabricationError``, exit 2, one line): a perpendicular piece whose
+xy piece turns or moves across the line where they meet, one that does not
+reach its xy piece's face, one with a moving axle, a joint with room for fewer
+than two tabs, travel slots running into other cuts.  Sizes in millimetres;
+the tabs' and slots' positions (``TabJoin``) are what the tests read back from
+the files.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from planar.core.model import Hole, Part, Pivot, Slide
+from planar.fabrication.joints import FabricationError
+from planar.fabrication.parts import Feature
+
+__all__ = ["FabView", "TabJoin", "TabPlan", "fab_view", "merge_travel", "plan_tabs", "slot_features", "travel_slots"]
+
+PLANES = ("xz", "yz")
+MIN_TABS = 2
+
+
+@dataclass
+class TabJoin:
+    """Tabs of ``piece`` (perpendicular) in slots of ``base`` (xy), lettered ``letter`` (``T1``, ...).
+
+    ``at``: the piece's plane (mm; world y for xz, x for yz); ``side``: +1 when the piece lies on the
+    model's +z side of the xy plane; ``edge``: the world z (mm) where it stands on the xy piece's face;
+    ``spans``: each tab's ends along the line where the planes meet (world
+    x for xz, y for yz, mm); ``slots``: each slot's centre (base frame, mm) and the slot's long-axis angle.
+    """
+
+    letter: str
+    piece: str
+    base: str
+    plane: str
+    at: float
+    side: int
+    #: the edge the piece stands on: world z (mm) of its plane; its tabs run from there ``thickness`` away from it
+    edge: float
+    spans: list[tuple[float, float]]
+    tab_width: float
+    slot_size: tuple[float, float]
+    slots: list[tuple[tuple[float, float], float]] = field(default_factory=list)
+    #: the piece's own-frame outline change: keep this half-plane polygon, add these tab rectangles (mm)
+    keep: Any = None
+    tabs: list[Any] = field(default_factory=list)
+
+
+class FabView:
+    """A mechanism as fabrication cuts it: repeated perpendicular guides dropped, brackets added.
+
+    Everything else (driver, notes, keyed cams, poses) is the wrapped mechanism's; a bracket stands still.
+    """
+
+    def __init__(self, mech: Any, parts: list[Part], joints: list[Any], extra: list[str], notes: list[str]) -> None:
+        self._mech = mech
+        self.parts = tuple(parts)
+        self.joints = tuple(joints)
+        self.extra = extra
+        self.notes = list(getattr(mech, "notes", [])) + notes
+        self.bodies: dict[str, list[str]] = {k: list(v) for k, v in getattr(mech, "bodies", {}).items()}
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._mech, name)
+
+    def part(self, name: str) -> Part:
+        for p in self.parts:
+            if p.name == name:
+                return p
+        return self._mech.part(name)
+
+    def run(self, *args: Any, **kw: Any) -> Any:
+        m = self._mech.run(*args, **kw)
+        for n in self.extra:
+            m.poses[n] = np.zeros((len(m), 3))
+        return m
+
+
+def _bodies(mech: Any) -> dict[str, list[str]]:
+    """Rigid bodies -> pieces (a toy assembly's own; else each part alone, every ground one body)."""
+    got = getattr(mech, "bodies", None)
+    if got:
+        return {k: list(v) for k, v in got.items()}
+    out: dict[str, list[str]] = {}
+    for p in mech.parts:
+        out.setdefault("frame" if p.ground else p.name, []).append(p.name)
+    return out
+
+
+def _joined(mech: Any, bodies: dict[str, list[str]]) -> dict[str, str]:
+    """Perpendicular piece -> the xy piece of its body it is tab-joined to."""
+    plane = {p.name: p.plane for p in mech.parts}
+    out: dict[str, str] = {}
+    for pieces in bodies.values():
+        xy = [n for n in pieces if plane.get(n) == "xy"]
+        for n in pieces:
+            if plane.get(n) in PLANES and xy:
+                if len(xy) > 1:
+                    raise FabricationError(f"part {n!r}: its body has {len(xy)} xy pieces ({', '.join(xy)}); "
+                                           "no rule says which one its tabs go into, it cannot be tab-joined")
+                out[n] = xy[0]
+    return out
+
+
+def fab_view(mech: Any, samples: int = 48) -> Any:
+    """``mech`` as it is cut (see the module docstring); ``mech`` itself when nothing stands perpendicular."""
+    from planar.toys.assembly import _without_cuts_of
+
+    parts = list(mech.parts)
+    if not any(p.plane in PLANES for p in parts) or not any(p.plane == "xy" for p in parts):
+        return mech
+    bodies = _bodies(mech)
+    joined = _joined(mech, bodies)
+    body_of = {n: b for b, ps in bodies.items() for n in ps}
+    plane = {p.name: p.plane for p in parts}
+    # repeated guides: a perpendicular slide between two joined pieces repeats their bodies' xy slide
+    joints, dropped = [], []
+    for j in mech.joints:
+        if isinstance(j, Slide) and plane.get(j.a) in PLANES and j.a in joined and j.b in joined:
+            dropped.append(j)
+        else:
+            joints.append(j)
+    notes: list[str] = []
+    if dropped:
+        parts, removed = _without_cuts_of(parts, dropped, joints)
+        for j in dropped:
+            notes.append(f"{j.b}: its slide {j.name!r} in {j.a} is not cut: both pieces stand on the xy stack, "
+                         f"whose own slide guides them ({body_of.get(j.b, j.b)} on {body_of.get(j.a, j.a)})")
+    # brackets for perpendicular pieces that no pin holds
+    held = set(joined)
+    for j in joints:
+        if isinstance(j, Pivot) and plane.get(j.a) == plane.get(j.b) and plane.get(j.a) in PLANES:
+            held |= {j.a, j.b}
+    loose = [p for p in parts if p.plane in PLANES and p.name not in held]
+    extra: list[str] = []
+    if loose:
+        motion = mech.run(samples_per_cycle=samples)
+        ok = np.flatnonzero(motion.valid)
+        ok = ok if ok.size else np.arange(len(motion))
+        for p in loose:
+            bracket, pivot = _bracket(p, np.asarray(motion.poses[p.name], float)[ok])
+            parts.append(bracket)
+            joints.append(pivot)
+            extra.append(bracket.name)
+            notes.append(f"{bracket.name}: a bracket on the frame holding the axle of {p.name} (pin joint "
+                         f"{pivot.name!r}); nothing in the model holds it")
+    view = FabView(mech, parts, joints, extra, notes)
+    frame = next((b for b, ps in bodies.items() if any(n in ps for n in (q.name for q in mech.parts if q.ground))),
+                 "frame")
+    view.bodies = {**bodies, frame: bodies.get(frame, []) + extra}
+    return view
+
+
+def _bracket(p: Part, poses: np.ndarray) -> tuple[Part, Pivot]:
+    """A frame piece in ``p``'s plane holding ``p``'s stationary hole (its axle), its base on ``z = 0``."""
+    best = None
+    for f in p.features:
+        if not isinstance(f, Hole):
+            continue
+        c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+        w = np.c_[poses[:, 0] + c * f.centre[0] - s * f.centre[1], poses[:, 1] + s * f.centre[0] + c * f.centre[1]]
+        if float(np.ptp(w, axis=0).max()) < 1e-9 * max(1.0, float(np.abs(w).max())):
+            best = (f, (float(w[0, 0]), float(w[0, 1])))
+            break
+    if best is None:
+        raise FabricationError(f"part {p.name!r} ({p.plane}): no pin holds it and it turns about no fixed hole; "
+                               "no bracket can hold it, it cannot be tab-joined")
+    f, (u, z) = best
+    if abs(z) < 2 * f.diameter:
+        raise FabricationError(f"part {p.name!r} ({p.plane}): its axle lies on the xy plane (z = {z:.3g}); "
+                               "no room for a bracket standing on the frame, it cannot be tab-joined")
+    boss = 1.5 * f.diameter
+    # the base reaches past the piece's own way through the stack on both sides, room for a tab beyond it
+    c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+    reach = max(float(np.abs(poses[:, 0] + c * x - s * y - u).max()) + r for x, y, r in p.hull)
+    base = max(boss, 0.5 * abs(z), reach + 2 * boss)
+    name = f"frame.{p.plane}.{p.name}"
+    part = Part(name, ((u, z, boss), (u - base, 0.0, boss), (u + base, 0.0, boss)), (Hole((u, z), f.diameter),),
+                ground=True, plane=p.plane, offset=p.offset)
+    return part, Pivot(f"{name}.axle", name, p.name, anchor_a=(u, z), anchor_b=(float(f.centre[0]), float(f.centre[1])))
+
+
+# ------------------------------------------------------------------------------------------------ planning
+
+
+def _world(poly: Any, pose: tuple[float, float, float]) -> Any:
+    from shapely import affinity
+
+    x, y, a = pose
+    c, s = math.cos(a), math.sin(a)
+    return affinity.affine_transform(poly, [c, -s, s, c, x, y])
+
+
+def _local(poly: Any, pose: tuple[float, float, float]) -> Any:
+    from shapely import affinity
+
+    x, y, a = pose
+    c, s = math.cos(a), math.sin(a)
+    # inverse of p -> R p + t: R^T (p - t)
+    return affinity.affine_transform(poly, [c, s, -s, c, -(c * x + s * y), -(-s * x + c * y)])
+
+
+def _intervals(geom: Any) -> list[tuple[float, float]]:
+    """The x-extents of the pieces of a line's intersection (sorted)."""
+    if geom.is_empty:
+        return []
+    parts = getattr(geom, "geoms", [geom])
+    out = []
+    for g in parts:
+        if g.geom_type == "LineString" and g.length > 0:
+            xs = np.asarray(g.coords)[:, 0]
+            out.append((float(xs.min()), float(xs.max())))
+    return sorted(out)
+
+
+def _and(a: list[tuple[float, float]], b: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    out = []
+    for a0, a1 in a:
+        for b0, b1 in b:
+            lo, hi = max(a0, b0), min(a1, b1)
+            if hi > lo:
+                out.append((lo, hi))
+    return sorted(out)
+
+
+def _along(region: Any, level: float, half: float, lo: float, hi: float) -> list[tuple[float, float]]:
+    """Where a strip ``level +- half`` (in the second coordinate) lies inside ``region``, as x intervals."""
+    from shapely.geometry import LineString
+
+    got: list[tuple[float, float]] | None = None
+    for dy in (-half, -half / 2, 0.0, half / 2, half):
+        iv = _intervals(region.intersection(LineString([(lo, level + dy), (hi, level + dy)])))
+        got = iv if got is None else _and(got, iv)
+    return got or []
+
+
+def _place(intervals: list[tuple[float, float]], w: float, g: float) -> list[float]:
+    """Tab centres: as many ``w`` wide, ``g`` apart as fit in each interval, centred in it."""
+    out: list[float] = []
+    for lo, hi in intervals:
+        n = int(math.floor((hi - lo + g) / (w + g) + 1e-9))
+        if n <= 0:
+            continue
+        span = n * w + (n - 1) * g
+        x0 = (lo + hi - span) / 2 + w / 2
+        out += [x0 + k * (w + g) for k in range(n)]
+    return out
+
+
+def _layer_footprint(mat: Any, plane: str, at: float, track_n: np.ndarray, track_r: np.ndarray, band: Any,
+                     t: float) -> Any:
+    """Where a perpendicular piece (its cut outline ``mat``, its ``plane`` at ``at``, mm) passes through the layer
+    ``band`` (world, mm) over its pose ``track_n``: strips of thickness ``t``, in the frame of the xy piece whose
+    track is ``track_r``."""
+    import shapely
+    from shapely.geometry import Polygon, box
+
+    mat = mat.simplify(0.05)
+    strips = []
+    for k in range(len(track_n)):
+        got = _world(mat, tuple(track_n[k])).intersection(band)
+        if got.area <= 1e-6:
+            continue
+        a, _, b, _ = got.bounds
+        strip = box(a, at - t / 2, b, at + t / 2) if plane == "xz" else box(at - t / 2, a, at + t / 2, b)
+        strips.append(_local(strip, tuple(track_r[k])))
+    return shapely.union_all(strips) if strips else Polygon()
+
+
+def _static_pose(track: np.ndarray, what: str, keep: tuple[int, ...]) -> None:
+    """Refuse a track whose coordinates ``keep`` (indices into x, y, angle) change over the cycle."""
+    spread = np.ptp(track[:, list(keep)], axis=0)
+    if float(spread.max()) > 1e-6:
+        raise FabricationError(f"{what}: it moves across the line where it meets the xy stack (by up to "
+                               f"{float(spread.max()):.3g}) over the cycle; it cannot be tab-joined")
+
+
+@dataclass
+class TabPlan:
+    """The tab joints, the travel slots (xy piece -> cuts, mm) letting perpendicular pieces pass through other
+    layers, what was done (notes), and the stack's lower face along the model's z (mm)."""
+
+    joins: list[TabJoin] = field(default_factory=list)
+    travel: dict[str, list[Feature]] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+    z_stack: float = 0.0
+    #: every perpendicular piece's plane position (mm: y for xz, x for yz)
+    planes: dict[str, float] = field(default_factory=dict)
+    #: pose tracks over the cycle (mm, mm, rad) and each piece's shape as cut (own frame, mm)
+    track: dict[str, Any] = field(default_factory=dict)
+    shape: dict[str, Any] = field(default_factory=dict)
+
+
+def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any], s: Any,
+              samples: int = 48) -> TabPlan:
+    """Tab joints of every perpendicular piece that is rigid with an xy piece, and travel slots for every
+    perpendicular piece passing through another xy layer (see the module docstring).
+
+    ``layers``: each piece's layer in its plane; ``material``: each piece's nominal material (mm, own frame).
+    """
+    import shapely
+    from shapely.geometry import LineString, Polygon, box
+
+    parts = {p.name: p for p in mech.parts}
+    if not any(p.plane in PLANES for p in parts.values()) or not any(p.plane == "xy" for p in parts.values()):
+        return TabPlan()
+    bodies = _bodies(mech)
+    joined = _joined(mech, bodies)
+    if not joined:
+        return TabPlan()
+    u = s.unit_mm
+    t = s.thickness_mm
+    motion = mech.run(samples_per_cycle=samples)
+    ok = np.flatnonzero(motion.valid)
+    ok = ok if ok.size else np.arange(len(motion))
+    track = {n: np.asarray(motion.poses[n], float)[ok] * [u, u, 1.0] for n in parts}
+    pose: dict[str, tuple[float, float, float]] = {
+        n: (float(track[n][0, 0]), float(track[n][0, 1]), float(track[n][0, 2])) for n in parts}
+    for n, q in joined.items():
+        pl = parts[n].plane
+        k = 1 if pl == "xz" else 0  # the xy coordinate across the perpendicular plane (y for xz, x for yz)
+        _static_pose(track[n], f"part {n!r} ({pl})", (1, 2))
+        _static_pose(track[q], f"part {q!r}, the xy piece {n!r} stands on", (k, 2))
+        shift = track[n][:, 0] - track[q][:, 1 - k]
+        if float(np.ptp(shift)) > 1e-6:
+            raise FabricationError(f"part {n!r} ({pl}) does not move with {q!r} along the line where they meet; "
+                                   "it cannot be tab-joined")
+    w, g = 2 * t, 2 * t
+    hw = (t + s.clearance) / 2
+    wall = s.min_wall
+    perp = [n for n, p in parts.items() if p.plane in PLANES]
+    xy = [n for n, p in parts.items() if p.plane == "xy"]
+    touching = {frozenset((j.a, j.b)) for j in mech.joints}
+    # the stack along z: layer k of the xy plane between z0 + k t and z0 + (k + 1) t (mm).  The model's xy
+    # plane (z = 0: where the #8 driver slides and the #6/#9 pin meets its driver's edge) is the mid-plane of
+    # the layer the perpendicular stages ride on, as near as the pieces' cuts allow: a piece below the stack
+    # (the model's -z side, where the #8 plates and the #6/#9 axles hang) stands on its xy piece's lower face,
+    # one above on its upper face, and keeps min_wall between its edge and its own cuts.
+    world = {n: _world(material[n], pose[n]) for n in perp}
+    sides = {n: 1 if world[n].centroid.y > 0 else -1 for n in joined}
+    face = {n: ((layers.get(joined[n]) or 0) + (1 if sides[n] > 0 else 0)) * t for n in joined}
+    lo_b, hi_b = [-math.inf], [math.inf]
+    for n in joined:
+        cuts = [Polygon(r) for r in world[n].interiors]
+        if cuts and sides[n] < 0:
+            lo_b.append(max(c.bounds[3] for c in cuts) + wall - face[n])
+        elif cuts:
+            hi_b.append(min(c.bounds[1] for c in cuts) - wall - face[n])
+    if max(lo_b) > min(hi_b):
+        raise FabricationError("the pieces standing perpendicular to the xy stack need it both higher and lower "
+                               "for their cuts' walls; they cannot be tab-joined")
+    riders = {joined[n] for n in joined if not parts[n].ground}
+    riders |= {j.a for j in mech.joints if getattr(j, "b", None) in perp and getattr(j, "a", None) in xy}
+    ride = [layers.get(n) or 0 for n in sorted(riders)] or [0]
+    target = -(float(np.mean(ride)) + 0.5) * t
+    z_stack = min(max(target, max(lo_b)), min(hi_b))
+
+    def band(r: str) -> Any:
+        lz = (layers.get(r) or 0) * t + z_stack
+        return box(-1e5, lz + 0.01, 1e5, lz + t - 0.01)
+
+    def footprint(n: str, at: float, r: str) -> Any:
+        """Where piece ``n`` (its plane at ``at``, mm) passes through ``r``'s layer over the cycle, ``r``'s frame."""
+        return _layer_footprint(shape[n], parts[n].plane, at, track[n], track[r], band(r), t)
+
+    shape = dict(material)  # each piece as cut (a tab-joined one: cut flat along its edge, tabs added)
+    # pieces whose plane is fixed already (a yz piece at its x) keep their way through the layers clear
+    fixed_at = {n: parts[n].offset * u for n in perp if parts[n].plane == "yz" and n not in joined}
+    out: list[TabJoin] = []
+    for pl in PLANES:
+        mine = [n for n in joined if parts[n].plane == pl]
+        if not mine:
+            continue
+        # each piece's edge: the face of its xy piece's layer, and the side it lies on
+        edges: dict[str, tuple[int, float, list[tuple[float, float]], Any]] = {}
+        for n in mine:
+            mat = world[n]
+            side = sides[n]
+            x0, z0, x1, z1 = mat.bounds
+            ze = z_stack + face[n]
+            if (side > 0 and z0 > ze + 1e-6) or (side < 0 and z1 < ze - 1e-6):
+                raise FabricationError(f"part {n!r} ({pl}): it does not reach the face of {joined[n]!r} (z = "
+                                       f"{ze:.3g} mm), where it would stand on it; it cannot be tab-joined")
+            keep = box(x0 - 1, ze, x1 + 1, z1 + 1) if side > 0 else box(x0 - 1, z0 - 1, x1 + 1, ze)
+            root = mat.intersection(keep)
+            # the tab's root: solid material for a wall's depth behind the edge
+            iv = _along(root, ze + side * wall / 2, wall / 2 - 1e-3, x0 - 1, x1 + 1)
+            edges[n] = (side, ze, iv, keep)
+        keepout = {q: shapely.union_all([footprint(m, a, q) for m, a in fixed_at.items()]).buffer(s.clearance)
+                   for q in set(joined.values())}
+
+        # where each xy piece has room for a slot on a line (its frame: through its pose)
+        regions: dict[str, Any] = {}
+        for q in {joined[n] for n in mine}:
+            qm = material[q]
+            holes = [Polygon(r) for r in qm.interiors] if qm.geom_type == "Polygon" else \
+                [Polygon(r) for g_ in qm.geoms for r in g_.interiors]
+            if not keepout[q].is_empty:
+                holes.append(keepout[q])
+            if parts[q].polygon is None and s.widen:  # a hull grows to hold its slots: only its cuts matter
+                region = box(*qm.buffer(10 * (t + wall) + 50).bounds)
+            else:
+                region = qm.buffer(-wall)
+                region = Polygon(region.exterior) if region.geom_type == "Polygon" else region
+            regions[q] = region.difference(shapely.union_all([h.buffer(wall) for h in holes])) if holes else region
+        turned_of: dict[str, Any] = {}
+
+        def room(n: str, at: float, pl: str = pl, regions: dict[str, Any] = regions,
+                 turned_of: dict[str, Any] = turned_of) -> list[tuple[float, float]]:
+            from shapely import affinity
+
+            q = joined[n]
+            # the line where the planes meet, in the xy piece's frame, as a strip of half-width hw
+            lo, hi = -1e4, 1e4
+            line = LineString([(lo, at), (hi, at)]) if pl == "xz" else LineString([(at, lo), (at, hi)])
+            local = _local(line, pose[q])
+            (a0, b0), (a1, b1) = np.asarray(local.coords)
+            ang = math.atan2(b1 - b0, a1 - a0)
+            # turn the xy piece's frame so the line runs along x at height `level`
+            if q not in turned_of:
+                turned_of[q] = affinity.rotate(regions[q], -ang, origin=(0, 0), use_radians=True)
+            turned = turned_of[q]
+            p0 = affinity.rotate(local, -ang, origin=(0, 0), use_radians=True)
+            level = float(np.asarray(p0.coords)[0, 1])
+            iv = _along(turned, level, hw, -1e4, 1e4)
+            # back to the world coordinate along the line (the line runs lo -> hi)
+            offset = lo - float(np.asarray(p0.coords)[0, 0])
+            return [(a + offset, b + offset) for a, b in iv]
+
+        def base_y(y0: float, mine: list[str] = mine) -> dict[str, float]:
+            return {n: y0 + ((layers.get(n) or 0) + 0.5) * t for n in mine}
+
+        if pl == "yz":  # the yz pieces stay at their x: each bracket stands beside its piece
+            ats = {}
+            for n in mine:
+                ref = n[len("frame.yz."):] if n.startswith("frame.yz.") and n[len("frame.yz."):] in parts else n
+                ats[n] = parts[ref].offset * u + ((layers.get(n) or 0) - (layers.get(ref) or 0)) * t
+            candidates = [ats]
+        else:
+            steps = [0.0] + [sgn * 0.5 * k for k in range(1, 121) for sgn in (1, -1)]  # up to 60 mm either way
+            candidates = [base_y(y0) for y0 in steps]
+        # an xz plane's way through the other layers (each piece's body, cut flat, within each xy layer's band
+        # at each sample): where it must cut a travel slot, the slot must keep its walls too
+        ways: dict[tuple[str, str], list[tuple[int, float, float]]] = {}
+        if pl == "xz":
+            for n in (m for m in perp if parts[m].plane == "xz"):
+                body = material[n].intersection(_local(edges[n][3], pose[n])) if n in edges else material[n]
+                body = body.simplify(0.05)
+                for r in xy:
+                    if r == joined.get(n) or frozenset((n, r)) in touching:
+                        continue
+                    bd = band(r)
+                    got = [(k, _world(body, tuple(track[n][k])).intersection(bd)) for k in range(len(ok))]
+                    hits = [(k, g_.bounds[0], g_.bounds[2]) for k, g_ in got if g_.area > 1e-6]
+                    if hits:
+                        ways[(n, r)] = hits
+        walls_of = {r: [Polygon(h) for h in material[r].interiors] for r in xy if material[r].geom_type == "Polygon"}
+
+        def clear_way(y_of: dict[str, float], plan: dict[str, list[float]],
+                      ways: dict[tuple[str, str], list[tuple[int, float, float]]] = ways,
+                      walls_of: dict[str, list[Any]] = walls_of) -> bool:
+            slots_of: dict[str, list[Any]] = {}
+            for m, cs in plan.items():
+                slots_of.setdefault(joined[m], []).extend(
+                    _local(box(c - w / 2, y_of[m] - hw, c + w / 2, y_of[m] + hw), pose[joined[m]]) for c in cs)
+            rects: dict[str, list[Any]] = {}
+            for (n, r), hits in ways.items():
+                at = y_of[n]
+                foot = shapely.union_all([_local(box(a, at - t / 2, b, at + t / 2), tuple(track[r][k]))
+                                          for k, a, b in hits])
+                # a hull piece grows round its slots: its material is then at least their hull's
+                hull = parts[r].polygon is None and s.widen
+                where = shapely.union_all([material[r]] + [q.buffer(wall) for q in slots_of.get(r, [])]).convex_hull \
+                    if hull else material[r]
+                if foot.intersection(where).area <= 0.5:
+                    continue
+                rects.setdefault(r, []).append(foot.buffer(s.clearance, join_style="mitre").minimum_rotated_rectangle)
+            for r, rs in rects.items():
+                # side by side, two ways are one travel slot (merge_travel)
+                rs = [g_.minimum_rotated_rectangle for g_ in
+                      getattr(shapely.union_all([q.buffer(wall / 2) for q in rs]), "geoms",
+                              [shapely.union_all([q.buffer(wall / 2) for q in rs])])]
+                for rect in rs:
+                    if any(rect.distance(h) < wall for h in walls_of.get(r, [])):
+                        return False
+                    if parts[r].polygon is not None and not material[r].buffer(-wall).convex_hull.contains(rect):
+                        return False
+                    if any(q.distance(rect) < wall for q in slots_of.get(r, [])):
+                        return False
+            return True
+
+        chosen = None
+        failed: str | None = None
+        blocked = False
+        for ats in candidates:
+            plan = {}
+            for n in mine:
+                side, ze, iv, keep = edges[n]
+                centres = _place(_and(iv, room(n, ats[n])), w, g)
+                if len(centres) < MIN_TABS:
+                    failed = failed or n  # the first piece that failed at the model's own position
+                    break
+                plan[n] = centres
+            else:
+                if pl == "xz" and ways:
+                    y0 = next(ats[n] - ((layers.get(n) or 0) + 0.5) * t for n in mine)
+                    y_of = {m: y0 + ((layers.get(m) or 0) + 0.5) * t for m in perp if parts[m].plane == "xz"}
+                    if not clear_way(y_of, plan):
+                        blocked = True
+                        continue
+                chosen = (ats, plan)
+                break
+        if chosen is None and blocked:
+            raise FabricationError(f"parts {', '.join(repr(n) for n in mine)} ({pl}): wherever their tabs have room, "
+                                   "the travel slots the pieces of this plane need through the other layers would run "
+                                   f"into other cuts (less than {wall:g} mm between); they cannot be tab-joined "
+                                   "(a larger unit_mm or a thinner sheet)")
+        if chosen is None:
+            n = failed or mine[0]
+            raise FabricationError(f"part {n!r} ({pl}): no line where it meets {joined[n]!r} has room for "
+                                   f"{MIN_TABS} tabs {w:g} mm wide with {wall:g} mm of material round their slots; "
+                                   "it cannot be tab-joined (a larger unit_mm or a thinner sheet)")
+        ats, plan = chosen
+        if pl == "xz":  # every xz piece's plane, joined or not, in the layer order
+            y0 = next(ats[n] - ((layers.get(n) or 0) + 0.5) * t for n in mine)
+            fixed_at.update({n: y0 + ((layers.get(n) or 0) + 0.5) * t for n in perp
+                             if parts[n].plane == "xz" and n not in joined})
+        for n in mine:
+            fixed_at[n] = ats[n]
+            side, ze, _, keep = edges[n]
+            q = joined[n]
+            spans = [(c - w / 2, c + w / 2) for c in plan[n]]
+            tabs = [box(a, ze - t, b, ze + 0.01) if side > 0 else box(a, ze - 0.01, b, ze + t) for a, b in spans]
+            slots = []
+            for c in plan[n]:
+                wc = (c, ats[n]) if pl == "xz" else (ats[n], c)
+                qx, qy, qa = pose[q]
+                cs, sn = math.cos(qa), math.sin(qa)
+                dx, dy = wc[0] - qx, wc[1] - qy
+                centre = (cs * dx + sn * dy, -sn * dx + cs * dy)
+                along = (0.0 if pl == "xz" else math.pi / 2) - qa
+                slots.append((centre, along))
+            jn = TabJoin(f"T{len(out) + 1}", n, q, pl, float(ats[n]), side, ze, spans, w,
+                         (w + s.clearance, t + s.clearance), slots, _local(keep, pose[n]),
+                         [_local(tb, pose[n]) for tb in tabs])
+            out.append(jn)
+            shape[n] = shapely.union_all([material[n].intersection(jn.keep)] + jn.tabs)
+    return TabPlan(out, {}, [], z_stack, fixed_at, track, shape)
+
+
+def travel_slots(mech: Any, layers: dict[str, int | None], material: dict[str, Any], s: Any,
+                 plan: TabPlan) -> tuple[dict[str, list[Feature]], list[str]]:
+    """Travel slots (xy piece -> cuts, mm) for perpendicular pieces that pass through another xy piece's layer
+    where it has material (``material``: as cut so far), and a note for each; pieces joined by a joint
+    (the #6/#9 pin on its driver's edge) touch by design and get none."""
+    from shapely.geometry import box
+
+    parts = {p.name: p for p in mech.parts}
+    t = s.thickness_mm
+    joined = {jn.piece: jn.base for jn in plan.joins}
+    touching = {frozenset((j.a, j.b)) for j in mech.joints}
+    track = plan.track
+
+    def footprint(n: str, at: float, r: str) -> Any:
+        lz = (layers.get(r) or 0) * t + plan.z_stack
+        return _layer_footprint(plan.shape[n], parts[n].plane, at, track[n], track[r],
+                                box(-1e5, lz + 0.01, 1e5, lz + t - 0.01), t)
+
+    out: dict[str, list[Feature]] = {}
+    notes: list[str] = []
+    for n, at in plan.planes.items():
+        for r in (q for q, p in parts.items() if p.plane == "xy"):
+            if r == joined.get(n) or frozenset((n, r)) in touching:
+                continue  # its tabs go through their own slots; a contact touches on purpose
+            foot = footprint(n, at, r)
+            if foot.is_empty or foot.intersection(material[r]).area <= 0.5:
+                continue
+            rect = foot.buffer(s.clearance, join_style="mitre").minimum_rotated_rectangle
+            length, width, ang = _rect_sides(rect)
+            c = rect.centroid
+            out.setdefault(r, []).append(
+                Feature("rect", f"travel slot for {n}", (float(c.x), float(c.y)), width / 2, R=length / 2, t0=ang))
+            notes.append(f"{r}: a travel slot {length:.1f} x {width:.1f} mm for {n} ({parts[n].plane}), which "
+                         "passes through its layer")
+    return out, notes
+
+
+def merge_travel(feats: list[Feature], wall: float) -> list[Feature]:
+    """Travel slots closer than ``wall`` to each other (two perpendicular pieces side by side) as one slot:
+    the smallest rectangle round both."""
+    from planar.fabrication.sheet import cut_polygon
+
+    out = list(feats)
+    merged = True
+    while merged:
+        merged = False
+        for i in range(len(out)):
+            for j in range(i + 1, len(out)):
+                a, b = cut_polygon(out[i].cut(0.0)), cut_polygon(out[j].cut(0.0))
+                if a.distance(b) < wall:
+                    rect = a.union(b).minimum_rotated_rectangle
+                    length, width, ang = _rect_sides(rect)
+                    c = rect.centroid
+                    what = out[i].what + " and " + out[j].what.removeprefix("travel slot for ")
+                    out[i] = Feature("rect", what, (float(c.x), float(c.y)), width / 2, R=length / 2, t0=ang)
+                    del out[j]
+                    merged = True
+                    break
+            if merged:
+                break
+    return out
+
+
+def _rect_sides(rect: Any) -> tuple[float, float, float]:
+    """A rectangle's long side, short side and the long side's angle (rad)."""
+    xy = np.asarray(rect.exterior.coords)[:4]
+    e1, e2 = xy[1] - xy[0], xy[2] - xy[1]
+    a, b = float(np.hypot(*e1)), float(np.hypot(*e2))
+    long = e1 if a >= b else e2
+    return max(a, b), min(a, b), math.atan2(long[1], long[0])
+
+
+def slot_features(joins: list[TabJoin]) -> dict[str, list[Feature]]:
+    """The xy pieces' through-slots as fabrication features (mm, own frame)."""
+    out: dict[str, list[Feature]] = {}
+    for jn in joins:
+        L, W = jn.slot_size
+        for c, ang in jn.slots:
+            out.setdefault(jn.base, []).append(Feature("rect", f"tab slot {jn.letter}", c, W / 2, R=L / 2, t0=ang))
+    return out
+

@@ -1,0 +1,206 @@
+"""Two motions of one mechanism side by side: analytic against simulated.
+
+Per part: the largest and RMS distance between the part's hull points
+(model units, and as a fraction of the mechanism's size) and the largest
+angle difference; per joint: the residual of the second motion; and the
+first sample where a part's error passes ``threshold`` (fraction of size).
+
+A comparison *fails* (:attr:`Comparison.passed` is false, ``planar compare``
+exits with :data:`EXIT_MISMATCH`) when a part's error passes the threshold,
+when the simulation reported a failure (left its analytic pose, switched
+assembly branch, blew up), when the motor torque differs from inverse
+dynamics by more than ``torque_threshold`` of its peak, or when the motor
+saturated.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planar.core.geometry import poses_apply, wrap_angle
+from planar.core.model import Mechanism, Motion, joint_residuals
+
+__all__ = ["EXIT_MISMATCH", "Comparison", "PartError", "compare", "format_comparison"]
+
+#: exit status of ``planar compare`` when a check fails (2 is a user error, 0 all checks passed)
+EXIT_MISMATCH = 3
+
+
+@dataclass
+class PartError:
+    part: str
+    max_error: float
+    rms_error: float
+    max_rel_error: float
+    max_angle_error: float
+    first_over: int | None
+
+
+@dataclass
+class Comparison:
+    mechanism: str
+    size: float
+    samples: int
+    threshold: float
+    parts: list[PartError]
+    joints: dict[str, float]
+    first_over: int | None
+    torque: dict[str, Any] | None = None
+    notes: list[str] = field(default_factory=list)
+    #: the simulation's own failure report (sample, part, how), if any
+    failure: str | None = None
+    #: largest torque difference allowed, fraction of the analytic peak
+    torque_threshold: float = 0.01
+
+    @property
+    def max_rel_error(self) -> float:
+        return max((p.max_rel_error for p in self.parts), default=0.0)
+
+    def problems(self) -> list[str]:
+        """Every failed check, one line each (empty when all passed)."""
+        out = []
+        if self.failure:
+            out.append(f"simulation failed: {self.failure}")
+        if self.max_rel_error > self.threshold:
+            worst = max(self.parts, key=lambda p: p.max_rel_error)
+            out.append(f"part {worst.part!r} is {worst.max_rel_error:.3g} of the size off (threshold "
+                       f"{self.threshold:g}) from sample {worst.first_over}")
+        t = self.torque
+        if t:
+            if t.get("saturated"):
+                s = t["saturated"]
+                shown = ", ".join(str(i) for i in s[:12]) + (", ..." if len(s) > 12 else "")
+                out.append(f"motor saturated at {len(s)} sample(s) [{shown}] "
+                           f"(force limit {t.get('motor_force_limit'):g}, needed peak {t['peak']:.4g})")
+            if t.get("failure") and not self.failure:
+                out.append(f"motor-driven simulation failed: {t['failure']}")
+            if t["max_rel_diff"] > self.torque_threshold:
+                out.append(f"motor torque differs from inverse dynamics by {t['max_rel_diff']:.2%} of its peak "
+                           f"(threshold {self.torque_threshold:.0%})")
+        return out
+
+    @property
+    def passed(self) -> bool:
+        return not self.problems()
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "mechanism": self.mechanism,
+            "size": self.size,
+            "samples": self.samples,
+            "threshold": self.threshold,
+            "max_rel_error": self.max_rel_error,
+            "first_over_threshold": self.first_over,
+            "parts": {p.part: {"max_error": p.max_error, "rms_error": p.rms_error,
+                               "max_rel_error": p.max_rel_error, "max_angle_error": p.max_angle_error,
+                               "first_over_threshold": p.first_over} for p in self.parts},
+            "joints": {k: {"max_residual": v, "max_rel_residual": v / self.size} for k, v in self.joints.items()},
+            "torque": self.torque,
+            "notes": self.notes,
+            "failure": self.failure,
+            "passed": self.passed,
+            "problems": self.problems(),
+        }
+
+
+def _part_points(mech: Mechanism, part: str) -> NDArray[np.float64]:
+    """Points that stand for a part: its hull circle centres (so rotation errors count too)."""
+    p = mech.part(part)
+    pts = np.array([(x, y) for x, y, _ in p.hull] or [(0.0, 0.0)])
+    return pts
+
+
+def compare(mech: Mechanism, reference: Motion, other: Motion, threshold: float = 1e-3) -> Comparison:
+    """Errors of ``other`` against ``reference`` (same samples) for every part and joint."""
+    size = mech.size
+    # samples the simulation marked as failed still count (their poses are what it did), so the table agrees
+    # with the failure it reports; a non-finite pose counts as infinitely far
+    finite = np.ones(len(reference), bool)
+    for p in mech.parts:
+        finite &= np.isfinite(other.poses[p.name]).all(axis=1)
+    ok = reference.valid.copy()
+    parts = []
+    first_all: int | None = None
+    for p in mech.parts:
+        pts = _part_points(mech, p.name)
+        a = poses_apply(reference.poses[p.name], pts)  # (N, M, 2)
+        b = poses_apply(other.poses[p.name], pts)
+        with np.errstate(invalid="ignore", over="ignore"):
+            d = np.hypot(*(a - b).transpose(2, 0, 1)).max(axis=1)  # worst point per sample
+        d = np.where(ok, np.where(finite, d, np.inf), 0.0)
+        with np.errstate(invalid="ignore"):
+            ang = np.abs(wrap_angle(reference.poses[p.name][:, 2] - other.poses[p.name][:, 2]))
+        ang = np.where(ok & finite, ang, 0.0)
+        over = np.flatnonzero(d > threshold * size)
+        first = int(over[0]) if over.size else None
+        if first is not None and (first_all is None or first < first_all):
+            first_all = first
+        n = max(int(ok.sum()), 1)
+        parts.append(PartError(p.name, float(d.max()), float(np.sqrt((d[ok & finite] ** 2).sum() / n)),
+                               float(d.max() / size), float(ang.max()), first))
+    res = joint_residuals(mech, other)
+    joints = {k: float(np.max(np.where(ok & finite, v, 0.0))) for k, v in res.items()}
+    failure = None
+    if not other.valid.all():
+        i = int(np.flatnonzero(~other.valid)[0])
+        failure = other.fail_table[int(other.fail_code[i])][1] if other.fail_code[i] >= 0 else f"sample {i} invalid"
+    return Comparison(mech.name, size, len(reference), threshold, parts, joints, first_all, failure=failure)
+
+
+def format_comparison(c: Comparison) -> str:
+    """A table for the terminal."""
+    lines = [f"{c.mechanism}: {c.samples} samples, size {c.size:.4g}, threshold {c.threshold:g} of size",
+             f"  {'part':<16}{'max err':>11}{'rms err':>11}{'max/size':>11}{'max angle':>11}  first over",
+             ]
+    for p in c.parts:
+        first = "-" if p.first_over is None else str(p.first_over)
+        lines.append(f"  {p.part:<16}{p.max_error:11.3e}{p.rms_error:11.3e}{p.max_rel_error:11.3e}"
+                     f"{p.max_angle_error:11.3e}  {first}")
+    lines.append(f"  {'joint':<16}{'residual':>11}{'/size':>11}")
+    for k, v in c.joints.items():
+        lines.append(f"  {k:<16}{v:11.3e}{v / c.size:11.3e}")
+    if c.torque:
+        t = c.torque
+        lines.append(f"  motor torque: pymunk vs inverse dynamics: max |diff| {t['max_abs_diff']:.3e} "
+                     f"({100 * t['max_rel_diff']:.2g}% of peak {t['peak']:.4g}); motor-driven poses within "
+                     f"{t['pose_error']:.2e} of the size")
+    for n in c.notes:
+        lines.append(f"  note: {n}")
+    for n in c.problems():
+        lines.append(f"  FAILED: {n}")
+    return "\n".join(lines)
+
+
+def compare_scene(scene: Any, settings: Any = None, threshold: float = 1e-3, torque_threshold: float = 0.01,
+                  with_series: bool = False) -> tuple[Comparison, Any]:
+    """Simulate a scene, compare it with its analytic motion, and (for a steadily turning driver) the
+    motor torque with inverse dynamics; returns the comparison and the simulation result.
+
+    The simulation stops at the first part further than ``threshold`` of the
+    size from its analytic pose.
+    """
+    from dataclasses import replace
+
+    from planar.errors import PlanarError
+    from planar.physics.simulate import DEFAULT_SETTINGS, simulate_scene, torque_comparison
+
+    settings = replace(settings or DEFAULT_SETTINGS, tolerance=threshold)
+    sim = simulate_scene(scene, settings)
+    result = compare(scene.mechanism, scene.motion(), sim.motion, threshold=threshold)
+    result.torque_threshold = torque_threshold
+    mech = scene.mechanism
+    if mech.driver.kind == "rotation" and mech.driver.amplitude is None and len(getattr(mech, "stages", [])) <= 1:
+        try:
+            tc = torque_comparison(mech, scene.motion().t, scene.effects, settings)
+            keep = ("peak", "max_abs_diff", "max_rel_diff", "samples_compared", "motor_force_limit", "saturated",
+                    "failure", "pose_error", "pins", "note")
+            result.torque = {k: tc[k] for k in keep}
+            if with_series:
+                result.torque.update(analytic=tc["analytic"], simulated=tc["simulated"])
+        except PlanarError as err:
+            result.notes.append(f"torque not compared: {err}")
+    return result, sim

@@ -1,0 +1,284 @@
+"""A validated scene built into its mechanism: :class:`Scene` and :func:`build_scene`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from planar.core.effects import Effects, Load, Spring
+from planar.core.model import Mechanism, Motion
+from planar.errors import InputError, PlanarError, SceneError
+from planar.scene.schema import CamSpec, ChainSpec, ElementalSpec, FourBarSpec, LinkageSpec, SceneSpec, SliderCrankSpec, ToySpec
+
+__all__ = ["Scene", "build_scene"]
+
+
+@dataclass
+class Scene:
+    """A validated scene and the mechanism it describes."""
+
+    spec: SceneSpec
+    mechanism: Mechanism
+    path: str = "<scene>"
+    polygons: dict[str, tuple[str, np.ndarray]] = field(default_factory=dict)
+
+    def sample_count(self) -> int:
+        """Samples of :meth:`motion`, checked against :mod:`planar.core.limits` (samples and memory)
+        before anything is allocated; :class:`~planar.errors.LimitError` names the scene's field."""
+        from planar.core.limits import check_count, check_memory
+
+        d = self.spec.driver
+        period = self.mechanism.driver.period
+        value: float | None
+        if d.duration is not None:
+            field_name, value, cycles = "driver.duration", d.duration, d.duration / period
+        else:
+            field_name, value = "driver.cycles", d.cycles
+            cycles = d.cycles if d.cycles is not None else 1.0
+            if d.cycles is None:                          # one cycle: the per-cycle count is what asks
+                field_name, value = "driver.samples_per_cycle", d.samples_per_cycle
+        total = d.samples_per_cycle * cycles
+        where = f"{self.path}: {field_name}"
+        n = check_count("samples", where, round(total) if math.isfinite(total) else total,
+                        "samples in all (samples_per_cycle x cycles)", shown=value)
+        # poses (x, y, angle) of every part, points (x, y), driver, time and the solver's working copies
+        per_sample = 8 * (3 * len(self.mechanism.parts) + 2 * len(self.mechanism.points) + 4) * 4
+        check_memory(where, value, float(per_sample) * max(n, 2), "a motion")
+        return max(2, n)
+
+    def motion(self) -> Motion:
+        """The analytic motion over the scene's cycles (or duration)."""
+        d = self.spec.driver
+        drv = self.mechanism.driver
+        n = self.sample_count()
+        t = np.arange(n) * (drv.period / d.samples_per_cycle)
+        return self.mechanism.solve(drv.value(t), t=t)
+
+    @property
+    def name(self) -> str:
+        return self.spec.name or Path(self.path).stem
+
+    def save(self, path: str | Path) -> None:
+        """Write this scene as a TOML scene file that :func:`load_scene` reads back to the same motion.
+
+        The keys the scene was given are written (defaults left out), angles
+        as given with the scene's ``angle_unit``; atomic.  A mechanism built in
+        Python becomes a scene with :func:`planar.scene.load.scene_from_mechanism`.
+        """
+        from planar.scene.write import write_scene
+
+        write_scene(self.spec, path)
+
+    @property
+    def effects(self) -> Effects:
+        """The scene's ``[effects]`` as the model's plain record (what ``simulate`` takes)."""
+        e = self.spec.effects
+        return Effects(
+            gravity=None if e.gravity is None else (float(e.gravity[0]), float(e.gravity[1])),
+            damping=e.damping, density=e.density,
+            springs=tuple(Spring(s.a, s.b, s.stiffness, (float(s.anchor_a[0]), float(s.anchor_a[1])),
+                                 (float(s.anchor_b[0]), float(s.anchor_b[1])), s.rest_length, s.damping)
+                          for s in e.springs),
+            loads=tuple(Load(ld.point, (float(ld.force[0]), float(ld.force[1]))) for ld in e.loads),
+            motor_force_limit=e.motor_force_limit,
+        )
+
+def _angle(spec: SceneSpec, v: float) -> float:
+    return math.radians(v) if spec.angle_unit == "deg" else float(v)
+
+
+def build_scene(spec: SceneSpec, path: str = "<scene>") -> Scene:
+    """Build the mechanism a validated scene describes."""
+    m = spec.mechanism
+    rate = 2 * math.pi * spec.driver.speed
+    if not (math.isfinite(rate) and math.isfinite(2 * math.pi / rate) and rate > 0):
+        raise SceneError(f"{path}: driver.speed = {spec.driver.speed!r}: expected a speed whose period "
+                         "(1 / speed seconds) and angular rate are finite numbers")
+    phase = _angle(spec, spec.driver.phase)
+    try:
+        rock = _rocking(spec, m)
+    except InputError as e:
+        raise SceneError(f"{path}: {e}") from None
+    try:
+        with np.errstate(all="ignore"):
+            mech = _build(spec, m, rate, phase, rock)
+    except PlanarError as e:
+        raise SceneError(f"{path}: mechanism: {e}") from None
+    except (ValueError, ArithmeticError) as e:  # numbers past what a builder's arithmetic holds (NaN, overflow)
+        raise SceneError(f"{path}: mechanism: cannot be built from these numbers "
+                         f"({type(e).__name__}: {' '.join(str(e).split())}); check for extreme values") from None
+    polygons: dict[str, tuple[str, np.ndarray]] = {}
+    names = {p.name for p in mech.parts}
+    for i, poly in enumerate(getattr(m, "polygons", [])):
+        if poly.name in polygons:
+            raise SceneError(f"{path}: mechanism.polygons[{i}].name: a second polygon named {poly.name!r} "
+                             "(polygon names must differ)")
+        if poly.part not in names:
+            raise SceneError(f"{path}: mechanism.polygons[{i}].part: no part {poly.part!r} "
+                             f"(got {poly.part!r}; parts are {sorted(names)})")
+        polygons[poly.name] = (poly.part, np.asarray(poly.points, float))
+    for i, n in enumerate(spec.render.sweep):
+        if n not in polygons:
+            raise SceneError(f"{path}: render.sweep[{i}]: no polygon {n!r} (got {n!r}; polygons are {sorted(polygons)})")
+    if spec.render.trails is not None:
+        for i, n in enumerate(spec.render.trails):
+            if n not in mech.points:
+                raise SceneError(f"{path}: render.trails[{i}]: no named point {n!r} "
+                                 f"(got {n!r}; points are {sorted(mech.points)})")
+    for i, load in enumerate(spec.effects.loads):
+        if load.point not in mech.points:
+            raise SceneError(f"{path}: effects.loads[{i}].point: no named point {load.point!r} "
+                             f"(got {load.point!r}; points are {sorted(mech.points)})")
+    for i, s in enumerate(spec.effects.springs):
+        for side in ("a", "b"):
+            if getattr(s, side) not in names:
+                raise SceneError(f"{path}: effects.springs[{i}].{side}: no part {getattr(s, side)!r} "
+                                 f"(got {getattr(s, side)!r}; parts are {sorted(names)})")
+    return Scene(spec, mech, path, polygons)
+
+
+#: mechanism types whose driver can rock (``[driver] amplitude``)
+_ROCKING = ("fourbar", "slidercrank", "linkage")
+
+
+def _rocking(spec: SceneSpec, m: Any) -> dict[str, Any]:
+    """Keyword arguments ``amplitude``/``centre`` for a rocking input (radians or model units), or none."""
+    d = spec.driver
+    if d.amplitude is None:
+        return {}
+    if m.type not in _ROCKING:
+        raise InputError("driver.amplitude", d.amplitude,
+                         f"no amplitude for a {m.type!r} mechanism (a rocking input is for {', '.join(_ROCKING)})")
+    if isinstance(m, LinkageSpec):
+        from planar.linkages import NODE_KINDS
+
+        first = next((n for n in m.nodes if NODE_KINDS[n.kind].is_input), None)
+        if first is not None and first.kind == "actuator":  # a translating input: model units
+            return {"amplitude": float(d.amplitude), "centre": float(d.centre)}
+    return {"amplitude": _angle(spec, d.amplitude), "centre": _angle(spec, d.centre)}
+
+
+def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, Any]) -> Mechanism:
+    from planar.scene.catalog import get
+
+    placement: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    if hasattr(m, "placement"):
+        placement = (m.placement[0], m.placement[1], _angle(spec, m.placement[2]))
+    if isinstance(m, FourBarSpec):
+        from planar.linkages import FourBar
+
+        return FourBar(m.ground, m.crank, m.coupler, m.rocker, coupler_point=m.coupler_point,
+                       circuit=m.circuit, placement=placement, rate=rate, phase=phase,
+                       name=spec.name or "fourbar", **rock)
+    if isinstance(m, SliderCrankSpec):
+        from planar.linkages import SliderCrank
+
+        return SliderCrank(m.crank, m.rod, offset=m.offset, branch=m.branch, placement=placement,
+                           rate=rate, phase=phase, name=spec.name or "slidercrank", **rock)
+    if isinstance(m, LinkageSpec):
+        from planar.linkages import NODE_KINDS, Link, Linkage
+
+        nodes = []
+        for n in m.nodes:
+            cls = NODE_KINDS[n.kind]  # each node kind declares the scene keys it is built from
+            args = [_angle(spec, getattr(n, f)) if f in cls.angle_fields and getattr(n, f) is not None
+                    else getattr(n, f) for f in cls.scene_fields]
+            nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
+        links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
+        return Linkage(spec.name or "linkage", nodes, links, points=m.points, placement=placement,
+                       rate=rate, phase=phase, **rock)
+    if isinstance(m, ElementalSpec):
+        from planar.windup import ELEMENTAL, ElementalMechanism, params_for
+        from planar.windup.params import coerce
+
+        base = params_for(m.number)
+        angle_params = ELEMENTAL[m.number].angle_params
+        kw: dict[str, Any] = {}
+        known = sorted(f for f in vars(base))
+        for k, v in m.params.items():
+            if k not in known:
+                raise InputError(f"params.{k}", v, f"a parameter of mechanism #{m.number}, one of {known}")
+            val = coerce(f"params.{k}", getattr(base, k), v)  # a vector of the right length, or a number
+            if k in angle_params:
+                val = tuple(_angle(spec, x) for x in val) if isinstance(val, tuple) else _angle(spec, val)
+            kw[k] = val
+        try:
+            return ElementalMechanism(m.number, base.replace(**kw), rate=rate, phase=phase)
+        except InputError as e:  # check_params names "#5.F_o": the scene's key is params.F_o
+            if e.field.startswith(f"#{m.number}.") and e.field[len(f"#{m.number}."):] != "params":
+                raise InputError("params." + e.field[len(f"#{m.number}."):], e.value, e.expected) from None
+            raise
+    if isinstance(m, ChainSpec):
+        from planar.windup.chain import chain_mechanism
+
+        return chain_mechanism(m.chain, rate=rate, name=spec.name or " ".join(m.chain))
+    if isinstance(m, ToySpec):
+        from planar.windup.chain import ToyMechanism
+
+        cams = {}
+        if m.left:
+            cams["left"] = [tuple(c) for c in m.left]
+        if m.right:
+            cams["right"] = [tuple(c) for c in m.right]
+        from planar.windup import ELEMENTAL
+        from planar.windup.table import realise
+
+        overrides: dict[Any, dict[str, Any]] = {}
+        names: dict[tuple[str, tuple[str, ...]], str] = {}
+        for i, sg in enumerate(m.stages):
+            key = (sg.cam, tuple(sg.chain))
+            if not any(tuple(c[:len(key[1])]) == key[1] for c in cams.get(sg.cam, [])):
+                raise InputError(f"mechanism.stages[{i}].chain", sg.chain, f"a prefix of a chain on the {sg.cam} cam")
+            angle_params = ELEMENTAL[realise(sg.chain[-1]).number].angle_params
+            kw = {}
+            for k, v in sg.params.items():
+                val = tuple(v) if isinstance(v, list) else v
+                if k in angle_params:
+                    val = tuple(_angle(spec, x) for x in val) if isinstance(val, tuple) else _angle(spec, val)
+                kw[k] = val
+            if kw:
+                overrides[key] = kw
+            if sg.name is not None:
+                names[key] = sg.name
+        return ToyMechanism(cams, phase=_angle(spec, m.phase), rate=rate, name=spec.name or "toy",
+                            overrides=overrides, names=names)
+    if isinstance(m, CamSpec):
+        return _build_cam(spec, m, rate, phase)
+    try:
+        mech = get(m.name)
+    except InputError as e:
+        raise InputError("name", m.name, e.expected) from None
+    if rate != 2 * math.pi or phase:
+        from dataclasses import replace
+
+        mech.driver = replace(mech.driver, rate=rate, phase=phase)
+    return mech
+
+
+def _build_cam(spec: SceneSpec, m: CamSpec, rate: float, phase: float) -> Mechanism:
+    """A :class:`planar.cams.CamMechanism` from a ``type = "cam"`` mechanism table."""
+    from planar.cams import CamMechanism, CamProfile, FollowerGeometry, Program, Segment
+    from planar.linkages import NODE_KINDS, Link
+
+    f = m.follower
+    osc = f.motion == "oscillating"
+    program = Program([Segment(sg.law, _angle(spec, sg.angle), _angle(spec, sg.lift) if osc else float(sg.lift))
+                       for sg in m.segments], "mechanism.segments")
+    geom = FollowerGeometry(f.kind, f.motion, float(f.roller_radius or 0.0), (float(f.axis[0]), float(f.axis[1])),
+                            float(f.offset), (0.0, 0.0) if f.pivot is None else (float(f.pivot[0]), float(f.pivot[1])),
+                            float(f.arm or 0.0), float(f.face_offset), int(f.branch))
+    profile = CamProfile(program, float(m.base_radius), geom, "mechanism")
+    limit = math.radians(45.0 if osc else 30.0) if m.max_pressure_angle is None else _angle(spec, m.max_pressure_angle)
+    nodes = []
+    for n in m.nodes:
+        cls = NODE_KINDS[n.kind]
+        args = [_angle(spec, getattr(n, k)) if k in cls.angle_fields else getattr(n, k) for k in cls.scene_fields]
+        nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
+    links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
+    return CamMechanism(spec.name or "cam", profile, nodes, links, points=m.points or None, rate=rate, phase=phase,
+                        max_pressure_angle=limit, unit=spec.angle_unit, width=m.link_width)

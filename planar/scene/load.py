@@ -1,0 +1,125 @@
+"""Scene files: one TOML file describes a mechanism, its driver, effects, drawing and fabrication.
+
+This module reads and validates a file; :mod:`planar.scene.schema` holds the keys and
+:mod:`planar.scene.build` the mechanism built from them.
+
+Validated with pydantic: unknown keys are errors, and every error names the
+file, the field path, the bad value and what was expected, on one line
+(:class:`planar.SceneError`).  ``planar schema`` prints the JSON schema
+(committed as ``gallery/scene.schema.json``).
+
+Angles are radians unless the scene says ``angle_unit = "deg"``; lengths are
+model units (``[fabrication] unit_mm`` says what one unit is in millimetres).
+"""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from pydantic import ValidationError
+
+from planar.core.model import Mechanism
+from planar.errors import SceneError
+from planar.scene.build import Scene, build_scene
+from planar.scene.schema import _NAME, SceneSpec, scene_schema
+
+__all__ = ["Scene", "SceneSpec", "build_scene", "load_scene", "parse_scene", "scene_from_mechanism", "scene_schema"]
+
+
+# --------------------------------------------------------------------------- loading
+
+
+def _loc(loc: tuple) -> str:
+    out = ""
+    for i, part in enumerate(loc):
+        if isinstance(part, int):
+            out += f"[{part}]"
+        elif i == 1 and loc[0] == "mechanism" and part in ("fourbar", "slidercrank", "linkage", "elemental", "chain",
+                                                           "toy", "catalog", "cam"):
+            continue  # the discriminated union's tag
+        elif i > 0 and (str(part) in ("float", "int", "str", "bool") or str(part).startswith(("list[", "tuple["))):
+            continue  # which member of a union (a number or a list of numbers) pydantic tried
+        elif not re.fullmatch(r"[A-Za-z0-9_\-]+", str(part)):
+            out += f"[{str(part)!r}]"  # a key with spaces, dots or control characters, shown quoted on one line
+        else:
+            out += ("." if out else "") + str(part)
+    return out
+
+
+def _format_validation(path: str, e: ValidationError) -> str:
+    errs = e.errors(include_url=False)
+    first = errs[0]
+    where = _loc(tuple(first["loc"]))
+    msg = first["msg"]
+    if first["type"] == "string_pattern_mismatch" and (first.get("ctx") or {}).get("pattern") == _NAME:
+        msg = "expected a name without control characters (newline, tab), commas or double quotes"
+    got = first.get("input")
+    text = f"{path}: {where or 'scene'}: {msg}"
+    if first["type"] not in ("missing",) and not isinstance(got, dict):
+        text += f" (got {got!r})"
+    if len(errs) > 1:
+        text += f" (and {len(errs) - 1} more problem{'s' if len(errs) > 2 else ''})"
+    return text
+
+
+def parse_scene(data: dict[str, Any], path: str = "<scene>") -> SceneSpec:
+    """Validate a scene given as a dict (a parsed TOML document)."""
+    try:
+        return SceneSpec.model_validate(data)
+    except ValidationError as e:
+        raise SceneError(_format_validation(path, e)) from None
+
+def _read_text(p: str) -> str:
+    """The scene file as text: UTF-8 (a UTF-8 byte-order mark is skipped) or UTF-16 with its byte-order mark."""
+    try:
+        with open(p, "rb") as fh:
+            raw = fh.read(64 * 2**20 + 1)
+    except FileNotFoundError:
+        raise SceneError(f"{p}: no such file") from None
+    except IsADirectoryError:
+        raise SceneError(f"{p}: is a directory, not a scene file") from None
+    except OSError as e:  # a loop of symbolic links, no permission, a device
+        raise SceneError(f"{p}: cannot be read ({e.strerror or e})") from None
+    if len(raw) > 64 * 2**20:
+        raise SceneError(f"{p}: larger than 64 MiB; a scene file is a short TOML text")
+    if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        codec = "utf-16"
+    else:
+        codec = "utf-8-sig"
+    try:
+        text = raw.decode(codec)
+    except UnicodeDecodeError as e:
+        raise SceneError(f"{p}: not a text file in UTF-8 (or UTF-16 with a byte-order mark): "
+                         f"byte {e.start} is {raw[e.start:e.start + 1]!r}") from None
+    text = text.removeprefix("\ufeff")  # a byte-order mark some editors repeat inside the text
+    if "\x00" in text:
+        raise SceneError(f"{p}: not a text file (it holds NUL bytes); a scene is TOML text")
+    return text
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read, validate and build the scene in ``path`` (UTF-8, or UTF-16 with a byte-order mark)."""
+    p = str(path)
+    text = _read_text(p)
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise SceneError(f"{p}: not valid TOML: {' '.join(str(e).split())}") from None
+    return build_scene(parse_scene(data, p), p)
+
+
+def scene_from_mechanism(mech: Mechanism, **tables: Any) -> Scene:
+    """A :class:`~planar.scene.load.Scene` of a mechanism built in Python, validated like a scene file.
+
+    ``tables`` (see :func:`planar.scene.write.scene_data`): ``name``, ``driver``,
+    ``effects``, ``render``, ``fabrication`` (dicts of scene keys) and
+    ``polygons``; ``scene.save(path)`` writes it as a scene file.  The
+    scene's mechanism is rebuilt from the keys: what is saved is what runs.
+    """
+    from planar.scene.write import scene_data
+
+    where = f"<{type(mech).__name__} {mech.name!r}>"
+    return build_scene(parse_scene(scene_data(mech, **tables), where), where)

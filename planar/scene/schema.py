@@ -1,0 +1,588 @@
+"""Scene files as data: the pydantic models of every table and key (strict types, one-line errors).
+
+Angles are radians unless the scene says ``angle_unit = "deg"``; lengths are
+model units (``[fabrication] unit_mm`` says what one unit is in millimetres).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any, Literal, Union
+
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, Strict, StrictBool, model_validator
+
+Vec2 = tuple[float, float]
+# strict types: a number is a TOML number (true is not 1.0, "4" is not 4.0), a flag is true or false
+Pos = Annotated[float, Strict(), Field(gt=0, allow_inf_nan=False)]
+Real = Annotated[float, Strict(), Field(allow_inf_nan=False)]
+#: a name written into CSV headers, DXF groups and SVG text: no control character, comma or double quote
+_NAME = r'^[^\x00-\x1f\x7f,"]*$'
+Name = Annotated[str, Strict(), Field(min_length=1, max_length=80, pattern=_NAME)]
+Title = Annotated[str, Strict(), Field(max_length=80, pattern=_NAME)]
+
+
+def _whole(v: Any) -> Any:
+    if isinstance(v, bool) or not isinstance(v, int):
+        raise ValueError("expected 1 or -1 (a whole number)")
+    return v
+
+
+Branch = Annotated[Literal[1, -1], BeforeValidator(_whole)]
+
+
+class _Strict(BaseModel):
+    # a docstring under a field is its description in the JSON schema (``planar schema``)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, use_attribute_docstrings=True)
+
+
+class PolygonSpec(_Strict):
+    """A polygon fixed to a part (a foot), in that part's frame; drawn swept with it.
+
+    Example: ``[[mechanism.polygons]]`` ``name = "foot"``, ``part = "coupler"``,
+    ``points = [[5.1, -2.25], [6.6, -2.25], [6.6, -1.95], [5.1, -1.95]]``.
+    """
+
+    name: Name
+    """The polygon's name (``[render] sweep`` refers to it), e.g. ``"foot"``."""
+    part: Name
+    """The part it is fixed to, e.g. ``"coupler"`` (a four-bar's parts: crank, coupler, rocker)."""
+    points: Annotated[list[tuple[Real, Real]], Field(min_length=3)]
+    """At least three ``[x, y]`` vertices in the part's frame (model units), e.g. ``[[0, 0], [1, 0], [1, 0.2]]``."""
+
+
+class FourBarSpec(_Strict):
+    """A four-bar linkage driven at its crank (parts ``crank``, ``coupler``, ``rocker``; point ``coupler_point``).
+
+    Example: ``type = "fourbar"``, ``ground = 4.0``, ``crank = 1.0``,
+    ``coupler = 4.0``, ``rocker = 3.0``, ``coupler_point = [5.5, -2.0]``.
+    """
+
+    type: Literal["fourbar"]
+    """``"fourbar"``: ground pivots at (0, 0) and (ground, 0) before placement."""
+    ground: Pos
+    """Distance between the ground pivots O2 and O4 (model units), e.g. ``4.0``."""
+    crank: Pos
+    """Crank length O2-B (the driven link), e.g. ``1.0``."""
+    coupler: Pos
+    """Coupler length B-C, e.g. ``4.0``."""
+    rocker: Pos
+    """Rocker length O4-C, e.g. ``3.0``."""
+    coupler_point: tuple[Real, Real] = (0.5, 0.0)
+    """The named point ``coupler_point`` in the coupler's frame: origin at the crank pin B, x toward the
+    rocker pin C, e.g. ``[5.5, -2.0]``."""
+    circuit: Literal["open", "crossed"] = "open"
+    """Assembly: ``"open"`` (C left of the diagonal B -> O4, declared with the crank at 90 degrees) or
+    ``"crossed"``."""
+    placement: tuple[Real, Real, Real] = (0.0, 0.0, 0.0)
+    """``[x, y, angle]`` of the whole linkage in the world (angle in the scene's angle unit), e.g.
+    ``[0.0, 0.0, 0.0]``."""
+    polygons: list[PolygonSpec] = []
+    """Polygons fixed to parts (feet), swept in drawings: ``[[mechanism.polygons]]`` tables."""
+
+
+class SliderCrankSpec(_Strict):
+    """An offset slider-crank: crank about (0, 0), slider on the line ``y = offset`` (parts ``crank``, ``rod``,
+    ``slider``; point ``slider_pin``).
+
+    Example: ``type = "slidercrank"``, ``crank = 1.0``, ``rod = 3.0``, ``offset = 0.2``.
+    """
+
+    type: Literal["slidercrank"]
+    """``"slidercrank"``."""
+    crank: Pos
+    """Crank radius (model units), e.g. ``1.0``."""
+    rod: Pos
+    """Connecting-rod length from crank pin to wrist pin, e.g. ``3.0``."""
+    offset: Real = 0.0
+    """The slider's line ``y = offset`` (model units), e.g. ``0.2``; ``|offset| < crank + rod``."""
+    branch: Branch = 1
+    """``1``: the slider on the +x side of the crank; ``-1``: the -x side."""
+    placement: tuple[Real, Real, Real] = (0.0, 0.0, 0.0)
+    """``[x, y, angle]`` of the whole mechanism in the world (angle in the scene's angle unit)."""
+    polygons: list[PolygonSpec] = []
+    """Polygons fixed to parts, swept in drawings."""
+
+
+class NodeSpec(_Strict):
+    """A joint centre of a general linkage, placed in closed form from nodes declared before it.
+
+    Which keys a node needs depends on its ``kind`` (one ``[[mechanism.nodes]]`` table each):
+
+    * ``fixed`` — a ground point: ``{ name = "O", kind = "fixed", at = [0.0, 0.0] }``;
+    * ``crank`` — the input, turning about a node: ``{ name = "A", kind = "crank", centre = "O",
+      radius = 15.0, phase = 0.0 }`` (angle = driver + phase, counter-clockwise);
+    * ``actuator`` — the input, translating: ``{ name = "P", kind = "actuator", origin = "O",
+      axis = [1.0, 0.0], offset = 0.0 }`` (origin + (driver + offset) along the unit axis);
+    * ``rrr`` — a dyad, at ``ra`` from ``a`` and ``rb`` from ``b`` (circle-circle):
+      ``{ name = "B", kind = "rrr", a = "A", ra = 50.0, b = "Z", rb = 41.5, branch = -1 }``
+      (``branch = 1``: left of a -> b at the first sample, then by continuity);
+    * ``rrp`` — a pin in a straight slot, at ``ra`` from ``a`` on the line ``p -> q`` shifted left by
+      ``offset``: ``{ name = "S", kind = "rrp", a = "A", ra = 3.0, p = "G1", q = "G2", branch = 1 }``
+      (``branch = 1``: the root further along p -> q);
+    * ``rigid`` — fixed in the frame of ``a`` (origin) and ``b`` (x axis): coupler points, ternary
+      links: ``{ name = "T", kind = "rigid", a = "Q", b = "A", local = [4.0, 0.0] }``;
+    * ``geared`` — a crank geared to another: ``{ name = "B", kind = "geared", centre = "O2", radius = 1.2,
+      mesh = "A", ratio = -1.0, phase = 90.0 }`` (angle = ratio * angle(mesh) + phase; both centres fixed);
+    * ``driven`` — an input with its own law of the ``[driver]`` clock theta: ``{ name = "B", kind = "driven",
+      centre = "O2", radius = 1.5, cycles = 2.0, phase = 90.0, mean = 110.0, amplitude = 30.0 }``;
+    * ``triad`` — one of three nodes on a ternary link, each ``ra`` from its node ``a``, solved together:
+      ``{ name = "T1", kind = "triad", members = ["T2", "T3"], a = "C", ra = 3.27, local = [0.0, 0.0],
+      at = [2.0, 3.0] }`` (``at``: roughly where it is with the driver at 0; the members give ``a``, ``ra``,
+      ``local``, ``at``).
+    """
+
+    name: Name
+    """The node's name (links, points and later nodes refer to it), e.g. ``"B"``."""
+    kind: Literal["fixed", "crank", "actuator", "rrr", "rrp", "rigid", "geared", "driven", "triad"]
+    """One of ``fixed``, ``crank``, ``actuator``, ``rrr``, ``rrp``, ``rigid``, ``geared``, ``driven``, ``triad``
+    (see the node's description)."""
+    at: tuple[Real, Real] | None = None
+    """``fixed``: the ground point ``[x, y]`` (model units), e.g. ``[-38.0, -7.8]``; ``triad``: roughly where the
+    node is with the driver at 0 (picks the assembly)."""
+    centre: Name | None = None
+    """``crank``, ``geared``, ``driven``: the node it turns about, e.g. ``"O"``."""
+    radius: Pos | None = None
+    """``crank``, ``geared``, ``driven``: its radius (model units), e.g. ``15.0``."""
+    phase: Real = 0.0
+    """``crank``: added to the driver angle; ``geared``: added to ratio * angle(mesh); ``driven``: in its law
+    (scene's angle unit), e.g. ``90``."""
+    origin: Name | None = None
+    """``actuator``: the node it translates from, e.g. ``"O"``."""
+    axis: tuple[Real, Real] = (1.0, 0.0)
+    """``actuator``: the direction it translates along (normalised), e.g. ``[0.0, 1.0]``."""
+    a: Name | None = None
+    """``rrr``, ``rrp``, ``triad``: the node at distance ``ra``; ``rigid``: the frame's origin node. E.g. ``"A"``."""
+    ra: Pos | None = None
+    """``rrr``, ``rrp``, ``triad``: the link length from ``a`` (model units), e.g. ``50.0``."""
+    b: Name | None = None
+    """``rrr``: the node at distance ``rb``; ``rigid``: the node the frame's x axis points to. E.g. ``"Z"``."""
+    rb: Pos | None = None
+    """``rrr``: the link length from ``b`` (model units), e.g. ``41.5``."""
+    p: Name | None = None
+    """``rrp``: the slot line's first node (the line runs p -> q), e.g. ``"G1"``."""
+    q: Name | None = None
+    """``rrp``: the slot line's second node, e.g. ``"G2"``."""
+    branch: Branch = 1
+    """``rrr``: ``1`` left of a -> b, ``-1`` right; ``rrp``: ``1`` further along p -> q. Holds at the first
+    sample and is carried by continuity."""
+    offset: Real = 0.0
+    """``rrp``: the slot line shifted left of p -> q by this (model units); ``actuator``: added to the
+    driver value."""
+    local: tuple[Real, Real] | None = None
+    """``rigid``: ``[u, v]`` in the frame of ``a`` (origin) and ``b`` (x axis), model units, e.g. ``[4.0, 0.0]``;
+    ``triad``: the node's place on the ternary link (any frame), e.g. ``[3.0, 0.0]``."""
+    mesh: Name | None = None
+    """``geared``: the crank node it meshes with (``crank``, ``geared`` or ``driven``), e.g. ``"A"``."""
+    ratio: Real | None = None
+    """``geared``: angular velocity ratio, negative (external spur gears): angle = ratio * angle(mesh) + phase,
+    e.g. ``-1.0``."""
+    cycles: Pos = 1.0
+    """``driven``: turns (or rocking cycles) per cycle of the ``[driver]`` clock, e.g. ``2.0``."""
+    amplitude: Pos | None = None
+    """``driven``: a rocking input: angle = mean + amplitude sin(cycles theta + phase) (scene's angle unit),
+    e.g. ``30.0``; without it the node turns: angle = phase + cycles theta."""
+    mean: Real = 0.0
+    """``driven``: the middle of a rocking input's swing (scene's angle unit), e.g. ``110.0``."""
+    members: tuple[Name, Name] | None = None
+    """``triad``: on the triad's first node only, the two other nodes (declared after it), e.g.
+    ``["T2", "T3"]``."""
+
+    @model_validator(mode="after")
+    def _needs(self) -> "NodeSpec":
+        from planar.linkages import NODE_KINDS
+
+        # the kind's own scene keys; those with a default here (phase, axis, branch, offset) are never None
+        kind = NODE_KINDS[self.kind]
+        missing = [f for f in getattr(kind, "required_fields", kind.scene_fields) if getattr(self, f) is None]
+        if missing:
+            raise ValueError(f"a {self.kind!r} node needs {', '.join(missing)}")
+        return self
+
+
+class LinkSpec(_Strict):
+    """A rigid part carrying nodes: ``{ name = "upper", nodes = ["Z", "B", "D"] }``; a block sliding along a
+    line of another link: ``{ name = "block", nodes = ["A"], guide = ["Q", "T"] }``."""
+
+    name: Name
+    """The part's name (the ground is ``ground``, made of the fixed nodes unless declared), e.g. ``"lever"``."""
+    nodes: Annotated[list[Name], Field(min_length=1)]
+    """The nodes it carries; its frame has its origin at the first and x toward the second, e.g.
+    ``["Q", "T"]``. A node shared by two links is a pivot."""
+    guide: tuple[Name, Name] | None = None
+    """With one node: a block on that node sliding along the line ``[p, q]`` of the link carrying both,
+    e.g. ``["Q", "T"]``."""
+
+
+class LinkageSpec(_Strict):
+    """A general pivot/slot linkage of nodes and links (see ``gallery/jansen-leg.toml``,
+    ``gallery/quick-return.toml``)."""
+
+    type: Literal["linkage"]
+    """``"linkage"``."""
+    nodes: Annotated[list[NodeSpec], Field(min_length=2)]
+    """``[[mechanism.nodes]]`` tables, each placed from nodes declared before it; exactly the first
+    ``crank`` or ``actuator`` is the input."""
+    links: Annotated[list[LinkSpec], Field(min_length=1)]
+    """``[[mechanism.links]]`` tables: the parts."""
+    points: dict[Name, Name] = {}
+    """Named points: name -> node, e.g. ``{ foot = "F" }`` (columns of the motion table, trails, loads)."""
+    placement: tuple[Real, Real, Real] = (0.0, 0.0, 0.0)
+    """``[x, y, angle]`` of the whole linkage in the world (angle in the scene's angle unit)."""
+    polygons: list[PolygonSpec] = []
+    """Polygons fixed to parts, swept in drawings."""
+
+
+class ElementalSpec(_Strict):
+    """One of the 11 elemental wind-up mechanisms: ``type = "elemental"``, ``number = 2``,
+    ``params = { D_jc = [0.0, 0.08] }``."""
+
+    type: Literal["elemental"]
+    """``"elemental"``."""
+    number: Annotated[int, Strict(), Field(ge=1, le=11)]
+    """Which mechanism, 1-11 (the supplement's numbering; README's table of parameters), e.g. ``5``."""
+    params: dict[Name, Union[Real, list[Real]]] = {}
+    """Parameters overriding the supplement's defaults, by name (README: "Elemental parameters"), e.g.
+    ``{ F_jc = [-0.5, 0.0], amplitude = 20 }``; angles (``phi``, ``D_theta``, an Oz ``amplitude``) in the
+    scene's angle unit."""
+
+
+class ChainSpec(_Strict):
+    """A motion transfer chain from the motor: ``type = "chain"``, ``chain = ["Rz->Tx", "Tx->Oz"]``."""
+
+    type: Literal["chain"]
+    """``"chain"``."""
+    chain: Annotated[list[Name], Field(min_length=1)]
+    """Patterns ``"In->Out"``, the first driven by the motor (``Rz``), each by the previous one's output
+    (``planar chains`` lists them), e.g. ``["Rz->OzT", "OzT->Oz"]``."""
+
+
+class ToyStageSpec(_Strict):
+    """One stage of a toy given its own parameters or a name: ``[[mechanism.stages]]`` with ``cam``,
+    ``chain`` (the stage's prefix) and ``params`` (as an elemental's), e.g. what ``planar design`` writes."""
+
+    cam: Literal["left", "right"]
+    """The cam whose tree holds the stage, ``"left"`` or ``"right"``."""
+    chain: Annotated[list[str], Field(min_length=1)]
+    """The patterns from the motor to this stage (a prefix of one of the cam's chains), e.g. ``["Rz->Tx"]``."""
+    params: dict[str, Union[Real, list[Real]]] = {}
+    """The stage mechanism's parameters overriding its defaults (angles in the scene's angle unit)."""
+    name: str | None = None
+    """A name for the stage's end effector: a point at its follower's origin (trails, motion tables)."""
+
+
+class ToySpec(_Strict):
+    """A wind-up toy: chains on the motor's left and right cams (see ``gallery/horse.toml``)."""
+
+    type: Literal["toy"]
+    """``"toy"``."""
+    left: list[Annotated[list[Name], Field(min_length=1)]] = []
+    """Chains on the left cam, e.g. ``[["Rz->OzT", "OzT->Oz"]]``; chains sharing a prefix share its stages."""
+    right: list[Annotated[list[Name], Field(min_length=1)]] = []
+    """Chains on the right cam, e.g. ``[["Rz->OzT", "OzT->Ty"], ["Rz->OzT", "OzT->Oz"]]``."""
+    phase: Real = math.pi
+    """The right cam's lead over the left (scene's angle unit), e.g. ``180`` with ``angle_unit = "deg"``."""
+    stages: list[ToyStageSpec] = []
+    """Stages with their own parameters or end-effector names (``[[mechanism.stages]]``)."""
+
+    @model_validator(mode="after")
+    def _some(self) -> "ToySpec":
+        if not self.left and not self.right:
+            raise ValueError("a toy needs at least one chain on the left or right cam")
+        return self
+
+
+class CatalogSpec(_Strict):
+    """A built-in mechanism by name: ``type = "catalog"``, ``name = "jansen"``."""
+
+    type: Literal["catalog"]
+    """``"catalog"``."""
+    name: Name
+    """A name of ``planar.scene.catalog.CATALOG``, e.g. ``"jansen"``, ``"kangaroo"``, ``"windup-5"``, ``"horse"``."""
+
+
+class CamSegmentSpec(_Strict):
+    """One segment of a cam's program: ``law`` over ``angle`` of cam turn (angle unit), changing the
+    follower's displacement by ``lift`` (model units; an oscillating follower's in the angle unit)."""
+
+    law: Literal["cycloidal", "harmonic", "polynomial-345", "dwell"]
+    """The motion law of the segment, e.g. ``"cycloidal"``: cycloidal, simple harmonic, 3-4-5 polynomial or dwell."""
+    angle: Pos
+    """Cam turn over which the segment runs (angle unit), e.g. ``90.0``; the segments' angles sum to one turn."""
+    lift: Real = 0.0
+    """Change of the follower's displacement over the segment, e.g. ``16.0`` (model units; an oscillating
+    follower's in the angle unit; negative for a return, 0 for a dwell); the lifts sum to 0."""
+
+
+class CamFollowerSpec(_Strict):
+    """A cam's follower: what touches the cam (``kind``) and how it moves (``motion``); see planar.cams."""
+
+    kind: Literal["knife", "roller", "flat"]
+    """What touches the cam, e.g. ``"roller"``: a knife edge, a roller or a flat face."""
+    motion: Literal["translating", "oscillating"] = "translating"
+    """How the follower moves, e.g. ``"oscillating"``: along ``axis`` or about ``pivot``."""
+    roller_radius: Pos | None = None
+    """Radius of the roller (roller followers only), e.g. ``0.45``."""
+    axis: tuple[Real, Real] = (0.0, 1.0)
+    """Direction of lift of a translating follower, e.g. ``[0.0, 1.0]``."""
+    offset: Real = 0.0
+    """Distance of a translating follower's axis to the left of the cam's centre, e.g. ``0.2``."""
+    pivot: tuple[Real, Real] | None = None
+    """Ground pivot of an oscillating follower's arm, e.g. ``[3.4, 2.0]``."""
+    arm: Pos | None = None
+    """Pivot to the roller's centre (knife: its tip) of an oscillating follower, e.g. ``3.2``."""
+    face_offset: Real = 0.0
+    """A flat face's distance from the pivot's line, toward the cam, e.g. ``0.3``."""
+    branch: Branch = 1
+    """Which of the two arm positions touching the base circle (oscillating), ``1`` or ``-1``."""
+
+    @model_validator(mode="after")
+    def _needs(self) -> "CamFollowerSpec":
+        if (self.kind == "roller") != (self.roller_radius is not None):
+            raise ValueError("roller_radius is given for a roller follower, and only for one")
+        if self.motion == "oscillating" and (self.pivot is None or self.arm is None):
+            raise ValueError("an oscillating follower needs pivot and arm")
+        if self.motion == "translating" and (self.pivot is not None or self.arm is not None):
+            raise ValueError("pivot and arm are for an oscillating follower (a translating one has axis, offset)")
+        return self
+
+
+class CamSpec(_Strict):
+    """A disc cam turning about (0, 0), its follower, and the linkage the follower drives (planar.cams)."""
+
+    type: Literal["cam"]
+    """``"cam"``."""
+    base_radius: Pos
+    """The cam outline's least radius (model units), e.g. ``1.5``."""
+    follower: CamFollowerSpec
+    """The follower: ``[mechanism.follower]`` with ``kind``, ``motion`` and its geometry."""
+    segments: Annotated[list[CamSegmentSpec], Field(min_length=2)]
+    """The program, one ``[[mechanism.segments]]`` table per segment (at least two), in cam-angle order."""
+    max_pressure_angle: Pos | None = None
+    """Largest pressure angle allowed (angle unit), e.g. ``30.0``; default 30 deg translating, 45 oscillating."""
+    link_width: Pos | None = None
+    """Width of the follower and the linked parts, e.g. ``0.5``; default 8 % of their span."""
+    nodes: list[NodeSpec] = []
+    """Linkage nodes the follower drives, as in a ``linkage`` scene; the follower's are ``tip`` and ``pivot``."""
+    links: list[LinkSpec] = []
+    """Links of the driven linkage, as in a ``linkage`` scene (``follower`` may list extra nodes)."""
+    points: dict[Name, Name] = {}
+    """Named points: name to node, e.g. ``{ beak = "H" }``; default the follower's ``tip``."""
+    polygons: list[PolygonSpec] = []
+    """Polygons fixed to parts (drawn swept with them), as in other scenes."""
+
+
+MechanismSpec = Annotated[
+    Union[FourBarSpec, SliderCrankSpec, LinkageSpec, ElementalSpec, ChainSpec, ToySpec, CatalogSpec, CamSpec],
+    Field(discriminator="type"),
+]
+
+
+class DriverSpec(_Strict):
+    """The input's law: ``speed`` cycles per second, for ``cycles`` or ``duration`` seconds.
+
+    Without ``amplitude`` the input turns fully: ``phase + 2 pi speed t``.
+    With ``amplitude`` it rocks: ``centre + amplitude sin(2 pi speed t + phase)``,
+    for a limited input (double-rockers, straight-line linkages).  For a
+    rotary input (a four-bar's or slider-crank's crank, a linkage's crank node)
+    ``amplitude``, ``centre`` and ``phase`` are in the scene's angle unit, the
+    input angle counter-clockwise from the linkage's own x axis (a four-bar's
+    ground line, before ``placement``; a crank node adds its own ``phase``);
+    for a linkage driven by an actuator node, ``amplitude`` and ``centre`` are
+    model units along its axis.
+    """
+
+    speed: Pos = 1.0
+    """Cycles per second of the input (a turn, or a rocking period), e.g. ``0.5``."""
+    cycles: Pos | None = None
+    """How many cycles to solve (default 1), e.g. ``2``; or give ``duration``."""
+    duration: Pos | None = None
+    """Seconds to solve instead of ``cycles``, e.g. ``3.0``."""
+    samples_per_cycle: Annotated[int, Strict(), Field(ge=4)] = 72
+    """Samples (and animation frames) per cycle, at least 4, e.g. ``36``; samples x cycles at most
+    ``PLANAR_MAX_SAMPLES`` (:mod:`planar.core.limits`)."""
+    phase: Real = 0.0
+    """Input at t = 0 for a turning input, or the sine's phase for a rocking one (scene's angle unit)."""
+    amplitude: Pos | None = None
+    """Rock instead of turning: ``centre + amplitude sin(2 pi speed t + phase)`` (angle unit, or model units
+    for an actuator), e.g. ``25``; fourbar, slidercrank and linkage only."""
+    centre: Real = 0.0
+    """Middle of a rocking input (needs ``amplitude``), e.g. ``60``."""
+
+    @model_validator(mode="after")
+    def _one(self) -> "DriverSpec":
+        if self.cycles is not None and self.duration is not None:
+            raise ValueError("give cycles or duration, not both")
+        if self.amplitude is None and "centre" in self.model_fields_set:
+            raise ValueError("centre is the middle of a rocking input: give amplitude too")
+        return self
+
+
+class LoadSpec(_Strict):
+    """A force (model force units, world frame) the mechanism exerts at a named point."""
+
+    point: Name
+    """The named point it acts at, e.g. ``"coupler_point"``, ``"foot"``."""
+    force: tuple[Real, Real]
+    """``[fx, fy]`` the mechanism exerts there (model force units, world frame), e.g. ``[0.0, 10.0]``."""
+
+
+class SpringSpec(_Strict):
+    """A damped spring between two parts (anchors in each part's frame)."""
+
+    a: Name
+    """The first part, e.g. ``"crank"``."""
+    anchor_a: tuple[Real, Real] = (0.0, 0.0)
+    """Its anchor in part ``a``'s frame (model units), e.g. ``[0.5, 0.0]``."""
+    b: Name
+    """The second part, e.g. ``"rocker"``."""
+    anchor_b: tuple[Real, Real] = (0.0, 0.0)
+    """Its anchor in part ``b``'s frame."""
+    rest_length: Annotated[float, Strict(), Field(ge=0)] | None = None
+    """Unstretched length (model units); default: the anchors' distance at the first sample."""
+    stiffness: Pos
+    """Force per unit of stretch, e.g. ``10.0``."""
+    damping: Annotated[float, Strict(), Field(ge=0)] = 0.0
+    """Force per unit of stretching speed, e.g. ``0.1``."""
+
+
+class EffectsSpec(_Strict):
+    """Physical effects for the physics rebuild and the motor torque; none unless named."""
+
+    gravity: tuple[Real, Real] | None = None
+    """``[gx, gy]`` in model units per s^2, e.g. ``[0.0, -9.81]``; none unless given."""
+    damping: Annotated[float, Strict(), Field(gt=0, le=1)] | None = None
+    """Space damping: fraction of every body's velocity kept per second, in (0, 1], e.g. ``0.99``."""
+    density: Pos = 1.0
+    """Mass per unit area of every part (inertia in ``compare`` and the motor torque), e.g. ``0.01``."""
+    springs: list[SpringSpec] = []
+    """Damped springs between parts: ``[{ a = "crank", b = "rocker", stiffness = 10.0 }]``."""
+    loads: list[LoadSpec] = []
+    """Forces at named points: ``[{ point = "coupler_point", force = [0.0, 10.0] }]``."""
+    motor_force_limit: Pos | None = None
+    """``compare`` drives with a motor of this largest torque instead of an exact input, e.g. ``50.0``."""
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_contact(cls, data: Any) -> Any:
+        for key in ("contact", "friction"):
+            if isinstance(data, dict) and key in data:
+                raise ValueError(f"'{key}' was removed: the parts of a mechanism sit on layers and never touch, "
+                                 "so collisions (and their friction) are not simulated; delete the key")
+        return data
+
+
+class RenderSpec(_Strict):
+    """How ``planar render`` draws the animation."""
+
+    width: Annotated[int, Strict(), Field(ge=16, le=4096)] = 480
+    """Frame width in pixels (16-4096), e.g. ``480``."""
+    height: Annotated[int, Strict(), Field(ge=16, le=4096)] = 360
+    """Frame height in pixels (16-4096), e.g. ``360``."""
+    supersample: Annotated[int, Strict(), Field(ge=1, le=4)] = 2
+    """Antialiasing factor 1-4 (drawn this much larger, then reduced)."""
+    trails: list[Name] | None = None
+    """Named points whose paths are drawn, e.g. ``["coupler_point"]``; default every named point."""
+    sweep: list[Name] = []
+    """Polygons drawn swept along the motion, e.g. ``["foot"]``."""
+    background: Annotated[Name, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#ffffff"
+    """Background colour ``#rrggbb``, e.g. ``"#ffffff"``."""
+    show_pins: StrictBool = True
+    """Draw the pins of the joints."""
+    fps: Annotated[float, Strict(), Field(gt=0, le=240)] | None = None
+    """Frames per second of the animation, e.g. ``25.0``; default 25, or 50 when a cycle would get fewer than 12
+    frames; a GIF plays at most 50. A cycle plays for ``1/speed`` seconds within one frame delay."""
+    opacity: Annotated[float, Strict(), Field(ge=0, le=1)] = 1.0
+    """Fill opacity of moving parts, 0-1, e.g. ``0.6``: below 1 what lies under a part shows through."""
+    exploded: StrictBool = False
+    """Draw a wind-up toy as its exploded stage panels instead of assembled (default: assembled), e.g. ``true``."""
+
+
+class FabricationSpec(_Strict):
+    """How ``planar export`` cuts the parts (millimetres)."""
+
+    unit_mm: Pos = 10.0
+    """What one model unit is in millimetres, e.g. ``15.0``."""
+    thickness_mm: Pos = 3.0
+    """Sheet thickness (pin lengths, spacers), e.g. ``3.0``."""
+    kerf_mm: Annotated[float, Strict(), Field(ge=0, le=2)] = 0.15
+    """Beam width 0-2 mm: outlines grow and holes shrink by half of it."""
+    pin_diameter_mm: Pos = 3.0
+    """Diameter of every pin (holes and slots are cut at this plus ``clearance_mm``)."""
+    clearance_mm: Annotated[float, Strict(), Field(ge=0, le=2)] = 0.1
+    """Running clearance added to pivot holes and slots, 0-2 mm."""
+    sheet_mm: tuple[Pos, Pos] = (300.0, 200.0)
+    """Sheet ``[width, height]``; parts that do not fit go on more sheets."""
+    # manufacturability (planar.fabrication.parts): thinnest material between a cut and the outline, smallest part,
+    # smallest engraved text, clearance past each end of a pin's travel in its slot; narrow parts are
+    # widened (widen = true) or refused
+    min_wall_mm: Pos = 1.5
+    """Thinnest material between a cut and the outline (narrow parts widened or refused)."""
+    min_part_mm: Pos = 5.0
+    """Smallest part accepted (its smaller side)."""
+    min_label_mm: Pos = 1.5
+    """Smallest engraved label height; below it the part's number is engraved."""
+    slot_end_margin_mm: Annotated[float, Strict(), Field(ge=0, le=50)] = 1.0
+    """Slot length past each end of the pin's travel."""
+    widen: StrictBool = True
+    """Widen a rounded part too narrow for its holes (``false``: refuse it)."""
+    # assembly: pin head allowance per end; drive: D-shaft (diameter, distance across the flat), motor
+    # screws either side of the shaft, ground-plate mounting holes
+    pin_head_mm: Annotated[float, Strict(), Field(ge=0, le=50)] = 1.5
+    """Pin head allowance per end (pin length = thickness x layers + two heads)."""
+    shaft_diameter_mm: Pos = 3.0
+    """Motor shaft diameter (the driven part's D hole)."""
+    shaft_flat_mm: Pos = 2.5
+    """Distance across the shaft's flat (the D)."""
+    motor_screw_mm: Pos = 1.7
+    """Motor screw hole diameter."""
+    motor_screw_spacing_mm: Pos = 9.0
+    """Distance between the two motor screws, across the shaft (N20: 9)."""
+    mounting_hole_mm: Pos = 3.2
+    """Diameter of the ground plates' mounting holes (on ears)."""
+    # nesting and file conventions
+    spacing_mm: Annotated[float, Strict(), Field(ge=0, le=100)] = 3.0
+    """Gap between nested parts."""
+    margin_mm: Annotated[float, Strict(), Field(ge=0, le=100)] = 5.0
+    """Margin from the sheet's edge."""
+    svg_stroke_mm: Pos = 0.025
+    """SVG stroke width (hairline for laser software)."""
+    cut_colour: Annotated[Name, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#ff0000"
+    """Colour of cut lines ``#rrggbb``."""
+    engrave_colour: Annotated[Name, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#0000ff"
+    """Colour of engraved lines (labels, letters) ``#rrggbb``."""
+
+
+#: millimetres per model unit of a wind-up scene that does not say (the paper's toys are about 0.9 units across)
+WINDUP_UNIT_MM = 100.0
+
+
+class SceneSpec(_Strict):
+    """A whole scene file."""
+
+    name: Title = ""
+    """The scene's name (titles, the mechanism's name); default the file's stem, e.g. ``"kangaroo-leg"``."""
+    angle_unit: Literal["rad", "deg"] = "rad"
+    """Unit of every angle in the file: ``"rad"`` or ``"deg"``."""
+    mechanism: MechanismSpec
+    """The mechanism, by ``type``: fourbar, slidercrank, linkage, elemental, chain, toy, catalog."""
+    driver: DriverSpec = DriverSpec()
+    """The input's law over time."""
+    effects: EffectsSpec = EffectsSpec()
+    """Physical effects (physics rebuild, motor torque); nothing unless named."""
+    render: RenderSpec = RenderSpec()
+    """Drawing options."""
+    fabrication: FabricationSpec = FabricationSpec()
+    """Laser-cutting options (mm); a wind-up scene (elemental, chain, toy) cuts at 100 mm per unit unless its
+    ``unit_mm`` says otherwise (the supplement's units: a toy about 9 cm across)."""
+
+    @model_validator(mode="after")
+    def _windup_unit(self) -> "SceneSpec":
+        if self.mechanism.type in ("elemental", "chain", "toy") and "unit_mm" not in self.fabrication.model_fields_set:
+            self.fabrication = self.fabrication.model_copy(update={"unit_mm": WINDUP_UNIT_MM})
+        return self
+
+
+def scene_schema() -> dict[str, Any]:
+    """JSON schema of a scene file."""
+    return SceneSpec.model_json_schema()
+

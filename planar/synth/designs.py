@@ -1,0 +1,35 @@
+"""What every synthesised design shares: its checks' verdict, and a four-bar from its dimensions."""
+
+from __future__ import annotations
+
+from typing import Any
+
+
+class Checked:
+    """A design whose ``checks`` hold ``ok_...`` verdicts (and figures under other keys)."""
+
+    checks: dict[str, Any]
+
+    @property
+    def ok(self) -> bool:
+        """Every check passed."""
+        return all(bool(v) for k, v in self.checks.items() if k.startswith("ok_"))
+
+
+class PlacedFourBar:
+    """A design given as a four-bar's lengths, coupler point, circuit and placement."""
+
+    ground: float
+    crank: float
+    coupler: float
+    rocker: float
+    coupler_point: tuple[float, float]
+    circuit: str
+    placement: tuple[float, float, float]
+
+    def fourbar(self, **kw: Any):
+        """The design as a :class:`planar.linkages.FourBar`."""
+        from planar.linkages import FourBar
+
+        return FourBar(self.ground, self.crank, self.coupler, self.rocker, coupler_point=self.coupler_point,
+                       circuit=self.circuit, placement=self.placement, **kw)  # type: ignore[arg-type]

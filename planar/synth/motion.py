@@ -1,0 +1,362 @@
+"""Motion generation by Burmester theory: a four-bar whose coupler takes 3, 4 or 5 given poses.
+
+A pose is ``(x, y, angle)`` of the guided body (radians): a body point ``z``
+(body frame) is at ``W_j(z) = d_j + R_j z`` in pose ``j``.  A dyad (moving
+pivot ``z``, fixed pivot ``c``) keeps ``|W_j(z) - c|`` equal for every pose;
+subtracting pose 1's equation removes ``|z|^2`` and leaves, for ``j >= 2``,
+the bilinear ``row_j(z) . (c, 1) = 0`` with
+``row_j(z) = (-2 (d_j - d_1 + (R_j - R_1) z), |d_j|^2 - |d_1|^2 + 2 (R_j^T d_j - R_1^T d_1) . z)``.
+
+* 3 poses: any moving pivot; its fixed pivot is the centre of its three
+  positions (a grid of moving pivots is tried).
+* 4 poses: ``det [row_2; row_3; row_4](z) = 0``, a cubic in ``z``: the
+  circle-point curve, sampled along rays (each ray's cubic interpolated at
+  4 nodes and its roots taken as eigenvalues of companion matrices, all rays
+  at once); each circle point's fixed pivot (least squares of the 3 rows)
+  traces the centre-point curve.
+* 5 poses: the Burmester points, where the circle-point curves of poses
+  1-4 and 1, 2, 3, 5 meet (0, 2 or 4 real points), by root finding started
+  at the grid minima of both determinants; the grid widens (4, 16, 64 times
+  the poses' extent) while fewer than 2 or an odd number are found.
+
+Two dyads make a four-bar: the first is the crank.  Pairs are chosen with the
+body at one circuit in every pose (no branch defect), the poses met in the
+given order by the crank moving one way (no order defect, see
+:func:`crank_order`: exact assembly arcs of the crank, so no dead zone between
+poses), the crank turning fully if any pair allows it, link ratio within
+``max_ratio``, then the smallest ratio; :class:`NoMotionDesign` when no pair
+qualifies.  The result is checked by solving the four-bar with planar's solver
+at each pose's crank angle and comparing the coupler poses, and at 4096 crank
+angles over the swept range (all must assemble).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planar.errors import InputError, PlanarError
+from planar.synth.designs import Checked, PlacedFourBar
+
+__all__ = ["MotionDesign", "burmester", "circle_point_curve", "burmester_points", "dyad_rows"]
+
+Array = NDArray[np.float64]
+
+
+def _rot(a: Array) -> Array:
+    c, s = np.cos(a), np.sin(a)
+    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)  # (..., 2, 2)
+
+
+def dyad_rows(poses: Array, z: Array) -> Array:
+    """``row_j(z)`` for ``j = 2..n``: ``(K, n-1, 3)`` for body points ``z`` ``(K, 2)``."""
+    d = poses[:, :2]
+    R = _rot(poses[:, 2])
+    dz = d[1:] - d[0]                                     # (n-1, 2)
+    dR = R[1:] - R[0]                                     # (n-1, 2, 2)
+    g = np.einsum("jki,jk->ji", R[1:], d[1:]) - R[0].T @ d[0]   # R_j^T d_j - R_1^T d_1
+    const = (d[1:] ** 2).sum(1) - (d[0] ** 2).sum()
+    lin = -2.0 * (dz[None] + np.einsum("jab,kb->kja", dR, z))     # (K, n-1, 2)
+    last = const[None] + 2.0 * np.einsum("ja,ka->kj", g, z)
+    return np.concatenate([lin, last[..., None]], -1)
+
+
+def fixed_pivots(poses: Array, z: Array) -> tuple[Array, Array]:
+    """Least-squares fixed pivot ``c`` for each moving pivot ``z`` and the largest radius mismatch."""
+    rows = dyad_rows(poses, z)
+    A, b = rows[..., :2], -rows[..., 2]
+    AtA = np.einsum("kja,kjb->kab", A, A)
+    Atb = np.einsum("kja,kj->ka", A, b)
+    det = AtA[:, 0, 0] * AtA[:, 1, 1] - AtA[:, 0, 1] * AtA[:, 1, 0]
+    det = np.where(np.abs(det) < 1e-300, np.nan, det)
+    cx = (Atb[:, 0] * AtA[:, 1, 1] - Atb[:, 1] * AtA[:, 0, 1]) / det
+    cy = (AtA[:, 0, 0] * Atb[:, 1] - AtA[:, 1, 0] * Atb[:, 0]) / det
+    c = np.column_stack([cx, cy])
+    W = poses[None, :, :2] + np.einsum("jab,kb->kja", _rot(poses[:, 2]), z)
+    r = np.hypot(*(W - c[:, None, :]).transpose(2, 0, 1))
+    return c, np.ptp(r, axis=1)
+
+
+def _scale(poses: Array) -> float:
+    return float(max(np.hypot(*np.ptp(poses[:, :2], axis=0)), 1e-3))
+
+
+def _det3(rows: Array) -> Array:
+    return np.linalg.det(rows)
+
+
+def circle_point_curve(poses: Array, rays: int = 720, reach: float = 4.0) -> tuple[Array, Array]:
+    """Points ``(K, 2)`` of the circle-point curve (body frame) of 4 poses and their centre points ``(K, 2)``.
+
+    Rays from the centroid of the body's positions (in the body frame at pose
+    1) at ``rays`` angles; each ray's determinant is a cubic in the distance
+    ``t`` along it, interpolated exactly at 4 nodes; real roots with ``|t| <=
+    reach L`` (``L`` the extent of the poses) are kept.
+    """
+    if len(poses) != 4:
+        raise InputError("poses", len(poses), "4 poses for a circle-point curve")
+    L = _scale(poses)
+    z0 = np.zeros(2)
+    psi = np.linspace(0.0, np.pi, rays, endpoint=False)
+    u = np.column_stack([np.cos(psi), np.sin(psi)])
+    nodes = np.array([-1.5, -0.5, 0.5, 1.5]) * L
+    vals = np.stack([_det3(dyad_rows(poses, z0 + t * u)) for t in nodes], 1)   # (rays, 4)
+    V = np.vander(nodes, 4)                                   # t^3 t^2 t 1
+    coef = np.linalg.solve(V, vals.T).T                       # (rays, 4), highest first
+    lead = coef[:, 0]
+    scale = np.abs(coef).max(1)
+    pts: list[Array] = []
+    cubic = np.abs(lead) > 1e-12 * scale
+    if cubic.any():
+        cc = coef[cubic] / lead[cubic, None]
+        comp = np.zeros((cc.shape[0], 3, 3))
+        comp[:, 0, :] = -cc[:, 1:]
+        comp[:, 1, 0] = 1.0
+        comp[:, 2, 1] = 1.0
+        roots = np.linalg.eigvals(comp)
+        real = np.abs(roots.imag) <= 1e-9 * np.maximum(1.0, np.abs(roots.real))
+        uu = u[cubic]
+        for k in range(3):
+            keep = real[:, k] & (np.abs(roots[:, k].real) <= reach * L)
+            pts.append(z0 + roots[keep, k].real[:, None] * uu[keep])
+    z = np.concatenate(pts) if pts else np.zeros((0, 2))
+    c, _ = fixed_pivots(poses, z)
+    good = np.isfinite(c).all(1) & (np.hypot(*(c - poses[:, :2].mean(0)).T) <= 4 * reach * L)
+    return z[good], c[good]
+
+
+def burmester_points(poses: Array, grid: int = 60, reach: float = 4.0) -> tuple[Array, Array]:
+    """Burmester points of 5 poses: moving pivots ``(K, 2)`` and fixed pivots ``(K, 2)``, ``K`` in 0..4."""
+    from scipy.optimize import root
+
+    if len(poses) != 5:
+        raise InputError("poses", len(poses), "5 poses for Burmester points")
+    L = _scale(poses)
+    p4, p5 = poses[[0, 1, 2, 3]], poses[[0, 1, 2, 4]]
+    g = np.linspace(-reach * L, reach * L, grid)
+    Z = np.stack(np.meshgrid(g, g), -1).reshape(-1, 2)
+    f4, f5 = _det3(dyad_rows(p4, Z)), _det3(dyad_rows(p5, Z))
+    s4, s5 = np.abs(f4).max() + 1e-300, np.abs(f5).max() + 1e-300
+    f = (f4 / s4) ** 2 + (f5 / s5) ** 2
+    starts = Z[np.argsort(f)[:40]]
+
+    def eqs(z: Array) -> Array:
+        zz = z[None, :]
+        return np.array([_det3(dyad_rows(p4, zz))[0] / s4, _det3(dyad_rows(p5, zz))[0] / s5])
+
+    found: list[Array] = []
+    for z0 in starts:
+        r = root(eqs, z0, method="hybr")
+        if not r.success or np.abs(eqs(r.x)).max() > 1e-10:
+            continue
+        if np.hypot(*r.x) > 2 * reach * L:
+            continue
+        if all(np.hypot(*(r.x - q)) > 1e-6 * L for q in found):
+            found.append(r.x)
+    z = np.array(found).reshape(-1, 2)
+    c, mismatch = fixed_pivots(poses, z)
+    ok = np.isfinite(c).all(1) & (mismatch <= 1e-6 * L)
+    return z[ok], c[ok]
+
+
+@dataclass
+class MotionDesign(Checked, PlacedFourBar):
+    ground: float
+    crank: float
+    coupler: float
+    rocker: float
+    coupler_point: tuple[float, float]
+    angle_offset: float               # body angle - coupler angle
+    circuit: str
+    placement: tuple[float, float, float]
+    theta: Array                      # crank angle at each pose
+    poses: Array
+    dyads: Array                      # (2, 4): moving pivot (body frame), fixed pivot (world)
+    grashof: str
+    candidates: int
+    crank_range: tuple[float, float] | None = None   # swept crank angles (rad, unwrapped) of a rocking crank
+    in_order: bool = True                            # the crank meets the poses in the given order
+    checks: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"type": "fourbar", "ground": self.ground, "crank": self.crank, "coupler": self.coupler,
+                "rocker": self.rocker, "coupler_point": list(self.coupler_point), "circuit": self.circuit,
+                "placement": list(self.placement), "theta": [float(t) for t in self.theta],
+                "grashof": self.grashof, "dyads": self.dyads.tolist(), "candidate_dyads": self.candidates,
+                "crank_range": None if self.crank_range is None else list(self.crank_range),
+                "ok": self.ok, "checks": self.checks}
+
+
+class NoMotionDesign(PlanarError):
+    """No candidate four-bar meets the constraints (the CLI exits 3 and writes nothing)."""
+
+
+def crank_order(theta: Array, d: Array, a: Array, b: Array, r: Array) -> tuple[NDArray[np.bool_], NDArray[np.bool_],
+                                                                              Array, Array]:
+    """Whether the crank reaches the poses in order, and the crank's swept range.
+
+    ``theta`` ``(P, n)``: crank angle (rad, from the ground line O2-O4) at each
+    pose; ``d, a, b, r`` ``(P,)``: ground, crank, coupler, rocker.  The crank
+    assembles where ``|b - r| <= |B - O4| <= b + r``, i.e. ``cmin <= cos theta
+    <= cmax`` (exact): the whole turn, or one or two arcs symmetric about the
+    ground line.  A crank that turns fully must meet the poses in their order
+    within one turn, forward or backward (cyclically); a crank confined to an
+    arc rocks, so all poses must lie on the same arc, in monotonic order along
+    it, and it sweeps only that arc (no toggle or dead zone between poses).
+    Returns ``(in_order, full, lo, hi)``: ``lo, hi`` the swept crank range
+    (unwrapped, rad; ``lo = hi = nan`` for a full turn).
+    """
+    two = 2.0 * np.pi
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cmin = (a ** 2 + d ** 2 - (b + r) ** 2) / (2 * a * d)
+        cmax = (a ** 2 + d ** 2 - (b - r) ** 2) / (2 * a * d)
+    full = (cmin <= -1.0) & (cmax >= 1.0)
+    fwd = np.mod(np.diff(theta, axis=1), two)
+    bwd = np.mod(-np.diff(theta, axis=1), two)
+    turn_ok = ((fwd > 0).all(1) & (fwd.sum(1) < two)) | ((bwd > 0).all(1) & (bwd.sum(1) < two))
+    around_pi = (cmin <= -1.0) & ~full                    # one arc centred on theta = pi
+    u = np.where(around_pi[:, None], np.mod(theta, two), (theta + np.pi) % two - np.pi)
+    # two arcs (neither limit outside [-1, 1]): the poses must share the sign of theta
+    two_arcs = (cmin > -1.0) & (cmax < 1.0)
+    same = (np.sign(u) == np.sign(u[:, :1])).all(1) | ~two_arcs
+    du = np.diff(u, axis=1)
+    mono = (du > 0).all(1) | (du < 0).all(1)
+    arc_ok = same & mono & ~full
+    lo = np.where(full, np.nan, u.min(1))
+    hi = np.where(full, np.nan, u.max(1))
+    return np.where(full, turn_ok, arc_ok), full, lo, hi
+
+
+def _choose(poses: Array, z: Array, c: Array, max_ratio: float) -> tuple[int, int, bool]:
+    """The best ordered pair (crank dyad, rocker dyad) among candidate dyads (see the module)."""
+    K = len(z)
+    if K < 2:
+        raise NoMotionDesign(f"only {K} dyad found for these {len(poses)} poses: a four-bar needs two")
+    I, J = np.meshgrid(np.arange(K), np.arange(K), indexing="ij")
+    I, J = I[I != J], J[I != J]
+    R = _rot(poses[:, 2])
+    W = poses[None, :, :2] + np.einsum("jab,kb->kja", R, z)          # (K, n, 2)
+    B, C = W[I], W[J]                                                 # (P, n, 2)
+    O2, O4 = c[I][:, None, :], c[J][:, None, :]
+    a = np.hypot(*(B[:, 0] - O2[:, 0]).T)
+    r = np.hypot(*(C[:, 0] - O4[:, 0]).T)
+    b = np.hypot(*(z[I] - z[J]).T)
+    d = np.hypot(*(O4[:, 0] - O2[:, 0]).T)
+    Lk = np.stack([d, a, b, r], 1)
+    lo, hi = Lk.min(1), Lk.max(1)
+    L = _scale(poses)
+    e1, e2 = O4 - B, C - B
+    side = np.sign(e1[..., 0] * e2[..., 1] - e1[..., 1] * e2[..., 0])   # (P, n)
+    one_circuit = (np.abs(side.sum(1)) == side.shape[1]) & (side[:, 0] != 0)
+    g = O4[:, 0] - O2[:, 0]
+    theta = (np.arctan2(B[..., 1] - O2[..., 1], B[..., 0] - O2[..., 0])
+             - np.arctan2(g[:, 1], g[:, 0])[:, None])                 # crank angle from the ground line
+    in_order, full, _, _ = crank_order(theta, d, a, b, r)
+    ratio = hi / np.maximum(lo, 1e-300)
+    usable = one_circuit & (lo > 1e-3 * L) & (ratio <= max_ratio)
+    if not usable.any():
+        raise NoMotionDesign(f"none of the {len(I)} pairs of the {K} dyads found takes the body through all "
+                             f"{len(poses)} poses on one circuit with links within the ratio {max_ratio:g} "
+                             "(a larger --max-ratio, or other poses)")
+    if not (usable & in_order).any():
+        raise NoMotionDesign(f"order defect: each of the {int(usable.sum())} four-bars that reach all {len(poses)} "
+                             "poses on one circuit meets them out of the given order (or with a dead zone "
+                             "between them) as the crank moves in one direction (other poses, or their order)")
+    usable &= in_order
+    pick = usable & full if (usable & full).any() else usable
+    k = int(np.flatnonzero(pick)[np.argmin(ratio[pick])])
+    return int(I[k]), int(J[k]), bool(full[k])
+
+
+def burmester(poses: Array, max_ratio: float = 10.0, grid: int = 24) -> MotionDesign:
+    """A four-bar guiding a body through 3, 4 or 5 ``poses`` ``(n, 3)`` (see the module)."""
+    poses = np.asarray(poses, float)
+    if poses.ndim != 2 or poses.shape[1] != 3 or not 3 <= len(poses) <= 5:
+        raise InputError("poses", poses.shape, "3, 4 or 5 poses (x, y, angle)")
+    L = _scale(poses)
+    if len(poses) == 3:
+        g = np.linspace(-2 * L, 2 * L, grid)
+        # moving pivots on a grid in the body frame, centred on the body's positions seen from pose 1
+        z = np.stack(np.meshgrid(g, g), -1).reshape(-1, 2)
+        centre = _rot(-poses[0, 2]) @ (poses[:, :2].mean(0) - poses[0, :2])
+        z = z + centre
+        c, _ = fixed_pivots(poses, z)
+    elif len(poses) == 4:
+        z, c = circle_point_curve(poses)
+        if len(z) > 240:
+            idx = np.linspace(0, len(z) - 1, 240).round().astype(int)
+            z, c = z[idx], c[idx]
+    else:
+        # real Burmester points come in pairs: widen the search while fewer than 2 or an odd number are found
+        for reach, grid in ((4.0, 60), (16.0, 120), (64.0, 160)):
+            z, c = burmester_points(poses, grid=grid, reach=reach)
+            if len(z) >= 2 and len(z) % 2 == 0:
+                break
+        if len(z) < 2:
+            raise NoMotionDesign(f"these 5 poses have {len(z)} Burmester points within 64 times their extent (2 or "
+                                 "4 are needed): no four-bar takes the body through all five (drop a pose, or move "
+                                 "one)")
+    ok = np.isfinite(c).all(1)
+    z, c = z[ok], c[ok]
+    i, j, _ = _choose(poses, z, c, max_ratio)
+    return _design(poses, z[i], c[i], z[j], c[j], len(z))
+
+
+def _design(poses: Array, zi: Array, ci: Array, zj: Array, cj: Array, candidates: int) -> MotionDesign:
+    from planar.linkages import grashof_class
+
+    R = _rot(poses[:, 2])
+    B = poses[:, :2] + R @ zi
+    C = poses[:, :2] + R @ zj
+    g = cj - ci
+    phi = float(np.arctan2(g[1], g[0]))
+    d = float(np.hypot(*g))
+    a = float(np.hypot(*(B[0] - ci)))
+    b = float(np.hypot(*(zi - zj)))
+    r = float(np.hypot(*(C[0] - cj)))
+    e = (C[0] - B[0]) / b
+    q = poses[0, :2] - B[0]
+    local = (float(q @ e), float(-q[0] * e[1] + q[1] * e[0]))
+    off = float(poses[0, 2] - np.arctan2(e[1], e[0]))
+    e1, e2 = cj - B[0], C[0] - B[0]
+    circuit = "open" if e1[0] * e2[1] - e1[1] * e2[0] > 0 else "crossed"
+    theta = np.arctan2(B[:, 1] - ci[1], B[:, 0] - ci[0]) - phi
+    ordered, full, lo, hi = crank_order(theta[None], *(np.array([v]) for v in (d, a, b, r)))
+    if not full[0]:                                   # a rocking crank: its angles as crank_order unwraps them
+        cmin = (a * a + d * d - (b + r) ** 2) / (2 * a * d)
+        theta = theta % (2 * np.pi) if cmin <= -1.0 else (theta + np.pi) % (2 * np.pi) - np.pi
+    md = MotionDesign(d, a, b, r, local, off, circuit, (float(ci[0]), float(ci[1]), phi), theta, poses,
+                      np.array([[*zi, *ci], [*zj, *cj]]), grashof_class(a, b, r, d), candidates,
+                      None if full[0] else (float(lo[0]), float(hi[0])), bool(ordered[0]))
+    check_motion(md)
+    return md
+
+
+def check_motion(md: MotionDesign, samples: int = 4096) -> None:
+    """Solve the four-bar at each pose's crank angle with planar's solver; compare the coupler poses.
+
+    Between poses the four-bar is solved again at ``samples`` crank angles
+    over the swept range (the whole turn, or the rocking arc): every one must
+    assemble on the design's circuit (no dead zone or toggle between poses).
+    """
+    fb = md.fourbar()
+    m = fb.solve(md.theta)
+    pos = m.points["coupler_point"]
+    ang = m.poses["coupler"][:, 2] + md.angle_offset
+    L = _scale(md.poses)
+    dp = np.hypot(*(pos - md.poses[:, :2]).T)
+    da = np.abs((ang - md.poses[:, 2] + np.pi) % (2 * np.pi) - np.pi)
+    lo, hi = md.crank_range if md.crank_range is not None else (0.0, 2 * np.pi)
+    sweep = fb.solve(np.linspace(lo, hi, samples))
+    md.checks = {
+        "max_position_error": float(dp.max()) if m.valid.all() else float("inf"),
+        "max_angle_error_rad": float(da.max()) if m.valid.all() else float("inf"),
+        "ok_reaches_every_pose": bool(m.valid.all() and dp.max() <= 1e-6 * L and da.max() <= 1e-6),
+        "ok_poses_in_order": md.in_order,
+        "ok_assembles_between_poses": bool(sweep.valid.all()),
+        "sweep_samples": samples,
+        "crank_turns_fully": md.crank_range is None,
+    }

@@ -1,0 +1,334 @@
+"""Global search over four-bar candidates, then local refinement.
+
+The objective is evaluated for a whole population at once with
+:func:`planar.synth.kernel.coupler_points`: every candidate's coupler point
+at the prescribed crank angles (timed targets), or at ``samples`` crank angles
+over the turn, each target scored by its nearest sample (untimed).  Design
+constraints are penalties added to the error of a candidate that breaks them,
+in proportion to how far it does:
+
+* the crank turns fully: Grashof (``s + l <= p + q``) with the crank or the
+  ground the shortest link (crank-rocker or double-crank), by a margin;
+* link ratio: longest / shortest link at most ``max_ratio``;
+* ground pivots inside ``region`` ``(xmin, ymin, xmax, ymax)``.
+
+The search: ``n_sample`` random candidates (uniform in the bounds; the
+"atlas" stage, cheap because it is one kernel call), the best of them seed
+:func:`scipy.optimize.differential_evolution` (``vectorized=True``, the
+population evaluated by one kernel call per generation), and
+:func:`scipy.optimize.least_squares` refines distinct candidates, half from
+DE's final population and half from the sample's best, the crank angles at
+the targets becoming variables for untimed targets (its Jacobian by forward
+differences, all perturbed candidates in one kernel call).  Candidates are
+screened in float32, refined and checked in float64.  Same inputs and
+``seed``, same result.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planar.synth.kernel import N_PARAMS, coupler_points
+
+__all__ = ["Constraints", "PathObjective", "search_fourbar", "SearchResult", "violation", "constraint_failures",
+           "region_failures", "REL_TOL"]
+
+Array = NDArray[np.float64]
+
+#: relative tolerance of the final constraint check (rounding-level overshoots pass)
+REL_TOL = 1e-9
+
+#: relative margin kept from a change-point (s + l = p + q) and from equal shortest links
+GRASHOF_MARGIN = 1e-3
+
+
+@dataclass(frozen=True)
+class Constraints:
+    """What a designer asks of the linkage besides the path (see the module)."""
+
+    full_turn: bool = True
+    max_ratio: float = 10.0
+    region: tuple[float, float, float, float] | None = None
+
+
+def violation(X: Array, cons: Constraints, scale: float, margin: float = GRASHOF_MARGIN) -> Array:
+    """How far each candidate ``(P, 9)`` breaks the constraints, in units of ``scale`` (0 when it keeps them).
+
+    ``margin`` (a fraction of the links' total length) is kept from a
+    change-point; the search uses :data:`GRASHOF_MARGIN`, the refinement
+    twice that (so it stays inside), the final check none.
+    """
+    L = X[:, :4]
+    r1, r2 = X[:, 0], X[:, 1]
+    lo, hi = L.min(1), L.max(1)
+    v = np.zeros(X.shape[0])
+    if cons.full_turn:
+        total = L.sum(1)
+        pq = total - lo - hi
+        v += np.maximum(0.0, lo + hi - pq + margin * total)
+        v += np.maximum(0.0, np.minimum(r1, r2) - np.minimum(X[:, 2], X[:, 3]) + margin * total)
+    v += np.maximum(0.0, hi - cons.max_ratio * (1.0 - margin) * lo)
+    if cons.region is not None:
+        x0, y0, x1, y1 = cons.region
+        ox, oy = X[:, 6], X[:, 7]
+        o4x, o4y = ox + r1 * np.cos(X[:, 8]), oy + r1 * np.sin(X[:, 8])
+        for px, py in ((ox, oy), (o4x, o4y)):
+            v += np.maximum(0.0, x0 - px) + np.maximum(0.0, px - x1) + np.maximum(0.0, y0 - py) + np.maximum(0.0, py - y1)
+    return v / scale
+
+
+def region_failures(pivots: dict[str, tuple[float, float]], cons: Constraints) -> list[str]:
+    """One line per ground pivot outside ``cons.region`` (to :data:`REL_TOL` of the box's size), naming it."""
+    if cons.region is None:
+        return []
+    x0, y0, x1, y1 = cons.region
+    tol = REL_TOL * max(x1 - x0, y1 - y0, abs(x0), abs(x1), abs(y0), abs(y1))
+    out = []
+    for name, (px, py) in pivots.items():
+        if not (x0 - tol <= px <= x1 + tol and y0 - tol <= py <= y1 + tol):
+            out.append(f"pivot {name} at ({px:.6g}, {py:.6g}) is outside the --pivots box "
+                       f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}")
+    return out
+
+
+def ratio_failures(links: dict[str, float], max_ratio: float) -> list[str]:
+    """The link ratio (longest / shortest of ``links``, names to lengths) over ``max_ratio`` (relative
+    tolerance :data:`REL_TOL`), as one line naming both links, or nothing."""
+    if not np.isfinite(max_ratio):
+        return []
+    lo = min(links, key=lambda k: links[k])
+    hi = max(links, key=lambda k: links[k])
+    if links[hi] <= max_ratio * links[lo] * (1.0 + REL_TOL):
+        return []
+    return [f"link ratio {links[hi] / links[lo]:.10g} (longest {hi} {links[hi]:.6g} / shortest {lo} "
+            f"{links[lo]:.6g}) is over --max-ratio {max_ratio:g}"]
+
+
+def constraint_failures(p: Array, cons: Constraints) -> list[str]:
+    """The constraints a four-bar (kernel row ``p``, world units) breaks, each named with its value and
+    limit (relative tolerance :data:`REL_TOL`); empty when it keeps them all."""
+    r1, r2, r3, r4 = (float(v) for v in p[:4])
+    out: list[str] = []
+    if cons.full_turn:
+        L = sorted((r1, r2, r3, r4))
+        tol = REL_TOL * sum(L)
+        if L[0] + L[3] > L[1] + L[2] + tol:
+            out.append(f"the crank turns fully: shortest + longest link {L[0] + L[3]:.10g} > the other two "
+                       f"{L[1] + L[2]:.10g} (not Grashof)")
+        elif min(r1, r2) > min(r3, r4) + tol:
+            out.append(f"the crank turns fully: neither crank {r2:.6g} nor ground {r1:.6g} is the shortest link "
+                       f"(coupler {r3:.6g}, rocker {r4:.6g})")
+    out += ratio_failures({"ground": r1, "crank": r2, "coupler": r3, "rocker": r4}, cons.max_ratio)
+    x0, y0, phi = (float(v) for v in p[6:9])
+    out += region_failures({"O2": (x0, y0), "O4": (x0 + r1 * np.cos(phi), y0 + r1 * np.sin(phi))}, cons)
+    return out
+
+
+@dataclass
+class PathObjective:
+    """Sum of squared distances to the targets for a population of candidates.
+
+    ``targets`` ``(N, 2)``; ``theta`` ``(N,)`` prescribed crank angles or
+    ``None``; a candidate row is the kernel's 9 parameters and a tenth column
+    whose sign is the circuit.  ``samples`` crank angles per candidate over a
+    turn when untimed.
+    """
+
+    targets: Array
+    theta: Array | None
+    cons: Constraints
+    samples: int = 64
+    scale: float = field(init=False)
+    penalty: float = field(init=False)
+
+    def __post_init__(self) -> None:
+        t = self.targets
+        self.scale = float(max(np.hypot(*np.ptp(t, axis=0)), 1e-9))
+        # any feasible candidate beats every infeasible one that is not absurdly far
+        self.penalty = 100.0 * self.scale**2 * len(t)
+
+    def __call__(self, x: Array) -> Array:
+        """``x`` ``(10, P)`` as scipy's vectorised DE passes it; returns ``(P,)``."""
+        return self.population(np.asarray(x, float).T)
+
+    def population(self, X: Array, dtype: type = np.float32) -> Array:
+        """Objective of candidates ``X`` ``(P, 10)`` (screened in ``dtype``; float64 sums)."""
+        X = np.atleast_2d(X)
+        circ = np.where(X[:, 9] >= 0, 1.0, -1.0)
+        P9 = X[:, :N_PARAMS]
+        tx, ty = self.targets[:, 0], self.targets[:, 1]
+        if self.theta is not None:
+            x, y, ok = coupler_points(P9, self.theta, circ, dtype=dtype)
+            tx, ty = tx.astype(dtype), ty.astype(dtype)
+            d2 = (x - tx) ** 2 + (y - ty) ** 2
+            d2 = np.where(ok, d2, 4.0 * self.scale**2)
+            err = d2.sum(1, dtype=float)
+        else:
+            th = np.linspace(0.0, 2 * np.pi, self.samples, endpoint=False)
+            x, y, ok = coupler_points(P9, th, circ, dtype=dtype)
+            far = 1e6 * self.scale**2
+            err = np.zeros(X.shape[0])
+            tx, ty = tx.astype(dtype), ty.astype(dtype)
+            for k in range(len(tx)):
+                d2 = (x - tx[k]) ** 2
+                d2 += (y - ty[k]) ** 2
+                d2[~ok] = far
+                err += d2.min(1)
+        v = violation(P9, self.cons, self.scale)
+        return err + np.where(v > 0, self.penalty * (1.0 + v), 0.0)
+
+
+@dataclass
+class SearchResult:
+    """The best candidate: parameters (9), circuit (+1/-1), crank angles at the targets, error."""
+
+    params: Array
+    circuit: int
+    theta: Array
+    sse: float
+    feasible: bool
+    evaluations: int
+    stages: dict[str, float]
+
+
+def default_bounds(targets: Array, cons: Constraints, theta_given: bool) -> list[tuple[float, float]]:
+    """Search bounds from the targets' extent ``L`` and centre: lengths ``[L/50, 4 L]``, coupler point
+    ``+-4 L``, crank pivot within ``4 L`` of the centre (or the region), ground angle any."""
+    t = np.asarray(targets, float)
+    L = float(max(np.hypot(*np.ptp(t, axis=0)), 1e-9))
+    c = t.mean(0)
+    b = [(L / 50, 4 * L)] * 4 + [(-4 * L, 4 * L)] * 2
+    if cons.region is not None:
+        x0, y0, x1, y1 = cons.region
+        b += [(x0, x1), (y0, y1)]
+    else:
+        b += [(c[0] - 4 * L, c[0] + 4 * L), (c[1] - 4 * L, c[1] + 4 * L)]
+    b += [(-np.pi, np.pi), (-1.0, 1.0)]
+    return b
+
+
+def _nearest_theta(obj: PathObjective, row: Array, n: int = 720) -> Array:
+    th = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    circ = np.array([1.0 if row[9] >= 0 else -1.0])
+    x, y, ok = coupler_points(row[None, :N_PARAMS], th, circ)
+    d2 = (x[0][None, :] - obj.targets[:, 0:1]) ** 2 + (y[0][None, :] - obj.targets[:, 1:2]) ** 2
+    d2[:, ~ok[0]] = np.inf
+    return th[np.argmin(d2, axis=1)]
+
+
+def _refine(obj: PathObjective, row: Array, bounds: list[tuple[float, float]], max_nfev: int) -> tuple[Array, Array, float]:
+    """least_squares from ``row``: returns (row, theta at the targets, sse with penalties)."""
+    from scipy.optimize import least_squares
+
+    circ = np.array([1.0 if row[9] >= 0 else -1.0])
+    lo = np.array([b[0] for b in bounds[:N_PARAMS]])
+    hi = np.array([b[1] for b in bounds[:N_PARAMS]])
+    timed = obj.theta is not None
+    n = len(obj.targets)
+    th0: Array = obj.theta if obj.theta is not None else _nearest_theta(obj, row)
+    w = np.sqrt(obj.penalty)
+
+    def split(z: Array) -> tuple[Array, Array]:
+        return z[:N_PARAMS], (obj.theta if timed else z[N_PARAMS:])  # type: ignore[return-value]
+
+    def rows(Z: Array) -> Array:
+        """Residuals of many variable vectors ``Z`` ``(K, m)`` in one kernel call: ``(K, 2 n + 1)``."""
+        P = Z[:, :N_PARAMS]
+        th = np.broadcast_to(th0, (len(Z), n)) if timed else Z[:, N_PARAMS:]
+        x, y, ok = coupler_points(P, np.ascontiguousarray(th), np.full(len(Z), circ[0]))
+        r = np.concatenate([x - obj.targets[:, 0], y - obj.targets[:, 1]], axis=1)
+        r = np.where(np.concatenate([ok, ok], axis=1), r, obj.scale)
+        v = violation(P, obj.cons, obj.scale, 2 * GRASHOF_MARGIN)
+        return np.concatenate([r, (w * v)[:, None]], axis=1)
+
+    def resid(z: Array) -> Array:
+        return rows(z[None, :])[0]
+
+    def jac(z: Array) -> Array:
+        # forward differences, every perturbed vector in one call (the kernel is vectorised over candidates)
+        h = 1.49e-8 * np.maximum(1.0, np.abs(z))
+        h = np.where(z + h > hi, -h, h)    # stay inside the bounds
+        Z = np.vstack([z[None, :], z[None, :] + np.diag(h)])
+        R = rows(Z)
+        return ((R[1:] - R[0]) / h[:, None]).T
+
+    z0 = np.clip(row[:N_PARAMS], lo, hi)
+    if not timed:
+        z0 = np.concatenate([z0, th0])
+        lo = np.concatenate([lo, np.full(n, -np.inf)])
+        hi = np.concatenate([hi, np.full(n, np.inf)])
+    # keep strictly inside the bounds (least_squares requires it)
+    fin = np.isfinite(lo) & np.isfinite(hi)
+    span = np.where(fin, hi - lo, 0.0)
+    z0 = np.where(fin, np.clip(z0, np.where(fin, lo, 0.0) + 1e-9 * span, np.where(fin, hi, 0.0) - 1e-9 * span), z0)
+    res = least_squares(resid, z0, jac=jac, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=max_nfev)
+    p, th = split(res.x)
+    out = np.append(p, row[9])
+    return out, np.asarray(th, float).copy(), float(obj.population(out[None, :], np.float64)[0]) if timed else float(
+        np.sum(res.fun[: 2 * n] ** 2) + (obj.penalty if violation(p[None, :], obj.cons, obj.scale)[0] > 0 else 0.0))
+
+
+def search_fourbar(
+    targets: Array,
+    theta: Array | None = None,
+    cons: Constraints | None = None,
+    bounds: list[tuple[float, float]] | None = None,
+    n_sample: int = 100_000,
+    maxiter: int = 200,
+    popsize: int = 30,
+    refine: int = 4,
+    seed: int = 0,
+    samples: int = 64,
+) -> SearchResult:
+    """Random sample, differential evolution, least-squares refinement (see the module)."""
+    cons = cons if cons is not None else Constraints()
+    import time
+
+    from scipy.optimize import differential_evolution
+
+    targets = np.asarray(targets, float)
+    th = None if theta is None else np.asarray(theta, float)
+    obj = PathObjective(targets, th, cons, samples)
+    b = bounds if bounds is not None else default_bounds(targets, cons, th is not None)
+    lo = np.array([v[0] for v in b])
+    hi = np.array([v[1] for v in b])
+    rng = np.random.default_rng(seed)
+    stages: dict[str, float] = {}
+    t0 = time.perf_counter()
+    X = lo + (hi - lo) * rng.random((n_sample, len(b)))
+    f = obj.population(X)
+    stages["sample_s"] = time.perf_counter() - t0
+    evals = n_sample
+    npop = popsize * len(b)
+    order = np.argsort(f, kind="stable")
+    init = X[order[:npop]]
+    t1 = time.perf_counter()
+    de = differential_evolution(obj, b, init=init, maxiter=maxiter, tol=0.0, atol=0.0, seed=seed,
+                                vectorized=True, updating="deferred", polish=False, mutation=(0.5, 1.0),
+                                recombination=0.9)
+    stages["de_s"] = time.perf_counter() - t1
+    evals += (int(de.nit) + 1) * len(init)  # scipy counts vectorised calls, not candidates
+    # refine the DE best and the best distinct candidates of the sample and the final population
+    # half the starts from DE's final population (its basin), half from the sample's best (other basins)
+    starts: list[Array] = []
+    for pool, k in ((np.vstack([de.x[None, :], de.population[np.argsort(de.population_energies)]]), (refine + 1) // 2),
+                    (X[order[: 50 * refine]], refine)):
+        for row in pool:
+            if len(starts) >= k:
+                break
+            if all(np.linalg.norm((row - s) / (hi - lo)) > 0.05 for s in starts):
+                starts.append(row)
+    t2 = time.perf_counter()
+    best: tuple[float, Array, Array] | None = None
+    for row in starts:
+        r, tt, e = _refine(obj, row, b, max_nfev=60 * (len(b) + (0 if th is not None else len(targets))))
+        if best is None or e < best[0]:
+            best = (e, r, tt)
+    stages["refine_s"] = time.perf_counter() - t2
+    assert best is not None
+    e, r, tt = best
+    feasible = not constraint_failures(r[:N_PARAMS], cons)
+    return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), feasible, evals, stages)

@@ -1,0 +1,158 @@
+"""Reading synthesis targets: CSV tables (points, angle pairs, poses) and SVG paths.
+
+Every bad input is one :class:`planar.InputError` naming the file, the row
+and the field.  Angles in files are radians unless the caller says degrees.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planar.errors import InputError
+
+__all__ = ["read_table", "read_path_targets", "read_svg_points", "normalisation", "check_theta", "SIZE_RANGE"]
+
+#: the targets' size (RMS distance from their centroid) and coordinates planar synthesises at: the search's
+#: kernel multiplies four lengths together, so 1e60 keeps every such product finite and normal (the search
+#: works in normalised units; the result is checked in the file's units). Measured: the same relative
+#: error from 1e-90 to 1e75; at 1e90 the kernel's check in the file's units overflows.
+SIZE_RANGE = (1e-60, 1e60)
+
+Array = NDArray[np.float64]
+
+
+def read_table(path: str | Path, required: tuple[str, ...], optional: tuple[str, ...] = (),
+               min_rows: int = 1, strict: bool = False) -> dict[str, Array]:
+    """Columns of a CSV file with a header row: every ``required`` column and the ``optional`` ones present.
+
+    A UTF-8 byte-order mark is skipped.  ``strict``: a column that is neither required nor optional
+    (a misspelt one) is an error naming it and the accepted ones.
+    """
+    p = str(path)
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as fh:
+            rows = list(csv.reader(fh))
+    except FileNotFoundError:
+        raise InputError(p, "missing", "an existing CSV file") from None
+    except (IsADirectoryError, UnicodeDecodeError) as e:
+        raise InputError(p, type(e).__name__, "a readable CSV text file") from None
+    rows = [r for r in rows if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
+    if not rows:
+        raise InputError(p, "empty", f"a header row with columns {', '.join(required)}")
+    header = [h.strip().lower() for h in rows[0]]
+    for col in required:
+        if col not in header:
+            raise InputError(f"{p}: header", rows[0], f"columns {', '.join(required + optional)} "
+                             f"({', '.join(optional) or 'none'} optional)")
+    if strict:
+        for h, raw in zip(header, rows[0]):
+            if h not in required + optional:
+                raise InputError(f"{p}: header: column", raw.strip(), f"one of the columns {', '.join(required + optional)} "
+                                 f"({', '.join(optional) or 'none'} optional)")
+    cols = [c for c in required + optional if c in header]
+    out: dict[str, list[float]] = {c: [] for c in cols}
+    for i, r in enumerate(rows[1:], start=2):
+        for c in cols:
+            j = header.index(c)
+            cell = r[j].strip() if j < len(r) else ""
+            try:
+                v = float(cell)
+            except ValueError:
+                raise InputError(f"{p}: row {i}: {c}", cell, "a number") from None
+            if not math.isfinite(v):
+                raise InputError(f"{p}: row {i}: {c}", cell, "a finite number")
+            out[c].append(v)
+    n = len(rows) - 1
+    if n < min_rows:
+        raise InputError(p, f"{n} rows", f"at least {min_rows} data rows")
+    return {c: np.asarray(v, float) for c, v in out.items()}
+
+
+def read_svg_points(path: str | Path, n: int) -> Array:
+    """``n`` points spaced evenly by arc length along the first shape of an SVG file (y up).
+
+    The SVG is read by svgelements (transforms applied); a closed shape gives
+    ``n`` distinct points around it, an open one ``n`` points from end to end.
+    SVG's y axis points down, planar's up: y is negated.
+    """
+    import svgelements as se
+
+    p = str(path)
+    if n < 3:
+        raise InputError("--points", n, "3 or more points to sample from the SVG path")
+    try:
+        svg = se.SVG.parse(p)
+    except FileNotFoundError:
+        raise InputError(p, "missing", "an existing SVG file") from None
+    except Exception as e:  # svgelements raises parser errors of several kinds
+        raise InputError(p, type(e).__name__, "a readable SVG file") from None
+    for el in svg.elements():
+        if isinstance(el, se.Shape) and not isinstance(el, se.Group):
+            path_ = se.Path(el)
+            if len(path_) == 0 or path_.length() <= 0:
+                continue
+            d = path_.d()
+            closed = d.rstrip().upper().endswith("Z")
+            s = np.linspace(0.0, 1.0, n, endpoint=not closed)
+            pts = np.asarray(path_.npoint(s), float)
+            pts[:, 1] = -pts[:, 1]
+            return pts
+    raise InputError(p, "no path", "an SVG with a path or shape of non-zero length")
+
+
+def read_path_targets(path: str | Path, svg_points: int | None = 12) -> tuple[Array, Array | None]:
+    """Targets ``(N, 2)`` and crank angles ``(N,)`` or ``None``, from ``x,y[,theta]`` CSV or an SVG path.
+
+    ``svg_points``: points sampled along an SVG (12 when ``None``); given with a CSV it is an error.
+    A CSV column other than ``x``, ``y``, ``theta`` is an error.
+    """
+    if str(path).lower().endswith(".svg"):
+        return read_svg_points(path, 12 if svg_points is None else svg_points), None
+    if svg_points is not None:
+        raise InputError("--points", svg_points, f"no --points with a CSV target ({path}: every row is a target)")
+    t = read_table(path, ("x", "y"), ("theta",), min_rows=3, strict=True)
+    return np.column_stack([t["x"], t["y"]]), t.get("theta")
+
+
+def normalisation(targets: Array, name: str = "targets") -> tuple[Array, float]:
+    """The targets' centroid ``(2,)`` and size ``s`` (RMS distance from the centroid, model units).
+
+    Synthesis works on ``(targets - centroid) / s`` so its tolerances and steps do not depend on the
+    units.  Raises :class:`InputError` when ``s`` or a coordinate is outside :data:`SIZE_RANGE`.
+    """
+    t = np.asarray(targets, float)
+    lo, hi = SIZE_RANGE
+    big = float(np.max(np.abs(t)))
+    if not big <= hi:
+        raise InputError(name, f"a coordinate of {big:.3g}", f"coordinates within {hi:g} model units "
+                         "(the solvers multiply four lengths; scale the targets down)")
+    c = t.mean(0)
+    s = float(np.sqrt(np.mean(np.sum((t - c) ** 2, axis=1))))
+    if not lo <= s <= hi:
+        raise InputError(name, f"size {s:.3g} (RMS distance from the centroid)",
+                         f"a size between {lo:g} and {hi:g} model units (the solvers multiply four "
+                         "lengths; scale the targets)")
+    return c, s
+
+
+def check_theta(theta: Array, name: str, deg: bool) -> None:
+    """Refuse crank angles (radians) spanning more than a turn, or two targets at the same angle."""
+    span = float(np.ptp(theta))
+    if span > 2 * np.pi * (1 + 1e-12):
+        unit = "deg" if deg else "rad"
+        shown = np.degrees(span) if deg else span
+        raise InputError(f"{name}: theta", f"values spanning {shown:.6g} {unit}",
+                         "crank angles within one turn" + ("" if deg else " (they look like degrees: add --deg)"))
+    w = np.mod(theta, 2 * np.pi)
+    order = np.argsort(w, kind="stable")
+    gap = np.diff(np.append(w[order], w[order[0]] + 2 * np.pi))
+    k = int(np.argmin(gap))
+    if gap[k] <= 1e-12 * 2 * np.pi:
+        i, j = sorted((int(order[k]), int(order[(k + 1) % len(order)])))
+        raise InputError(f"{name}: theta", f"targets {i + 1} and {j + 1} (in data-row order) at the same "
+                         f"crank angle {theta[i]:.6g}", "a different crank angle (modulo a turn) at every target")

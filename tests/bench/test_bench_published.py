@@ -1,0 +1,80 @@
+"""The synthesis benchmark's error measure checked against pylinkage's solver, and its published figures."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from planar.bench.peers.pylinkage import PylinkageFourBar, place
+from planar.bench.synthesis import PROBLEMS, format_synthesis, score_params, subset4
+
+pytest.importorskip("pylinkage")
+
+# a Grashof crank-rocker placed off the origin (planar's 9 parameters), used as input only
+FOURBAR = np.array([3.0, 1.0, 3.2, 2.5, 1.1, 0.6, 2.0, 1.5, 0.3])
+
+
+@pytest.mark.parametrize("circuit", [1.0, -1.0])
+def test_timed_sse_matches_pylinkage_simulation(circuit):
+    """planar's sse at the prescribed angles equals pylinkage's, simulated by pylinkage from the same joints."""
+    prob = PROBLEMS["cabrera-2002-case-2"]
+    t, th = np.asarray(prob["targets"], float), np.asarray(prob["theta"], float)
+    d = score_params(FOURBAR, circuit, t, th)
+    assert d is not None and d.checks["ok_crank_turns_fully"]
+    assert d.sse == pytest.approx(PylinkageFourBar(t, th).sse(FOURBAR, circuit), rel=1e-9)
+
+
+def test_untimed_sse_matches_pylinkage_simulation():
+    """Untimed: each target's nearest of 7200 crank angles, in planar and in pylinkage's simulation."""
+    t = np.asarray(PROBLEMS["kunjur-1997-line"]["targets"], float) / 10.0
+    d = score_params(FOURBAR, 1.0, t, None)
+    assert d is not None
+    assert d.sse == pytest.approx(PylinkageFourBar(t, None, steps=7200).sse(FOURBAR, 1.0), rel=1e-9)
+
+
+def test_place_closes_the_loop():
+    A, D, B, C, P = place(FOURBAR, -1.0)
+    r1, r2, r3, r4 = FOURBAR[:4]
+    assert np.hypot(*(D - A)) == pytest.approx(r1) and np.hypot(*(B - A)) == pytest.approx(r2)
+    assert np.hypot(*(C - B)) == pytest.approx(r3) and np.hypot(*(C - D)) == pytest.approx(r4)
+    assert place(np.array([10.0, 1.0, 1.0, 1.0, 0, 0, 0, 0, 0]), 1.0) is None
+
+
+def test_peer_refuses_angles_off_its_steps():
+    from planar.errors import PlanarError
+
+    with pytest.raises(PlanarError, match="whole multiples"):
+        PylinkageFourBar(np.zeros((3, 2)), np.array([0.0, 0.1, 0.2]))
+
+
+@pytest.mark.parametrize("name", sorted(PROBLEMS))
+def test_published_figures(name):
+    """A published error is recomputed from the published linkage; without one the entry says where it was sought."""
+    prob = PROBLEMS[name]
+    t = np.asarray(prob["targets"], float)
+    th = None if prob["theta"] is None else np.asarray(prob["theta"], float)
+    if prob["published_params"] is None:
+        assert prob["published"] == "not found" and "searched" in prob["searched"]
+        return
+    p, circuit = prob["published_params"]
+    d = score_params(np.asarray(p, float), circuit, t, th)
+    assert d is not None and math.isfinite(d.sse)
+    assert d.sse == pytest.approx(float(prob["published"]), rel=0.05)
+
+
+def test_subset4_and_format():
+    assert subset4(6) == [0, 2, 3, 5] and subset4(5) == [0, 1, 3, 4] and subset4(4) == [0, 1, 2, 3]
+    case = {"problem": "p", "targets": 6, "timed": False, "published_best_error": "not found",
+            "published_source": "s",
+            "planar": {"sse_median": 1.0, "sse_min": 1.0, "sse_max": 1.0, "time_s": {"median": 1.0}, "ok": True},
+            "pylinkage": {"sse": None, "solutions": 0, "time_s": {"median": 0.1}},
+            "pylinkage_without_grashof": {"sse": None, "solutions": 0, "crank_turns_fully": None, "time_s": 0.1},
+            "pylinkage_four_targets": {"sse": 0.2, "solutions": 5, "crank_turns_fully": True, "time_s": 0.1},
+            "pylinkage_optimisers": {"sse_median": 0.3, "sse_min": 0.2, "sse_max": 0.4,
+                                     "pylinkage_sse_of_best": 0.2, "time_s": {"median": 1.0}, "evaluations": 9}}
+    k = {"median": 1.0, "min": 1.0, "max": 1.0, "samples": 64, "threads": 1,
+         "float64": {"median": 1.0, "min": 1.0, "max": 1.0}}
+    out = format_synthesis({"repeats": 1, "cores": 2, "kernel_candidates_per_s": k, "cases": [case]})
+    assert "pylinkage optimisers" in out and "published_searched" in out

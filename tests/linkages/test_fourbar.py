@@ -1,0 +1,192 @@
+"""Four-bar and slider-crank: closed forms cross-checked, circuits, limits, bad input."""
+
+import numpy as np
+import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
+from scipy.optimize import fsolve
+
+from planar import AssemblyError, InputError
+from planar.core.geometry import wrap_angle
+from planar.linkages import FourBar, SliderCrank, grashof_class
+
+length = st.floats(0.2, 10.0)
+
+
+def _numeric_fourbar(a, b, c, d, theta, guess):
+    """Independent solution: Newton on the loop-closure equations."""
+    def f(x):
+        t3, t4 = x
+        return [a * np.cos(theta) + b * np.cos(t3) - c * np.cos(t4) - d,
+                a * np.sin(theta) + b * np.sin(t3) - c * np.sin(t4)]
+    return fsolve(f, guess, xtol=1e-13)
+
+
+@pytest.mark.parametrize("circuit", ["open", "crossed"])
+def test_closed_form_matches_numerical_loop_closure(circuit):
+    fb = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0), circuit=circuit)
+    th = np.linspace(0, 2 * np.pi, 73)
+    m = fb.solve(th)
+    t3 = m.poses["coupler"][:, 2]
+    t4 = m.poses["rocker"][:, 2]
+    for i in range(0, 73, 6):
+        n3, n4 = _numeric_fourbar(1.0, 4.0, 3.0, 4.0, th[i], [t3[i] + 0.05, t4[i] - 0.05])
+        assert abs(wrap_angle(n3 - t3[i])) < 1e-9
+        assert abs(wrap_angle(n4 - t4[i])) < 1e-9
+
+
+@given(length, length, length, length, st.sampled_from(["open", "crossed"]))
+@example(0.2, 0.2, 0.20000000000000004, 0.2, "open")  # found by hypothesis: r1^2 - r2^2 cancelled (now (r1-r2)(r1+r2))
+@settings(max_examples=60, deadline=None)
+def test_half_angle_agrees_with_circle_circle(a, b, c, d, circuit):
+    if max(a, b, c, d) >= (a + b + c + d) - max(a, b, c, d):
+        with pytest.raises(InputError):
+            FourBar(d, a, b, c, circuit=circuit)
+        return
+    try:
+        fb = FourBar(d, a, b, c, coupler_point=(0.3, 0.2), circuit=circuit)
+    except AssemblyError:
+        return
+    th = np.linspace(0, 2 * np.pi, 181)
+    # a scattered batch (not a path) keeps the declared circuit at every sample, as the half-angle
+    # form does; along a path a change-point linkage would carry its branch through the flat positions
+    order = np.random.default_rng(0).permutation(th.size)
+    m_shuffled = fb.solve(th[order])
+    inv = np.argsort(order)
+    m = type(m_shuffled)(th, {k: v[inv] for k, v in m_shuffled.poses.items()}, m_shuffled.valid[inv],
+                         m_shuffled.fail_code[inv], m_shuffled.fail_table)
+    t3, t4, ok = fb.angles(th)
+    # away from the toggle positions both methods agree tightly
+    mu = fb.transmission_angle(th)
+    good = m.valid & ok & (np.sin(mu) > 1e-3)
+    assert np.array_equal(m.valid[np.sin(mu) > 1e-3], ok[np.sin(mu) > 1e-3])
+    scale = max(a, b, c, d)
+    assert np.all(np.abs(wrap_angle(t3 - m.poses["coupler"][:, 2]))[good] < 1e-8 * scale / min(a, b, c, d) / np.sin(mu[good]))
+    assert np.all(np.abs(wrap_angle(t4 - m.poses["rocker"][:, 2]))[good] < 1e-8 * scale / min(a, b, c, d) / np.sin(mu[good]))
+
+
+@pytest.mark.parametrize("dims,expected", [
+    ((1, 4, 3, 4), "crank-rocker"),
+    ((3, 3.5, 3.2, 1), "double-crank"),
+    ((3, 1, 3.2, 3.5), "double-rocker"),
+    ((3, 3.5, 1, 3.2), "rocker-crank"),
+    ((2, 2, 2, 2), "change-point"),
+    ((1, 3, 2, 4), "change-point"),
+    ((3, 3, 3, 4.5), "non-Grashof"),
+])
+def test_grashof_classes(dims, expected):
+    assert grashof_class(*dims) == expected
+
+
+def test_crank_rocker_turns_fully_and_keeps_its_circuit():
+    fb = FourBar(4.0, 1.0, 4.0, 3.0)
+    assert fb.input_range() == [(0.0, 2 * np.pi)]
+    assert fb.toggle_angles().size == 0
+    th = np.linspace(0, 2 * np.pi, 20001)
+    m = fb.solve(th)
+    assert m.valid.all()
+    # branch continuity: consecutive samples move by at most a Lipschitz step
+    step = np.hypot(*np.diff(m.points["coupler_point"], axis=0).T)
+    assert step.max() < 10 * (th[1] - th[0]) * fb.size
+    # the circuit never flips: C stays left of B -> O4
+    pos, _ = fb.solve_nodes(th)
+    B, C, O4 = pos["B"], pos["C"], pos["O4"]
+    side = (O4 - B)[:, 0] * (C - B)[:, 1] - (O4 - B)[:, 1] * (C - B)[:, 0]
+    assert np.all(side > 0)
+    # the coupler returns to its start after a revolution
+    assert np.allclose(m.poses["coupler"][0], m.poses["coupler"][-1], atol=1e-12)
+
+
+def test_non_grashof_toggles_and_invalid_samples_with_reasons():
+    fb = FourBar(4.5, 3.0, 3.0, 3.0)  # non-Grashof triple rocker
+    assert fb.grashof == "non-Grashof"
+    ranges = fb.input_range()
+    assert len(ranges) == 1
+    lo, hi = ranges[0]
+    # at the toggle angles coupler and rocker are in line: |B - O4| = b + c
+    for t in fb.toggle_angles():
+        B = 3.0 * np.array([np.cos(t), np.sin(t)])
+        assert abs(np.hypot(*(B - [4.5, 0])) - 6.0) < 1e-9
+    th = np.linspace(-np.pi, np.pi, 3601)
+    m = fb.solve(th)
+    inside = (th > lo + 1e-9) & (th < hi - 1e-9)
+    outside = (th < lo - 1e-9) | (th > hi + 1e-9)
+    assert m.valid[inside].all() and not m.valid[outside].any()
+    assert m.failed_joints == {"C"}
+    i = int(np.flatnonzero(~m.valid)[0])
+    assert "'C'" in m.reason(i) and "cannot" in m.reason(i)
+    assert all(np.isfinite(p).all() for p in m.poses.values())
+    # driven exactly to the toggle the solution stays valid and finite
+    mt = fb.solve(fb.toggle_angles())
+    assert mt.valid.all()
+
+
+def test_change_point_passes_the_flat_position():
+    fb = FourBar(2.0, 1.0, 2.0, 1.0)  # parallelogram: change point
+    assert fb.grashof == "change-point"
+    th = np.linspace(0, 2 * np.pi, 7201)
+    m = fb.solve(th)
+    assert m.valid.all()
+    assert all(np.isfinite(p).all() for p in m.poses.values())
+
+
+@pytest.mark.parametrize("kw,field", [
+    (dict(ground=4, crank=-1, coupler=4, rocker=3), "crank"),
+    (dict(ground=4, crank=0, coupler=4, rocker=3), "crank"),
+    (dict(ground=4, crank=float("nan"), coupler=4, rocker=3), "crank"),
+    (dict(ground=10, crank=1, coupler=2, rocker=3), "links"),
+    (dict(ground=4, crank=1, coupler=4, rocker=3, circuit="sideways"), "circuit"),
+])
+def test_bad_dimensions_are_named(kw, field):
+    with pytest.raises(InputError) as e:
+        FourBar(**kw)
+    assert field in str(e.value)
+
+
+def test_nan_driver_value_rejected():
+    with pytest.raises(InputError):
+        FourBar(4, 1, 4, 3).solve([0.0, float("nan")])
+
+
+def test_placement_moves_everything_rigidly():
+    a = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2, 1))
+    b = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2, 1), placement=(1.0, 2.0, 0.5))
+    th = np.linspace(0, 2 * np.pi, 50)
+    pa, pb = a.solve(th).points["coupler_point"], b.solve(th).points["coupler_point"]
+    c, s = np.cos(0.5), np.sin(0.5)
+    expected = pa @ np.array([[c, s], [-s, c]]) + [1.0, 2.0]
+    np.testing.assert_allclose(pb, expected, atol=1e-12)
+
+
+def test_coupler_pose_sweeps_a_foot_polygon():
+    from planar.core.geometry import poses_apply
+    fb = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0))
+    th = np.linspace(0, 2 * np.pi, 90)
+    m = fb.solve(th)
+    foot = np.array([[2.0, 1.0], [2.6, 1.0], [2.6, 1.2], [2.0, 1.2]])  # in the coupler frame
+    swept = poses_apply(m.poses["coupler"], foot)
+    assert swept.shape == (90, 4, 2)
+    # vertex 0 is the coupler point; the foot keeps its shape at every pose
+    np.testing.assert_allclose(swept[:, 0], m.points["coupler_point"], atol=1e-12)
+    np.testing.assert_allclose(np.hypot(*(swept[:, 1] - swept[:, 0]).T), 0.6, atol=1e-12)
+
+
+def test_slider_crank_matches_textbook_formula():
+    for e in (0.0, 0.4, -0.7):
+        sc = SliderCrank(1.0, 3.0, offset=e)
+        th = np.linspace(0, 2 * np.pi, 721)
+        m = sc.solve(th)
+        assert m.valid.all()
+        np.testing.assert_allclose(m.points["slider_pin"][:, 0], sc.slider_position(th), atol=1e-12)
+        np.testing.assert_allclose(m.points["slider_pin"][:, 1], e, atol=1e-12)
+        # the slider block never rotates
+        np.testing.assert_allclose(m.poses["slider"][:, 2], m.poses["slider"][0, 2], atol=1e-15)
+
+
+def test_slider_crank_that_cannot_reach_the_guide():
+    with pytest.raises(InputError, match="offset"):
+        SliderCrank(1.0, 1.0, offset=3.0)
+    sc = SliderCrank(1.0, 1.0, offset=1.5)  # reaches only near the top
+    m = sc.solve(np.linspace(0, 2 * np.pi, 361))
+    assert m.valid.any() and not m.valid.all()
+    assert "S" in m.failed_joints
