@@ -36,35 +36,95 @@ def bom_text(fab: Any) -> str:
         plane = asm.plane.get(p.name, "xy")
         where = "" if layer is None else (f"{layer + 1}" if plane == "xy" else f"{plane} {layer + 1}")
         extra = [f"engraved {p.label!r}" if p.label and p.label != p.name else ""] + notes_of.get(p.name, [])
-        w.writerow(["part", p.name, 1, where, p.sheet + 1, f"{x1 - x0:.1f} x {y1 - y0:.1f} x {s.thickness_mm:g}",
-                    "", "; ".join(e for e in extra if e)])
+        w.writerow(
+            [
+                "part",
+                p.name,
+                1,
+                where,
+                p.sheet + 1,
+                f"{x1 - x0:.1f} x {y1 - y0:.1f} x {s.thickness_mm:g}",
+                "",
+                "; ".join(e for e in extra if e),
+            ]
+        )
     ri = s.pin_mm + s.clearance
     for pp in asm.pins:
         lo, hi = pp.layers or (0, 0)
         joins = " + ".join(pp.parts)
         if pp.shaft:
-            w.writerow(["motor shaft", pp.letter, 1, f"{lo + 1}-{hi + 1}", "",
-                        f"D {s.shaft_mm:g} ({s.shaft_flat_mm:g} across flat)", joins,
-                        f"joint {', '.join(pp.joints)}; motor under the ground plate, 2 screws M{s.motor_screw_mm:g} "
-                        f"{s.motor_screw_spacing_mm:g} mm apart"])
+            w.writerow(
+                [
+                    "motor shaft",
+                    pp.letter,
+                    1,
+                    f"{lo + 1}-{hi + 1}",
+                    "",
+                    f"D {s.shaft_mm:g} ({s.shaft_flat_mm:g} across flat)",
+                    joins,
+                    f"joint {', '.join(pp.joints)}; motor under the ground plate, 2 screws M{s.motor_screw_mm:g} "
+                    f"{s.motor_screw_spacing_mm:g} mm apart",
+                ]
+            )
         else:
-            w.writerow(["pin", pp.letter, 1, f"{lo + 1}-{hi + 1}", "", f"{pp.diameter_mm:g} x {pp.length_mm:g}",
-                        joins, f"joint {', '.join(pp.joints)}" + (f"; passes through {', '.join(pp.clashes)}"
-                                                           if pp.clashes else "")])
+            w.writerow(
+                [
+                    "pin",
+                    pp.letter,
+                    1,
+                    f"{lo + 1}-{hi + 1}",
+                    "",
+                    f"{pp.diameter_mm:g} x {pp.length_mm:g}",
+                    joins,
+                    f"joint {', '.join(pp.joints)}" + (f"; passes through {', '.join(pp.clashes)}" if pp.clashes else ""),
+                ]
+            )
         if pp.spacers:
-            sp = [p for p in lay.parts if p.name.startswith(f"spacer {pp.letter}") and
-                  p.name[len(f"spacer {pp.letter}"):].isdigit()]
+            sp = [
+                p
+                for p in lay.parts
+                if p.name.startswith(f"spacer {pp.letter}") and p.name[len(f"spacer {pp.letter}") :].isdigit()
+            ]
             od = 2 * max((c.radius for c in [p.outer for p in sp] if hasattr(c, "radius")), default=0.0) - s.kerf
-            w.writerow(["spacer", pp.letter, pp.spacers, "", "+".join(str(p.sheet + 1) for p in sp),
-                        f"{ri:g} x {od:g} x {s.thickness_mm:g}", joins, "cut from the sheet; on the pin between its layers"])
+            w.writerow(
+                [
+                    "spacer",
+                    pp.letter,
+                    pp.spacers,
+                    "",
+                    "+".join(str(p.sheet + 1) for p in sp),
+                    f"{ri:g} x {od:g} x {s.thickness_mm:g}",
+                    joins,
+                    "cut from the sheet; on the pin between its layers",
+                ]
+            )
     for jn in getattr(fab, "joins", []):  # tab-and-slot joints of pieces standing perpendicular (planar.fabrication.tabs)
         lo, hi = jn.slot_size
-        w.writerow(["tabs", jn.letter, len(jn.spans), "", "", f"{jn.tab_width:g} x {s.thickness_mm:g}",
-                    f"{jn.piece} -> {jn.base}",
-                    f"the {len(jn.spans)} tabs {jn.letter} of {jn.piece} ({jn.plane}) into the {len(jn.slots)} slots "
-                    f"{jn.letter} ({lo:g} x {hi:g} mm) of {jn.base}; glue them"])
+        w.writerow(
+            [
+                "tabs",
+                jn.letter,
+                len(jn.spans),
+                "",
+                "",
+                f"{jn.tab_width:g} x {s.thickness_mm:g}",
+                f"{jn.piece} -> {jn.base}",
+                f"the {len(jn.spans)} tabs {jn.letter} of {jn.piece} ({jn.plane}) into the {len(jn.slots)} slots "
+                f"{jn.letter} ({lo:g} x {hi:g} mm) of {jn.base}; glue them",
+            ]
+        )
     grounds = [p for p in lay.parts if asm.layers.get(p.name) is not None and p.name in fab.grounds]
     if grounds:
-        w.writerow(["mounting screw", "", 2 * len(grounds), "", "", f"M{s.mounting_hole_mm - 0.2:g}", "",
-                    f"{s.mounting_hole_mm:g} mm holes, two per ground plate"])
+        w.writerow(
+            [
+                "mounting screw",
+                "",
+                2 * len(grounds),
+                "",
+                "",
+                f"M{s.mounting_hole_mm - 0.2:g}",
+                "",
+                f"{s.mounting_hole_mm:g} mm holes, two per ground plate",
+            ]
+        )
     return buf.getvalue()

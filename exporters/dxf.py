@@ -30,13 +30,21 @@ __all__ = ["LAYERS", "aci", "dxf_bytes", "preview_png", "write_dxf"]
 #: layer -> default ACI colour
 LAYERS = {"CUT_INNER": 1, "CUT_OUTER": 1, "ENGRAVE": 5, "SHEET": 8}
 
-_ACI = {1: (255, 0, 0), 2: (255, 255, 0), 3: (0, 255, 0), 4: (0, 255, 255), 5: (0, 0, 255), 6: (255, 0, 255),
-        7: (255, 255, 255), 8: (128, 128, 128)}
+_ACI = {
+    1: (255, 0, 0),
+    2: (255, 255, 0),
+    3: (0, 255, 0),
+    4: (0, 255, 255),
+    5: (0, 0, 255),
+    6: (255, 0, 255),
+    7: (255, 255, 255),
+    8: (128, 128, 128),
+}
 
 
 def aci(colour: str) -> int:
     """The nearest of AutoCAD's first eight colour indices to ``#rrggbb``."""
-    rgb = tuple(int(colour[i:i + 2], 16) for i in (1, 3, 5))
+    rgb = tuple(int(colour[i : i + 2], 16) for i in (1, 3, 5))
     return min(_ACI, key=lambda k: sum((a - b) ** 2 for a, b in zip(_ACI[k], rgb)))
 
 
@@ -84,8 +92,9 @@ def build_document(layout: Layout, sheet: int = 0, settings: Any = None, note: s
     def add(c, layer: str):
         if isinstance(c, Circle):
             return msp.add_circle(c.centre, c.radius, dxfattribs={"layer": layer})
-        return msp.add_lwpolyline([(x, y, 0.0, 0.0, b) for x, y, b in c.vertices], format="xyseb", close=True,
-                                  dxfattribs={"layer": layer})
+        return msp.add_lwpolyline(
+            [(x, y, 0.0, 0.0, b) for x, y, b in c.vertices], format="xyseb", close=True, dxfattribs={"layer": layer}
+        )
 
     for part in layout.on_sheet(sheet):
         ents = [add(c, "CUT_INNER") for c in part.inner]

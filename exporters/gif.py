@@ -100,8 +100,7 @@ def _frame_bytes(idx: np.ndarray, box: tuple[int, int, int, int], delay_ms: int,
     return gce + b"".join(GifImagePlugin.getdata(im, offset=(x0, y0)))
 
 
-def write_gif(path: str | os.PathLike, frames: Iterable, delay_ms: int,
-              palette: Sequence[tuple[int, int, int]]) -> int:
+def write_gif(path: str | os.PathLike, frames: Iterable, delay_ms: int, palette: Sequence[tuple[int, int, int]]) -> int:
     """Write ``frames`` to ``path`` as a looping GIF, streaming; returns the number of frames.
 
     ``frames`` are PIL RGB images, or index arrays already made by
@@ -112,8 +111,7 @@ def write_gif(path: str | os.PathLike, frames: Iterable, delay_ms: int,
     from planar.errors import InputError
 
     if delay_ms < MIN_DELAY_MS or delay_ms % 10:
-        raise InputError("delay_ms", delay_ms, f"a multiple of 10 ms, at least {MIN_DELAY_MS} ms "
-                         "(browsers slow shorter delays)")
+        raise InputError("delay_ms", delay_ms, f"a multiple of 10 ms, at least {MIN_DELAY_MS} ms (browsers slow shorter delays)")
     pal = _unique_palette(list(palette)[:255])
     flat = bytes(c for rgb in pal for c in rgb)
     index = indexer(palette[:255])

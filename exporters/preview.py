@@ -39,8 +39,7 @@ def sheet_png(layout: Layout, sheet: int = 0, settings: Any = None, px_per_mm: f
     # faint grain: fixed stripes, no randomness
     ys = np.linspace(0, H, 60)
     for k, yv in enumerate(ys):
-        ax.plot([0, W], [yv + 0.8 * math.sin(k * 1.7), yv + 0.8 * math.sin(k * 1.7 + 2)], color="#d6b98c",
-                lw=0.6, alpha=0.5)
+        ax.plot([0, W], [yv + 0.8 * math.sin(k * 1.7), yv + 0.8 * math.sin(k * 1.7 + 2)], color="#d6b98c", lw=0.6, alpha=0.5)
 
     def ring(c) -> np.ndarray:
         if isinstance(c, Circle):

@@ -79,13 +79,16 @@ def svg_text(layout: Layout, sheet: int = 0, settings: Any = None) -> str:
         for st in p.engrave:
             d = " ".join(("M" if i == 0 else "L") + f" {_f(float(a))} {_f(y(float(b)))}" for i, (a, b) in enumerate(st))
             layers["ENGRAVE"].append(f'<path d="{d}"/>')
-    out = ['<?xml version="1.0" encoding="UTF-8"?>',
-           f'<svg xmlns="http://www.w3.org/2000/svg" width="{_f(W)}mm" height="{_f(H)}mm" '
-           f'viewBox="0 0 {_f(W)} {_f(H)}">']
+    out = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{_f(W)}mm" height="{_f(H)}mm" viewBox="0 0 {_f(W)} {_f(H)}">',
+    ]
     colour = {"CUT_INNER": cut, "CUT_OUTER": cut, "ENGRAVE": eng}
     for name in ("CUT_INNER", "CUT_OUTER", "ENGRAVE"):
-        out.append(f'<g id="{name}" fill="none" stroke="{colour[name]}" stroke-width="{_f(stroke)}" '
-                   f'stroke-linecap="round" stroke-linejoin="round">')
+        out.append(
+            f'<g id="{name}" fill="none" stroke="{colour[name]}" stroke-width="{_f(stroke)}" '
+            f'stroke-linecap="round" stroke-linejoin="round">'
+        )
         out.extend("  " + e for e in layers[name])
         out.append("</g>")
     out.append("</svg>")
@@ -141,10 +144,12 @@ def assembly_svg_text(fab: Any) -> str:
     def Y(v: float) -> float:
         return y1 - v
 
-    out = ['<?xml version="1.0" encoding="UTF-8"?>',
-           f'<svg xmlns="http://www.w3.org/2000/svg" width="{_f(W)}mm" height="{_f(H)}mm" viewBox="0 0 {_f(W)} {_f(H)}" '
-           f'font-family="sans-serif">',
-           f'<rect x="0" y="0" width="{_f(W)}" height="{_f(H)}" fill="#ffffff"/>']
+    out = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{_f(W)}mm" height="{_f(H)}mm" viewBox="0 0 {_f(W)} {_f(H)}" '
+        f'font-family="sans-serif">',
+        f'<rect x="0" y="0" width="{_f(W)}" height="{_f(H)}" fill="#ffffff"/>',
+    ]
     for layer, name, g in shapes:
         check_name("part name", name)
         geoms = getattr(g, "geoms", [g])
@@ -153,15 +158,21 @@ def assembly_svg_text(fab: Any) -> str:
             for ring in [poly.exterior, *poly.interiors]:
                 xy = list(ring.coords)
                 d.append("M " + " L ".join(f"{X(a):.3f} {Y(b):.3f}" for a, b in xy) + " Z")
-        out.append(f'<path d="{" ".join(d)}" fill="{LAYER_FILLS[layer % len(LAYER_FILLS)]}" fill-opacity="0.75" '
-                   f'fill-rule="evenodd" stroke="#333333" stroke-width="{_f(fs * 0.08)}"><title>{escape(name)} '
-                   f'(layer {layer + 1})</title></path>')
+        out.append(
+            f'<path d="{" ".join(d)}" fill="{LAYER_FILLS[layer % len(LAYER_FILLS)]}" fill-opacity="0.75" '
+            f'fill-rule="evenodd" stroke="#333333" stroke-width="{_f(fs * 0.08)}"><title>{escape(name)} '
+            f"(layer {layer + 1})</title></path>"
+        )
     for pp in asm.pins:
         px, py = _pin_xy(asm, pp)
-        out.append(f'<circle cx="{_f(X(px))}" cy="{_f(Y(py))}" r="{_f(fs * 0.7)}" fill="#ffffff" stroke="#000000" '
-                   f'stroke-width="{_f(fs * 0.06)}"/>')
-        out.append(f'<text x="{_f(X(px))}" y="{_f(Y(py) + fs * 0.35)}" font-size="{_f(fs)}" text-anchor="middle">'
-                   f'{escape(pp.letter)}</text>')
+        out.append(
+            f'<circle cx="{_f(X(px))}" cy="{_f(Y(py))}" r="{_f(fs * 0.7)}" fill="#ffffff" stroke="#000000" '
+            f'stroke-width="{_f(fs * 0.06)}"/>'
+        )
+        out.append(
+            f'<text x="{_f(X(px))}" y="{_f(Y(py) + fs * 0.35)}" font-size="{_f(fs)}" text-anchor="middle">'
+            f"{escape(pp.letter)}</text>"
+        )
     lx = x1 - x0 + 5
     for i, t in enumerate(legend):
         out.append(f'<text x="{_f(lx)}" y="{_f(fs * 1.5 * (i + 1))}" font-size="{_f(fs)}">{escape(t)}</text>')
@@ -199,7 +210,9 @@ def _legend(fab: Any) -> list[str]:
         joins = " + ".join(pp.parts)
         lines.append(f"{pp.letter}: {what}, {joins}, layers {lo + 1}-{hi + 1}{sp}")
     for jn in getattr(fab, "joins", []):  # tab-and-slot joints (planar.fabrication.tabs)
-        lines.append(f"{jn.letter}: the {len(jn.spans)} tabs of {jn.piece} ({jn.plane}) into the slots {jn.letter} of "
-                     f"{jn.base} (layer {(asm.layers.get(jn.base) or 0) + 1}), standing {'below' if jn.side < 0 else 'above'}"
-                     " it; glue")
+        lines.append(
+            f"{jn.letter}: the {len(jn.spans)} tabs of {jn.piece} ({jn.plane}) into the slots {jn.letter} of "
+            f"{jn.base} (layer {(asm.layers.get(jn.base) or 0) + 1}), standing {'below' if jn.side < 0 else 'above'}"
+            " it; glue"
+        )
     return lines

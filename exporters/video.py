@@ -43,8 +43,9 @@ def write_video(path: str | os.PathLike, frames: Iterable, fps: float) -> int:
     if suffix not in VIDEO_CODECS:
         raise InputError("-o", str(path), f"a video file ending in {' or '.join(VIDEO_CODECS)}")
     if not video_available():
-        raise InputError("-o", str(path), "the video extra for MP4/WebM output: pip install 'planar[video]' "
-                                          "(imageio-ffmpeg), or write a .gif")
+        raise InputError(
+            "-o", str(path), "the video extra for MP4/WebM output: pip install 'planar[video]' (imageio-ffmpeg), or write a .gif"
+        )
     import imageio.v2 as iio2
 
     parent = target.parent if str(target.parent) else Path(".")
@@ -55,9 +56,18 @@ def write_video(path: str | os.PathLike, frames: Iterable, fps: float) -> int:
     params = extra + ["-threads", "1", "-map_metadata", "-1", "-fflags", "+bitexact", "-flags:v", "+bitexact"]
     n = 0
     try:
-        writer = iio2.get_writer(str(tmp), format="FFMPEG", mode="I", fps=fps, codec=codec, quality=None,
-                                 pixelformat="yuv420p", macro_block_size=2, ffmpeg_log_level="error",
-                                 output_params=params)
+        writer = iio2.get_writer(
+            str(tmp),
+            format="FFMPEG",
+            mode="I",
+            fps=fps,
+            codec=codec,
+            quality=None,
+            pixelformat="yuv420p",
+            macro_block_size=2,
+            ffmpeg_log_level="error",
+            output_params=params,
+        )
         try:
             for f in frames:
                 writer.append_data(np.asarray(f.convert("RGB") if hasattr(f, "convert") else f, dtype=np.uint8))

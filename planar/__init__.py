@@ -17,8 +17,16 @@ if TYPE_CHECKING:  # pragma: no cover
     from planar.core.model import Driver, Mechanism, Motion, Part, joint_residuals
 
 __all__ = [
-    "AssemblyError", "InputError", "LimitError", "PlanarError", "SceneError",
-    "Driver", "Mechanism", "Motion", "Part", "joint_residuals",
+    "AssemblyError",
+    "InputError",
+    "LimitError",
+    "PlanarError",
+    "SceneError",
+    "Driver",
+    "Mechanism",
+    "Motion",
+    "Part",
+    "joint_residuals",
 ]
 __version__ = "0.1.0"
 
@@ -28,5 +36,6 @@ _MODEL_NAMES = ("Driver", "Mechanism", "Motion", "Part", "joint_residuals")
 def __getattr__(name: str) -> Any:
     if name in _MODEL_NAMES:
         from planar.core import model
+
         return getattr(model, name)
     raise AttributeError(f"module 'planar' has no attribute {name!r}")

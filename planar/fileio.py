@@ -108,8 +108,13 @@ def _same_file(a: Path, b: Path) -> bool:
         return False
 
 
-def check_output(option: str, path: str | os.PathLike | None, suffixes: Sequence[str],
-                 inputs: Iterable[str | os.PathLike] = (), directory: bool = False) -> None:
+def check_output(
+    option: str,
+    path: str | os.PathLike | None,
+    suffixes: Sequence[str],
+    inputs: Iterable[str | os.PathLike] = (),
+    directory: bool = False,
+) -> None:
     """Refuse an output path before any work: empty, in a missing folder, a directory (or, with
     ``directory``, a file), one of the ``inputs``, or (for a file) a suffix not in ``suffixes``.
 
@@ -146,8 +151,7 @@ def check_name(field: str, name: str) -> str:
     """
     bad = [c for c in str(name) if ord(c) < 32 or 127 <= ord(c) < 160]
     if bad or not str(name):
-        raise InputError(field, name, "a name without control characters (newline, tab, ...)"
-                         if bad else "a non-empty name")
+        raise InputError(field, name, "a name without control characters (newline, tab, ...)" if bad else "a non-empty name")
     return str(name)
 
 

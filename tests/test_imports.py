@@ -25,8 +25,9 @@ def _modules(root: Path, packages: tuple[str, ...]) -> dict[str, Path]:
 
 
 def _is_type_checking(test: ast.expr) -> bool:
-    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or \
-        (isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
+        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING"
+    )
 
 
 class _Imports(ast.NodeVisitor):
@@ -94,7 +95,7 @@ def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
         path.append(v)
         for w in sorted(graph.get(v, ())):
             if state.get(w) == 1:
-                return path[path.index(w):] + [w]
+                return path[path.index(w) :] + [w]
             if w not in state:
                 c = visit(w)
                 if c:
@@ -117,8 +118,9 @@ def test_the_cycle_finder_finds_a_lazy_cycle(tmp_path):
     pkg.mkdir()
     (pkg / "__init__.py").write_text("")
     (pkg / "a.py").write_text("from . import b\n")
-    (pkg / "b.py").write_text("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from .c import C\n"
-                              "def f():\n    from .a import g\n")
+    (pkg / "b.py").write_text(
+        "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from .c import C\ndef f():\n    from .a import g\n"
+    )
     (pkg / "c.py").write_text("from .b import f\n")
     g = import_graph(tmp_path, ("pkg",))
     assert g["pkg.a"] == {"pkg.b"} and g["pkg.b"] == {"pkg.a"}  # the TYPE_CHECKING import is not counted
@@ -147,17 +149,28 @@ def test_every_module_imports_on_its_own_in_a_fresh_interpreter():
         "        bad[name] = repr(e)\n"
         "print(json.dumps(bad))\n"
     )
-    r = subprocess.run([sys.executable, "-c", code], check=False, capture_output=True, text=True, cwd=ROOT,
-                       env={"PYTHONPATH": str(ROOT), "PATH": "", "MPLBACKEND": "Agg"})
+    r = subprocess.run(
+        [sys.executable, "-c", code],
+        check=False,
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        env={"PYTHONPATH": str(ROOT), "PATH": "", "MPLBACKEND": "Agg"},
+    )
     assert r.returncode == 0, r.stderr
     assert json.loads(r.stdout) == {}
 
 
 @pytest.mark.parametrize("module", ["planar", "planar.app.pipeline", "planar.cli.main"])
 def test_light_imports(module):
-    code = (f"import sys, json; import {module}; "
-            f"print(json.dumps(sorted(m for m in {HEAVY!r} if m in sys.modules)))")
-    r = subprocess.run([sys.executable, "-c", code], check=False, capture_output=True, text=True, cwd=ROOT,
-                       env={"PYTHONPATH": str(ROOT), "PATH": ""})
+    code = f"import sys, json; import {module}; print(json.dumps(sorted(m for m in {HEAVY!r} if m in sys.modules)))"
+    r = subprocess.run(
+        [sys.executable, "-c", code],
+        check=False,
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        env={"PYTHONPATH": str(ROOT), "PATH": ""},
+    )
     assert r.returncode == 0, r.stderr
     assert json.loads(r.stdout) == []

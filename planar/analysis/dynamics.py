@@ -101,8 +101,9 @@ def mass_properties(part: Any, density: float) -> tuple[float, tuple[float, floa
     return mass, (cx, cy), moment
 
 
-def part_mass_table(mech: Any, effects: Any, densities: dict[str, float] | None = None
-                    ) -> dict[str, tuple[float, tuple[float, float], float]]:
+def part_mass_table(
+    mech: Any, effects: Any, densities: dict[str, float] | None = None
+) -> dict[str, tuple[float, tuple[float, float], float]]:
     """``mass_properties`` of every moving part at the scene's (or the per-part) density."""
     density = effects.density if effects is not None else 1.0
     return {p.name: mass_properties(p, (densities or {}).get(p.name, density)) for p in mech.parts if not p.ground}
@@ -118,8 +119,9 @@ def _spring_length(s: Any, m: Any) -> Array:
     return np.hypot(*(pb - pa).T)
 
 
-def inverse_dynamics_torque(mech: Any, t: Array, effects: Any = None, densities: dict[str, float] | None = None,
-                            t_rest: float | None = None) -> Array:
+def inverse_dynamics_torque(
+    mech: Any, t: Array, effects: Any = None, densities: dict[str, float] | None = None, t_rest: float | None = None
+) -> Array:
     """Motor torque needed at times ``t`` (s) for a driver turning at its constant rate.
 
     ``effects``: an :class:`~planar.core.effects.Effects`-like record (gravity,
@@ -140,7 +142,7 @@ def inverse_dynamics_torque(mech: Any, t: Array, effects: Any = None, densities:
         gp = plane_gravity(getattr(mech.part(name), "plane", "xy"), g)
         c = np.asarray(cog, float)
         X0, Xp, Xm = (poses_apply(m.poses[name], c) for m in (m0, mp, mm))
-        v = (Xp - Xm) / (2 * h)                    # d X_G / dt
+        v = (Xp - Xm) / (2 * h)  # d X_G / dt
         a = (Xp - 2 * X0 + Xm) / (h * h)
         fwd = _wrapped(mp.poses[name][:, 2] - m0.poses[name][:, 2])
         back = _wrapped(m0.poses[name][:, 2] - mm.poses[name][:, 2])

@@ -42,8 +42,18 @@ from planar.errors import InputError
 if TYPE_CHECKING:
     from planar.core.model import Driver, Mechanism, Motion
 
-__all__ = ["PartRates", "Derivatives", "driver_rates", "rates_method", "mechanism_rates", "motion_derivatives", "motor_torque",
-           "point_rates", "transmission_angles", "derivative_columns"]
+__all__ = [
+    "PartRates",
+    "Derivatives",
+    "driver_rates",
+    "rates_method",
+    "mechanism_rates",
+    "motion_derivatives",
+    "motor_torque",
+    "point_rates",
+    "transmission_angles",
+    "derivative_columns",
+]
 
 Array = NDArray[np.float64]
 Mask = NDArray[np.bool_]
@@ -103,12 +113,12 @@ def driver_rates(driver: "Driver", t: ArrayLike) -> tuple[Array, Array]:
     if driver.amplitude is None:
         return np.full_like(tt, driver.rate), np.zeros_like(tt)
     arg = driver.rate * tt + driver.phase
-    return (driver.amplitude * driver.rate * np.cos(arg),
-            -driver.amplitude * driver.rate**2 * np.sin(arg))
+    return (driver.amplitude * driver.rate * np.cos(arg), -driver.amplitude * driver.rate**2 * np.sin(arg))
 
 
-def mechanism_rates(mech: "Mechanism", q: ArrayLike, qd: ArrayLike = 1.0, qdd: ArrayLike = 0.0
-                    ) -> tuple[dict[str, PartRates], Mask, str]:
+def mechanism_rates(
+    mech: "Mechanism", q: ArrayLike, qd: ArrayLike = 1.0, qdd: ArrayLike = 0.0
+) -> tuple[dict[str, PartRates], Mask, str]:
     """Rates of every part for driver values ``q``, rates ``qd`` and ``qdd`` per sample.
 
     Returns ``(parts, valid, method)``; ``method`` names how they were found.
@@ -137,8 +147,9 @@ def mechanism_rates(mech: "Mechanism", q: ArrayLike, qd: ArrayLike = 1.0, qdd: A
         from planar.toys.rates import assembly_rates
 
         raw, valid = assembly_rates(mech, qa, qdv, qddv)
-        method = ("wind-up closed forms differentiated analytically, composed through the toy's stages, "
-                  "turned to each piece's place")
+        method = (
+            "wind-up closed forms differentiated analytically, composed through the toy's stages, turned to each piece's place"
+        )
         return {k: PartRates(*v) for k, v in raw.items()}, valid, method
     from planar.windup.rates import windup_rates
 
@@ -201,8 +212,7 @@ def transmission_angles(mech: "Mechanism", q: ArrayLike) -> dict[str, Array]:
     if not isinstance(mech, Linkage):
         return {}
     # a dyad whose two links are one part (a node on a ternary link) transmits nothing: no angle
-    rrr = [n for n in mech.nodes if isinstance(n, RRR)
-           and not any({n.name, n.a, n.b} <= set(lk.nodes) for lk in mech.links)]
+    rrr = [n for n in mech.nodes if isinstance(n, RRR) and not any({n.name, n.a, n.b} <= set(lk.nodes) for lk in mech.links)]
     if not rrr:
         return {}
     pos, _ = _node_solve(mech, np.atleast_1d(np.asarray(q, float)))
@@ -218,16 +228,20 @@ def motion_derivatives(mech: "Mechanism", motion: "Motion") -> Derivatives:
     return _derivatives(mech, motion, parts, ok, method)
 
 
-def _derivatives(mech: "Mechanism", motion: "Motion", parts: dict[str, PartRates], ok: Mask,
-                 method: str = "") -> Derivatives:
+def _derivatives(mech: "Mechanism", motion: "Motion", parts: dict[str, PartRates], ok: Mask, method: str = "") -> Derivatives:
     points = {}
     for name, (part, _) in mech.points.items():
         points[name] = point_rates(motion.poses[part], parts[part], motion.points[name])
     return Derivatives(parts, points, ok & motion.valid, method, transmission_angles(mech, motion.driver))
 
 
-def motor_torque(mech: "Mechanism", motion: "Motion", effects: Any = None, t_rest: float | None = None,
-                 densities: dict[str, float] | None = None) -> tuple[Array, Mask]:
+def motor_torque(
+    mech: "Mechanism",
+    motion: "Motion",
+    effects: Any = None,
+    t_rest: float | None = None,
+    densities: dict[str, float] | None = None,
+) -> tuple[Array, Mask]:
     """Inverse-dynamics motor torque per sample from exact rates (see the module's note).
 
     ``effects``: an :class:`~planar.core.effects.Effects` (gravity, loads, springs,
@@ -240,8 +254,7 @@ def motor_torque(mech: "Mechanism", motion: "Motion", effects: Any = None, t_res
     return _torque(mech, motion, rates, coef, effects, t_rest, densities), ok
 
 
-def _rates_and_coefficients(mech: "Mechanism", motion: "Motion"
-                            ) -> tuple[dict[str, PartRates], dict[str, PartRates], Mask]:
+def _rates_and_coefficients(mech: "Mechanism", motion: "Motion") -> tuple[dict[str, PartRates], dict[str, PartRates], Mask]:
     """Rates at the driver's law and at unit driver speed (the velocity coefficients ``d/dq``)."""
     if motion.t is None:
         raise InputError(f"{mech.name}.motion.t", None, "sample times (solve with t=..., or Mechanism.run)")
@@ -251,8 +264,15 @@ def _rates_and_coefficients(mech: "Mechanism", motion: "Motion"
     return rates, coef, ok & ok1 & motion.valid
 
 
-def _torque(mech: "Mechanism", motion: "Motion", rates: dict[str, PartRates], coef: dict[str, PartRates],
-            effects: Any, t_rest: float | None, densities: dict[str, float] | None) -> Array:
+def _torque(
+    mech: "Mechanism",
+    motion: "Motion",
+    rates: dict[str, PartRates],
+    coef: dict[str, PartRates],
+    effects: Any,
+    t_rest: float | None,
+    densities: dict[str, float] | None,
+) -> Array:
     from planar.analysis.dynamics import gravity_and_damping, part_mass_table, plane_gravity
 
     assert motion.t is not None

@@ -82,9 +82,7 @@ def _perp(v: Array) -> Array:
 TOGGLE_SINE = 1e-6
 
 
-def fourbar_velocities(
-    fb: "FourBar", theta: ArrayLike, omega2: ArrayLike = 1.0
-) -> tuple[Array, Array, NDArray[np.bool_]]:
+def fourbar_velocities(fb: "FourBar", theta: ArrayLike, omega2: ArrayLike = 1.0) -> tuple[Array, Array, NDArray[np.bool_]]:
     """Coupler and rocker angular velocities ``(omega3, omega4, valid)``.
 
     Notes eqs. (6)-(7), corrected (no ``r_1`` term), solved per sample with
@@ -147,9 +145,7 @@ def fourbar_accelerations(
     return al3, al4, ok & okv & ~sing
 
 
-def node_velocities(
-    link: "Linkage", q: ArrayLike, qdot: ArrayLike = 1.0
-) -> tuple[dict[str, Array], NDArray[np.bool_]]:
+def node_velocities(link: "Linkage", q: ArrayLike, qdot: ArrayLike = 1.0) -> tuple[dict[str, Array], NDArray[np.bool_]]:
     """Velocity ``(N, 2)`` of every node of a :class:`~planar.linkages.Linkage`.
 
     Each dyad's closure conditions are differentiated and solved as a 2x2
@@ -201,9 +197,7 @@ def _dyad_mask(link: "Linkage", q: ArrayLike) -> NDArray[np.bool_]:
     return ok
 
 
-def point_velocities(
-    link: "Linkage", q: ArrayLike, qdot: ArrayLike = 1.0
-) -> tuple[dict[str, Array], NDArray[np.bool_]]:
+def point_velocities(link: "Linkage", q: ArrayLike, qdot: ArrayLike = 1.0) -> tuple[dict[str, Array], NDArray[np.bool_]]:
     """World velocities ``(N, 2)`` of the linkage's named points (placement applied)."""
     vel, valid = node_velocities(link, q, qdot)
     ang = link.placement[2]
@@ -233,9 +227,7 @@ def finite_difference(x: ArrayLike, step: float, periodic: bool = True) -> Array
     return np.gradient(x, step, axis=0, edge_order=2)
 
 
-def instant_centre(
-    p1: ArrayLike, v1: ArrayLike, p2: ArrayLike, v2: ArrayLike
-) -> tuple[Array, Array, NDArray[np.bool_]]:
+def instant_centre(p1: ArrayLike, v1: ArrayLike, p2: ArrayLike, v2: ArrayLike) -> tuple[Array, Array, NDArray[np.bool_]]:
     """Instant centre of a body from two of its points and their velocities.
 
     The centre lies on the normal to each velocity (notes 2.1.1).  Returns
@@ -283,8 +275,9 @@ def fourbar_instant_centre(fb: "FourBar", theta: ArrayLike, omega2: float = 1.0)
     return np.where(valid[..., None], centre, 0.0), np.where(valid, omega, 0.0), valid
 
 
-def world_velocity(v_relative: ArrayLike, v_frame: ArrayLike, omega_frame: ArrayLike = 0.0,
-                   r_from_frame_origin: ArrayLike | None = None) -> Array:
+def world_velocity(
+    v_relative: ArrayLike, v_frame: ArrayLike, omega_frame: ArrayLike = 0.0, r_from_frame_origin: ArrayLike | None = None
+) -> Array:
     """Absolute velocity of a point on a moving machine (notes 2.1.4).
 
     ``v_world = v_frame + omega_frame x r + v_relative``; with a machine that
@@ -311,9 +304,7 @@ def _check_eff(name: str, eta: float) -> float:
     return float(eta)
 
 
-def input_torque(
-    coefficients: ArrayLike, forces: ArrayLike, eta_trans: float = 1.0, eta_link: float = 1.0
-) -> Array:
+def input_torque(coefficients: ArrayLike, forces: ArrayLike, eta_trans: float = 1.0, eta_link: float = 1.0) -> Array:
     """Motor torque per sample from velocity coefficients and loads (notes eq. 5).
 
     ``coefficients`` ``(N, k, 2)`` holds ``dX_i/dq`` for ``k`` load points;
@@ -346,7 +337,10 @@ def input_torque(
 
 
 def virtual_work_torque(
-    points: ArrayLike, q: ArrayLike, forces: ArrayLike, periodic: bool = True,
+    points: ArrayLike,
+    q: ArrayLike,
+    forces: ArrayLike,
+    periodic: bool = True,
     valid: ArrayLike | None = None,
 ) -> tuple[Array, NDArray[np.bool_]]:
     """Torque by virtual work (notes eqs. 12-13): ``tau dq = sum_i F_i . dX_i``; returns ``(tau, valid)``.
@@ -360,8 +354,7 @@ def virtual_work_torque(
     P = np.asarray(points, float)
     qa = np.asarray(q, float)
     if P.ndim != 3 or P.shape[-1] != 2 or qa.shape != P.shape[:1] or len(qa) < 3:
-        raise InputError("points, q", f"arrays of shapes {P.shape}, {qa.shape}",
-                         "points (N, k, 2) and q (N,) with N >= 3")
+        raise InputError("points, q", f"arrays of shapes {P.shape}, {qa.shape}", "points (N, k, 2) and q (N,) with N >= 3")
     f = np.asarray(forces, float)
     if not np.isfinite(f).all():
         raise InputError("forces", f, "finite forces")
@@ -385,8 +378,11 @@ def virtual_work_torque(
 
 
 def motor_torque(
-    link: "Linkage", q: ArrayLike, loads: Mapping[str, ArrayLike],
-    eta_trans: float = 1.0, eta_link: float = 1.0,
+    link: "Linkage",
+    q: ArrayLike,
+    loads: Mapping[str, ArrayLike],
+    eta_trans: float = 1.0,
+    eta_link: float = 1.0,
 ) -> tuple[Array, NDArray[np.bool_]]:
     """Input torque a linkage needs for forces at its named points (several feet, one motor).
 
@@ -410,8 +406,9 @@ def motor_torque(
         try:
             forces.append(np.broadcast_to(f, qa.shape + (2,)))
         except ValueError:
-            raise InputError(f"{link.name}.loads[{n!r}]", f"an array of shape {f.shape}",
-                             f"a force of shape (2,) or ({len(qa)}, 2)") from None
+            raise InputError(
+                f"{link.name}.loads[{n!r}]", f"an array of shape {f.shape}", f"a force of shape (2,) or ({len(qa)}, 2)"
+            ) from None
     if not names:
         return np.zeros(qa.shape), np.asarray(valid, bool)
     coeff = np.stack([vel[n] for n in names], axis=1)
@@ -425,9 +422,7 @@ def motor_torque(
 # --------------------------------------------------------------------------
 
 
-def static_foot_loads(
-    weight: float, com_x: ArrayLike, foot_x: ArrayLike, contact: ArrayLike
-) -> tuple[Array, NDArray[np.bool_]]:
+def static_foot_loads(weight: float, com_x: ArrayLike, foot_x: ArrayLike, contact: ArrayLike) -> tuple[Array, NDArray[np.bool_]]:
     """Normal load on each foot in contact, from weight and the centre of mass.
 
     Vertical force balance ``sum f_i = W`` and moment balance about the
@@ -453,13 +448,16 @@ def static_foot_loads(
     one = on.sum(1) == 1
     f[one] = np.where(on[one], weight, 0.0)
     moment = np.where(on, f * (fx - xc[:, None]), 0.0).sum(1)
-    stable = (on.any(1) & np.all(f >= -1e-9 * abs(weight), axis=1)
-              & np.isclose(f.sum(1), weight) & (np.abs(moment) <= 1e-9 * abs(weight) * (1 + np.abs(fx).max(1))))
+    stable = (
+        on.any(1)
+        & np.all(f >= -1e-9 * abs(weight), axis=1)
+        & np.isclose(f.sum(1), weight)
+        & (np.abs(moment) <= 1e-9 * abs(weight) * (1 + np.abs(fx).max(1)))
+    )
     return f, stable
 
 
-def fourier_acceleration(amplitudes: ArrayLike, freq_hz: float, t: ArrayLike,
-                         phases: ArrayLike | None = None) -> Array:
+def fourier_acceleration(amplitudes: ArrayLike, freq_hz: float, t: ArrayLike, phases: ArrayLike | None = None) -> Array:
     """Vertical acceleration of ``y = sum_k Y_k sin(k w t + phi_k)`` (notes eqs. 9-10).
 
     ``y'' = -sum_k k^2 w^2 Y_k sin(k w t + phi_k)``, ``w = 2 pi freq``.

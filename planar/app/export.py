@@ -36,8 +36,16 @@ def _commit(files: dict[Path, bytes]) -> None:
                 fh.write(data)
 
 
-def write_outputs(fab: Fabrication | None, dxf=None, svg=None, preview=None, bom=None, assembly=None,
-                  kerf_test=None, settings: FabSettings | None = None) -> list[Path]:
+def write_outputs(
+    fab: Fabrication | None,
+    dxf=None,
+    svg=None,
+    preview=None,
+    bom=None,
+    assembly=None,
+    kerf_test=None,
+    settings: FabSettings | None = None,
+) -> list[Path]:
     """Render every requested output in memory, then write them all (see the module docstring)."""
     from planar.app.formats import writer
 
@@ -81,5 +89,3 @@ def write_outputs(fab: Fabrication | None, dxf=None, svg=None, preview=None, bom
         raise InputError("output", ", ".join(map(str, files)), "distinct output files")
     _commit(files)
     return list(files)
-
-

@@ -27,9 +27,22 @@ if TYPE_CHECKING:
     from planar.scene.load import Scene
 
 __all__ = [
-    "DEMO_EXTRAS", "DEMO_SCENES", "build_gallery", "compare_scene", "export_mechanism", "export_scene",
-    "gallery_scenes", "overlay_motion", "plot_mechanism", "render_mechanism", "render_scene", "run_demo",
-    "scene_style", "write_catalog_motion", "write_mechanism_motion", "write_scene_motion",
+    "DEMO_EXTRAS",
+    "DEMO_SCENES",
+    "build_gallery",
+    "compare_scene",
+    "export_mechanism",
+    "export_scene",
+    "gallery_scenes",
+    "overlay_motion",
+    "plot_mechanism",
+    "render_mechanism",
+    "render_scene",
+    "run_demo",
+    "scene_style",
+    "write_catalog_motion",
+    "write_mechanism_motion",
+    "write_scene_motion",
 ]
 
 
@@ -67,8 +80,16 @@ def scene_style(scene: Scene) -> Style:
     from planar.draw.frames import Style
 
     r = scene.spec.render
-    return Style(width=r.width, height=r.height, supersample=r.supersample, background=r.background,
-                 trails=r.trails, show_pins=r.show_pins, opacity=r.opacity, exploded=r.exploded)
+    return Style(
+        width=r.width,
+        height=r.height,
+        supersample=r.supersample,
+        background=r.background,
+        trails=r.trails,
+        show_pins=r.show_pins,
+        opacity=r.opacity,
+        exploded=r.exploded,
+    )
 
 
 def overlay_motion(scene: Scene) -> Motion:
@@ -80,8 +101,10 @@ def overlay_motion(scene: Scene) -> Motion:
 
     sim = simulate_scene(scene)
     if sim.blowup is not None:
-        raise SimulationError(f"{scene.path}: the simulation {sim.motion.reason(sim.blowup[0])}; "
-                              "no animation written (try more substeps: planar compare --substeps)")
+        raise SimulationError(
+            f"{scene.path}: the simulation {sim.motion.reason(sim.blowup[0])}; "
+            "no animation written (try more substeps: planar compare --substeps)"
+        )
     return sim.motion
 
 
@@ -95,21 +118,34 @@ def animation_plan(scene: Scene, out: str | Path, fps: float | None = None) -> "
 
     fps = fps if fps is not None else scene.spec.render.fps
     try:
-        return plan_frames(scene.mechanism.driver.period, scene_duration(scene), fps,
-                           tick_ms=10.0 if Path(out).suffix.lower() == ".gif" else None)
+        return plan_frames(
+            scene.mechanism.driver.period,
+            scene_duration(scene),
+            fps,
+            tick_ms=10.0 if Path(out).suffix.lower() == ".gif" else None,
+        )
     except InputError as e:  # the planner names "duration" or "speed": say which key of which scene
         d = scene.spec.driver
         if e.field == "duration":
-            key, value = ("driver.duration", d.duration) if d.duration is not None else \
-                ("driver.cycles", d.cycles if d.cycles is not None else 1.0)
+            key, value = (
+                ("driver.duration", d.duration)
+                if d.duration is not None
+                else ("driver.cycles", d.cycles if d.cycles is not None else 1.0)
+            )
             raise InputError(f"{scene.path}: {key}", value, e.expected) from None
         if e.field == "speed":
             raise InputError(f"{scene.path}: driver.speed", d.speed, e.expected) from None
         raise
 
 
-def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, progress: bool = True,
-                 fps: float | None = None, notes: list[str] | None = None) -> int:
+def render_scene(
+    scene: Scene,
+    out: str | Path,
+    overlay: Motion | None = None,
+    progress: bool = True,
+    fps: float | None = None,
+    notes: list[str] | None = None,
+) -> int:
     """Render a scene's analytic motion (and optionally an overlay motion) to ``out``; returns the frame count.
 
     The format follows the suffix: ``.gif`` (streamed, reproducible), ``.mp4``
@@ -134,8 +170,11 @@ def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, p
         video_available = writer("mp4").video_available
 
         if not video_available():
-            raise InputError("-o", str(out), f"the video extra for {suffix} output: pip install 'planar[video]' "
-                                             "(imageio-ffmpeg), or write a .gif")
+            raise InputError(
+                "-o",
+                str(out),
+                f"the video extra for {suffix} output: pip install 'planar[video]' (imageio-ffmpeg), or write a .gif",
+            )
 
     from planar.core.limits import check_count
 
@@ -146,20 +185,30 @@ def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, p
     shown = 1.0 if shown is None else shown  # one cycle unless the scene says
     plan = animation_plan(scene, out, fps)
     check_count("frames", f"{scene.path}: {field_name}", plan.frames, "frames", shown=shown)
-    check_count("samples", f"{scene.path}: {field_name}", plan.frames * max(
-        1, math.ceil(scene.spec.driver.samples_per_cycle / plan.frames_per_cycle)), "samples to draw from", shown=shown)
+    check_count(
+        "samples",
+        f"{scene.path}: {field_name}",
+        plan.frames * max(1, math.ceil(scene.spec.driver.samples_per_cycle / plan.frames_per_cycle)),
+        "samples to draw from",
+        shown=shown,
+    )
     if suffix == ".gif" and plan.delay_ms > GIF_MAX_DELAY_MS:
-        raise InputError(f"{scene.path}: driver.speed", scene.spec.driver.speed,
-                         f"a frame delay a GIF can hold (at most {GIF_MAX_DELAY_MS / 1000:g} s; this needs "
-                         f"{plan.delay_ms / 1000:.4g} s): a higher speed or frame rate")
+        raise InputError(
+            f"{scene.path}: driver.speed",
+            scene.spec.driver.speed,
+            f"a frame delay a GIF can hold (at most {GIF_MAX_DELAY_MS / 1000:g} s; this needs "
+            f"{plan.delay_ms / 1000:.4g} s): a higher speed or frame rate",
+        )
     motion, fine = animation_motion(scene, plan)
     if notes is not None:
         if plan.note():
             notes.append(plan.note())
         bad = ~fine.valid
         if bad.any():
-            notes.append(f"{int(bad.sum())} of the {len(fine)} samples drawn from cannot be assembled and are drawn "
-                         f"tinted red; first: {fine.reason(int(bad.argmax()))}")
+            notes.append(
+                f"{int(bad.sum())} of the {len(fine)} samples drawn from cannot be assembled and are drawn "
+                f"tinted red; first: {fine.reason(int(bad.argmax()))}"
+            )
     if overlay is not None:
         overlay = resample(overlay, plan.times())
     polys = {n: scene.polygons[n] for n in scene.spec.render.sweep}
@@ -180,8 +229,9 @@ def render_scene(scene: Scene, out: str | Path, overlay: Motion | None = None, p
         return write_video(out, r.frames(progress=progress), plan.fps)
 
 
-def build_gallery(source: str | Path, output: str | Path | None = None,
-                  progress: bool = False) -> Iterator[tuple[Path, Path, int]]:
+def build_gallery(
+    source: str | Path, output: str | Path | None = None, progress: bool = False
+) -> Iterator[tuple[Path, Path, int]]:
     """Render every scene of the folder ``source`` to ``output`` (default: beside the scenes).
 
     Yields ``(scene file, GIF written, frames)`` as each GIF is finished.
@@ -217,20 +267,23 @@ def numeric_guard(scene: Scene, doing: str) -> Iterator[None]:
     except (np.linalg.LinAlgError, OverflowError, FloatingPointError, ValueError) as e:
         if type(e).__module__.startswith("planar"):
             raise
-        raise InputError(f"{scene.path}: mechanism", f"parts up to {scene.mechanism.size:.4g} units across",
-                         f"numbers (sizes, loads, densities) at which {doing} can be computed ({type(e).__name__}: "
-                         f"{' '.join(str(e).split())})"
-                         ) from None
+        raise InputError(
+            f"{scene.path}: mechanism",
+            f"parts up to {scene.mechanism.size:.4g} units across",
+            f"numbers (sizes, loads, densities) at which {doing} can be computed ({type(e).__name__}: "
+            f"{' '.join(str(e).split())})",
+        ) from None
     except Exception as e:
         if type(e).__name__ != "GEOSException":
             raise
-        raise InputError(f"{scene.path}: mechanism", f"parts up to {scene.mechanism.size:.4g} units across",
-                         f"numbers (sizes, loads, densities) at which {doing} can be computed (shapely: "
-                         f"{' '.join(str(e).split())})") from None
+        raise InputError(
+            f"{scene.path}: mechanism",
+            f"parts up to {scene.mechanism.size:.4g} units across",
+            f"numbers (sizes, loads, densities) at which {doing} can be computed (shapely: {' '.join(str(e).split())})",
+        ) from None
 
 
-def write_scene_motion(scene: Scene, out: str | Path, derivatives: bool = False,
-                       notes: list[str] | None = None) -> Motion:
+def write_scene_motion(scene: Scene, out: str | Path, derivatives: bool = False, notes: list[str] | None = None) -> Motion:
     """Write the scene's analytic motion table (CSV) to ``out``; returns the motion.
 
     ``notes``: where to add what the table is, when not the obvious (see :func:`table_motion`).
@@ -277,8 +330,9 @@ def write_catalog_motion(name: str, out: str | Path, samples: int = 360) -> Moti
     return motion
 
 
-def table_motion(mech: Mechanism, motion: Motion | None, samples: int = 360,
-                 notes: list[str] | None = None) -> tuple[Mechanism, Motion]:
+def table_motion(
+    mech: Mechanism, motion: Motion | None, samples: int = 360, notes: list[str] | None = None
+) -> tuple[Mechanism, Motion]:
     """The mechanism and motion a motion table reports: ``mech`` and ``motion`` (or one cycle of
     ``samples`` samples), except for a wind-up toy, whose table is its assembly in the toy's frame
     (:class:`planar.toys.assembly.ToyAssembly`: every piece in its own plane, a Ty effector moving
@@ -298,8 +352,10 @@ def table_motion(mech: Mechanism, motion: Motion | None, samples: int = 360,
         asm = toy_assembly(mech)
     except InputError as e:
         if notes is not None:
-            notes.append(f"{mech.name} cannot be assembled ({e}); the table has its stages' panels instead: "
-                         "each stage in its own frame, side by side, not the toy's frame")
+            notes.append(
+                f"{mech.name} cannot be assembled ({e}); the table has its stages' panels instead: "
+                "each stage in its own frame, side by side, not the toy's frame"
+            )
         return mech, motion
     return asm, asm.solve(motion.driver, t=motion.t)
 
@@ -307,10 +363,17 @@ def table_motion(mech: Mechanism, motion: Motion | None, samples: int = 360,
 # --------------------------------------------------------------------------- fabrication
 
 
-def export_scene(scene: Scene, dxf: str | Path | None = None, svg: str | Path | None = None,
-                 kerf: float | None = None, sheet: tuple[float, float] | None = None,
-                 preview: str | Path | None = None, bom: str | Path | None = None,
-                 assembly: str | Path | None = None, kerf_test: str | Path | None = None) -> "Fabrication":
+def export_scene(
+    scene: Scene,
+    dxf: str | Path | None = None,
+    svg: str | Path | None = None,
+    kerf: float | None = None,
+    sheet: tuple[float, float] | None = None,
+    preview: str | Path | None = None,
+    bom: str | Path | None = None,
+    assembly: str | Path | None = None,
+    kerf_test: str | Path | None = None,
+) -> "Fabrication":
     """Check, layer and nest a scene's parts and write the requested files (see :mod:`planar.app.export`).
 
     ``kerf`` (mm) and ``sheet`` (width, height in mm) default to the scene's
@@ -328,9 +391,12 @@ def export_scene(scene: Scene, dxf: str | Path | None = None, svg: str | Path | 
         raise InputError(where, f"{w:g} x {h:g}", f"a sheet of finite, positive sides up to {MAX_SHEET_MM:g} mm")
     across = scene.mechanism.size * spec.unit_mm  # the largest part's diameter, mm
     if not across <= math.hypot(w, h):
-        raise InputError(f"{scene.path}: fabrication.unit_mm", spec.unit_mm,
-                         f"parts that fit the {w:g} x {h:g} mm sheet (the largest part is {across:.4g} mm across; "
-                         "a smaller unit_mm or a larger sheet)")
+        raise InputError(
+            f"{scene.path}: fabrication.unit_mm",
+            spec.unit_mm,
+            f"parts that fit the {w:g} x {h:g} mm sheet (the largest part is {across:.4g} mm across; "
+            "a smaller unit_mm or a larger sheet)",
+        )
     fab = build(scene, FabSettings.from_spec(spec, kerf, sheet))
     fab.written = write_outputs(fab, dxf, svg, preview, bom, assembly, kerf_test)
     return fab
@@ -339,8 +405,13 @@ def export_scene(scene: Scene, dxf: str | Path | None = None, svg: str | Path | 
 # --------------------------------------------------------------------------- physics comparison
 
 
-def compare_scene(scene: Scene, settings: SimSettings | None = None, threshold: float = 1e-3,
-                  torque_threshold: float = 0.01, with_series: bool = False) -> tuple[Comparison, SimResult]:
+def compare_scene(
+    scene: Scene,
+    settings: SimSettings | None = None,
+    threshold: float = 1e-3,
+    torque_threshold: float = 0.01,
+    with_series: bool = False,
+) -> tuple[Comparison, SimResult]:
     """Simulate ``scene`` in pymunk and compare it with its analytic motion (and the motor torque).
 
     See :func:`planar.physics.compare.compare_scene`; ``result.passed`` is false when
@@ -365,8 +436,13 @@ def render_mechanism(mech: Mechanism, out: str | Path, progress: bool = False, *
     return render_scene(scene_from_mechanism(mech, **tables), out, progress=progress)
 
 
-def export_mechanism(mech: Mechanism, dxf: str | Path | None = None, svg: str | Path | None = None,
-                     fabrication: dict[str, Any] | None = None, **files: Any) -> "Fabrication":
+def export_mechanism(
+    mech: Mechanism,
+    dxf: str | Path | None = None,
+    svg: str | Path | None = None,
+    fabrication: dict[str, Any] | None = None,
+    **files: Any,
+) -> "Fabrication":
     """Lay out a mechanism built in Python for cutting, as ``planar export`` would its scene.
 
     ``fabrication``: ``[fabrication]`` keys (``unit_mm``, ``kerf_mm``, ...);
@@ -399,19 +475,29 @@ def plot_mechanism(mech: Mechanism, out: str | Path, what: list[str] | None = No
 #: the embedded default: a wind-up toy and a four-bar walking leg
 DEMO_SCENES: dict[str, dict] = {
     "horse": {
-        "name": "horse", "angle_unit": "deg",
-        "mechanism": {"type": "toy", "left": [["Rz->OzT", "OzT->Oz"]],
-                      "right": [["Rz->OzT", "OzT->Ty"], ["Rz->OzT", "OzT->Oz"]], "phase": 180},
+        "name": "horse",
+        "angle_unit": "deg",
+        "mechanism": {
+            "type": "toy",
+            "left": [["Rz->OzT", "OzT->Oz"]],
+            "right": [["Rz->OzT", "OzT->Ty"], ["Rz->OzT", "OzT->Oz"]],
+            "phase": 180,
+        },
         "driver": {"speed": 0.5, "samples_per_cycle": 48},
         "render": {"width": 480, "height": 360},
         "fabrication": {"unit_mm": 100.0, "sheet_mm": [400.0, 300.0]},  # one frame spans every pivot
     },
     "kangaroo-leg": {
         "name": "kangaroo-leg",
-        "mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0,
-                      "coupler_point": [5.5, -2.0],
-                      "polygons": [{"name": "foot", "part": "coupler",
-                                    "points": [[5.1, -2.25], [6.6, -2.25], [6.6, -1.95], [5.1, -1.95]]}]},
+        "mechanism": {
+            "type": "fourbar",
+            "ground": 4.0,
+            "crank": 1.0,
+            "coupler": 4.0,
+            "rocker": 3.0,
+            "coupler_point": [5.5, -2.0],
+            "polygons": [{"name": "foot", "part": "coupler", "points": [[5.1, -2.25], [6.6, -2.25], [6.6, -1.95], [5.1, -1.95]]}],
+        },
         "driver": {"speed": 1.0, "samples_per_cycle": 48},
         "effects": {"loads": [{"point": "coupler_point", "force": [0.0, 10.0]}]},
         "render": {"width": 480, "height": 360, "sweep": ["foot"]},
@@ -447,8 +533,10 @@ def run_demo(output: str | Path) -> Iterator[str]:
         dxf = out / f"{name}.dxf"
         fab = export_scene(scene, dxf=dxf)
         rings = sum(pp.spacers for pp in fab.assembly.pins)
-        line += (f"; {len(fab.layout.parts) - rings} parts{f' + {rings} spacer rings' if rings else ''} on "
-                 f"{fab.layout.sheets} sheet(s) -> {', '.join(map(str, fab.written))}")
+        line += (
+            f"; {len(fab.layout.parts) - rings} parts{f' + {rings} spacer rings' if rings else ''} on "
+            f"{fab.layout.sheets} sheet(s) -> {', '.join(map(str, fab.written))}"
+        )
         yield line
         for extra in DEMO_EXTRAS:
             extra(scene, out)

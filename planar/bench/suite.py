@@ -29,6 +29,7 @@ if TYPE_CHECKING:
 
 __all__ = ["bench_kinematics", "BENCHMARKS"]
 
+
 def _best_time(fn: Callable[[], Any], repeats: int) -> float:
     best = math.inf
     for _ in range(repeats):
@@ -59,9 +60,7 @@ def _pylinkage_of(lk: Any, step: float) -> Any:
         import pylinkage as pl
         from pylinkage.simulation import Linkage as PlLinkage
     except ImportError as e:  # pragma: no cover - depends on the environment
-        raise PlanarError(
-            "planar bench kinematics needs the peer library pylinkage: pip install 'planar[bench]'"
-        ) from e
+        raise PlanarError("planar bench kinematics needs the peer library pylinkage: pip install 'planar[bench]'") from e
     from planar.linkages.dyads import RRR, Crank, Fixed, Rigid
 
     start = lk.node_positions(np.array([0.0]))
@@ -76,8 +75,7 @@ def _pylinkage_of(lk: Any, step: float) -> Any:
         if isinstance(nd, Fixed):
             c = pl.Ground(float(nd.xy[0]), float(nd.xy[1]), name=nd.name)
         elif isinstance(nd, Crank):
-            c = pl.Crank(anchor=comps[nd.centre], radius=nd.radius, angular_velocity=step,
-                         initial_angle=nd.phase, name=nd.name)
+            c = pl.Crank(anchor=comps[nd.centre], radius=nd.radius, angular_velocity=step, initial_angle=nd.phase, name=nd.name)
         elif isinstance(nd, RRR):
             x, y = start[nd.name][0]
             c = pl.RRRDyad(anchor(nd.a), anchor(nd.b), nd.ra, nd.rb, x=float(x), y=float(y), name=nd.name)
@@ -116,8 +114,7 @@ def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
     t0 = time.perf_counter()
     motion = mech.solve(q_peer)  # the first call: numba import and kernel load (or compile) included
     first_call = time.perf_counter() - t0
-    diff_points = max(float(np.max(np.abs(motion.points[p] - traj[:, names.index(nd)])))
-                      for p, nd in mech.point_nodes.items())
+    diff_points = max(float(np.max(np.abs(motion.points[p] - traj[:, names.index(nd)]))) for p, nd in mech.point_nodes.items())
 
     # warm-up, outside the timing: pylinkage's numba compile (cached) and one call of the full size each (planar's
     # first call of a size takes new memory, which its later calls recycle: the "new memory per call" rate below
@@ -161,7 +158,7 @@ def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
             peer_rates.append(n / (time.perf_counter() - t0))
             peer_cpu.append(time.process_time() - c0)
 
-        for fn in ((run_planar, run_peer, run_fresh) if r % 2 == 0 else (run_fresh, run_peer, run_planar)):
+        for fn in (run_planar, run_peer, run_fresh) if r % 2 == 0 else (run_fresh, run_peer, run_planar):
             fn()
     ratios = [a / b for a, b in zip(planar_rates, peer_rates)]
     return {
@@ -236,23 +233,32 @@ def bench_kinematics(n: int = 1_000_000, repeats: int = 7) -> dict[str, Any]:
 
 def format_kinematics(r: dict[str, Any]) -> str:
     """Human-readable table of :func:`bench_kinematics` results."""
-    lines = [(f"public solve vs {r['peer']}, {r['n']:,} crank angles, median (min-max) of {r['repeats']} "
-              f"interleaved repeats, {r['cores']} cores")]
+    lines = [
+        (
+            f"public solve vs {r['peer']}, {r['n']:,} crank angles, median (min-max) of {r['repeats']} "
+            f"interleaved repeats, {r['cores']} cores"
+        )
+    ]
     for c in r["cases"]:
         p, q, k = c["planar_samples_per_s"], c["peer_samples_per_s"], c["ratio_per_repeat"]
         lines += [
             f"  {c['linkage']} ({c['nodes']} nodes, {c['parts']} parts)",
-            (f"    planar solve ({c['threads']} threads) {p['median'] / 1e6:8.2f} M samples/s "
-             f"({p['min'] / 1e6:.2f}-{p['max'] / 1e6:.2f}), {c['kernels']} kernels "
-             f"(the process's first solve, up to 20,000 samples, numba import and kernel load included: "
-             f"{c['first_call_s']:.2f} s)"),
-            (f"    pylinkage step_fast        {q['median'] / 1e6:8.2f} M samples/s "
-             f"({q['min'] / 1e6:.2f}-{q['max'] / 1e6:.2f})"),
+            (
+                f"    planar solve ({c['threads']} threads) {p['median'] / 1e6:8.2f} M samples/s "
+                f"({p['min'] / 1e6:.2f}-{p['max'] / 1e6:.2f}), {c['kernels']} kernels "
+                f"(the process's first solve, up to 20,000 samples, numba import and kernel load included: "
+                f"{c['first_call_s']:.2f} s)"
+            ),
+            (f"    pylinkage step_fast        {q['median'] / 1e6:8.2f} M samples/s ({q['min'] / 1e6:.2f}-{q['max'] / 1e6:.2f})"),
             f"    ratio                      {c['ratio']:8.2f}  (per repeat {k['min']:.2f}-{k['max']:.2f})",
-            (f"    planar, new memory per call {c['planar_new_memory_samples_per_s']['median'] / 1e6:7.2f} M samples/s "
-             f"(PLANAR_RECYCLE=0): ratio {c['ratio_new_memory']:.2f}"),
-            (f"    processor time             {c['planar_cpu_s']['median'] * 1e3:8.1f} ms vs "
-             f"{c['peer_cpu_s']['median'] * 1e3:.1f} ms: ratio {c['cpu_ratio']:.2f}"),
+            (
+                f"    planar, new memory per call {c['planar_new_memory_samples_per_s']['median'] / 1e6:7.2f} M samples/s "
+                f"(PLANAR_RECYCLE=0): ratio {c['ratio_new_memory']:.2f}"
+            ),
+            (
+                f"    processor time             {c['planar_cpu_s']['median'] * 1e3:8.1f} ms vs "
+                f"{c['peer_cpu_s']['median'] * 1e3:.1f} ms: ratio {c['cpu_ratio']:.2f}"
+            ),
             f"    max |planar - peer|        {c['max_abs_diff_vs_peer']:8.1e}  (size {c['size']:.3g})"
             + ("" if c["agrees"] else f"  DISAGREES (more than {AGREEMENT:g}, or invalid samples)"),
         ]
@@ -356,12 +362,14 @@ def bench_render(n: int = 120, repeats: int = 5, width: int = 480, height: int =
 
 
 def format_render(r: dict[str, Any]) -> str:
-    return "\n".join([
-        f"four-bar GIF, {r['frames']} frames at {r['size_px'][0]}x{r['size_px'][1]}",
-        f"  planar        {r['planar_fps']:8.1f} frames/s   {r['planar_gif_bytes']:>9,} bytes",
-        f"  matplotlib    {r['peer_fps']:8.1f} frames/s   {r['peer_gif_bytes']:>9,} bytes",
-        f"  ratio planar/matplotlib  {r['ratio']:.2f} (frames/s), size {r['size_ratio']:.2f}",
-    ])
+    return "\n".join(
+        [
+            f"four-bar GIF, {r['frames']} frames at {r['size_px'][0]}x{r['size_px'][1]}",
+            f"  planar        {r['planar_fps']:8.1f} frames/s   {r['planar_gif_bytes']:>9,} bytes",
+            f"  matplotlib    {r['peer_fps']:8.1f} frames/s   {r['peer_gif_bytes']:>9,} bytes",
+            f"  ratio planar/matplotlib  {r['ratio']:.2f} (frames/s), size {r['size_ratio']:.2f}",
+        ]
+    )
 
 
 BENCHMARKS["render"] = (bench_render, format_render)
@@ -414,12 +422,17 @@ def accuracy_settings(quick: bool = False, grid: Mapping[str, Sequence[float]] |
 
     if grid is None:
         grid = ACCURACY_QUICK_GRID if quick else ACCURACY_GRID
-    out = [SimSettings(substeps=int(s), iterations=int(i), correction=float(b), tolerance=1.0, step_drift=None)
-           for s in grid["substeps"] for i in grid["iterations"] for b in grid["correction"]]
+    out = [
+        SimSettings(substeps=int(s), iterations=int(i), correction=float(b), tolerance=1.0, step_drift=None)
+        for s in grid["substeps"]
+        for i in grid["iterations"]
+        for b in grid["correction"]
+    ]
     extra = [replace(DEFAULT_SETTINGS, tolerance=1.0)]
     if not quick:
-        extra += [SimSettings(substeps=k, iterations=40, correction=0.2, step_drift=d, tolerance=1.0)
-                  for k, d in ACCURACY_ADAPTIVE]
+        extra += [
+            SimSettings(substeps=k, iterations=40, correction=0.2, step_drift=d, tolerance=1.0) for k, d in ACCURACY_ADAPTIVE
+        ]
         extra.append(_previous_defaults())
     keys = {_setting_key(x) for x in out}
     for x in extra:
@@ -433,8 +446,9 @@ def _machine() -> str:
     """The machine a benchmark ran on: architecture, processor, cores, Python."""
     import platform
 
-    return (f"{platform.machine()} {platform.processor() or ''} {os.cpu_count()} cores, "
-            f"Python {platform.python_version()}").replace("  ", " ")
+    return (
+        f"{platform.machine()} {platform.processor() or ''} {os.cpu_count()} cores, Python {platform.python_version()}"
+    ).replace("  ", " ")
 
 
 def _previous_defaults() -> Any:
@@ -452,10 +466,15 @@ def _pareto(points: list[tuple[float, float]]) -> list[bool]:
     return out
 
 
-def bench_accuracy(scenes: str | os.PathLike, out_dir: str = "planar-bench-accuracy", quick: bool = False,
-                   repeats: int = 2, progress: bool = True,
-                   grid: Mapping[str, Sequence[float]] | None = None,
-                   effects_fraction: float = 1.0) -> dict[str, Any]:
+def bench_accuracy(
+    scenes: str | os.PathLike,
+    out_dir: str = "planar-bench-accuracy",
+    quick: bool = False,
+    repeats: int = 2,
+    progress: bool = True,
+    grid: Mapping[str, Sequence[float]] | None = None,
+    effects_fraction: float = 1.0,
+) -> dict[str, Any]:
     """Simulation error against the analytic motion vs wall time, over the settings that trade them.
 
     ``scenes`` is the folder of scene files to measure (``planar bench
@@ -486,8 +505,12 @@ def bench_accuracy(scenes: str | os.PathLike, out_dir: str = "planar-bench-accur
 
     scene_files = gallery_scenes(scenes)  # checks the folder before any work
     if quick:  # the quick run's three: a four-bar, a slider-crank and the Jansen leg when the folder has them
-        scene_files.sort(key=lambda p: (ACCURACY_QUICK_SCENES.index(p.stem) if p.stem in ACCURACY_QUICK_SCENES
-                                        else len(ACCURACY_QUICK_SCENES), p.name))
+        scene_files.sort(
+            key=lambda p: (
+                ACCURACY_QUICK_SCENES.index(p.stem) if p.stem in ACCURACY_QUICK_SCENES else len(ACCURACY_QUICK_SCENES),
+                p.name,
+            )
+        )
     settings = accuracy_settings(quick, grid)
     d = replace(DEFAULT_SETTINGS, tolerance=1.0)
     prev = _previous_defaults()
@@ -531,17 +554,27 @@ def bench_accuracy(scenes: str | os.PathLike, out_dir: str = "planar-bench-accur
                     torque_err = tc["max_rel_diff"] if tc["failure"] is None else math.inf
                 except PlanarError:
                     motor_ok = False
-            rows.append({"mechanism": sc.name, "setting": _setting_label(st), "substeps": sim.built["substeps"],
-                         "iterations": sim.built["iterations"], "correction": st.correction,
-                         "step_drift": "" if st.step_drift is None else st.step_drift,
-                         "error_bias": "" if st.error_bias is None else st.error_bias,
-                         "dt_s": sim_seconds / (len(ref) - 1) / sim.built["substeps"],
-                         "error": err, "motor_error": motor_err, "torque_error": torque_err,
-                         "seconds_per_sim_second": best / sim_seconds})
+            rows.append(
+                {
+                    "mechanism": sc.name,
+                    "setting": _setting_label(st),
+                    "substeps": sim.built["substeps"],
+                    "iterations": sim.built["iterations"],
+                    "correction": st.correction,
+                    "step_drift": "" if st.step_drift is None else st.step_drift,
+                    "error_bias": "" if st.error_bias is None else st.error_bias,
+                    "dt_s": sim_seconds / (len(ref) - 1) / sim.built["substeps"],
+                    "error": err,
+                    "motor_error": motor_err,
+                    "torque_error": torque_err,
+                    "seconds_per_sim_second": best / sim_seconds,
+                }
+            )
             if bar is not None:
                 bar.update()
     if bar is not None:
         bar.close()
+
     # aggregate per setting
     def worst(rs, key):
         v = [r[key] for r in rs if not math.isnan(r[key])]
@@ -550,12 +583,21 @@ def bench_accuracy(scenes: str | os.PathLike, out_dir: str = "planar-bench-accur
     agg = []
     for st in settings:
         rs = [r for r in rows if r["setting"] == _setting_label(st)]
-        agg.append({"setting": _setting_label(st), "substeps": st.substeps, "iterations": st.iterations,
-                    "correction": st.correction, "step_drift": st.step_drift, "error_bias": st.error_bias,
-                    "max_error": max(worst(rs, "error"), worst(rs, "motor_error")),
-                    "kinematic_error": worst(rs, "error"), "motor_error": worst(rs, "motor_error"),
-                    "torque_error": worst(rs, "torque_error"),
-                    "seconds_per_sim_second": sum(r["seconds_per_sim_second"] for r in rs)})
+        agg.append(
+            {
+                "setting": _setting_label(st),
+                "substeps": st.substeps,
+                "iterations": st.iterations,
+                "correction": st.correction,
+                "step_drift": st.step_drift,
+                "error_bias": st.error_bias,
+                "max_error": max(worst(rs, "error"), worst(rs, "motor_error")),
+                "kinematic_error": worst(rs, "error"),
+                "motor_error": worst(rs, "motor_error"),
+                "torque_error": worst(rs, "torque_error"),
+                "seconds_per_sim_second": sum(r["seconds_per_sim_second"] for r in rs),
+            }
+        )
     front = _pareto([(a["seconds_per_sim_second"], a["max_error"]) for a in agg])
     for a, f in zip(agg, front):
         a["frontier"] = f and math.isfinite(a["max_error"])  # a setting that fails somewhere is no choice
@@ -567,29 +609,62 @@ def bench_accuracy(scenes: str | os.PathLike, out_dir: str = "planar-bench-accur
             r["frontier"] = f
     default = next(a for a in agg if a["default"])
     effects_cost = _effects_cost(repeats=max(3, repeats), fraction=effects_fraction)
-    per_mech_default = {r["mechanism"]: {"kinematic": r["error"], "motor": r["motor_error"], "torque": r["torque_error"],
-                                         "substeps": r["substeps"]}
-                        for r in rows if r["setting"] == _setting_label(d)}
+    per_mech_default = {
+        r["mechanism"]: {
+            "kinematic": r["error"],
+            "motor": r["motor_error"],
+            "torque": r["torque_error"],
+            "substeps": r["substeps"],
+        }
+        for r in rows
+        if r["setting"] == _setting_label(d)
+    }
     previous = next((a for a in agg if a["previous_default"]), None)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     from planar.fileio import atomic_write
 
     with atomic_write(out / "accuracy.csv", "w") as fh:
-        w = csv.DictWriter(fh, fieldnames=["mechanism", "setting", "substeps", "iterations", "correction",
-                                           "step_drift", "error_bias", "dt_s", "error", "motor_error",
-                                           "torque_error", "seconds_per_sim_second", "frontier"], lineterminator="\n")
+        w = csv.DictWriter(
+            fh,
+            fieldnames=[
+                "mechanism",
+                "setting",
+                "substeps",
+                "iterations",
+                "correction",
+                "step_drift",
+                "error_bias",
+                "dt_s",
+                "error",
+                "motor_error",
+                "torque_error",
+                "seconds_per_sim_second",
+                "frontier",
+            ],
+            lineterminator="\n",
+        )
         w.writeheader()
         for r in rows:
             w.writerow(r)
         for a in agg:
-            w.writerow({"mechanism": "ALL (worst error, total time)", "setting": a["setting"],
-                        "substeps": a["substeps"], "iterations": a["iterations"], "correction": a["correction"],
-                        "step_drift": "" if a["step_drift"] is None else a["step_drift"],
-                        "error_bias": "" if a["error_bias"] is None else a["error_bias"], "dt_s": "",
-                        "error": a["kinematic_error"], "motor_error": a["motor_error"],
-                        "torque_error": a["torque_error"], "seconds_per_sim_second": a["seconds_per_sim_second"],
-                        "frontier": a["frontier"]})
+            w.writerow(
+                {
+                    "mechanism": "ALL (worst error, total time)",
+                    "setting": a["setting"],
+                    "substeps": a["substeps"],
+                    "iterations": a["iterations"],
+                    "correction": a["correction"],
+                    "step_drift": "" if a["step_drift"] is None else a["step_drift"],
+                    "error_bias": "" if a["error_bias"] is None else a["error_bias"],
+                    "dt_s": "",
+                    "error": a["kinematic_error"],
+                    "motor_error": a["motor_error"],
+                    "torque_error": a["torque_error"],
+                    "seconds_per_sim_second": a["seconds_per_sim_second"],
+                    "frontier": a["frontier"],
+                }
+            )
     _accuracy_chart(out / "accuracy.png", agg)
     return {
         "benchmark": "accuracy",
@@ -627,8 +702,10 @@ def _effects_cost(repeats: int = 3, fraction: float = 1.0) -> dict[str, float]:
     from planar.physics.simulate import simulate
     from planar.scene.load import build_scene, parse_scene
 
-    base = {"mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0,
-                          "coupler_point": [2.0, 1.0]}, "driver": {"samples_per_cycle": 360}}
+    base = {
+        "mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0, "coupler_point": [2.0, 1.0]},
+        "driver": {"samples_per_cycle": 360},
+    }
     variants: dict[str, dict[str, Any] | None] = {
         "none": None,
         "unused": {"springs": [], "loads": []},
@@ -669,8 +746,10 @@ def _accuracy_chart(path, agg: list[dict[str, Any]]) -> None:
     f = np.array([a["frontier"] for a in agg])
     order = np.argsort(t[f])
     dflt = [i for i, a in enumerate(agg) if a["default"]]
-    for axis, y, label, line in ((ax, e, "worst position error / size (kinematic and motor mode)", 1e-4),
-                                 (ax2, tq, "worst motor torque error / peak", 1e-2)):
+    for axis, y, label, line in (
+        (ax, e, "worst position error / size (kinematic and motor mode)", 1e-4),
+        (ax2, tq, "worst motor torque error / peak", 1e-2),
+    ):
         bad = ~np.isfinite(y)
         y = np.where(bad, 1.0, y)
         axis.scatter(t[~f & ~bad], y[~f & ~bad], s=14, c="#9a9a9a", label="setting")
@@ -686,8 +765,16 @@ def _accuracy_chart(path, agg: list[dict[str, Any]]) -> None:
         prev = [i for i, a in enumerate(agg) if a.get("previous_default")]
         if prev:
             i = prev[0]
-            axis.scatter([t[i]], [y[i]], s=80, marker="s", facecolors="none", edgecolors="#b07aa1", linewidths=2,
-                         label="defaults before issue 12")
+            axis.scatter(
+                [t[i]],
+                [y[i]],
+                s=80,
+                marker="s",
+                facecolors="none",
+                edgecolors="#b07aa1",
+                linewidths=2,
+                label="defaults before issue 12",
+            )
         axis.axhline(line, ls=":", c="#e15759", lw=1)
         axis.set_xscale("log")
         axis.set_yscale("log")
@@ -708,36 +795,47 @@ def _accuracy_chart(path, agg: list[dict[str, Any]]) -> None:
 
 
 def format_accuracy(r: dict[str, Any]) -> str:
-    lines = [f"pymunk rebuild vs analytic, {len(r['mechanisms'])} mechanisms x {r['settings']} settings "
-             f"({r['machine']})",
-             "  frontier (substeps/iterations/correction; N+ = at least N, raised for the step drift):",
-             f"  {'setting':<28}{'worst err':>10}{'torque':>10}{'s/sim s':>10}"]
+    lines = [
+        f"pymunk rebuild vs analytic, {len(r['mechanisms'])} mechanisms x {r['settings']} settings ({r['machine']})",
+        "  frontier (substeps/iterations/correction; N+ = at least N, raised for the step drift):",
+        f"  {'setting':<28}{'worst err':>10}{'torque':>10}{'s/sim s':>10}",
+    ]
     for a in sorted(r["frontier"], key=lambda a: a["seconds_per_sim_second"]):
         mark = "  <- default" if a["default"] else ""
-        lines.append(f"  {a['setting']:<28}{a['max_error']:>10.2e}{a['torque_error']:>10.2e}"
-                     f"{a['seconds_per_sim_second']:>10.3f}{mark}")
+        lines.append(
+            f"  {a['setting']:<28}{a['max_error']:>10.2e}{a['torque_error']:>10.2e}{a['seconds_per_sim_second']:>10.3f}{mark}"
+        )
     d = r["default"]
-    lines.append(f"  default ({d['setting']}): worst error {d['max_error']:.2e} (kinematic {d['kinematic_error']:.2e}, "
-                 f"motor {d['motor_error']:.2e}), torque {d['torque_error']:.2e}, "
-                 f"{d['seconds_per_sim_second']:.3f} s per simulated second, "
-                 f"{'on' if r['default_on_frontier'] else 'NOT on'} the frontier")
+    lines.append(
+        f"  default ({d['setting']}): worst error {d['max_error']:.2e} (kinematic {d['kinematic_error']:.2e}, "
+        f"motor {d['motor_error']:.2e}), torque {d['torque_error']:.2e}, "
+        f"{d['seconds_per_sim_second']:.3f} s per simulated second, "
+        f"{'on' if r['default_on_frontier'] else 'NOT on'} the frontier"
+    )
     p = r.get("previous_default")
     if p is not None:
-        lines.append(f"  defaults before issue 12 ({p['setting']}): worst error {p['max_error']:.2e}, torque "
-                     f"{p['torque_error']:.2e}, {p['seconds_per_sim_second']:.3f} s per simulated second "
-                     f"(defaults / before = {d['seconds_per_sim_second'] / p['seconds_per_sim_second']:.2f})")
+        lines.append(
+            f"  defaults before issue 12 ({p['setting']}): worst error {p['max_error']:.2e}, torque "
+            f"{p['torque_error']:.2e}, {p['seconds_per_sim_second']:.3f} s per simulated second "
+            f"(defaults / before = {d['seconds_per_sim_second'] / p['seconds_per_sim_second']:.2f})"
+        )
+
     def num(x: float) -> str:
         return "-" if math.isnan(x) else f"{x:.2e}"  # "-": no steady motor (a rocking driver, staged toys)
 
     for k, v in sorted(r["default_errors"].items()):
-        lines.append(f"    {k:<22} substeps {v['substeps']:>3}  kinematic {num(v['kinematic']):>8}  "
-                     f"motor {num(v['motor']):>8}  torque {num(v['torque']):>8}")
+        lines.append(
+            f"    {k:<22} substeps {v['substeps']:>3}  kinematic {num(v['kinematic']):>8}  "
+            f"motor {num(v['motor']):>8}  torque {num(v['torque']):>8}"
+        )
     for k, v in r["skipped"].items():
         lines.append(f"  skipped {k}: {v}")
     ec = r["effects_cost"]
-    lines.append("  effects cost (four-bar leg, s per simulated second): " +
-                 ", ".join(f"{k} {v:.4f}" for k, v in ec.items()) +
-                 f"; unused/none = {ec['unused'] / ec['none']:.2f}")
+    lines.append(
+        "  effects cost (four-bar leg, s per simulated second): "
+        + ", ".join(f"{k} {v:.4f}" for k, v in ec.items())
+        + f"; unused/none = {ec['unused'] / ec['none']:.2f}"
+    )
     lines.append(f"  wrote {r['csv']} and {r['chart']}")
     return "\n".join(lines)
 
@@ -781,9 +879,14 @@ def bench_sim(n: int = 360, repeats: int = 7) -> dict[str, Any]:
 
     st = DEFAULT_SETTINGS
     mechs = {"four-bar": FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0)), "jansen": get("jansen")}
-    out: dict[str, Any] = {"benchmark": "sim", "samples": n, "substeps": st.substeps, "repeats": repeats,
-                           "machine": _machine(),
-                           "mechanisms": {}}
+    out: dict[str, Any] = {
+        "benchmark": "sim",
+        "samples": n,
+        "substeps": st.substeps,
+        "repeats": repeats,
+        "machine": _machine(),
+        "mechanisms": {},
+    }
     for name, mech in mechs.items():
         t = mech.driver.times(n)
         ratios, ours, bare = [], [], []
@@ -815,12 +918,16 @@ def bench_sim(n: int = 360, repeats: int = 7) -> dict[str, Any]:
 
 
 def format_sim(r: dict[str, Any]) -> str:
-    head = (f"physics step cost, planar vs bare pymunk on the same space ({r['samples']} samples x "
-            f"{r['substeps']} substeps, {r['repeats']} interleaved repeats; {r['machine']})")
+    head = (
+        f"physics step cost, planar vs bare pymunk on the same space ({r['samples']} samples x "
+        f"{r['substeps']} substeps, {r['repeats']} interleaved repeats; {r['machine']})"
+    )
     lines = [head]
     for name, m in r["mechanisms"].items():
-        lines.append(f"  {name:<10} planar {m['planar_us_per_step']:8.2f} us/step   bare {m['bare_pymunk_us_per_step']:8.2f}"
-                     f" us/step   ratio {m['ratio']:.2f} (spread {m['ratio_spread'][0]:.2f}-{m['ratio_spread'][1]:.2f})")
+        lines.append(
+            f"  {name:<10} planar {m['planar_us_per_step']:8.2f} us/step   bare {m['bare_pymunk_us_per_step']:8.2f}"
+            f" us/step   ratio {m['ratio']:.2f} (spread {m['ratio_spread'][0]:.2f}-{m['ratio_spread'][1]:.2f})"
+        )
     lines.append(f"  ratio (worst mechanism, median): {r['ratio']:.2f}")
     return "\n".join(lines)
 

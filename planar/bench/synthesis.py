@@ -104,8 +104,9 @@ def _from_pylinkage(sol: Any, targets: Array, theta: Array | None) -> FourBarDes
     u, v = float(q @ e), float(e[0] * q[1] - e[1] * q[0])
     e1 = D - B
     circ = 1.0 if e1[0] * (C - B)[1] - e1[1] * (C - B)[0] > 0 else -1.0
-    row = np.array([np.hypot(*g), sol.crank_length, sol.coupler_length, sol.rocker_length, u, v, A[0], A[1],
-                    math.atan2(g[1], g[0])])
+    row = np.array(
+        [np.hypot(*g), sol.crank_length, sol.coupler_length, sol.rocker_length, u, v, A[0], A[1], math.atan2(g[1], g[0])]
+    )
     return score_params(row, circ, targets, theta)
 
 
@@ -127,9 +128,20 @@ def score_params(p: Array, circuit: float, targets: Array, theta: Array | None) 
         th = _nearest_theta(PathObjective(targets, None, Constraints(full_turn=False, max_ratio=1e12)), row, 7200)
     else:
         th = np.asarray(theta, float)
-    d = FourBarDesign(float(row[0]), float(row[1]), float(row[2]), float(row[3]), (float(row[4]), float(row[5])),
-                      "open" if circ > 0 else "crossed", (float(row[6]), float(row[7]), float(row[8])), th,
-                      float("nan"), targets, theta is not None, 0.0)
+    d = FourBarDesign(
+        float(row[0]),
+        float(row[1]),
+        float(row[2]),
+        float(row[3]),
+        (float(row[4]), float(row[5])),
+        "open" if circ > 0 else "crossed",
+        (float(row[6]), float(row[7]), float(row[8])),
+        th,
+        float("nan"),
+        targets,
+        theta is not None,
+        0.0,
+    )
     try:
         x, y, _ = coupler_points(row[None, :9], th[None, :], np.array([circ]))
         check_design(d, np.column_stack([x[0], y[0]]))
@@ -138,8 +150,7 @@ def score_params(p: Array, circuit: float, targets: Array, theta: Array | None) 
     return d
 
 
-def _pylinkage_run(name: str, prob: dict[str, Any], quick: bool, require_grashof: bool,
-                   four: bool = False) -> dict[str, Any]:
+def _pylinkage_run(name: str, prob: dict[str, Any], quick: bool, require_grashof: bool, four: bool = False) -> dict[str, Any]:
     """pylinkage's synthesis on the problem's targets (``four``: on :func:`subset4` of them, every
     solution kept, ``require_grashof=False``), each solution scored by planar's measure on all targets."""
     try:
@@ -191,10 +202,15 @@ def _pylinkage_optimise(prob: dict[str, Any], quick: bool) -> dict[str, Any]:
     th = None if prob["theta"] is None else np.asarray(prob["theta"], float)
     r = optimise(t, th, "quick" if quick else "normal")
     d = score_params(r["params"], r["circuit"], t, th)
-    return {"call": f"pylinkage {pylinkage.__version__} " + r["calls"], "time_s": r["time_s"],
-            "evaluations": r["evaluations"], "pylinkage_sse": r["pylinkage_sse"],
-            "sse": None if d is None else d.sse, "ok": d is not None and d.ok,
-            "best": None if d is None else d.to_dict()}
+    return {
+        "call": f"pylinkage {pylinkage.__version__} " + r["calls"],
+        "time_s": r["time_s"],
+        "evaluations": r["evaluations"],
+        "pylinkage_sse": r["pylinkage_sse"],
+        "sse": None if d is None else d.sse,
+        "ok": d is not None and d.ok,
+        "best": None if d is None else d.to_dict(),
+    }
 
 
 def kernel_rate(n: int = 200_000, samples: int = 64, repeats: int = 5) -> dict[str, Any]:
@@ -210,20 +226,27 @@ def kernel_rate(n: int = 200_000, samples: int = 64, repeats: int = 5) -> dict[s
     coupler_points(X[:1000], th)
     rates: dict[type, list[float]] = {np.float32: [], np.float64: []}
     for r in range(repeats):
-        for dt in ((np.float32, np.float64) if r % 2 == 0 else (np.float64, np.float32)):
+        for dt in (np.float32, np.float64) if r % 2 == 0 else (np.float64, np.float32):
             t0 = time.perf_counter()
             coupler_points(X, th, dtype=dt)
             rates[dt].append(n / (time.perf_counter() - t0))
     from planar.linkages.chunked import threads_default
 
     r32, r64 = rates[np.float32], rates[np.float64]
-    return {"candidates": n, "samples": samples, "threads": threads_default(),
-            "median": float(np.median(r32)), "min": float(min(r32)), "max": float(max(r32)),
-            "float64": {"median": float(np.median(r64)), "min": float(min(r64)), "max": float(max(r64))}}
+    return {
+        "candidates": n,
+        "samples": samples,
+        "threads": threads_default(),
+        "median": float(np.median(r32)),
+        "min": float(min(r32)),
+        "max": float(max(r32)),
+        "float64": {"median": float(np.median(r64)), "min": float(min(r64)), "max": float(max(r64))},
+    }
 
 
-def bench_synthesis(repeats: int = 3, quick: bool = False, n: int | None = None,
-                    problems: tuple[str, ...] | None = None) -> dict[str, Any]:
+def bench_synthesis(
+    repeats: int = 3, quick: bool = False, n: int | None = None, problems: tuple[str, ...] | None = None
+) -> dict[str, Any]:
     """Both problems, planar and pylinkage alternating ``repeats`` times (see the module).
 
     ``quick``: one repeat, planar's ``quick`` budget, pylinkage's coarser
@@ -247,7 +270,7 @@ def bench_synthesis(repeats: int = 3, quick: bool = False, n: int | None = None,
         peer: list[dict[str, Any]] = []
         opt: list[dict[str, Any]] = []
         for r in range(repeats):
-            for side in (("planar", "peer", "opt") if r % 2 == 0 else ("opt", "peer", "planar")):
+            for side in ("planar", "peer", "opt") if r % 2 == 0 else ("opt", "peer", "planar"):
                 if side == "planar":
                     ours.append(synthesise_path(t, th, Constraints(), budget=budget, seed=r))
                 elif side == "peer":
@@ -257,7 +280,7 @@ def bench_synthesis(repeats: int = 3, quick: bool = False, n: int | None = None,
         loose = _pylinkage_run(name, prob, quick, require_grashof=False)
         four = _pylinkage_run(name, prob, quick, require_grashof=False, four=True)
         six: dict[str, Any] = {}
-        if not quick:   # one run per six-bar topology (seed 0): the same targets, what a six-bar adds
+        if not quick:  # one run per six-bar topology (seed 0): the same targets, what a six-bar adds
             from planar.synth.sixbar import TOPOLOGIES, synthesise_sixbar
 
             for topo in TOPOLOGIES:
@@ -267,27 +290,33 @@ def bench_synthesis(repeats: int = 3, quick: bool = False, n: int | None = None,
         times = [d.seconds for d in ours]
         ptimes = [p["time_s"] for p in peer]
         sses = [d.sse for d in ours]
-        cases.append({
-            "problem": name,
-            "targets": len(t),
-            "timed": th is not None,
-            "published_best_error": prob["published"],
-            "published_source": prob["source"],
-            "published_searched": prob["searched"],
-            "planar": {
-                "sse_median": float(np.median(sses)), "sse_min": float(min(sses)), "sse_max": float(max(sses)),
-                "time_s": {"median": float(np.median(times)), "min": float(min(times)), "max": float(max(times))},
-                "budget": budget, "ok": all(d.ok for d in ours), "best": best.to_dict(),
-            },
-            "pylinkage": {
-                **peer[0], "time_s": {"median": float(np.median(ptimes)), "min": float(min(ptimes)),
-                                      "max": float(max(ptimes))},
-            },
-            "pylinkage_without_grashof": loose,
-            "pylinkage_four_targets": four,
-            "pylinkage_optimisers": _summary(opt),
-            "planar_sixbar": six,
-        })
+        cases.append(
+            {
+                "problem": name,
+                "targets": len(t),
+                "timed": th is not None,
+                "published_best_error": prob["published"],
+                "published_source": prob["source"],
+                "published_searched": prob["searched"],
+                "planar": {
+                    "sse_median": float(np.median(sses)),
+                    "sse_min": float(min(sses)),
+                    "sse_max": float(max(sses)),
+                    "time_s": {"median": float(np.median(times)), "min": float(min(times)), "max": float(max(times))},
+                    "budget": budget,
+                    "ok": all(d.ok for d in ours),
+                    "best": best.to_dict(),
+                },
+                "pylinkage": {
+                    **peer[0],
+                    "time_s": {"median": float(np.median(ptimes)), "min": float(min(ptimes)), "max": float(max(ptimes))},
+                },
+                "pylinkage_without_grashof": loose,
+                "pylinkage_four_targets": four,
+                "pylinkage_optimisers": _summary(opt),
+                "planar_sixbar": six,
+            }
+        )
     rate = kernel_rate(n or (50_000 if quick else 250_000), repeats=1 if quick else 5)
     return {
         "benchmark": "synthesis",
@@ -305,11 +334,18 @@ def _summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
     sses = [r["sse"] if r["sse"] is not None else math.inf for r in runs]
     times = [r["time_s"] for r in runs]
     best = runs[int(np.argmin(sses))]
-    return {"call": best["call"], "runs": len(runs),
-            "sse_median": float(np.median(sses)), "sse_min": float(min(sses)), "sse_max": float(max(sses)),
-            "time_s": {"median": float(np.median(times)), "min": float(min(times)), "max": float(max(times))},
-            "evaluations": best["evaluations"], "pylinkage_sse_of_best": best["pylinkage_sse"],
-            "ok": all(r["ok"] for r in runs), "best": best["best"]}
+    return {
+        "call": best["call"],
+        "runs": len(runs),
+        "sse_median": float(np.median(sses)),
+        "sse_min": float(min(sses)),
+        "sse_max": float(max(sses)),
+        "time_s": {"median": float(np.median(times)), "min": float(min(times)), "max": float(max(times))},
+        "evaluations": best["evaluations"],
+        "pylinkage_sse_of_best": best["pylinkage_sse"],
+        "ok": all(r["ok"] for r in runs),
+        "best": best["best"],
+    }
 
 
 def _e(v: Any) -> str:
@@ -318,11 +354,13 @@ def _e(v: Any) -> str:
 
 def format_synthesis(r: dict[str, Any]) -> str:
     k = r["kernel_candidates_per_s"]
-    lines = [f"path synthesis, planar vs pylinkage's synthesis and optimisers, {r['repeats']} interleaved repeat(s), "
-             f"{r['cores']} cores",
-             f"  kernel: {k['median']:,.0f} candidate four-bars/s at {k['samples']} samples, float32 "
-             f"({k['min']:,.0f}-{k['max']:,.0f}); float64 {k['float64']['median']:,.0f} "
-             f"({k['float64']['min']:,.0f}-{k['float64']['max']:,.0f}); {k['threads']} threads"]
+    lines = [
+        f"path synthesis, planar vs pylinkage's synthesis and optimisers, {r['repeats']} interleaved repeat(s), "
+        f"{r['cores']} cores",
+        f"  kernel: {k['median']:,.0f} candidate four-bars/s at {k['samples']} samples, float32 "
+        f"({k['min']:,.0f}-{k['max']:,.0f}); float64 {k['float64']['median']:,.0f} "
+        f"({k['float64']['min']:,.0f}-{k['float64']['max']:,.0f}); {k['threads']} threads",
+    ]
     for c in r["cases"]:
         p, q, q2 = c["planar"], c["pylinkage"], c["pylinkage_without_grashof"]
         q4, o = c["pylinkage_four_targets"], c["pylinkage_optimisers"]
@@ -342,8 +380,10 @@ def format_synthesis(r: dict[str, Any]) -> str:
             f"time {o['time_s']['median']:.2f} s  {o['evaluations']} evaluations",
         ]
         for topo, v in c.get("planar_sixbar", {}).items():
-            lines.append(f"    planar {topo} six-bar (one run): sse {_e(v['sse'])}  time {v['time_s']:.2f} s  "
-                         f"{'ok' if v['ok'] else 'CHECK FAILED'}")
+            lines.append(
+                f"    planar {topo} six-bar (one run): sse {_e(v['sse'])}  time {v['time_s']:.2f} s  "
+                f"{'ok' if v['ok'] else 'CHECK FAILED'}"
+            )
     if any(c["published_best_error"] == "not found" for c in r["cases"]):
         lines.append("  published errors not found: --json's published_searched (and the README) say where this looked")
     return "\n".join(lines)

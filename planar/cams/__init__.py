@@ -11,5 +11,4 @@ from planar.cams.laws import LAWS, Program, Segment
 from planar.cams.mechanism import CamMechanism
 from planar.cams.profile import CamError, CamProfile, CamReport, FollowerGeometry
 
-__all__ = ["LAWS", "CamContact", "CamError", "CamMechanism", "CamProfile", "CamReport", "FollowerGeometry",
-           "Program", "Segment"]
+__all__ = ["LAWS", "CamContact", "CamError", "CamMechanism", "CamProfile", "CamReport", "FollowerGeometry", "Program", "Segment"]

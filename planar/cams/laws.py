@@ -118,21 +118,26 @@ class Program:
                 raise InputError(f"{w}.lift", sg.lift, f"a non-zero lift for a {sg.law} segment (or law = 'dwell')")
         total = sum(sg.angle for sg in self.segments)
         if abs(total - TWO_PI) > 1e-9 * TWO_PI:
-            raise InputError(f"{where}", f"angles summing to {math.degrees(total):.6g} deg",
-                             "segment angles summing to one turn (360 deg)")
+            raise InputError(
+                f"{where}", f"angles summing to {math.degrees(total):.6g} deg", "segment angles summing to one turn (360 deg)"
+            )
         self.starts = np.concatenate([[0.0], np.cumsum([sg.angle for sg in self.segments])[:-1]])
         levels = np.concatenate([[0.0], np.cumsum([sg.lift for sg in self.segments])])
         scale = max(abs(sg.lift) for sg in self.segments) if any(sg.lift for sg in self.segments) else 1.0
         if abs(levels[-1]) > 1e-9 * scale:
-            raise InputError(f"{where}", f"lifts summing to {levels[-1]:.6g}",
-                             "lifts summing to 0 (the follower returns to where it started)")
+            raise InputError(
+                f"{where}", f"lifts summing to {levels[-1]:.6g}", "lifts summing to 0 (the follower returns to where it started)"
+            )
         if not any(sg.lift for sg in self.segments):
             raise InputError(f"{where}", "only dwells", "at least one rise and one return")
         for i in range(len(self.segments)):
             if levels[i + 1] < -1e-9 * scale:
-                raise InputError(f"{where}[{i}].lift", self.segments[i].lift,
-                                 f"a lift that keeps the follower at or above its start (it would go to "
-                                 f"{levels[i + 1]:.6g}, inside the base circle)")
+                raise InputError(
+                    f"{where}[{i}].lift",
+                    self.segments[i].lift,
+                    f"a lift that keeps the follower at or above its start (it would go to "
+                    f"{levels[i + 1]:.6g}, inside the base circle)",
+                )
         self.levels = levels[:-1]
         self.max_lift = float(levels.max())
 

@@ -53,10 +53,19 @@ class CamMechanism(Mechanism):
     the linkage's, 8 % of its span).
     """
 
-    def __init__(self, name: str, profile: CamProfile, nodes: Sequence[NodeKind] = (),
-                 links: Sequence[Link] = (), points: Mapping[str, str] | None = None,
-                 rate: float = 2 * math.pi, phase: float = 0.0, max_pressure_angle: float = math.radians(30.0),
-                 unit: str = "deg", width: float | None = None) -> None:
+    def __init__(
+        self,
+        name: str,
+        profile: CamProfile,
+        nodes: Sequence[NodeKind] = (),
+        links: Sequence[Link] = (),
+        points: Mapping[str, str] | None = None,
+        rate: float = 2 * math.pi,
+        phase: float = 0.0,
+        max_pressure_angle: float = math.radians(30.0),
+        unit: str = "deg",
+        width: float | None = None,
+    ) -> None:
         self.profile = profile
         self._width = width
         self._unit = unit
@@ -98,8 +107,9 @@ class CamMechanism(Mechanism):
         contact_point, normal = tip_local, (0.0, 1.0)
         if f.kind == "knife":
             # a pointed tip: the hull circle at the tip becomes a point (a circle of 1e-4 of the base radius)
-            hull = [c for c in hull if math.dist(c[:2], tip_local) > 1e-12] + \
-                [(tip_local[0], tip_local[1], 1e-4 * profile.base_radius)]
+            hull = [c for c in hull if math.dist(c[:2], tip_local) > 1e-12] + [
+                (tip_local[0], tip_local[1], 1e-4 * profile.base_radius)
+            ]
             contact_body = "follower"
         elif f.kind == "roller":
             contact_body = "roller"
@@ -143,12 +153,14 @@ class CamMechanism(Mechanism):
         deg = self._unit == "deg"
         ang = (lambda a: f"{math.degrees(a):.3g} deg") if deg else (lambda a: f"{a:.3g} rad")
         what = "the outline's" if p.follower.kind == "flat" else "the pitch curve's convex"
-        out = [f"cam: largest pressure angle {ang(r.max_pressure_angle)} at cam angle {ang(r.pressure_angle_at)}, "
-               f"in {p.program.describe(r.pressure_segment, self._unit)}",
-               f"cam: least radius of curvature ({what}) {r.min_radius:.4g} at cam angle {ang(r.min_radius_at)}"
-               + (f" against the roller radius {p.rr:g}" if p.follower.kind == "roller" else ""),
-               f"cam: outline cut as {self._outline_points} straight segments within {r.chord_sag:.2g} of the exact "
-               "curve (model units)"]
+        out = [
+            f"cam: largest pressure angle {ang(r.max_pressure_angle)} at cam angle {ang(r.pressure_angle_at)}, "
+            f"in {p.program.describe(r.pressure_segment, self._unit)}",
+            f"cam: least radius of curvature ({what}) {r.min_radius:.4g} at cam angle {ang(r.min_radius_at)}"
+            + (f" against the roller radius {p.rr:g}" if p.follower.kind == "roller" else ""),
+            f"cam: outline cut as {self._outline_points} straight segments within {r.chord_sag:.2g} of the exact "
+            "curve (model units)",
+        ]
         return out
 
     # ------------------------------------------------------------------ building
@@ -157,27 +169,45 @@ class CamMechanism(Mechanism):
         q = self.profile.follower_output(th)[0]
         return float(q.min()), float(q.max())
 
-    def _linkage(self, name: str, nodes: Sequence[NodeKind], extra: tuple[str, ...], links: list[Link],
-                 points: Mapping[str, str] | None, q: tuple[float, float]) -> Linkage:
+    def _linkage(
+        self,
+        name: str,
+        nodes: Sequence[NodeKind],
+        extra: tuple[str, ...],
+        links: list[Link],
+        points: Mapping[str, str] | None,
+        q: tuple[float, float],
+    ) -> Linkage:
         p = self.profile
         f = p.follower
         own: list[NodeKind] = [Fixed("cam_centre", (0.0, 0.0))]
         if f.motion == "translating":
             o = p.e * p.n
             ax = (float(p.a[0]), float(p.a[1]))
-            own += [Fixed("axis0", (float(o[0]), float(o[1]))),
-                    Fixed("axis1", (float(o[0] + p.a[0]), float(o[1] + p.a[1]))),
-                    Actuator("tip", "axis0", ax, p.s0), Actuator("stem", "axis0", ax, p.s0 + (self._back or 1.0))]
+            own += [
+                Fixed("axis0", (float(o[0]), float(o[1]))),
+                Fixed("axis1", (float(o[0] + p.a[0]), float(o[1] + p.a[1]))),
+                Actuator("tip", "axis0", ax, p.s0),
+                Actuator("stem", "axis0", ax, p.s0 + (self._back or 1.0)),
+            ]
             follower = Link("follower", ("stem", "tip") + extra, guide=("axis0", "axis1"))
         else:
             own += [Fixed("pivot", (float(f.pivot[0]), float(f.pivot[1]))), Crank("tip", "pivot", float(f.arm))]
             follower = Link("follower", ("pivot", "tip") + extra)
         lo, hi = q
-        return Linkage(name, own + list(nodes), [follower] + links, points=points,
-                       amplitude=max(0.5 * (hi - lo), 1e-12), centre=0.5 * (hi + lo), width=self._width)
+        return Linkage(
+            name,
+            own + list(nodes),
+            [follower] + links,
+            points=points,
+            amplitude=max(0.5 * (hi - lo), 1e-12),
+            centre=0.5 * (hi + lo),
+            width=self._width,
+        )
 
-    def _face_hull(self, hull: list[tuple[float, float, float]], tip: tuple[float, float],
-                   w: float) -> tuple[list[tuple[float, float, float]], tuple[float, float], tuple[float, float]]:
+    def _face_hull(
+        self, hull: list[tuple[float, float, float]], tip: tuple[float, float], w: float
+    ) -> tuple[list[tuple[float, float, float]], tuple[float, float], tuple[float, float]]:
         """The follower's hull with a flat face covering the contact's travel (plus half a width each way)."""
         p = self.profile
         f = p.follower
@@ -200,9 +230,11 @@ class CamMechanism(Mechanism):
         worst = min(behind, default=0.0)
         if worst < -1e-9 * max(1.0, p.base_radius):
             need = f.face_offset - worst
-            raise CamError(f"{p.where}.follower.face_offset: the follower's pin boss ({r:.4g} in radius) reaches "
-                           f"{-worst:.4g} past the flat face toward the cam; a face_offset of at least {need:.4g} "
-                           "keeps it behind the face")
+            raise CamError(
+                f"{p.where}.follower.face_offset: the follower's pin boss ({r:.4g} in radius) reaches "
+                f"{-worst:.4g} past the flat face toward the cam; a face_offset of at least {need:.4g} "
+                "keeps it behind the face"
+            )
         return hull + add, point, normal
 
     def _check_clear(self, samples: int = 72) -> None:
@@ -213,7 +245,7 @@ class CamMechanism(Mechanism):
         fol = self.part("follower").outline
         th = np.arange(samples) * (2 * np.pi / samples)
         pose = self.solve(th).poses["follower"]
-        limit = 1e-4 * self.profile.base_radius ** 2
+        limit = 1e-4 * self.profile.base_radius**2
         for k in range(samples):
             x, y, a = pose[k]
             c, s = math.cos(a - th[k]), math.sin(a - th[k])  # the follower seen from the cam
@@ -221,9 +253,11 @@ class CamMechanism(Mechanism):
             seen = affinity.affine_transform(fol, [c, -s, s, c, cx * x - cy * y, cy * x + cx * y])
             area = float(seen.intersection(cam).area)
             if area > limit:
-                raise CamError(f"{self.profile.where}.follower: the follower's outline overlaps the cam by {area:.3g} "
-                               f"(model units^2) at cam angle {math.degrees(th[k]):.4g} deg; it touches the cam in one "
-                               "layer, so move its pivot or give a smaller link_width")
+                raise CamError(
+                    f"{self.profile.where}.follower: the follower's outline overlaps the cam by {area:.3g} "
+                    f"(model units^2) at cam angle {math.degrees(th[k]):.4g} deg; it touches the cam in one "
+                    "layer, so move its pivot or give a smaller link_width"
+                )
 
     # ------------------------------------------------------------------ solving
     def _solve_poses(self, q: Array) -> tuple[dict[str, Array], list[tuple[NDArray[np.bool_], str, str]]]:

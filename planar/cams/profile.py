@@ -127,8 +127,7 @@ class CamProfile:
     angle.
     """
 
-    def __init__(self, program: Program, base_radius: float, follower: FollowerGeometry,
-                 where: str = "mechanism") -> None:
+    def __init__(self, program: Program, base_radius: float, follower: FollowerGeometry, where: str = "mechanism") -> None:
         self.program = program
         self.follower = f = follower
         self.where = where
@@ -153,8 +152,9 @@ class CamProfile:
             self.n = _J(self.a)
             self.e = float(f.offset)
             if f.kind != "flat" and abs(self.e) >= rp:
-                raise InputError(f"{fw}.offset", f.offset,
-                                 f"an offset smaller than the prime circle's radius {rp:g} (base + roller radius)")
+                raise InputError(
+                    f"{fw}.offset", f.offset, f"an offset smaller than the prime circle's radius {rp:g} (base + roller radius)"
+                )
             self.s0 = math.sqrt(rp * rp - self.e * self.e) if f.kind != "flat" else rb
             self.sign = 1.0
             self.psi0 = 0.0
@@ -170,15 +170,21 @@ class CamProfile:
             if f.kind != "flat":
                 c = (rp * rp - D * D - f.arm**2) / (2 * f.arm * D) if D > 0 else 2.0
                 if abs(c) >= 1:
-                    raise InputError(f"{fw}.arm", f.arm, f"an arm that reaches the prime circle (radius {rp:g}) "
-                                     f"from the pivot {D:g} from the cam's centre")
+                    raise InputError(
+                        f"{fw}.arm",
+                        f.arm,
+                        f"an arm that reaches the prime circle (radius {rp:g}) from the pivot {D:g} from the cam's centre",
+                    )
                 self.psi0 = gamma - f.branch * math.acos(c)
                 self.sign = -float(np.sign(math.sin(self.psi0 - gamma)))
             else:
                 sf = float(f.branch)  # the face normal (away from the cam) is sf * J u
                 if not (rb + f.face_offset < D):
-                    raise InputError(f"{fw}.pivot", f.pivot, f"a pivot farther than base_radius + face_offset "
-                                     f"({rb + f.face_offset:g}) from the cam's centre")
+                    raise InputError(
+                        f"{fw}.pivot",
+                        f.pivot,
+                        f"a pivot farther than base_radius + face_offset ({rb + f.face_offset:g}) from the cam's centre",
+                    )
                 alpha = math.asin(-sf * (rb + f.face_offset) / D)
                 self.psi0 = gamma + math.pi - alpha
                 self.sf = sf
@@ -406,8 +412,10 @@ class CamProfile:
                 b1 = self.face(th)["b1"]
                 if np.any(b1 >= 0):
                     k = int(np.argmax(b1 >= 0))
-                    raise CamError(f"{prog.describe(i, unit)}: the oscillating face turns as fast as the cam at "
-                                   f"cam angle {fmt(th[k])}: no envelope (a smaller lift or a longer segment)")
+                    raise CamError(
+                        f"{prog.describe(i, unit)}: the oscillating face turns as fast as the cam at "
+                        f"cam angle {fmt(th[k])}: no envelope (a smaller lift or a longer segment)"
+                    )
             rho = self.radius_of_curvature(th)
             phi = self.pressure_angle(th)
             kp = int(np.argmax(phi))
@@ -426,21 +434,36 @@ class CamProfile:
             if rmin < worst_r[0]:
                 worst_r = (rmin, float(th[kr]), i)
             if f.kind == "flat" and rmin <= 0:
-                raise CamError(f"{prog.describe(i, unit)}: cusp: the flat face's outline has radius of curvature "
-                               f"{rmin:.4g} (base_radius + s + s'' must stay positive) at cam angle {fmt(th[kr])}; "
-                               "a larger base_radius or a longer segment avoids it")
+                raise CamError(
+                    f"{prog.describe(i, unit)}: cusp: the flat face's outline has radius of curvature "
+                    f"{rmin:.4g} (base_radius + s + s'' must stay positive) at cam angle {fmt(th[kr])}; "
+                    "a larger base_radius or a longer segment avoids it"
+                )
             if f.kind == "roller" and rmin <= self.rr:
-                raise CamError(f"{prog.describe(i, unit)}: undercut: the pitch curve's radius of curvature falls to "
-                               f"{rmin:.4g} at cam angle {fmt(th[kr])}, not more than the roller radius {self.rr:g} "
-                               "(a larger base_radius, a smaller roller or a longer segment avoids it)")
+                raise CamError(
+                    f"{prog.describe(i, unit)}: undercut: the pitch curve's radius of curvature falls to "
+                    f"{rmin:.4g} at cam angle {fmt(th[kr])}, not more than the roller radius {self.rr:g} "
+                    "(a larger base_radius, a smaller roller or a longer segment avoids it)"
+                )
             if phi[kp] > max_pressure_angle:
-                raise CamError(f"{prog.describe(i, unit)}: pressure angle {fmt(float(phi[kp]))} at cam angle "
-                               f"{fmt(th[kp])} exceeds max_pressure_angle {fmt(max_pressure_angle)} "
-                               "(a larger base_radius or a longer segment lowers it)")
+                raise CamError(
+                    f"{prog.describe(i, unit)}: pressure angle {fmt(float(phi[kp]))} at cam angle "
+                    f"{fmt(th[kp])} exceeds max_pressure_angle {fmt(max_pressure_angle)} "
+                    "(a larger base_radius or a longer segment lowers it)"
+                )
         poly, sag = self.outline_polygon()
         self._check_simple(poly)
-        return CamReport(worst_p[0], worst_p[1], worst_p[2], worst_r[0], worst_r[1], worst_r[2], segs,
-                         (travel[0], travel[1]) if f.kind == "flat" else (0.0, 0.0), sag)
+        return CamReport(
+            worst_p[0],
+            worst_p[1],
+            worst_p[2],
+            worst_r[0],
+            worst_r[1],
+            worst_r[2],
+            segs,
+            (travel[0], travel[1]) if f.kind == "flat" else (0.0, 0.0),
+            sag,
+        )
 
     def _check_simple(self, poly: Array) -> None:
         """The outline does not cross itself and is turned counter-clockwise (shapely)."""
@@ -448,5 +471,7 @@ class CamProfile:
 
         p = Polygon(poly)
         if not p.is_valid or p.exterior.is_ccw is False or p.area <= 0:
-            raise CamError(f"{self.where}: the cam outline crosses itself (the follower cannot stay on it); "
-                           "a larger base_radius or gentler segments avoid it")
+            raise CamError(
+                f"{self.where}: the cam outline crosses itself (the follower cannot stay on it); "
+                "a larger base_radius or gentler segments avoid it"
+            )

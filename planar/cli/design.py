@@ -49,8 +49,9 @@ def _cmd_design(args: argparse.Namespace) -> int:
     from planar.scene.load import _NAME
 
     if not isinstance(name, str) or not re.match(_NAME, name) or len(name) > 80:
-        raise InputError(f"{args.request}: name", name, "a string of at most 80 characters without commas, double "
-                         "quotes or control characters")
+        raise InputError(
+            f"{args.request}: name", name, "a string of at most 80 characters without commas, double quotes or control characters"
+        )
     d = design_toy(effectors, name=name, max_length=args.max_length, source=str(args.request))
     scene = design_scene(d.toy, name)
     scene.save(args.output)
@@ -84,8 +85,9 @@ def summary_lines(d: Any, rep: dict[str, Any], phys: dict[str, Any], name: str, 
     out: list[str] = []
     trees = "; ".join(f"{cam}: " + ", ".join(" ".join(c) for c in chains) for cam, chains in rep["cams"].items())
     lead = f"; right cam {math.degrees(d.toy.phase):.0f} deg ahead" if len(d.toy.cams) == 2 else ""
-    out.append(f"{name}: cost {d.cost:g} ({d.toy.mechanism_count} mechanisms), {trees}{lead}; "
-               f"{d.tried} of {d.candidates} trees sized")
+    out.append(
+        f"{name}: cost {d.cost:g} ({d.toy.mechanism_count} mechanisms), {trees}{lead}; {d.tried} of {d.candidates} trees sized"
+    )
     for k, r in enumerate(d.rejected):
         if k == 0 and d.fallback:
             out.append(f"  written although it failed a check (no tree tried passed; the cheapest): {r}")
@@ -96,9 +98,11 @@ def summary_lines(d: Any, rep: dict[str, Any], phys: dict[str, Any], name: str, 
     for e in rep["effectors"]:
         unit = "deg" if e["motion"][0] == "O" else "units"
         flag = "[ok]" if e["error"] <= TOLERANCE else "[FAIL]"
-        out.append(f"  {e['name']} ({e['motion']}, {e['cam']} cam): requested {e['requested']:g} {unit}, "
-                   f"measured {e['achieved']:.6g} {unit} ({100 * e['error']:.2g} %) {flag}; "
-                   f"{e['sized']['stage']}: {e['sized']['parameter']} = {e['sized']['value']:.6g}")
+        out.append(
+            f"  {e['name']} ({e['motion']}, {e['cam']} cam): requested {e['requested']:g} {unit}, "
+            f"measured {e['achieved']:.6g} {unit} ({100 * e['error']:.2g} %) {flag}; "
+            f"{e['sized']['stage']}: {e['sized']['parameter']} = {e['sized']['value']:.6g}"
+        )
     n_layers = len(set(d.layers.values()))
     pl = d.placement
     b = d.before
@@ -106,45 +110,64 @@ def summary_lines(d: Any, rep: dict[str, Any], phys: dict[str, Any], name: str, 
         if b["export_refused"]:
             out.append(f"  before placement: {d.before_reason}")
         else:
-            out.append(f"  before placement: {b['layers']} layers, {b['collisions']} same-layer collisions, "
-                       f"{b['pin_clashes']} pins through pieces")
+            out.append(
+                f"  before placement: {b['layers']} layers, {b['collisions']} same-layer collisions, "
+                f"{b['pin_clashes']} pins through pieces"
+            )
         if pl.kept:
-            out.append(f"  placement ({', '.join(pl.variables)}; {pl.evaluations} layouts annealed, "
-                       f"{pl.checked} checked against the export): footprint {pl.footprint[0]:.3g} -> "
-                       f"{pl.footprint[1]:.3g} units^2, overlap of unjoined pieces {pl.overlap[0]:.3g} -> "
-                       f"{pl.overlap[1]:.3g}")
+            out.append(
+                f"  placement ({', '.join(pl.variables)}; {pl.evaluations} layouts annealed, "
+                f"{pl.checked} checked against the export): footprint {pl.footprint[0]:.3g} -> "
+                f"{pl.footprint[1]:.3g} units^2, overlap of unjoined pieces {pl.overlap[0]:.3g} -> "
+                f"{pl.overlap[1]:.3g}"
+            )
         elif pl.checked:
-            out.append(f"  placement ({', '.join(pl.variables)}; {pl.evaluations} layouts annealed): none of the "
-                       f"{pl.checked} best kept (each added a collision, pin clash or layer); the start kept")
+            out.append(
+                f"  placement ({', '.join(pl.variables)}; {pl.evaluations} layouts annealed): none of the "
+                f"{pl.checked} best kept (each added a collision, pin clash or layer); the start kept"
+            )
         else:
-            out.append(f"  placement ({', '.join(pl.variables)}; {pl.evaluations} layouts annealed): no layout "
-                       "improved on the start; the start kept")
+            out.append(
+                f"  placement ({', '.join(pl.variables)}; {pl.evaluations} layouts annealed): no layout "
+                "improved on the start; the start kept"
+            )
     else:
         out.append("  placement: no stage of this tree can move without changing a motion")
     if d.export_refused:
         why = d.export_refused.removeprefix("the export refuses it: ")
         out.append(f"  export: it refuses the pieces [FAIL]: {why} (no layer plan, so no collision or pin check)")
     else:
-        out.append(f"  {len(d.layers)} pieces in {n_layers} layers (the export's plan); same-layer collisions over "
-                   f"24 poses: {len(d.collisions)}, pins through pieces: {len(d.clashes)} "
-                   + ("[ok]" if not (d.collisions or d.clashes) else "[FAIL] " + ", ".join(
-                  [f"{a}/{b} {ov:.3g} mm^2" for a, b, ov in d.collisions] + d.clashes)))
+        out.append(
+            f"  {len(d.layers)} pieces in {n_layers} layers (the export's plan); same-layer collisions over "
+            f"24 poses: {len(d.collisions)}, pins through pieces: {len(d.clashes)} "
+            + (
+                "[ok]"
+                if not (d.collisions or d.clashes)
+                else "[FAIL] " + ", ".join([f"{a}/{b} {ov:.3g} mm^2" for a, b, ov in d.collisions] + d.clashes)
+            )
+        )
     tq = phys["torque_rel_diff"]
     if tq is None:
         out.append("  physics (as planar toy): not run [FAIL]")
     else:
         tq_ok = tq <= TORQUE_TOLERANCE  # a failure of another kind is its own [FAIL] line below
-        out.append(f"  physics (as planar toy): motor torque vs inverse dynamics {tq:.2g} of the peak "
-                   f"(limit {TORQUE_TOLERANCE:g}) " + ("[ok]" if tq_ok else "[FAIL]"))
+        out.append(
+            f"  physics (as planar toy): motor torque vs inverse dynamics {tq:.2g} of the peak "
+            f"(limit {TORQUE_TOLERANCE:g}) " + ("[ok]" if tq_ok else "[FAIL]")
+        )
     for why in failures:
         out.append(f"    [FAIL] {why}")
     if d.gravity_x:
-        out.append(f"  gravity along +x in the written toy (it holds the tab of #8 stage {', '.join(d.gravity_x)} on "
-                   "its face): stand the real toy with the drawing's +x axis pointing down")
+        out.append(
+            f"  gravity along +x in the written toy (it holds the tab of #8 stage {', '.join(d.gravity_x)} on "
+            "its face): stand the real toy with the drawing's +x axis pointing down"
+        )
     if d.gravity_y:
-        out.append(f"  gravity along -y in the written toy (it holds the pin of #6/#9 stage {', '.join(d.gravity_y)} on "
-                   "its driver's edge): tilt the real toy so that the drawing's -y axis points down"
-                   + (" as well (+x and -y at 45 degrees)" if d.gravity_x else ""))
+        out.append(
+            f"  gravity along -y in the written toy (it holds the pin of #6/#9 stage {', '.join(d.gravity_y)} on "
+            "its driver's edge): tilt the real toy so that the drawing's -y axis points down"
+            + (" as well (+x and -y at 45 degrees)" if d.gravity_x else "")
+        )
     for m in rep.get("small_motions", []):
         out.append(f"  [FAIL] {m['text']}")
     out.append(f"  wrote {output} ({sum(d.seconds.values()):.2f} s)")
@@ -153,16 +176,19 @@ def summary_lines(d: Any, rep: dict[str, Any], phys: dict[str, Any], name: str, 
 
 def add_parser(sub: Any) -> None:
     """Register ``planar design``."""
-    d = sub.add_parser("design", help="a wind-up toy from requested end-effector motions (writes a toy scene)",
-                       description="Design a wind-up toy from a request file of [[effector]] tables (name, motion "
-                                   "Ox Oy Oz Tx Ty Tz OzT, range in degrees for O/OzT or model units for T, "
-                                   "optional cam left/right and phase in cycles, 0 <= phase < 1: a quarter turn is "
-                                   "0.25). Exit status 2 for bad input or a range no buildable chain reaches "
-                                   "(one line naming the file, effector and value; nothing written); 3 when the toy "
-                                   "written fails a check (a range off by more than 1 %, a same-layer collision, a "
-                                   "pin through a piece, the export refusing it, its physics: motor torque, a #8 "
-                                   "tab letting go, a stage not simulated; or a cam throw or effector stroke under "
-                                   "3 times the fit's play, which the cut parts will not make), each failure named.")
+    d = sub.add_parser(
+        "design",
+        help="a wind-up toy from requested end-effector motions (writes a toy scene)",
+        description="Design a wind-up toy from a request file of [[effector]] tables (name, motion "
+        "Ox Oy Oz Tx Ty Tz OzT, range in degrees for O/OzT or model units for T, "
+        "optional cam left/right and phase in cycles, 0 <= phase < 1: a quarter turn is "
+        "0.25). Exit status 2 for bad input or a range no buildable chain reaches "
+        "(one line naming the file, effector and value; nothing written); 3 when the toy "
+        "written fails a check (a range off by more than 1 %, a same-layer collision, a "
+        "pin through a piece, the export refusing it, its physics: motor torque, a #8 "
+        "tab letting go, a stage not simulated; or a cam throw or effector stroke under "
+        "3 times the fit's play, which the cut parts will not make), each failure named.",
+    )
     d.add_argument("request", help="request file (TOML, [[effector]] tables)")
     d.add_argument("-o", "--output", required=True, help="toy scene file to write (TOML)")
     d.add_argument("--json", action="store_true", help="print a JSON report")

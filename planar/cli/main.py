@@ -76,8 +76,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     kwargs = {}
     if args.n is not None:
         if args.name == "accuracy":
-            raise InputError("-n", args.n,
-                             "no problem size for the accuracy benchmark (it runs the scenes of --scenes)")
+            raise InputError("-n", args.n, "no problem size for the accuracy benchmark (it runs the scenes of --scenes)")
         kwargs["n"] = args.n
     if args.repeats is not None:
         kwargs["repeats"] = args.repeats
@@ -122,8 +121,10 @@ def _cmd_chains(args: argparse.Namespace) -> int:
         for c in cs:
             path = " -> ".join([c[0].split("->")[0]] + [p.split("->")[1] for p in c])
             # the second column pastes into a scene; the third says whether render, export and toy can build it
-            print(f"   {path:<28} chain = {json.dumps(list(c)):<40} "
-                  + ("assembles" if why[c] is None else f"motion only: {why[c]}"))
+            print(
+                f"   {path:<28} chain = {json.dumps(list(c)):<40} "
+                + ("assembles" if why[c] is None else f"motion only: {why[c]}")
+            )
     return 0
 
 
@@ -211,8 +212,13 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     if args.error_bias is not None and not (0 <= args.error_bias <= 1):
         raise InputError("--error-bias", args.error_bias, "a number between 0 and 1")
     scene = load_scene(args.scene)
-    settings = SimSettings(**{k: v for k, v in (("substeps", args.substeps), ("iterations", args.iterations),
-                                                 ("error_bias", args.error_bias)) if v is not None})
+    settings = SimSettings(
+        **{
+            k: v
+            for k, v in (("substeps", args.substeps), ("iterations", args.iterations), ("error_bias", args.error_bias))
+            if v is not None
+        }
+    )
     if args.step_drift is not None:  # 0: fixed substeps
         settings = replace(settings, step_drift=args.step_drift or None)
     result, sim = compare_scene(scene, settings, args.threshold, args.torque_threshold, with_series=args.json)
@@ -220,17 +226,22 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     assert t is not None  # a simulation records its output times
     if args.json:
         d = result.to_dict()
-        d["settings"] = {"substeps": sim.built.get("substeps"), "iterations": sim.built.get("iterations"),
-                         "step_drift": settings.step_drift,
-                         "correction": sim.built.get("correction"),
-                         "error_bias": settings.error_bias}
+        d["settings"] = {
+            "substeps": sim.built.get("substeps"),
+            "iterations": sim.built.get("iterations"),
+            "step_drift": settings.step_drift,
+            "correction": sim.built.get("correction"),
+            "error_bias": settings.error_bias,
+        }
         d["wall_time_s"] = sim.wall_time
         d["built"] = {k: v for k, v in sim.built.items()}
         print(json.dumps(d, indent=2, default=str))
     else:
         print(format_comparison(result))
-        print(f"  simulated in {sim.wall_time:.3f} s ({sim.steps} steps; substeps {sim.built.get('substeps')}, "
-              f"iterations {sim.built.get('iterations')}, correction per step {sim.built.get('correction'):.3g})")
+        print(
+            f"  simulated in {sim.wall_time:.3f} s ({sim.steps} steps; substeps {sim.built.get('substeps')}, "
+            f"iterations {sim.built.get('iterations')}, correction per step {sim.built.get('correction'):.3g})"
+        )
     return 0 if result.passed else EXIT_MISMATCH
 
 
@@ -245,9 +256,14 @@ def _sheet(text: str) -> tuple[float, float]:
 
 
 #: export's outputs: (option, attribute, suffixes)
-_EXPORT_OUTPUTS = (("-o", "output", (".dxf",)), ("--svg", "svg", (".svg",)), ("--preview", "preview", (".png",)),
-                   ("--bom", "bom", (".csv",)), ("--assembly", "assembly", (".svg",)),
-                   ("--kerf-test", "kerf_test", (".dxf", ".svg")))
+_EXPORT_OUTPUTS = (
+    ("-o", "output", (".dxf",)),
+    ("--svg", "svg", (".svg",)),
+    ("--preview", "preview", (".png",)),
+    ("--bom", "bom", (".csv",)),
+    ("--assembly", "assembly", (".svg",)),
+    ("--kerf-test", "kerf_test", (".dxf", ".svg")),
+)
 
 
 def _cmd_export(args: argparse.Namespace) -> int:
@@ -256,15 +272,17 @@ def _cmd_export(args: argparse.Namespace) -> int:
     from planar.scene.load import load_scene
 
     if all(getattr(args, attr) is None for _, attr, _ in _EXPORT_OUTPUTS):
-        raise InputError("export", args.scene, "an output: -o parts.dxf, --svg, --preview, --bom, --assembly "
-                                               "or --kerf-test (nothing would be written)")
+        raise InputError(
+            "export",
+            args.scene,
+            "an output: -o parts.dxf, --svg, --preview, --bom, --assembly or --kerf-test (nothing would be written)",
+        )
     _outputs(args, (args.scene,), *_EXPORT_OUTPUTS)
     if args.kerf is not None and not (0 <= args.kerf <= 2):
         raise InputError("--kerf", args.kerf, "a kerf between 0 and 2 mm")
     scene = load_scene(args.scene)
     sheet = _sheet(args.sheet) if args.sheet else None
-    fab = export_scene(scene, args.output, args.svg, args.kerf, sheet, args.preview, args.bom, args.assembly,
-                       args.kerf_test)
+    fab = export_scene(scene, args.output, args.svg, args.kerf, sheet, args.preview, args.bom, args.assembly, args.kerf_test)
     for note in fab.notes:
         print(f"note: {note}")
     for w in fab.warnings:  # a toy's motion the cut parts will not make (the design exits 3 for it; cut anyway)
@@ -276,12 +294,15 @@ def _cmd_export(args: argparse.Namespace) -> int:
 def build_parser() -> argparse.ArgumentParser:
     from planar.bench.suite import BENCHMARKS
 
-    p = _Parser(prog="planar", description="2D rigid-body mechanisms: exact kinematics and more.",
-                epilog="Exit status: 0 success, 2 a user error (one line naming the file, field or option), "
-                       "3 a result that failed its own check (compare, toy, design, synth; each failure named, "
-                       "design and synth still write their result), 1 an internal error (run with --debug for the traceback). "
-                       "Limits on work (PLANAR_MAX_SAMPLES, PLANAR_MAX_FRAMES, PLANAR_MAX_CHAIN, "
-                       "PLANAR_MAX_MEMORY): see the README.")
+    p = _Parser(
+        prog="planar",
+        description="2D rigid-body mechanisms: exact kinematics and more.",
+        epilog="Exit status: 0 success, 2 a user error (one line naming the file, field or option), "
+        "3 a result that failed its own check (compare, toy, design, synth; each failure named, "
+        "design and synth still write their result), 1 an internal error (run with --debug for the traceback). "
+        "Limits on work (PLANAR_MAX_SAMPLES, PLANAR_MAX_FRAMES, PLANAR_MAX_CHAIN, "
+        "PLANAR_MAX_MEMORY): see the README.",
+    )
     p.add_argument("--debug", action="store_true", help="show the Python traceback of an error")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
@@ -293,13 +314,19 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("name", choices=sorted(BENCHMARKS))
     b.add_argument("--json", action="store_true", help="print a JSON object (with a 'ratio' key)")
     b.add_argument("-n", type=int, default=None, help="problem size (samples)")
-    b.add_argument("--repeats", type=int, default=None,
-                   help="timing repeats (kinematics: 7 by default, interleaved with the peer; median and spread reported)")
+    b.add_argument(
+        "--repeats",
+        type=int,
+        default=None,
+        help="timing repeats (kinematics: 7 by default, interleaved with the peer; median and spread reported)",
+    )
     b.add_argument("-o", "--output", default="planar-bench-accuracy", help="accuracy: folder for the CSV and chart")
-    b.add_argument("--quick", action="store_true",
-                   help="accuracy: a small grid on three mechanisms; synthesis: one repeat, small budgets")
-    b.add_argument("--scenes", default="gallery",
-                   help="accuracy: folder of scene files to measure (default: ./gallery, the repository's)")
+    b.add_argument(
+        "--quick", action="store_true", help="accuracy: a small grid on three mechanisms; synthesis: one repeat, small budgets"
+    )
+    b.add_argument(
+        "--scenes", default="gallery", help="accuracy: folder of scene files to measure (default: ./gallery, the repository's)"
+    )
     b.set_defaults(func=_cmd_bench)
 
     ch = sub.add_parser("chains", help="motion transfer chains from the motor (Rz) to an end effector")
@@ -311,19 +338,30 @@ def build_parser() -> argparse.ArgumentParser:
 
     r = sub.add_parser("render", help="render a scene's animation to a GIF (or MP4/WebM)")
     r.add_argument("scene", help="scene file (TOML)")
-    r.add_argument("-o", "--output", required=True,
-                   help="animation to write: .gif, or .mp4/.webm with the video extra (pip install 'planar[video]')")
-    r.add_argument("--fps", type=float, default=None,
-                   help="frames per second (default: the scene's [render] fps, else 25, or 50 for fast cycles; "
-                        "a GIF plays at most 50); a cycle plays for 1/speed seconds within one frame")
+    r.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        help="animation to write: .gif, or .mp4/.webm with the video extra (pip install 'planar[video]')",
+    )
+    r.add_argument(
+        "--fps",
+        type=float,
+        default=None,
+        help="frames per second (default: the scene's [render] fps, else 25, or 50 for fast cycles; "
+        "a GIF plays at most 50); a cycle plays for 1/speed seconds within one frame",
+    )
     r.add_argument("--overlay", action="store_true", help="draw the pymunk simulation over the analytic motion")
     r.set_defaults(func=_cmd_render)
 
     mo = sub.add_parser("motion", help="write a scene's motion table (CSV)")
     mo.add_argument("scene", help="scene file (TOML)")
     mo.add_argument("-o", "--output", required=True, help="CSV file to write")
-    mo.add_argument("--derivatives", action="store_true",
-                    help="add <point>.vx/.vy/.ax/.ay, <part>.omega/.alpha, transmission angles and motor torque")
+    mo.add_argument(
+        "--derivatives",
+        action="store_true",
+        help="add <point>.vx/.vy/.ax/.ay, <part>.omega/.alpha, transmission angles and motor torque",
+    )
     mo.set_defaults(func=_cmd_motion)
 
     g = sub.add_parser("gallery", help="render every scene of a folder to a GIF")
@@ -338,17 +376,31 @@ def build_parser() -> argparse.ArgumentParser:
     cp = sub.add_parser("compare", help="simulate a scene in pymunk and compare with the analytic motion")
     cp.add_argument("scene", help="scene file (TOML)")
     cp.add_argument("--json", action="store_true", help="print JSON (each part carries max_rel_error)")
-    cp.add_argument("--threshold", type=float, default=1e-3,
-                    help="error threshold, fraction of size (1e-3); exit status 3 when a check fails")
-    cp.add_argument("--torque-threshold", type=float, default=0.01,
-                    help="motor torque vs inverse dynamics, fraction of its peak (0.01)")
-    cp.add_argument("--substeps", type=int, default=None,
-                    help="physics steps per sample, at least (28); raised where joints turn fast, see --step-drift")
-    cp.add_argument("--step-drift", type=float, default=None,
-                    help="largest predicted joint drift per step, fraction of size (3.5e-6); 0 keeps --substeps fixed")
+    cp.add_argument(
+        "--threshold", type=float, default=1e-3, help="error threshold, fraction of size (1e-3); exit status 3 when a check fails"
+    )
+    cp.add_argument(
+        "--torque-threshold", type=float, default=0.01, help="motor torque vs inverse dynamics, fraction of its peak (0.01)"
+    )
+    cp.add_argument(
+        "--substeps",
+        type=int,
+        default=None,
+        help="physics steps per sample, at least (28); raised where joints turn fast, see --step-drift",
+    )
+    cp.add_argument(
+        "--step-drift",
+        type=float,
+        default=None,
+        help="largest predicted joint drift per step, fraction of size (3.5e-6); 0 keeps --substeps fixed",
+    )
     cp.add_argument("--iterations", type=int, default=None, help="solver iterations per step, at least (40)")
-    cp.add_argument("--error-bias", type=float, default=None,
-                    help="joint error left after one second (replaces the correction of 0.2 per step)")
+    cp.add_argument(
+        "--error-bias",
+        type=float,
+        default=None,
+        help="joint error left after one second (replaces the correction of 0.2 per step)",
+    )
     cp.set_defaults(func=_cmd_compare)
 
     ex = sub.add_parser("export", help="every part laid flat for a laser cutter (DXF, SVG)")
@@ -444,14 +496,20 @@ def _main(argv: Sequence[str] | None) -> int:
     except MemoryError:
         if args.debug:
             raise
-        print("planar: error: out of memory; ask for fewer samples or frames (or lower PLANAR_MAX_MEMORY "
-              "so this is refused before it starts)", file=sys.stderr)
+        print(
+            "planar: error: out of memory; ask for fewer samples or frames (or lower PLANAR_MAX_MEMORY "
+            "so this is refused before it starts)",
+            file=sys.stderr,
+        )
         return 2
     except Exception as e:  # the guard: a bug in planar, still one line
         if args.debug:
             raise
-        print(f"planar: internal error: {type(e).__name__}: {_one_line(e)[:300]} "
-              f"(a bug in planar; run again with --debug for the traceback)", file=sys.stderr)
+        print(
+            f"planar: internal error: {type(e).__name__}: {_one_line(e)[:300]} "
+            f"(a bug in planar; run again with --debug for the traceback)",
+            file=sys.stderr,
+        )
         return 1
 
 

@@ -24,20 +24,30 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 
 def add_parser(sub: Any) -> None:
     """Register ``planar plot`` on the subcommand parsers ``sub``."""
-    p = sub.add_parser("plot", help="charts of a scene: point paths, transmission angle, speeds, torque",
-                       description="Draw the charts a designer looks at (matplotlib) from the scene's exact "
-                                   "motion and rates: curve (paths of the named points), follower and "
-                                   "pressure (a cam's follower motion and pressure angle), transmission "
-                                   "(angle at each RRR dyad, linkages only), velocity and acceleration "
-                                   "(angular, every moving part), torque (motor torque under [effects], "
-                                   "and the loads alone). Horizontal axis: crank (cam) angle for a turning "
-                                   "input, else time.")
+    p = sub.add_parser(
+        "plot",
+        help="charts of a scene: point paths, transmission angle, speeds, torque",
+        description="Draw the charts a designer looks at (matplotlib) from the scene's exact "
+        "motion and rates: curve (paths of the named points), follower and "
+        "pressure (a cam's follower motion and pressure angle), transmission "
+        "(angle at each RRR dyad, linkages only), velocity and acceleration "
+        "(angular, every moving part), torque (motor torque under [effects], "
+        "and the loads alone). Horizontal axis: crank (cam) angle for a turning "
+        "input, else time.",
+    )
     p.add_argument("scene", help="scene file (TOML)")
     p.add_argument("-o", "--output", required=True, help="figure to write: .png or .svg")
-    p.add_argument("--what", default=None,
-                   help="comma-separated charts: curve,follower,pressure,transmission,velocity,speed,"
-                        "acceleration,torque "
-                        "(default: every chart that applies)")
-    p.add_argument("--samples", type=int, default=None,
-                   help="samples per cycle for the charts (default: the scene's [driver] samples_per_cycle)")
+    p.add_argument(
+        "--what",
+        default=None,
+        help="comma-separated charts: curve,follower,pressure,transmission,velocity,speed,"
+        "acceleration,torque "
+        "(default: every chart that applies)",
+    )
+    p.add_argument(
+        "--samples",
+        type=int,
+        default=None,
+        help="samples per cycle for the charts (default: the scene's [driver] samples_per_cycle)",
+    )
     p.set_defaults(func=_cmd_plot)

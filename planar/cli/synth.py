@@ -52,8 +52,7 @@ def _check_output(args: argparse.Namespace, source: str) -> None:
     check_output("-o", args.output, (".toml",), (source,))
 
 
-def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, Any], ok: bool,
-            failing: list[str]) -> int:
+def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, Any], ok: bool, failing: list[str]) -> int:
     from planar.synth.scene_out import write_scene
 
     scene = write_scene(args.output, text)
@@ -83,9 +82,11 @@ def _path_failing(d: Any) -> list[str]:
         if k == "ok_constraints":
             out += d.checks["constraint_failures"]
         elif k == "ok_accuracy":
-            out.append(f"RMS distance to the targets {d.checks['rms_error']:.3g} of their size (RMS distance from "
-                       f"their centroid, {d.checks['size']:.6g}), over --tolerance {d.checks['tolerance']:g} "
-                       f"(sse {d.sse:.6g})")
+            out.append(
+                f"RMS distance to the targets {d.checks['rms_error']:.3g} of their size (RMS distance from "
+                f"their centroid, {d.checks['size']:.6g}), over --tolerance {d.checks['tolerance']:g} "
+                f"(sse {d.sse:.6g})"
+            )
         elif k == "ok_valid_over_turn" and d.checks.get("failures"):
             out += d.checks["failures"]
         else:
@@ -100,7 +101,8 @@ def _unusable(d: Any, kind: str, region: bool) -> str | None:
         return f"{what} reaches the targets; the best found: " + "; ".join(d.checks["constraint_failures"])
     if not math.isfinite(d.sse):
         return f"no {kind} found that can be assembled at every target's crank angle" + (
-            f" ({d.checks['error']})" if d.checks.get("error") else "")
+            f" ({d.checks['error']})" if d.checks.get("error") else ""
+        )
     return None
 
 
@@ -121,8 +123,11 @@ def _cmd_path(args: argparse.Namespace) -> int:
         raise InputError("--topology", args.topology, "--topology only with --type sixbar")
     targets, theta = read_path_targets(args.target, args.points)
     if len(targets) > MAX_TARGETS:
-        raise InputError(args.target, f"{len(targets)} targets", f"at most {MAX_TARGETS} targets (a path is "
-                         "matched at each; thin the file or use --points for an SVG)")
+        raise InputError(
+            args.target,
+            f"{len(targets)} targets",
+            f"at most {MAX_TARGETS} targets (a path is matched at each; thin the file or use --points for an SVG)",
+        )
     normalisation(targets, str(args.target))
     if theta is not None:
         if args.deg:
@@ -139,19 +144,35 @@ def _cmd_path(args: argparse.Namespace) -> int:
     fb = d.fourbar()
     amp, centre = _rocking(fb, d.theta)
     text = fourbar_scene_text(
-        "synth-path", d.ground, d.crank, d.coupler, d.rocker, d.coupler_point, d.circuit, d.placement,
-        comments=[f"planar synth path {args.target}: {len(targets)} targets, "
-                  f"{'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
-                  "crank angle at each target (rad): " + ", ".join(f"{t:.6g}" for t in d.theta)],
-        amplitude=amp, centre=centre)
+        "synth-path",
+        d.ground,
+        d.crank,
+        d.coupler,
+        d.rocker,
+        d.coupler_point,
+        d.circuit,
+        d.placement,
+        comments=[
+            f"planar synth path {args.target}: {len(targets)} targets, {'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
+            "crank angle at each target (rad): " + ", ".join(f"{t:.6g}" for t in d.theta),
+        ],
+        amplitude=amp,
+        centre=centre,
+    )
     report = {"command": "synth path", "targets": len(targets), **d.to_dict()}
-    return _finish_path(args, f"four-bar ({fb.grashof}, {d.circuit}), sse {d.sse:.3g} (RMS distance "
-                        f"{d.checks['rms_error']:.3g} of the targets' size) over {len(targets)} targets "
-                        f"in {d.seconds:.2f} s", text, report, d.ok, failing)
+    return _finish_path(
+        args,
+        f"four-bar ({fb.grashof}, {d.circuit}), sse {d.sse:.3g} (RMS distance "
+        f"{d.checks['rms_error']:.3g} of the targets' size) over {len(targets)} targets "
+        f"in {d.seconds:.2f} s",
+        text,
+        report,
+        d.ok,
+        failing,
+    )
 
 
-def _finish_path(args: argparse.Namespace, what: str, text: str, report: dict[str, Any], ok: bool,
-                 failing: list[str]) -> int:
+def _finish_path(args: argparse.Namespace, what: str, text: str, report: dict[str, Any], ok: bool, failing: list[str]) -> int:
     """:func:`_finish`, except that a scene planar cannot build is no design (nothing written, exit 3)."""
     from planar.errors import PlanarError
     from planar.scene.load import build_scene, parse_scene
@@ -162,8 +183,9 @@ def _finish_path(args: argparse.Namespace, what: str, text: str, report: dict[st
         build_scene(parse_scene(tomllib.loads(text), str(args.output)), str(args.output))
     except PlanarError as e:
         msg = str(e).replace(f"{args.output}: ", "", 1)
-        return _no_design(args, "synth path", {"targets": report["targets"]},
-                              f"the design found does not assemble as a scene ({msg})")
+        return _no_design(
+            args, "synth path", {"targets": report["targets"]}, f"the design found does not assemble as a scene ({msg})"
+        )
     return _finish(args, what, text, report, ok, failing)
 
 
@@ -172,22 +194,32 @@ def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | N
     from planar.synth.sixbar import synthesise_sixbar
 
     topology = args.topology or "stephenson"
-    d = synthesise_sixbar(targets, theta, topology, cons, budget=args.budget, seed=args.seed,
-                          tolerance=args.tolerance)
+    d = synthesise_sixbar(targets, theta, topology, cons, budget=args.budget, seed=args.seed, tolerance=args.tolerance)
     why = _unusable(d, f"{topology} six-bar", cons.region is not None)
     if why is not None:
         return _no_design(args, "synth path", {"targets": len(targets)}, why)
     failing = _path_failing(d)
     text = linkage_scene_text(
-        f"synth-sixbar-{d.topology}", d.nodes(), d.links(), {"tracer": "T"},
-        comments=[f"planar synth path {args.target} --type sixbar --topology {d.topology}: {len(targets)} targets, "
-                  f"{'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
-                  "crank angle at each target (rad, from the ground line O2-O4): "
-                  + ", ".join(f"{t:.6g}" for t in d.theta)])
+        f"synth-sixbar-{d.topology}",
+        d.nodes(),
+        d.links(),
+        {"tracer": "T"},
+        comments=[
+            f"planar synth path {args.target} --type sixbar --topology {d.topology}: {len(targets)} targets, "
+            f"{'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
+            "crank angle at each target (rad, from the ground line O2-O4): " + ", ".join(f"{t:.6g}" for t in d.theta),
+        ],
+    )
     report = {"command": "synth path", "targets": len(targets), **d.to_dict()}
-    return _finish_path(args, f"{d.topology} six-bar, sse {d.sse:.3g} (RMS distance {d.checks['rms_error']:.3g} of "
-                        f"the targets' size) over {len(targets)} targets in {d.seconds:.2f} s",
-                        text, report, d.ok, failing)
+    return _finish_path(
+        args,
+        f"{d.topology} six-bar, sse {d.sse:.3g} (RMS distance {d.checks['rms_error']:.3g} of "
+        f"the targets' size) over {len(targets)} targets in {d.seconds:.2f} s",
+        text,
+        report,
+        d.ok,
+        failing,
+    )
 
 
 def _plus(v: float) -> str:
@@ -203,9 +235,11 @@ def _free_hint(phi: np.ndarray, psi: np.ndarray, args: argparse.Namespace, cons:
     d, _ = synthesise_function(phi, psi, args.ground, dataclasses.replace(cons, free_offsets=True), args.tolerance)
     if d is None or not d.ok:
         return ""
-    return (f"with --free-offsets (only the pairs' differences kept) a valid four-bar has error {d.max_error:.3g} rad, "
-            f"input zero at {math.degrees(d.input_offset):.6g} deg, output zero at "
-            f"{math.degrees(d.output_offset):.6g} deg from the ground line")
+    return (
+        f"with --free-offsets (only the pairs' differences kept) a valid four-bar has error {d.max_error:.3g} rad, "
+        f"input zero at {math.degrees(d.input_offset):.6g} deg, output zero at "
+        f"{math.degrees(d.output_offset):.6g} deg from the ground line"
+    )
 
 
 def _cmd_function(args: argparse.Namespace) -> int:
@@ -235,43 +269,76 @@ def _cmd_function(args: argparse.Namespace) -> int:
 
     for name, span in zip(("input", "output"), spans(phi, psi)):
         if span > 2 * math.pi:
-            raise InputError(f"{args.pairs}: {name}", f"a span of {span:.6g} rad",
-                             "a span of at most 2 pi rad (one turn" + ("" if args.deg else "; --deg for degrees") + ")")
-    cons = FunctionConstraints(free_offsets=args.free_offsets, full_turn=args.full_turn, max_ratio=args.max_ratio,
-                               min_transmission=math.radians(args.min_transmission))
+            raise InputError(
+                f"{args.pairs}: {name}",
+                f"a span of {span:.6g} rad",
+                "a span of at most 2 pi rad (one turn" + ("" if args.deg else "; --deg for degrees") + ")",
+            )
+    cons = FunctionConstraints(
+        free_offsets=args.free_offsets,
+        full_turn=args.full_turn,
+        max_ratio=args.max_ratio,
+        min_transmission=math.radians(args.min_transmission),
+    )
     d, why = synthesise_function(phi, psi, args.ground, cons, args.tolerance)
     hint = "" if (d is not None and d.ok) or args.free_offsets else _free_hint(phi, psi, args, cons)
-    if d is None:                                       # nothing valid to write
+    if d is None:  # nothing valid to write
         return _no_design(args, "synth function", {"pairs": len(phi)}, why, hint)
-    th = d.phi + d.input_offset                         # crank angles from the ground line
-    amp, centre = (None, 0.0) if d.checks["crank_turns_fully"] else (
-        max(0.5 * float(np.ptp(th)), 1e-6), 0.5 * float(th.max() + th.min()))
+    th = d.phi + d.input_offset  # crank angles from the ground line
+    amp, centre = (
+        (None, 0.0) if d.checks["crank_turns_fully"] else (max(0.5 * float(np.ptp(th)), 1e-6), 0.5 * float(th.max() + th.min()))
+    )
     failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]
     if not d.checks["ok_output_error"]:
         failing[failing.index("output error")] = (
             f"output angle error {d.max_error:.3g} rad (limit {args.tolerance:g}) on the best valid four-bar"
-            + (f"; {d.note}" if d.note else "") + (f"; {hint}" if hint else ""))
-    offs = (f"crank angle from the ground line = input {_plus(d.input_offset)} rad, "
-            f"rocker angle = output {_plus(d.output_offset)} rad")
+            + (f"; {d.note}" if d.note else "")
+            + (f"; {hint}" if hint else "")
+        )
+    offs = (
+        f"crank angle from the ground line = input {_plus(d.input_offset)} rad, "
+        f"rocker angle = output {_plus(d.output_offset)} rad"
+    )
     text = fourbar_scene_text(
-        "synth-function", d.ground, d.crank, d.coupler, d.rocker, (0.5 * d.coupler, 0.0), d.circuit,
+        "synth-function",
+        d.ground,
+        d.crank,
+        d.coupler,
+        d.rocker,
+        (0.5 * d.coupler, 0.0),
+        d.circuit,
         (0.0, 0.0, d.ground_angle),
-        comments=[f"planar synth function {args.pairs}: {len(phi)} pairs, max output error {d.max_error:.3g} rad "
-                  f"({d.method})", offs + " (the placement turns both by its angle)"],
-        amplitude=amp, centre=centre)
+        comments=[
+            f"planar synth function {args.pairs}: {len(phi)} pairs, max output error {d.max_error:.3g} rad ({d.method})",
+            offs + " (the placement turns both by its angle)",
+        ],
+        amplitude=amp,
+        centre=centre,
+    )
     report = {"command": "synth function", "pairs": len(phi), **d.to_dict(), **({"hint": hint} if hint else {})}
-    shift = "" if not args.free_offsets else (f"; input zero at {math.degrees(d.input_offset):.6g} deg, output zero "
-                                               f"at {math.degrees(d.output_offset):.6g} deg from the ground line")
-    return _finish(args, f"four-bar ({d.grashof}, {d.circuit}, {d.method}), max output angle error {d.max_error:.3g} "
-                   f"rad, transmission angle >= {d.checks['min_transmission_deg']:.3g} deg{shift}",
-                   text, report, d.ok, failing)
+    shift = (
+        ""
+        if not args.free_offsets
+        else (
+            f"; input zero at {math.degrees(d.input_offset):.6g} deg, output zero "
+            f"at {math.degrees(d.output_offset):.6g} deg from the ground line"
+        )
+    )
+    return _finish(
+        args,
+        f"four-bar ({d.grashof}, {d.circuit}, {d.method}), max output angle error {d.max_error:.3g} "
+        f"rad, transmission angle >= {d.checks['min_transmission_deg']:.3g} deg{shift}",
+        text,
+        report,
+        d.ok,
+        failing,
+    )
 
 
 def _no_design(args: argparse.Namespace, command: str, count: dict[str, int], why: str, hint: str = "") -> int:
     """No design meets the constraints: say why (JSON ``reason``), write nothing, exit 3."""
     if args.json:
-        print(json.dumps({"command": command, **count, "ok": False, "reason": why,
-                          **({"hint": hint} if hint else {})}, indent=2))
+        print(json.dumps({"command": command, **count, "ok": False, "reason": why, **({"hint": hint} if hint else {})}, indent=2))
     else:
         print(f"check failed: {why}; nothing written" + (f"\n{hint}" if hint else ""))
     return EXIT_CHECK
@@ -285,13 +352,16 @@ def _check_poses(name: str, poses: np.ndarray) -> None:
         for j in range(i + 1, len(poses)):
             dth = abs((ang[j] - ang[i] + math.pi) % (2 * math.pi) - math.pi)
             if math.hypot(*(poses[j, :2] - poses[i, :2])) <= 1e-9 * L and dth <= 1e-9:
-                raise InputError(name, f"rows {i + 1} and {j + 1}", "different poses (these two are the same "
-                                 "position and angle)")
+                raise InputError(name, f"rows {i + 1} and {j + 1}", "different poses (these two are the same position and angle)")
     turn = np.abs((ang - ang[0] + math.pi) % (2 * math.pi) - math.pi)
     if turn.max() <= 1e-9:
-        raise InputError(f"{name}: angle", ang.tolist(), "a body that turns between poses (every angle is the "
-                         "same: a pure translation, which no Burmester four-bar's coupler makes except a "
-                         "parallelogram whose positions lie on one circle)")
+        raise InputError(
+            f"{name}: angle",
+            ang.tolist(),
+            "a body that turns between poses (every angle is the "
+            "same: a pure translation, which no Burmester four-bar's coupler makes except a "
+            "parallelogram whose positions lie on one circle)",
+        )
 
 
 def _cmd_motion(args: argparse.Namespace) -> int:
@@ -312,18 +382,37 @@ def _cmd_motion(args: argparse.Namespace) -> int:
         d = burmester(poses, max_ratio=args.max_ratio)
     except NoMotionDesign as e:
         return _no_design(args, "synth motion", {"poses": len(poses)}, str(e))
-    amp, centre = (None, 0.0) if d.crank_range is None else (
-        max(0.5 * (d.crank_range[1] - d.crank_range[0]), 1e-6), 0.5 * (d.crank_range[0] + d.crank_range[1]))
+    amp, centre = (
+        (None, 0.0)
+        if d.crank_range is None
+        else (max(0.5 * (d.crank_range[1] - d.crank_range[0]), 1e-6), 0.5 * (d.crank_range[0] + d.crank_range[1]))
+    )
     failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]
     text = fourbar_scene_text(
-        "synth-motion", d.ground, d.crank, d.coupler, d.rocker, d.coupler_point, d.circuit, d.placement,
-        comments=[f"planar synth motion {args.poses}: {len(poses)} poses; the body's angle is the coupler's "
-                  f"+ {d.angle_offset:.9g} rad",
-                  "crank angle at each pose (rad): " + ", ".join(f"{v:.6g}" for v in d.theta)],
-        amplitude=amp, centre=centre)
+        "synth-motion",
+        d.ground,
+        d.crank,
+        d.coupler,
+        d.rocker,
+        d.coupler_point,
+        d.circuit,
+        d.placement,
+        comments=[
+            f"planar synth motion {args.poses}: {len(poses)} poses; the body's angle is the coupler's + {d.angle_offset:.9g} rad",
+            "crank angle at each pose (rad): " + ", ".join(f"{v:.6g}" for v in d.theta),
+        ],
+        amplitude=amp,
+        centre=centre,
+    )
     report = {"command": "synth motion", "poses": len(poses), "angle_offset": d.angle_offset, **d.to_dict()}
-    return _finish(args, f"four-bar ({d.grashof}, {d.circuit}) through {len(poses)} poses, position error "
-                   f"{d.checks['max_position_error']:.3g}", text, report, d.ok, failing)
+    return _finish(
+        args,
+        f"four-bar ({d.grashof}, {d.circuit}) through {len(poses)} poses, position error {d.checks['max_position_error']:.3g}",
+        text,
+        report,
+        d.ok,
+        failing,
+    )
 
 
 #: most target points ``synth path`` takes (the search evaluates every candidate at each)
@@ -341,53 +430,79 @@ def add_parser(sub: Any) -> None:
     p.add_argument("target", help="CSV with columns x,y and optional theta (crank angle), or an .svg file")
     p.add_argument("-o", "--output", required=True, help="scene file (TOML) to write")
     p.add_argument("--type", choices=("fourbar", "sixbar"), default="fourbar", help="linkage type (fourbar)")
-    p.add_argument("--topology", choices=("stephenson", "watt"), default=None,
-                   help="six-bar only: a dyad hung from the coupler (stephenson, the default) or from the rocker "
-                        "(watt)")
-    p.add_argument("--json", action="store_true",
-                   help="print the design, sse, checks.rms_error and time_s as JSON (or ok false and the reason)")
-    p.add_argument("--budget", choices=("quick", "normal", "thorough"), default="normal",
-                   help="search effort (normal: about 1-4 s)")
-    p.add_argument("--max-ratio", type=float, default=10.0,
-                   help="longest / shortest link at most this (10; six-bar: every side of every link, the "
-                        "ground's three included)")
-    p.add_argument("--pivots", default=None,
-                   help="ground pivots inside XMIN,YMIN,XMAX,YMAX (write --pivots=-1,... when XMIN is negative)")
+    p.add_argument(
+        "--topology",
+        choices=("stephenson", "watt"),
+        default=None,
+        help="six-bar only: a dyad hung from the coupler (stephenson, the default) or from the rocker (watt)",
+    )
+    p.add_argument(
+        "--json",
+        action="store_true",
+        help="print the design, sse, checks.rms_error and time_s as JSON (or ok false and the reason)",
+    )
+    p.add_argument(
+        "--budget", choices=("quick", "normal", "thorough"), default="normal", help="search effort (normal: about 1-4 s)"
+    )
+    p.add_argument(
+        "--max-ratio",
+        type=float,
+        default=10.0,
+        help="longest / shortest link at most this (10; six-bar: every side of every link, the ground's three included)",
+    )
+    p.add_argument(
+        "--pivots", default=None, help="ground pivots inside XMIN,YMIN,XMAX,YMAX (write --pivots=-1,... when XMIN is negative)"
+    )
     p.add_argument("--points", type=int, default=None, help="points sampled along an SVG target (12; SVG only)")
     p.add_argument("--deg", action="store_true", help="the theta column is in degrees")
-    p.add_argument("--tolerance", type=float, default=0.01,
-                   help="largest RMS distance to the targets accepted, as a fraction of the targets' size (their "
-                        "RMS distance from their centroid); beyond it the design is written and exits 3 (0.01)")
+    p.add_argument(
+        "--tolerance",
+        type=float,
+        default=0.01,
+        help="largest RMS distance to the targets accepted, as a fraction of the targets' size (their "
+        "RMS distance from their centroid); beyond it the design is written and exits 3 (0.01)",
+    )
     p.add_argument("--seed", type=int, default=0, help="random seed of the search (same seed, same result)")
     p.set_defaults(func=_cmd_path)
 
     f = ss.add_parser("function", help="input/output angle pairs (Freudenstein): CSV input,output")
-    f.add_argument("pairs", help="CSV with columns input,output (crank and rocker angles counter-clockwise from "
-                   "the world +x axis, the crank pivot at the origin, the rocker pivot on the x axis, either side; "
-                   "the crank turning from the smallest input to the largest; each span at most one turn)")
+    f.add_argument(
+        "pairs",
+        help="CSV with columns input,output (crank and rocker angles counter-clockwise from "
+        "the world +x axis, the crank pivot at the origin, the rocker pivot on the x axis, either side; "
+        "the crank turning from the smallest input to the largest; each span at most one turn)",
+    )
     f.add_argument("-o", "--output", required=True, help="scene file (TOML) to write")
     f.add_argument("--ground", type=float, default=1.0, help="ground link length (sets the scale; 1)")
     f.add_argument("--deg", action="store_true", help="angles in degrees")
-    f.add_argument("--tolerance", type=float, default=0.01,
-                   help="largest output angle error accepted on the chosen circuit, rad (0.01)")
-    f.add_argument("--free-offsets", action="store_true",
-                   help="only the pairs' differences matter: the synthesis chooses where input and output "
-                        "angles are zero (reported)")
+    f.add_argument(
+        "--tolerance", type=float, default=0.01, help="largest output angle error accepted on the chosen circuit, rad (0.01)"
+    )
+    f.add_argument(
+        "--free-offsets",
+        action="store_true",
+        help="only the pairs' differences matter: the synthesis chooses where input and output angles are zero (reported)",
+    )
     f.add_argument("--full-turn", action="store_true", help="the crank must turn fully (Grashof crank)")
     f.add_argument("--max-ratio", type=float, default=10.0, help="longest / shortest link at most this (10)")
-    f.add_argument("--min-transmission", type=float, default=0.0,
-                   help="keep the transmission angle at least this far from 0 and 180 (a toggle) over the "
-                        "motion, degrees (0)")
+    f.add_argument(
+        "--min-transmission",
+        type=float,
+        default=0.0,
+        help="keep the transmission angle at least this far from 0 and 180 (a toggle) over the motion, degrees (0)",
+    )
     f.add_argument("--json", action="store_true", help="print the design and its errors as JSON")
     f.set_defaults(func=_cmd_function)
 
     m = ss.add_parser("motion", help="3, 4 or 5 poses of the coupler (Burmester): CSV x,y,angle")
-    m.add_argument("poses", help="CSV with columns x,y,angle (the guided body's origin and angle), 3 to 5 rows, "
-                   "reached in this order as the crank moves one way (exit 3, nothing written, when no four-bar "
-                   "does)")
+    m.add_argument(
+        "poses",
+        help="CSV with columns x,y,angle (the guided body's origin and angle), 3 to 5 rows, "
+        "reached in this order as the crank moves one way (exit 3, nothing written, when no four-bar "
+        "does)",
+    )
     m.add_argument("-o", "--output", required=True, help="scene file (TOML) to write")
-    m.add_argument("--max-ratio", type=float, default=10.0,
-                   help="longest / shortest link at most this, a finite number > 1 (10)")
+    m.add_argument("--max-ratio", type=float, default=10.0, help="longest / shortest link at most this, a finite number > 1 (10)")
     m.add_argument("--deg", action="store_true", help="angles in degrees")
     m.add_argument("--json", action="store_true", help="print the design and its checks as JSON")
     m.set_defaults(func=_cmd_motion)

@@ -88,8 +88,7 @@ def block(shape: tuple[int, ...], dtype: Any = float) -> np.ndarray[Any, Any]:
         best = -1
         for i in range(len(_POOL)):
             size = _POOL[i].nbytes
-            if nbytes <= size <= 2 * nbytes and _count(_POOL, i) == _FREE \
-                    and (best < 0 or size < _POOL[best].nbytes):
+            if nbytes <= size <= 2 * nbytes and _count(_POOL, i) == _FREE and (best < 0 or size < _POOL[best].nbytes):
                 best = i
         if best >= 0:
             b = _POOL.pop(best)

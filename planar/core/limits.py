@@ -60,8 +60,9 @@ def check_count(name: str, field: str, value: float, what: str, shown: object = 
     cap = limit(name)
     if not math.isfinite(value) or value > cap:
         asked = "" if shown is None else f"; this asks for {value:.4g}"
-        raise LimitError(field, value if shown is None else shown,
-                         f"at most {cap:,} {what}{asked} (the limit; raise it with {var}=N)")
+        raise LimitError(
+            field, value if shown is None else shown, f"at most {cap:,} {what}{asked} (the limit; raise it with {var}=N)"
+        )
     return int(value)
 
 
@@ -71,12 +72,14 @@ def check_memory(field: str, value: object, n_bytes: float, what: str) -> None:
     cap = limit("memory")
     mib = n_bytes / 2**20
     if not math.isfinite(mib) or mib > cap:
-        raise LimitError(field, value, f"{what} within {cap:,} MiB (it needs about {mib:,.0f} MiB; "
-                                       f"raise the limit with {var}=MIB)")
+        raise LimitError(
+            field, value, f"{what} within {cap:,} MiB (it needs about {mib:,.0f} MiB; raise the limit with {var}=MIB)"
+        )
 
 
-def sample_count(samples_per_cycle: float, cycles: float, spc_field: str = "samples_per_cycle",
-                 cycles_field: str = "cycles") -> int:
+def sample_count(
+    samples_per_cycle: float, cycles: float, spc_field: str = "samples_per_cycle", cycles_field: str = "cycles"
+) -> int:
     """Samples of ``cycles`` cycles at ``samples_per_cycle``, checked against the ``samples`` limit."""
     try:
         spc, cyc = float(samples_per_cycle), float(cycles)

@@ -343,8 +343,11 @@ class Slide:
         if self.width is None:
             return ()
         p1, p2 = self.pin_points()
-        return ((self.a, Slot(self.start, self.end, self.width, "pin")),
-                (self.b, Hole(p1, self.width, "pin")), (self.b, Hole(p2, self.width, "pin")))
+        return (
+            (self.a, Slot(self.start, self.end, self.width, "pin")),
+            (self.b, Hole(p1, self.width, "pin")),
+            (self.b, Hole(p2, self.width, "pin")),
+        )
 
     def pins(self) -> tuple[tuple[str, Vec], ...]:
         return tuple((self.b, p) for p in self.pin_points())
@@ -484,9 +487,7 @@ class Motion:
     def failures(self) -> list[tuple[int, float, str, str]]:
         """``(index, driver value, joint, why)`` for every invalid sample."""
         idx = np.flatnonzero(~self.valid)
-        return [
-            (int(i), float(self.driver[i]), *self.fail_table[int(self.fail_code[i])]) for i in idx
-        ]
+        return [(int(i), float(self.driver[i]), *self.fail_table[int(self.fail_code[i])]) for i in idx]
 
     def take(self, index: ArrayLike) -> Motion:
         """The samples ``index`` (an index array or boolean mask) as a new motion."""
@@ -577,20 +578,20 @@ class Mechanism:
             cls = type(j)
             kname = cls.__dict__.get("kind")
             if not isinstance(kname, str) or JOINT_KINDS.get(kname) is not cls:
-                raise InputError(f"{self.name}.joints.{getattr(j, 'name', '?')}", cls.__name__,
-                                 f"a registered joint kind, one of {sorted(JOINT_KINDS)}")
+                raise InputError(
+                    f"{self.name}.joints.{getattr(j, 'name', '?')}",
+                    cls.__name__,
+                    f"a registered joint kind, one of {sorted(JOINT_KINDS)}",
+                )
             if j.name in seen:
                 raise InputError(f"{self.name}.joints", j.name, "unique joint names")
             seen.add(j.name)
             for side in ("a", "b"):
                 if getattr(j, side) not in names:
-                    raise InputError(f"{self.name}.joints.{j.name}.{side}", getattr(j, side),
-                                     f"one of the parts {names}")
+                    raise InputError(f"{self.name}.joints.{j.name}.{side}", getattr(j, side), f"one of the parts {names}")
 
     # -- to implement ------------------------------------------------------
-    def _solve_poses(
-        self, q: Array
-    ) -> tuple[dict[str, Array], list[tuple[NDArray[np.bool_], str, str]]]:
+    def _solve_poses(self, q: Array) -> tuple[dict[str, Array], list[tuple[NDArray[np.bool_], str, str]]]:
         """Poses for driver values ``q`` and the per-joint validity checks."""
         raise NotImplementedError
 
@@ -605,21 +606,25 @@ class Mechanism:
     def solve(self, q: ArrayLike, t: ArrayLike | None = None) -> Motion:
         """Solve all samples at once for driver values ``q`` (scalar or array)."""
         if isinstance(q, np.ma.MaskedArray) or np.asarray(q).dtype == bool:
-            raise InputError(f"{self.name}.solve(q)", f"a {'masked' if isinstance(q, np.ma.MaskedArray) else 'bool'}"
-                             " array", "plain driver values (a masked array: pass q[~q.mask] or q.filled(v))")
+            raise InputError(
+                f"{self.name}.solve(q)",
+                f"a {'masked' if isinstance(q, np.ma.MaskedArray) else 'bool'} array",
+                "plain driver values (a masked array: pass q[~q.mask] or q.filled(v))",
+            )
         from planar.core.limits import check_count
 
-        check_count("samples", f"{self.name}.solve(q)", float(np.size(q)), "samples of one motion",
-                    shown=f"{np.size(q):,} driver values")
+        check_count(
+            "samples", f"{self.name}.solve(q)", float(np.size(q)), "samples of one motion", shown=f"{np.size(q):,} driver values"
+        )
         qin = np.atleast_1d(check_finite(f"{self.name}.driver value", q))
         qa = new_block(qin.shape)  # the motion's own copy (recycled memory for a large batch)
         np.copyto(qa, qin)
         if qa.ndim != 1:  # an OzT driver's path is a function of its 1-D driver value too
-            raise InputError(f"{self.name}.solve(q)", f"an array of shape {qa.shape}",
-                             "a scalar or a 1-D array of driver values")
+            raise InputError(f"{self.name}.solve(q)", f"an array of shape {qa.shape}", "a scalar or a 1-D array of driver values")
         if t is not None and np.shape(t) != qa.shape[:1]:
-            raise InputError(f"{self.name}.solve(t)", f"an array of shape {np.shape(t)}",
-                             f"one time per driver value (shape {qa.shape[:1]})")
+            raise InputError(
+                f"{self.name}.solve(t)", f"an array of shape {np.shape(t)}", f"one time per driver value (shape {qa.shape[:1]})"
+            )
         poses, checks, pts = self._solve_points(qa)
         n = qa.shape[0]
         for p in self.parts:  # the ground never moves: its track is one row seen n times (read-only, no memory)

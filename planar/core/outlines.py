@@ -32,6 +32,7 @@ class Outlined(Protocol):
     @property
     def features(self) -> Sequence[Hole | Slot | ArcSlot]: ...
 
+
 __all__ = ["part_outline", "feature_shape", "QUAD_SEGS"]
 
 #: segments per quarter circle for shapely approximations

@@ -68,7 +68,8 @@ class Registry(Generic[H]):
             where = f" ({what})" if what else ""
             known = ", ".join(sorted(kind_name(k) for k in self._handlers))
             raise UnsupportedError(
-                f"{self.consumer} has no handler for {self.noun} {kind_name(obj)!r}{where}; it handles: {known}")
+                f"{self.consumer} has no handler for {self.noun} {kind_name(obj)!r}{where}; it handles: {known}"
+            )
         return handler
 
     def __contains__(self, kind: object) -> bool:

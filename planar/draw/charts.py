@@ -82,8 +82,13 @@ def _parse_what(scene: "Scene", what: Sequence[str] | None) -> list[str]:
         if w not in CHARTS:
             raise InputError("--what", w, f"one of {', '.join(CHARTS)}")
         if w not in avail:
-            why = ("it has no named points" if w in ("curve", "speed") else
-                   "it is not a cam" if w in ("follower", "pressure") else "it has no RRR dyad")
+            why = (
+                "it has no named points"
+                if w in ("curve", "speed")
+                else "it is not a cam"
+                if w in ("follower", "pressure")
+                else "it has no RRR dyad"
+            )
             raise InputError("--what", w, f"a chart that applies to {scene.name!r} ({why}); it has {', '.join(avail)}")
         if w not in chosen:
             chosen.append(w)
@@ -104,16 +109,29 @@ def _motion(scene: "Scene", samples_per_cycle: int | None) -> "Motion":
     from planar.core.limits import check_count, check_memory
 
     total = samples_per_cycle * cycles  # bounded before anything is allocated (planar.core.limits)
-    n = max(2, check_count("samples", "--samples", round(total) if math.isfinite(total) else total,
-                           "samples in all (--samples x the scene's cycles)", shown=samples_per_cycle))
-    check_memory("--samples", samples_per_cycle,
-                 8.0 * 4 * n * (3 * len(scene.mechanism.parts) + 2 * len(scene.mechanism.points) + 4), "the charts' motion")
+    n = max(
+        2,
+        check_count(
+            "samples",
+            "--samples",
+            round(total) if math.isfinite(total) else total,
+            "samples in all (--samples x the scene's cycles)",
+            shown=samples_per_cycle,
+        ),
+    )
+    check_memory(
+        "--samples",
+        samples_per_cycle,
+        8.0 * 4 * n * (3 * len(scene.mechanism.parts) + 2 * len(scene.mechanism.points) + 4),
+        "the charts' motion",
+    )
     t = np.arange(n) * (drv.period / samples_per_cycle)
     return scene.mechanism.solve(drv.value(t), t=t)
 
 
-def scene_figure(scene: "Scene", what: Sequence[str] | None = None, width_in: float = 6.4,
-                 samples_per_cycle: int | None = None) -> "Figure":
+def scene_figure(
+    scene: "Scene", what: Sequence[str] | None = None, width_in: float = 6.4, samples_per_cycle: int | None = None
+) -> "Figure":
     """The charts ``what`` (default: every chart that applies) of ``scene``, stacked in one figure.
 
     ``samples_per_cycle``: sample the motion this finely instead of the
@@ -177,8 +195,7 @@ def scene_figure(scene: "Scene", what: Sequence[str] | None = None, width_in: fl
             ax.axhline(limit, color="#d62728", lw=0.8, ls="--")
             ax.axhline(-limit, color="#d62728", lw=0.8, ls="--")
             k2 = int(np.nanargmax(np.abs(deg)))
-            ax.set_title(f"pressure angle: largest {abs(deg[k2]):.1f}° at {x[k2]:.4g}{xunit} (allowed {limit:.0f}°)",
-                         fontsize=9)
+            ax.set_title(f"pressure angle: largest {abs(deg[k2]):.1f}° at {x[k2]:.4g}{xunit} (allowed {limit:.0f}°)", fontsize=9)
             ax.set_ylabel("pressure angle (deg)")
         elif chart == "transmission":
             lo, hi = GOOD_TRANSMISSION
@@ -189,8 +206,7 @@ def scene_figure(scene: "Scene", what: Sequence[str] | None = None, width_in: fl
                 ln.set_gid(f"transmission:{nm.split('.')[0]}")
                 if np.isfinite(deg).any():  # mark the worst sample: the furthest from 90 degrees
                     k = int(np.nanargmax(np.abs(deg - 90.0)))
-                    ax.annotate(f"{deg[k]:.0f}°", (x[k], deg[k]), fontsize=8, xytext=(3, 3),
-                                textcoords="offset points")
+                    ax.annotate(f"{deg[k]:.0f}°", (x[k], deg[k]), fontsize=8, xytext=(3, 3), textcoords="offset points")
             ax.set_ylim(0, 180)
             ax.set_ylabel("transmission angle (deg)")
             ax.set_title(f"transmission angle at each dyad (band: {lo:g}-{hi:g}°)", fontsize=9)
@@ -252,8 +268,9 @@ def _render(fig: Any, fmt: str) -> bytes:
     return buf.getvalue()
 
 
-def write_plot(scene: "Scene", out: str | os.PathLike[str], what: Sequence[str] | None = None,
-               samples_per_cycle: int | None = None) -> list[str]:
+def write_plot(
+    scene: "Scene", out: str | os.PathLike[str], what: Sequence[str] | None = None, samples_per_cycle: int | None = None
+) -> list[str]:
     """Write the charts of ``scene`` to ``out`` (``.png`` or ``.svg``, reproducible bytes); returns the charts.
 
     ``what`` and ``samples_per_cycle`` as for :func:`scene_figure`.

@@ -33,8 +33,7 @@ __all__ = ["Style", "Renderer", "project", "palette_colors"]
 Array = NDArray[np.float64]
 RGB = tuple[int, int, int]
 
-PART_COLORS = ("#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b07aa1", "#ff9da7",
-               "#9c755f", "#bab0ac")
+PART_COLORS = ("#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b07aa1", "#ff9da7", "#9c755f", "#bab0ac")
 
 
 def _rgb(c: str | Sequence[int]) -> RGB:
@@ -102,8 +101,20 @@ def palette_colors(style: Style, n_parts: int) -> list[RGB]:
     and toward the outline, so antialiased edges quantise without dithering, identically every run."""
     bg = np.array(_rgb(style.background), float)
     ol = np.array(_rgb(style.outline), float)
-    base = [_rgb(c) for c in (style.background, style.ground, style.outline, style.pin, style.trail, style.invalid,
-                              style.overlay, style.sweep, style.ground_outline)]
+    base = [
+        _rgb(c)
+        for c in (
+            style.background,
+            style.ground,
+            style.outline,
+            style.pin,
+            style.trail,
+            style.invalid,
+            style.overlay,
+            style.sweep,
+            style.ground_outline,
+        )
+    ]
     base += [_rgb(style.part_colors[i % len(style.part_colors)]) for i in range(min(n_parts, len(style.part_colors)))]
     out: list[RGB] = []
     for c in base:
@@ -187,8 +198,11 @@ class Renderer:
         self.base = self._static_layer()
         self.trail_layer = self._trail_layer()
         self.dot = {c: self._dot(_rgb(c), 2.2) for c in (s.pin, s.trail, s.invalid)}
-        self.mark_px = ([(self._px(r), c) for r, c in self.marks.rings], [(self._px(r), c) for r, c in self.marks.lines],
-                        [(self._px(r), c) for r, c in self.marks.dots])
+        self.mark_px = (
+            [(self._px(r), c) for r, c in self.marks.rings],
+            [(self._px(r), c) for r, c in self.marks.lines],
+            [(self._px(r), c) for r, c in self.marks.dots],
+        )
 
     # -- geometry, all frames at once --------------------------------------------
     def _world_geometry(self, motion: Motion) -> dict:
@@ -231,8 +245,10 @@ class Renderer:
         fine_keep = self._fine_valid if self._fine_valid.any() else np.ones_like(self._fine_valid)
         tracks = [r for rings in world["parts"] for r in rings]  # (N, M, 2) each
         tracks += list(world["sweeps"].values())  # (N, M, 2)
-        allp = np.concatenate([np.asarray(v)[keep].reshape(-1, 2) for v in tracks]
-                              + [np.asarray(v)[fine_keep].reshape(-1, 2) for v in world["trails"].values()])
+        allp = np.concatenate(
+            [np.asarray(v)[keep].reshape(-1, 2) for v in tracks]
+            + [np.asarray(v)[fine_keep].reshape(-1, 2) for v in world["trails"].values()]
+        )
         allp = allp[np.all(np.isfinite(allp), axis=1)]
         if allp.size == 0:
             allp = np.zeros((1, 2))

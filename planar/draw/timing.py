@@ -27,8 +27,7 @@ from planar.errors import InputError
 if TYPE_CHECKING:  # pragma: no cover
     from planar.scene.load import Scene
 
-__all__ = ["FramePlan", "plan_frames", "scene_duration", "animation_motion", "resample", "MAX_FRAMES",
-           "DEFAULT_DELAY_MS"]
+__all__ = ["FramePlan", "plan_frames", "scene_duration", "animation_motion", "resample", "MAX_FRAMES", "DEFAULT_DELAY_MS"]
 
 #: default frame delay: 25 frames per second
 DEFAULT_DELAY_MS = 40
@@ -75,9 +74,11 @@ class FramePlan:
         """A one-line note when a cycle plays more than one frame delay away from its period, else ``""``."""
         if abs(self.cycle_play_s - self.period_s) <= self.delay_ms / 1000.0:
             return ""
-        return (f"a cycle of {self.period_s:.3g} s plays in {self.cycle_play_s:.3g} s ({self.slowdown:.3g}x slower: "
-                f"{self.frames_per_cycle} frames of {self.delay_ms:g} ms, the fewest that show the motion at the "
-                "fastest rate a GIF plays; an .mp4 plays it at speed)")
+        return (
+            f"a cycle of {self.period_s:.3g} s plays in {self.cycle_play_s:.3g} s ({self.slowdown:.3g}x slower: "
+            f"{self.frames_per_cycle} frames of {self.delay_ms:g} ms, the fewest that show the motion at the "
+            "fastest rate a GIF plays; an .mp4 plays it at speed)"
+        )
 
     def times(self) -> np.ndarray:
         """The motion time (s) of each frame."""
@@ -107,11 +108,16 @@ def plan_frames(period_s: float, duration_s: float, fps: float | None = None, ti
         if tick_ms is not None:
             delay = round(delay / tick_ms) * tick_ms
             if fps > 50 or delay < 20:
-                raise InputError("--fps", fps, "at most 50 frames per second in a GIF (browsers slow shorter "
-                                               "frame delays than 20 ms)")
+                raise InputError(
+                    "--fps", fps, "at most 50 frames per second in a GIF (browsers slow shorter frame delays than 20 ms)"
+                )
         if period_s * 1000.0 / delay < MIN_FRAMES_ASKED:
-            raise InputError("--fps", fps, f"at least {MIN_FRAMES_ASKED} frames per cycle: {MIN_FRAMES_ASKED / period_s:.3g} "
-                                           f"frames per second or more for a cycle of {period_s:.3g} s")
+            raise InputError(
+                "--fps",
+                fps,
+                f"at least {MIN_FRAMES_ASKED} frames per cycle: {MIN_FRAMES_ASKED / period_s:.3g} "
+                f"frames per second or more for a cycle of {period_s:.3g} s",
+            )
     else:
         delay = float(DEFAULT_DELAY_MS)
         if 1000.0 * period_s / delay < MIN_FRAMES_PER_CYCLE:
@@ -121,9 +127,13 @@ def plan_frames(period_s: float, duration_s: float, fps: float | None = None, ti
     from planar.core.limits import limit
 
     if frames > limit("frames"):  # MAX_FRAMES unless PLANAR_MAX_FRAMES raises it
-        raise InputError("duration", duration_s, f"an animation of at most {limit('frames')} frames ({frames} asked "
-                                                 f"for at {1000.0 / delay:.3g} frames per second; shorten the duration, "
-                                                 "lower --fps or raise PLANAR_MAX_FRAMES)")
+        raise InputError(
+            "duration",
+            duration_s,
+            f"an animation of at most {limit('frames')} frames ({frames} asked "
+            f"for at {1000.0 / delay:.3g} frames per second; shorten the duration, "
+            "lower --fps or raise PLANAR_MAX_FRAMES)",
+        )
     return FramePlan(float(period_s), float(delay), per_cycle, frames)
 
 
@@ -171,5 +181,12 @@ def resample(motion: Motion, t: np.ndarray) -> Motion:
     j = np.clip(np.searchsorted(src, t), 1, len(src) - 1)
     valid = motion.valid[j] & motion.valid[j - 1]
     code = np.where(valid, -1, np.maximum(motion.fail_code[j], motion.fail_code[j - 1])).astype(np.int16)
-    return Motion(driver=np.interp(t, src, motion.driver), poses=poses, valid=valid, fail_code=code,
-                  fail_table=list(motion.fail_table), points={k: lerp(v) for k, v in motion.points.items()}, t=t)
+    return Motion(
+        driver=np.interp(t, src, motion.driver),
+        poses=poses,
+        valid=valid,
+        fail_code=code,
+        fail_table=list(motion.fail_table),
+        points={k: lerp(v) for k, v in motion.points.items()},
+        t=t,
+    )

@@ -176,8 +176,7 @@ def assembled(mech: Mechanism, motion: Motion) -> tuple[Mechanism, Motion, Marks
     view = _ViewMechanism(f"{asm.name}", parts, joints, asm.driver, points)
     view.view = "xy"  # type: ignore[attr-defined]
     pts = {k: poses_apply(poses[part], xy) for k, (part, xy) in points.items()}
-    vm = Motion(driver=m.driver, poses=poses, valid=m.valid, fail_code=m.fail_code, fail_table=m.fail_table,
-                points=pts, t=m.t)
+    vm = Motion(driver=m.driver, poses=poses, valid=m.valid, fail_code=m.fail_code, fail_table=m.fail_table, points=pts, t=m.t)
     return view, vm, marks
 
 

@@ -143,21 +143,45 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
             tab = tab_of.get(part.name)
             key = (part.name, extra, None if tab is None else (tab.letter, tab.edge, tuple(tab.spans)))
             if key not in cut_cache:  # a part that no tab, slot or travel slot changed is cut once
-                cut_cache[key] = part_cuts(part, s, n, {i for (pn, i) in pinned if pn == part.name}, drive_at,
-                                           motor_at, mounting=part.ground and part.plane == "xy",
-                                           letters=letters[part.name], drive_flat=flat, extra=extra, tabs=tab)
+                cut_cache[key] = part_cuts(
+                    part,
+                    s,
+                    n,
+                    {i for (pn, i) in pinned if pn == part.name},
+                    drive_at,
+                    motor_at,
+                    mounting=part.ground and part.plane == "xy",
+                    letters=letters[part.name],
+                    drive_flat=flat,
+                    extra=extra,
+                    tabs=tab,
+                )
             pc = copy.deepcopy(cut_cache[key])
             if drive_at is not None and part.name in keyed:
-                _phase_mark(pc, (drive_at[0] * s.unit_mm, drive_at[1] * s.unit_mm), flat, keyed[part.name],
-                            dict(getattr(mech, "key_turn", {})).get(part.name, 0.0))
+                _phase_mark(
+                    pc,
+                    (drive_at[0] * s.unit_mm, drive_at[1] * s.unit_mm),
+                    flat,
+                    keyed[part.name],
+                    dict(getattr(mech, "key_turn", {})).get(part.name, 0.0),
+                )
             part_notes.extend(pc.notes)
             cuts.append(pc)
         return cuts, part_notes
 
     def plan(cuts: list[PartCut]) -> tuple[dict[str, Any], Assembly]:
         material = {pc.name: nominal_material(pc.outer, pc.inner, s.kerf / 2) for pc in cuts}
-        return material, plan_assembly(mech, material, pins, contacts, s.unit_mm, s.thickness_mm, s.pin_mm,
-                                       s.pin_head, shaft.joint if shaft is not None else None)
+        return material, plan_assembly(
+            mech,
+            material,
+            pins,
+            contacts,
+            s.unit_mm,
+            s.thickness_mm,
+            s.pin_mm,
+            s.pin_head,
+            shaft.joint if shaft is not None else None,
+        )
 
     cuts, part_notes = cut_all([], {})
     material0, asm = plan(cuts)
@@ -196,21 +220,27 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
             moved = [n for n in asm2.layers if asm2.layers[n] != layers_used.get(n)]
             raise FabricationError(
                 f"part {moved[0]!r}: its layer keeps changing as the tab joints are cut; they cannot be planned"
-                if moved else "the pieces standing perpendicular are still in the way of other layers after 4 "
-                "rounds of travel slots; they cannot be tab-joined")
+                if moved
+                else "the pieces standing perpendicular are still in the way of other layers after 4 "
+                "rounds of travel slots; they cannot be tab-joined"
+            )
         notes.extend(travel_notes)
         asm = asm2
         tabs = {jn.piece: jn for jn in joins}
         for pc in cuts:
             if pc.name in tabs:
                 jn = tabs[pc.name]
-                pc.notes.append(f"{pc.name}: {len(jn.spans)} tab(s) {jn.letter}, {jn.tab_width:g} x "
-                                f"{s.thickness_mm:g} mm, into the slots {jn.letter} of {jn.base}")
+                pc.notes.append(
+                    f"{pc.name}: {len(jn.spans)} tab(s) {jn.letter}, {jn.tab_width:g} x "
+                    f"{s.thickness_mm:g} mm, into the slots {jn.letter} of {jn.base}"
+                )
                 part_notes.append(pc.notes[-1])
             for jn in joins:
                 if jn.base == pc.name:
-                    pc.notes.append(f"{pc.name}: {len(jn.slots)} slot(s) {jn.letter} "
-                                    f"{jn.slot_size[0]:g} x {jn.slot_size[1]:g} mm for the tabs of {jn.piece}")
+                    pc.notes.append(
+                        f"{pc.name}: {len(jn.slots)} slot(s) {jn.letter} "
+                        f"{jn.slot_size[0]:g} x {jn.slot_size[1]:g} mm for the tabs of {jn.piece}"
+                    )
                     part_notes.append(pc.notes[-1])
         _engrave_joins(cuts, joins, s)
     notes.extend(part_notes)
@@ -223,8 +253,14 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
     ro = max(ri + s.min_wall, s.min_part / 2)
     for pp in asm.pins:
         for j in range(pp.spacers):
-            cuts.append(PartCut(f"spacer {pp.letter}{j + 1}", Circle((0.0, 0.0), ro + k2), [Circle((0.0, 0.0), ri - k2)],
-                                nominal_holes=[((0.0, 0.0), ri)]))
+            cuts.append(
+                PartCut(
+                    f"spacer {pp.letter}{j + 1}",
+                    Circle((0.0, 0.0), ro + k2),
+                    [Circle((0.0, 0.0), ri - k2)],
+                    nominal_holes=[((0.0, 0.0), ri)],
+                )
+            )
     layout = nest(cuts, s.sheet, s.spacing, s.margin, s.kerf, s.unit_mm)
     warnings: list[str] = []
     from planar.windup.chain import ToyMechanism
@@ -233,9 +269,20 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
         from planar.toys.fitcheck import small_motion_text, small_motions
 
         warnings = [small_motion_text(m, s) for m in small_motions(scene.mechanism, s)]
-    return Fabrication(scene.name, s, layout, asm, notes, shaft.joint if shaft is not None else None, material,
-                       [p.name for p in mech.parts if p.ground and p.plane == "xy"], joins=joins,
-                       stack_z=tab_plan.z_stack, planes=dict(tab_plan.planes), warnings=warnings)
+    return Fabrication(
+        scene.name,
+        s,
+        layout,
+        asm,
+        notes,
+        shaft.joint if shaft is not None else None,
+        material,
+        [p.name for p in mech.parts if p.ground and p.plane == "xy"],
+        joins=joins,
+        stack_z=tab_plan.z_stack,
+        planes=dict(tab_plan.planes),
+        warnings=warnings,
+    )
 
 
 def _engrave_joins(cuts: list[PartCut], joins: list[Any], s: FabSettings) -> None:
@@ -250,8 +297,7 @@ def _engrave_joins(cuts: list[PartCut], joins: list[Any], s: FabSettings) -> Non
             from shapely.geometry import LineString
 
             mat = mat.difference(LineString(e).buffer(0.5))
-        base.engrave.extend(letter_marks(mat, [(c, jn.slot_size[0] / 2, jn.letter) for c, _ in jn.slots],
-                                         max(s.min_label, 1.5)))
+        base.engrave.extend(letter_marks(mat, [(c, jn.slot_size[0] / 2, jn.letter) for c, _ in jn.slots], max(s.min_label, 1.5)))
         piece = by_name[jn.piece]
         mat = nominal_material(piece.outer, piece.inner, s.kerf / 2)
         for e in piece.engrave:
@@ -259,8 +305,9 @@ def _engrave_joins(cuts: list[PartCut], joins: list[Any], s: FabSettings) -> Non
 
             mat = mat.difference(LineString(e).buffer(0.5))
         mid = jn.tabs[0].centroid
-        piece.engrave.extend(letter_marks(mat, [((float(mid.x), float(mid.y)), s.thickness_mm, jn.letter)],
-                                          max(s.min_label, 1.5)))
+        piece.engrave.extend(
+            letter_marks(mat, [((float(mid.x), float(mid.y)), s.thickness_mm, jn.letter)], max(s.min_label, 1.5))
+        )
 
 
 def sheet_paths(path: str | os.PathLike, sheets: int) -> list[Path]:
@@ -297,7 +344,8 @@ def summary(fab: Fabrication) -> str:
     layers = max(asm.n_layers.values()) if asm.n_layers else 0
     spacers = sum(p.spacers for p in asm.pins)
     rings = f" + {spacers} spacer ring(s)" if spacers else ""
-    return (f"{len(lay.parts) - spacers} parts{rings} on {lay.sheets} sheet(s) of {lay.sheet_size[0]:g} x "
-            f"{lay.sheet_size[1]:g} mm (utilisation {util}), kerf {lay.kerf:g} mm, {layers} layer(s) of "
-            f"{fab.settings.thickness_mm:g} mm, {len(asm.pins)} pin(s)")
-
+    return (
+        f"{len(lay.parts) - spacers} parts{rings} on {lay.sheets} sheet(s) of {lay.sheet_size[0]:g} x "
+        f"{lay.sheet_size[1]:g} mm (utilisation {util}), kerf {lay.kerf:g} mm, {layers} layer(s) of "
+        f"{fab.settings.thickness_mm:g} mm, {len(asm.pins)} pin(s)"
+    )

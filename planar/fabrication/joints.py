@@ -98,8 +98,7 @@ def _pin_in_arc_slot(mech: Mechanism, j: PinInArcSlot) -> tuple[list[PinSpec], l
 @PIN_RULES.register(Slide)
 def _slide(mech: Mechanism, j: Slide) -> tuple[list[PinSpec], list[Contact]]:
     pts = j.pin_points()
-    return [PinSpec(f"{j.name}#{k + 1}", (j.b, j.a), (_v(p), _v(j.start)), ("hole", "slot"))
-            for k, p in enumerate(pts)], []
+    return [PinSpec(f"{j.name}#{k + 1}", (j.b, j.a), (_v(p), _v(j.start)), ("hole", "slot")) for k, p in enumerate(pts)], []
 
 
 @PIN_RULES.register(KeyedShaft)
@@ -160,8 +159,11 @@ def pin_features(mech: Mechanism) -> set[tuple[str, int]]:
                     out.add((j.b, pin_part.features.index(h)))
             for i, f in enumerate(slot_part.features):
                 if isinstance(j, PinInArcSlot):
-                    if isinstance(f, ArcSlot) and _close(f.centre, j.centre) \
-                            and abs(f.radius - j.radius) < TOL * max(1.0, j.radius):
+                    if (
+                        isinstance(f, ArcSlot)
+                        and _close(f.centre, j.centre)
+                        and abs(f.radius - j.radius) < TOL * max(1.0, j.radius)
+                    ):
                         out.add((j.a, i))
                 elif isinstance(f, Slot) and _close(f.start, j.start) and _close(f.end, j.end):
                     out.add((j.a, i))

@@ -118,9 +118,18 @@ def _swept(poly, poses: np.ndarray, u: float):
     return shapely.union_all([_placed(poly, p, u) for p in poses]).buffer(0)
 
 
-def plan_assembly(mech: Any, material: dict[str, Any], pins: list[PinSpec], contacts: list[Contact],
-                  unit_mm: float, thickness: float, pin_mm: float, pin_head: float,
-                  shaft_pin: str | None = None, samples: int = 48) -> Assembly:
+def plan_assembly(
+    mech: Any,
+    material: dict[str, Any],
+    pins: list[PinSpec],
+    contacts: list[Contact],
+    unit_mm: float,
+    thickness: float,
+    pin_mm: float,
+    pin_head: float,
+    shaft_pin: str | None = None,
+    samples: int = 48,
+) -> Assembly:
     """Layers, pins and spacers for ``mech`` whose parts' material polygons (mm, own frame) are given."""
     from shapely.geometry import LineString, Point
 
@@ -141,14 +150,26 @@ def plan_assembly(mech: Any, material: dict[str, Any], pins: list[PinSpec], cont
         pa = poses[a]
         c, s = np.cos(pa[:, 2]), np.sin(pa[:, 2])
         xy = np.c_[pa[:, 0] + c * loc[0] - s * loc[1], pa[:, 1] + s * loc[0] + c * loc[1]] * u
-        geom = LineString(xy).buffer(pin_mm / 2) if len(xy) > 1 and np.ptp(xy, axis=0).max() > 1e-9 \
+        geom = (
+            LineString(xy).buffer(pin_mm / 2)
+            if len(xy) > 1 and np.ptp(xy, axis=0).max() > 1e-9
             else Point(xy[0]).buffer(pin_mm / 2)
+        )
         paths.append(geom)
     stacks = pin_stacks(pins)
     stack_parts = [tuple(dict.fromkeys(p for i in st for p in pins[i].parts)) for st in stacks]
-    crossing = [sorted({q for i in st for q in names if q not in sp and plane[q] == plane[sp[0]]
-                        and swept[q].intersection(paths[i]).area > OVERLAP_MM2 / 5}, key=names.index)
-                for st, sp in zip(stacks, stack_parts)]
+    crossing = [
+        sorted(
+            {
+                q
+                for i in st
+                for q in names
+                if q not in sp and plane[q] == plane[sp[0]] and swept[q].intersection(paths[i]).area > OVERLAP_MM2 / 5
+            },
+            key=names.index,
+        )
+        for st, sp in zip(stacks, stack_parts)
+    ]
     # contacts merge parts into one node
     root = {n: n for n in names}
 
@@ -158,9 +179,12 @@ def plan_assembly(mech: Any, material: dict[str, Any], pins: list[PinSpec], cont
         return n
 
     notes: list[str] = []
+
     def worst_overlap(x: str, y: str) -> float:
-        return max(_placed(material[x], poses[x][i], u).intersection(_placed(material[y], poses[y][i], u)).area
-                   for i in range(len(poses[x])))
+        return max(
+            _placed(material[x], poses[x][i], u).intersection(_placed(material[y], poses[y][i], u)).area
+            for i in range(len(poses[x]))
+        )
 
     for ct in contacts:
         x, y = ct.parts
@@ -177,7 +201,8 @@ def plan_assembly(mech: Any, material: dict[str, Any], pins: list[PinSpec], cont
 
                 raise FabricationError(
                     f"joint {ct.joint!r}: {x} must touch {y} in one layer, but their material overlaps by "
-                    f"{worst:.1f} mm^2 over the cycle (a larger window or slot, or a smaller cam, clears it)")
+                    f"{worst:.1f} mm^2 over the cycle (a larger window or slot, or a smaller cam, clears it)"
+                )
             ra, rb = find(x), find(y)
             if ra != rb:
                 root[max(ra, rb, key=names.index)] = min(ra, rb, key=names.index)
@@ -214,13 +239,27 @@ def plan_assembly(mech: Any, material: dict[str, Any], pins: list[PinSpec], cont
         clashes = [q for q in crossing[i] if (lq := layers[q]) is not None and lo < lq < hi]
         shaft = any(pins[j].joint == shaft_pin for j in st)
         joints = tuple(pins[j].joint for j in st)
-        plans.append(PinPlan(letter(i), pin, (lo, hi), (hi - lo + 1) - len(ls), thickness * (hi - lo + 1) + 2 * pin_head,
-                             pin_mm, shaft, sp, joints, clashes))
+        plans.append(
+            PinPlan(
+                letter(i),
+                pin,
+                (lo, hi),
+                (hi - lo + 1) - len(ls),
+                thickness * (hi - lo + 1) + 2 * pin_head,
+                pin_mm,
+                shaft,
+                sp,
+                joints,
+                clashes,
+            )
+        )
         if clashes:
             notes.append(f"pin {letter(i)} ({', '.join(joints)}) passes through {', '.join(clashes)} between its layers")
     first = int(ok[0])
-    pose = {n: (float(motion.poses[n][first, 0] * u), float(motion.poses[n][first, 1] * u),
-                float(motion.poses[n][first, 2])) for n in names}
+    pose = {
+        n: (float(motion.poses[n][first, 0] * u), float(motion.poses[n][first, 1] * u), float(motion.poses[n][first, 2]))
+        for n in names
+    }
     return Assembly(layers, n_layers, plans, contacts, pose, notes, plane, u)
 
 
@@ -238,8 +277,13 @@ def _score(pins_q: list, a: dict[str, int]) -> tuple[int, int, int]:
     return clash, spacers, spread
 
 
-def _search(order: list[str], adj: dict, k: int, score: Callable[[dict[str, int]], tuple[int, int, int]],
-            fixed: dict[str, int] | None = None) -> tuple[tuple[int, int, int], dict[str, int]] | None:
+def _search(
+    order: list[str],
+    adj: dict,
+    k: int,
+    score: Callable[[dict[str, int]], tuple[int, int, int]],
+    fixed: dict[str, int] | None = None,
+) -> tuple[tuple[int, int, int], dict[str, int]] | None:
     """Best assignment of ``k`` layers to ``order`` (neighbours in ``adj`` apart), depth first with bounds;
     ``fixed`` nodes take only their given layer."""
     best: list = [None]
@@ -258,7 +302,7 @@ def _search(order: list[str], adj: dict, k: int, score: Callable[[dict[str, int]
             return
         r = order[idx]
         used = {assign[n] for n in adj[r] if n in assign}
-        for c in ([fixed[r]] if fixed and r in fixed else range(k)):
+        for c in [fixed[r]] if fixed and r in fixed else range(k):
             if c not in used:
                 assign[r] = c
                 dfs(idx + 1)

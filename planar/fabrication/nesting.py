@@ -46,8 +46,9 @@ def _upright(pc: PartCut) -> PartCut:
     return pc
 
 
-def nest(cuts: Sequence[PartCut], sheet: tuple[float, float], spacing: float, margin: float,
-         kerf: float, unit_mm: float) -> Layout:
+def nest(
+    cuts: Sequence[PartCut], sheet: tuple[float, float], spacing: float, margin: float, kerf: float, unit_mm: float
+) -> Layout:
     """Place every part on as few sheets as rectpack finds; coordinates per sheet, mm."""
     import rectpack
 
@@ -61,15 +62,19 @@ def nest(cuts: Sequence[PartCut], sheet: tuple[float, float], spacing: float, ma
         x0, y0, x1, y1 = _bbox(pc)
         w, h = int(math.ceil((x1 - x0 + spacing) * _Q)), int(math.ceil((y1 - y0 + spacing) * _Q))
         if not ((w <= binw and h <= binh) or (h <= binw and w <= binh)):
-            raise InputError(f"part {pc.name!r}", f"{x1 - x0:.1f} x {y1 - y0:.1f} mm",
-                             f"a part that fits the {W:g} x {H:g} mm sheet inside {margin:g} mm margins "
-                             "(use a larger --sheet or a smaller unit_mm)")
+            raise InputError(
+                f"part {pc.name!r}",
+                f"{x1 - x0:.1f} x {y1 - y0:.1f} mm",
+                f"a part that fits the {W:g} x {H:g} mm sheet inside {margin:g} mm margins "
+                "(use a larger --sheet or a smaller unit_mm)",
+            )
         rects.append((w, h))
     best = None
     for algo in (rectpack.MaxRectsBssf, rectpack.MaxRectsBaf, rectpack.MaxRectsBl, rectpack.GuillotineBssfMaxas):
         for sort in (rectpack.SORT_AREA, rectpack.SORT_LSIDE, rectpack.SORT_PERI):
-            packer = rectpack.newPacker(mode=rectpack.PackingMode.Offline, bin_algo=rectpack.PackingBin.BFF,
-                                        pack_algo=algo, sort_algo=sort, rotation=True)
+            packer = rectpack.newPacker(
+                mode=rectpack.PackingMode.Offline, bin_algo=rectpack.PackingBin.BFF, pack_algo=algo, sort_algo=sort, rotation=True
+            )
             for i, (w, h) in enumerate(rects):
                 packer.add_rect(w, h, rid=i)
             packer.add_bin(binw, binh, count=len(rects))

@@ -86,15 +86,30 @@ class FabSettings:
 
     @classmethod
     def from_spec(cls, fab: Any, kerf: float | None = None, sheet: tuple[float, float] | None = None) -> FabSettings:
-        return cls(unit_mm=fab.unit_mm, thickness_mm=fab.thickness_mm, kerf=fab.kerf_mm if kerf is None else kerf,
-                   pin_mm=fab.pin_diameter_mm, clearance=fab.clearance_mm,
-                   sheet=(float((sheet or fab.sheet_mm)[0]), float((sheet or fab.sheet_mm)[1])),
-                   min_wall=fab.min_wall_mm, min_part=fab.min_part_mm, min_label=fab.min_label_mm,
-                   slot_end=fab.slot_end_margin_mm, widen=fab.widen, pin_head=fab.pin_head_mm,
-                   shaft_mm=fab.shaft_diameter_mm, shaft_flat_mm=fab.shaft_flat_mm,
-                   motor_screw_mm=fab.motor_screw_mm, motor_screw_spacing_mm=fab.motor_screw_spacing_mm,
-                   mounting_hole_mm=fab.mounting_hole_mm, spacing=fab.spacing_mm, margin=fab.margin_mm,
-                   svg_stroke_mm=fab.svg_stroke_mm, cut_colour=fab.cut_colour, engrave_colour=fab.engrave_colour)
+        return cls(
+            unit_mm=fab.unit_mm,
+            thickness_mm=fab.thickness_mm,
+            kerf=fab.kerf_mm if kerf is None else kerf,
+            pin_mm=fab.pin_diameter_mm,
+            clearance=fab.clearance_mm,
+            sheet=(float((sheet or fab.sheet_mm)[0]), float((sheet or fab.sheet_mm)[1])),
+            min_wall=fab.min_wall_mm,
+            min_part=fab.min_part_mm,
+            min_label=fab.min_label_mm,
+            slot_end=fab.slot_end_margin_mm,
+            widen=fab.widen,
+            pin_head=fab.pin_head_mm,
+            shaft_mm=fab.shaft_diameter_mm,
+            shaft_flat_mm=fab.shaft_flat_mm,
+            motor_screw_mm=fab.motor_screw_mm,
+            motor_screw_spacing_mm=fab.motor_screw_spacing_mm,
+            mounting_hole_mm=fab.mounting_hole_mm,
+            spacing=fab.spacing_mm,
+            margin=fab.margin_mm,
+            svg_stroke_mm=fab.svg_stroke_mm,
+            cut_colour=fab.cut_colour,
+            engrave_colour=fab.engrave_colour,
+        )
 
 
 @dataclass(frozen=True)
@@ -138,20 +153,28 @@ class Feature:
             return [(self.a[0], self.a[1], self.r + wall), (self.b[0], self.b[1], self.r + wall)]
         if self.kind == "rect":
             c, s = math.cos(self.t0), math.sin(self.t0)
-            return [(self.a[0] + c * x - s * y, self.a[1] + s * x + c * y, wall)
-                    for x in (-self.R, self.R) for y in (-self.r, self.r)]
+            return [
+                (self.a[0] + c * x - s * y, self.a[1] + s * x + c * y, wall) for x in (-self.R, self.R) for y in (-self.r, self.r)
+            ]
         # along the arc: chords between neighbours sag by at most 0.02 mm, made up by a larger radius
         sag = 0.02
         dmax = 2 * math.acos(max(-1.0, 1 - sag / max(self.R, 1e-9)))
         n = max(2, int(math.ceil((self.t1 - self.t0) / dmax)) + 1)
         step = (self.t1 - self.t0) / (n - 1)
         rho = self.r + wall + self.R * (1 - math.cos(step / 2))
-        return [(self.a[0] + self.R * math.cos(t), self.a[1] + self.R * math.sin(t), rho)
-                for t in np.linspace(self.t0, self.t1, n)]
+        return [
+            (self.a[0] + self.R * math.cos(t), self.a[1] + self.R * math.sin(t), rho) for t in np.linspace(self.t0, self.t1, n)
+        ]
 
 
-def _features(part: Part, s: FabSettings, pinned: set[int], drive_at: tuple[float, float] | None,
-              motor_at: tuple[float, float] | None, drive_flat: float = math.pi / 2) -> list[Feature]:
+def _features(
+    part: Part,
+    s: FabSettings,
+    pinned: set[int],
+    drive_at: tuple[float, float] | None,
+    motor_at: tuple[float, float] | None,
+    drive_flat: float = math.pi / 2,
+) -> list[Feature]:
     u = s.unit_mm
     out: list[Feature] = []
     for i, f in enumerate(part.features):
@@ -160,18 +183,34 @@ def _features(part: Part, s: FabSettings, pinned: set[int], drive_at: tuple[floa
             c = (f.centre[0] * u, f.centre[1] * u)
             if drive_at is not None and math.dist(f.centre, drive_at) < 1e-9 * max(1.0, u):
                 if not s.shaft_flat_mm < s.shaft_mm:
-                    raise FabricationError(f"fabrication.shaft_flat_mm: {s.shaft_flat_mm:g} mm across the flat must be "
-                                           f"less than the shaft diameter {s.shaft_mm:g} mm")
+                    raise FabricationError(
+                        f"fabrication.shaft_flat_mm: {s.shaft_flat_mm:g} mm across the flat must be "
+                        f"less than the shaft diameter {s.shaft_mm:g} mm"
+                    )
                 # snug, not zero: the clearance on the diameter and across the flat (half of it each side)
-                out.append(Feature("d", f"motor shaft D-hole {s.shaft_mm:g} mm", c, (s.shaft_mm + s.clearance) / 2,
-                                   flat=s.shaft_flat_mm - s.shaft_mm / 2 + s.clearance / 2, t0=drive_flat))
+                out.append(
+                    Feature(
+                        "d",
+                        f"motor shaft D-hole {s.shaft_mm:g} mm",
+                        c,
+                        (s.shaft_mm + s.clearance) / 2,
+                        flat=s.shaft_flat_mm - s.shaft_mm / 2 + s.clearance / 2,
+                        t0=drive_flat,
+                    )
+                )
                 continue
             if motor_at is not None and math.dist(f.centre, motor_at) < 1e-9 * max(1.0, u):
                 d = s.shaft_mm + 4 * s.clearance + 0.5
                 out.append(Feature("hole", "motor shaft clearance", c, d / 2))
                 for sx in (-1, 1):
-                    out.append(Feature("hole", "motor screw", (c[0] + sx * s.motor_screw_spacing_mm / 2, c[1]),
-                                       (s.motor_screw_mm + s.clearance) / 2))
+                    out.append(
+                        Feature(
+                            "hole",
+                            "motor screw",
+                            (c[0] + sx * s.motor_screw_spacing_mm / 2, c[1]),
+                            (s.motor_screw_mm + s.clearance) / 2,
+                        )
+                    )
                 continue
             d = (s.pin_mm if pin else f.diameter * u) + s.clearance
             out.append(Feature("hole", "pin hole" if pin else "hole", c, d / 2))
@@ -235,12 +274,15 @@ def _outer(part: Part, s: FabSettings, feats: list[Feature], k2: float) -> tuple
     if after.area > before.area * (1 + 1e-6) + 1e-6:
         wall = _min_wall(before, own)
         if not s.widen:
-            raise FabricationError(f"part {part.name!r}: {wall:.3f} mm wall between a cut and the outline, less than "
-                                   f"min_wall_mm {s.min_wall:g} (widen = false)")
+            raise FabricationError(
+                f"part {part.name!r}: {wall:.3f} mm wall between a cut and the outline, less than "
+                f"min_wall_mm {s.min_wall:g} (widen = false)"
+            )
         # a negative wall is a cut reaching out of the part (e.g. a frame's travel slot past its plate)
         was = f"a {wall:.3f} mm wall" if wall >= 0 else f"a cut reaching {-wall:.3f} mm out of the outline"
-        notes.append(f"{part.name}: widened from {was} to a {s.min_wall:g} mm wall "
-                     f"(area {before.area:.0f} -> {after.area:.0f} mm^2)")
+        notes.append(
+            f"{part.name}: widened from {was} to a {s.min_wall:g} mm wall (area {before.area:.0f} -> {after.area:.0f} mm^2)"
+        )
         base = base + extra
     if ears:
         base = base + ears
@@ -267,9 +309,16 @@ def _drop_contained(feats: list[Feature]) -> list[Feature]:
     polys = [cut_polygon(f.cut(0.0)) for f in feats]
     keep = []
     for i, p in enumerate(polys):
-        inside = any(j != i and (polys[j].buffer(1e-6).contains(p) and (polys[j].area > p.area or j < i)
-                                 or _same_guide(feats[i], feats[j], j < i) or _same_arc(feats[i], feats[j], j < i))
-                     for j in range(len(polys)))
+        inside = any(
+            j != i
+            and (
+                polys[j].buffer(1e-6).contains(p)
+                and (polys[j].area > p.area or j < i)
+                or _same_guide(feats[i], feats[j], j < i)
+                or _same_arc(feats[i], feats[j], j < i)
+            )
+            for j in range(len(polys))
+        )
         if not inside:
             keep.append(feats[i])
     return keep
@@ -279,13 +328,18 @@ def _pins_held(name: str, feats: list[Feature], kept: list[Feature]) -> list[Fea
     """``kept``, after refusing a pin hole of ``feats`` that a larger cut swallowed (the pin would rattle in
     it; the Bunny's pin B once sat in a 6.1 mm hole): only the same hole again may stand for it."""
     for f in feats:
-        if f.kind == "hole" and f.what == "pin hole" and f not in kept and not any(
-                g.kind == "hole" and math.dist(g.a, f.a) < 1e-6 and abs(g.r - f.r) < 1e-9 for g in kept):
-            big = next((g for g in kept if cut_polygon(g.cut(0.0)).buffer(1e-6).contains(cut_polygon(f.cut(0.0)))),
-                       None)
+        if (
+            f.kind == "hole"
+            and f.what == "pin hole"
+            and f not in kept
+            and not any(g.kind == "hole" and math.dist(g.a, f.a) < 1e-6 and abs(g.r - f.r) < 1e-9 for g in kept)
+        ):
+            big = next((g for g in kept if cut_polygon(g.cut(0.0)).buffer(1e-6).contains(cut_polygon(f.cut(0.0)))), None)
             what = f"its {big.what} {2 * big.r:.2f} mm wide" if big is not None else "another cut"
-            raise FabricationError(f"part {name!r}: its pin hole {2 * f.r:.2f} mm at ({f.a[0]:.1f}, {f.a[1]:.1f}) mm "
-                                   f"lies inside {what}; the pin would not be held")
+            raise FabricationError(
+                f"part {name!r}: its pin hole {2 * f.r:.2f} mm at ({f.a[0]:.1f}, {f.a[1]:.1f}) mm "
+                f"lies inside {what}; the pin would not be held"
+            )
     return kept
 
 
@@ -437,10 +491,19 @@ def letter_marks(material, holes: list[tuple[tuple[float, float], float, str]], 
     return out
 
 
-def part_cuts(part: Part, s: FabSettings, number: int, pinned: set[int] = frozenset(),  # type: ignore[assignment]
-              drive_at: tuple[float, float] | None = None, motor_at: tuple[float, float] | None = None,
-              mounting: bool = False, letters: Sequence[tuple[tuple[float, float], str]] = (),
-              drive_flat: float = math.pi / 2, extra: Sequence[Feature] = (), tabs: Any = None) -> PartCut:
+def part_cuts(
+    part: Part,
+    s: FabSettings,
+    number: int,
+    pinned: set[int] = frozenset(),  # type: ignore[assignment]
+    drive_at: tuple[float, float] | None = None,
+    motor_at: tuple[float, float] | None = None,
+    mounting: bool = False,
+    letters: Sequence[tuple[tuple[float, float], str]] = (),
+    drive_flat: float = math.pi / 2,
+    extra: Sequence[Feature] = (),
+    tabs: Any = None,
+) -> PartCut:
     """A part's cuts in mm in its own frame, kerf applied, checked (see the module docstring).
 
     ``pinned``: indices of the part's features a pin goes through; ``drive_at`` / ``motor_at``: the
@@ -454,11 +517,11 @@ def part_cuts(part: Part, s: FabSettings, number: int, pinned: set[int] = frozen
     feats = _features(part, s, set(pinned), drive_at, motor_at, drive_flat) + list(extra)
     for f in feats:
         if f.r - k2 <= 0 or (f.kind == "d" and f.flat - k2 <= -(f.r - k2)):
-            raise FabricationError(f"part {part.name!r}: {f.what} {2 * f.r:.2f} mm wide is not wider than the "
-                                   f"kerf {s.kerf:g} mm")
+            raise FabricationError(f"part {part.name!r}: {f.what} {2 * f.r:.2f} mm wide is not wider than the kerf {s.kerf:g} mm")
     if mounting:
-        base = [(x * s.unit_mm, y * s.unit_mm, r * s.unit_mm) for x, y, r in part.hull] + \
-            [c for f in feats for c in f.wall_circles(s.min_wall)]
+        base = [(x * s.unit_mm, y * s.unit_mm, r * s.unit_mm) for x, y, r in part.hull] + [
+            c for f in feats for c in f.wall_circles(s.min_wall)
+        ]
         feats = feats + _mounting_holes(base, s)
     feats = _pins_held(part.name, feats, _drop_contained(feats))
     gap, fa, fb = _closest_cuts(feats)
@@ -466,7 +529,8 @@ def part_cuts(part: Part, s: FabSettings, number: int, pinned: set[int] = frozen
         raise FabricationError(
             f"part {part.name!r}: {gap:.2f} mm of material between its {fa.what} at "
             f"({fa.a[0]:.1f}, {fa.a[1]:.1f}) mm and its {fb.what} at ({fb.a[0]:.1f}, {fb.a[1]:.1f}) mm, less than "
-            f"min_wall_mm {s.min_wall:g} (a larger unit_mm, a smaller pin_diameter_mm or a smaller min_wall_mm)")
+            f"min_wall_mm {s.min_wall:g} (a larger unit_mm, a smaller pin_diameter_mm or a smaller min_wall_mm)"
+        )
     nominal_outer, notes = _outer(part, s, feats, 0.0)
     outer = nominal_outer if k2 == 0 else _outer(part, s, feats, k2)[0]
     if tabs is not None:
@@ -474,11 +538,17 @@ def part_cuts(part: Part, s: FabSettings, number: int, pinned: set[int] = frozen
     outer_poly = cut_polygon(nominal_outer)
     wall = _min_wall(outer_poly, feats)
     if wall < s.min_wall - WALL_TOL:
-        raise FabricationError(f"part {part.name!r}: {wall:.2f} mm wall between a cut and the outline, less than "
-                               f"min_wall_mm {s.min_wall:g}" + (" (a part with an explicit outline, such as a "
-                                                              "cam, roller or flat follower, is not widened: make "
-                                                              "it larger or the pin smaller)"
-                                                              if part.polygon is not None else ""))
+        raise FabricationError(
+            f"part {part.name!r}: {wall:.2f} mm wall between a cut and the outline, less than "
+            f"min_wall_mm {s.min_wall:g}"
+            + (
+                " (a part with an explicit outline, such as a "
+                "cam, roller or flat follower, is not widened: make "
+                "it larger or the pin smaller)"
+                if part.polygon is not None
+                else ""
+            )
+        )
     rect = outer_poly.minimum_rotated_rectangle
     xy = np.asarray(rect.exterior.coords)[:4]
     narrow = float(min(np.hypot(*(xy[1] - xy[0])), np.hypot(*(xy[2] - xy[1]))))
@@ -500,8 +570,7 @@ def part_cuts(part: Part, s: FabSettings, number: int, pinned: set[int] = frozen
             holes.append(((x * u, y * u), near.r if near.kind != "arc" else 0.0, letter))
         engrave = engrave + letter_marks(material, [h for h in holes if h[1] > 0], max(s.min_label, 1.5))
     nominal = [(f.a, f.r) for f in feats if f.kind == "hole"]
-    return PartCut(part.name, outer, [f.cut(k2) for f in feats], engrave, text, height,
-                   nominal_holes=nominal, notes=notes)
+    return PartCut(part.name, outer, [f.cut(k2) for f in feats], engrave, text, height, nominal_holes=nominal, notes=notes)
 
 
 def _with_tabs(name: str, poly: Any, jn: Any, k2: float) -> tuple[Contour, Contour]:
@@ -510,8 +579,9 @@ def _with_tabs(name: str, poly: Any, jn: Any, k2: float) -> tuple[Contour, Conto
 
     got = shapely.union_all([poly.intersection(jn.keep)] + list(jn.tabs)).simplify(1e-4)
     if got.geom_type != "Polygon" or len(got.interiors):
-        raise FabricationError(f"part {name!r}: cut flat along the xy plane it stands on, it falls apart "
-                               f"({got.geom_type}); it cannot be tab-joined")
+        raise FabricationError(
+            f"part {name!r}: cut flat along the xy plane it stands on, it falls apart ({got.geom_type}); it cannot be tab-joined"
+        )
 
     def contour(p: Any) -> Contour:
         p = shapely.geometry.polygon.orient(p, 1.0)
@@ -529,4 +599,3 @@ def nominal_material(pc_outer: Cut, inner: Sequence[Cut], k2: float = 0.0):
     for c in inner:
         poly = poly.difference(cut_polygon(c).buffer(k2, quad_segs=32) if k2 else cut_polygon(c))
     return poly
-

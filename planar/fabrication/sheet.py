@@ -99,12 +99,15 @@ class PartCut:
         c, s = math.cos(angle), math.sin(angle)
         rot = np.array([[c, -s], [s, c]])
         a0, x0, y0 = self.placed
-        return replace(self, outer=self.outer.transformed(angle, dx, dy),
-                       placed=(a0 + angle, c * x0 - s * y0 + dx, s * x0 + c * y0 + dy),
-                       inner=[k.transformed(angle, dx, dy) for k in self.inner],
-                       engrave=[np.asarray(e) @ rot.T + (dx, dy) for e in self.engrave],
-                       nominal_holes=[((c * x - s * y + dx, s * x + c * y + dy), r) for (x, y), r in self.nominal_holes],
-                       notes=list(self.notes))
+        return replace(
+            self,
+            outer=self.outer.transformed(angle, dx, dy),
+            placed=(a0 + angle, c * x0 - s * y0 + dx, s * x0 + c * y0 + dy),
+            inner=[k.transformed(angle, dx, dy) for k in self.inner],
+            engrave=[np.asarray(e) @ rot.T + (dx, dy) for e in self.engrave],
+            nominal_holes=[((c * x - s * y + dx, s * x + c * y + dy), r) for (x, y), r in self.nominal_holes],
+            notes=list(self.notes),
+        )
 
 
 @dataclass
@@ -191,6 +194,7 @@ def hull_of_circles(circles: Sequence[tuple[float, float, float]]) -> Cut:
             nrm, p1, p2 = t
             if all((np.array(keep[k][:2]) - p1) @ nrm + keep[k][2] <= tol for k in range(n) if k not in (i, j)):
                 out_edges[i].append((math.atan2(nrm[1], nrm[0]), j, nrm, p1, p2))
+
     # gift wrapping: start at the lowest point (outward normal straight down) and turn counter-clockwise;
     # a large circle can appear more than once on the hull, so the walk follows angles, not circles
     def next_edge(k: int, a: float):
@@ -211,8 +215,9 @@ def hull_of_circles(circles: Sequence[tuple[float, float, float]]) -> Cut:
     for _ in range(4 * n * n + 8):
         beta, j, _, p1, p2 = edge
         key = (src, j, beta)
-        hit = next((k for k, kk in enumerate(keys) if kk[:2] == key[:2]
-                    and abs(math.remainder(kk[2] - beta, 2 * math.pi)) < 1e-9), None)
+        hit = next(
+            (k for k, kk in enumerate(keys) if kk[:2] == key[:2] and abs(math.remainder(kk[2] - beta, 2 * math.pi)) < 1e-9), None
+        )
         if hit is not None:
             walk = walk[hit:]
             break

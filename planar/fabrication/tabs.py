@@ -151,8 +151,10 @@ def _joined(mech: Any, bodies: dict[str, list[str]]) -> dict[str, str]:
         for n in pieces:
             if plane.get(n) in PLANES and xy:
                 if len(xy) > 1:
-                    raise FabricationError(f"part {n!r}: its body has {len(xy)} xy pieces ({', '.join(xy)}); "
-                                           "no rule says which one its tabs go into, it cannot be tab-joined")
+                    raise FabricationError(
+                        f"part {n!r}: its body has {len(xy)} xy pieces ({', '.join(xy)}); "
+                        "no rule says which one its tabs go into, it cannot be tab-joined"
+                    )
                 out[n] = xy[0]
     return out
 
@@ -179,8 +181,10 @@ def fab_view(mech: Any, samples: int = 48) -> Any:
     if dropped:
         parts, removed = _without_cuts_of(parts, dropped, joints)
         for j in dropped:
-            notes.append(f"{j.b}: its slide {j.name!r} in {j.a} is not cut: both pieces stand on the xy stack, "
-                         f"whose own slide guides them ({body_of.get(j.b, j.b)} on {body_of.get(j.a, j.a)})")
+            notes.append(
+                f"{j.b}: its slide {j.name!r} in {j.a} is not cut: both pieces stand on the xy stack, "
+                f"whose own slide guides them ({body_of.get(j.b, j.b)} on {body_of.get(j.a, j.a)})"
+            )
     # brackets for perpendicular pieces that no pin holds
     held = set(joined)
     for j in joints:
@@ -197,11 +201,12 @@ def fab_view(mech: Any, samples: int = 48) -> Any:
             parts.append(bracket)
             joints.append(pivot)
             extra.append(bracket.name)
-            notes.append(f"{bracket.name}: a bracket on the frame holding the axle of {p.name} (pin joint "
-                         f"{pivot.name!r}); nothing in the model holds it")
+            notes.append(
+                f"{bracket.name}: a bracket on the frame holding the axle of {p.name} (pin joint "
+                f"{pivot.name!r}); nothing in the model holds it"
+            )
     view = FabView(mech, parts, joints, extra, notes)
-    frame = next((b for b, ps in bodies.items() if any(n in ps for n in (q.name for q in mech.parts if q.ground))),
-                 "frame")
+    frame = next((b for b, ps in bodies.items() if any(n in ps for n in (q.name for q in mech.parts if q.ground))), "frame")
     view.bodies = {**bodies, frame: bodies.get(frame, []) + extra}
     return view
 
@@ -218,20 +223,30 @@ def _bracket(p: Part, poses: np.ndarray) -> tuple[Part, Pivot]:
             best = (f, (float(w[0, 0]), float(w[0, 1])))
             break
     if best is None:
-        raise FabricationError(f"part {p.name!r} ({p.plane}): no pin holds it and it turns about no fixed hole; "
-                               "no bracket can hold it, it cannot be tab-joined")
+        raise FabricationError(
+            f"part {p.name!r} ({p.plane}): no pin holds it and it turns about no fixed hole; "
+            "no bracket can hold it, it cannot be tab-joined"
+        )
     f, (u, z) = best
     if abs(z) < 2 * f.diameter:
-        raise FabricationError(f"part {p.name!r} ({p.plane}): its axle lies on the xy plane (z = {z:.3g}); "
-                               "no room for a bracket standing on the frame, it cannot be tab-joined")
+        raise FabricationError(
+            f"part {p.name!r} ({p.plane}): its axle lies on the xy plane (z = {z:.3g}); "
+            "no room for a bracket standing on the frame, it cannot be tab-joined"
+        )
     boss = 1.5 * f.diameter
     # the base reaches past the piece's own way through the stack on both sides, room for a tab beyond it
     c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
     reach = max(float(np.abs(poses[:, 0] + c * x - s * y - u).max()) + r for x, y, r in p.hull)
     base = max(boss, 0.5 * abs(z), reach + 2 * boss)
     name = f"frame.{p.plane}.{p.name}"
-    part = Part(name, ((u, z, boss), (u - base, 0.0, boss), (u + base, 0.0, boss)), (Hole((u, z), f.diameter),),
-                ground=True, plane=p.plane, offset=p.offset)
+    part = Part(
+        name,
+        ((u, z, boss), (u - base, 0.0, boss), (u + base, 0.0, boss)),
+        (Hole((u, z), f.diameter),),
+        ground=True,
+        plane=p.plane,
+        offset=p.offset,
+    )
     return part, Pivot(f"{name}.axle", name, p.name, anchor_a=(u, z), anchor_b=(float(f.centre[0]), float(f.centre[1])))
 
 
@@ -302,8 +317,7 @@ def _place(intervals: list[tuple[float, float]], w: float, g: float) -> list[flo
     return out
 
 
-def _layer_footprint(mat: Any, plane: str, at: float, track_n: np.ndarray, track_r: np.ndarray, band: Any,
-                     t: float) -> Any:
+def _layer_footprint(mat: Any, plane: str, at: float, track_n: np.ndarray, track_r: np.ndarray, band: Any, t: float) -> Any:
     """Where a perpendicular piece (its cut outline ``mat``, its ``plane`` at ``at``, mm) passes through the layer
     ``band`` (world, mm) over its pose ``track_n``: strips of thickness ``t``, in the frame of the xy piece whose
     track is ``track_r``."""
@@ -326,8 +340,10 @@ def _static_pose(track: np.ndarray, what: str, keep: tuple[int, ...]) -> None:
     """Refuse a track whose coordinates ``keep`` (indices into x, y, angle) change over the cycle."""
     spread = np.ptp(track[:, list(keep)], axis=0)
     if float(spread.max()) > 1e-6:
-        raise FabricationError(f"{what}: it moves across the line where it meets the xy stack (by up to "
-                               f"{float(spread.max()):.3g}) over the cycle; it cannot be tab-joined")
+        raise FabricationError(
+            f"{what}: it moves across the line where it meets the xy stack (by up to "
+            f"{float(spread.max()):.3g}) over the cycle; it cannot be tab-joined"
+        )
 
 
 @dataclass
@@ -346,8 +362,7 @@ class TabPlan:
     shape: dict[str, Any] = field(default_factory=dict)
 
 
-def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any], s: Any,
-              samples: int = 48) -> TabPlan:
+def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any], s: Any, samples: int = 48) -> TabPlan:
     """Tab joints of every perpendicular piece that is rigid with an xy piece, and travel slots for every
     perpendicular piece passing through another xy layer (see the module docstring).
 
@@ -370,7 +385,8 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
     ok = ok if ok.size else np.arange(len(motion))
     track = {n: np.asarray(motion.poses[n], float)[ok] * [u, u, 1.0] for n in parts}
     pose: dict[str, tuple[float, float, float]] = {
-        n: (float(track[n][0, 0]), float(track[n][0, 1]), float(track[n][0, 2])) for n in parts}
+        n: (float(track[n][0, 0]), float(track[n][0, 1]), float(track[n][0, 2])) for n in parts
+    }
     for n, q in joined.items():
         pl = parts[n].plane
         k = 1 if pl == "xz" else 0  # the xy coordinate across the perpendicular plane (y for xz, x for yz)
@@ -378,8 +394,9 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
         _static_pose(track[q], f"part {q!r}, the xy piece {n!r} stands on", (k, 2))
         shift = track[n][:, 0] - track[q][:, 1 - k]
         if float(np.ptp(shift)) > 1e-6:
-            raise FabricationError(f"part {n!r} ({pl}) does not move with {q!r} along the line where they meet; "
-                                   "it cannot be tab-joined")
+            raise FabricationError(
+                f"part {n!r} ({pl}) does not move with {q!r} along the line where they meet; it cannot be tab-joined"
+            )
     w, g = 2 * t, 2 * t
     hw = (t + s.clearance) / 2
     wall = s.min_wall
@@ -402,8 +419,10 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
         elif cuts:
             hi_b.append(min(c.bounds[1] for c in cuts) - wall - face[n])
     if max(lo_b) > min(hi_b):
-        raise FabricationError("the pieces standing perpendicular to the xy stack need it both higher and lower "
-                               "for their cuts' walls; they cannot be tab-joined")
+        raise FabricationError(
+            "the pieces standing perpendicular to the xy stack need it both higher and lower "
+            "for their cuts' walls; they cannot be tab-joined"
+        )
     riders = {joined[n] for n in joined if not parts[n].ground}
     riders |= {j.a for j in mech.joints if getattr(j, "b", None) in perp and getattr(j, "a", None) in xy}
     ride = [layers.get(n) or 0 for n in sorted(riders)] or [0]
@@ -434,22 +453,29 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
             x0, z0, x1, z1 = mat.bounds
             ze = z_stack + face[n]
             if (side > 0 and z0 > ze + 1e-6) or (side < 0 and z1 < ze - 1e-6):
-                raise FabricationError(f"part {n!r} ({pl}): it does not reach the face of {joined[n]!r} (z = "
-                                       f"{ze:.3g} mm), where it would stand on it; it cannot be tab-joined")
+                raise FabricationError(
+                    f"part {n!r} ({pl}): it does not reach the face of {joined[n]!r} (z = "
+                    f"{ze:.3g} mm), where it would stand on it; it cannot be tab-joined"
+                )
             keep = box(x0 - 1, ze, x1 + 1, z1 + 1) if side > 0 else box(x0 - 1, z0 - 1, x1 + 1, ze)
             root = mat.intersection(keep)
             # the tab's root: solid material for a wall's depth behind the edge
             iv = _along(root, ze + side * wall / 2, wall / 2 - 1e-3, x0 - 1, x1 + 1)
             edges[n] = (side, ze, iv, keep)
-        keepout = {q: shapely.union_all([footprint(m, a, q) for m, a in fixed_at.items()]).buffer(s.clearance)
-                   for q in set(joined.values())}
+        keepout = {
+            q: shapely.union_all([footprint(m, a, q) for m, a in fixed_at.items()]).buffer(s.clearance)
+            for q in set(joined.values())
+        }
 
         # where each xy piece has room for a slot on a line (its frame: through its pose)
         regions: dict[str, Any] = {}
         for q in {joined[n] for n in mine}:
             qm = material[q]
-            holes = [Polygon(r) for r in qm.interiors] if qm.geom_type == "Polygon" else \
-                [Polygon(r) for g_ in qm.geoms for r in g_.interiors]
+            holes = (
+                [Polygon(r) for r in qm.interiors]
+                if qm.geom_type == "Polygon"
+                else [Polygon(r) for g_ in qm.geoms for r in g_.interiors]
+            )
             if not keepout[q].is_empty:
                 holes.append(keepout[q])
             if parts[q].polygon is None and s.widen:  # a hull grows to hold its slots: only its cuts matter
@@ -460,8 +486,9 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
             regions[q] = region.difference(shapely.union_all([h.buffer(wall) for h in holes])) if holes else region
         turned_of: dict[str, Any] = {}
 
-        def room(n: str, at: float, pl: str = pl, regions: dict[str, Any] = regions,
-                 turned_of: dict[str, Any] = turned_of) -> list[tuple[float, float]]:
+        def room(
+            n: str, at: float, pl: str = pl, regions: dict[str, Any] = regions, turned_of: dict[str, Any] = turned_of
+        ) -> list[tuple[float, float]]:
             from shapely import affinity
 
             q = joined[n]
@@ -488,7 +515,7 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
         if pl == "yz":  # the yz pieces stay at their x: each bracket stands beside its piece
             ats = {}
             for n in mine:
-                ref = n[len("frame.yz."):] if n.startswith("frame.yz.") and n[len("frame.yz."):] in parts else n
+                ref = n[len("frame.yz.") :] if n.startswith("frame.yz.") and n[len("frame.yz.") :] in parts else n
                 ats[n] = parts[ref].offset * u + ((layers.get(n) or 0) - (layers.get(ref) or 0)) * t
             candidates = [ats]
         else:
@@ -511,30 +538,41 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
                         ways[(n, r)] = hits
         walls_of = {r: [Polygon(h) for h in material[r].interiors] for r in xy if material[r].geom_type == "Polygon"}
 
-        def clear_way(y_of: dict[str, float], plan: dict[str, list[float]],
-                      ways: dict[tuple[str, str], list[tuple[int, float, float]]] = ways,
-                      walls_of: dict[str, list[Any]] = walls_of) -> bool:
+        def clear_way(
+            y_of: dict[str, float],
+            plan: dict[str, list[float]],
+            ways: dict[tuple[str, str], list[tuple[int, float, float]]] = ways,
+            walls_of: dict[str, list[Any]] = walls_of,
+        ) -> bool:
             slots_of: dict[str, list[Any]] = {}
             for m, cs in plan.items():
                 slots_of.setdefault(joined[m], []).extend(
-                    _local(box(c - w / 2, y_of[m] - hw, c + w / 2, y_of[m] + hw), pose[joined[m]]) for c in cs)
+                    _local(box(c - w / 2, y_of[m] - hw, c + w / 2, y_of[m] + hw), pose[joined[m]]) for c in cs
+                )
             rects: dict[str, list[Any]] = {}
             for (n, r), hits in ways.items():
                 at = y_of[n]
-                foot = shapely.union_all([_local(box(a, at - t / 2, b, at + t / 2), tuple(track[r][k]))
-                                          for k, a, b in hits])
+                foot = shapely.union_all([_local(box(a, at - t / 2, b, at + t / 2), tuple(track[r][k])) for k, a, b in hits])
                 # a hull piece grows round its slots: its material is then at least their hull's
                 hull = parts[r].polygon is None and s.widen
-                where = shapely.union_all([material[r]] + [q.buffer(wall) for q in slots_of.get(r, [])]).convex_hull \
-                    if hull else material[r]
+                where = (
+                    shapely.union_all([material[r]] + [q.buffer(wall) for q in slots_of.get(r, [])]).convex_hull
+                    if hull
+                    else material[r]
+                )
                 if foot.intersection(where).area <= 0.5:
                     continue
                 rects.setdefault(r, []).append(foot.buffer(s.clearance, join_style="mitre").minimum_rotated_rectangle)
             for r, rs in rects.items():
                 # side by side, two ways are one travel slot (merge_travel)
-                rs = [g_.minimum_rotated_rectangle for g_ in
-                      getattr(shapely.union_all([q.buffer(wall / 2) for q in rs]), "geoms",
-                              [shapely.union_all([q.buffer(wall / 2) for q in rs])])]
+                rs = [
+                    g_.minimum_rotated_rectangle
+                    for g_ in getattr(
+                        shapely.union_all([q.buffer(wall / 2) for q in rs]),
+                        "geoms",
+                        [shapely.union_all([q.buffer(wall / 2) for q in rs])],
+                    )
+                ]
                 for rect in rs:
                     if any(rect.distance(h) < wall for h in walls_of.get(r, [])):
                         return False
@@ -566,20 +604,25 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
                 chosen = (ats, plan)
                 break
         if chosen is None and blocked:
-            raise FabricationError(f"parts {', '.join(repr(n) for n in mine)} ({pl}): wherever their tabs have room, "
-                                   "the travel slots the pieces of this plane need through the other layers would run "
-                                   f"into other cuts (less than {wall:g} mm between); they cannot be tab-joined "
-                                   "(a larger unit_mm or a thinner sheet)")
+            raise FabricationError(
+                f"parts {', '.join(repr(n) for n in mine)} ({pl}): wherever their tabs have room, "
+                "the travel slots the pieces of this plane need through the other layers would run "
+                f"into other cuts (less than {wall:g} mm between); they cannot be tab-joined "
+                "(a larger unit_mm or a thinner sheet)"
+            )
         if chosen is None:
             n = failed or mine[0]
-            raise FabricationError(f"part {n!r} ({pl}): no line where it meets {joined[n]!r} has room for "
-                                   f"{MIN_TABS} tabs {w:g} mm wide with {wall:g} mm of material round their slots; "
-                                   "it cannot be tab-joined (a larger unit_mm or a thinner sheet)")
+            raise FabricationError(
+                f"part {n!r} ({pl}): no line where it meets {joined[n]!r} has room for "
+                f"{MIN_TABS} tabs {w:g} mm wide with {wall:g} mm of material round their slots; "
+                "it cannot be tab-joined (a larger unit_mm or a thinner sheet)"
+            )
         ats, plan = chosen
         if pl == "xz":  # every xz piece's plane, joined or not, in the layer order
             y0 = next(ats[n] - ((layers.get(n) or 0) + 0.5) * t for n in mine)
-            fixed_at.update({n: y0 + ((layers.get(n) or 0) + 0.5) * t for n in perp
-                             if parts[n].plane == "xz" and n not in joined})
+            fixed_at.update(
+                {n: y0 + ((layers.get(n) or 0) + 0.5) * t for n in perp if parts[n].plane == "xz" and n not in joined}
+            )
         for n in mine:
             fixed_at[n] = ats[n]
             side, ze, _, keep = edges[n]
@@ -595,16 +638,29 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
                 centre = (cs * dx + sn * dy, -sn * dx + cs * dy)
                 along = (0.0 if pl == "xz" else math.pi / 2) - qa
                 slots.append((centre, along))
-            jn = TabJoin(f"T{len(out) + 1}", n, q, pl, float(ats[n]), side, ze, spans, w,
-                         (w + s.clearance, t + s.clearance), slots, _local(keep, pose[n]),
-                         [_local(tb, pose[n]) for tb in tabs])
+            jn = TabJoin(
+                f"T{len(out) + 1}",
+                n,
+                q,
+                pl,
+                float(ats[n]),
+                side,
+                ze,
+                spans,
+                w,
+                (w + s.clearance, t + s.clearance),
+                slots,
+                _local(keep, pose[n]),
+                [_local(tb, pose[n]) for tb in tabs],
+            )
             out.append(jn)
             shape[n] = shapely.union_all([material[n].intersection(jn.keep)] + jn.tabs)
     return TabPlan(out, {}, [], z_stack, fixed_at, track, shape)
 
 
-def travel_slots(mech: Any, layers: dict[str, int | None], material: dict[str, Any], s: Any,
-                 plan: TabPlan) -> tuple[dict[str, list[Feature]], list[str]]:
+def travel_slots(
+    mech: Any, layers: dict[str, int | None], material: dict[str, Any], s: Any, plan: TabPlan
+) -> tuple[dict[str, list[Feature]], list[str]]:
     """Travel slots (xy piece -> cuts, mm) for perpendicular pieces that pass through another xy piece's layer
     where it has material (``material``: as cut so far), and a note for each; pieces joined by a joint
     (the #6/#9 pin on its driver's edge) touch by design and get none."""
@@ -618,8 +674,9 @@ def travel_slots(mech: Any, layers: dict[str, int | None], material: dict[str, A
 
     def footprint(n: str, at: float, r: str) -> Any:
         lz = (layers.get(r) or 0) * t + plan.z_stack
-        return _layer_footprint(plan.shape[n], parts[n].plane, at, track[n], track[r],
-                                box(-1e5, lz + 0.01, 1e5, lz + t - 0.01), t)
+        return _layer_footprint(
+            plan.shape[n], parts[n].plane, at, track[n], track[r], box(-1e5, lz + 0.01, 1e5, lz + t - 0.01), t
+        )
 
     out: dict[str, list[Feature]] = {}
     notes: list[str] = []
@@ -634,9 +691,11 @@ def travel_slots(mech: Any, layers: dict[str, int | None], material: dict[str, A
             length, width, ang = _rect_sides(rect)
             c = rect.centroid
             out.setdefault(r, []).append(
-                Feature("rect", f"travel slot for {n}", (float(c.x), float(c.y)), width / 2, R=length / 2, t0=ang))
-            notes.append(f"{r}: a travel slot {length:.1f} x {width:.1f} mm for {n} ({parts[n].plane}), which "
-                         "passes through its layer")
+                Feature("rect", f"travel slot for {n}", (float(c.x), float(c.y)), width / 2, R=length / 2, t0=ang)
+            )
+            notes.append(
+                f"{r}: a travel slot {length:.1f} x {width:.1f} mm for {n} ({parts[n].plane}), which passes through its layer"
+            )
     return out, notes
 
 
@@ -683,4 +742,3 @@ def slot_features(joins: list[TabJoin]) -> dict[str, list[Feature]]:
         for c, ang in jn.slots:
             out.setdefault(jn.base, []).append(Feature("rect", f"tab slot {jn.letter}", c, W / 2, R=L / 2, t0=ang))
     return out
-

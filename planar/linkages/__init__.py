@@ -7,7 +7,23 @@ from planar.linkages.slidercrank import SliderCrank
 from planar.linkages.triads import Triad
 
 __all__ = [
-    "NODE_KINDS", "NodeKind", "node_kind", "Actuator", "Crank", "Fixed", "Link", "Linkage", "RRP", "RRR", "Rigid",
-    "Geared", "Driven", "GearMesh", "Triad",
-    "FourBar", "SliderCrank", "freudenstein_angles", "grashof_class",
+    "NODE_KINDS",
+    "NodeKind",
+    "node_kind",
+    "Actuator",
+    "Crank",
+    "Fixed",
+    "Link",
+    "Linkage",
+    "RRP",
+    "RRR",
+    "Rigid",
+    "Geared",
+    "Driven",
+    "GearMesh",
+    "Triad",
+    "FourBar",
+    "SliderCrank",
+    "freudenstein_angles",
+    "grashof_class",
 ]

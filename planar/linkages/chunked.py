@@ -49,8 +49,18 @@ from numpy.typing import NDArray
 from planar.core.geometry import CONCENTRIC, TANGENCY_RTOL, line_circle, poses_apply
 from planar.linkages.plan import Linkage, NodeKind, _Plan
 
-__all__ = ["CHUNK", "JIT_CHUNK", "JIT_MIN", "KERNELS", "Solved", "fast_solve", "jit_available", "plan_for",
-           "solver_for", "threads_default"]
+__all__ = [
+    "CHUNK",
+    "JIT_CHUNK",
+    "JIT_MIN",
+    "KERNELS",
+    "Solved",
+    "fast_solve",
+    "jit_available",
+    "plan_for",
+    "solver_for",
+    "threads_default",
+]
 
 Array = NDArray[np.float64]
 Mask = NDArray[np.bool_]
@@ -107,6 +117,7 @@ def _kernel(kind: str) -> Callable[[Kernel], Kernel]:
     def reg(fn: Kernel) -> Kernel:
         KERNELS[kind] = fn
         return fn
+
     return reg
 
 
@@ -307,9 +318,17 @@ def plan_for(lk: Linkage) -> _Plan | None:
         b, g = BOUNDS[type(nd).kind](nd, b, g, bound, grows, index)
         bound.append(b)
         grows.append(g)
-    return _Plan(list(lk.nodes), kernels, checks, links,
-                 [(p, index[n]) for p, n in lk.point_nodes.items()],
-                 (lk.placement[0], lk.placement[1], lk.placement[2]), bound, grows, _NO_PROGRAM)
+    return _Plan(
+        list(lk.nodes),
+        kernels,
+        checks,
+        links,
+        [(p, index[n]) for p, n in lk.point_nodes.items()],
+        (lk.placement[0], lk.placement[1], lk.placement[2]),
+        bound,
+        grows,
+        _NO_PROGRAM,
+    )
 
 
 # ------------------------------------------------------------------ solving
@@ -395,8 +414,9 @@ class _ChunkOut:
     switch: bool  # a branch may switch: use the reference solve
 
 
-def _solve_range(plan: _Plan, q: Array, lo: int, hi: int, chunk: int, poses: dict[str, Array],
-                 points: dict[str, Array], tols: list[float]) -> list[_ChunkOut]:
+def _solve_range(
+    plan: _Plan, q: Array, lo: int, hi: int, chunk: int, poses: dict[str, Array], points: dict[str, Array], tols: list[float]
+) -> list[_ChunkOut]:
     """Solve samples ``lo:hi`` chunk by chunk into ``poses`` and ``points``."""
     size = min(chunk, hi - lo) + _OVERLAP
     w = Scratch(size)
@@ -461,8 +481,7 @@ def _tail(v: Coord, off: int) -> Coord:
     return v[off:] if isinstance(v, np.ndarray) else v
 
 
-def _place(x: Coord, y: Coord, ox: Array, oy: Array, placed: bool, px: float, py: float, c: float, s: float,
-           w: Scratch) -> None:
+def _place(x: Coord, y: Coord, ox: Array, oy: Array, placed: bool, px: float, py: float, c: float, s: float, w: Scratch) -> None:
     """``(ox, oy) = placement applied to (x, y)``, as :func:`planar.core.geometry.poses_compose`."""
     if not placed:
         ox[...] = x
@@ -479,8 +498,9 @@ def _place(x: Coord, y: Coord, ox: Array, oy: Array, placed: bool, px: float, py
     oy += m
 
 
-def fast_solve(lk: Linkage, q: Array, threads: int | None = None, chunk: int | None = None,
-               jit: bool | None = None) -> Solved | None:
+def fast_solve(
+    lk: Linkage, q: Array, threads: int | None = None, chunk: int | None = None, jit: bool | None = None
+) -> Solved | None:
     """``(poses, checks, points)`` for driver values ``q`` by the chunked path, or ``None``.
 
     ``None``: a node kind has no kernel, or a branch may switch by continuity
@@ -513,8 +533,7 @@ def fast_solve(lk: Linkage, q: Array, threads: int | None = None, chunk: int | N
     points = {name: np.empty((n, 2)) for name, _ in plan.points}
     nchunks = -(-n // chunk) if n else 0
     if nthreads > 1 and nchunks >= 2:
-        futs = [_pool().submit(_solve_range, plan, q, a, b, chunk, poses, points, tols)
-                for a, b in _cuts(n, chunk, nthreads)]
+        futs = [_pool().submit(_solve_range, plan, q, a, b, chunk, poses, points, tols) for a, b in _cuts(n, chunk, nthreads)]
         results = [r for f in futs for r in f.result()]
     else:
         results = _solve_range(plan, q, 0, n, chunk, poses, points, tols)
@@ -546,8 +565,7 @@ def _cuts(n: int, chunk: int, nthreads: int) -> list[tuple[int, int]]:
     return list(pairwise(cuts))
 
 
-def _finish(lk: Linkage, poses: dict[str, Array], checks: list[tuple[Mask, str, str]] | None,
-            points: dict[str, Array]) -> Solved:
+def _finish(lk: Linkage, poses: dict[str, Array], checks: list[tuple[Mask, str, str]] | None, points: dict[str, Array]) -> Solved:
     """Where a sample fails a frame may degenerate (two nodes meet): there the named points
     are taken through the part's pose, as the reference does."""
     if checks is not None:
@@ -567,6 +585,8 @@ JIT_MIN = 20_000
 JIT_CHUNK = 2048
 #: ranges of chunks per thread the compiled path hands out (balancing threads slowed by other load)
 JIT_RANGES_PER_THREAD = 4
+
+
 def jit_available() -> bool:
     """Whether the compiled kernels can be used (numba installed and ``PLANAR_JIT`` is not ``0``)."""
     if os.environ.get("PLANAR_JIT", "1") == "0":
@@ -602,8 +622,7 @@ def _program(plan: _Plan) -> Any:
     return plan.program
 
 
-def _solve_compiled(lk: Linkage, plan: _Plan, prog: Any, q: Array, tols: list[float], nthreads: int,
-                    chunk: int) -> Solved | None:
+def _solve_compiled(lk: Linkage, plan: _Plan, prog: Any, q: Array, tols: list[float], nthreads: int, chunk: int) -> Solved | None:
     from planar.core.buffers import block as new_block
     from planar.core.model import FinitePoses
     from planar.linkages.compiled import solve_range
@@ -639,8 +658,27 @@ def _solve_compiled(lk: Linkage, plan: _Plan, prog: Any, q: Array, tols: list[fl
             if t >= len(ranges) or min(found) < 0:
                 return
             a, b = ranges[t]
-            found[t] = int(solve_range(q, a, b, chunk, prog.kinds, prog.refs, prog.par, tol, prog.check_row,
-                                       prog.links, prog.pts, prog.pl, block, pblock, oks, fails[t], bad_chunks))
+            found[t] = int(
+                solve_range(
+                    q,
+                    a,
+                    b,
+                    chunk,
+                    prog.kinds,
+                    prog.refs,
+                    prog.par,
+                    tol,
+                    prog.check_row,
+                    prog.links,
+                    prog.pts,
+                    prog.pl,
+                    block,
+                    pblock,
+                    oks,
+                    fails[t],
+                    bad_chunks,
+                )
+            )
 
     workers = min(nthreads, len(ranges))
     if workers > 1:

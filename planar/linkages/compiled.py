@@ -61,10 +61,19 @@ _S4, _S5, _S6 = 2.75573137070700676789e-06, -2.50507602534068634195e-08, 1.58969
 _C1, _C2, _C3 = 4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015872894767294178e-05
 _C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.13596475577881948265e-11
 # fdlibm atan: polynomial for |x| < 7/16, pi/4 split in a high and a low part
-_AT = (3.33333333333329318027e-01, -1.99999999998764832476e-01, 1.42857142725034663711e-01,
-       -1.11111104054623557880e-01, 9.09088713343650656196e-02, -7.69187620504482999495e-02,
-       6.66107313738753120669e-02, -5.83357013379057348645e-02, 4.97687799461593236017e-02,
-       -3.65315727442169155270e-02, 1.62858201153657823623e-02)
+_AT = (
+    3.33333333333329318027e-01,
+    -1.99999999998764832476e-01,
+    1.42857142725034663711e-01,
+    -1.11111104054623557880e-01,
+    9.09088713343650656196e-02,
+    -7.69187620504482999495e-02,
+    6.66107313738753120669e-02,
+    -5.83357013379057348645e-02,
+    4.97687799461593236017e-02,
+    -3.65315727442169155270e-02,
+    1.62858201153657823623e-02,
+)
 _AT0, _AT1, _AT2, _AT3, _AT4, _AT5, _AT6, _AT7, _AT8, _AT9, _AT10 = _AT
 _PIO4_HI, _PIO4_LO = 7.85398163397448278999e-01, 3.06161699786838301793e-17
 _PIO2_HI, _PIO2_LO = 1.57079632679489655800e00, 6.12323399573676603587e-17
@@ -258,9 +267,9 @@ def _may_switch(x, y, ok, sep, tol, q, first, L):
     """
     t2 = tol * tol
     m = L - first
-    x0, x1, x2, x3 = x[first:], x[first - 1:], x[first - 2:], x[first - 3:]
-    y0, y1, y2, y3 = y[first:], y[first - 1:], y[first - 2:], y[first - 3:]
-    o0, o1, o2, o3 = ok[first:], ok[first - 1:], ok[first - 2:], ok[first - 3:]
+    x0, x1, x2, x3 = x[first:], x[first - 1 :], x[first - 2 :], x[first - 3 :]
+    y0, y1, y2, y3 = y[first:], y[first - 1 :], y[first - 2 :], y[first - 3 :]
+    o0, o1, o2, o3 = ok[first:], ok[first - 1 :], ok[first - 2 :], ok[first - 3 :]
     s = sep[first:]
     cand = 0
     for k in range(m):
@@ -270,7 +279,7 @@ def _may_switch(x, y, ok, sep, tol, q, first, L):
         cand += o0[k] & ((4.0 * (ex * ex + ey * ey) + t2 >= s[k]) | (not hist))
     if cand == 0:
         return False
-    q0, q1, q2, q3 = q[first:], q[first - 1:], q[first - 2:], q[first - 3:]
+    q0, q1, q2, q3 = q[first:], q[first - 1 :], q[first - 2 :], q[first - 3 :]
     for k in range(m):
         ex = x0[k] - 3.0 * x1[k] + 3.0 * x2[k] - x3[k]
         ey = y0[k] - 3.0 * y1[k] + 3.0 * y2[k] - y3[k]
@@ -337,8 +346,7 @@ def _k_point(x, y, m, pl, out):
 
 
 @njit(**_JIT)
-def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts, pl, poses, points, oks, fails,
-                bad_chunks):
+def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts, pl, poses, points, oks, fails, bad_chunks):
     """Solve samples ``lo:hi`` chunk by chunk; returns -1 where a branch may switch (then it stops
     early), else the number of pose and point rows holding a non-finite number.
 
@@ -407,8 +415,7 @@ def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts,
                         o[t] = okw[t]
         for li in range(links.shape[0]):
             o, a, b = links[li, 0], links[li, 1], links[li, 2]
-            nonfinite += _k_pose(X[o, off:], Y[o, off:], X[a, off:], Y[a, off:], X[b, off:], Y[b, off:], m, pl,
-                                 poses[li, i:j])
+            nonfinite += _k_pose(X[o, off:], Y[o, off:], X[a, off:], Y[a, off:], X[b, off:], Y[b, off:], m, pl, poses[li, i:j])
         for pi in range(pts.shape[0]):
             nonfinite += _k_point(X[pts[pi], off:], Y[pts[pi], off:], m, pl, points[pi, i:j])
     return nonfinite
@@ -421,8 +428,7 @@ def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts,
 ENCODERS: dict[str, Callable[[Any, dict[str, int]], tuple[int, tuple[int, ...], tuple[float, ...]]]] = {
     "fixed": lambda nd, ix: (FIXED, (), (float(nd.xy[0]), float(nd.xy[1]))),
     "crank": lambda nd, ix: (CRANK, (ix[nd.centre],), (float(nd.radius), float(nd.phase))),
-    "actuator": lambda nd, ix: (ACTUATOR, (ix[nd.origin],),
-                                (float(nd.unit_axis[0]), float(nd.unit_axis[1]), float(nd.offset))),
+    "actuator": lambda nd, ix: (ACTUATOR, (ix[nd.origin],), (float(nd.unit_axis[0]), float(nd.unit_axis[1]), float(nd.offset))),
     "rrr": lambda nd, ix: (RRR, (ix[nd.a], ix[nd.b]), (float(nd.ra), float(nd.rb), float(nd.branch))),
     "rrp": lambda nd, ix: (RRP, (ix[nd.a], ix[nd.p], ix[nd.q]), (float(nd.ra), float(nd.branch), float(nd.offset))),
     "rigid": lambda nd, ix: (RIGID, (ix[nd.a], ix[nd.b]), (float(nd.local[0]), float(nd.local[1]))),

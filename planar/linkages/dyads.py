@@ -64,8 +64,22 @@ from planar.core.model import Driver, Mechanism, Part, PinInSlot, Pivot, Slide, 
 from planar.errors import AssemblyError, InputError
 from planar.linkages.chunked import Solved, _Plan, fast_solve, plan_for
 
-__all__ = ["Fixed", "Crank", "Actuator", "RRR", "RRP", "Rigid", "Link", "Linkage", "Node", "NodeKind",
-           "NODE_KINDS", "node_kind", "carry_branch", "frame_rates"]
+__all__ = [
+    "Fixed",
+    "Crank",
+    "Actuator",
+    "RRR",
+    "RRP",
+    "Rigid",
+    "Link",
+    "Linkage",
+    "Node",
+    "NodeKind",
+    "NODE_KINDS",
+    "node_kind",
+    "carry_branch",
+    "frame_rates",
+]
 
 Vec = tuple[float, float]
 Array = NDArray[np.float64]
@@ -154,8 +168,11 @@ def carry_branch(keep: Array, other: Array, valid: Mask, path: Mask) -> NDArray[
     i1, i2, i3, i4 = p1[ks], p2[ks], p3[ks], p4[ks]
 
     def lagrange(t: Array, t1: Array, t2: Array, t3: Array) -> tuple[Array, Array, Array]:
-        return ((t - t2) * (t - t3) / ((t1 - t2) * (t1 - t3)), (t - t1) * (t - t3) / ((t2 - t1) * (t2 - t3)),
-                (t - t1) * (t - t2) / ((t3 - t1) * (t3 - t2)))
+        return (
+            (t - t2) * (t - t3) / ((t1 - t2) * (t1 - t3)),
+            (t - t1) * (t - t3) / ((t2 - t1) * (t2 - t3)),
+            (t - t1) * (t - t2) / ((t3 - t1) * (t3 - t2)),
+        )
 
     # quadratic (Lagrange) extrapolation in the sample index to k, and (the check of its credibility) to the
     # previous sample from the three before it
@@ -217,8 +234,9 @@ class NodeKind:
         """
         raise NotImplementedError
 
-    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
-                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+    def acceleration(
+        self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array], qd: Array, qdd: Array
+    ) -> tuple[Array, Mask | None]:
         """Acceleration ``(N, 2)`` from the closure differentiated twice (no differencing).
 
         ``pos``, ``vel`` hold every node's position and velocity (this one's
@@ -229,8 +247,9 @@ class NodeKind:
         """
         from planar.core.registry import UnsupportedError
 
-        raise UnsupportedError(f"rates (accelerations): node kind {self.kind!r} ({type(self).__name__}) "
-                               "has no acceleration method")
+        raise UnsupportedError(
+            f"rates (accelerations): node kind {self.kind!r} ({type(self).__name__}) has no acceleration method"
+        )
 
     def held_by(self) -> tuple[tuple[str, ...], ...]:
         """Groups of nodes (this one included) that one link must carry to hold this node's constraint."""
@@ -245,13 +264,13 @@ class NodeKind:
         declaration (a gear's partner, a triad's members) returns a copy holding it, or raises :class:`InputError`."""
         return self
 
-    def velocity_at(self, pos: Mapping[str, Array], vel: Mapping[str, Array], q: Array,
-                    qd: Array) -> tuple[Array, Mask | None]:
+    def velocity_at(self, pos: Mapping[str, Array], vel: Mapping[str, Array], q: Array, qd: Array) -> tuple[Array, Mask | None]:
         """:meth:`velocity` for kinds that also need the driver values ``q``."""
         return self.velocity(pos, vel, qd)
 
-    def acceleration_at(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
-                        q: Array, qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+    def acceleration_at(
+        self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array], q: Array, qd: Array, qdd: Array
+    ) -> tuple[Array, Mask | None]:
         """:meth:`acceleration` for kinds that also need the driver values ``q``."""
         return self.acceleration(pos, vel, acc, qd, qdd)
 
@@ -279,8 +298,9 @@ class Fixed(NodeKind):
     def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
         return np.zeros((qd.shape[0], 2)), None
 
-    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
-                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+    def acceleration(
+        self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array], qd: Array, qdd: Array
+    ) -> tuple[Array, Mask | None]:
         return np.zeros((qd.shape[0], 2)), None
 
 
@@ -315,8 +335,9 @@ class Crank(NodeKind):
     def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
         return vel[self.centre] + qd[:, None] * _perp(pos[self.name] - pos[self.centre]), None
 
-    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
-                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+    def acceleration(
+        self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array], qd: Array, qdd: Array
+    ) -> tuple[Array, Mask | None]:
         # P = C + r (cos, sin)(q + phase): aP = aC + qdd perp(P - C) - qd^2 (P - C)
         r = pos[self.name] - pos[self.centre]
         return acc[self.centre] + qdd[:, None] * _perp(r) - (qd * qd)[:, None] * r, None
@@ -355,8 +376,9 @@ class Actuator(NodeKind):
     def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
         return vel[self.origin] + qd[:, None] * self.unit_axis, None
 
-    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
-                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+    def acceleration(
+        self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array], qd: Array, qdd: Array
+    ) -> tuple[Array, Mask | None]:
         return acc[self.origin] + qdd[:, None] * self.unit_axis, None
 
 
@@ -392,8 +414,11 @@ class RRR(NodeKind):
         other, _ = circle_circle(pos[self.a], self.ra, pos[self.b], self.rb, -self.branch)
         flip = carry_branch(keep, other, ok, path)
         p = np.where(flip[:, None], other, keep) if flip.any() else keep
-        return p, (ok, f"links of length {self.ra:g} (from {self.a!r}) and {self.rb:g} (from {self.b!r}) "
-                       "cannot span the distance between them")
+        return p, (
+            ok,
+            f"links of length {self.ra:g} (from {self.a!r}) and {self.rb:g} (from {self.b!r}) "
+            "cannot span the distance between them",
+        )
 
     def held_by(self) -> tuple[tuple[str, ...], ...]:
         return ((self.name, self.a), (self.name, self.b))
@@ -408,14 +433,14 @@ class RRR(NodeKind):
         r1, r2 = P - pos[self.a], P - pos[self.b]
         return _solve2(r1, (r1 * vel[self.a]).sum(-1), r2, (r2 * vel[self.b]).sum(-1))
 
-    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
-                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+    def acceleration(
+        self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array], qd: Array, qdd: Array
+    ) -> tuple[Array, Mask | None]:
         # (P - A) . (vP - vA) = 0 differentiated: (P - A) . aP = (P - A) . aA - |vP - vA|^2 (and for B)
         P, vP = pos[self.name], vel[self.name]
         r1, r2 = P - pos[self.a], P - pos[self.b]
         w1, w2 = vP - vel[self.a], vP - vel[self.b]
-        return _solve2(r1, _dot(r1, acc[self.a]) - _dot(w1, w1),
-                       r2, _dot(r2, acc[self.b]) - _dot(w2, w2))
+        return _solve2(r1, _dot(r1, acc[self.a]) - _dot(w1, w1), r2, _dot(r2, acc[self.b]) - _dot(w2, w2))
 
     def transmission(self, pos: Mapping[str, Array]) -> Array:
         """Transmission angle (rad, in ``[0, pi]``) at this node: between the links to ``a`` and to ``b``."""
@@ -477,8 +502,9 @@ class RRP(NodeKind):
         b2 = self.offset * (w * vw).sum(-1) / wn - _cross(vw, P - p0) + _cross(w, vp0)
         return _solve2(r1, (r1 * vel[self.a]).sum(-1), _perp(w), b2)
 
-    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
-                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+    def acceleration(
+        self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array], qd: Array, qdd: Array
+    ) -> tuple[Array, Mask | None]:
         # the velocity's two conditions differentiated once more:
         # (P - A) . aP = (P - A) . aA - |vP - vA|^2
         # cross(w, aP) = cross(w, ap) - cross(aw, P - p) - 2 cross(vw, vP - vp)
@@ -489,8 +515,12 @@ class RRP(NodeKind):
         w, vw, aw = pos[self.q] - p0, vel[self.q] - vp0, acc[self.q] - ap0
         wn = np.hypot(w[:, 0], w[:, 1])
         wv = _dot(w, vw)
-        b2 = (_cross(w, ap0) - _cross(aw, P - p0) - 2.0 * _cross(vw, vP - vp0)
-              + self.offset * ((_dot(vw, vw) + _dot(w, aw)) / wn - wv * wv / wn**3))
+        b2 = (
+            _cross(w, ap0)
+            - _cross(aw, P - p0)
+            - 2.0 * _cross(vw, vP - vp0)
+            + self.offset * ((_dot(vw, vw) + _dot(w, aw)) / wn - wv * wv / wn**3)
+        )
         return _solve2(r1, _dot(r1, acc[self.a]) - _dot(v1, v1), _perp(w), b2)
 
 
@@ -531,8 +561,9 @@ class Rigid(NodeKind):
         omega = _cross(d, vel[self.b] - vel[self.a]) / (d * d).sum(-1)
         return vel[self.a] + omega[:, None] * _perp(pos[self.name] - a), None
 
-    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
-                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+    def acceleration(
+        self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array], qd: Array, qdd: Array
+    ) -> tuple[Array, Mask | None]:
         # aP = aA + alpha perp(P - A) - omega^2 (P - A), omega and alpha of the frame a -> b
         omega, alpha = frame_rates(pos[self.b] - pos[self.a], vel[self.b] - vel[self.a], acc[self.b] - acc[self.a])
         r = pos[self.name] - pos[self.a]
@@ -606,9 +637,12 @@ class Linkage(Mechanism):
             self.branch_reference = 0.0  # a triad's declared assembly holds at driver value 0
         clocked = [n.name for n in self.nodes if getattr(n, "clocked", False)]
         if clocked and amplitude is not None:
-            raise InputError(f"{name}.driver.amplitude", amplitude,
-                             f"no amplitude: with driven nodes ({', '.join(clocked)}) the driver is a clock "
-                             "(phase + rate t); give each driven node its own amplitude")
+            raise InputError(
+                f"{name}.driver.amplitude",
+                amplitude,
+                f"no amplitude: with driven nodes ({', '.join(clocked)}) the driver is a clock "
+                "(phase + rate t); give each driven node its own amplitude",
+            )
         self.ground_name = ground
         self.links = self._with_ground(tuple(links), ground)
         self._validate_links(name)
@@ -626,12 +660,18 @@ class Linkage(Mechanism):
         elif isinstance(self._driver_node, Crank):
             c = byname[self._driver_node.centre]
             origin = c.xy if isinstance(c, Fixed) else (0.0, 0.0)
-            driver = Driver(driver_link, "rotation", origin=origin, rate=rate, phase=phase,
-                            amplitude=amplitude, centre=centre)
+            driver = Driver(driver_link, "rotation", origin=origin, rate=rate, phase=phase, amplitude=amplitude, centre=centre)
         else:
             ax = np.asarray(getattr(self._driver_node, "axis", (1.0, 0.0)), float)
-            driver = Driver(driver_link, "translation", axis=(float(ax[0] / np.hypot(*ax)), float(ax[1] / np.hypot(*ax))),
-                            rate=rate, phase=phase, amplitude=amplitude if amplitude is not None else 1.0, centre=centre)
+            driver = Driver(
+                driver_link,
+                "translation",
+                axis=(float(ax[0] / np.hypot(*ax)), float(ax[1] / np.hypot(*ax))),
+                rate=rate,
+                phase=phase,
+                amplitude=amplitude if amplitude is not None else 1.0,
+                centre=centre,
+            )
         self.driver = driver
         # one sweep of the driver's cycle: the reference configuration, rigidity, slot travel
         self._sweep_q = self._cycle_inputs(driver)
@@ -646,9 +686,7 @@ class Linkage(Mechanism):
         self._check_rigid(name)
         span = self._span()
         self.width = check_positive(f"{name}.width", width) if width is not None else 0.08 * span
-        self.pin_diameter = (
-            check_positive(f"{name}.pin_diameter", pin_diameter) if pin_diameter is not None else 0.03 * span
-        )
+        self.pin_diameter = check_positive(f"{name}.pin_diameter", pin_diameter) if pin_diameter is not None else 0.03 * span
         self._anchors = self._local_anchors()
         parts, joints = self._build_parts_and_joints()
         pts = {}
@@ -713,9 +751,12 @@ class Linkage(Mechanism):
             for group in n.held_by():
                 if not any(all(g in lk.nodes for g in group) for lk in self.links):
                     others = ", ".join(repr(g) for g in group if g != n.name)
-                    raise InputError(f"{name}.nodes.{n.name}", n.name,
-                                     f"a link carrying {n.name!r} with {others} (the {n.kind} node is placed "
-                                     "from them; without that link no part holds it there)")
+                    raise InputError(
+                        f"{name}.nodes.{n.name}",
+                        n.name,
+                        f"a link carrying {n.name!r} with {others} (the {n.kind} node is placed "
+                        "from them; without that link no part holds it there)",
+                    )
 
     def _guide_owner(self, lk: Link) -> str:
         """The link (not ``lk``) that carries both nodes of ``lk``'s guide line."""
@@ -724,8 +765,11 @@ class Linkage(Mechanism):
         for other in self.links:
             if other.name != lk.name and p in other.nodes and q in other.nodes:
                 return other.name
-        raise InputError(f"{self.name}.links.{lk.name}.guide", list(lk.guide),
-                         "two nodes carried by one other link (the link the block slides along)")
+        raise InputError(
+            f"{self.name}.links.{lk.name}.guide",
+            list(lk.guide),
+            "two nodes carried by one other link (the link the block slides along)",
+        )
 
     def _link_of(self, node: str, exclude_ground: bool) -> str:
         for lk in self.links:
@@ -756,14 +800,16 @@ class Linkage(Mechanism):
         for lk in self.links:
             nodes = list(lk.nodes)
             for i, a in enumerate(nodes):
-                for b in nodes[i + 1:]:
+                for b in nodes[i + 1 :]:
                     d = np.hypot(*(P[a] - P[b]).T)
                     change = float(d.max() - d.min())
                     if change > tol:
                         raise InputError(
-                            f"{name}.links.{lk.name}", nodes,
+                            f"{name}.links.{lk.name}",
+                            nodes,
                             f"a rigid link: nodes {a!r} and {b!r} move relative to each other "
-                            f"(their distance changes by {change:.4g}, from {d.min():.6g} to {d.max():.6g})")
+                            f"(their distance changes by {change:.4g}, from {d.min():.6g} to {d.max():.6g})",
+                        )
             if lk.guide is not None and len(nodes) >= 2:
                 g = P[lk.guide[1]] - P[lk.guide[0]]
                 e = P[nodes[1]] - P[nodes[0]]
@@ -771,9 +817,11 @@ class Linkage(Mechanism):
                 dev = float(np.ptp(np.unwrap(turn)))
                 if dev > 1e-9:
                     raise InputError(
-                        f"{name}.links.{lk.name}", nodes,
+                        f"{name}.links.{lk.name}",
+                        nodes,
                         f"a block that keeps its guide's direction: nodes {nodes[0]!r}-{nodes[1]!r} turn by "
-                        f"{dev:.4g} rad against the guide {lk.guide[0]!r}-{lk.guide[1]!r}")
+                        f"{dev:.4g} rad against the guide {lk.guide[0]!r}-{lk.guide[1]!r}",
+                    )
 
     # -- solving ------------------------------------------------------------
     #: driver value at which the declared branches hold (``None``: at the first sample); see
@@ -924,9 +972,13 @@ class Linkage(Mechanism):
                 valid &= ok
         return vel, valid
 
-    def node_accelerations(self, q: ArrayLike, qdot: ArrayLike = 1.0, qddot: ArrayLike = 0.0,
-                           solved: tuple[dict[str, Array], list[tuple[Mask, str, str]]] | None = None,
-                           ) -> tuple[dict[str, Array], dict[str, Array], dict[str, Array], Mask]:
+    def node_accelerations(
+        self,
+        q: ArrayLike,
+        qdot: ArrayLike = 1.0,
+        qddot: ArrayLike = 0.0,
+        solved: tuple[dict[str, Array], list[tuple[Mask, str, str]]] | None = None,
+    ) -> tuple[dict[str, Array], dict[str, Array], dict[str, Array], Mask]:
         """Position, velocity and acceleration ``(N, 2)`` of every node (own frame, before placement).
 
         Each node kind differentiates its closure twice
@@ -956,8 +1008,9 @@ class Linkage(Mechanism):
                     valid &= mask
         return pos, vel, acc, valid
 
-    def link_rates(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array]
-                   ) -> dict[str, tuple[Array, Array, Array, Array]]:
+    def link_rates(
+        self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array]
+    ) -> dict[str, tuple[Array, Array, Array, Array]]:
         """Per link: ``(origin velocity, origin acceleration, omega, alpha)`` in the linkage's own frame.
 
         The link's frame is its pose's (origin at its first node, x toward its
@@ -1022,8 +1075,9 @@ class Linkage(Mechanism):
             first = links[0]
             for other in links[1:]:
                 jname = nd if len(links) == 2 else f"{nd}:{other}"
-                joints.append(Pivot(jname, first, other, self._anchors[first][nd], self._anchors[other][nd],
-                                    diameter=self.pin_diameter))
+                joints.append(
+                    Pivot(jname, first, other, self._anchors[first][nd], self._anchors[other][nd], diameter=self.pin_diameter)
+                )
         guided = {(lk.guide, nd): lk for lk in self.links if lk.guide is not None for nd in lk.nodes[:1]}
         for node in self.nodes:
             if isinstance(node, RRP) and ((node.p, node.q), node.name) not in guided:
@@ -1039,8 +1093,9 @@ class Linkage(Mechanism):
             parts.append(Part(lk.name, tuple(hull), (), ground=lk.name == self.ground_name))
         return parts, joints
 
-    def _slot_on(self, owner: str, node: str, p: str, q: str, offset: float, pad: float,
-                 hulls: dict[str, list[tuple[float, float, float]]]) -> tuple[Vec, Vec]:
+    def _slot_on(
+        self, owner: str, node: str, p: str, q: str, offset: float, pad: float, hulls: dict[str, list[tuple[float, float, float]]]
+    ) -> tuple[Vec, Vec]:
         """Ends of a slot on ``owner`` along ``p -> q`` covering ``node``'s travel plus ``pad``; widens the hull."""
         ap = np.asarray(self._anchors[owner][p])
         aq = np.asarray(self._anchors[owner][q])
@@ -1053,23 +1108,37 @@ class Linkage(Mechanism):
         hulls[owner].extend([(start_t[0], start_t[1], self.width / 2), (end_t[0], end_t[1], self.width / 2)])
         return start_t, end_t
 
-    def _pin_slot(self, node: RRP, links: list[str], hulls: dict[str, list[tuple[float, float, float]]],
-                  joints: list[Pivot | PinInSlot | Slide]) -> None:
+    def _pin_slot(
+        self,
+        node: RRP,
+        links: list[str],
+        hulls: dict[str, list[tuple[float, float, float]]],
+        joints: list[Pivot | PinInSlot | Slide],
+    ) -> None:
         owner = next((lk.name for lk in self.links if node.p in lk.nodes and node.q in lk.nodes), None)
         if owner is None:
-            raise InputError(f"{self.name}.nodes.{node.name}", (node.p, node.q),
-                             "line nodes carried by one link (the slot's part)")
+            raise InputError(
+                f"{self.name}.nodes.{node.name}", (node.p, node.q), "line nodes carried by one link (the slot's part)"
+            )
         start, end = self._slot_on(owner, node.name, node.p, node.q, node.offset, 0.0, hulls)
         riders = [lk for lk in links if lk != owner]
         if not riders:
-            raise InputError(f"{self.name}.nodes.{node.name}", node.name,
-                             "a link that carries the pin running in the slot")
+            raise InputError(f"{self.name}.nodes.{node.name}", node.name, "a link that carries the pin running in the slot")
         pin_link = riders[0]
-        joints.append(PinInSlot(f"{node.name}-slot", owner, pin_link, start, end,
-                                self._anchors[pin_link][node.name], width=self.pin_diameter))
+        joints.append(
+            PinInSlot(
+                f"{node.name}-slot", owner, pin_link, start, end, self._anchors[pin_link][node.name], width=self.pin_diameter
+            )
+        )
 
-    def _block_slide(self, lk: Link, node: str, guide: tuple[str, str],
-                     hulls: dict[str, list[tuple[float, float, float]]], joints: list[Pivot | PinInSlot | Slide]) -> None:
+    def _block_slide(
+        self,
+        lk: Link,
+        node: str,
+        guide: tuple[str, str],
+        hulls: dict[str, list[tuple[float, float, float]]],
+        joints: list[Pivot | PinInSlot | Slide],
+    ) -> None:
         """A block ``lk`` on ``node`` sliding along the line ``guide`` of the link that carries it."""
         owner = self._guide_owner(lk)
         p, q = guide
@@ -1082,14 +1151,18 @@ class Linkage(Mechanism):
         pins = [(anchor[0] - self.width, anchor[1]), (anchor[0] + self.width, anchor[1])]
         for px, py in pins:
             hulls[lk.name].append((px, py, self.width / 2))
-        joints.append(Slide(f"{lk.name}-slide", owner, lk.name, start, end, pins[0], (2 * self.width, 0.0),
-                            width=self.pin_diameter))
+        joints.append(
+            Slide(f"{lk.name}-slide", owner, lk.name, start, end, pins[0], (2 * self.width, 0.0), width=self.pin_diameter)
+        )
 
     @property
     def extra_driven_parts(self) -> list[str]:
         """Links of the inputs beyond the first that no gear ties to it (a simulation imposes their motion)."""
-        return [self._link_of(n.name, exclude_ground=True) for n in self.nodes
-                if getattr(n, "clocked", False) and n is not self._driver_node]
+        return [
+            self._link_of(n.name, exclude_ground=True)
+            for n in self.nodes
+            if getattr(n, "clocked", False) and n is not self._driver_node
+        ]
 
     def input_values(self, q: ArrayLike) -> dict[str, Array]:
         """Each input node's value (crank angle, rad, unwrapped) at driver values ``q`` when there are several.

@@ -141,7 +141,8 @@ class FourBar(Linkage):
         self.coupler_point = (float(cpf[0]), float(cpf[1]))
         if max(a, b, c, d) >= (a + b + c + d) - max(a, b, c, d):
             raise InputError(
-                f"{name}.links", (a, b, c, d),
+                f"{name}.links",
+                (a, b, c, d),
                 "the longest link shorter than the sum of the other three (else it cannot close)",
             )
         nodes = [

@@ -88,9 +88,12 @@ class Geared(NodeKind):
         check_finite(f"{where}.phase", self.phase)
         r = float(check_finite(f"{where}.ratio", self.ratio))
         if not r < 0:
-            raise InputError(f"{where}.ratio", self.ratio,
-                             "a negative ratio (external spur gears turn opposite ways; a positive ratio needs an "
-                             "idler or a belt, which planar does not build)")
+            raise InputError(
+                f"{where}.ratio",
+                self.ratio,
+                "a negative ratio (external spur gears turn opposite ways; a positive ratio needs an "
+                "idler or a belt, which planar does not build)",
+            )
 
     def bind(self, where: str, nodes: Mapping[str, NodeKind]) -> NodeKind:
         m = nodes[self.mesh]
@@ -98,8 +101,11 @@ class Geared(NodeKind):
             raise InputError(f"{where}.mesh", self.mesh, "a crank, geared or driven node (the gear it meshes with)")
         for c in (self.centre, m.centre):
             if not isinstance(nodes[c], Fixed):
-                raise InputError(f"{where}.centre" if c == self.centre else f"{where}.mesh", c,
-                                 "gear centres on fixed nodes (both gears turn about the ground)")
+                raise InputError(
+                    f"{where}.centre" if c == self.centre else f"{where}.mesh",
+                    c,
+                    "gear centres on fixed nodes (both gears turn about the ground)",
+                )
         return replace(self, base=m)
 
     def input_angle(self, q: Array) -> Array:
@@ -115,8 +121,9 @@ class Geared(NodeKind):
         w = self.ratio * _omega(pos, vel, self.base.name, self.base.centre)
         return vel[self.centre] + w[:, None] * _perp(pos[self.name] - pos[self.centre]), None
 
-    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
-                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+    def acceleration(
+        self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array], qd: Array, qdd: Array
+    ) -> tuple[Array, Mask | None]:
         assert isinstance(self.base, (Crank, Geared, Driven))
         m, c = self.base.name, self.base.centre
         w, al = frame_rates(pos[m] - pos[c], vel[m] - vel[c], acc[m] - acc[c])
@@ -131,8 +138,9 @@ class Geared(NodeKind):
         ca, cb = np.asarray(lk._ref_nodes[mesh_centre]), np.asarray(lk._ref_nodes[self.centre])
         d = float(np.hypot(*(cb - ca)))
         if d <= 0:
-            raise InputError(f"{lk.name}.nodes.{self.name}.centre", self.centre,
-                             f"a gear centre apart from its partner's {mesh_centre!r}")
+            raise InputError(
+                f"{lk.name}.nodes.{self.name}.centre", self.centre, f"a gear centre apart from its partner's {mesh_centre!r}"
+            )
         k = abs(self.ratio)
         ra, rb = d * k / (1 + k), d / (1 + k)
         xa, ya = lk._anchors[la][mesh_centre]
@@ -141,10 +149,13 @@ class Geared(NodeKind):
         for link, (cx, cy), radius in ((la, (xa, ya), ra), (lb, (xb, yb), rb)):
             reach = max(float(np.hypot(x - cx, y - cy)) + r for x, y, r in hulls[link])
             if reach > radius * (1 + 1e-9):
-                raise InputError(f"{lk.name}.links.{link}", list(next(k.nodes for k in lk.links if k.name == link)),
-                                 f"a gear part within its pitch circle (radius {radius:.4g}): it reaches "
-                                 f"{reach:.4g} from its centre (part width {lk.width:.4g}), so the two gears "
-                                 "could not turn in one layer; shorten the crank or move the centres apart")
+                raise InputError(
+                    f"{lk.name}.links.{link}",
+                    list(next(k.nodes for k in lk.links if k.name == link)),
+                    f"a gear part within its pitch circle (radius {radius:.4g}): it reaches "
+                    f"{reach:.4g} from its centre (part width {lk.width:.4g}), so the two gears "
+                    "could not turn in one layer; shorten the crank or move the centres apart",
+                )
         hulls[la].append((xa, ya, ra))
         hulls[lb].append((xb, yb, rb))
         ref = lk._link_poses({n: v[None, :] for n, v in lk._ref_nodes.items()}, 1)
@@ -152,8 +163,9 @@ class Geared(NodeKind):
         return [GearMesh(f"{self.name}-gear", la, lb, float(self.ratio), phase, (xa, ya), (xb, yb), ra, rb)]
 
 
-def _turning(pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array], node: str, centre: str,
-             w: Array, al: Array) -> Array:
+def _turning(
+    pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array], node: str, centre: str, w: Array, al: Array
+) -> Array:
     """Acceleration of ``node`` turning about ``centre`` at ``w`` (rad/s), ``al`` (rad/s^2)."""
     r = pos[node] - pos[centre]
     return acc[centre] + al[:, None] * _perp(r) - (w * w)[:, None] * r
@@ -215,7 +227,7 @@ class Driven(NodeKind):
         """``d2 angle / d theta2``."""
         if self.amplitude is None:
             return np.zeros_like(q)
-        return -self.amplitude * self.cycles ** 2 * np.sin(self.cycles * q + self.phase)
+        return -self.amplitude * self.cycles**2 * np.sin(self.cycles * q + self.phase)
 
     def make_driver(self, link: str, origin: tuple[float, float], rate: float, phase: float) -> Driver:
         """The linkage's driver when this node is its first input: the clock (kind ``"path"``)."""
@@ -228,17 +240,18 @@ class Driven(NodeKind):
     def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
         raise NotImplementedError("a driven node's velocity needs the clock value: call velocity_at")
 
-    def velocity_at(self, pos: Mapping[str, Array], vel: Mapping[str, Array], q: Array,
-                    qd: Array) -> tuple[Array, Mask | None]:
+    def velocity_at(self, pos: Mapping[str, Array], vel: Mapping[str, Array], q: Array, qd: Array) -> tuple[Array, Mask | None]:
         w = self.input_rate(q) * qd
         return vel[self.centre] + w[:, None] * _perp(pos[self.name] - pos[self.centre]), None
 
-    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
-                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+    def acceleration(
+        self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array], qd: Array, qdd: Array
+    ) -> tuple[Array, Mask | None]:
         raise NotImplementedError("a driven node's acceleration needs the clock value: call acceleration_at")
 
-    def acceleration_at(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
-                        q: Array, qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+    def acceleration_at(
+        self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array], q: Array, qd: Array, qdd: Array
+    ) -> tuple[Array, Mask | None]:
         w = self.input_rate(q) * qd
         al = self.input_accel(q) * qd * qd + self.input_rate(q) * qdd
         return _turning(pos, vel, acc, self.name, self.centre, w, al), None

@@ -57,5 +57,3 @@ class _Plan:
     bound: list[float]  # a bound on |coordinate| of each node, for q = 0 (actuators add |q|)
     grows: list[bool]  # node moves with |q| (downstream of an actuator)
     program: Any = None  # the compiled program (planar.linkages.compiled), built on first use
-
-

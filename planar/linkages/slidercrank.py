@@ -40,8 +40,9 @@ class SliderCrank(Linkage):
         l = check_positive(f"{name}.rod", rod)
         e = float(check_finite(f"{name}.offset", offset))
         if abs(e) >= r + l:
-            raise InputError(f"{name}.offset", offset,
-                             f"|offset| < crank + rod = {r + l:g} (else the rod never reaches the guide)")
+            raise InputError(
+                f"{name}.offset", offset, f"|offset| < crank + rod = {r + l:g} (else the rod never reaches the guide)"
+            )
         if isinstance(branch, bool) or branch not in (1, -1):
             raise InputError(f"{name}.branch", branch, "1 (slider on the +x side) or -1")
         self.r, self.l, self.e = r, l, e

@@ -80,8 +80,9 @@ def _residual(K: Array, u: Array, L: Array, S: Array) -> tuple[Array, Array]:
     return F, J
 
 
-def _newton(K: Array, u0: Array, L: Array, S: Array, scale: float,
-            iters: int = 50) -> tuple[Array, NDArray[np.bool_], NDArray[np.bool_]]:
+def _newton(
+    K: Array, u0: Array, L: Array, S: Array, scale: float, iters: int = 50
+) -> tuple[Array, NDArray[np.bool_], NDArray[np.bool_]]:
     """Newton from ``u0`` for every row at once: ``(u, converged, singular)``."""
     u = np.array(u0, float, copy=True)
     n = u.shape[0]
@@ -96,13 +97,18 @@ def _newton(K: Array, u0: Array, L: Array, S: Array, scale: float,
         err = (np.abs(F) / (2.0 * L)).max(1)
         done = err <= tol
         det = np.linalg.det(J)
-        bad = ~done & ~(np.abs(det) > 1e-12 * scale ** 4)
+        bad = ~done & ~(np.abs(det) > 1e-12 * scale**4)
         go = ~done & ~bad
         if go.any():
             step = np.linalg.solve(J[go], F[go][:, :, None])[:, :, 0]
             # damped: at most a quarter of the scale and half a radian per iteration
-            f = np.minimum(1.0, np.minimum(0.25 * scale / np.maximum(np.hypot(step[:, 0], step[:, 1]), 1e-300),
-                                           0.5 / np.maximum(np.abs(step[:, 2]), 1e-300)))
+            f = np.minimum(
+                1.0,
+                np.minimum(
+                    0.25 * scale / np.maximum(np.hypot(step[:, 0], step[:, 1]), 1e-300),
+                    0.5 / np.maximum(np.abs(step[:, 2]), 1e-300),
+                ),
+            )
             u[idx[go]] -= f[:, None] * step
         active[idx[done | bad]] = False
         sing[idx[bad]] = True
@@ -116,8 +122,9 @@ def _pose_distance(a: Array, b: Array, scale: float) -> Array:
     return np.hypot(np.hypot(a[:, 0] - b[:, 0], a[:, 1] - b[:, 1]), scale * d)
 
 
-def solve_triad(K: Array, L: Array, S: Array, u_ref: Array, cont: NDArray[np.bool_],
-                scale: float) -> tuple[Array, NDArray[np.bool_], NDArray[np.int8]]:
+def solve_triad(
+    K: Array, L: Array, S: Array, u_ref: Array, cont: NDArray[np.bool_], scale: float
+) -> tuple[Array, NDArray[np.bool_], NDArray[np.int8]]:
     """Ternary-link poses ``(N, 3)`` for outer nodes ``K`` ``(N, 3, 2)``, validity, and why (codes).
 
     ``cont[k]``: sample ``k`` continues sample ``k - 1`` (a path); the other
@@ -142,7 +149,7 @@ def solve_triad(K: Array, L: Array, S: Array, u_ref: Array, cont: NDArray[np.boo
         j = i
         while j + 1 < ks.size and ks[j + 1] == ks[j] + 1 and j + 1 - i < block:
             j += 1
-        rows = ks[i:j + 1]
+        rows = ks[i : j + 1]
         base = p - 1
         while base >= 0 and not ok[base]:
             base -= 1
@@ -210,9 +217,11 @@ def solve_triad(K: Array, L: Array, S: Array, u_ref: Array, cont: NDArray[np.boo
     return u, ok, code
 
 
-_WHY = {1: "Newton found no assembly (the loop cannot close)",
-        2: "its Jacobian is singular (a dead centre)",
-        3: "the solution jumped to another branch"}
+_WHY = {
+    1: "Newton found no assembly (the loop cannot close)",
+    2: "its Jacobian is singular (a dead centre)",
+    3: "the solution jumped to another branch",
+}
 
 
 @node_kind
@@ -257,8 +266,11 @@ class Triad(NodeKind):
         if not self.members:
             leaders = [n for n in nodes.values() if isinstance(n, Triad) and n.members and self.name in n.members]
             if len(leaders) != 1:
-                raise InputError(where, self.name, "a triad node named in the members of exactly one triad node "
-                                 f"declared before it (found {len(leaders)})")
+                raise InputError(
+                    where,
+                    self.name,
+                    f"a triad node named in the members of exactly one triad node declared before it (found {len(leaders)})",
+                )
             return self
         group = [self]
         for m in self.members:
@@ -268,15 +280,19 @@ class Triad(NodeKind):
             if order[m] < order[self.name]:
                 raise InputError(f"{where}.members", m, f"a node declared after {self.name!r} (the triad's first)")
             if order[node.a] > order[self.name]:
-                raise InputError(f"{where}.members", m, f"a member whose node {node.a!r} is declared before "
-                                 f"{self.name!r} (the triad is placed there)")
+                raise InputError(
+                    f"{where}.members",
+                    m,
+                    f"a member whose node {node.a!r} is declared before {self.name!r} (the triad is placed there)",
+                )
             group.append(node)
         S = np.array([g.local for g in group], float)
         area = (S[1, 0] - S[0, 0]) * (S[2, 1] - S[0, 1]) - (S[1, 1] - S[0, 1]) * (S[2, 0] - S[0, 0])
         size = max(float(np.ptp(S, axis=0).max()), 1e-300)
         if abs(area) <= 1e-9 * size * size:
-            raise InputError(f"{where}.local", [list(g.local) for g in group],
-                             "three local points of the ternary link not on one line")
+            raise InputError(
+                f"{where}.local", [list(g.local) for g in group], "three local points of the ternary link not on one line"
+            )
         return replace(self, group=tuple(group))
 
     # -- solving ------------------------------------------------------------
@@ -325,18 +341,18 @@ class Triad(NodeKind):
         n = T[0].shape[0]
         M = np.zeros((n, 6, 6))
         for i, g in enumerate(self.group):
-            M[:, i, 2 * i:2 * i + 2] = T[i] - pos[g.a]
+            M[:, i, 2 * i : 2 * i + 2] = T[i] - pos[g.a]
         for r, (i, j) in enumerate(self._PAIRS, 3):
             d = T[i] - T[j]
-            M[:, r, 2 * i:2 * i + 2] = d
-            M[:, r, 2 * j:2 * j + 2] = -d
+            M[:, r, 2 * i : 2 * i + 2] = d
+            M[:, r, 2 * j : 2 * j + 2] = -d
         scale = self._data()[3]
-        ok: Mask = np.abs(np.linalg.det(M)) > 1e-12 * scale ** 6
+        ok: Mask = np.abs(np.linalg.det(M)) > 1e-12 * scale**6
         M[~ok] = np.eye(6)
         x = np.asarray(np.linalg.solve(M, b[:, :, None])[:, :, 0], dtype=np.float64)
         dest = cast(dict, out)  # the first node places its members' rates too
         for k, g in enumerate(self.group[1:], 1):
-            dest[g.name] = x[:, 2 * k:2 * k + 2]
+            dest[g.name] = x[:, 2 * k : 2 * k + 2]
         return x[:, :2], ok
 
     def velocity(self, pos: Mapping[str, Array], vel: Mapping[str, Array], qd: Array) -> tuple[Array, Mask | None]:
@@ -349,8 +365,9 @@ class Triad(NodeKind):
             b[:, i] = ((pos[g.name] - pos[g.a]) * vel[g.a]).sum(-1)
         return self._rates(pos, b, vel)
 
-    def acceleration(self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array],
-                     qd: Array, qdd: Array) -> tuple[Array, Mask | None]:
+    def acceleration(
+        self, pos: Mapping[str, Array], vel: Mapping[str, Array], acc: Mapping[str, Array], qd: Array, qdd: Array
+    ) -> tuple[Array, Mask | None]:
         if not self.members:
             return acc[self.name], None
         # differentiated again: (T_i - A_i) . (a_i - aA_i) + |v_i - vA_i|^2 = 0,

@@ -67,20 +67,26 @@ class Comparison:
             out.append(f"simulation failed: {self.failure}")
         if self.max_rel_error > self.threshold:
             worst = max(self.parts, key=lambda p: p.max_rel_error)
-            out.append(f"part {worst.part!r} is {worst.max_rel_error:.3g} of the size off (threshold "
-                       f"{self.threshold:g}) from sample {worst.first_over}")
+            out.append(
+                f"part {worst.part!r} is {worst.max_rel_error:.3g} of the size off (threshold "
+                f"{self.threshold:g}) from sample {worst.first_over}"
+            )
         t = self.torque
         if t:
             if t.get("saturated"):
                 s = t["saturated"]
                 shown = ", ".join(str(i) for i in s[:12]) + (", ..." if len(s) > 12 else "")
-                out.append(f"motor saturated at {len(s)} sample(s) [{shown}] "
-                           f"(force limit {t.get('motor_force_limit'):g}, needed peak {t['peak']:.4g})")
+                out.append(
+                    f"motor saturated at {len(s)} sample(s) [{shown}] "
+                    f"(force limit {t.get('motor_force_limit'):g}, needed peak {t['peak']:.4g})"
+                )
             if t.get("failure") and not self.failure:
                 out.append(f"motor-driven simulation failed: {t['failure']}")
             if t["max_rel_diff"] > self.torque_threshold:
-                out.append(f"motor torque differs from inverse dynamics by {t['max_rel_diff']:.2%} of its peak "
-                           f"(threshold {self.torque_threshold:.0%})")
+                out.append(
+                    f"motor torque differs from inverse dynamics by {t['max_rel_diff']:.2%} of its peak "
+                    f"(threshold {self.torque_threshold:.0%})"
+                )
         return out
 
     @property
@@ -95,9 +101,16 @@ class Comparison:
             "threshold": self.threshold,
             "max_rel_error": self.max_rel_error,
             "first_over_threshold": self.first_over,
-            "parts": {p.part: {"max_error": p.max_error, "rms_error": p.rms_error,
-                               "max_rel_error": p.max_rel_error, "max_angle_error": p.max_angle_error,
-                               "first_over_threshold": p.first_over} for p in self.parts},
+            "parts": {
+                p.part: {
+                    "max_error": p.max_error,
+                    "rms_error": p.rms_error,
+                    "max_rel_error": p.max_rel_error,
+                    "max_angle_error": p.max_angle_error,
+                    "first_over_threshold": p.first_over,
+                }
+                for p in self.parts
+            },
             "joints": {k: {"max_residual": v, "max_rel_residual": v / self.size} for k, v in self.joints.items()},
             "torque": self.torque,
             "notes": self.notes,
@@ -140,8 +153,16 @@ def compare(mech: Mechanism, reference: Motion, other: Motion, threshold: float 
         if first is not None and (first_all is None or first < first_all):
             first_all = first
         n = max(int(ok.sum()), 1)
-        parts.append(PartError(p.name, float(d.max()), float(np.sqrt((d[ok & finite] ** 2).sum() / n)),
-                               float(d.max() / size), float(ang.max()), first))
+        parts.append(
+            PartError(
+                p.name,
+                float(d.max()),
+                float(np.sqrt((d[ok & finite] ** 2).sum() / n)),
+                float(d.max() / size),
+                float(ang.max()),
+                first,
+            )
+        )
     res = joint_residuals(mech, other)
     joints = {k: float(np.max(np.where(ok & finite, v, 0.0))) for k, v in res.items()}
     failure = None
@@ -153,21 +174,25 @@ def compare(mech: Mechanism, reference: Motion, other: Motion, threshold: float 
 
 def format_comparison(c: Comparison) -> str:
     """A table for the terminal."""
-    lines = [f"{c.mechanism}: {c.samples} samples, size {c.size:.4g}, threshold {c.threshold:g} of size",
-             f"  {'part':<16}{'max err':>11}{'rms err':>11}{'max/size':>11}{'max angle':>11}  first over",
-             ]
+    lines = [
+        f"{c.mechanism}: {c.samples} samples, size {c.size:.4g}, threshold {c.threshold:g} of size",
+        f"  {'part':<16}{'max err':>11}{'rms err':>11}{'max/size':>11}{'max angle':>11}  first over",
+    ]
     for p in c.parts:
         first = "-" if p.first_over is None else str(p.first_over)
-        lines.append(f"  {p.part:<16}{p.max_error:11.3e}{p.rms_error:11.3e}{p.max_rel_error:11.3e}"
-                     f"{p.max_angle_error:11.3e}  {first}")
+        lines.append(
+            f"  {p.part:<16}{p.max_error:11.3e}{p.rms_error:11.3e}{p.max_rel_error:11.3e}{p.max_angle_error:11.3e}  {first}"
+        )
     lines.append(f"  {'joint':<16}{'residual':>11}{'/size':>11}")
     for k, v in c.joints.items():
         lines.append(f"  {k:<16}{v:11.3e}{v / c.size:11.3e}")
     if c.torque:
         t = c.torque
-        lines.append(f"  motor torque: pymunk vs inverse dynamics: max |diff| {t['max_abs_diff']:.3e} "
-                     f"({100 * t['max_rel_diff']:.2g}% of peak {t['peak']:.4g}); motor-driven poses within "
-                     f"{t['pose_error']:.2e} of the size")
+        lines.append(
+            f"  motor torque: pymunk vs inverse dynamics: max |diff| {t['max_abs_diff']:.3e} "
+            f"({100 * t['max_rel_diff']:.2g}% of peak {t['peak']:.4g}); motor-driven poses within "
+            f"{t['pose_error']:.2e} of the size"
+        )
     for n in c.notes:
         lines.append(f"  note: {n}")
     for n in c.problems():
@@ -175,8 +200,9 @@ def format_comparison(c: Comparison) -> str:
     return "\n".join(lines)
 
 
-def compare_scene(scene: Any, settings: Any = None, threshold: float = 1e-3, torque_threshold: float = 0.01,
-                  with_series: bool = False) -> tuple[Comparison, Any]:
+def compare_scene(
+    scene: Any, settings: Any = None, threshold: float = 1e-3, torque_threshold: float = 0.01, with_series: bool = False
+) -> tuple[Comparison, Any]:
     """Simulate a scene, compare it with its analytic motion, and (for a steadily turning driver) the
     motor torque with inverse dynamics; returns the comparison and the simulation result.
 
@@ -196,8 +222,18 @@ def compare_scene(scene: Any, settings: Any = None, threshold: float = 1e-3, tor
     if mech.driver.kind == "rotation" and mech.driver.amplitude is None and len(getattr(mech, "stages", [])) <= 1:
         try:
             tc = torque_comparison(mech, scene.motion().t, scene.effects, settings)
-            keep = ("peak", "max_abs_diff", "max_rel_diff", "samples_compared", "motor_force_limit", "saturated",
-                    "failure", "pose_error", "pins", "note")
+            keep = (
+                "peak",
+                "max_abs_diff",
+                "max_rel_diff",
+                "samples_compared",
+                "motor_force_limit",
+                "saturated",
+                "failure",
+                "pose_error",
+                "pins",
+                "note",
+            )
             result.torque = {k: tc[k] for k in keep}
             if with_series:
                 result.torque.update(analytic=tc["analytic"], simulated=tc["simulated"])

@@ -148,7 +148,7 @@ class SimSettings:
         """Fraction of joint error corrected per step of ``dt`` seconds."""
         if self.error_bias is None:
             return self.correction
-        return 1.0 - self.error_bias ** dt
+        return 1.0 - self.error_bias**dt
 
 
 DEFAULT_SETTINGS = SimSettings()
@@ -206,12 +206,14 @@ def _check_mechanism(mech: Mechanism) -> None:
     if getattr(mech, "spatial", False):
         raise SimulationError(
             f"{mech.name}: a spatial mechanism (its follower turns about an axis in the driver's plane) "
-            "cannot be rebuilt in a 2D physics engine")
+            "cannot be rebuilt in a 2D physics engine"
+        )
     for st in getattr(mech, "stages", []):
         if st.mech.spatial:
             raise SimulationError(
                 f"{mech.name}: stage {st.label} ({st.realisation.pattern}, mechanism #{st.realisation.number}) "
-                "is spatial and cannot be rebuilt in a 2D physics engine")
+                "is spatial and cannot be rebuilt in a 2D physics engine"
+            )
 
 
 def _driven_parts(mech: Mechanism) -> list[str]:
@@ -324,8 +326,14 @@ def _lever_factor(mech: Mechanism, poses: dict[str, Array]) -> float:
     return f if f > 1.05 else 1.0
 
 
-def substeps_for(mech: Mechanism, poses: dict[str, Array], vel: dict[str, Array], dt_out: float,
-                 settings: SimSettings, correction: float | None = None) -> int:
+def substeps_for(
+    mech: Mechanism,
+    poses: dict[str, Array],
+    vel: dict[str, Array],
+    dt_out: float,
+    settings: SimSettings,
+    correction: float | None = None,
+) -> int:
     """Physics steps per output sample: ``settings.substeps``, raised for fast-turning joints.
 
     The error correction takes out a fraction ``c`` of a joint's error per
@@ -377,18 +385,23 @@ def mass_ratio_correction(settings: SimSettings, masses: list[float], mode: str 
     return c
 
 
-def moving_masses(mech: Mechanism, mode: str, effects: Effects | None,
-                  densities: dict[str, float] | None = None) -> list[float]:
+def moving_masses(mech: Mechanism, mode: str, effects: Effects | None, densities: dict[str, float] | None = None) -> list[float]:
     """Masses of the parts that move under the solver (not ground, not an imposed driver)."""
     density = effects.density if effects is not None else 1.0
     driven = _driven_parts(mech)
-    return [mass_properties(p, (densities or {}).get(p.name, density))[0] for p in mech.parts
-            if not p.ground and not (p.name in driven and mode == "kinematic")]
+    return [
+        mass_properties(p, (densities or {}).get(p.name, density))[0]
+        for p in mech.parts
+        if not p.ground and not (p.name in driven and mode == "kinematic")
+    ]
+
+
 _PIN_FRACTION = 0.1  # pin mass / its part's mass (see _Rebuild._pin)
 
 
-def _compensated(mass: float, cog: tuple[float, float], moment: float,
-                 pins: list[tuple[tuple[float, float], float]]) -> tuple[float, tuple[float, float], float, float]:
+def _compensated(
+    mass: float, cog: tuple[float, float], moment: float, pins: list[tuple[tuple[float, float], float]]
+) -> tuple[float, tuple[float, float], float, float]:
     """The part without its pins, so that part + pins has the part's mass, centre and moment.
 
     Returns ``(mass, cog, moment, scale)`` with ``scale`` the factor applied
@@ -446,9 +459,17 @@ class _Rebuild:
     seconds): velocities x dt, forces and gravity x dt^2, damping per step.
     """
 
-    def __init__(self, mech: Mechanism, analytic: Motion, effects: Effects | None, settings: SimSettings,
-                 mode: str, dt: float, densities: dict[str, float] | None = None,
-                 overrides: dict[str, tuple[float, tuple[float, float], float, float]] | None = None) -> None:
+    def __init__(
+        self,
+        mech: Mechanism,
+        analytic: Motion,
+        effects: Effects | None,
+        settings: SimSettings,
+        mode: str,
+        dt: float,
+        densities: dict[str, float] | None = None,
+        overrides: dict[str, tuple[float, tuple[float, float], float, float]] | None = None,
+    ) -> None:
         import pymunk
 
         self.pymunk = pymunk
@@ -457,8 +478,7 @@ class _Rebuild:
         self.mode = mode
         self.dt = dt
         space = pymunk.Space()
-        built: dict[str, Any] = {"gravity": None, "damping": None,
-                                 "springs": 0, "loads": 0, "constraints": 0, "bodies": 0}
+        built: dict[str, Any] = {"gravity": None, "damping": None, "springs": 0, "loads": 0, "constraints": 0, "bodies": 0}
         if effects is not None and effects.gravity is not None:
             space.gravity = (float(effects.gravity[0]) * dt * dt, float(effects.gravity[1]) * dt * dt)
             built["gravity"] = tuple(effects.gravity)
@@ -490,9 +510,11 @@ class _Rebuild:
                     m, cog, inertia, _ = self.overrides[p.name]
                 if not (math.isfinite(m) and m > 0 and math.isfinite(inertia) and inertia > 0):
                     # Chipmunk aborts the process on a mass it cannot use: say which part and why, first
-                    raise SimulationError(f"part {p.name!r}: mass {m:.4g} and moment {inertia:.4g} from [effects] "
-                                          f"density {d:.4g}: expected a positive, finite mass and moment (a density "
-                                          "or size this large or small leaves float64)")
+                    raise SimulationError(
+                        f"part {p.name!r}: mass {m:.4g} and moment {inertia:.4g} from [effects] "
+                        f"density {d:.4g}: expected a positive, finite mass and moment (a density "
+                        "or size this large or small leaves float64)"
+                    )
                 body = pymunk.Body(m, inertia)
                 masses.append(m)
                 # The body's frame is put at the part's centre of gravity (``center_of_gravity``
@@ -500,8 +522,7 @@ class _Rebuild:
                 # pin leave its groove, so part-frame anchors are shifted by ``cog`` instead.
                 self.cog[p.name] = cog
             plane = getattr(p, "plane", "xy")
-            if plane != "xy" and body.body_type == pymunk.Body.DYNAMIC and effects is not None \
-                    and effects.gravity is not None:
+            if plane != "xy" and body.body_type == pymunk.Body.DYNAMIC and effects is not None and effects.gravity is not None:
                 # a toy's piece in another plane feels the part of the toy's gravity in its plane
                 from planar.analysis.dynamics import plane_gravity
 
@@ -568,8 +589,9 @@ class _Rebuild:
                     rest = float(np.hypot(pa[0] - pb[0], pa[1] - pb[1]))
                 space.add(pymunk.DampedSpring(a, b, aa, bb, rest, s.stiffness * dt * dt, s.damping * dt))
                 built["springs"] += 1
-            self.loads = [(mech.points[ld.point][0], mech.points[ld.point][1], np.asarray(ld.force, float))
-                          for ld in effects.loads]
+            self.loads = [
+                (mech.points[ld.point][0], mech.points[ld.point][1], np.asarray(ld.force, float)) for ld in effects.loads
+            ]
             built["loads"] = len(self.loads)
         self.motor = None
         self.motor_limit: float | None = None
@@ -712,7 +734,8 @@ def _cam_on_line(rb: _Rebuild, j: CamOnLine, effects: Effects | None) -> list[An
     if not _holding_effect(effects):
         raise SimulationError(
             f"{rb.mech.name}: joint {j.name!r} is a contact held by gravity or a spring; "
-            "name one in the scene's [effects] (gravity = [...] or springs = [...])")
+            "name one in the scene's [effects] (gravity = [...] or springs = [...])"
+        )
     if j.radius != 0.0:
         raise SimulationError(f"{rb.mech.name}: joint {j.name!r}: a round cam on a face is not rebuilt")
     s0, s1 = _padded(rb._local(j.a, j.start), rb._local(j.a, j.end))
@@ -724,8 +747,10 @@ def _keyed_shaft(rb: _Rebuild, j: KeyedShaft, effects: Effects | None) -> list[A
     """A pivot on the shaft and a ``GearJoint`` (ratio 1) holding the phase."""
     B = rb.bodies
     phase = B[j.b].angle - B[j.a].angle
-    return [rb.pymunk.PivotJoint(B[j.a], B[j.b], rb._local(j.a, j.anchor_a), rb._local(j.b, j.anchor_b)),
-            rb.pymunk.GearJoint(B[j.a], B[j.b], phase, 1.0)]
+    return [
+        rb.pymunk.PivotJoint(B[j.a], B[j.b], rb._local(j.a, j.anchor_a), rb._local(j.b, j.anchor_b)),
+        rb.pymunk.GearJoint(B[j.a], B[j.b], phase, 1.0),
+    ]
 
 
 @REBUILDERS.register(CamContact)
@@ -735,7 +760,8 @@ def _cam_profile(rb: _Rebuild, j: CamContact, effects: Effects | None) -> list[A
         f"{rb.mech.name}: joint {j.name!r} is a profile cam (joint kind 'cam-profile'), which is not rebuilt in "
         "pymunk: holding the follower on the outline would take collision contact, which the rebuild does not use "
         "(parts sit in layers), and a groove along the analytic profile would only replay the analytic motion; "
-        "no comparison is made")
+        "no comparison is made"
+    )
 
 
 def _padded(a, b, frac: float = 0.1) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -776,8 +802,7 @@ def _hull_points(mech: Mechanism, part: str) -> Array:
 class _PoseCheck:
     """Deviation of simulated poses from the analytic ones, a block of samples at a time."""
 
-    def __init__(self, mech: Mechanism, analytic: dict[str, Array], names: list[str],
-                 cogs: Array, settings: SimSettings) -> None:
+    def __init__(self, mech: Mechanism, analytic: dict[str, Array], names: list[str], cogs: Array, settings: SimSettings) -> None:
         self.mech = mech
         self.names = names
         self.cogs = cogs  # (B, 2) body frame origin in the part frame
@@ -804,7 +829,7 @@ class _PoseCheck:
         dev = np.empty((n, len(self.names)))
         for k, name in enumerate(self.names):
             pts = poses_apply(poses[:, k], self.pts[name])
-            d = np.hypot(*(pts - self.ref[name][i0:i0 + n]).transpose(2, 0, 1)).max(axis=1)
+            d = np.hypot(*(pts - self.ref[name][i0 : i0 + n]).transpose(2, 0, 1)).max(axis=1)
             dev[:, k] = np.where(np.isfinite(d), d, np.inf)
         bad = (dev > self.tol).any(axis=1)
         if not bad.any():
@@ -818,10 +843,11 @@ class _PoseCheck:
         return i0 + i, self.names[k], float(dev[i, k])
 
 
-def _classify(mech: Mechanism, poses: dict[str, Array], i: int, part: str, err: float, t: float,
-              settings: SimSettings) -> SimFailure:
+def _classify(
+    mech: Mechanism, poses: dict[str, Array], i: int, part: str, err: float, t: float, settings: SimSettings
+) -> SimFailure:
     size = mech.size
-    one = {k: v[i:i + 1] for k, v in poses.items()}
+    one = {k: v[i : i + 1] for k, v in poses.items()}
     finite = all(np.isfinite(v).all() for v in one.values())
     res = {j.name: float(np.max(j.residual(one))) for j in mech.joints} if finite else {}
     worst_joint = max(res, key=lambda k: res[k]) if res else None
@@ -831,23 +857,46 @@ def _classify(mech: Mechanism, poses: dict[str, Array], i: int, part: str, err: 
         return SimFailure(i, t, part, "blow-up", math.inf, f"blew up {where}: non-finite body state")
     rel = err / size
     if worst > settings.blowup_tol * size:
-        return SimFailure(i, t, part, "blow-up", rel,
-                          f"blew up {where}: joint {worst_joint!r} residual {worst / size:.3g} of the size "
-                          f"(part off its analytic pose by {rel:.3g} of the size)")
+        return SimFailure(
+            i,
+            t,
+            part,
+            "blow-up",
+            rel,
+            f"blew up {where}: joint {worst_joint!r} residual {worst / size:.3g} of the size "
+            f"(part off its analytic pose by {rel:.3g} of the size)",
+        )
     if worst < 0.1 * err and rel > 10.0 * settings.tolerance:
         # every joint holds and the part is far off: another assembly branch (an offset of a few tolerances
         # with the joints holding is drift amplified by a long lever, reported below)
-        return SimFailure(i, t, part, "branch", rel,
-                          f"switched assembly branch {where}: the part is {rel:.3g} of the size from its "
-                          f"analytic pose while every joint holds (worst residual {worst / size:.2g} of the size)")
-    return SimFailure(i, t, part, "drift", rel,
-                      f"left the analytic motion {where}: {rel:.3g} of the size off (tolerance "
-                      f"{settings.tolerance:g}); joint {worst_joint!r} residual {worst / size:.3g} of the size")
+        return SimFailure(
+            i,
+            t,
+            part,
+            "branch",
+            rel,
+            f"switched assembly branch {where}: the part is {rel:.3g} of the size from its "
+            f"analytic pose while every joint holds (worst residual {worst / size:.2g} of the size)",
+        )
+    return SimFailure(
+        i,
+        t,
+        part,
+        "drift",
+        rel,
+        f"left the analytic motion {where}: {rel:.3g} of the size off (tolerance "
+        f"{settings.tolerance:g}); joint {worst_joint!r} residual {worst / size:.3g} of the size",
+    )
 
 
-def simulate(mech: Mechanism, t: Array, effects: Effects | None = None,
-             settings: SimSettings = DEFAULT_SETTINGS, mode: str = "kinematic",
-             densities: dict[str, float] | None = None) -> SimResult:
+def simulate(
+    mech: Mechanism,
+    t: Array,
+    effects: Effects | None = None,
+    settings: SimSettings = DEFAULT_SETTINGS,
+    mode: str = "kinematic",
+    densities: dict[str, float] | None = None,
+) -> SimResult:
     """Simulate ``mech`` at output times ``t`` (s, evenly spaced), driven by the analytic input.
 
     ``mode="motor"`` turns the driver with a ``SimpleMotor`` at the driver's
@@ -868,18 +917,30 @@ def simulate(mech: Mechanism, t: Array, effects: Effects | None = None,
     if mode == "motor" and (mech.driver.kind != "rotation" or mech.driver.amplitude is not None):
         raise SimulationError(f"{mech.name}: motor mode needs a driver turning at a constant rate")
     if mode == "motor" and getattr(mech, "extra_driven_parts", []):
-        raise SimulationError(f"{mech.name}: motor mode drives one part; this linkage has more inputs "
-                              f"({', '.join(mech.extra_driven_parts)}), each imposed kinematically")  # type: ignore[attr-defined]
+        raise SimulationError(
+            f"{mech.name}: motor mode drives one part; this linkage has more inputs "
+            f"({', '.join(mech.extra_driven_parts)}), each imposed kinematically"
+        )  # type: ignore[attr-defined]
     if mode == "motor" and len(_driven_parts(mech)) > 1:
-        raise SimulationError(f"{mech.name}: motor mode drives one part; this toy's stages are drawn apart, "
-                              "so each stage's driver must follow its parent kinematically")
+        raise SimulationError(
+            f"{mech.name}: motor mode drives one part; this toy's stages are drawn apart, "
+            "so each stage's driver must follow its parent kinematically"
+        )
     poses_a, vel_a, analytic = _analytic_pose_velocity(mech, t)
     if not analytic.valid.all():
         i = int(np.flatnonzero(~analytic.valid)[0])
-        raise SimulationError(f"{mech.name}: the analytic motion is invalid at sample {i} "
-                              f"({analytic.reason(i)}); the rebuild needs an assemblable cycle")
-    sub = substeps_for(mech, poses_a, vel_a, dt_out, settings,
-                       mass_ratio_correction(settings, moving_masses(mech, mode, effects, densities), mode))
+        raise SimulationError(
+            f"{mech.name}: the analytic motion is invalid at sample {i} "
+            f"({analytic.reason(i)}); the rebuild needs an assemblable cycle"
+        )
+    sub = substeps_for(
+        mech,
+        poses_a,
+        vel_a,
+        dt_out,
+        settings,
+        mass_ratio_correction(settings, moving_masses(mech, mode, effects, densities), mode),
+    )
     dt = dt_out / sub
     rb = _Rebuild(mech, analytic, effects, settings, mode, dt, densities)
     comp = rb.compensation()
@@ -913,8 +974,7 @@ def simulate(mech: Mechanism, t: Array, effects: Effects | None = None,
                 steady.append((rb.bodies[name], float(tg[0, 0]), float(tg[0, 1]), float(tg[0, 2])))
             else:
                 per_step.append((rb.bodies[name], tg[:, 0].tolist(), tg[:, 1].tolist(), tg[:, 2].tolist()))
-    loads = [(rb.bodies[part], rb._local(part, xy), (float(-F[0]) * dt * dt, float(-F[1]) * dt * dt))
-             for part, xy, F in rb.loads]
+    loads = [(rb.bodies[part], rb._local(part, xy), (float(-F[0]) * dt * dt, float(-F[1]) * dt * dt)) for part, xy, F in rb.loads]
     motor = rb.motor
     torque = np.full(n, np.nan) if mode == "motor" else None
     sat = np.zeros(n, dtype=bool)
@@ -929,8 +989,9 @@ def simulate(mech: Mechanism, t: Array, effects: Effects | None = None,
         if rb.motor_limit is not None:
             jmax = rb.motor_limit * dt * dt * (1.0 - 1e-9)
     angle0 = {id(b): a for b, _, _, a in steady}
-    rate = {id(b): wrap_angle(step_targets[nm][0, 2] - poses_a[nm][0, 2]) for nm, b in
-            ((nm, rb.bodies[nm]) for nm in step_targets)}
+    rate = {
+        id(b): wrap_angle(step_targets[nm][0, 2] - poses_a[nm][0, 2]) for nm, b in ((nm, rb.bodies[nm]) for nm in step_targets)
+    }
     space = rb.space
     step = space.step
     simple = not per_step and not loads and motor is None
@@ -968,14 +1029,15 @@ def simulate(mech: Mechanism, t: Array, effects: Effects | None = None,
                     jbig = max(jbig, abs(j))
             if jacc is not None and motor is not None:
                 if abs(jacc.value) != motor.impulse:
-                    raise SimulationError("the motor's signed impulse does not match pymunk's magnitude: "
-                                          "unknown pymunk motor layout")
+                    raise SimulationError(
+                        "the motor's signed impulse does not match pymunk's magnitude: unknown pymunk motor layout"
+                    )
                 torque[i] = jsum / (sub * dt * dt)  # type: ignore[index]
                 sat[i] = jbig >= jmax
         steps += sub
         raw[i] = [(b.position.x, b.position.y, b.angle) for b in bodies]
         if i + 1 - checked >= block or i == n - 1:
-            hit = check.block(check.part_poses(raw[checked:i + 1]), checked)
+            hit = check.block(check.part_poses(raw[checked : i + 1]), checked)
             checked = i + 1
             if hit is not None:
                 done = hit[0]
@@ -1004,18 +1066,29 @@ def simulate(mech: Mechanism, t: Array, effects: Effects | None = None,
     code = np.full(n, -1, dtype=np.int16)
     table: list[tuple[str, str]] = []
     if failure is not None:
-        valid[failure.sample:] = False
-        code[failure.sample:] = 0
+        valid[failure.sample :] = False
+        code[failure.sample :] = 0
         table.append(("simulation", failure.message))
     pts = {nm: poses_apply(out[part], xy) for nm, (part, xy) in mech.points.items()}
-    motion = Motion(driver=analytic.driver, poses=out, valid=valid, fail_code=code, fail_table=table,
-                    points=pts, t=t)
+    motion = Motion(driver=analytic.driver, poses=out, valid=valid, fail_code=code, fail_table=table, points=pts, t=t)
     res = joint_residuals(mech, motion)
     built = dict(rb.built, mode=mode, pins_compensated=sorted(comp), substeps=sub)
     pins = [(part, xy, body.mass) for body, part, xy in rb.pins]
     pose_error = {k: v / size for k, v in check.worst.items()}
-    return SimResult(motion, settings, mode, built, wall, steps, torque, failure, pins=pins, residuals=res,
-                     saturated=np.flatnonzero(sat), pose_error=pose_error)
+    return SimResult(
+        motion,
+        settings,
+        mode,
+        built,
+        wall,
+        steps,
+        torque,
+        failure,
+        pins=pins,
+        residuals=res,
+        saturated=np.flatnonzero(sat),
+        pose_error=pose_error,
+    )
 
 
 def simulate_scene(scene: Scene, settings: SimSettings = DEFAULT_SETTINGS, mode: str | None = None) -> SimResult:
@@ -1031,9 +1104,13 @@ def simulate_scene(scene: Scene, settings: SimSettings = DEFAULT_SETTINGS, mode:
 # --------------------------------------------------------------------------- torque
 
 
-def torque_comparison(mech: Mechanism, t: Array, effects: Effects | None,
-                      settings: SimSettings = DEFAULT_SETTINGS,
-                      densities: dict[str, float] | None = None) -> dict[str, Any]:
+def torque_comparison(
+    mech: Mechanism,
+    t: Array,
+    effects: Effects | None,
+    settings: SimSettings = DEFAULT_SETTINGS,
+    densities: dict[str, float] | None = None,
+) -> dict[str, Any]:
     """pymunk's motor torque (signed, read every step) against inverse dynamics with every named effect.
 
     pymunk's torque over an output interval is the mean of its step
@@ -1070,12 +1147,10 @@ def torque_comparison(mech: Mechanism, t: Array, effects: Effects | None,
         "failure": None if sim.failure is None else sim.failure.message,
         "pose_error": max(sim.pose_error.values(), default=0.0),
         "pins": "each groove's pin is a body of its own whose mass is taken out of its part "
-                "(same mass, centre and moment), so both sides model the same inertia",
+        "(same mass, centre and moment), so both sides model the same inertia",
         "note": "simulated torque: the motor's signed impulse per step / dt (mean over the interval)",
         "wall_time": sim.wall_time,
         "substeps": K,
         "iterations": sim.built["iterations"],
     }
     return out
-
-

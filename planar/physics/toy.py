@@ -47,8 +47,19 @@ from planar.core.model import CamOnLine, Driver, Mechanism, joint_kind
 from planar.toys.assembly import ToyAssembly, toy_assembly
 from planar.windup.mechanisms import SkewContact
 
-__all__ = ["ContactRun", "StageReport", "ToyPhysics", "contact_hold", "hold_margin", "liftoff_speed",
-           "plane_mechanism", "simulate_toy", "skew_hold", "skew_stage", "SkewHold"]
+__all__ = [
+    "ContactRun",
+    "StageReport",
+    "ToyPhysics",
+    "contact_hold",
+    "hold_margin",
+    "liftoff_speed",
+    "plane_mechanism",
+    "simulate_toy",
+    "skew_hold",
+    "skew_stage",
+    "SkewHold",
+]
 
 Array = NDArray[np.float64]
 
@@ -171,8 +182,7 @@ def _poses(mech: Any, q: Array, drive: StageDrive | None) -> dict[str, Array]:
     if drive is None:
         return mech.solve(q).poses
     u = drive[1](np.asarray(q, float))
-    return {"ground": np.zeros((len(u), 3)), "driver": mech._driver_pose(u),
-            "follower": mech._follower_pose(mech.forward(u).out)}
+    return {"ground": np.zeros((len(u), 3)), "driver": mech._driver_pose(u), "follower": mech._follower_pose(mech.forward(u).out)}
 
 
 # ---------------------------------------------------------------------------- #8: a contact that can let go
@@ -189,9 +199,17 @@ class ContactRun:
     liftoff_time: float | None = None
 
 
-def contact_hold(mech: Any, speed: float, gravity: tuple[float, float], cycles: float = 1.0,
-                 samples_per_cycle: int = 72, substeps: int = 64, density: float = 1.0,
-                 tolerance: float = 1e-3, drive: StageDrive | None = None) -> ContactRun:
+def contact_hold(
+    mech: Any,
+    speed: float,
+    gravity: tuple[float, float],
+    cycles: float = 1.0,
+    samples_per_cycle: int = 72,
+    substeps: int = 64,
+    density: float = 1.0,
+    tolerance: float = 1e-3,
+    drive: StageDrive | None = None,
+) -> ContactRun:
     """Simulate an elemental #8 (its own plane) with a contact that can only push.
 
     ``mech``: an :class:`~planar.windup.mechanisms.ElementalMechanism` #8 driven
@@ -234,8 +252,7 @@ def contact_hold(mech: Any, speed: float, gravity: tuple[float, float], cycles: 
     body.velocity = (-w0 * (body.position.y - ga[1]), w0 * (body.position.x - ga[0]))
     rc = 1e-4 * size
     rs = 0.02 * size  # a thick face (into the tab, -x of it) so that the edge cannot tunnel through in a step
-    face = pymunk.Segment(body, (j.start[0] - rs - cog[0], j.start[1] - cog[1]),
-                          (j.end[0] - rs - cog[0], j.end[1] - cog[1]), rs)
+    face = pymunk.Segment(body, (j.start[0] - rs - cog[0], j.start[1] - cog[1]), (j.end[0] - rs - cog[0], j.end[1] - cog[1]), rs)
     edge = pymunk.Circle(kin, rc, (j.centre[0] + rc, j.centre[1]))  # the window's material lies to +x of its edge
     face.friction = edge.friction = 0.0
     space.add(body, kin, face, edge, pymunk.PivotJoint(space.static_body, body, (float(ga[0]), float(ga[1]))))
@@ -273,8 +290,9 @@ def contact_hold(mech: Any, speed: float, gravity: tuple[float, float], cycles: 
     return ContactRun(speed, gap, float(err[:upto].max(initial=0.0)), lift, None if lift is None else float(t[lift]))
 
 
-def liftoff_speed(mech: Any, gravity: tuple[float, float], speeds: Any, refine: int = 5,
-                  **kw: Any) -> tuple[float | None, list[ContactRun]]:
+def liftoff_speed(
+    mech: Any, gravity: tuple[float, float], speeds: Any, refine: int = 5, **kw: Any
+) -> tuple[float | None, list[ContactRun]]:
     """Run :func:`contact_hold` at each of ``speeds`` (cycles/s, rising) until one lets go, then bisect ``refine``
     times between the last that held and it; returns the lowest speed seen to let go (None: it always held)
     and every run (the last one is the lowest that let go)."""
@@ -299,8 +317,9 @@ def liftoff_speed(mech: Any, gravity: tuple[float, float], speeds: Any, refine: 
     return None, runs
 
 
-def hold_margin(mech: Any, gravity: tuple[float, float], density: float = 1.0, samples: int = 720,
-                drive: StageDrive | None = None) -> float:
+def hold_margin(
+    mech: Any, gravity: tuple[float, float], density: float = 1.0, samples: int = 720, drive: StageDrive | None = None
+) -> float:
     """The speed (cycles/s) above which inverse dynamics needs the #8 contact to pull (it lets go); inf if never,
     0 if gravity cannot hold it even at rest.
 
@@ -343,10 +362,18 @@ def hold_margin(mech: Any, gravity: tuple[float, float], density: float = 1.0, s
 # ---------------------------------------------------------------------------- #6, #9: in the follower's plane
 
 
-def skew_stage(mech: Any, speed: float, cycles: float = 1.0, samples_per_cycle: int = 72, substeps: int = 128,
-               density: float = 1.0, tolerance: float = 1e-3, drive: StageDrive | None = None,
-               gravity: tuple[float, float] = (0.0, 0.0), record: list[tuple[float, float]] | None = None,
-               ) -> tuple[float, str | None]:
+def skew_stage(
+    mech: Any,
+    speed: float,
+    cycles: float = 1.0,
+    samples_per_cycle: int = 72,
+    substeps: int = 128,
+    density: float = 1.0,
+    tolerance: float = 1e-3,
+    drive: StageDrive | None = None,
+    gravity: tuple[float, float] = (0.0, 0.0),
+    record: list[tuple[float, float]] | None = None,
+) -> tuple[float, str | None]:
     """Rebuild #6/#9 in its follower's plane (yz) and run it; ``(worst error / size, refusal or None)``.
 
     ``gravity``: in the follower's plane (y, z).  The rebuilt contact is two-sided (a groove); ``record``,
@@ -406,8 +433,10 @@ def skew_stage(mech: Any, speed: float, cycles: float = 1.0, samples_per_cycle: 
     g0 = (side * r0 - cog[0], -0.5 * top * sgn_top - cog[1])
     g1 = (side * r0 - cog[0], 2.0 * top * sgn_top - cog[1])
     dt = float(t[1] - t[0]) / substeps
-    cons = [pymunk.PivotJoint(space.static_body, body, (float(f0[0]), float(f0[1]))),
-            pymunk.GrooveJoint(body, kin, g0, g1, (0.0, 0.0))]
+    cons = [
+        pymunk.PivotJoint(space.static_body, body, (float(f0[0]), float(f0[1]))),
+        pymunk.GrooveJoint(body, kin, g0, g1, (0.0, 0.0)),
+    ]
     for c_ in cons:  # correct a fifth of any joint error per step (pymunk's default leaves ~99 % per step here)
         c_.error_bias = 0.8 ** (1.0 / dt)
     space.add(body, kin, *cons)
@@ -439,8 +468,7 @@ def skew_stage(mech: Any, speed: float, cycles: float = 1.0, samples_per_cycle: 
     pts = np.asarray(fol.hull)[:, :2]
     err = float(np.hypot(*(poses_apply(track, pts) - poses_apply(ref, pts)).transpose(2, 0, 1)).max()) / size
     if not err <= tolerance:
-        return err, (f"{mech.name}: rebuilt in the follower's plane it strays {err:.3g} of the size "
-                     f"(tolerance {tolerance:g})")
+        return err, (f"{mech.name}: rebuilt in the follower's plane it strays {err:.3g} of the size (tolerance {tolerance:g})")
     return err, None
 
 
@@ -478,8 +506,9 @@ def _skew_gap_a(j: SkewContact, fpose: Array, dpose: Array, da: float = 0.0) -> 
     return (d * n).sum(1) / np.linalg.norm(n, axis=1)
 
 
-def _skew_terms(mech: Any, j: SkewContact, gravity: tuple[float, float], density: float, samples: int,
-                drive: StageDrive | None) -> tuple[Array, Array, Array, Array]:
+def _skew_terms(
+    mech: Any, j: SkewContact, gravity: tuple[float, float], density: float, samples: int, drive: StageDrive | None
+) -> tuple[Array, Array, Array, Array]:
     """Over one cycle at 1 cycle/s (``samples`` per cycle): ``(t, I_p phi'', M_g, push)`` of :func:`skew_hold`."""
     from planar.analysis.dynamics import mass_properties
 
@@ -500,8 +529,15 @@ def _skew_terms(mech: Any, j: SkewContact, gravity: tuple[float, float], density
     return t1, ip * alpha1, mg, np.sign(np.sign(s0) * ds)
 
 
-def skew_hold(mech: Any, gravity: tuple[float, float], speed: float, density: float = 1.0,
-              samples_per_cycle: int = 72, drive: StageDrive | None = None, fine: int = 1440) -> SkewHold:
+def skew_hold(
+    mech: Any,
+    gravity: tuple[float, float],
+    speed: float,
+    density: float = 1.0,
+    samples_per_cycle: int = 72,
+    drive: StageDrive | None = None,
+    fine: int = 1440,
+) -> SkewHold:
     """Inverse dynamics of a #6/#9 follower: can the driver's edge, which only pushes, keep it on its path?
 
     ``gravity``: in the follower's plane (y, z) (:func:`planar.analysis.dynamics.plane_gravity` ``"yz"``); ``speed``:
@@ -527,8 +563,10 @@ def skew_hold(mech: Any, gravity: tuple[float, float], speed: float, density: fl
     moment = speed**2 * ia - mg
     tol = 1e-9 * max(float(np.abs(mg).max()), float(np.abs(ia).max()) * speed**2, 1e-300)
     bad = np.flatnonzero(push * moment < -tol)
-    return SkewHold(speed, t1 / speed, moment, push, int(bad[0]) if bad.size else None, crit,
-                    (float(gravity[0]), float(gravity[1])))
+    return SkewHold(
+        speed, t1 / speed, moment, push, int(bad[0]) if bad.size else None, crit, (float(gravity[0]), float(gravity[1]))
+    )
+
 
 # ---------------------------------------------------------------------------- the whole toy
 
@@ -555,8 +593,9 @@ class ToyPhysics:
         return [s for s in self.stages if not s.simulated]
 
 
-def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, speeds: Any = None,
-                 densities: dict[str, float] | None = None) -> ToyPhysics:
+def simulate_toy(
+    toy: Any, t: Array, effects: Any = None, settings: Any = None, speeds: Any = None, densities: dict[str, float] | None = None
+) -> ToyPhysics:
     """The toy's coupled motor run with its torque against inverse dynamics, and every stage's own physics.
 
     ``t``: output times (s) at the toy's speed.  The coupled run holds the xy
@@ -587,8 +626,9 @@ def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, 
     flat = coupled_mechanism(asm, xz=has_xz and g != (0.0, 0.0))
     # 128 substeps, 80 iterations: measured, the motor torque's start transient at 32 substeps is 4 % of the peak
     # for the Bunny (its #8 tab coupled), 0.7 % at 64 and 1e-6 at 128 (Horse 2.6e-3, 2.6e-4, 2.9e-5)
-    tq = torque_comparison(flat, np.asarray(t, float), effects, settings or SimSettings(substeps=128, iterations=80),
-                           densities=densities)
+    tq = torque_comparison(
+        flat, np.asarray(t, float), effects, settings or SimSettings(substeps=128, iterations=80), densities=densities
+    )
     tq["pieces"] = [p.name for p in flat.parts]
     speed = toy.driver.rate / (2 * math.pi)
     out = ToyPhysics(tq)
@@ -603,27 +643,55 @@ def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, 
         drive: StageDrive = (toy.driver, stage_u)  # the stage as the toy drives it
         if num == 8:
             if g == (0.0, 0.0):
-                out.stages.append(StageReport(label, pat, False, (
-                    "#8: its contact is held by gravity or a spring in its plane (xz); " + (
-                        "the scene names none" if g3 == (0.0, 0.0) else
-                        f"the scene's gravity ({g3[0]:g}, {g3[1]:g}) has no x component, and its y is normal to "
-                        "the xz plane"))))
+                out.stages.append(
+                    StageReport(
+                        label,
+                        pat,
+                        False,
+                        (
+                            "#8: its contact is held by gravity or a spring in its plane (xz); "
+                            + (
+                                "the scene names none"
+                                if g3 == (0.0, 0.0)
+                                else f"the scene's gravity ({g3[0]:g}, {g3[1]:g}) has no x component, and its y is normal to "
+                                "the xz plane"
+                            )
+                        ),
+                    )
+                )
                 continue
             crit = hold_margin(st.mech, g, getattr(effects, "density", 1.0), drive=drive)
             sc = list(speeds) if speeds is not None else [speed * f for f in (1.0, 2.0, 4.0, 8.0)]
             lift, runs = liftoff_speed(st.mech, g, sc, drive=drive)
             r0 = runs[0]
-            out.liftoff[label] = {"predicted_speed": crit, "scanned": sc, "liftoff_speed": lift,
-                                  "sample": runs[-1].liftoff, "pose_error": r0.pose_error}
+            out.liftoff[label] = {
+                "predicted_speed": crit,
+                "scanned": sc,
+                "liftoff_speed": lift,
+                "sample": runs[-1].liftoff,
+                "pose_error": r0.pose_error,
+            }
             held = r0.liftoff is None
             agrees = r0.pose_error <= 1e-3
-            out.stages.append(StageReport(label, pat, agrees, (
-                ("" if agrees else f"#8: the one-sided run strays {r0.pose_error:.2g} of the size from the analytic "
-                 "motion (not accepted); ") +
-                f"#8 one-sided contact: {'holds' if held else 'lets go'} at {speed:g} cycles/s "
-                f"(pose error {r0.pose_error:.2g} of the size); lift-off "
-                + (f"at {lift:g} cycles/s, sample {runs[-1].liftoff}" if lift is not None else "not seen in the scan")
-                + f"; inverse dynamics predicts {crit:.3g} cycles/s")))
+            out.stages.append(
+                StageReport(
+                    label,
+                    pat,
+                    agrees,
+                    (
+                        (
+                            ""
+                            if agrees
+                            else f"#8: the one-sided run strays {r0.pose_error:.2g} of the size from the analytic "
+                            "motion (not accepted); "
+                        )
+                        + f"#8 one-sided contact: {'holds' if held else 'lets go'} at {speed:g} cycles/s "
+                        f"(pose error {r0.pose_error:.2g} of the size); lift-off "
+                        + (f"at {lift:g} cycles/s, sample {runs[-1].liftoff}" if lift is not None else "not seen in the scan")
+                        + f"; inverse dynamics predicts {crit:.3g} cycles/s"
+                    ),
+                )
+            )
         elif st.mech.spatial:
             out.stages.append(_skew_report(st, toy, drive, effects, g3, speed, np.asarray(t, float), out))
         else:
@@ -631,8 +699,9 @@ def simulate_toy(toy: Any, t: Array, effects: Any = None, settings: Any = None, 
     return out
 
 
-def _skew_report(st: Any, toy: Any, drive: StageDrive, effects: Any, g3: tuple[float, float], speed: float,
-                 t: Array, out: ToyPhysics) -> StageReport:
+def _skew_report(
+    st: Any, toy: Any, drive: StageDrive, effects: Any, g3: tuple[float, float], speed: float, t: Array, out: ToyPhysics
+) -> StageReport:
     """#6/#9 in :func:`simulate_toy`: the rebuild alone (pymunk, with gravity) and whether the edge holds the pin."""
     from planar.analysis.dynamics import plane_gravity
 
@@ -640,8 +709,12 @@ def _skew_report(st: Any, toy: Any, drive: StageDrive, effects: Any, g3: tuple[f
     j = next(j for j in mech.joints if isinstance(j, SkewContact))
     sprung = [f"{s.a}-{s.b}" for s in getattr(effects, "springs", ()) or () if mech.part(j.b).name in (s.a, s.b)]
     if sprung:
-        return StageReport(label, pat, False, f"#{st.realisation.number}: a spring on the yz follower ({sprung[0]}) "
-                           "is not modelled in its hold check")
+        return StageReport(
+            label,
+            pat,
+            False,
+            f"#{st.realisation.number}: a spring on the yz follower ({sprung[0]}) is not modelled in its hold check",
+        )
     gp = plane_gravity("yz", g3)
     g = (float(gp[0]), float(gp[1]))
     per = max(int(round(1.0 / (speed * float(t[1] - t[0])))), 4) if t.size > 1 else 72
@@ -649,7 +722,7 @@ def _skew_report(st: Any, toy: Any, drive: StageDrive, effects: Any, g3: tuple[f
     hold = skew_hold(mech, g, speed, dens, per, drive)
     rec: list[tuple[float, float]] = []
     err, why = skew_stage(mech, speed, drive=drive, gravity=g, record=rec, density=dens)
-    tr, mr = (np.array(rec, float).T if rec else (np.zeros(0), np.zeros(0)))
+    tr, mr = np.array(rec, float).T if rec else (np.zeros(0), np.zeros(0))
     keep = tr > tr[0] + 1.0 / (72 * speed) if tr.size else tr > 0  # its first sample interval: a start transient
     tr, mr = tr[keep], mr[keep]
     # pymunk's contact moment against the side the edge can push (the push sign at the nearest sample)
@@ -657,24 +730,37 @@ def _skew_report(st: Any, toy: Any, drive: StageDrive, effects: Any, g3: tuple[f
     pulls = np.flatnonzero(pk * mr < -1e-6 * max(float(np.abs(mr).max(initial=0.0)), 1e-300))
     sim_t = float(tr[pulls[0]]) if pulls.size else None
     held = hold.letgo is None
-    out.skew[label] = {"holds": held, "sample": hold.letgo, "time": None if held else float(hold.t[hold.letgo]),
-                       "critical_speed": hold.critical_speed, "gravity_yz": list(g),
-                       "moment_range": [float(hold.moment.min()), float(hold.moment.max())],
-                       "push_sign": float(hold.push[0]) if np.all(hold.push == hold.push[0]) else 0.0,
-                       "pymunk_pull_time": sim_t}
+    out.skew[label] = {
+        "holds": held,
+        "sample": hold.letgo,
+        "time": None if held else float(hold.t[hold.letgo]),
+        "critical_speed": hold.critical_speed,
+        "gravity_yz": list(g),
+        "moment_range": [float(hold.moment.min()), float(hold.moment.max())],
+        "push_sign": float(hold.push[0]) if np.all(hold.push == hold.push[0]) else 0.0,
+        "pymunk_pull_time": sim_t,
+    }
     crit = hold.critical_speed
-    hold_txt = (f"#{st.realisation.number} edge on the pin (it can only push): {'holds' if held else 'lets go'} at "
-                f"{speed:g} cycles/s" + ("" if held else f" (first at sample {hold.letgo}, t = {hold.t[hold.letgo]:.4g} s)")
-                + "; inverse dynamics: lets go " + ("at any speed" if crit == 0.0 else "never" if math.isinf(crit)
-                                                   else f"above {crit:.3g} cycles/s")
-                + f" (gravity in its plane ({g[0]:g}, {g[1]:g}))"
-                + ("; the rebuild (pymunk, two-sided) pulls first at " + (f"t = {sim_t:.4g} s" if sim_t is not None
-                                                               else "no step")))
+    hold_txt = (
+        f"#{st.realisation.number} edge on the pin (it can only push): {'holds' if held else 'lets go'} at "
+        f"{speed:g} cycles/s"
+        + ("" if held else f" (first at sample {hold.letgo}, t = {hold.t[hold.letgo]:.4g} s)")
+        + "; inverse dynamics: lets go "
+        + ("at any speed" if crit == 0.0 else "never" if math.isinf(crit) else f"above {crit:.3g} cycles/s")
+        + f" (gravity in its plane ({g[0]:g}, {g[1]:g}))"
+        + ("; the rebuild (pymunk, two-sided) pulls first at " + (f"t = {sim_t:.4g} s" if sim_t is not None else "no step"))
+    )
     if why is not None:
         return StageReport(label, pat, False, why + "; " + hold_txt)
-    return StageReport(label, pat, True, (
-        f"in the motor run, co-simulated in its plane (yz); alone, rebuilt in the follower's plane: "
-        f"{err:.2g} of the size; " + hold_txt))
+    return StageReport(
+        label,
+        pat,
+        True,
+        (
+            f"in the motor run, co-simulated in its plane (yz); alone, rebuilt in the follower's plane: "
+            f"{err:.2g} of the size; " + hold_txt
+        ),
+    )
 
 
 # ---------------------------------------------------------------------------- #6, #9 in the motor run
@@ -737,8 +823,9 @@ def _skew_load(rb: Any, j: SkewContact, effects: Any) -> list[Any]:
 
     drv, fol = rb.bodies[j.a], rb.bodies[j.b]
     if fol.body_type != pymunk.Body.DYNAMIC or drv.space is None:
-        raise SimulationError(f"joint {j.name!r}: the follower {j.b!r} must move under the solver, driven by "
-                              f"{j.a!r} in the motor's space")
+        raise SimulationError(
+            f"joint {j.name!r}: the follower {j.b!r} must move under the solver, driven by {j.a!r} in the motor's space"
+        )
     main = drv.space
     main.remove(fol)
     dt = rb.dt
@@ -789,7 +876,7 @@ def _skew_load(rb: Any, j: SkewContact, effects: Any) -> list[Any]:
             qp, qm = list(q), list(q)
             qp[k] += h
             qm[k] -= h
-            gq = (_skew_gap(j, pivot, a, (qp[0], qp[1], qp[2])) - _skew_gap(j, pivot, a, (qm[0], qm[1], qm[2])))
+            gq = _skew_gap(j, pivot, a, (qp[0], qp[1], qp[2])) - _skew_gap(j, pivot, a, (qm[0], qm[1], qm[2]))
             out.append(-gq / (2 * h) / ga)
         return out
 
@@ -805,8 +892,10 @@ def _skew_load(rb: Any, j: SkewContact, effects: Any) -> list[Any]:
         af = touching(q, fol.angle + fol.angular_velocity)
         ca, sa = math.cos(af), math.sin(af)
         fol.angle = af - fol.angular_velocity
-        fol.position = (pivot[0] + ca * fcog[0] - sa * fcog[1] - fol.velocity.x,
-                        pivot[1] + sa * fcog[0] + ca * fcog[1] - fol.velocity.y)
+        fol.position = (
+            pivot[0] + ca * fcog[0] - sa * fcog[1] - fol.velocity.x,
+            pivot[1] + sa * fcog[0] + ca * fcog[1] - fol.velocity.y,
+        )
         a1 = touching((q[0] + vp[0], q[1] + vp[1], q[2] + vp[2]), af + fol.angular_velocity)
         turn.rate = -(a1 - af)
         v0, w0 = fol.velocity, fol.angular_velocity
@@ -840,8 +929,10 @@ def _skew_load(rb: Any, j: SkewContact, effects: Any) -> list[Any]:
         pv = prev[0] if prev else vc
         prev[:] = [vc]
         d = main.damping
-        drv.force = drv.force + (ma * (vc[0] - pv[0] + (1.0 - d) * vc[0] - main.gravity[0]),
-                                 ma * (vc[1] - pv[1] + (1.0 - d) * vc[1] - main.gravity[1]))
+        drv.force = drv.force + (
+            ma * (vc[0] - pv[0] + (1.0 - d) * vc[0] - main.gravity[0]),
+            ma * (vc[1] - pv[1] + (1.0 - d) * vc[1] - main.gravity[1]),
+        )
         drv.torque = drv.torque - mc * jq[2] + ia * (vc[2] - pv[2] + (1.0 - d) * vc[2])
 
     def guarded(c_: Any, space_: Any) -> None:

@@ -1,5 +1,4 @@
-"""A validated scene built into its mechanism: :class:`Scene` and :func:`build_scene`.
-"""
+"""A validated scene built into its mechanism: :class:`Scene` and :func:`build_scene`."""
 
 from __future__ import annotations
 
@@ -40,12 +39,17 @@ class Scene:
         else:
             field_name, value = "driver.cycles", d.cycles
             cycles = d.cycles if d.cycles is not None else 1.0
-            if d.cycles is None:                          # one cycle: the per-cycle count is what asks
+            if d.cycles is None:  # one cycle: the per-cycle count is what asks
                 field_name, value = "driver.samples_per_cycle", d.samples_per_cycle
         total = d.samples_per_cycle * cycles
         where = f"{self.path}: {field_name}"
-        n = check_count("samples", where, round(total) if math.isfinite(total) else total,
-                        "samples in all (samples_per_cycle x cycles)", shown=value)
+        n = check_count(
+            "samples",
+            where,
+            round(total) if math.isfinite(total) else total,
+            "samples in all (samples_per_cycle x cycles)",
+            shown=value,
+        )
         # poses (x, y, angle) of every part, points (x, y), driver, time and the solver's working copies
         per_sample = 8 * (3 * len(self.mechanism.parts) + 2 * len(self.mechanism.points) + 4) * 4
         check_memory(where, value, float(per_sample) * max(n, 2), "a motion")
@@ -80,13 +84,24 @@ class Scene:
         e = self.spec.effects
         return Effects(
             gravity=None if e.gravity is None else (float(e.gravity[0]), float(e.gravity[1])),
-            damping=e.damping, density=e.density,
-            springs=tuple(Spring(s.a, s.b, s.stiffness, (float(s.anchor_a[0]), float(s.anchor_a[1])),
-                                 (float(s.anchor_b[0]), float(s.anchor_b[1])), s.rest_length, s.damping)
-                          for s in e.springs),
+            damping=e.damping,
+            density=e.density,
+            springs=tuple(
+                Spring(
+                    s.a,
+                    s.b,
+                    s.stiffness,
+                    (float(s.anchor_a[0]), float(s.anchor_a[1])),
+                    (float(s.anchor_b[0]), float(s.anchor_b[1])),
+                    s.rest_length,
+                    s.damping,
+                )
+                for s in e.springs
+            ),
             loads=tuple(Load(ld.point, (float(ld.force[0]), float(ld.force[1]))) for ld in e.loads),
             motor_force_limit=e.motor_force_limit,
         )
+
 
 def _angle(spec: SceneSpec, v: float) -> float:
     return math.radians(v) if spec.angle_unit == "deg" else float(v)
@@ -97,8 +112,10 @@ def build_scene(spec: SceneSpec, path: str = "<scene>") -> Scene:
     m = spec.mechanism
     rate = 2 * math.pi * spec.driver.speed
     if not (math.isfinite(rate) and math.isfinite(2 * math.pi / rate) and rate > 0):
-        raise SceneError(f"{path}: driver.speed = {spec.driver.speed!r}: expected a speed whose period "
-                         "(1 / speed seconds) and angular rate are finite numbers")
+        raise SceneError(
+            f"{path}: driver.speed = {spec.driver.speed!r}: expected a speed whose period "
+            "(1 / speed seconds) and angular rate are finite numbers"
+        )
     phase = _angle(spec, spec.driver.phase)
     try:
         rock = _rocking(spec, m)
@@ -110,17 +127,21 @@ def build_scene(spec: SceneSpec, path: str = "<scene>") -> Scene:
     except PlanarError as e:
         raise SceneError(f"{path}: mechanism: {e}") from None
     except (ValueError, ArithmeticError) as e:  # numbers past what a builder's arithmetic holds (NaN, overflow)
-        raise SceneError(f"{path}: mechanism: cannot be built from these numbers "
-                         f"({type(e).__name__}: {' '.join(str(e).split())}); check for extreme values") from None
+        raise SceneError(
+            f"{path}: mechanism: cannot be built from these numbers "
+            f"({type(e).__name__}: {' '.join(str(e).split())}); check for extreme values"
+        ) from None
     polygons: dict[str, tuple[str, np.ndarray]] = {}
     names = {p.name for p in mech.parts}
     for i, poly in enumerate(getattr(m, "polygons", [])):
         if poly.name in polygons:
-            raise SceneError(f"{path}: mechanism.polygons[{i}].name: a second polygon named {poly.name!r} "
-                             "(polygon names must differ)")
+            raise SceneError(
+                f"{path}: mechanism.polygons[{i}].name: a second polygon named {poly.name!r} (polygon names must differ)"
+            )
         if poly.part not in names:
-            raise SceneError(f"{path}: mechanism.polygons[{i}].part: no part {poly.part!r} "
-                             f"(got {poly.part!r}; parts are {sorted(names)})")
+            raise SceneError(
+                f"{path}: mechanism.polygons[{i}].part: no part {poly.part!r} (got {poly.part!r}; parts are {sorted(names)})"
+            )
         polygons[poly.name] = (poly.part, np.asarray(poly.points, float))
     for i, n in enumerate(spec.render.sweep):
         if n not in polygons:
@@ -128,17 +149,22 @@ def build_scene(spec: SceneSpec, path: str = "<scene>") -> Scene:
     if spec.render.trails is not None:
         for i, n in enumerate(spec.render.trails):
             if n not in mech.points:
-                raise SceneError(f"{path}: render.trails[{i}]: no named point {n!r} "
-                                 f"(got {n!r}; points are {sorted(mech.points)})")
+                raise SceneError(
+                    f"{path}: render.trails[{i}]: no named point {n!r} (got {n!r}; points are {sorted(mech.points)})"
+                )
     for i, load in enumerate(spec.effects.loads):
         if load.point not in mech.points:
-            raise SceneError(f"{path}: effects.loads[{i}].point: no named point {load.point!r} "
-                             f"(got {load.point!r}; points are {sorted(mech.points)})")
+            raise SceneError(
+                f"{path}: effects.loads[{i}].point: no named point {load.point!r} "
+                f"(got {load.point!r}; points are {sorted(mech.points)})"
+            )
     for i, s in enumerate(spec.effects.springs):
         for side in ("a", "b"):
             if getattr(s, side) not in names:
-                raise SceneError(f"{path}: effects.springs[{i}].{side}: no part {getattr(s, side)!r} "
-                                 f"(got {getattr(s, side)!r}; parts are {sorted(names)})")
+                raise SceneError(
+                    f"{path}: effects.springs[{i}].{side}: no part {getattr(s, side)!r} "
+                    f"(got {getattr(s, side)!r}; parts are {sorted(names)})"
+                )
     return Scene(spec, mech, path, polygons)
 
 
@@ -152,8 +178,11 @@ def _rocking(spec: SceneSpec, m: Any) -> dict[str, Any]:
     if d.amplitude is None:
         return {}
     if m.type not in _ROCKING:
-        raise InputError("driver.amplitude", d.amplitude,
-                         f"no amplitude for a {m.type!r} mechanism (a rocking input is for {', '.join(_ROCKING)})")
+        raise InputError(
+            "driver.amplitude",
+            d.amplitude,
+            f"no amplitude for a {m.type!r} mechanism (a rocking input is for {', '.join(_ROCKING)})",
+        )
     if isinstance(m, LinkageSpec):
         from planar.linkages import NODE_KINDS
 
@@ -172,26 +201,46 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, A
     if isinstance(m, FourBarSpec):
         from planar.linkages import FourBar
 
-        return FourBar(m.ground, m.crank, m.coupler, m.rocker, coupler_point=m.coupler_point,
-                       circuit=m.circuit, placement=placement, rate=rate, phase=phase,
-                       name=spec.name or "fourbar", **rock)
+        return FourBar(
+            m.ground,
+            m.crank,
+            m.coupler,
+            m.rocker,
+            coupler_point=m.coupler_point,
+            circuit=m.circuit,
+            placement=placement,
+            rate=rate,
+            phase=phase,
+            name=spec.name or "fourbar",
+            **rock,
+        )
     if isinstance(m, SliderCrankSpec):
         from planar.linkages import SliderCrank
 
-        return SliderCrank(m.crank, m.rod, offset=m.offset, branch=m.branch, placement=placement,
-                           rate=rate, phase=phase, name=spec.name or "slidercrank", **rock)
+        return SliderCrank(
+            m.crank,
+            m.rod,
+            offset=m.offset,
+            branch=m.branch,
+            placement=placement,
+            rate=rate,
+            phase=phase,
+            name=spec.name or "slidercrank",
+            **rock,
+        )
     if isinstance(m, LinkageSpec):
         from planar.linkages import NODE_KINDS, Link, Linkage
 
         nodes = []
         for n in m.nodes:
             cls = NODE_KINDS[n.kind]  # each node kind declares the scene keys it is built from
-            args = [_angle(spec, getattr(n, f)) if f in cls.angle_fields and getattr(n, f) is not None
-                    else getattr(n, f) for f in cls.scene_fields]
+            args = [
+                _angle(spec, getattr(n, f)) if f in cls.angle_fields and getattr(n, f) is not None else getattr(n, f)
+                for f in cls.scene_fields
+            ]
             nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
         links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
-        return Linkage(spec.name or "linkage", nodes, links, points=m.points, placement=placement,
-                       rate=rate, phase=phase, **rock)
+        return Linkage(spec.name or "linkage", nodes, links, points=m.points, placement=placement, rate=rate, phase=phase, **rock)
     if isinstance(m, ElementalSpec):
         from planar.windup import ELEMENTAL, ElementalMechanism, params_for
         from planar.windup.params import coerce
@@ -210,8 +259,8 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, A
         try:
             return ElementalMechanism(m.number, base.replace(**kw), rate=rate, phase=phase)
         except InputError as e:  # check_params names "#5.F_o": the scene's key is params.F_o
-            if e.field.startswith(f"#{m.number}.") and e.field[len(f"#{m.number}."):] != "params":
-                raise InputError("params." + e.field[len(f"#{m.number}."):], e.value, e.expected) from None
+            if e.field.startswith(f"#{m.number}.") and e.field[len(f"#{m.number}.") :] != "params":
+                raise InputError("params." + e.field[len(f"#{m.number}.") :], e.value, e.expected) from None
             raise
     if isinstance(m, ChainSpec):
         from planar.windup.chain import chain_mechanism
@@ -232,7 +281,7 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, A
         names: dict[tuple[str, tuple[str, ...]], str] = {}
         for i, sg in enumerate(m.stages):
             key = (sg.cam, tuple(sg.chain))
-            if not any(tuple(c[:len(key[1])]) == key[1] for c in cams.get(sg.cam, [])):
+            if not any(tuple(c[: len(key[1])]) == key[1] for c in cams.get(sg.cam, [])):
                 raise InputError(f"mechanism.stages[{i}].chain", sg.chain, f"a prefix of a chain on the {sg.cam} cam")
             angle_params = ELEMENTAL[realise(sg.chain[-1]).number].angle_params
             kw = {}
@@ -245,8 +294,9 @@ def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, A
                 overrides[key] = kw
             if sg.name is not None:
                 names[key] = sg.name
-        return ToyMechanism(cams, phase=_angle(spec, m.phase), rate=rate, name=spec.name or "toy",
-                            overrides=overrides, names=names)
+        return ToyMechanism(
+            cams, phase=_angle(spec, m.phase), rate=rate, name=spec.name or "toy", overrides=overrides, names=names
+        )
     if isinstance(m, CamSpec):
         return _build_cam(spec, m, rate, phase)
     try:
@@ -267,11 +317,21 @@ def _build_cam(spec: SceneSpec, m: CamSpec, rate: float, phase: float) -> Mechan
 
     f = m.follower
     osc = f.motion == "oscillating"
-    program = Program([Segment(sg.law, _angle(spec, sg.angle), _angle(spec, sg.lift) if osc else float(sg.lift))
-                       for sg in m.segments], "mechanism.segments")
-    geom = FollowerGeometry(f.kind, f.motion, float(f.roller_radius or 0.0), (float(f.axis[0]), float(f.axis[1])),
-                            float(f.offset), (0.0, 0.0) if f.pivot is None else (float(f.pivot[0]), float(f.pivot[1])),
-                            float(f.arm or 0.0), float(f.face_offset), int(f.branch))
+    program = Program(
+        [Segment(sg.law, _angle(spec, sg.angle), _angle(spec, sg.lift) if osc else float(sg.lift)) for sg in m.segments],
+        "mechanism.segments",
+    )
+    geom = FollowerGeometry(
+        f.kind,
+        f.motion,
+        float(f.roller_radius or 0.0),
+        (float(f.axis[0]), float(f.axis[1])),
+        float(f.offset),
+        (0.0, 0.0) if f.pivot is None else (float(f.pivot[0]), float(f.pivot[1])),
+        float(f.arm or 0.0),
+        float(f.face_offset),
+        int(f.branch),
+    )
     profile = CamProfile(program, float(m.base_radius), geom, "mechanism")
     limit = math.radians(45.0 if osc else 30.0) if m.max_pressure_angle is None else _angle(spec, m.max_pressure_angle)
     nodes = []
@@ -280,5 +340,15 @@ def _build_cam(spec: SceneSpec, m: CamSpec, rate: float, phase: float) -> Mechan
         args = [_angle(spec, getattr(n, k)) if k in cls.angle_fields else getattr(n, k) for k in cls.scene_fields]
         nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
     links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
-    return CamMechanism(spec.name or "cam", profile, nodes, links, points=m.points or None, rate=rate, phase=phase,
-                        max_pressure_angle=limit, unit=spec.angle_unit, width=m.link_width)
+    return CamMechanism(
+        spec.name or "cam",
+        profile,
+        nodes,
+        links,
+        points=m.points or None,
+        rate=rate,
+        phase=phase,
+        max_pressure_angle=limit,
+        unit=spec.angle_unit,
+        width=m.link_width,
+    )

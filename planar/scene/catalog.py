@@ -23,14 +23,22 @@ def jansen_leg(crank: float = 15.0) -> Linkage:
     (``upper``: Z-B-D and ``lower``: C-E-F) make it a multi-loop linkage.
     """
     nodes = [
-        Fixed("O", (0.0, 0.0)), Fixed("Z", (-38.0, -7.8)), Crank("A", "O", crank),
-        RRR("B", "A", 50.0, "Z", 41.5, -1), RRR("C", "A", 61.9, "Z", 39.3, 1),
-        RRR("D", "B", 55.8, "Z", 40.1, -1), RRR("E", "D", 39.4, "C", 36.7, -1),
+        Fixed("O", (0.0, 0.0)),
+        Fixed("Z", (-38.0, -7.8)),
+        Crank("A", "O", crank),
+        RRR("B", "A", 50.0, "Z", 41.5, -1),
+        RRR("C", "A", 61.9, "Z", 39.3, 1),
+        RRR("D", "B", 55.8, "Z", 40.1, -1),
+        RRR("E", "D", 39.4, "C", 36.7, -1),
         RRR("F", "E", 65.7, "C", 49.0, -1),
     ]
     links = [
-        Link("crank", ("O", "A")), Link("j", ("A", "B")), Link("k", ("A", "C")),
-        Link("upper", ("Z", "B", "D")), Link("c", ("Z", "C")), Link("f", ("D", "E")),
+        Link("crank", ("O", "A")),
+        Link("j", ("A", "B")),
+        Link("k", ("A", "C")),
+        Link("upper", ("Z", "B", "D")),
+        Link("c", ("Z", "C")),
+        Link("f", ("D", "E")),
         Link("lower", ("C", "E", "F")),
     ]
     return Linkage("jansen", nodes, links, points={"foot": "F"})
@@ -42,14 +50,14 @@ def kangaroo_leg() -> FourBar:
     The coupler carries the foot; sweep a foot polygon with the coupler's pose
     (notes section 1.2).
     """
-    return FourBar(ground=4.0, crank=1.0, coupler=4.0, rocker=3.0, coupler_point=(5.5, -2.0),
-                   placement=(0.0, 0.0, 0.0), name="kangaroo")
+    return FourBar(
+        ground=4.0, crank=1.0, coupler=4.0, rocker=3.0, coupler_point=(5.5, -2.0), placement=(0.0, 0.0, 0.0), name="kangaroo"
+    )
 
 
 def paddle_boat() -> FourBar:
     """The paddling-boat linkage of notes Fig. 4: a crank-rocker whose coupler is the paddle."""
-    return FourBar(ground=3.0, crank=0.8, coupler=3.2, rocker=2.4, coupler_point=(1.2, -2.6),
-                   name="paddle")
+    return FourBar(ground=3.0, crank=0.8, coupler=3.2, rocker=2.4, coupler_point=(1.2, -2.6), name="paddle")
 
 
 CATALOG: dict[str, Callable[[], Mechanism]] = {

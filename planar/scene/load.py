@@ -37,8 +37,11 @@ def _loc(loc: tuple) -> str:
     for i, part in enumerate(loc):
         if isinstance(part, int):
             out += f"[{part}]"
-        elif i == 1 and loc[0] == "mechanism" and part in ("fourbar", "slidercrank", "linkage", "elemental", "chain",
-                                                           "toy", "catalog", "cam"):
+        elif (
+            i == 1
+            and loc[0] == "mechanism"
+            and part in ("fourbar", "slidercrank", "linkage", "elemental", "chain", "toy", "catalog", "cam")
+        ):
             continue  # the discriminated union's tag
         elif i > 0 and (str(part) in ("float", "int", "str", "bool") or str(part).startswith(("list[", "tuple["))):
             continue  # which member of a union (a number or a list of numbers) pydantic tried
@@ -72,6 +75,7 @@ def parse_scene(data: dict[str, Any], path: str = "<scene>") -> SceneSpec:
     except ValidationError as e:
         raise SceneError(_format_validation(path, e)) from None
 
+
 def _read_text(p: str) -> str:
     """The scene file as text: UTF-8 (a UTF-8 byte-order mark is skipped) or UTF-16 with its byte-order mark."""
     try:
@@ -92,8 +96,9 @@ def _read_text(p: str) -> str:
     try:
         text = raw.decode(codec)
     except UnicodeDecodeError as e:
-        raise SceneError(f"{p}: not a text file in UTF-8 (or UTF-16 with a byte-order mark): "
-                         f"byte {e.start} is {raw[e.start:e.start + 1]!r}") from None
+        raise SceneError(
+            f"{p}: not a text file in UTF-8 (or UTF-16 with a byte-order mark): byte {e.start} is {raw[e.start : e.start + 1]!r}"
+        ) from None
     text = text.removeprefix("\ufeff")  # a byte-order mark some editors repeat inside the text
     if "\x00" in text:
         raise SceneError(f"{p}: not a text file (it holds NUL bytes); a scene is TOML text")

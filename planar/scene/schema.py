@@ -466,8 +466,10 @@ class EffectsSpec(_Strict):
     def _no_contact(cls, data: Any) -> Any:
         for key in ("contact", "friction"):
             if isinstance(data, dict) and key in data:
-                raise ValueError(f"'{key}' was removed: the parts of a mechanism sit on layers and never touch, "
-                                 "so collisions (and their friction) are not simulated; delete the key")
+                raise ValueError(
+                    f"'{key}' was removed: the parts of a mechanism sit on layers and never touch, "
+                    "so collisions (and their friction) are not simulated; delete the key"
+                )
         return data
 
 
@@ -585,4 +587,3 @@ class SceneSpec(_Strict):
 def scene_schema() -> dict[str, Any]:
     """JSON schema of a scene file."""
     return SceneSpec.model_json_schema()
-

@@ -57,17 +57,34 @@ def mechanism_table(mech: "Mechanism") -> dict[str, Any]:
 
     if isinstance(mech, FourBar):
         g = mech.dims
-        return {"type": "fourbar", "ground": g.d, "crank": g.a, "coupler": g.b, "rocker": g.c,
-                "coupler_point": list(mech.coupler_point), "circuit": mech.circuit, "placement": _placement(mech)}
+        return {
+            "type": "fourbar",
+            "ground": g.d,
+            "crank": g.a,
+            "coupler": g.b,
+            "rocker": g.c,
+            "coupler_point": list(mech.coupler_point),
+            "circuit": mech.circuit,
+            "placement": _placement(mech),
+        }
     if isinstance(mech, SliderCrank):
         branch = next(int(n.branch) for n in mech.nodes if isinstance(n, RRP))
-        return {"type": "slidercrank", "crank": mech.r, "rod": mech.l, "offset": mech.e, "branch": branch,
-                "placement": _placement(mech)}
+        return {
+            "type": "slidercrank",
+            "crank": mech.r,
+            "rod": mech.l,
+            "offset": mech.e,
+            "branch": branch,
+            "placement": _placement(mech),
+        }
     if isinstance(mech, Linkage):
         span = mech._span()
         if not (math.isclose(mech.width, 0.08 * span) and math.isclose(mech.pin_diameter, 0.03 * span)):
-            raise InputError(f"{mech.name}.width", (mech.width, mech.pin_diameter),
-                             "the default part width and pin diameter (a scene file cannot set them)")
+            raise InputError(
+                f"{mech.name}.width",
+                (mech.width, mech.pin_diameter),
+                "the default part width and pin diameter (a scene file cannot set them)",
+            )
         nodes = []
         for n in mech.nodes:
             row: dict[str, Any] = {"name": n.name, "kind": n.kind}
@@ -82,24 +99,34 @@ def mechanism_table(mech: "Mechanism") -> dict[str, Any]:
             if lk.guide is not None:
                 row["guide"] = list(lk.guide)
             links.append(row)
-        return {"type": "linkage", "nodes": nodes, "links": links, "points": dict(mech.point_nodes),
-                "placement": _placement(mech)}
+        return {
+            "type": "linkage",
+            "nodes": nodes,
+            "links": links,
+            "points": dict(mech.point_nodes),
+            "placement": _placement(mech),
+        }
     if isinstance(mech, ElementalMechanism):
         base = params_for(mech.number)
-        changed = {f.name: _f(getattr(mech.params, f.name)) for f in fields(mech.params)
-                   if getattr(mech.params, f.name) != getattr(base, f.name)}
+        changed = {
+            f.name: _f(getattr(mech.params, f.name))
+            for f in fields(mech.params)
+            if getattr(mech.params, f.name) != getattr(base, f.name)
+        }
         return {"type": "elemental", "number": mech.number, "params": changed}
     if isinstance(mech, ToyMechanism):
         table: dict[str, Any] = {"type": "toy", "phase": mech.phase}
         for cam, chains in mech.cams.items():
             table[cam] = [list(c) for c in chains]
         given = getattr(mech, "stage_overrides", {})
-        rebuilt = ToyMechanism(mech.cams, phase=mech.phase, rate=mech.driver.rate, name=mech.name,
-                               overrides=given)
+        rebuilt = ToyMechanism(mech.cams, phase=mech.phase, rate=mech.driver.rate, name=mech.name, overrides=given)
         for a, b in zip(mech.stages, rebuilt.stages):
             if a.mech.params != b.mech.params:
-                raise InputError(f"{mech.name}.stage {' '.join(a.key)}", a.mech.params,
-                                 "a stage whose parameters the toy recorded (ToyMechanism overrides)")
+                raise InputError(
+                    f"{mech.name}.stage {' '.join(a.key)}",
+                    a.mech.params,
+                    "a stage whose parameters the toy recorded (ToyMechanism overrides)",
+                )
         stages: dict[tuple[str, tuple[str, ...]], dict[str, Any]] = {}
         for (cam, key), kw in given.items():
             stages[(cam, key)] = {"cam": cam, "chain": list(key), "params": {k: _f(v) for k, v in kw.items()}}
@@ -108,8 +135,11 @@ def mechanism_table(mech: "Mechanism") -> dict[str, Any]:
         if stages:
             table["stages"] = list(stages.values())
         return table
-    raise InputError("mechanism", type(mech).__name__,
-                     "a FourBar, SliderCrank, Linkage, ElementalMechanism or ToyMechanism (those a scene describes)")
+    raise InputError(
+        "mechanism",
+        type(mech).__name__,
+        "a FourBar, SliderCrank, Linkage, ElementalMechanism or ToyMechanism (those a scene describes)",
+    )
 
 
 def driver_table(mech: "Mechanism") -> dict[str, Any]:
@@ -129,10 +159,15 @@ def driver_table(mech: "Mechanism") -> dict[str, Any]:
     return out
 
 
-def scene_data(mech: "Mechanism", name: str | None = None, driver: Mapping[str, Any] | None = None,
-               effects: Mapping[str, Any] | None = None, render: Mapping[str, Any] | None = None,
-               fabrication: Mapping[str, Any] | None = None,
-               polygons: Mapping[str, tuple[str, Any]] | None = None) -> dict[str, Any]:
+def scene_data(
+    mech: "Mechanism",
+    name: str | None = None,
+    driver: Mapping[str, Any] | None = None,
+    effects: Mapping[str, Any] | None = None,
+    render: Mapping[str, Any] | None = None,
+    fabrication: Mapping[str, Any] | None = None,
+    polygons: Mapping[str, tuple[str, Any]] | None = None,
+) -> dict[str, Any]:
     """The scene keys (a dict, as parsed TOML) of a mechanism built in Python, with optional ``[driver]``
     (e.g. ``samples_per_cycle``, ``cycles``), ``[effects]``, ``[render]`` and ``[fabrication]`` keys and
     swept ``polygons`` (name -> (part, points)).
@@ -141,10 +176,13 @@ def scene_data(mech: "Mechanism", name: str | None = None, driver: Mapping[str, 
     if polygons:
         if table["type"] not in ("fourbar", "slidercrank", "linkage"):
             raise InputError("polygons", list(polygons), f"no polygons on a {table['type']!r} mechanism")
-        table["polygons"] = [{"name": k, "part": p, "points": _f(np.asarray(pts, float))}
-                             for k, (p, pts) in polygons.items()]
-    data: dict[str, Any] = {"name": name or mech.name, "angle_unit": "rad", "mechanism": table,
-                            "driver": {**driver_table(mech), **dict(driver or {})}}
+        table["polygons"] = [{"name": k, "part": p, "points": _f(np.asarray(pts, float))} for k, (p, pts) in polygons.items()]
+    data: dict[str, Any] = {
+        "name": name or mech.name,
+        "angle_unit": "rad",
+        "mechanism": table,
+        "driver": {**driver_table(mech), **dict(driver or {})},
+    }
     for key, extra in (("effects", effects), ("render", render), ("fabrication", fabrication)):
         if extra:
             data[key] = _f(dict(extra))

@@ -141,22 +141,40 @@ class Design:
             "mechanisms": self.toy.mechanism_count,
             "cams": {cam: [list(c) for c in chains] for cam, chains in self.toy.cams.items()},
             "phase_deg": math.degrees(self.toy.phase),
-            "effectors": [{"name": e.name, "motion": e.motion, "cam": cam, "chain": list(chain),
-                           "requested": e.range, "achieved": self.ranges[e.name],
-                           "error": abs(self.ranges[e.name] - e.range) / e.range,
-                           "sized": {"stage": self.sizing[e.name][0], "parameter": self.sizing[e.name][1],
-                                     "value": self.sizing[e.name][2]}}
-                          for e, (cam, chain) in zip(self.effectors, self.assignment)],
+            "effectors": [
+                {
+                    "name": e.name,
+                    "motion": e.motion,
+                    "cam": cam,
+                    "chain": list(chain),
+                    "requested": e.range,
+                    "achieved": self.ranges[e.name],
+                    "error": abs(self.ranges[e.name] - e.range) / e.range,
+                    "sized": {
+                        "stage": self.sizing[e.name][0],
+                        "parameter": self.sizing[e.name][1],
+                        "value": self.sizing[e.name][2],
+                    },
+                }
+                for e, (cam, chain) in zip(self.effectors, self.assignment)
+            ],
             "trees_considered": self.candidates,
             "trees_sized": self.tried,
             "layers": {k: v + 1 for k, v in self.layers.items()},  # numbered from 1, as in the BOM
             "layer_count": len(set(self.layers.values())),
             "before_placement": self.before,
-            "placement": None if self.placement is None else {
-                "variables": self.placement.variables, "objective": list(self.placement.objective),
-                "footprint": list(self.placement.footprint), "overlap": list(self.placement.overlap),
-                "evaluations": self.placement.evaluations, "rejected": self.placement.rejected,
-                "kept": self.placement.kept, "checked": self.placement.checked},
+            "placement": None
+            if self.placement is None
+            else {
+                "variables": self.placement.variables,
+                "objective": list(self.placement.objective),
+                "footprint": list(self.placement.footprint),
+                "overlap": list(self.placement.overlap),
+                "evaluations": self.placement.evaluations,
+                "rejected": self.placement.rejected,
+                "kept": self.placement.kept,
+                "checked": self.placement.checked,
+            },
             "collisions": [{"a": a, "b": b, "overlap": ov} for a, b, ov in self.collisions],
             "pin_clashes": [] if self.export_refused else self.clashes,
             "export_refused": self.export_refused or None,
@@ -200,10 +218,18 @@ def load_request(path: str | Path) -> list[Effector]:
         name = r.get("name")
         if isinstance(name, str) and name.strip():
             where = f"{p}: effector {name!r}"
-        if not isinstance(name, str) or not name.strip() or any(c in name for c in '.:+,"') or name == "frame" \
-                or any(ord(c) < 32 or ord(c) == 127 for c in name):
-            raise InputError(f"{where}.name", name, "a name without '.', ':', '+', ',', '\"' or control characters, "
-                             "not 'frame' (the effector's piece)")
+        if (
+            not isinstance(name, str)
+            or not name.strip()
+            or any(c in name for c in '.:+,"')
+            or name == "frame"
+            or any(ord(c) < 32 or ord(c) == 127 for c in name)
+        ):
+            raise InputError(
+                f"{where}.name",
+                name,
+                "a name without '.', ':', '+', ',', '\"' or control characters, not 'frame' (the effector's piece)",
+            )
         motion = r.get("motion")
         if motion not in MOTION_TYPES:
             raise InputError(f"{where}.motion", motion, f"one of {', '.join(MOTION_TYPES)}")
@@ -304,6 +330,7 @@ def _setter(number: int, base_kw: dict[str, Any], name: str, comp: int | None):
             cur[comp] = float(v)
             out[name] = tuple(cur)
         return out
+
     return kw, float(default if comp is None else default[comp])
 
 
@@ -317,6 +344,7 @@ def _span_fn(chain: Chain, depth: int, cam_phase: float, overrides: dict[Chain, 
         ov[chain[:depth]] = kw_of(v)
         outs = _compose(chain, cam_phase, ov, q)
         return float("nan") if outs is None else _span(outs[-1])
+
     return f, kw_of, name, bracket, current
 
 
@@ -333,8 +361,15 @@ def _scan(f, bracket: tuple[float, float], cache: dict | None = None, key: Any =
 def _scan_key(chain: Chain, depth: int, overrides: dict[Chain, dict[str, Any]]) -> Any:
     """What a scan depends on: the chain, the sized stage and the overrides along the chain (a cam's phase
     only shifts the cycle)."""
-    return (chain, depth, tuple((k, tuple(sorted((n, repr(v)) for n, v in overrides[k].items())))
-                                for k in (chain[:d] for d in range(1, len(chain) + 1)) if k in overrides))
+    return (
+        chain,
+        depth,
+        tuple(
+            (k, tuple(sorted((n, repr(v)) for n, v in overrides[k].items())))
+            for k in (chain[:d] for d in range(1, len(chain) + 1))
+            if k in overrides
+        ),
+    )
 
 
 def _solve(f, sc: _Scan, target: float, current: float) -> float | None:
@@ -351,8 +386,7 @@ def _solve(f, sc: _Scan, target: float, current: float) -> float | None:
             roots.append(float(sc.values[k]))
         elif a * b < 0:
             try:
-                roots.append(float(brentq(lambda v: f(v) - target, sc.values[k], sc.values[k + 1],
-                                          xtol=1e-14, rtol=1e-13)))
+                roots.append(float(brentq(lambda v: f(v) - target, sc.values[k], sc.values[k + 1], xtol=1e-14, rtol=1e-13)))
             except ValueError:  # an invalid sliver between the scan values
                 continue
     roots = [r for r in roots if np.isfinite(f(r))]
@@ -362,16 +396,18 @@ def _solve(f, sc: _Scan, target: float, current: float) -> float | None:
 # ----------------------------------------------------------------------------- trees
 
 
-def _candidates(effectors: list[Effector], options: list[list[Chain]], limit: int = 500_000
-                ) -> list[tuple[float, int, list[tuple[str, Chain]]]]:
+def _candidates(
+    effectors: list[Effector], options: list[list[Chain]], limit: int = 500_000
+) -> list[tuple[float, int, list[tuple[str, Chain]]]]:
     """Every assignment of one chain and one cam per effector, cheapest first (cost, then enumeration order)."""
     cams = [[e.cam] if e.cam else list(CAMS) for e in effectors]
     if not any(e.cam for e in effectors):
         cams[0] = [CAMS[0]]  # with no cam named, a tree and its mirror image (cams swapped) are one design
     n = math.prod(len(o) for o in options) * math.prod(len(c) for c in cams)
     if n > limit:
-        raise InputError("request", [e.name for e in effectors],
-                         f"fewer chain and cam combinations than {limit:,} (this request has {n:,})")
+        raise InputError(
+            "request", [e.name for e in effectors], f"fewer chain and cam combinations than {limit:,} (this request has {n:,})"
+        )
     out = []
     k = 0
     for combo in itertools.product(*options):
@@ -402,19 +438,30 @@ def _no_tree(effectors: list[Effector], options: list[list[Chain]]) -> tuple[str
     for i, j in itertools.combinations(range(len(effectors)), 2):
         a, b = effectors[i], effectors[j]
         shared = set(options[i]) & set(options[j])
-        if shared and set(options[i]) == shared == set(options[j]) and set(cams[i]) == set(cams[j]) \
-                and len(cams[i]) * len(options[i]) == 1:
+        if (
+            shared
+            and set(options[i]) == shared == set(options[j])
+            and set(cams[i]) == set(cams[j])
+            and len(cams[i]) * len(options[i]) == 1
+        ):
             chain = " ".join(next(iter(shared)))
-            return (f"effectors {a.name!r} and {b.name!r} ({a.motion}, {b.motion})", f"{cams[i][0]} cam",
-                    f"effectors with a follower each: their only chain, {chain}, on one cam is one stage "
-                    "(put them on different cams, or ask for different motions)")
-    return ("request", [e.name for e in effectors],
-            "an assignment of one chain and one cam per effector (two effectors cannot be one stage's follower, "
-            "and one cam turns its effectors at one phase)")
+            return (
+                f"effectors {a.name!r} and {b.name!r} ({a.motion}, {b.motion})",
+                f"{cams[i][0]} cam",
+                f"effectors with a follower each: their only chain, {chain}, on one cam is one stage "
+                "(put them on different cams, or ask for different motions)",
+            )
+    return (
+        "request",
+        [e.name for e in effectors],
+        "an assignment of one chain and one cam per effector (two effectors cannot be one stage's follower, "
+        "and one cam turns its effectors at one phase)",
+    )
 
 
-def _size_tree(effectors: list[Effector], pairs: list[tuple[str, Chain]], phase: float, q: Array,
-               cache: dict) -> tuple[dict[tuple[str, Chain], dict[str, Any]], dict[str, tuple[str, str, float]]] | None:
+def _size_tree(
+    effectors: list[Effector], pairs: list[tuple[str, Chain]], phase: float, q: Array, cache: dict
+) -> tuple[dict[tuple[str, Chain], dict[str, Any]], dict[str, tuple[str, str, float]]] | None:
     """Sized overrides (by ``(cam, prefix)``) for one tree, or None when some effector cannot be sized in it."""
     cam_phase = {"left": 0.0, "right": phase}
     per_cam: dict[str, dict[Chain, dict[str, Any]]] = {cam: {} for cam in CAMS}
@@ -477,8 +524,9 @@ def effector_ranges(toy: ToyMechanism, samples: int = SAMPLES) -> dict[str, tupl
     return out
 
 
-def layer_collisions(toy: ToyMechanism, samples: int = 24, unit_mm: float = 100.0
-                     ) -> tuple[dict[str, int], list[tuple[str, str, float]], list[str]]:
+def layer_collisions(
+    toy: ToyMechanism, samples: int = 24, unit_mm: float = 100.0
+) -> tuple[dict[str, int], list[tuple[str, str, float]], list[str]]:
     """The toy's fabrication (what ``planar export`` cuts) checked for collisions over ``samples`` poses.
 
     Returns ``(layers, collisions, pin clashes)``: the export's layer of every
@@ -527,8 +575,11 @@ def layer_collisions(toy: ToyMechanism, samples: int = 24, unit_mm: float = 100.
 
 
 #: the written toy's scene tables: half a cycle a second, 36 frames a cycle, a small GIF, 100 mm a unit
-SCENE_TABLES: dict[str, Any] = {"driver": {"speed": 0.5, "samples_per_cycle": 36},
-                                "render": {"width": 360, "height": 270}, "fabrication": {"unit_mm": 100.0}}
+SCENE_TABLES: dict[str, Any] = {
+    "driver": {"speed": 0.5, "samples_per_cycle": 36},
+    "render": {"width": 360, "height": 270},
+    "fabrication": {"unit_mm": 100.0},
+}
 #: Earth's gravity in the written scene's model units per s^2 (9810 mm/s^2 at its ``unit_mm``): physics runs in
 #: model units, so a toy cut at 100 mm per unit falls at 98.1 units/s^2
 EARTH_GRAVITY = 9810.0 / SCENE_TABLES["fabrication"]["unit_mm"]
@@ -579,20 +630,34 @@ def physics_check(scene: Any) -> dict[str, Any]:
         motion = scene.motion()
         phys = simulate_toy(toy, motion.t, scene.effects, speeds=[speed])
     except PlanarError as e:
-        return {"ok": False, "torque_rel_diff": None, "failure": f"the physics refuses the toy: {e}",
-                "lets_go": [], "pin_lets_go": [], "not_simulated": [], "stages": [], "speed": speed}
+        return {
+            "ok": False,
+            "torque_rel_diff": None,
+            "failure": f"the physics refuses the toy: {e}",
+            "lets_go": [],
+            "pin_lets_go": [],
+            "not_simulated": [],
+            "stages": [],
+            "speed": speed,
+        }
     tq = phys.torque
-    lets_go = sorted(k for k, v in phys.liftoff.items()
-                     if v["liftoff_speed"] is not None and v["liftoff_speed"] <= speed)
+    lets_go = sorted(k for k, v in phys.liftoff.items() if v["liftoff_speed"] is not None and v["liftoff_speed"] <= speed)
     pin_lets_go = sorted(k for k, v in phys.skew.items() if not v["holds"])  # #6/#9: the edge would have to pull
-    missing = [{"stage": s.stage, "pattern": s.pattern, "effector": effector.get(s.stage), "reason": s.detail}
-               for s in phys.not_simulated]
-    ok = (tq["failure"] is None and tq["max_rel_diff"] <= TORQUE_TOLERANCE and not lets_go and not pin_lets_go
-          and not missing)
-    return {"ok": bool(ok), "torque_rel_diff": float(tq["max_rel_diff"]), "failure": tq["failure"],
-            "lets_go": lets_go, "pin_lets_go": pin_lets_go, "not_simulated": missing, "speed": speed,
-            "stages": [{"stage": s.stage, "pattern": s.pattern, "simulated": s.simulated, "detail": s.detail}
-                       for s in phys.stages]}
+    missing = [
+        {"stage": s.stage, "pattern": s.pattern, "effector": effector.get(s.stage), "reason": s.detail}
+        for s in phys.not_simulated
+    ]
+    ok = tq["failure"] is None and tq["max_rel_diff"] <= TORQUE_TOLERANCE and not lets_go and not pin_lets_go and not missing
+    return {
+        "ok": bool(ok),
+        "torque_rel_diff": float(tq["max_rel_diff"]),
+        "failure": tq["failure"],
+        "lets_go": lets_go,
+        "pin_lets_go": pin_lets_go,
+        "not_simulated": missing,
+        "speed": speed,
+        "stages": [{"stage": s.stage, "pattern": s.pattern, "simulated": s.simulated, "detail": s.detail} for s in phys.stages],
+    }
 
 
 def physics_failures(phys: dict[str, Any]) -> list[str]:
@@ -601,8 +666,10 @@ def physics_failures(phys: dict[str, Any]) -> list[str]:
     if phys["failure"]:
         out.append(str(phys["failure"]))
     elif phys["torque_rel_diff"] is not None and phys["torque_rel_diff"] > TORQUE_TOLERANCE:
-        out.append(f"motor torque strays {phys['torque_rel_diff']:.2g} of its peak from inverse dynamics "
-                   f"(more than {TORQUE_TOLERANCE:g})")
+        out.append(
+            f"motor torque strays {phys['torque_rel_diff']:.2g} of its peak from inverse dynamics "
+            f"(more than {TORQUE_TOLERANCE:g})"
+        )
     for k in phys["lets_go"]:
         out.append(f"stage {k}'s tab lets go at {phys['speed']:g} cycles/s")
     for k in phys.get("pin_lets_go", []):
@@ -681,6 +748,7 @@ def _posed(shape: Any, pose: Array) -> Any:
 
     def move(xy: Array) -> Array:
         return np.column_stack([P[:, 0] + c * xy[:, 0] - s * xy[:, 1], P[:, 1] + s * xy[:, 0] + c * xy[:, 1]])
+
     return shapely.transform(geoms, move)
 
 
@@ -715,8 +783,10 @@ def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
             pose = pose[:1]  # a frame does not move
         shape = p.outline.simplify(SIMPLIFY)  # 0.3 mm: the objective need not follow every facet of a cam
         swept[p.name] = shapely.union_all(_posed(shape, pose))
-    footprint = sum(float(shapely.union_all([g for n, g in swept.items() if plane[n] == pl]).convex_hull.area)
-                    for pl in sorted(set(plane.values())))
+    footprint = sum(
+        float(shapely.union_all([g for n, g in swept.items() if plane[n] == pl]).convex_hull.area)
+        for pl in sorted(set(plane.values()))
+    )
     overlap = 0.0
     names = [n for n in swept if not asm.part(n).ground]
     for a, b in itertools.combinations(names, 2):
@@ -734,15 +804,19 @@ def _layout_score(toy: ToyMechanism, samples: int = 8) -> tuple[float, float]:
         c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
         x, y = pin.at[0]
         path = np.c_[pose[:, 0] + c * x - s * y, pose[:, 1] + s * x + c * y]
-        geom = shapely.buffer(shapely.points(path[0]) if np.ptp(path, axis=0).max() < 1e-9
-                              else shapely.linestrings(path), PIN_RADIUS)
+        geom = shapely.buffer(
+            shapely.points(path[0]) if np.ptp(path, axis=0).max() < 1e-9 else shapely.linestrings(path), PIN_RADIUS
+        )
         for n in names:
             if n not in on and plane[n] == plane[a]:
                 overlap += float(swept[n].intersection(geom).area)
     # a piece's cuts too close to one another, the frame's to the motor (each piece in its own frame)
     for p in asm.parts:
-        cuts = [feature_shape(f, WALL / 2) for f in p.features
-                if not (p.ground and p.plane == "xy" and isinstance(f, Hole) and np.hypot(*f.centre) < 1e-9)]
+        cuts = [
+            feature_shape(f, WALL / 2)
+            for f in p.features
+            if not (p.ground and p.plane == "xy" and isinstance(f, Hole) and np.hypot(*f.centre) < 1e-9)
+        ]
         if p.ground and p.plane == "xy":
             cuts += [shapely.Point(sx * MOTOR_SCREW_X, 0.0).buffer(MOTOR_SCREW_R + WALL / 2) for sx in (-1, 1)]
             cuts.append(shapely.Point(0.0, 0.0).buffer(MOTOR_SHAFT_R + WALL / 2))
@@ -833,15 +907,21 @@ def placement_variables(toy: ToyMechanism, samples: int = 181) -> list[Placement
     # the first in MOVES order is kept
     out: list[PlacementVariable] = []
     for v in found:
-        if not any(o.cam == v.cam and o.key == v.key and o.comp == v.comp and
-                   dict(o.shifts).keys() <= dict(v.shifts).keys() for o in out):
+        if not any(
+            o.cam == v.cam and o.key == v.key and o.comp == v.comp and dict(o.shifts).keys() <= dict(v.shifts).keys() for o in out
+        ):
             out.append(v)
     return out
 
 
-def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, overrides: dict[tuple[str, Chain], dict[str, Any]],
-                 names: dict[tuple[str, Chain], str], seed: int = 0
-                 ) -> tuple[list[tuple[dict[tuple[str, Chain], dict[str, Any]], tuple[float, float, float]]], Placement]:
+def place_stages(
+    cams: dict[str, list[Chain]],
+    phase: float,
+    name: str,
+    overrides: dict[tuple[str, Chain], dict[str, Any]],
+    names: dict[tuple[str, Chain], str],
+    seed: int = 0,
+) -> tuple[list[tuple[dict[tuple[str, Chain], dict[str, Any]], tuple[float, float, float]]], Placement]:
     """Anneal the placement variables (:func:`placement_variables`) to a compact toy whose pieces overlap little.
 
     Returns the best ``PLACEMENT_OPTIONS`` distinct layouts the annealing
@@ -882,8 +962,7 @@ def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, override
         if toy is None:
             return math.inf, math.inf, math.inf, None
         outs, checks = toy.world_motion(q)
-        if not all(np.all(ok) for ok, _, _ in checks) or any(
-                not np.allclose(outs[k], ref[k], rtol=0, atol=1e-9) for k in ref):
+        if not all(np.all(ok) for ok, _, _ in checks) or any(not np.allclose(outs[k], ref[k], rtol=0, atol=1e-9) for k in ref):
             return math.inf, math.inf, math.inf, None
         try:
             fp, ovl = _layout_score(toy)
@@ -918,8 +997,7 @@ def place_stages(cams: dict[str, list[Chain]], phase: float, name: str, override
             if fy < f0 and all(np.abs(y - st[3]).max() > 1e-9 for st in states):
                 states.append((fy, fpy, ovy, y.copy()))
     options = [(layout(xs), (f, fp, ov)) for f, fp, ov, xs in sorted(states, key=lambda t: t[0])[:PLACEMENT_OPTIONS]]
-    return options, Placement(labels, (f0, f0), (fp0, fp0), (ov0, ov0), evals, rejected,
-                              time.perf_counter() - t0, kept=False)
+    return options, Placement(labels, (f0, f0), (fp0, fp0), (ov0, ov0), evals, rejected, time.perf_counter() - t0, kept=False)
 
 
 #: cam-in-window stages (#1-#3): their motion follows the eccentricity alone, not the disc's radius
@@ -928,9 +1006,13 @@ DISC_CAMS = (1, 2, 3)
 DISC_MARGIN = 0.01
 
 
-def _disc_cams(cams: dict[str, list[Chain]], phase: float, name: str,
-               overrides: dict[tuple[str, Chain], dict[str, Any]], names: dict[tuple[str, Chain], str]
-               ) -> dict[tuple[str, Chain], dict[str, Any]] | None:
+def _disc_cams(
+    cams: dict[str, list[Chain]],
+    phase: float,
+    name: str,
+    overrides: dict[tuple[str, Chain], dict[str, Any]],
+    names: dict[tuple[str, Chain], str],
+) -> dict[tuple[str, Chain], dict[str, Any]] | None:
     """``overrides`` with every #1-#3 cam that would be a crank (its axle's boss leaving the disc,
     ``|D_jc| + 2 D_ar > D_jr``) grown into a disc holding the boss, or None when none is; None too when the
     grown toy moves differently (compared on 181 samples to 1e-9) or cannot be built.
@@ -957,15 +1039,18 @@ def _disc_cams(cams: dict[str, list[Chain]], phase: float, name: str,
         return None
     ref, _ = toy.world_motion(q)
     got, checks = disc.world_motion(q)
-    if not all(np.all(ok) for ok, _, _ in checks) or any(
-            not np.allclose(got[k], ref[k], rtol=0, atol=1e-9) for k in ref):
+    if not all(np.all(ok) for ok, _, _ in checks) or any(not np.allclose(got[k], ref[k], rtol=0, atol=1e-9) for k in ref):
         return None
     return out
 
 
-def _variants(cams: dict[str, list[Chain]], phase: float, name: str,
-              overrides: dict[tuple[str, Chain], dict[str, Any]], names: dict[tuple[str, Chain], str]
-              ) -> list[tuple[str, dict[tuple[str, Chain], dict[str, Any]]]]:
+def _variants(
+    cams: dict[str, list[Chain]],
+    phase: float,
+    name: str,
+    overrides: dict[tuple[str, Chain], dict[str, Any]],
+    names: dict[tuple[str, Chain], str],
+) -> list[tuple[str, dict[tuple[str, Chain], dict[str, Any]]]]:
     """The sized tree as sized, then (when it has cranks) with its cams grown into discs (:func:`_disc_cams`)."""
     out: list[tuple[str, dict[tuple[str, Chain], dict[str, Any]]]] = [("", overrides)]
     try:
@@ -980,9 +1065,16 @@ def _variants(cams: dict[str, list[Chain]], phase: float, name: str,
 # ----------------------------------------------------------------------------- the pipeline
 
 
-def design_toy(effectors: list[Effector], name: str = "designed toy", max_length: int = 3,
-               max_trees: int = 200, place: bool = True, max_fabricated: int = 4, physics: bool = True,
-               source: str = "") -> Design:
+def design_toy(
+    effectors: list[Effector],
+    name: str = "designed toy",
+    max_length: int = 3,
+    max_trees: int = 200,
+    place: bool = True,
+    max_fabricated: int = 4,
+    physics: bool = True,
+    source: str = "",
+) -> Design:
     """Design a toy for ``effectors`` (see the module docstring); an unreachable request is an
     :class:`InputError` naming ``source`` (the request file), the effector, its range and the ranges the
     chains the toy assembly can build reach (chains it refuses, e.g. a stage turned out of its plane, are
@@ -1035,8 +1127,11 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
     options = [enumerate_chains(e.motion, max_length)[e.motion] for e in effectors]
     for e, opts in zip(effectors, options):
         if not opts:
-            raise InputError(f"{at}effector {e.name!r} ({e.motion}) chain length", max_length,
-                             f"enough stages for a chain from the motor to {e.motion} (--max-length)")
+            raise InputError(
+                f"{at}effector {e.name!r} ({e.motion}) chain length",
+                max_length,
+                f"enough stages for a chain from the motor to {e.motion} (--max-length)",
+            )
     cands = _candidates(effectors, options)
     if not cands:
         where, value, expected = _no_tree(effectors, options)
@@ -1055,8 +1150,9 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
         phase = _toy_phase(effectors, pairs)
         sized = _size_tree(effectors, pairs, phase, q, cache)
         if sized is None:
-            why_not.append("; ".join(f"{cam}: {' '.join(c)}" for cam, c in pairs) + ": no parameter value gives "
-                           "every requested range")
+            why_not.append(
+                "; ".join(f"{cam}: {' '.join(c)}" for cam, c in pairs) + ": no parameter value gives every requested range"
+            )
             continue
         overrides, sizing = sized
         cams: dict[str, list[Chain]] = {}
@@ -1067,15 +1163,17 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
         made = False
         for how, variant in _variants(cams, phase, name, overrides, names):
             try:
-                toy = ToyMechanism({k: v for k, v in cams.items()}, phase=phase, name=name, overrides=variant,
-                                   names=names)
+                toy = ToyMechanism({k: v for k, v in cams.items()}, phase=phase, name=name, overrides=variant, names=names)
                 from planar.toys.assembly import toy_assembly
 
                 toy_assembly(toy)
             except InputError as err:  # a tree the assembly refuses (a mirrored or turned out-of-plane stage)
-                why_not.append("; ".join(f"{cam}: {' '.join(c)}" for cam, c in pairs)
-                               + (f" ({how})" if how else "") + f": the toy assembly cannot build it (it would "
-                               f"{_reasons([str(err)])})")
+                why_not.append(
+                    "; ".join(f"{cam}: {' '.join(c)}" for cam, c in pairs)
+                    + (f" ({how})" if how else "")
+                    + f": the toy assembly cannot build it (it would "
+                    f"{_reasons([str(err)])})"
+                )
                 continue
             t_size = time.perf_counter() - t0 - t_enum
             t1 = time.perf_counter()
@@ -1083,12 +1181,17 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
             checked = layer_collisions(toy)
             layers_before = len(set(checked[0].values()))
             checked_before = checked
-            before = {"layers": layers_before, "collisions": len(checked[1]), "pin_clashes": len(checked[2]),
-                      "export_refused": int(not checked[0])}
+            before = {
+                "layers": layers_before,
+                "collisions": len(checked[1]),
+                "pin_clashes": len(checked[2]),
+                "export_refused": int(not checked[0]),
+            }
 
             def bad(c: tuple[dict[str, int], list, list]) -> tuple[int, int, int, int]:
                 """An export that refuses the pieces (no layers) first, then collisions, pin clashes, layers."""
                 return int(not c[0]), len(c[1]), len(c[2]), len(set(c[0].values()))
+
             if place:
                 layouts, placement = place_stages(cams, phase, name, variant, names)
                 for placed, (f, fp, ov) in layouts:
@@ -1118,9 +1221,26 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
                 ranges[e.name] = math.degrees(val) if e.motion[0] == "O" else val
             layers, collisions, clashes = checked
             secs = {"enumerate": t_enum, "rank_and_size": t_size, "place_and_check": time.perf_counter() - t1}
-            d = Design(toy, effectors, pairs, cost, ranges, len(cands), tried, sizing, layers, collisions, secs,
-                       placement, layers_before, clashes, rejected, before,
-                       before_reason=checked_before[2][0] if before["export_refused"] else "", variant=how)
+            d = Design(
+                toy,
+                effectors,
+                pairs,
+                cost,
+                ranges,
+                len(cands),
+                tried,
+                sizing,
+                layers,
+                collisions,
+                secs,
+                placement,
+                layers_before,
+                clashes,
+                rejected,
+                before,
+                before_reason=checked_before[2][0] if before["export_refused"] else "",
+                variant=how,
+            )
             problems = [f"{a}/{b} collide" for a, b, _ in collisions] + clashes
             if not problems and physics:
                 t2 = time.perf_counter()
@@ -1130,8 +1250,13 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
             if not problems:
                 return d
             # a tree whose pieces collide, whose pins cross pieces or whose physics fails: try the next cheapest
-            rejected.append(f"cost {cost:g} " + "; ".join(f"{cam}: {' '.join(c)}" for cam, c in pairs)
-                            + (f" ({how})" if how else "") + ": " + ", ".join(problems))
+            rejected.append(
+                f"cost {cost:g} "
+                + "; ".join(f"{cam}: {' '.join(c)}" for cam, c in pairs)
+                + (f" ({how})" if how else "")
+                + ": "
+                + ", ".join(problems)
+            )
             if first is None:
                 first = d
         fabricated += made
@@ -1151,18 +1276,26 @@ def design_toy(effectors: list[Effector], name: str = "designed toy", max_length
         turned = [c for c in opts if refused(c) is not None and reaches(e, c)]
         if turned:
             why = _reasons([str(refused(c)) for c in turned])
-            listed = ", ".join(" ".join(c) for c in turned[:3]) + (f" and {len(turned) - 3} more" if len(turned) > 3
-                                                                    else "")
-            raise InputError(f"{at}effector {e.name!r} ({e.motion}) range", e.range,
-                             f"a range the toy assembly can build: the chains that reach {value} ({listed}) "
-                             f"{why}, which planar's toy assembly cannot build; buildable chains up to "
-                             f"{max_length} stages {where}")
-        raise InputError(f"{at}effector {e.name!r} ({e.motion}) range", e.range,
-                         f"a range buildable chains reach (buildable chains up to {max_length} stages {where})")
+            listed = ", ".join(" ".join(c) for c in turned[:3]) + (f" and {len(turned) - 3} more" if len(turned) > 3 else "")
+            raise InputError(
+                f"{at}effector {e.name!r} ({e.motion}) range",
+                e.range,
+                f"a range the toy assembly can build: the chains that reach {value} ({listed}) "
+                f"{why}, which planar's toy assembly cannot build; buildable chains up to "
+                f"{max_length} stages {where}",
+            )
+        raise InputError(
+            f"{at}effector {e.name!r} ({e.motion}) range",
+            e.range,
+            f"a range buildable chains reach (buildable chains up to {max_length} stages {where})",
+        )
     reason = why_not[0] if why_not else "none could be sized"
-    raise InputError(f"{at}request", [e.name for e in effectors],
-                     f"a tree that can be sized and assembled (none of the {tried} cheapest that could reach the "
-                     f"ranges; the cheapest: {reason})")
+    raise InputError(
+        f"{at}request",
+        [e.name for e in effectors],
+        f"a tree that can be sized and assembled (none of the {tried} cheapest that could reach the "
+        f"ranges; the cheapest: {reason})",
+    )
 
 
 def _assembly_reason(err: str) -> tuple[str, str]:

@@ -31,5 +31,13 @@ class PlacedFourBar:
         """The design as a :class:`planar.linkages.FourBar`."""
         from planar.linkages import FourBar
 
-        return FourBar(self.ground, self.crank, self.coupler, self.rocker, coupler_point=self.coupler_point,
-                       circuit=self.circuit, placement=self.placement, **kw)  # type: ignore[arg-type]
+        return FourBar(
+            self.ground,
+            self.crank,
+            self.coupler,
+            self.rocker,
+            coupler_point=self.coupler_point,
+            circuit=self.circuit,
+            placement=self.placement,
+            **kw,
+        )  # type: ignore[arg-type]

@@ -55,14 +55,14 @@ class FunctionDesign(Checked):
     K: Array
     phi: Array
     psi: Array
-    output_error: Array               # solved output angle - requested, radians
+    output_error: Array  # solved output angle - requested, radians
     grashof: str
-    ground_angle: float = 0.0         # placement angle: 0, or pi when the rocker pivot is on the negative x axis
-    input_offset: float = 0.0         # crank angle from the ground line = input + input_offset (rad)
-    output_offset: float = 0.0        # rocker angle from the ground line = output + output_offset (rad)
-    method: str = "closed form"       # "closed form" (Freudenstein) or "search" (see .function_search)
+    ground_angle: float = 0.0  # placement angle: 0, or pi when the rocker pivot is on the negative x axis
+    input_offset: float = 0.0  # crank angle from the ground line = input + input_offset (rad)
+    output_offset: float = 0.0  # rocker angle from the ground line = output + output_offset (rad)
+    method: str = "closed form"  # "closed form" (Freudenstein) or "search" (see .function_search)
     checks: dict[str, Any] = field(default_factory=dict)
-    note: str = ""                    # why Freudenstein's closed form was not the design (search only)
+    note: str = ""  # why Freudenstein's closed form was not the design (search only)
 
     @property
     def max_error(self) -> float:
@@ -71,17 +71,36 @@ class FunctionDesign(Checked):
     def fourbar(self, **kw: Any):
         from planar.linkages import FourBar
 
-        return FourBar(self.ground, self.crank, self.coupler, self.rocker, coupler_point=(0.5 * self.coupler, 0.0),
-                       circuit=self.circuit, placement=(0.0, 0.0, self.ground_angle), **kw)  # type: ignore[arg-type]
+        return FourBar(
+            self.ground,
+            self.crank,
+            self.coupler,
+            self.rocker,
+            coupler_point=(0.5 * self.coupler, 0.0),
+            circuit=self.circuit,
+            placement=(0.0, 0.0, self.ground_angle),
+            **kw,
+        )  # type: ignore[arg-type]
 
     def to_dict(self) -> dict[str, Any]:
-        return {"type": "fourbar", "ground": self.ground, "crank": self.crank, "coupler": self.coupler,
-                "rocker": self.rocker, "circuit": self.circuit, "ground_angle": self.ground_angle,
-                "input_offset_rad": self.input_offset, "output_offset_rad": self.output_offset,
-                "method": self.method, "K": [float(k) for k in self.K],
-                "grashof": self.grashof, "max_output_error_rad": self.max_error,
-                "output_error_rad": [float(e) for e in self.output_error], "checks": self.checks,
-                **({"note": self.note} if self.note else {})}
+        return {
+            "type": "fourbar",
+            "ground": self.ground,
+            "crank": self.crank,
+            "coupler": self.coupler,
+            "rocker": self.rocker,
+            "circuit": self.circuit,
+            "ground_angle": self.ground_angle,
+            "input_offset_rad": self.input_offset,
+            "output_offset_rad": self.output_offset,
+            "method": self.method,
+            "K": [float(k) for k in self.K],
+            "grashof": self.grashof,
+            "max_output_error_rad": self.max_error,
+            "output_error_rad": [float(e) for e in self.output_error],
+            "checks": self.checks,
+            **({"note": self.note} if self.note else {}),
+        }
 
 
 def _pairs(phi: Array, psi: Array, ground: float) -> tuple[Array, Array]:
@@ -103,14 +122,16 @@ def freudenstein_fit(phi: Array, psi: Array, ground: float = 1.0) -> FunctionDes
     M = np.column_stack([np.cos(psi), -np.cos(phi), np.ones_like(phi)])
     rhs = np.cos(phi - psi)
     if np.linalg.matrix_rank(M) < 3:
-        raise InputError("pairs", [[float(a), float(b)] for a, b in zip(phi, psi)],
-                         "pairs with 3 different input angles and 3 different output angles (the system is singular)")
+        raise InputError(
+            "pairs",
+            [[float(a), float(b)] for a, b in zip(phi, psi)],
+            "pairs with 3 different input angles and 3 different output angles (the system is singular)",
+        )
     K = np.linalg.solve(M, rhs) if len(phi) == 3 else np.linalg.lstsq(M, rhs, rcond=None)[0]
     K1, K2, K3 = (float(k) for k in K)
     if K1 * K2 <= 0:
-        raise InputError("pairs", f"K1 = {K1:.4g}, K2 = {K2:.4g}",
-                         "pairs a four-bar can generate (K1 and K2 of one sign)")
-    turn = 0.0 if K1 > 0 else np.pi      # rocker pivot on the negative x axis: the four-bar turned by pi
+        raise InputError("pairs", f"K1 = {K1:.4g}, K2 = {K2:.4g}", "pairs a four-bar can generate (K1 and K2 of one sign)")
+    turn = 0.0 if K1 > 0 else np.pi  # rocker pivot on the negative x axis: the four-bar turned by pi
     d = float(ground)
     a, c = d / abs(K1), d / abs(K2)
     b2 = a * a + c * c + d * d - 2 * a * c * K3
@@ -125,7 +146,7 @@ def freudenstein_fit(phi: Array, psi: Array, ground: float = 1.0) -> FunctionDes
         if best is None or e < best[0]:
             best = (e, circuit, err)
     assert best is not None
-    off = 0.0 - turn                     # never -0.0
+    off = 0.0 - turn  # never -0.0
     return FunctionDesign(d, a, b, c, best[1], K, phi, psi, best[2], grashof_class(a, b, c, d), turn, off, off)
 
 
@@ -141,9 +162,23 @@ def _design(x: Array, circuit: int, phi: Array, psi: Array, ground: float, free:
     a, b, c, A, B = (float(v) for v in x)
     K = np.array([1.0 / a, 1.0 / c, (a * a - b * b + c * c + 1.0) / (2.0 * a * c)])
     g = float(ground)
-    turn = 0.0 if free else float(-A) + 0.0               # + 0.0: never -0.0
-    return FunctionDesign(g, a * g, b * g, c * g, "open" if circuit > 0 else "crossed", K, phi, psi,
-                          np.full(len(phi), np.nan), grashof_class(a, b, c, 1.0), turn, A + 0.0, B + 0.0, "search")
+    turn = 0.0 if free else float(-A) + 0.0  # + 0.0: never -0.0
+    return FunctionDesign(
+        g,
+        a * g,
+        b * g,
+        c * g,
+        "open" if circuit > 0 else "crossed",
+        K,
+        phi,
+        psi,
+        np.full(len(phi), np.nan),
+        grashof_class(a, b, c, 1.0),
+        turn,
+        A + 0.0,
+        B + 0.0,
+        "search",
+    )
 
 
 def check_function(d: FunctionDesign, cons: Any, tolerance: float, dense: int = 361) -> None:
@@ -157,20 +192,20 @@ def check_function(d: FunctionDesign, cons: Any, tolerance: float, dense: int = 
     pairs counts as a turn of error.
     """
     fb = d.fourbar()
-    th = d.phi + d.input_offset                           # crank angles from the ground line
+    th = d.phi + d.input_offset  # crank angles from the ground line
     t = np.unique(np.concatenate([np.linspace(th.min(), th.max(), dense), th]))
     m = fb.solve(t)
     rocker = np.unwrap(m.poses["rocker"][:, 2])
     at = np.searchsorted(t, th)
-    want = d.psi + d.output_offset + d.ground_angle      # requested rocker world angles,
-    order = np.argsort(th)                                # unwrapped in the crank's order (steps < pi)
+    want = d.psi + d.output_offset + d.ground_angle  # requested rocker world angles,
+    order = np.argsort(th)  # unwrapped in the crank's order (steps < pi)
     want[order] = np.unwrap(want[order])
     i0 = int(np.argmin(th))
     e0 = float(_wrap(rocker[at[i0]] - want[i0]))
     d.output_error = (rocker[at] - rocker[at[i0]]) - (want - want[i0]) + e0
     mu = fb.transmission_angle(t)
     margin = float(np.minimum(mu, np.pi - mu).min())
-    if cons.full_turn:                                    # the linkage passes the whole turn: its margin too
+    if cons.full_turn:  # the linkage passes the whole turn: its margin too
         mu = fb.transmission_angle(np.linspace(0.0, 2 * np.pi, 721))
         margin_turn = float(np.minimum(mu, np.pi - mu).min())
     lengths = np.array([d.ground, d.crank, d.coupler, d.rocker])
@@ -186,13 +221,14 @@ def check_function(d: FunctionDesign, cons: Any, tolerance: float, dense: int = 
         "link_ratio": ratio,
         "crank_turns_fully": bool(full),
     }
-    if cons.full_turn:                                    # only when asked (--full-turn)
+    if cons.full_turn:  # only when asked (--full-turn)
         d.checks["ok_full_turn"] = bool(full)
         d.checks["min_transmission_full_turn_deg"] = float(np.degrees(margin_turn))
 
 
-def synthesise_function(phi: Array, psi: Array, ground: float = 1.0, cons: Any = None,
-                        tolerance: float = 0.01) -> tuple[FunctionDesign | None, str]:
+def synthesise_function(
+    phi: Array, psi: Array, ground: float = 1.0, cons: Any = None, tolerance: float = 0.01
+) -> tuple[FunctionDesign | None, str]:
     """The four-bar that follows ``psi`` at ``phi`` on one circuit, checked; or ``None`` and why none is valid.
 
     Freudenstein's closed form is kept when it is valid and exact (``EXACT``)
@@ -210,14 +246,15 @@ def synthesise_function(phi: Array, psi: Array, ground: float = 1.0, cons: Any =
         raise InputError("pairs", [float(v) for v in psi], "output angles that change")
     for name, span in zip(("input", "output"), spans(phi, psi)):
         if span > 2 * np.pi:
-            raise InputError(f"pairs: {name}", f"a span of {span:.6g} rad",
-                             "a span of at most 2 pi rad (one turn; --deg for degrees)")
+            raise InputError(
+                f"pairs: {name}", f"a span of {span:.6g} rad", "a span of at most 2 pi rad (one turn; --deg for degrees)"
+            )
     closed: FunctionDesign | None = None
     note = ""
     if not cons.free_offsets:
         try:
             closed = freudenstein_fit(phi, psi, ground)
-        except InputError as exc:                           # no real four-bar at these offsets: search
+        except InputError as exc:  # no real four-bar at these offsets: search
             note = f"Freudenstein's closed form gives no four-bar ({exc.value})"
     if closed is not None:
         x = _normalised(closed)[None, :]
@@ -231,14 +268,27 @@ def synthesise_function(phi: Array, psi: Array, ground: float = 1.0, cons: Any =
             check_function(closed, cons, tolerance)
             return closed, ""
         lengths = np.array([closed.ground, closed.crank, closed.coupler, closed.rocker])
-        why = [text for bad, text in zip(v > 0, (
-            "does not move over the inputs' arc on one circuit" + (
-                "" if cons.min_transmission == 0 else
-                f" keeping the transmission angle {np.degrees(cons.min_transmission):g} deg from a toggle"),
-            "its crank cannot turn fully", f"link ratio {lengths.max() / lengths.min():.3g} > {cons.max_ratio:g}")) if bad]
+        why = [
+            text
+            for bad, text in zip(
+                v > 0,
+                (
+                    "does not move over the inputs' arc on one circuit"
+                    + (
+                        ""
+                        if cons.min_transmission == 0
+                        else f" keeping the transmission angle {np.degrees(cons.min_transmission):g} deg from a toggle"
+                    ),
+                    "its crank cannot turn fully",
+                    f"link ratio {lengths.max() / lengths.min():.3g} > {cons.max_ratio:g}",
+                ),
+            )
+            if bad
+        ]
         how = f"error {cerr:.3g} rad at the pairs" if np.isfinite(cerr) else "some pairs not on its circuit"
-        note = (f"Freudenstein's closed form ({closed.grashof}, {closed.circuit}, {how}) "
-                + ("was less accurate than the search's" if not why else "is no valid four-bar: " + ", ".join(why)))
+        note = f"Freudenstein's closed form ({closed.grashof}, {closed.circuit}, {how}) " + (
+            "was less accurate than the search's" if not why else "is no valid four-bar: " + ", ".join(why)
+        )
     assert r is not None
     if r.x is None:
         return None, r.reason + (f"; {note}" if note else "")

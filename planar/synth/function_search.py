@@ -64,10 +64,10 @@ class FunctionConstraints:
 class SearchResult:
     """The chosen candidate (normalised, ground 1) or ``None``, and why none was valid."""
 
-    x: Array | None                   # a, b, c, A, B
+    x: Array | None  # a, b, c, A, B
     circuit: int
     max_error: float
-    margin: float                     # transmission margin over the arc (rad)
+    margin: float  # transmission margin over the arc (rad)
     candidates: int
     refined: int
     reason: str = ""
@@ -110,7 +110,7 @@ def output_errors(X: Array, circuit: Array, phi: Array, psi: Array) -> tuple[Arr
     ``(coupler, 0)`` in the coupler's frame), the rocker angle is
     ``atan2(C - O4)`` with ``O4 = (1, 0)``.
     """
-    a, b, c, A, B = (X[:, i:i + 1] for i in range(5))
+    a, b, c, A, B = (X[:, i : i + 1] for i in range(5))
     K = np.zeros((len(X), 9))
     K[:, 0], K[:, 1], K[:, 2], K[:, 3], K[:, 4] = 1.0, X[:, 0], X[:, 1], X[:, 2], X[:, 1]
     cx, cy, ok = coupler_points(K, phi[None, :] + A, circuit)
@@ -133,7 +133,7 @@ def violations(X: Array, phi: Array, cons: FunctionConstraints, slack: float = 0
 def _closed_form_seeds(phi: Array, psi: Array, A: Array, B: Array) -> Array:
     """Freudenstein's linear least squares at each offset pair ``(A, B)``: rows ``a, b, c, A, B`` (real ones)."""
     th, ps = phi[None, :] + A[:, None], psi[None, :] + B[:, None]
-    M = np.stack([np.cos(ps), -np.cos(th), np.ones_like(th)], axis=-1)          # (G, n, 3)
+    M = np.stack([np.cos(ps), -np.cos(th), np.ones_like(th)], axis=-1)  # (G, n, 3)
     rhs = np.cos(th - ps)
     MtM = np.einsum("gni,gnj->gij", M, M)
     Mtr = np.einsum("gni,gn->gi", M, rhs)
@@ -142,7 +142,7 @@ def _closed_form_seeds(phi: Array, psi: Array, A: Array, B: Array) -> Array:
     A, B = A[good], B[good]
     same = K[:, 0] * K[:, 1] > 0
     K, A, B = K[same], A[same], B[same]
-    turn = np.where(K[:, 0] < 0, np.pi, 0.0)               # negative K1, K2: the frame turned by pi
+    turn = np.where(K[:, 0] < 0, np.pi, 0.0)  # negative K1, K2: the frame turned by pi
     a, c = 1.0 / np.abs(K[:, 0]), 1.0 / np.abs(K[:, 1])
     b2 = a * a + c * c + 1.0 - 2.0 * a * c * K[:, 2]
     real = b2 > 0
@@ -161,7 +161,7 @@ def _seeds(phi: Array, psi: Array, cons: FunctionConstraints, n_random: int, gri
         rnd = np.column_stack([np.exp(lr * (2 * s[:, :3] - 1)), np.pi * (2 * s[:, 3:] - 1)])
     else:
         cf = _closed_form_seeds(phi, psi, np.array([0.0, -np.pi]), np.array([0.0, -np.pi]))
-        cf = cf[np.isclose(cf[:, 3], cf[:, 4])]            # fixed: A = B, 0 or -pi (up to 2 pi)
+        cf = cf[np.isclose(cf[:, 3], cf[:, 4])]  # fixed: A = B, 0 or -pi (up to 2 pi)
         s = qmc.Sobol(3, scramble=True, seed=seed).random(n_random)
         L = np.exp(lr * (2 * s - 1))
         off = np.repeat([0.0, -np.pi], n_random)[:, None]
@@ -208,15 +208,14 @@ def _refine(x0: Array, circuit: int, phi: Array, psi: Array, cons: FunctionConst
         h = 1e-7 * np.maximum(1.0, np.abs(z))
         R = many(np.vstack([z, z + np.diag(h)]))
         D = R[1:] - R[0]
-        D[:, :len(phi)] = _wrap(D[:, :len(phi)])
+        D[:, : len(phi)] = _wrap(D[:, : len(phi)])
         return (D / h[:, None]).T
 
     z0 = np.concatenate([np.log(x0[:3]), x0[3:] if free else []])
     lo = np.concatenate([np.full(3, -lr), np.full(len(z0) - 3, -np.inf)])
     hi = -lo
     z0 = np.clip(z0, lo + 1e-9, hi - 1e-9)
-    r = least_squares(fun, z0, jac=jac, bounds=(lo, hi), method="trf", xtol=1e-13, ftol=1e-13, gtol=1e-13,
-                      max_nfev=100)
+    r = least_squares(fun, z0, jac=jac, bounds=(lo, hi), method="trf", xtol=1e-13, ftol=1e-13, gtol=1e-13, max_nfev=100)
     return full(r.x[None, :])[0]
 
 
@@ -230,32 +229,40 @@ def _counts(X: Array, circ: Array, phi: Array, cons: FunctionConstraints) -> dic
     s4 = s3
     if cons.full_turn:
         s4 = s3 & (arc_margin(a, b, c, np.zeros_like(a), np.full_like(a, TWO_PI)) >= cons.floor)
-    return {"assemble_over_arc": int(s1.sum()), "and_link_ratio": int(s2.sum()),
-            "and_transmission": int(s3.sum()), "and_full_turn": int(s4.sum())}
+    return {
+        "assemble_over_arc": int(s1.sum()),
+        "and_link_ratio": int(s2.sum()),
+        "and_transmission": int(s3.sum()),
+        "and_full_turn": int(s4.sum()),
+    }
 
 
 def _why(counts: dict[str, int], phi: Array, cons: FunctionConstraints) -> str:
     arc = np.degrees(np.ptp(phi))
-    steps = [("assemble_over_arc", f"assembles over the inputs' {arc:.4g} deg arc on one circuit"),
-             ("and_link_ratio", f"keeps longest / shortest link <= {cons.max_ratio:g}"),
-             ("and_transmission", f"keeps the transmission angle >= {np.degrees(cons.min_transmission):.4g} deg "
-                                  "from a toggle"),
-             ("and_full_turn", "lets the crank turn fully")]
+    steps = [
+        ("assemble_over_arc", f"assembles over the inputs' {arc:.4g} deg arc on one circuit"),
+        ("and_link_ratio", f"keeps longest / shortest link <= {cons.max_ratio:g}"),
+        ("and_transmission", f"keeps the transmission angle >= {np.degrees(cons.min_transmission):.4g} deg from a toggle"),
+        ("and_full_turn", "lets the crank turn fully"),
+    ]
     met = [text for key, text in steps if counts[key] > 0]
     first = next(text for key, text in steps if counts[key] == 0)
-    return (f"no four-bar {first}" + (f" while it {', '.join(met)}" if met else "")
-            + (" (the pairs at their given angles; --free-offsets lets the offsets vary)" if not cons.free_offsets
-               else ""))
+    return (
+        f"no four-bar {first}"
+        + (f" while it {', '.join(met)}" if met else "")
+        + (" (the pairs at their given angles; --free-offsets lets the offsets vary)" if not cons.free_offsets else "")
+    )
 
 
-def search_function(phi: Array, psi: Array, cons: FunctionConstraints, n_random: int = 1 << 14,
-                    grid: int = 72, starts: int = 12, seed: int = 0) -> SearchResult:
+def search_function(
+    phi: Array, psi: Array, cons: FunctionConstraints, n_random: int = 1 << 14, grid: int = 72, starts: int = 12, seed: int = 0
+) -> SearchResult:
     """The valid candidate with the smallest output-angle error (see the module); ties: the larger margin.
 
     The seeds are judged at up to ``SCREEN`` pairs spread over the inputs (the arc test uses all of
     them); the refinement and the choice at every pair.
     """
-    order = np.argsort(phi, kind="stable")              # seeds judged at most SCREEN pairs, spread over the arc
+    order = np.argsort(phi, kind="stable")  # seeds judged at most SCREEN pairs, spread over the arc
     sub = order[np.unique(np.round(np.linspace(0, len(phi) - 1, min(len(phi), SCREEN))).astype(int))]
     X = _seeds(phi[sub], psi[sub], cons, n_random, grid, seed)
     X = np.vstack([X, X])

@@ -50,14 +50,14 @@ def _block(X: Array, ct: Array, st: Array, circuit: Array) -> tuple[Array, Array
     x0, y0, phi = X[:, 6:7], X[:, 7:8], X[:, 8:9]
     cp, sp = np.cos(phi), np.sin(phi)
     bx = (r2 * cp) * ct
-    bx -= (r2 * sp) * st                   # B - O2, world
+    bx -= (r2 * sp) * st  # B - O2, world
     by = (r2 * sp) * ct
     by += (r2 * cp) * st
-    dx = r1 * cp - bx                      # O4 - B
+    dx = r1 * cp - bx  # O4 - B
     dy = r1 * sp - by
     L2 = r1 * r2 * ct
     L2 *= -2.0
-    L2 += r1 * r1 + r2 * r2                # |O4 - B|^2 (law of cosines)
+    L2 += r1 * r1 + r2 * r2  # |O4 - B|^2 (law of cosines)
     A = 0.5 * L2
     A += 0.5 * (r3 * r3 - r4 * r4)
     h2 = (r3 * r3) * L2
@@ -66,7 +66,7 @@ def _block(X: Array, ct: Array, st: Array, circuit: Array) -> tuple[Array, Array
     np.maximum(h2, 0.0, out=h2)
     w = np.sqrt(h2, out=h2)
     w *= circuit[:, None]
-    np.maximum(L2, 1e-12 * (r1 * r1 + r2 * r2), out=L2)   # B on O4: invalid (h2 < 0), kept finite
+    np.maximum(L2, 1e-12 * (r1 * r1 + r2 * r2), out=L2)  # B on O4: invalid (h2 < 0), kept finite
     inv = np.reciprocal(L2, out=L2)
     inv *= 1.0 / r3
     # alpha = (u A - v w) / (r3 L2), beta = (u w + v A) / (r3 L2)
@@ -87,8 +87,9 @@ def _block(X: Array, ct: Array, st: Array, circuit: Array) -> tuple[Array, Array
     return px, py, ok
 
 
-def coupler_points(X: Array, theta: Array, circuit: Array | None = None,
-                   threads: int | None = None, dtype: type = np.float64) -> tuple[Array, Array, Mask]:
+def coupler_points(
+    X: Array, theta: Array, circuit: Array | None = None, threads: int | None = None, dtype: type = np.float64
+) -> tuple[Array, Array, Mask]:
     """World coupler points ``(x, y)`` each ``(P, S)`` and validity ``(P, S)``.
 
     ``theta`` is ``(S,)`` crank angles shared by every candidate or ``(P, S)``

@@ -55,11 +55,11 @@ def dyad_rows(poses: Array, z: Array) -> Array:
     """``row_j(z)`` for ``j = 2..n``: ``(K, n-1, 3)`` for body points ``z`` ``(K, 2)``."""
     d = poses[:, :2]
     R = _rot(poses[:, 2])
-    dz = d[1:] - d[0]                                     # (n-1, 2)
-    dR = R[1:] - R[0]                                     # (n-1, 2, 2)
-    g = np.einsum("jki,jk->ji", R[1:], d[1:]) - R[0].T @ d[0]   # R_j^T d_j - R_1^T d_1
+    dz = d[1:] - d[0]  # (n-1, 2)
+    dR = R[1:] - R[0]  # (n-1, 2, 2)
+    g = np.einsum("jki,jk->ji", R[1:], d[1:]) - R[0].T @ d[0]  # R_j^T d_j - R_1^T d_1
     const = (d[1:] ** 2).sum(1) - (d[0] ** 2).sum()
-    lin = -2.0 * (dz[None] + np.einsum("jab,kb->kja", dR, z))     # (K, n-1, 2)
+    lin = -2.0 * (dz[None] + np.einsum("jab,kb->kja", dR, z))  # (K, n-1, 2)
     last = const[None] + 2.0 * np.einsum("ja,ka->kj", g, z)
     return np.concatenate([lin, last[..., None]], -1)
 
@@ -103,9 +103,9 @@ def circle_point_curve(poses: Array, rays: int = 720, reach: float = 4.0) -> tup
     psi = np.linspace(0.0, np.pi, rays, endpoint=False)
     u = np.column_stack([np.cos(psi), np.sin(psi)])
     nodes = np.array([-1.5, -0.5, 0.5, 1.5]) * L
-    vals = np.stack([_det3(dyad_rows(poses, z0 + t * u)) for t in nodes], 1)   # (rays, 4)
-    V = np.vander(nodes, 4)                                   # t^3 t^2 t 1
-    coef = np.linalg.solve(V, vals.T).T                       # (rays, 4), highest first
+    vals = np.stack([_det3(dyad_rows(poses, z0 + t * u)) for t in nodes], 1)  # (rays, 4)
+    V = np.vander(nodes, 4)  # t^3 t^2 t 1
+    coef = np.linalg.solve(V, vals.T).T  # (rays, 4), highest first
     lead = coef[:, 0]
     scale = np.abs(coef).max(1)
     pts: list[Array] = []
@@ -169,33 +169,45 @@ class MotionDesign(Checked, PlacedFourBar):
     coupler: float
     rocker: float
     coupler_point: tuple[float, float]
-    angle_offset: float               # body angle - coupler angle
+    angle_offset: float  # body angle - coupler angle
     circuit: str
     placement: tuple[float, float, float]
-    theta: Array                      # crank angle at each pose
+    theta: Array  # crank angle at each pose
     poses: Array
-    dyads: Array                      # (2, 4): moving pivot (body frame), fixed pivot (world)
+    dyads: Array  # (2, 4): moving pivot (body frame), fixed pivot (world)
     grashof: str
     candidates: int
-    crank_range: tuple[float, float] | None = None   # swept crank angles (rad, unwrapped) of a rocking crank
-    in_order: bool = True                            # the crank meets the poses in the given order
+    crank_range: tuple[float, float] | None = None  # swept crank angles (rad, unwrapped) of a rocking crank
+    in_order: bool = True  # the crank meets the poses in the given order
     checks: dict[str, Any] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"type": "fourbar", "ground": self.ground, "crank": self.crank, "coupler": self.coupler,
-                "rocker": self.rocker, "coupler_point": list(self.coupler_point), "circuit": self.circuit,
-                "placement": list(self.placement), "theta": [float(t) for t in self.theta],
-                "grashof": self.grashof, "dyads": self.dyads.tolist(), "candidate_dyads": self.candidates,
-                "crank_range": None if self.crank_range is None else list(self.crank_range),
-                "ok": self.ok, "checks": self.checks}
+        return {
+            "type": "fourbar",
+            "ground": self.ground,
+            "crank": self.crank,
+            "coupler": self.coupler,
+            "rocker": self.rocker,
+            "coupler_point": list(self.coupler_point),
+            "circuit": self.circuit,
+            "placement": list(self.placement),
+            "theta": [float(t) for t in self.theta],
+            "grashof": self.grashof,
+            "dyads": self.dyads.tolist(),
+            "candidate_dyads": self.candidates,
+            "crank_range": None if self.crank_range is None else list(self.crank_range),
+            "ok": self.ok,
+            "checks": self.checks,
+        }
 
 
 class NoMotionDesign(PlanarError):
     """No candidate four-bar meets the constraints (the CLI exits 3 and writes nothing)."""
 
 
-def crank_order(theta: Array, d: Array, a: Array, b: Array, r: Array) -> tuple[NDArray[np.bool_], NDArray[np.bool_],
-                                                                              Array, Array]:
+def crank_order(
+    theta: Array, d: Array, a: Array, b: Array, r: Array
+) -> tuple[NDArray[np.bool_], NDArray[np.bool_], Array, Array]:
     """Whether the crank reaches the poses in order, and the crank's swept range.
 
     ``theta`` ``(P, n)``: crank angle (rad, from the ground line O2-O4) at each
@@ -211,13 +223,13 @@ def crank_order(theta: Array, d: Array, a: Array, b: Array, r: Array) -> tuple[N
     """
     two = 2.0 * np.pi
     with np.errstate(divide="ignore", invalid="ignore"):
-        cmin = (a ** 2 + d ** 2 - (b + r) ** 2) / (2 * a * d)
-        cmax = (a ** 2 + d ** 2 - (b - r) ** 2) / (2 * a * d)
+        cmin = (a**2 + d**2 - (b + r) ** 2) / (2 * a * d)
+        cmax = (a**2 + d**2 - (b - r) ** 2) / (2 * a * d)
     full = (cmin <= -1.0) & (cmax >= 1.0)
     fwd = np.mod(np.diff(theta, axis=1), two)
     bwd = np.mod(-np.diff(theta, axis=1), two)
     turn_ok = ((fwd > 0).all(1) & (fwd.sum(1) < two)) | ((bwd > 0).all(1) & (bwd.sum(1) < two))
-    around_pi = (cmin <= -1.0) & ~full                    # one arc centred on theta = pi
+    around_pi = (cmin <= -1.0) & ~full  # one arc centred on theta = pi
     u = np.where(around_pi[:, None], np.mod(theta, two), (theta + np.pi) % two - np.pi)
     # two arcs (neither limit outside [-1, 1]): the poses must share the sign of theta
     two_arcs = (cmin > -1.0) & (cmax < 1.0)
@@ -238,8 +250,8 @@ def _choose(poses: Array, z: Array, c: Array, max_ratio: float) -> tuple[int, in
     I, J = np.meshgrid(np.arange(K), np.arange(K), indexing="ij")
     I, J = I[I != J], J[I != J]
     R = _rot(poses[:, 2])
-    W = poses[None, :, :2] + np.einsum("jab,kb->kja", R, z)          # (K, n, 2)
-    B, C = W[I], W[J]                                                 # (P, n, 2)
+    W = poses[None, :, :2] + np.einsum("jab,kb->kja", R, z)  # (K, n, 2)
+    B, C = W[I], W[J]  # (P, n, 2)
     O2, O4 = c[I][:, None, :], c[J][:, None, :]
     a = np.hypot(*(B[:, 0] - O2[:, 0]).T)
     r = np.hypot(*(C[:, 0] - O4[:, 0]).T)
@@ -249,22 +261,27 @@ def _choose(poses: Array, z: Array, c: Array, max_ratio: float) -> tuple[int, in
     lo, hi = Lk.min(1), Lk.max(1)
     L = _scale(poses)
     e1, e2 = O4 - B, C - B
-    side = np.sign(e1[..., 0] * e2[..., 1] - e1[..., 1] * e2[..., 0])   # (P, n)
+    side = np.sign(e1[..., 0] * e2[..., 1] - e1[..., 1] * e2[..., 0])  # (P, n)
     one_circuit = (np.abs(side.sum(1)) == side.shape[1]) & (side[:, 0] != 0)
     g = O4[:, 0] - O2[:, 0]
-    theta = (np.arctan2(B[..., 1] - O2[..., 1], B[..., 0] - O2[..., 0])
-             - np.arctan2(g[:, 1], g[:, 0])[:, None])                 # crank angle from the ground line
+    theta = (
+        np.arctan2(B[..., 1] - O2[..., 1], B[..., 0] - O2[..., 0]) - np.arctan2(g[:, 1], g[:, 0])[:, None]
+    )  # crank angle from the ground line
     in_order, full, _, _ = crank_order(theta, d, a, b, r)
     ratio = hi / np.maximum(lo, 1e-300)
     usable = one_circuit & (lo > 1e-3 * L) & (ratio <= max_ratio)
     if not usable.any():
-        raise NoMotionDesign(f"none of the {len(I)} pairs of the {K} dyads found takes the body through all "
-                             f"{len(poses)} poses on one circuit with links within the ratio {max_ratio:g} "
-                             "(a larger --max-ratio, or other poses)")
+        raise NoMotionDesign(
+            f"none of the {len(I)} pairs of the {K} dyads found takes the body through all "
+            f"{len(poses)} poses on one circuit with links within the ratio {max_ratio:g} "
+            "(a larger --max-ratio, or other poses)"
+        )
     if not (usable & in_order).any():
-        raise NoMotionDesign(f"order defect: each of the {int(usable.sum())} four-bars that reach all {len(poses)} "
-                             "poses on one circuit meets them out of the given order (or with a dead zone "
-                             "between them) as the crank moves in one direction (other poses, or their order)")
+        raise NoMotionDesign(
+            f"order defect: each of the {int(usable.sum())} four-bars that reach all {len(poses)} "
+            "poses on one circuit meets them out of the given order (or with a dead zone "
+            "between them) as the crank moves in one direction (other poses, or their order)"
+        )
     usable &= in_order
     pick = usable & full if (usable & full).any() else usable
     k = int(np.flatnonzero(pick)[np.argmin(ratio[pick])])
@@ -296,9 +313,11 @@ def burmester(poses: Array, max_ratio: float = 10.0, grid: int = 24) -> MotionDe
             if len(z) >= 2 and len(z) % 2 == 0:
                 break
         if len(z) < 2:
-            raise NoMotionDesign(f"these 5 poses have {len(z)} Burmester points within 64 times their extent (2 or "
-                                 "4 are needed): no four-bar takes the body through all five (drop a pose, or move "
-                                 "one)")
+            raise NoMotionDesign(
+                f"these 5 poses have {len(z)} Burmester points within 64 times their extent (2 or "
+                "4 are needed): no four-bar takes the body through all five (drop a pose, or move "
+                "one)"
+            )
     ok = np.isfinite(c).all(1)
     z, c = z[ok], c[ok]
     i, j, _ = _choose(poses, z, c, max_ratio)
@@ -325,12 +344,26 @@ def _design(poses: Array, zi: Array, ci: Array, zj: Array, cj: Array, candidates
     circuit = "open" if e1[0] * e2[1] - e1[1] * e2[0] > 0 else "crossed"
     theta = np.arctan2(B[:, 1] - ci[1], B[:, 0] - ci[0]) - phi
     ordered, full, lo, hi = crank_order(theta[None], *(np.array([v]) for v in (d, a, b, r)))
-    if not full[0]:                                   # a rocking crank: its angles as crank_order unwraps them
+    if not full[0]:  # a rocking crank: its angles as crank_order unwraps them
         cmin = (a * a + d * d - (b + r) ** 2) / (2 * a * d)
         theta = theta % (2 * np.pi) if cmin <= -1.0 else (theta + np.pi) % (2 * np.pi) - np.pi
-    md = MotionDesign(d, a, b, r, local, off, circuit, (float(ci[0]), float(ci[1]), phi), theta, poses,
-                      np.array([[*zi, *ci], [*zj, *cj]]), grashof_class(a, b, r, d), candidates,
-                      None if full[0] else (float(lo[0]), float(hi[0])), bool(ordered[0]))
+    md = MotionDesign(
+        d,
+        a,
+        b,
+        r,
+        local,
+        off,
+        circuit,
+        (float(ci[0]), float(ci[1]), phi),
+        theta,
+        poses,
+        np.array([[*zi, *ci], [*zj, *cj]]),
+        grashof_class(a, b, r, d),
+        candidates,
+        None if full[0] else (float(lo[0]), float(hi[0])),
+        bool(ordered[0]),
+    )
     check_motion(md)
     return md
 

@@ -43,9 +43,7 @@ def normalised(cons: Constraints, c: Array, s: float) -> Constraints:
     if cons.region is None:
         return cons
     x0, y0, x1, y1 = cons.region
-    return Constraints(cons.full_turn, cons.max_ratio,
-                       ((x0 - c[0]) / s, (y0 - c[1]) / s, (x1 - c[0]) / s, (y1 - c[1]) / s))
-
+    return Constraints(cons.full_turn, cons.max_ratio, ((x0 - c[0]) / s, (y0 - c[1]) / s, (x1 - c[0]) / s, (y1 - c[1]) / s))
 
 
 @dataclass
@@ -59,8 +57,8 @@ class FourBarDesign(Checked, PlacedFourBar):
     coupler_point: tuple[float, float]
     circuit: str
     placement: tuple[float, float, float]
-    theta: Array                      # crank angle at each target (radians from the ground line)
-    sse: float                        # from planar's solver at ``theta``
+    theta: Array  # crank angle at each target (radians from the ground line)
+    sse: float  # from planar's solver at ``theta``
     targets: Array
     timed: bool
     seconds: float
@@ -68,10 +66,20 @@ class FourBarDesign(Checked, PlacedFourBar):
 
     def to_dict(self) -> dict[str, Any]:
         return {
-            "type": "fourbar", "ground": self.ground, "crank": self.crank, "coupler": self.coupler,
-            "rocker": self.rocker, "coupler_point": list(self.coupler_point), "circuit": self.circuit,
-            "placement": list(self.placement), "theta": [float(t) for t in self.theta], "sse": self.sse,
-            "timed": self.timed, "time_s": self.seconds, "ok": self.ok, "checks": self.checks,
+            "type": "fourbar",
+            "ground": self.ground,
+            "crank": self.crank,
+            "coupler": self.coupler,
+            "rocker": self.rocker,
+            "coupler_point": list(self.coupler_point),
+            "circuit": self.circuit,
+            "placement": list(self.placement),
+            "theta": [float(t) for t in self.theta],
+            "sse": self.sse,
+            "timed": self.timed,
+            "time_s": self.seconds,
+            "ok": self.ok,
+            "checks": self.checks,
         }
 
 
@@ -95,8 +103,8 @@ def check_design(d: FourBarDesign, kernel_points: Array | None = None) -> None:
         "grashof": g,
         "ok_crank_turns_fully": g in ("crank-rocker", "double-crank") and bool(path.valid.all()),
         "ok_valid_at_targets": bool(at.valid.all()),
-        "ok_same_circuit_over_turn": bool(batch.valid.all() and path.valid.all()) and bool(
-            np.max(np.abs(batch.points["coupler_point"] - path.points["coupler_point"][perm])) <= 1e-9 * scale),
+        "ok_same_circuit_over_turn": bool(batch.valid.all() and path.valid.all())
+        and bool(np.max(np.abs(batch.points["coupler_point"] - path.points["coupler_point"][perm])) <= 1e-9 * scale),
         "max_target_distance": float(np.max(np.hypot(*(pts - d.targets).T))) if at.valid.all() else float("inf"),
     }
     if kernel_points is not None:
@@ -131,9 +139,11 @@ def synthesise_path(
         raise InputError("theta", len(theta), f"one crank angle per target ({len(t)})")
     if np.ptp(t, axis=0).max() <= 0:
         raise InputError("targets", t[0].tolist(), "targets that are not all the same point")
-    kw = {"quick": dict(n_sample=20_000, maxiter=60, popsize=15, refine=3),
-          "normal": dict(n_sample=100_000, maxiter=200, popsize=30, refine=8),
-          "thorough": dict(n_sample=500_000, maxiter=600, popsize=40, refine=16)}
+    kw = {
+        "quick": dict(n_sample=20_000, maxiter=60, popsize=15, refine=3),
+        "normal": dict(n_sample=100_000, maxiter=200, popsize=30, refine=8),
+        "thorough": dict(n_sample=500_000, maxiter=600, popsize=40, refine=16),
+    }
     if budget not in kw:
         raise InputError("budget", budget, f"one of {', '.join(kw)}")
     t0 = time.perf_counter()
@@ -144,9 +154,20 @@ def synthesise_path(
     p = r.params.copy()
     p[:6] *= s
     p[6:8] = p[6:8] * s + c
-    d = FourBarDesign(float(p[0]), float(p[1]), float(p[2]), float(p[3]), (float(p[4]), float(p[5])),
-                      "open" if r.circuit > 0 else "crossed", (float(p[6]), float(p[7]), float(p[8])),
-                      np.asarray(r.theta, float), float("nan"), t, theta is not None, secs)
+    d = FourBarDesign(
+        float(p[0]),
+        float(p[1]),
+        float(p[2]),
+        float(p[3]),
+        (float(p[4]), float(p[5])),
+        "open" if r.circuit > 0 else "crossed",
+        (float(p[6]), float(p[7]), float(p[8])),
+        np.asarray(r.theta, float),
+        float("nan"),
+        t,
+        theta is not None,
+        secs,
+    )
     from planar.synth.kernel import coupler_points
 
     x, y, _ = coupler_points(p[None, :], d.theta[None, :], np.array([float(r.circuit)]))

@@ -24,10 +24,20 @@ def _vec(v: Sequence[float]) -> str:
     return "[" + ", ".join(_f(x) for x in v) + "]"
 
 
-def fourbar_scene_text(name: str, ground: float, crank: float, coupler: float, rocker: float,
-                       coupler_point: Sequence[float], circuit: str, placement: Sequence[float],
-                       comments: Sequence[str] = (), amplitude: float | None = None, centre: float = 0.0,
-                       samples_per_cycle: int = 72) -> str:
+def fourbar_scene_text(
+    name: str,
+    ground: float,
+    crank: float,
+    coupler: float,
+    rocker: float,
+    coupler_point: Sequence[float],
+    circuit: str,
+    placement: Sequence[float],
+    comments: Sequence[str] = (),
+    amplitude: float | None = None,
+    centre: float = 0.0,
+    samples_per_cycle: int = 72,
+) -> str:
     """The scene text of a four-bar (radians); ``amplitude``/``centre`` give a rocking driver."""
     lines = [f"# {c}" for c in comments]
     lines += [
@@ -67,20 +77,41 @@ def _value(v: Any) -> str:
     return _f(v)
 
 
-def linkage_scene_text(name: str, nodes: Sequence[dict[str, Any]], links: Sequence[tuple[str, Sequence[str]]],
-                       points: dict[str, str], comments: Sequence[str] = (), samples_per_cycle: int = 72) -> str:
+def linkage_scene_text(
+    name: str,
+    nodes: Sequence[dict[str, Any]],
+    links: Sequence[tuple[str, Sequence[str]]],
+    points: dict[str, str],
+    comments: Sequence[str] = (),
+    samples_per_cycle: int = 72,
+) -> str:
     """The scene text of a general linkage (``type = "linkage"``; node tables as the scene schema's)."""
     lines = [f"# {c}" for c in comments]
-    lines += [f'name = "{name}"', 'angle_unit = "rad"', "", "[mechanism]", 'type = "linkage"',
-              "points = { " + ", ".join(f'{k} = "{v}"' for k, v in points.items()) + " }", ""]
+    lines += [
+        f'name = "{name}"',
+        'angle_unit = "rad"',
+        "",
+        "[mechanism]",
+        'type = "linkage"',
+        "points = { " + ", ".join(f'{k} = "{v}"' for k, v in points.items()) + " }",
+        "",
+    ]
     for n in nodes:
         lines.append("[[mechanism.nodes]]")
         lines += [f"{k} = {_value(v)}" for k, v in n.items()]
         lines.append("")
     for lname, lnodes in links:
         lines += ["[[mechanism.links]]", f'name = "{lname}"', f"nodes = {_value(list(lnodes))}", ""]
-    lines += ["[driver]", "speed = 1.0", "cycles = 1", f"samples_per_cycle = {int(samples_per_cycle)}", "",
-              "[render]", "trails = [" + ", ".join(f'"{k}"' for k in points) + "]", ""]
+    lines += [
+        "[driver]",
+        "speed = 1.0",
+        "cycles = 1",
+        f"samples_per_cycle = {int(samples_per_cycle)}",
+        "",
+        "[render]",
+        "trails = [" + ", ".join(f'"{k}"' for k in points) + "]",
+        "",
+    ]
     return "\n".join(lines)
 
 

@@ -33,8 +33,16 @@ from numpy.typing import NDArray
 
 from planar.synth.kernel import N_PARAMS, coupler_points
 
-__all__ = ["Constraints", "PathObjective", "search_fourbar", "SearchResult", "violation", "constraint_failures",
-           "region_failures", "REL_TOL"]
+__all__ = [
+    "Constraints",
+    "PathObjective",
+    "search_fourbar",
+    "SearchResult",
+    "violation",
+    "constraint_failures",
+    "region_failures",
+    "REL_TOL",
+]
 
 Array = NDArray[np.float64]
 
@@ -89,8 +97,7 @@ def region_failures(pivots: dict[str, tuple[float, float]], cons: Constraints) -
     out = []
     for name, (px, py) in pivots.items():
         if not (x0 - tol <= px <= x1 + tol and y0 - tol <= py <= y1 + tol):
-            out.append(f"pivot {name} at ({px:.6g}, {py:.6g}) is outside the --pivots box "
-                       f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}")
+            out.append(f"pivot {name} at ({px:.6g}, {py:.6g}) is outside the --pivots box x {x0:g}..{x1:g}, y {y0:g}..{y1:g}")
     return out
 
 
@@ -103,8 +110,10 @@ def ratio_failures(links: dict[str, float], max_ratio: float) -> list[str]:
     hi = max(links, key=lambda k: links[k])
     if links[hi] <= max_ratio * links[lo] * (1.0 + REL_TOL):
         return []
-    return [f"link ratio {links[hi] / links[lo]:.10g} (longest {hi} {links[hi]:.6g} / shortest {lo} "
-            f"{links[lo]:.6g}) is over --max-ratio {max_ratio:g}"]
+    return [
+        f"link ratio {links[hi] / links[lo]:.10g} (longest {hi} {links[hi]:.6g} / shortest {lo} "
+        f"{links[lo]:.6g}) is over --max-ratio {max_ratio:g}"
+    ]
 
 
 def constraint_failures(p: Array, cons: Constraints) -> list[str]:
@@ -116,11 +125,15 @@ def constraint_failures(p: Array, cons: Constraints) -> list[str]:
         L = sorted((r1, r2, r3, r4))
         tol = REL_TOL * sum(L)
         if L[0] + L[3] > L[1] + L[2] + tol:
-            out.append(f"the crank turns fully: shortest + longest link {L[0] + L[3]:.10g} > the other two "
-                       f"{L[1] + L[2]:.10g} (not Grashof)")
+            out.append(
+                f"the crank turns fully: shortest + longest link {L[0] + L[3]:.10g} > the other two "
+                f"{L[1] + L[2]:.10g} (not Grashof)"
+            )
         elif min(r1, r2) > min(r3, r4) + tol:
-            out.append(f"the crank turns fully: neither crank {r2:.6g} nor ground {r1:.6g} is the shortest link "
-                       f"(coupler {r3:.6g}, rocker {r4:.6g})")
+            out.append(
+                f"the crank turns fully: neither crank {r2:.6g} nor ground {r1:.6g} is the shortest link "
+                f"(coupler {r3:.6g}, rocker {r4:.6g})"
+            )
     out += ratio_failures({"ground": r1, "crank": r2, "coupler": r3, "rocker": r4}, cons.max_ratio)
     x0, y0, phi = (float(v) for v in p[6:9])
     out += region_failures({"O2": (x0, y0), "O4": (x0 + r1 * np.cos(phi), y0 + r1 * np.sin(phi))}, cons)
@@ -250,7 +263,7 @@ def _refine(obj: PathObjective, row: Array, bounds: list[tuple[float, float]], m
     def jac(z: Array) -> Array:
         # forward differences, every perturbed vector in one call (the kernel is vectorised over candidates)
         h = 1.49e-8 * np.maximum(1.0, np.abs(z))
-        h = np.where(z + h > hi, -h, h)    # stay inside the bounds
+        h = np.where(z + h > hi, -h, h)  # stay inside the bounds
         Z = np.vstack([z[None, :], z[None, :] + np.diag(h)])
         R = rows(Z)
         return ((R[1:] - R[0]) / h[:, None]).T
@@ -267,8 +280,13 @@ def _refine(obj: PathObjective, row: Array, bounds: list[tuple[float, float]], m
     res = least_squares(resid, z0, jac=jac, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=max_nfev)
     p, th = split(res.x)
     out = np.append(p, row[9])
-    return out, np.asarray(th, float).copy(), float(obj.population(out[None, :], np.float64)[0]) if timed else float(
-        np.sum(res.fun[: 2 * n] ** 2) + (obj.penalty if violation(p[None, :], obj.cons, obj.scale)[0] > 0 else 0.0))
+    return (
+        out,
+        np.asarray(th, float).copy(),
+        float(obj.population(out[None, :], np.float64)[0])
+        if timed
+        else float(np.sum(res.fun[: 2 * n] ** 2) + (obj.penalty if violation(p[None, :], obj.cons, obj.scale)[0] > 0 else 0.0)),
+    )
 
 
 def search_fourbar(
@@ -306,16 +324,29 @@ def search_fourbar(
     order = np.argsort(f, kind="stable")
     init = X[order[:npop]]
     t1 = time.perf_counter()
-    de = differential_evolution(obj, b, init=init, maxiter=maxiter, tol=0.0, atol=0.0, seed=seed,
-                                vectorized=True, updating="deferred", polish=False, mutation=(0.5, 1.0),
-                                recombination=0.9)
+    de = differential_evolution(
+        obj,
+        b,
+        init=init,
+        maxiter=maxiter,
+        tol=0.0,
+        atol=0.0,
+        seed=seed,
+        vectorized=True,
+        updating="deferred",
+        polish=False,
+        mutation=(0.5, 1.0),
+        recombination=0.9,
+    )
     stages["de_s"] = time.perf_counter() - t1
     evals += (int(de.nit) + 1) * len(init)  # scipy counts vectorised calls, not candidates
     # refine the DE best and the best distinct candidates of the sample and the final population
     # half the starts from DE's final population (its basin), half from the sample's best (other basins)
     starts: list[Array] = []
-    for pool, k in ((np.vstack([de.x[None, :], de.population[np.argsort(de.population_energies)]]), (refine + 1) // 2),
-                    (X[order[: 50 * refine]], refine)):
+    for pool, k in (
+        (np.vstack([de.x[None, :], de.population[np.argsort(de.population_energies)]]), (refine + 1) // 2),
+        (X[order[: 50 * refine]], refine),
+    ):
         for row in pool:
             if len(starts) >= k:
                 break

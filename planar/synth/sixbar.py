@@ -42,7 +42,7 @@ __all__ = ["SixBarDesign", "synthesise_sixbar", "sixbar_points", "TOPOLOGIES"]
 
 Array = NDArray[np.float64]
 TOPOLOGIES = ("stephenson", "watt")
-N6 = 15          # continuous parameters; columns 15, 16 are the circuit signs
+N6 = 15  # continuous parameters; columns 15, 16 are the circuit signs
 #: the second dyad must close with h^2 / (l5^2 |E - O6|^2) at least this over the turn
 DYAD_MARGIN = 1e-4
 
@@ -60,7 +60,7 @@ def sixbar_points(X: Array, theta: Array, topology: str) -> tuple[Array, Array, 
         ex, ey, ok = coupler_points(X[:, :9], th, c1)
     else:
         P9 = X[:, :9].copy()
-        P9[:, 4] = P9[:, 2]      # C is the coupler point (coupler, 0)
+        P9[:, 4] = P9[:, 2]  # C is the coupler point (coupler, 0)
         P9[:, 5] = 0.0
         cx, cy, ok = coupler_points(P9, th, c1)
         r1, r4, phi = X[:, 0:1], X[:, 3:4], X[:, 8:9]
@@ -79,7 +79,7 @@ def sixbar_points(X: Array, theta: Array, topology: str) -> tuple[Array, Array, 
     margin = np.where(ok, margin, -1.0)
     w = np.sqrt(np.maximum(h2, 0.0)) * c2[:, None]
     inv = 1.0 / np.maximum(L2, 1e-300)
-    fx = ex + (A * dx - w * dy) * inv        # F = E + (A d + w perp(d)) / L2
+    fx = ex + (A * dx - w * dy) * inv  # F = E + (A d + w perp(d)) / L2
     fy = ey + (A * dy + w * dx) * inv
     kx, ky = (fx - ex) / l5, (fy - ey) / l5
     return ex + tu * kx - tv * ky, ey + tu * ky + tv * kx, margin
@@ -91,9 +91,16 @@ def link_lengths(X: Array, topology: str) -> dict[str, Array]:
     ``O4 C E``)."""
     r1, r2, r3, r4, eu, ev, x0, y0, phi = (X[:, k] for k in range(9))
     o4x, o4y = x0 + r1 * np.cos(phi), y0 + r1 * np.sin(phi)
-    out = {"ground O2-O4": r1, "crank": r2, "coupler B-C": r3, "rocker O4-C": r4,
-           "ground O2-O6": np.hypot(X[:, 9] - x0, X[:, 10] - y0), "ground O4-O6": np.hypot(X[:, 9] - o4x, X[:, 10] - o4y),
-           "link5 E-F": X[:, 11], "link6 F-O6": X[:, 12]}
+    out = {
+        "ground O2-O4": r1,
+        "crank": r2,
+        "coupler B-C": r3,
+        "rocker O4-C": r4,
+        "ground O2-O6": np.hypot(X[:, 9] - x0, X[:, 10] - y0),
+        "ground O4-O6": np.hypot(X[:, 9] - o4x, X[:, 10] - o4y),
+        "link5 E-F": X[:, 11],
+        "link6 F-O6": X[:, 12],
+    }
     if topology == "stephenson":
         out["coupler B-E"] = np.hypot(eu, ev)
         out["coupler C-E"] = np.hypot(eu - r3, ev)
@@ -110,8 +117,7 @@ def _violation6(X: Array, cons: Constraints, scale: float, margin: float, topolo
     if cons.region is not None:
         x0, y0, x1, y1 = cons.region
         px, py = X[:, 9], X[:, 10]
-        v += (np.maximum(0.0, x0 - px) + np.maximum(0.0, px - x1) + np.maximum(0.0, y0 - py)
-              + np.maximum(0.0, py - y1)) / scale
+        v += (np.maximum(0.0, x0 - px) + np.maximum(0.0, px - x1) + np.maximum(0.0, y0 - py) + np.maximum(0.0, py - y1)) / scale
     return v
 
 
@@ -141,7 +147,7 @@ class _Objective:
 
     def __call__(self, x: Array) -> Array:
         X = np.asarray(x, float).T
-        return np.concatenate([self.population(X[i:i + 4096]) for i in range(0, len(X), 4096)])
+        return np.concatenate([self.population(X[i : i + 4096]) for i in range(0, len(X), 4096)])
 
     def population(self, X: Array) -> Array:
         turn = np.linspace(0.0, 2 * np.pi, self.samples, endpoint=False)
@@ -163,7 +169,7 @@ class _Objective:
 @dataclass
 class SixBarDesign(Checked):
     topology: str
-    params: Array              # the 17 columns (see the module)
+    params: Array  # the 17 columns (see the module)
     theta: Array
     targets: Array
     timed: bool
@@ -184,17 +190,34 @@ class SixBarDesign(Checked):
             {"name": "B", "kind": "crank", "centre": "O2", "radius": r2, "phase": phi},
             {"name": "C", "kind": "rrr", "a": "B", "ra": r3, "b": "O4", "rb": r4, "branch": 1 if p[15] >= 0 else -1},
             {"name": "E", "kind": "rigid", "a": e_from[0], "b": e_from[1], "local": (eu, ev)},
-            {"name": "F", "kind": "rrr", "a": "E", "ra": float(p[11]), "b": "O6", "rb": float(p[12]),
-             "branch": 1 if p[16] >= 0 else -1},
+            {
+                "name": "F",
+                "kind": "rrr",
+                "a": "E",
+                "ra": float(p[11]),
+                "b": "O6",
+                "rb": float(p[12]),
+                "branch": 1 if p[16] >= 0 else -1,
+            },
             {"name": "T", "kind": "rigid", "a": "E", "b": "F", "local": (float(p[13]), float(p[14]))},
         ]
 
     def links(self) -> list[tuple[str, tuple[str, ...]]]:
         if self.topology == "stephenson":
-            return [("crank", ("O2", "B")), ("coupler", ("B", "C", "E")), ("rocker", ("O4", "C")),
-                    ("link5", ("E", "F", "T")), ("link6", ("O6", "F"))]
-        return [("crank", ("O2", "B")), ("coupler", ("B", "C")), ("rocker", ("O4", "C", "E")),
-                ("link5", ("E", "F", "T")), ("link6", ("O6", "F"))]
+            return [
+                ("crank", ("O2", "B")),
+                ("coupler", ("B", "C", "E")),
+                ("rocker", ("O4", "C")),
+                ("link5", ("E", "F", "T")),
+                ("link6", ("O6", "F")),
+            ]
+        return [
+            ("crank", ("O2", "B")),
+            ("coupler", ("B", "C")),
+            ("rocker", ("O4", "C", "E")),
+            ("link5", ("E", "F", "T")),
+            ("link6", ("O6", "F")),
+        ]
 
     def linkage(self):
         from planar.linkages import NODE_KINDS, Link, Linkage
@@ -206,9 +229,17 @@ class SixBarDesign(Checked):
         return Linkage(f"sixbar-{self.topology}", nodes, [Link(a, b) for a, b in self.links()], points={"tracer": "T"})
 
     def to_dict(self) -> dict[str, Any]:
-        return {"type": f"sixbar-{self.topology}", "nodes": self.nodes(), "links": self.links(),
-                "theta": [float(t) for t in self.theta], "sse": self.sse, "timed": self.timed,
-                "time_s": self.seconds, "ok": self.ok, "checks": self.checks}
+        return {
+            "type": f"sixbar-{self.topology}",
+            "nodes": self.nodes(),
+            "links": self.links(),
+            "theta": [float(t) for t in self.theta],
+            "sse": self.sse,
+            "timed": self.timed,
+            "time_s": self.seconds,
+            "ok": self.ok,
+            "checks": self.checks,
+        }
 
 
 def _refine(obj: _Objective, row: Array, lo: Array, hi: Array, max_nfev: int) -> tuple[Array, Array, float]:
@@ -285,14 +316,20 @@ def _fourbar_seed(t: Array, th: Array | None, cons: Constraints, seed: int) -> A
     dist = np.hypot(x[0] - o6[0], y[0] - o6[1])
     l6 = float(dist.mean())
     l5 = float(0.6 * np.ptp(dist) + 0.1 * L)
-    if max(l5, l6) > 4 * L:        # outside the search bounds: no seed
+    if max(l5, l6) > 4 * L:  # outside the search bounds: no seed
         return None
     return np.concatenate([r.params, o6, [l5, l6, 0.0, 0.0, float(r.circuit), 1.0]])
 
 
-def synthesise_sixbar(targets: Array, theta: Array | None = None, topology: str = "stephenson",
-                      cons: Constraints | None = None, budget: str | tuple[int, int, int, int] = "normal",
-                      seed: int = 0, tolerance: float = DEFAULT_TOLERANCE) -> SixBarDesign:
+def synthesise_sixbar(
+    targets: Array,
+    theta: Array | None = None,
+    topology: str = "stephenson",
+    cons: Constraints | None = None,
+    budget: str | tuple[int, int, int, int] = "normal",
+    seed: int = 0,
+    tolerance: float = DEFAULT_TOLERANCE,
+) -> SixBarDesign:
     """A six-bar (``topology`` ``"stephenson"`` or ``"watt"``) whose tracer passes through ``targets``.
 
     ``tolerance``: as :func:`planar.synth.path.synthesise_path`'s.
@@ -325,7 +362,7 @@ def synthesise_sixbar(targets: Array, theta: Array | None = None, topology: str 
     c0, s0 = normalisation(tw)
     t, cons = (tw - c0) / s0, normalised(cons_w, c0, s0)
     obj = _Objective(t, th, cons, topology)
-    fb = default_bounds(t, cons, th is not None)            # 9 four-bar bounds + circuit
+    fb = default_bounds(t, cons, th is not None)  # 9 four-bar bounds + circuit
     L = obj.scale
     c = t.mean(0)
     if cons.region is not None:
@@ -340,8 +377,20 @@ def synthesise_sixbar(targets: Array, theta: Array | None = None, topology: str 
     f = obj(X.T)
     order = np.argsort(f, kind="stable")
     init = X[order[: popsize * len(b)]]
-    de = differential_evolution(obj, b, init=init, maxiter=maxiter, tol=0.0, atol=0.0, seed=seed, vectorized=True,
-                                updating="deferred", polish=False, mutation=(0.5, 1.0), recombination=0.9)
+    de = differential_evolution(
+        obj,
+        b,
+        init=init,
+        maxiter=maxiter,
+        tol=0.0,
+        atol=0.0,
+        seed=seed,
+        vectorized=True,
+        updating="deferred",
+        polish=False,
+        mutation=(0.5, 1.0),
+        recombination=0.9,
+    )
     pool = np.vstack([de.x[None], de.population[np.argsort(de.population_energies)], X[order[: 4 * refine]]])
     if topology == "stephenson":
         seed_row = _fourbar_seed(t, th, cons, seed)
@@ -410,7 +459,7 @@ def check_sixbar(d: SixBarDesign, cons: Constraints, scale: float, tolerance: fl
     turn = np.linspace(0.0, 2 * np.pi, 360, endpoint=False)
     path = lk.solve(np.sort(np.concatenate([turn, th])))
     full = lk.solve(turn)
-    at = lk.solve(th[order])     # a path through the targets' crank angles, ascending
+    at = lk.solve(th[order])  # a path through the targets' crank angles, ascending
     pts = np.empty_like(d.targets)
     pts[order] = at.points["tracer"]
     x, y, _ = sixbar_points(d.params[None], d.theta, d.topology)
@@ -419,8 +468,9 @@ def check_sixbar(d: SixBarDesign, cons: Constraints, scale: float, tolerance: fl
     dense = np.linspace(0.0, 2 * np.pi, 36_000, endpoint=False)
     _, _, m = sixbar_points(d.params[None], dense, d.topology)
     ranges = invalid_ranges(m[0] <= 0, dense) or invalid_ranges(~full.valid, turn)
-    failures = [f"the linkage cannot be assembled for driver angles {a:.4g}..{b:.4g} rad (from the ground line "
-                "O2-O4)" for a, b in ranges]
+    failures = [
+        f"the linkage cannot be assembled for driver angles {a:.4g}..{b:.4g} rad (from the ground line O2-O4)" for a, b in ranges
+    ]
     _, size = normalisation(d.targets)
     rms = math.sqrt(d.sse / len(d.targets)) / size if math.isfinite(d.sse) else float("inf")
     d.checks = {

@@ -26,8 +26,9 @@ SIZE_RANGE = (1e-60, 1e60)
 Array = NDArray[np.float64]
 
 
-def read_table(path: str | Path, required: tuple[str, ...], optional: tuple[str, ...] = (),
-               min_rows: int = 1, strict: bool = False) -> dict[str, Array]:
+def read_table(
+    path: str | Path, required: tuple[str, ...], optional: tuple[str, ...] = (), min_rows: int = 1, strict: bool = False
+) -> dict[str, Array]:
     """Columns of a CSV file with a header row: every ``required`` column and the ``optional`` ones present.
 
     A UTF-8 byte-order mark is skipped.  ``strict``: a column that is neither required nor optional
@@ -47,13 +48,17 @@ def read_table(path: str | Path, required: tuple[str, ...], optional: tuple[str,
     header = [h.strip().lower() for h in rows[0]]
     for col in required:
         if col not in header:
-            raise InputError(f"{p}: header", rows[0], f"columns {', '.join(required + optional)} "
-                             f"({', '.join(optional) or 'none'} optional)")
+            raise InputError(
+                f"{p}: header", rows[0], f"columns {', '.join(required + optional)} ({', '.join(optional) or 'none'} optional)"
+            )
     if strict:
         for h, raw in zip(header, rows[0]):
             if h not in required + optional:
-                raise InputError(f"{p}: header: column", raw.strip(), f"one of the columns {', '.join(required + optional)} "
-                                 f"({', '.join(optional) or 'none'} optional)")
+                raise InputError(
+                    f"{p}: header: column",
+                    raw.strip(),
+                    f"one of the columns {', '.join(required + optional)} ({', '.join(optional) or 'none'} optional)",
+                )
     cols = [c for c in required + optional if c in header]
     out: dict[str, list[float]] = {c: [] for c in cols}
     for i, r in enumerate(rows[1:], start=2):
@@ -129,14 +134,19 @@ def normalisation(targets: Array, name: str = "targets") -> tuple[Array, float]:
     lo, hi = SIZE_RANGE
     big = float(np.max(np.abs(t)))
     if not big <= hi:
-        raise InputError(name, f"a coordinate of {big:.3g}", f"coordinates within {hi:g} model units "
-                         "(the solvers multiply four lengths; scale the targets down)")
+        raise InputError(
+            name,
+            f"a coordinate of {big:.3g}",
+            f"coordinates within {hi:g} model units (the solvers multiply four lengths; scale the targets down)",
+        )
     c = t.mean(0)
     s = float(np.sqrt(np.mean(np.sum((t - c) ** 2, axis=1))))
     if not lo <= s <= hi:
-        raise InputError(name, f"size {s:.3g} (RMS distance from the centroid)",
-                         f"a size between {lo:g} and {hi:g} model units (the solvers multiply four "
-                         "lengths; scale the targets)")
+        raise InputError(
+            name,
+            f"size {s:.3g} (RMS distance from the centroid)",
+            f"a size between {lo:g} and {hi:g} model units (the solvers multiply four lengths; scale the targets)",
+        )
     return c, s
 
 
@@ -146,13 +156,19 @@ def check_theta(theta: Array, name: str, deg: bool) -> None:
     if span > 2 * np.pi * (1 + 1e-12):
         unit = "deg" if deg else "rad"
         shown = np.degrees(span) if deg else span
-        raise InputError(f"{name}: theta", f"values spanning {shown:.6g} {unit}",
-                         "crank angles within one turn" + ("" if deg else " (they look like degrees: add --deg)"))
+        raise InputError(
+            f"{name}: theta",
+            f"values spanning {shown:.6g} {unit}",
+            "crank angles within one turn" + ("" if deg else " (they look like degrees: add --deg)"),
+        )
     w = np.mod(theta, 2 * np.pi)
     order = np.argsort(w, kind="stable")
     gap = np.diff(np.append(w[order], w[order[0]] + 2 * np.pi))
     k = int(np.argmin(gap))
     if gap[k] <= 1e-12 * 2 * np.pi:
         i, j = sorted((int(order[k]), int(order[(k + 1) % len(order)])))
-        raise InputError(f"{name}: theta", f"targets {i + 1} and {j + 1} (in data-row order) at the same "
-                         f"crank angle {theta[i]:.6g}", "a different crank angle (modulo a turn) at every target")
+        raise InputError(
+            f"{name}: theta",
+            f"targets {i + 1} and {j + 1} (in data-row order) at the same crank angle {theta[i]:.6g}",
+            "a different crank angle (modulo a turn) at every target",
+        )

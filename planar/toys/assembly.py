@@ -130,8 +130,7 @@ def _place_pivot(j: Pivot, name: str, a: str, b: str, ma: XForm, mb: XForm, st: 
 
 @PLACERS.register(PinInSlot)
 def _place_pin_slot(j: PinInSlot, name: str, a: str, b: str, ma: XForm, mb: XForm, st: Any) -> PinInSlot:
-    return replace(j, name=name, a=a, b=b, start=_xf_point(ma, j.start), end=_xf_point(ma, j.end),
-                   pin=_xf_point(mb, j.pin))
+    return replace(j, name=name, a=a, b=b, start=_xf_point(ma, j.start), end=_xf_point(ma, j.end), pin=_xf_point(mb, j.pin))
 
 
 @PLACERS.register(PinInArcSlot)
@@ -141,21 +140,35 @@ def _place_pin_arc(j: PinInArcSlot, name: str, a: str, b: str, ma: XForm, mb: XF
 
 @PLACERS.register(Slide)
 def _place_slide(j: Slide, name: str, a: str, b: str, ma: XForm, mb: XForm, st: Any) -> Slide:
-    return replace(j, name=name, a=a, b=b, start=_xf_point(ma, j.start), end=_xf_point(ma, j.end),
-                   anchor=_xf_point(mb, j.anchor), axis=_xf_vec(mb, j.axis))
+    return replace(
+        j,
+        name=name,
+        a=a,
+        b=b,
+        start=_xf_point(ma, j.start),
+        end=_xf_point(ma, j.end),
+        anchor=_xf_point(mb, j.anchor),
+        axis=_xf_vec(mb, j.axis),
+    )
 
 
 @PLACERS.register(CamOnLine)
 def _place_cam_line(j: CamOnLine, name: str, a: str, b: str, ma: XForm, mb: XForm, st: Any) -> CamOnLine:
-    return replace(j, name=name, a=a, b=b, start=_xf_point(ma, j.start), end=_xf_point(ma, j.end),
-                   centre=_xf_point(mb, j.centre))
+    return replace(j, name=name, a=a, b=b, start=_xf_point(ma, j.start), end=_xf_point(ma, j.end), centre=_xf_point(mb, j.centre))
 
 
 @PLACERS.register(SkewContact)
 def _place_skew(j: SkewContact, name: str, a: str, b: str, ma: XForm, mb: XForm, st: Any) -> SkewContact:
     # the driver (xy) moves with ma; the follower (yz) keeps its frame and its axis moves to x + tx
-    return replace(j, name=name, a=a, b=b, edge_point=_xf_point(ma, j.edge_point), edge_dir=_xf_vec(ma, j.edge_dir),
-                   pin_x=j.pin_x + st.place[0])
+    return replace(
+        j,
+        name=name,
+        a=a,
+        b=b,
+        edge_point=_xf_point(ma, j.edge_point),
+        edge_dir=_xf_vec(ma, j.edge_dir),
+        pin_x=j.pin_x + st.place[0],
+    )
 
 
 # ---------------------------------------------------------------------------- the assembly
@@ -190,16 +203,20 @@ def _placements(toy: Any) -> list[_Placed]:
         ang = math.atan2(R[1, 0], R[0, 0])
         proper = abs(R[2, 2] - 1.0) < 1e-12 and abs(np.linalg.det(R[:2, :2]) - 1.0) < 1e-12
         if not proper:
-            raise InputError(f"{toy.name}.stage {' '.join(st.key)}",
-                             f"realised as #{st.realisation.number} mirrored or turned out of the xy plane",
-                             "a stage turned about z only (a mirrored stage is not assembled)")
+            raise InputError(
+                f"{toy.name}.stage {' '.join(st.key)}",
+                f"realised as #{st.realisation.number} mirrored or turned out of the xy plane",
+                "a stage turned about z only (a mirrored stage is not assembled)",
+            )
         plane = st.mech.part("driver").plane
         other = sorted({p.plane for p in st.mech.parts} - {"xy"})
         if other and abs(ang) > 1e-12:
-            raise InputError(f"{toy.name}.stage {' '.join(st.key)}",
-                             f"realised as #{st.realisation.number} turned {math.degrees(ang):g} deg about z",
-                             f"a stage with parts moving in {', '.join(other)} that is not turned (a turned "
-                             f"#{st.realisation.number} would move in another plane, which no part records)")
+            raise InputError(
+                f"{toy.name}.stage {' '.join(st.key)}",
+                f"realised as #{st.realisation.number} turned {math.degrees(ang):g} deg about z",
+                f"a stage with parts moving in {', '.join(other)} that is not turned (a turned "
+                f"#{st.realisation.number} would move in another plane, which no part records)",
+            )
         d0 = _rest_pose(st, "driver")
         if st.parent is None:
             anchor = (0.0, 0.0)  # the motor axis
@@ -207,8 +224,11 @@ def _placements(toy: Any) -> list[_Placed]:
             par = out[st.parent]
             f0 = _rest_pose(par.stage, "follower")
             if par.stage.mech.part("follower").plane != "xy":
-                raise InputError(f"{toy.name}.stage {' '.join(st.key)}", par.stage.realisation.pattern,
-                                 "a parent whose follower moves in xy (its follower carries the child's driver)")
+                raise InputError(
+                    f"{toy.name}.stage {' '.join(st.key)}",
+                    par.stage.realisation.pattern,
+                    "a parent whose follower moves in xy (its follower carries the child's driver)",
+                )
             anchor = _xf_point(par.place, f0[:2])
         if plane == "xy":
             c, s = math.cos(ang), math.sin(ang)
@@ -251,17 +271,26 @@ def _merge(name: str, members: list[tuple[Part, XForm]], plane: str, ground: boo
             # pivot hole and its child driver's axle hole are one axle (both pivots are one pin); a second,
             # larger hole there would be pinned to nothing and swallow the pin's hole (#3 -> #1: 6.1 mm for a
             # 3 mm pin on the frame)
-            if g not in feats and not (isinstance(g, Hole) and any(
-                    isinstance(h, Hole) and math.dist(h.centre, g.centre) <= 1e-9 * max(1.0, math.hypot(*g.centre))
-                    for h in feats)):
+            if g not in feats and not (
+                isinstance(g, Hole)
+                and any(
+                    isinstance(h, Hole) and math.dist(h.centre, g.centre) <= 1e-9 * max(1.0, math.hypot(*g.centre)) for h in feats
+                )
+            ):
                 feats.append(g)
         c, s = math.cos(m[2]), math.sin(m[2])
         polys.append(affinity.affine_transform(_hull_poly(part), [c, -s, s, c, m[0], m[1]]))
     offset = members[0][0].offset
     if len(members) == 1:
         p0, m0 = members[0]
-        return replace(p0, name=name, hull=tuple(hull), features=tuple(feats), ground=ground,
-                       polygon=None if p0.polygon is None else tuple(_xf_point(m0, q) for q in p0.polygon)), notes
+        return replace(
+            p0,
+            name=name,
+            hull=tuple(hull),
+            features=tuple(feats),
+            ground=ground,
+            polygon=None if p0.polygon is None else tuple(_xf_point(m0, q) for q in p0.polygon),
+        ), notes
     # every cut keeps material round it (fabrication adds slot end margins and walls): each feature's
     # shape grown by three quarters of its width joins the outline
     from planar.core.outlines import feature_shape
@@ -380,8 +409,12 @@ class ToyAssembly(Mechanism):
         for p in self.placed:
             for j in p.stage.mech.joints:
                 a, b = f"{p.label}.{j.a}", f"{p.label}.{j.b}"
-                if p.stage.parent is None and isinstance(j, Pivot) and {j.a, j.b} == {"ground", "driver"} \
-                        and cam_name[p.stage.index] != main_cam:
+                if (
+                    p.stage.parent is None
+                    and isinstance(j, Pivot)
+                    and {j.a, j.b} == {"ground", "driver"}
+                    and cam_name[p.stage.index] != main_cam
+                ):
                     continue  # the axle of a second cam: it is keyed to the first instead (below)
                 placer = PLACERS.get(j, f"joint {j.name!r} of stage {p.label}")
                 joints.append(placer(j, f"{p.label}.{j.name}", piece_of[a], piece_of[b], xf[a], xf[b], p))
@@ -422,8 +455,11 @@ class ToyAssembly(Mechanism):
         for p in self.placed:
             st = p.stage
             u, res = toy._last_bases[st.index]
-            tracks = {"ground": np.zeros((q.size, 3)), "driver": st.mech._driver_pose(u),
-                      "follower": st.mech._follower_pose(res.out)}
+            tracks = {
+                "ground": np.zeros((q.size, 3)),
+                "driver": st.mech._driver_pose(u),
+                "follower": st.mech._follower_pose(res.out),
+            }
             for name, pose in tracks.items():
                 out[f"{p.label}.{name}"] = _world_track(p, st.mech.part(name), np.asarray(pose, float))
         return out, checks
@@ -483,8 +519,9 @@ def assembly_residual(asm: ToyAssembly, samples: int = 73) -> dict[str, float]:
     return {j.name: float(np.max(np.asarray(j.residual(m.poses))[ok], initial=0.0)) for j in asm.joints}
 
 
-def _without_cuts_of(parts: list[Part], dropped: list[Any], kept: list[Any], tol: float = 1e-9
-                     ) -> tuple[list[Part], list[tuple[str, Any]]]:
+def _without_cuts_of(
+    parts: list[Part], dropped: list[Any], kept: list[Any], tol: float = 1e-9
+) -> tuple[list[Part], list[tuple[str, Any]]]:
     """``parts`` without the slots and pin holes of the ``dropped`` slides (features at their slot ends or at
     their pin points), except that where a ``kept`` joint has a pin at the same place (piece frames) one hole
     stays (the first there, the one the kept pin goes through); and the ``(piece, feature)`` pairs removed."""
@@ -519,8 +556,10 @@ def _without_cuts_of(parts: list[Part], dropped: list[Any], kept: list[Any], tol
                     removed.append((part.name, f))
                     continue
                 kept_at.append(at_kept)
-            if isinstance(f, Slot) and any(near(f.start, a) and near(f.end, b) or near(f.start, b) and near(f.end, a)
-                                           for a, b in drop_slots.get(part.name, ())):
+            if isinstance(f, Slot) and any(
+                near(f.start, a) and near(f.end, b) or near(f.start, b) and near(f.end, a)
+                for a, b in drop_slots.get(part.name, ())
+            ):
                 removed.append((part.name, f))
                 continue
             feats.append(f)
@@ -562,4 +601,3 @@ def _without_redundant_slides(joints: list[Any]) -> tuple[list[Any], list[Any]]:
                 continue
         out.append(j)
     return out, dropped
-

@@ -55,8 +55,14 @@ def motion_sizes(toy: Any, settings: Any, samples: int = 73) -> list[dict[str, A
         if st.realisation.number not in CAM_STAGES:
             continue
         P = st.mech.params
-        out.append({"kind": "cam throw", "what": f"stage {st.label} {st.realisation.pattern}",
-                    "mm": 2.0 * float(np.hypot(P.D_jc[0], P.D_jc[1])) * unit, "limit_mm": limit})
+        out.append(
+            {
+                "kind": "cam throw",
+                "what": f"stage {st.label} {st.realisation.pattern}",
+                "mm": 2.0 * float(np.hypot(P.D_jc[0], P.D_jc[1])) * unit,
+                "limit_mm": limit,
+            }
+        )
     if not toy.names:
         return out
     asm = toy_assembly(toy)
@@ -70,15 +76,15 @@ def motion_sizes(toy: Any, settings: Any, samples: int = 73) -> list[dict[str, A
             pts = np.array([at], dtype=float)
         pose = np.asarray(m.poses[piece])[np.asarray(m.valid, dtype=bool)]
         c, s = np.cos(pose[:, 2])[:, None], np.sin(pose[:, 2])[:, None]
-        track = np.stack([pose[:, :1] + c * pts[:, 0] - s * pts[:, 1],
-                          pose[:, 1:2] + s * pts[:, 0] + c * pts[:, 1]], axis=-1)
-        out.append({"kind": "effector stroke", "what": f"effector {name!r}", "mm": _travel(track) * unit,
-                    "limit_mm": limit})
+        track = np.stack([pose[:, :1] + c * pts[:, 0] - s * pts[:, 1], pose[:, 1:2] + s * pts[:, 0] + c * pts[:, 1]], axis=-1)
+        out.append({"kind": "effector stroke", "what": f"effector {name!r}", "mm": _travel(track) * unit, "limit_mm": limit})
     return out
 
 
 def small_motion_text(item: dict[str, Any], settings: Any) -> str:
     """One line for an item of :func:`small_motions`."""
-    return (f"{item['what']}: {item['kind']} {item['mm']:.3g} mm is under {FIT_MARGIN:g} x the fit's play "
-            f"({fit_play(settings):g} mm, the larger of clearance_mm {settings.clearance:g} and kerf_mm "
-            f"{settings.kerf:g}): the cut parts will not make this motion (ask for a larger range)")
+    return (
+        f"{item['what']}: {item['kind']} {item['mm']:.3g} mm is under {FIT_MARGIN:g} x the fit's play "
+        f"({fit_play(settings):g} mm, the larger of clearance_mm {settings.clearance:g} and kerf_mm "
+        f"{settings.kerf:g}): the cut parts will not make this motion (ask for a larger range)"
+    )

@@ -251,8 +251,13 @@ class ToyMechanism(Mechanism):
             outs[st.index] = _to_world(r, res.out)
             valid_in[st.index] = ok_in & res.valid
             bases[st.index] = (u, res)
-            checks.append((res.valid, f"{st.label}.{ELEMENTAL[r.number].contact_joint}",
-                           f"stage {st.label} ({r.pattern}, mechanism #{r.number}): {res.why}"))
+            checks.append(
+                (
+                    res.valid,
+                    f"{st.label}.{ELEMENTAL[r.number].contact_joint}",
+                    f"stage {st.label} ({r.pattern}, mechanism #{r.number}): {res.why}",
+                )
+            )
         self._last_bases = bases
         return outs, checks
 
@@ -265,8 +270,11 @@ class ToyMechanism(Mechanism):
             dp = st.mech._driver_pose(u)
             fp = st.mech._follower_pose(res.out)
             gp = np.zeros((q.size, 3))
-            for pname, pose, part in (("ground", gp, st.mech.part("ground")), ("driver", dp, st.mech.part("driver")),
-                                      ("follower", fp, st.mech.part("follower"))):
+            for pname, pose, part in (
+                ("ground", gp, st.mech.part("ground")),
+                ("driver", dp, st.mech.part("driver")),
+                ("follower", fp, st.mech.part("follower")),
+            ):
                 pose = pose.copy()
                 if part.plane == "yz":
                     pose[:, 0] += oy
@@ -328,8 +336,14 @@ def tree_cost(cams: Mapping[str, Iterable[Sequence[str]]]) -> float:
     return len(nodes) + 2.0 * float(np.mean(lengths))
 
 
-def rank_trees(targets: Sequence[str], max_length: int = 3, top: int = 10, optional: bool = False,
-               cams: Sequence[str] = ("left", "right"), limit: int = 2_000_000) -> list[tuple[float, dict[str, list[Chain]]]]:
+def rank_trees(
+    targets: Sequence[str],
+    max_length: int = 3,
+    top: int = 10,
+    optional: bool = False,
+    cams: Sequence[str] = ("left", "right"),
+    limit: int = 2_000_000,
+) -> list[tuple[float, dict[str, list[Chain]]]]:
     """Candidate trees for the requested end-effector motions, cheapest first.
 
     Each target takes one chain (up to ``max_length``) on one cam; ties keep
@@ -368,13 +382,17 @@ def rank_trees(targets: Sequence[str], max_length: int = 3, top: int = 10, optio
 
 def horse(**kw: Any) -> ToyMechanism:
     """The paper's Horse: Rz->OzT->Oz on one cam, Rz->OzT->{Ty, Oz} (legs) on the other, half a turn apart."""
-    return ToyMechanism({
-        "left": [("Rz->OzT", "OzT->Oz")],
-        "right": [("Rz->OzT", "OzT->Ty"), ("Rz->OzT", "OzT->Oz")],
-    }, phase=kw.pop("phase", math.pi), name=kw.pop("name", "horse"), **kw)
+    return ToyMechanism(
+        {
+            "left": [("Rz->OzT", "OzT->Oz")],
+            "right": [("Rz->OzT", "OzT->Ty"), ("Rz->OzT", "OzT->Oz")],
+        },
+        phase=kw.pop("phase", math.pi),
+        name=kw.pop("name", "horse"),
+        **kw,
+    )
 
 
 def bunny(**kw: Any) -> ToyMechanism:
     """The paper's Bunny: Rz->Tx->{Ox, Oy} (ears on one slider)."""
-    return ToyMechanism({"left": [("Rz->Tx", "Tx->Ox"), ("Rz->Tx", "Tx->Oy")]},
-                        name=kw.pop("name", "bunny"), **kw)
+    return ToyMechanism({"left": [("Rz->Tx", "Tx->Ox"), ("Rz->Tx", "Tx->Oy")]}, name=kw.pop("name", "bunny"), **kw)

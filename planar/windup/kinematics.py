@@ -153,8 +153,7 @@ def forward_3(P: P_.P3, theta: Array) -> Stage:
     a0 = np.arctan2(*(p0 - m0)[::-1])
     alpha = wrap_angle(np.arctan2(p[:, 1] - m[:, 1], p[:, 0] - m[:, 0]) - a0)
     out = np.column_stack([p[:, 0] - p0[0], p[:, 1] - p0[1], alpha])
-    return Stage(out, ok, f"the cam circle (R={R:.4g}) and the track (r={r:.4g}) do not meet",
-                 aux={"m": m, "p": p})
+    return Stage(out, ok, f"the cam circle (R={R:.4g}) and the track (r={r:.4g}) do not meet", aux={"m": m, "p": p})
 
 
 # ---------------------------------------------------------------- #4 Oz -> Ty
@@ -351,8 +350,7 @@ def forward_10(P: P_.P10, u: Array) -> Stage:
     br = 1.0 if p0[0] >= P.D_o[0] else -1.0
     base = np.broadcast_to(np.array([0.0, p0[1]]), m.shape)
     p, ok, _ = line_circle(base, np.broadcast_to([1.0, 0.0], m.shape), m, R, br)
-    return Stage(p[:, 0] - p0[0], ok, f"the arc slot (R={R:.4g}) no longer reaches the pin's guide line",
-                 aux={"m": m, "p": p})
+    return Stage(p[:, 0] - p0[0], ok, f"the arc slot (R={R:.4g}) no longer reaches the pin's guide line", aux={"m": m, "p": p})
 
 
 # ---------------------------------------------------------------- #11 OzT -> Oz
@@ -373,5 +371,4 @@ def forward_11(P: P_.P11, u: Array) -> Stage:
     p, ok = circle_circle(m, R, np.broadcast_to(s, m.shape), r, br)
     a0 = np.arctan2(p0[1] - s[1], p0[0] - s[0])
     alpha = wrap_angle(np.arctan2(p[:, 1] - s[1], p[:, 0] - s[0]) - a0)
-    return Stage(alpha, ok, f"the arc slot (R={R:.4g}) and the pin's circle (r={r:.4g}) do not meet",
-                 aux={"m": m, "p": p})
+    return Stage(alpha, ok, f"the arc slot (R={R:.4g}) and the pin's circle (r={r:.4g}) do not meet", aux={"m": m, "p": p})

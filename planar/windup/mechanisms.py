@@ -47,11 +47,23 @@ from planar.windup import kinematics as K
 from planar.windup import params as P_
 from planar.windup.kinematics import Stage
 
-__all__ = ["ElementalMechanism", "ElementalRecord", "ELEMENTAL", "MOTIONS", "CONTACT_JOINT", "SkewContact",
-           "elemental", "params_for", "register_elemental", "check_params", "standalone_driver",
-           "standalone_motion"]
+__all__ = [
+    "ElementalMechanism",
+    "ElementalRecord",
+    "ELEMENTAL",
+    "MOTIONS",
+    "CONTACT_JOINT",
+    "SkewContact",
+    "elemental",
+    "params_for",
+    "register_elemental",
+    "check_params",
+    "standalone_driver",
+    "standalone_motion",
+]
 
 Array = NDArray[np.float64]
+
 
 def _xy(v) -> tuple[float, float]:
     return (float(v[0]), float(v[1]))
@@ -106,8 +118,15 @@ class SkewContact:
 class ElementalMechanism(Mechanism):
     """Elemental mechanism ``number`` (1-11) with parameters ``params``."""
 
-    def __init__(self, number: int, params: P_.Params | None = None, rate: float = 2 * np.pi,
-                 phase: float = 0.0, sizing_input: Array | None = None, **overrides: Any) -> None:
+    def __init__(
+        self,
+        number: int,
+        params: P_.Params | None = None,
+        rate: float = 2 * np.pi,
+        phase: float = 0.0,
+        sizing_input: Array | None = None,
+        **overrides: Any,
+    ) -> None:
         """``sizing_input``: the driver motions the parts must serve (slot and track lengths);
         by default one cycle of the standalone driver law."""
         self.record = rec = elemental_record(number)
@@ -196,12 +215,23 @@ class ElementalMechanism(Mechanism):
         window = Slot((wc[0], wc[1] - d), (wc[0], wc[1] + d), 2 * P.D_jr)
         slot, pins, slide = self._ground_slide(fo, (1.0, 0.0), (st.out.min(), st.out.max()), P.F_sr)
         m = P.D_jr * 0.35
-        follower = Part("follower", ((wc[0], wc[1] - d, P.D_jr + m), (wc[0], wc[1] + d, P.D_jr + m),
-                                     (pins[0][0], pins[0][1], 2 * P.F_sr), (pins[1][0], pins[1][1], 2 * P.F_sr)),
-                        (window, Hole(pins[0], 2 * P.F_sr), Hole(pins[1], 2 * P.F_sr)))
+        follower = Part(
+            "follower",
+            (
+                (wc[0], wc[1] - d, P.D_jr + m),
+                (wc[0], wc[1] + d, P.D_jr + m),
+                (pins[0][0], pins[0][1], 2 * P.F_sr),
+                (pins[1][0], pins[1][1], 2 * P.F_sr),
+            ),
+            (window, Hole(pins[0], 2 * P.F_sr), Hole(pins[1], 2 * P.F_sr)),
+        )
         drv = self._cam_driver()
-        ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*slot.start, 2 * P.F_sr), (*slot.end, 2 * P.F_sr)),
-                      (Hole(_xy(P.D_o), 2 * P.D_ar), slot), ground=True)
+        ground = Part(
+            "ground",
+            ((*_xy(P.D_o), 3 * P.D_ar), (*slot.start, 2 * P.F_sr), (*slot.end, 2 * P.F_sr)),
+            (Hole(_xy(P.D_o), 2 * P.D_ar), slot),
+            ground=True,
+        )
         joints = [
             Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
             PinInSlot("cam-window", "follower", "driver", start=window.start, end=window.end, pin=_sub(P.D_jc, P.D_o)),
@@ -223,11 +253,18 @@ class ElementalMechanism(Mechanism):
         x0, x1 = float(loc[:, 0].min()), float(loc[:, 0].max())
         window = Slot((x0, y0), (x1, y0), 2 * P.D_jr)
         mg = P.D_jr * 0.35
-        follower = Part("follower", ((0.0, 0.0, 2 * P.F_sr), (x0, y0, P.D_jr + mg), (x1, y0, P.D_jr + mg)),
-                        (Hole((0.0, 0.0), 2 * P.F_sr), window))
+        follower = Part(
+            "follower",
+            ((0.0, 0.0, 2 * P.F_sr), (x0, y0, P.D_jr + mg), (x1, y0, P.D_jr + mg)),
+            (Hole((0.0, 0.0), 2 * P.F_sr), window),
+        )
         drv = self._cam_driver()
-        ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*s, 3 * P.F_sr)),
-                      (Hole(_xy(P.D_o), 2 * P.D_ar), Hole(s, 2 * P.F_sr)), ground=True)
+        ground = Part(
+            "ground",
+            ((*_xy(P.D_o), 3 * P.D_ar), (*s, 3 * P.F_sr)),
+            (Hole(_xy(P.D_o), 2 * P.D_ar), Hole(s, 2 * P.F_sr)),
+            ground=True,
+        )
         joints = [
             Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
             Pivot("pivot", "ground", "follower", anchor_a=s, anchor_b=(0.0, 0.0)),
@@ -247,13 +284,18 @@ class ElementalMechanism(Mechanism):
         ang = np.unwrap(np.arctan2(p[:, 1] - s[1], p[:, 0] - s[0]))
         pad = 1.5 * P.F_jr / r
         track = ArcSlot(s, r, float(ang.min() - pad), float(ang.max() + pad), 2 * P.F_jr)
-        follower = Part("follower", ((0.0, 0.0, 2 * P.F_jr), (*hole, P.D_jr * 1.35)),
-                        (Hole((0.0, 0.0), 2 * P.F_jr), Hole(hole, 2 * P.D_jr)))
+        follower = Part(
+            "follower", ((0.0, 0.0, 2 * P.F_jr), (*hole, P.D_jr * 1.35)), (Hole((0.0, 0.0), 2 * P.F_jr), Hole(hole, 2 * P.D_jr))
+        )
         drv = self._cam_driver()
         mid = 0.5 * (track.angle0 + track.angle1)
         ends = [(s[0] + r * np.cos(a), s[1] + r * np.sin(a)) for a in (track.angle0, track.angle1, mid)]
-        ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), *[(x, y, 2 * P.F_jr) for x, y in ends]),
-                      (Hole(_xy(P.D_o), 2 * P.D_ar), track), ground=True)
+        ground = Part(
+            "ground",
+            ((*_xy(P.D_o), 3 * P.D_ar), *[(x, y, 2 * P.F_jr) for x, y in ends]),
+            (Hole(_xy(P.D_o), 2 * P.D_ar), track),
+            ground=True,
+        )
         joints = [
             Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
             Pivot("cam-hole", "driver", "follower", anchor_a=_sub(P.D_jc, P.D_o), anchor_b=hole),
@@ -271,11 +313,18 @@ class ElementalMechanism(Mechanism):
         Y0 = p0[1] - P.D_o[1]
         slot = self._driver_slot(q, st.aux["p"], Y0, 2 * P.F_jr)
         gslot, pins, slide = self._ground_slide(fo, (0.0, 1.0), (st.out.min(), st.out.max()), P.F_sr)
-        follower = Part("follower", ((*pin, 2 * P.F_jr), (*pins[0], 2 * P.F_sr), (*pins[1], 2 * P.F_sr)),
-                        (Hole(pin, 2 * P.F_jr), Hole(pins[0], 2 * P.F_sr), Hole(pins[1], 2 * P.F_sr)))
+        follower = Part(
+            "follower",
+            ((*pin, 2 * P.F_jr), (*pins[0], 2 * P.F_sr), (*pins[1], 2 * P.F_sr)),
+            (Hole(pin, 2 * P.F_jr), Hole(pins[0], 2 * P.F_sr), Hole(pins[1], 2 * P.F_sr)),
+        )
         drv = self._slotted_driver(slot)
-        ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*gslot.start, 2 * P.F_sr), (*gslot.end, 2 * P.F_sr)),
-                      (Hole(_xy(P.D_o), 2 * P.D_ar), gslot), ground=True)
+        ground = Part(
+            "ground",
+            ((*_xy(P.D_o), 3 * P.D_ar), (*gslot.start, 2 * P.F_sr), (*gslot.end, 2 * P.F_sr)),
+            (Hole(_xy(P.D_o), 2 * P.D_ar), gslot),
+            ground=True,
+        )
         joints = [
             Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
             PinInSlot("pin-slot", "driver", "follower", start=slot.start, end=slot.end, pin=pin),
@@ -291,11 +340,16 @@ class ElementalMechanism(Mechanism):
         p0 = (s[0] + pin[0], s[1] + pin[1])
         d = p0[1] - P.D_o[1]
         slot = self._driver_slot(q, st.aux["p"], d, 2 * P.F_jr)
-        follower = Part("follower", ((0.0, 0.0, 2 * P.F_ar), (*pin, 2 * P.F_jr)),
-                        (Hole((0.0, 0.0), 2 * P.F_ar), Hole(pin, 2 * P.F_jr)))
+        follower = Part(
+            "follower", ((0.0, 0.0, 2 * P.F_ar), (*pin, 2 * P.F_jr)), (Hole((0.0, 0.0), 2 * P.F_ar), Hole(pin, 2 * P.F_jr))
+        )
         drv = self._slotted_driver(slot)
-        ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar), (*s, 3 * P.F_ar)),
-                      (Hole(_xy(P.D_o), 2 * P.D_ar), Hole(s, 2 * P.F_ar)), ground=True)
+        ground = Part(
+            "ground",
+            ((*_xy(P.D_o), 3 * P.D_ar), (*s, 3 * P.F_ar)),
+            (Hole(_xy(P.D_o), 2 * P.D_ar), Hole(s, 2 * P.F_ar)),
+            ground=True,
+        )
         joints = [
             Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
             Pivot("pivot", "ground", "follower", anchor_a=s, anchor_b=(0.0, 0.0)),
@@ -321,8 +375,11 @@ class ElementalMechanism(Mechanism):
         """The oscillating arm of #4/#5: an axle at its origin and ``slot`` (parallel to x) for the follower's pin."""
         P = self.world
         y = slot.start[1]
-        return Part("driver", ((0.0, 0.0, 3 * P.D_ar), (slot.start[0], y, slot.width), (slot.end[0], y, slot.width)),
-                    (Hole((0.0, 0.0), 2 * P.D_ar), slot))
+        return Part(
+            "driver",
+            ((0.0, 0.0, 3 * P.D_ar), (slot.start[0], y, slot.width), (slot.end[0], y, slot.width)),
+            (Hole((0.0, 0.0), 2 * P.D_ar), slot),
+        )
 
     def _driver_slot(self, theta: Array, pins: Array, y: float, width: float) -> Slot:
         """The slot, parallel to x at height ``y`` in the (turning) driver's frame, covering the pin's travel."""
@@ -334,8 +391,13 @@ class ElementalMechanism(Mechanism):
     def _spatial_follower(self, P, N: float, r: float, arm: float) -> Part:
         """Follower of #6/#9 in its own yz plane: pivot at (0, 0), pin up to the driver's plane."""
         top = -N  # the driver's plane, relative to the pivot axis
-        return Part("follower", ((0.0, 0.0, 2 * P.F_ar), (0.0, top, r)), (Hole((0.0, 0.0), 2 * P.F_ar),),
-                    plane="yz", offset=float(P.F_o[0]))
+        return Part(
+            "follower",
+            ((0.0, 0.0, 2 * P.F_ar), (0.0, top, r)),
+            (Hole((0.0, 0.0), 2 * P.F_ar),),
+            plane="yz",
+            offset=float(P.F_o[0]),
+        )
 
     def _build_6(self):
         P = self.world
@@ -344,14 +406,23 @@ class ElementalMechanism(Mechanism):
         h = p0[1] - P.D_o[1] - r
         ex = p0[0] - P.D_o[0]
         N = P.F_o[2] - P.D_o[2]
-        drv = Part("driver", ((0.0, 0.0, 3 * P.D_ar), (ex - 2 * r, h - r, r), (ex + 2 * r, h - r, r)),
-                   (Hole((0.0, 0.0), 2 * P.D_ar),))
+        drv = Part(
+            "driver", ((0.0, 0.0, 3 * P.D_ar), (ex - 2 * r, h - r, r), (ex + 2 * r, h - r, r)), (Hole((0.0, 0.0), 2 * P.D_ar),)
+        )
         follower = self._spatial_follower(P, N, r, abs(N))
         ground = Part("ground", ((*_xy(P.D_o), 3 * P.D_ar),), (Hole(_xy(P.D_o), 2 * P.D_ar),), ground=True)
         joints = [
             Pivot("axle", "ground", "driver", anchor_a=_xy(P.D_o), anchor_b=(0.0, 0.0)),
-            SkewContact("edge-pin", "driver", "follower", edge_point=(0.0, h), edge_dir=(1.0, 0.0),
-                        pin_x=float(P.F_o[0]), radius=r, plane_z=float(P.D_o[2])),
+            SkewContact(
+                "edge-pin",
+                "driver",
+                "follower",
+                edge_point=(0.0, h),
+                edge_dir=(1.0, 0.0),
+                pin_x=float(P.F_o[0]),
+                radius=r,
+                plane_z=float(P.D_o[2]),
+            ),
         ]
         return [ground, drv, follower], joints
 
@@ -365,17 +436,24 @@ class ElementalMechanism(Mechanism):
         u = np.asarray(_sub(P.D_jc, s))
         u = u / np.hypot(*u)
         slot = Slot(_xy(u * dist.min()), _xy(u * dist.max()), 2 * P.D_jr)
-        follower = Part("follower", ((0.0, 0.0, 2 * P.F_ar), (*slot.start, 2 * P.D_jr), (*slot.end, 2 * P.D_jr)),
-                        (Hole((0.0, 0.0), 2 * P.F_ar), slot))
+        follower = Part(
+            "follower",
+            ((0.0, 0.0, 2 * P.F_ar), (*slot.start, 2 * P.D_jr), (*slot.end, 2 * P.D_jr)),
+            (Hole((0.0, 0.0), 2 * P.F_ar), slot),
+        )
         gslot_lo, gslot_hi = -P.amplitude, P.amplitude
         L = 4 * P.D_sr
         g0 = (P.D_o[0] + gslot_lo - L, P.D_o[1])
         g1 = (P.D_o[0] + gslot_hi + 2 * L, P.D_o[1])
         gslot = Slot(g0, g1, 2 * P.D_sr)
-        drv = Part("driver", ((0.0, 0.0, 2 * P.D_sr), (L, 0.0, 2 * P.D_sr), (*pin, 2 * P.D_jr)),
-                   (Hole((0.0, 0.0), 2 * P.D_sr), Hole((L, 0.0), 2 * P.D_sr), Hole(pin, 2 * P.D_jr)))
-        ground = Part("ground", ((*g0, 2 * P.D_sr), (*g1, 2 * P.D_sr), (*s, 3 * P.F_ar)),
-                      (gslot, Hole(s, 2 * P.F_ar)), ground=True)
+        drv = Part(
+            "driver",
+            ((0.0, 0.0, 2 * P.D_sr), (L, 0.0, 2 * P.D_sr), (*pin, 2 * P.D_jr)),
+            (Hole((0.0, 0.0), 2 * P.D_sr), Hole((L, 0.0), 2 * P.D_sr), Hole(pin, 2 * P.D_jr)),
+        )
+        ground = Part(
+            "ground", ((*g0, 2 * P.D_sr), (*g1, 2 * P.D_sr), (*s, 3 * P.F_ar)), (gslot, Hole(s, 2 * P.F_ar)), ground=True
+        )
         joints = [
             Slide("driver-slide", "ground", "driver", start=g0, end=g1, anchor=(0.0, 0.0), axis=(L, 0.0)),
             Pivot("pivot", "ground", "follower", anchor_a=s, anchor_b=(0.0, 0.0)),
@@ -400,9 +478,11 @@ class ElementalMechanism(Mechanism):
         cx = a_loc[0] - w / 2
         win = Slot((cx, a_loc[1] - 0.08), (cx, a_loc[1] + 0.08), w)
         rim = w / 2 + 0.04
-        drv = Part("driver", ((0.0, 0.0, 2 * P.D_ar), (L, 0.0, 2 * P.D_ar), (cx, a_loc[1] - 0.08, rim),
-                              (cx, a_loc[1] + 0.08, rim)),
-                   (Hole((0.0, 0.0), 2 * P.D_ar), Hole((L, 0.0), 2 * P.D_ar), win))
+        drv = Part(
+            "driver",
+            ((0.0, 0.0, 2 * P.D_ar), (L, 0.0, 2 * P.D_ar), (cx, a_loc[1] - 0.08, rim), (cx, a_loc[1] + 0.08, rim)),
+            (Hole((0.0, 0.0), 2 * P.D_ar), Hole((L, 0.0), 2 * P.D_ar), win),
+        )
         # the contact slides along the tab's face: the face must cover its travel t (distance along
         # the tab from the pivot), which grows past F_jh as the window moves away
         _, st = self._sweep()
@@ -412,10 +492,16 @@ class ElementalMechanism(Mechanism):
         # the tab's +x side is its contact face x = F_jcx all along (a convex hull: the pivot's boss
         # reaches no further than the face where it can, keeping 0.3 F_ar of wall round the hole)
         boss = min(2 * P.F_ar, max(P.F_jcx, 1.3 * P.F_ar))
-        follower = Part("follower", ((0.0, 0.0, boss), (P.F_jcx - P.F_jr, t_hi, P.F_jr)),
-                        (Hole((0.0, 0.0), 2 * P.F_ar),), plane="xz")
-        ground = Part("ground", ((*g0, 2 * P.D_ar), (*g1, 2 * P.D_ar), (*B, 3 * P.F_ar)),
-                      (gslot, Hole(B, 2 * P.F_ar)), ground=True, plane="xz")
+        follower = Part(
+            "follower", ((0.0, 0.0, boss), (P.F_jcx - P.F_jr, t_hi, P.F_jr)), (Hole((0.0, 0.0), 2 * P.F_ar),), plane="xz"
+        )
+        ground = Part(
+            "ground",
+            ((*g0, 2 * P.D_ar), (*g1, 2 * P.D_ar), (*B, 3 * P.F_ar)),
+            (gslot, Hole(B, 2 * P.F_ar)),
+            ground=True,
+            plane="xz",
+        )
         drv = Part(drv.name, drv.hull, drv.features, plane="xz")
         # the tab's face in its frame (origin B, x along the tab's initial direction rotated): the follower's
         # pose angle is psi - psi0 with psi0 the rest direction (+z); in the follower frame the tab runs
@@ -441,14 +527,25 @@ class ElementalMechanism(Mechanism):
         d = np.array([np.cos(phi), -np.sin(phi)])
         a = np.asarray(e_loc) - 0.15 * d
         b = np.asarray(e_loc) + 0.15 * d
-        drv = Part("driver", ((0.0, 0.0, 2 * P.D_ar), (L, 0.0, 2 * P.D_ar), (*_xy(a - [0, r]), r), (*_xy(b - [0, r]), r)),
-                   (Hole((0.0, 0.0), 2 * P.D_ar), Hole((L, 0.0), 2 * P.D_ar)))
+        drv = Part(
+            "driver",
+            ((0.0, 0.0, 2 * P.D_ar), (L, 0.0, 2 * P.D_ar), (*_xy(a - [0, r]), r), (*_xy(b - [0, r]), r)),
+            (Hole((0.0, 0.0), 2 * P.D_ar), Hole((L, 0.0), 2 * P.D_ar)),
+        )
         follower = self._spatial_follower(P, N, r, abs(N))
         ground = Part("ground", ((*g0, 2 * P.D_ar), (*g1, 2 * P.D_ar)), (gslot,), ground=True)
         joints = [
             Slide("driver-slide", "ground", "driver", start=g0, end=g1, anchor=(0.0, 0.0), axis=(L, 0.0)),
-            SkewContact("slot-pin", "driver", "follower", edge_point=e_loc, edge_dir=_xy(d),
-                        pin_x=float(P.F_o[0]), radius=r, plane_z=float(P.D_o[2])),
+            SkewContact(
+                "slot-pin",
+                "driver",
+                "follower",
+                edge_point=e_loc,
+                edge_dir=_xy(d),
+                pin_x=float(P.F_o[0]),
+                radius=r,
+                plane_z=float(P.D_o[2]),
+            ),
         ]
         return [ground, drv, follower], joints
 
@@ -473,8 +570,11 @@ class ElementalMechanism(Mechanism):
         R = float(np.hypot(*_sub(p0, P.D_o)))
         drv, arc = self._arc_driver(P, qs, st, p0, R)
         gslot, pins, slide = self._ground_slide(fo, (1.0, 0.0), (st.out.min(), st.out.max()), P.F_sr)
-        follower = Part("follower", ((*pin, 2 * P.F_jr), (*pins[0], 2 * P.F_sr), (*pins[1], 2 * P.F_sr)),
-                        (Hole(pin, 2 * P.F_jr), Hole(pins[0], 2 * P.F_sr), Hole(pins[1], 2 * P.F_sr)))
+        follower = Part(
+            "follower",
+            ((*pin, 2 * P.F_jr), (*pins[0], 2 * P.F_sr), (*pins[1], 2 * P.F_sr)),
+            (Hole(pin, 2 * P.F_jr), Hole(pins[0], 2 * P.F_sr), Hole(pins[1], 2 * P.F_sr)),
+        )
         ground = Part("ground", ((*gslot.start, 2 * P.F_sr), (*gslot.end, 2 * P.F_sr)), (gslot,), ground=True)
         joints = [
             PinInArcSlot("pin-arc", "driver", "follower", centre=arc.centre, radius=R, pin=pin),
@@ -490,8 +590,9 @@ class ElementalMechanism(Mechanism):
         p0 = (s[0] + pin[0], s[1] + pin[1])
         R = float(np.hypot(*_sub(p0, P.D_o)))
         drv, arc = self._arc_driver(P, qs, st, p0, R)
-        follower = Part("follower", ((0.0, 0.0, 2 * P.F_ar), (*pin, 2 * P.F_jr)),
-                        (Hole((0.0, 0.0), 2 * P.F_ar), Hole(pin, 2 * P.F_jr)))
+        follower = Part(
+            "follower", ((0.0, 0.0, 2 * P.F_ar), (*pin, 2 * P.F_jr)), (Hole((0.0, 0.0), 2 * P.F_ar), Hole(pin, 2 * P.F_jr))
+        )
         ground = Part("ground", ((*s, 3 * P.F_ar),), (Hole(s, 2 * P.F_ar),), ground=True)
         joints = [
             Pivot("pivot", "ground", "follower", anchor_a=s, anchor_b=(0.0, 0.0)),
@@ -659,23 +760,68 @@ EM = ElementalMechanism
 for _rec in (
     ElementalRecord(1, ("Rz", "Tx"), P_.P1, K.forward_1, EM._build_1, "cam-window", _slide_x, lengths=(_CAM_ECC,)),
     ElementalRecord(2, ("Rz", "Oz"), P_.P2, K.forward_2, EM._build_2, "cam-window", _pivot, lengths=(_CAM_ECC,)),
-    ElementalRecord(3, ("Rz", "OzT"), P_.P3, K.forward_3, EM._build_3, "track", _free, lengths=(
-        _CAM_ECC, ("S_c", "track radius |S_c|", lambda P: _norm2(P.S_c)),
-        ("F_o", "cam-to-pin distance |F_o - D_jc|", lambda P: _norm2(_sub(P.F_o, P.D_jc))))),
-    ElementalRecord(4, ("Oz", "Ty"), P_.P4, K.forward_4, EM._build_4, "pin-slot", _slide_y,
-                    angle_params=("phi", "D_theta", "amplitude")),
-    ElementalRecord(5, ("Oz", "Oz"), P_.P5, K.forward_5, EM._build_5, "pin-slot", _pivot,
-                    lengths=(("F_jc", "pin radius |F_jc|", lambda P: _norm2(P.F_jc)),),
-                    angle_params=("phi", "D_theta", "amplitude")),
-    ElementalRecord(6, ("Oz", "Ox"), P_.P6, K.forward_6, EM._build_6, "edge-pin", _tilt_yz, spatial=True,
-                    angle_params=("phi", "D_theta", "amplitude")),
-    ElementalRecord(7, ("Tx", "Oz"), P_.P7, K.forward_7, EM._build_7, "pin-slot", _pivot, lengths=(
-        ("F_o", "pin-to-pivot distance |F_o - D_jc|", lambda P: _norm2(_sub(P.F_o, P.D_jc))),)),
+    ElementalRecord(
+        3,
+        ("Rz", "OzT"),
+        P_.P3,
+        K.forward_3,
+        EM._build_3,
+        "track",
+        _free,
+        lengths=(
+            _CAM_ECC,
+            ("S_c", "track radius |S_c|", lambda P: _norm2(P.S_c)),
+            ("F_o", "cam-to-pin distance |F_o - D_jc|", lambda P: _norm2(_sub(P.F_o, P.D_jc))),
+        ),
+    ),
+    ElementalRecord(
+        4, ("Oz", "Ty"), P_.P4, K.forward_4, EM._build_4, "pin-slot", _slide_y, angle_params=("phi", "D_theta", "amplitude")
+    ),
+    ElementalRecord(
+        5,
+        ("Oz", "Oz"),
+        P_.P5,
+        K.forward_5,
+        EM._build_5,
+        "pin-slot",
+        _pivot,
+        lengths=(("F_jc", "pin radius |F_jc|", lambda P: _norm2(P.F_jc)),),
+        angle_params=("phi", "D_theta", "amplitude"),
+    ),
+    ElementalRecord(
+        6,
+        ("Oz", "Ox"),
+        P_.P6,
+        K.forward_6,
+        EM._build_6,
+        "edge-pin",
+        _tilt_yz,
+        spatial=True,
+        angle_params=("phi", "D_theta", "amplitude"),
+    ),
+    ElementalRecord(
+        7,
+        ("Tx", "Oz"),
+        P_.P7,
+        K.forward_7,
+        EM._build_7,
+        "pin-slot",
+        _pivot,
+        lengths=(("F_o", "pin-to-pivot distance |F_o - D_jc|", lambda P: _norm2(_sub(P.F_o, P.D_jc))),),
+    ),
     ElementalRecord(8, ("Tx", "Oy"), P_.P8, K.forward_8, EM._build_8, "window-tab", _pivot_xz, view="xz"),
     ElementalRecord(9, ("Tx", "Ox"), P_.P9, K.forward_9, EM._build_9, "slot-pin", _tilt_yz, spatial=True),
     ElementalRecord(10, ("OzT", "Tx"), P_.P10, K.forward_10, EM._build_10, "pin-arc", _slide_x),
-    ElementalRecord(11, ("OzT", "Oz"), P_.P11, K.forward_11, EM._build_11, "pin-arc", _pivot,
-                    lengths=(("F_jc", "pin radius |F_jc|", lambda P: _norm2(P.F_jc)),)),
+    ElementalRecord(
+        11,
+        ("OzT", "Oz"),
+        P_.P11,
+        K.forward_11,
+        EM._build_11,
+        "pin-arc",
+        _pivot,
+        lengths=(("F_jc", "pin radius |F_jc|", lambda P: _norm2(P.F_jc)),),
+    ),
 ):
     register_elemental(_rec)
 

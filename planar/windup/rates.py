@@ -99,8 +99,11 @@ def _oval_rates(e0: Jet, e: Jet, p0: Array, N: float, r: float, alpha: Array) ->
     (w, w1, w2), (d, d1, d2) = (e0[0] - p0, e0[1], e0[2]), e
     X = d[:, 0] * w[:, 1] - d[:, 1] * w[:, 0]
     X1 = (d1[:, 0] * w[:, 1] - d1[:, 1] * w[:, 0]) + (d[:, 0] * w1[:, 1] - d[:, 1] * w1[:, 0])
-    X2 = ((d2[:, 0] * w[:, 1] - d2[:, 1] * w[:, 0]) + 2 * (d1[:, 0] * w1[:, 1] - d1[:, 1] * w1[:, 0])
-          + (d[:, 0] * w2[:, 1] - d[:, 1] * w2[:, 0]))
+    X2 = (
+        (d2[:, 0] * w[:, 1] - d2[:, 1] * w[:, 0])
+        + 2 * (d1[:, 0] * w1[:, 1] - d1[:, 1] * w1[:, 0])
+        + (d[:, 0] * w2[:, 1] - d[:, 1] * w2[:, 0])
+    )
     ex, ex1, ex2 = d[:, 0], d1[:, 0], d2[:, 0]
     K = N * N - r * r
     t = np.tan(alpha)
@@ -149,8 +152,9 @@ def forward_rates(number: int, params: Any, u: Array, u1: Array, u2: Array) -> t
         s = p0 + _xy(P.S_c)
         p = st.aux["p"]
         node = RRR("p", "m", 1.0, "s", 1.0)
-        pv, pa, ok = _dyad(node, {"p": p, "m": m, "s": np.broadcast_to(s, m.shape)},
-                           {"m": m1, "s": _zeros(n)}, {"m": m2, "s": _zeros(n)})
+        pv, pa, ok = _dyad(
+            node, {"p": p, "m": m, "s": np.broadcast_to(s, m.shape)}, {"m": m1, "s": _zeros(n)}, {"m": m2, "s": _zeros(n)}
+        )
         al1, al2 = _angle(p - m, pv - m1, pa - m2)
         return np.column_stack([pv, al1]), np.column_stack([pa, al2]), ok
     if number == 4:
@@ -176,8 +180,12 @@ def forward_rates(number: int, params: Any, u: Array, u1: Array, u2: Array) -> t
         tv, ta = _turning(q, tip, u1, u2)
         z = _zeros(n)
         node5 = RRP("p", "s", 1.0, "b", "t")
-        pv, pa, ok = _dyad(node5, {"p": p, "s": np.broadcast_to(s, p.shape), "b": base, "t": tip},
-                           {"s": z, "b": bv, "t": tv}, {"s": z, "b": ba, "t": ta})
+        pv, pa, ok = _dyad(
+            node5,
+            {"p": p, "s": np.broadcast_to(s, p.shape), "b": base, "t": tip},
+            {"s": z, "b": bv, "t": tv},
+            {"s": z, "b": ba, "t": ta},
+        )
         return (*_angle(p - s, pv, pa), ok)
     if number in (6, 9):
         p0 = _xy(P.F_o)
@@ -219,13 +227,11 @@ def forward_rates(number: int, params: Any, u: Array, u1: Array, u2: Array) -> t
         g1 = np.broadcast_to(np.array([0.0, p0[1]]), m.shape)
         g2 = np.broadcast_to(np.array([1.0, p0[1]]), m.shape)
         node10 = RRP("p", "m", 1.0, "g1", "g2")
-        pv, pa, ok = _dyad(node10, {"p": p, "m": m, "g1": g1, "g2": g2},
-                           {"m": m1, "g1": z, "g2": z}, {"m": m2, "g1": z, "g2": z})
+        pv, pa, ok = _dyad(node10, {"p": p, "m": m, "g1": g1, "g2": g2}, {"m": m1, "g1": z, "g2": z}, {"m": m2, "g1": z, "g2": z})
         return pv[:, 0], pa[:, 0], ok
     s = _xy(P.F_o)
     node11 = RRR("p", "m", 1.0, "s", 1.0)
-    pv, pa, ok = _dyad(node11, {"p": p, "m": m, "s": np.broadcast_to(s, m.shape)},
-                       {"m": m1, "s": z}, {"m": m2, "s": z})
+    pv, pa, ok = _dyad(node11, {"p": p, "m": m, "s": np.broadcast_to(s, m.shape)}, {"m": m1, "s": z}, {"m": m2, "s": z})
     return (*_angle(p - s, pv, pa), ok)
 
 
@@ -264,8 +270,7 @@ def _follower_kind(mech: ElementalMechanism) -> str:
     from planar.windup import mechanisms as M
 
     fp = mech.record.follower_pose
-    table = {M._slide_x: "x", M._slide_y: "y", M._free: "free", M._pivot: "pivot", M._tilt_yz: "pivot",
-             M._pivot_xz: "-pivot"}
+    table = {M._slide_x: "x", M._slide_y: "y", M._free: "free", M._pivot: "pivot", M._tilt_yz: "pivot", M._pivot_xz: "-pivot"}
     if fp not in table:
         raise UnsupportedError(f"rates: no rule for the follower pose {fp.__name__} of mechanism #{mech.number}")
     return table[fp]
@@ -279,8 +284,7 @@ def _stage_part_rates(mech: ElementalMechanism, u: Jet, out1: Array, out2: Array
     }
 
 
-def elemental_rates(mech: ElementalMechanism, q: Array, qd: Array, qdd: Array
-                    ) -> tuple[dict[str, tuple[Array, ...]], Mask]:
+def elemental_rates(mech: ElementalMechanism, q: Array, qd: Array, qdd: Array) -> tuple[dict[str, tuple[Array, ...]], Mask]:
     """Part rates ``(v, a, omega, alpha)`` of an elemental mechanism (its view plane's coordinates)."""
     u = driver_motion_rates(mech, q, qd, qdd)
     out1, out2, ok = forward_rates(mech.number, mech.params, u[0], u[1], u[2])
@@ -310,8 +314,7 @@ def toy_rates(toy: Any, q: Array, qd: Array, qdd: Array) -> tuple[dict[str, tupl
     return parts, valid
 
 
-def windup_rates(mech: "Mechanism", q: Array, qd: Array, qdd: Array
-                 ) -> tuple[dict[str, tuple[Array, ...]], Mask, str]:
+def windup_rates(mech: "Mechanism", q: Array, qd: Array, qdd: Array) -> tuple[dict[str, tuple[Array, ...]], Mask, str]:
     """Part rates ``(v, a, omega, alpha)`` of an elemental mechanism or a toy (see the module's note), with the
     validity and the method's name; other mechanisms are refused by name."""
     from planar.windup.chain import ToyMechanism
@@ -322,5 +325,6 @@ def windup_rates(mech: "Mechanism", q: Array, qd: Array, qdd: Array
     if isinstance(mech, ToyMechanism):
         raw, ok = toy_rates(mech, q, qd, qdd)
         return raw, ok, "wind-up closed forms differentiated analytically, composed through the toy's stages"
-    raise UnsupportedError(f"rates (velocities, accelerations, torque): no closed-form derivatives for "
-                           f"{type(mech).__name__} {mech.name!r}")
+    raise UnsupportedError(
+        f"rates (velocities, accelerations, torque): no closed-form derivatives for {type(mech).__name__} {mech.name!r}"
+    )

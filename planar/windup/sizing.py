@@ -90,8 +90,7 @@ class _Range:
             raise InputError(f"#{number}.parameter", name, f"a parameter of #{number}")
         cur = getattr(self.base, name)
         if (comp is None) != (np.ndim(cur) == 0) or (comp is not None and not 0 <= comp < len(cur)):
-            raise InputError(f"#{number}.{name}.component", comp,
-                             "None for a scalar parameter, else an index of its components")
+            raise InputError(f"#{number}.{name}.component", comp, "None for a scalar parameter, else an index of its components")
         self.current = float(cur if comp is None else cur[comp])
         self.rec = ELEMENTAL[number]
 
@@ -133,7 +132,7 @@ def _refined_runs(f: _Range, lo: float, hi: float) -> list[tuple[np.ndarray, np.
         j = i
         while j + 1 < g.size and ok[j + 1]:
             j += 1
-        xs, ys = list(g[i:j + 1]), list(y[i:j + 1])
+        xs, ys = list(g[i : j + 1]), list(y[i : j + 1])
         # edges next to an invalid scan value: bisect validity to the boundary
         for edge, out in ((i, i - 1), (j, j + 1)):
             if 0 <= out < g.size:
@@ -151,8 +150,12 @@ def _refined_runs(f: _Range, lo: float, hi: float) -> list[tuple[np.ndarray, np.
             for sgn in (1.0, -1.0):
                 a, b = sgn * (y[k] - y[k - 1]), sgn * (y[k] - y[k + 1])
                 if a >= 0 and b >= 0 and (a > 0 or b > 0):
-                    r = minimize_scalar(lambda v, s=sgn: -s * f(v), bounds=(g[k - 1], g[k + 1]), method="bounded",
-                                        options={"xatol": 1e-12 * max(1.0, abs(g[k]))})
+                    r = minimize_scalar(
+                        lambda v, s=sgn: -s * f(v),
+                        bounds=(g[k - 1], g[k + 1]),
+                        method="bounded",
+                        options={"xatol": 1e-12 * max(1.0, abs(g[k]))},
+                    )
                     if np.isfinite(r.fun):
                         xs.append(float(r.x))
                         ys.append(-sgn * float(r.fun))
@@ -162,16 +165,22 @@ def _refined_runs(f: _Range, lo: float, hi: float) -> list[tuple[np.ndarray, np.
     return runs
 
 
-def reachable_ranges(number: int, parameter: str | None = None, component: int | None = None,
-                     bracket: tuple[float, float] | None = None, **fixed: Any) -> list[tuple[float, float]]:
+def reachable_ranges(
+    number: int,
+    parameter: str | None = None,
+    component: int | None = None,
+    bracket: tuple[float, float] | None = None,
+    **fixed: Any,
+) -> list[tuple[float, float]]:
     """The follower ranges reachable by varying the design parameter in ``bracket``: one
     ``(lo, hi)`` per run of valid values (see the module's description)."""
     f, lo, hi = _setup(number, parameter, component, bracket, fixed)
     return [(float(ys.min()), float(ys.max())) for _, ys in _refined_runs(f, lo, hi)]
 
 
-def _setup(number: int, parameter: str | None, component: int | None, bracket: tuple[float, float] | None,
-           fixed: dict[str, Any]) -> tuple[_Range, float, float]:
+def _setup(
+    number: int, parameter: str | None, component: int | None, bracket: tuple[float, float] | None, fixed: dict[str, Any]
+) -> tuple[_Range, float, float]:
     if not isinstance(number, (int, np.integer)) or isinstance(number, bool) or number not in DESIGN_PARAMETER:
         raise InputError("mechanism", number, "an elemental mechanism number 1-11")
     name, comp, br, _ = DESIGN_PARAMETER[int(number)]
@@ -183,8 +192,14 @@ def _setup(number: int, parameter: str | None, component: int | None, bracket: t
     return _Range(int(number), name, comp, fixed), lo, hi
 
 
-def size_for_range(number: int, target: float, parameter: str | None = None, component: int | None = None,
-                   bracket: tuple[float, float] | None = None, **fixed: Any) -> Sizing:
+def size_for_range(
+    number: int,
+    target: float,
+    parameter: str | None = None,
+    component: int | None = None,
+    bracket: tuple[float, float] | None = None,
+    **fixed: Any,
+) -> Sizing:
     """The mechanism whose follower range (peak to peak) equals ``target``.
 
     By default the design parameter of :data:`DESIGN_PARAMETER` is varied
@@ -212,8 +227,9 @@ def size_for_range(number: int, target: float, parameter: str | None = None, com
                 continue
     if not roots:
         spans = " or ".join(f"between {ys.min():.6g} and {ys.max():.6g}" for _, ys in runs)
-        raise InputError(f"#{number}.target", target,
-                         f"a range #{number} can reach by varying {f.name} in [{lo:g}, {hi:g}]: {spans}")
+        raise InputError(
+            f"#{number}.target", target, f"a range #{number} can reach by varying {f.name} in [{lo:g}, {hi:g}]: {spans}"
+        )
     v = min(roots, key=lambda r: abs(r - f.current))
     mech = ElementalMechanism(int(number), f.params(v))
     return Sizing(mech, f.name, float(v), motion_range(mech))

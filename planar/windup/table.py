@@ -21,8 +21,7 @@ import numpy as np
 from planar.errors import InputError
 from planar.windup.mechanisms import MOTIONS
 
-__all__ = ["TABLE", "OPTIONAL", "MOTION_TYPES", "Realisation", "realise", "patterns", "enumerate_chains",
-           "chain_counts"]
+__all__ = ["TABLE", "OPTIONAL", "MOTION_TYPES", "Realisation", "realise", "patterns", "enumerate_chains", "chain_counts"]
 
 #: driver motion -> follower motions (30 patterns)
 TABLE: dict[str, tuple[str, ...]] = {
@@ -120,8 +119,7 @@ def realise(pattern: str) -> Realisation:
                     continue  # the motor turns one way: keep z up
                 rows = tuple((int(row[0]), int(row[1]), int(row[2])) for row in R)
                 return Realisation(pattern, k, rows, si, so)
-    raise InputError("pattern", pattern, "a motion transfer that some elemental mechanism realises "
-                                         "(planar chains lists them)")
+    raise InputError("pattern", pattern, "a motion transfer that some elemental mechanism realises (planar chains lists them)")
 
 
 def patterns(optional: bool = False) -> list[str]:
@@ -132,8 +130,7 @@ def patterns(optional: bool = False) -> list[str]:
     return out
 
 
-def enumerate_chains(target: str | None = None, max_length: int = 3,
-                     optional: bool = False) -> dict[str, list[tuple[str, ...]]]:
+def enumerate_chains(target: str | None = None, max_length: int = 3, optional: bool = False) -> dict[str, list[tuple[str, ...]]]:
     """Every chain from the motor (Rz) of length 1..``max_length``, grouped by end effector.
 
     A chain is a tuple of patterns, e.g. ``("Rz->Tx", "Tx->Ox")``.  Chains

@@ -17,8 +17,15 @@ from planar.scene.catalog import CATALOG, get
 from planar.scene.load import load_scene
 
 LINKAGES = [n for n in CATALOG if isinstance(get(n), Linkage)]
-GALLERY = ["quick-return", "oscillating-cylinder", "peaucellier", "watt-straight-line", "double-rocker",
-           "jansen-leg", "slider-crank"]
+GALLERY = [
+    "quick-return",
+    "oscillating-cylinder",
+    "peaucellier",
+    "watt-straight-line",
+    "double-rocker",
+    "jansen-leg",
+    "slider-crank",
+]
 
 
 def _central(x: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
@@ -39,19 +46,24 @@ def _check_against_differences(mech, n: int) -> float:
     for name, (v, a) in der.points.items():
         fv, fa = _central(mo.points[name], h)
         # a point on a pivoting part's axis stands still: measure against the mechanism's size x rate
-        worst = max(worst, np.abs(fv - v[1:-1])[ok].max() / max(np.abs(v).max(), mech.size * w),
-                    np.abs(fa - a[1:-1])[ok].max() / max(np.abs(a).max(), mech.size * w * w))
+        worst = max(
+            worst,
+            np.abs(fv - v[1:-1])[ok].max() / max(np.abs(v).max(), mech.size * w),
+            np.abs(fa - a[1:-1])[ok].max() / max(np.abs(a).max(), mech.size * w * w),
+        )
     for name, r in der.parts.items():
         ang = np.unwrap(mo.poses[name][:, 2])
         fo, fal = _central(ang, h)
         # a part turning with the crank has alpha 0 (to round-off): measure against the driver's rate
         scale_o = max(np.abs(r.omega).max(), mech.driver.rate)
         scale_a = max(np.abs(r.alpha).max(), mech.driver.rate**2)
-        worst = max(worst, np.abs(fo - r.omega[1:-1])[ok].max() / scale_o,
-                    np.abs(fal - r.alpha[1:-1])[ok].max() / scale_a)
+        worst = max(worst, np.abs(fo - r.omega[1:-1])[ok].max() / scale_o, np.abs(fal - r.alpha[1:-1])[ok].max() / scale_a)
         fv, fa = _central(mo.poses[name][:, :2], h)
-        worst = max(worst, np.abs(fv - r.v[1:-1])[ok].max() / max(np.abs(r.v).max(), mech.size * w),
-                    np.abs(fa - r.a[1:-1])[ok].max() / max(np.abs(r.a).max(), mech.size * w * w))
+        worst = max(
+            worst,
+            np.abs(fv - r.v[1:-1])[ok].max() / max(np.abs(r.v).max(), mech.size * w),
+            np.abs(fa - r.a[1:-1])[ok].max() / max(np.abs(r.a).max(), mech.size * w * w),
+        )
     return worst
 
 
@@ -115,8 +127,13 @@ def test_torque_equals_inverse_dynamics_by_differences() -> None:
     from planar.core.effects import Effects, Load, Spring
 
     mech = get("jansen")
-    eff = Effects(gravity=(0.0, -9.81), damping=0.9, density=0.01, loads=(Load("foot", (3.0, 10.0)),),
-                  springs=(Spring("crank", "lower", 2.0, damping=0.3),))
+    eff = Effects(
+        gravity=(0.0, -9.81),
+        damping=0.9,
+        density=0.01,
+        loads=(Load("foot", (3.0, 10.0)),),
+        springs=(Spring("crank", "lower", 2.0, damping=0.3),),
+    )
     t = mech.driver.times(90)
     mo = mech.solve(mech.driver.value(t), t=t)
     tau, ok = motor_torque(mech, mo, eff)
@@ -135,8 +152,7 @@ def test_torque_of_a_rocking_driver_divides_power_by_its_own_speed() -> None:
     power_over_rate = inverse_dynamics_torque(mech, t, sc.effects)
     qd, _ = driver_rates(mech.driver, t)
     keep = np.abs(qd) > 0.2 * np.abs(qd).max()
-    assert np.allclose(tau[keep], (power_over_rate * mech.driver.rate / qd)[keep], rtol=1e-5,
-                       atol=1e-6 * np.abs(tau).max())
+    assert np.allclose(tau[keep], (power_over_rate * mech.driver.rate / qd)[keep], rtol=1e-5, atol=1e-6 * np.abs(tau).max())
 
 
 def test_motion_derivatives_columns(tmp_path) -> None:
@@ -144,8 +160,18 @@ def test_motion_derivatives_columns(tmp_path) -> None:
     assert main(["motion", "gallery/kangaroo-leg.toml", "-o", str(out), "--derivatives"]) == 0
     rows = list(csv.DictReader(out.open()))
     cols = rows[0].keys()
-    for c in ("coupler_point.vx", "coupler_point.vy", "coupler_point.ax", "coupler_point.ay", "coupler.omega",
-              "rocker.alpha", "C.transmission", "torque", "torque.loads", "rates_valid"):
+    for c in (
+        "coupler_point.vx",
+        "coupler_point.vy",
+        "coupler_point.ax",
+        "coupler_point.ay",
+        "coupler.omega",
+        "rocker.alpha",
+        "C.transmission",
+        "torque",
+        "torque.loads",
+        "rates_valid",
+    ):
         assert c in cols
     assert list(cols)[-1] == "valid"
     sc = load_scene("gallery/kangaroo-leg.toml")
@@ -171,8 +197,9 @@ def _spectral(x: np.ndarray, period: float) -> tuple[np.ndarray, np.ndarray]:
     return np.fft.ifft(ik * X, axis=0), np.fft.ifft(ik * ik * X, axis=0)
 
 
-GALLERY_ALL = sorted(p.stem for p in __import__("pathlib").Path("gallery").glob("*.toml")
-                     if "cam" not in p.stem)  # a cam's motion law is piecewise: not for FFT (see below)
+GALLERY_ALL = sorted(
+    p.stem for p in __import__("pathlib").Path("gallery").glob("*.toml") if "cam" not in p.stem
+)  # a cam's motion law is piecewise: not for FFT (see below)
 
 
 def test_cam_rates_equal_central_differences_of_the_poses() -> None:
@@ -261,12 +288,26 @@ def test_rrp_on_a_moving_line_with_offset_and_an_actuator() -> None:
     and a translating input that rocks (qdd != 0)."""
     from planar.linkages import RRP, RRR, Actuator, Crank, Fixed, Link, Rigid
 
-    slot = Linkage("slot", [Fixed("O", (0.0, 0.0)), Fixed("Z", (2.5, 0.5)), Crank("A", "O", 3.0),
-                            RRP("S", "Z", 3.0, "O", "A", 1, 0.3), Rigid("T", "Z", "S", (3.0, 0.5))],
-                   [Link("crank", ("O", "A")), Link("arm", ("Z", "S", "T"))], points={"tip": "T", "pin": "S"})
-    act = Linkage("act", [Fixed("O", (0.0, 0.0)), Fixed("Z", (0.0, 2.0)), Actuator("P", "O", (1.0, 0.2)),
-                          RRR("B", "P", 2.5, "Z", 2.0)],
-                  [Link("rod", ("P", "B")), Link("arm", ("Z", "B"))], points={"b": "B"}, amplitude=0.6, centre=0.5)
+    slot = Linkage(
+        "slot",
+        [
+            Fixed("O", (0.0, 0.0)),
+            Fixed("Z", (2.5, 0.5)),
+            Crank("A", "O", 3.0),
+            RRP("S", "Z", 3.0, "O", "A", 1, 0.3),
+            Rigid("T", "Z", "S", (3.0, 0.5)),
+        ],
+        [Link("crank", ("O", "A")), Link("arm", ("Z", "S", "T"))],
+        points={"tip": "T", "pin": "S"},
+    )
+    act = Linkage(
+        "act",
+        [Fixed("O", (0.0, 0.0)), Fixed("Z", (0.0, 2.0)), Actuator("P", "O", (1.0, 0.2)), RRR("B", "P", 2.5, "Z", 2.0)],
+        [Link("rod", ("P", "B")), Link("arm", ("Z", "B"))],
+        points={"b": "B"},
+        amplitude=0.6,
+        centre=0.5,
+    )
     for mech in (slot, act):
         assert _check_against_differences(mech, 2000) < 1e-3
         t = mech.driver.times(256)
@@ -299,9 +340,11 @@ def test_a_node_kind_without_acceleration_is_refused_by_name() -> None:
 
     node_kind(Pinned)
     try:
-        link = Linkage("l", [Fixed("O", (0.0, 0.0)), Pinned("Z", (3.0, 0.0)), Crank("A", "O", 1.0),
-                             RRR("B", "A", 3.0, "Z", 2.0)],
-                       [Link("crank", ("O", "A")), Link("c", ("A", "B")), Link("r", ("Z", "B"))])
+        link = Linkage(
+            "l",
+            [Fixed("O", (0.0, 0.0)), Pinned("Z", (3.0, 0.0)), Crank("A", "O", 1.0), RRR("B", "A", 3.0, "Z", 2.0)],
+            [Link("crank", ("O", "A")), Link("c", ("A", "B")), Link("r", ("Z", "B"))],
+        )
         t = link.driver.times(8)
         with pytest.raises(UnsupportedError, match="test-no-acceleration"):
             motion_derivatives(link, link.solve(link.driver.value(t), t=t))

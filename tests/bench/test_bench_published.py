@@ -66,15 +66,25 @@ def test_published_figures(name):
 
 def test_subset4_and_format():
     assert subset4(6) == [0, 2, 3, 5] and subset4(5) == [0, 1, 3, 4] and subset4(4) == [0, 1, 2, 3]
-    case = {"problem": "p", "targets": 6, "timed": False, "published_best_error": "not found",
-            "published_source": "s",
-            "planar": {"sse_median": 1.0, "sse_min": 1.0, "sse_max": 1.0, "time_s": {"median": 1.0}, "ok": True},
-            "pylinkage": {"sse": None, "solutions": 0, "time_s": {"median": 0.1}},
-            "pylinkage_without_grashof": {"sse": None, "solutions": 0, "crank_turns_fully": None, "time_s": 0.1},
-            "pylinkage_four_targets": {"sse": 0.2, "solutions": 5, "crank_turns_fully": True, "time_s": 0.1},
-            "pylinkage_optimisers": {"sse_median": 0.3, "sse_min": 0.2, "sse_max": 0.4,
-                                     "pylinkage_sse_of_best": 0.2, "time_s": {"median": 1.0}, "evaluations": 9}}
-    k = {"median": 1.0, "min": 1.0, "max": 1.0, "samples": 64, "threads": 1,
-         "float64": {"median": 1.0, "min": 1.0, "max": 1.0}}
+    case = {
+        "problem": "p",
+        "targets": 6,
+        "timed": False,
+        "published_best_error": "not found",
+        "published_source": "s",
+        "planar": {"sse_median": 1.0, "sse_min": 1.0, "sse_max": 1.0, "time_s": {"median": 1.0}, "ok": True},
+        "pylinkage": {"sse": None, "solutions": 0, "time_s": {"median": 0.1}},
+        "pylinkage_without_grashof": {"sse": None, "solutions": 0, "crank_turns_fully": None, "time_s": 0.1},
+        "pylinkage_four_targets": {"sse": 0.2, "solutions": 5, "crank_turns_fully": True, "time_s": 0.1},
+        "pylinkage_optimisers": {
+            "sse_median": 0.3,
+            "sse_min": 0.2,
+            "sse_max": 0.4,
+            "pylinkage_sse_of_best": 0.2,
+            "time_s": {"median": 1.0},
+            "evaluations": 9,
+        },
+    }
+    k = {"median": 1.0, "min": 1.0, "max": 1.0, "samples": 64, "threads": 1, "float64": {"median": 1.0, "min": 1.0, "max": 1.0}}
     out = format_synthesis({"repeats": 1, "cores": 2, "kernel_candidates_per_s": k, "cases": [case]})
     assert "pylinkage optimisers" in out and "published_searched" in out

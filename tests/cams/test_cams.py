@@ -23,8 +23,14 @@ d = math.radians
 
 def rdrd(lift):
     """Rise, dwell, return, dwell."""
-    return Program([Segment("polynomial-345", d(100), lift), Segment("dwell", d(50)),
-                    Segment("cycloidal", d(130), -lift), Segment("dwell", d(80))])
+    return Program(
+        [
+            Segment("polynomial-345", d(100), lift),
+            Segment("dwell", d(50)),
+            Segment("cycloidal", d(130), -lift),
+            Segment("dwell", d(80)),
+        ]
+    )
 
 
 FOLLOWERS = {
@@ -65,8 +71,14 @@ def test_law_ends_and_derivatives_match_finite_differences(name):
 
 
 def test_program_derivatives_and_continuity():
-    prog = Program([Segment("cycloidal", d(120), 0.5), Segment("dwell", d(60)),
-                    Segment("harmonic", d(90), -0.2), Segment("polynomial-345", d(90), -0.3)])
+    prog = Program(
+        [
+            Segment("cycloidal", d(120), 0.5),
+            Segment("dwell", d(60)),
+            Segment("harmonic", d(90), -0.2),
+            Segment("polynomial-345", d(90), -0.3),
+        ]
+    )
     th = np.linspace(-2 * np.pi, 4 * np.pi, 60001)  # three turns: the program repeats
     s, v, a = prog.evaluate(th)
     h = th[1] - th[0]
@@ -82,13 +94,16 @@ def test_program_derivatives_and_continuity():
     assert np.abs(np.concatenate(prog.evaluate([-1e-17, 2 * np.pi, -1e-300]))).max() < 1e-12
 
 
-@pytest.mark.parametrize("segments, words", [
-    ([("cycloidal", 120, 0.5), ("cycloidal", 120, -0.5)], ["one turn", "240"]),
-    ([("cycloidal", 180, 0.5), ("cycloidal", 180, -0.4)], ["summing to 0", "0.1"]),
-    ([("cycloidal", 180, -0.5), ("cycloidal", 180, 0.5)], ["[0].lift", "inside the base circle"]),
-    ([("dwell", 180, 0.5), ("cycloidal", 180, -0.5)], ["[0].lift", "0 for a dwell"]),
-    ([("spline", 180, 0.5), ("cycloidal", 180, -0.5)], ["[0].law", "'spline'"]),
-])
+@pytest.mark.parametrize(
+    "segments, words",
+    [
+        ([("cycloidal", 120, 0.5), ("cycloidal", 120, -0.5)], ["one turn", "240"]),
+        ([("cycloidal", 180, 0.5), ("cycloidal", 180, -0.4)], ["summing to 0", "0.1"]),
+        ([("cycloidal", 180, -0.5), ("cycloidal", 180, 0.5)], ["[0].lift", "inside the base circle"]),
+        ([("dwell", 180, 0.5), ("cycloidal", 180, -0.5)], ["[0].lift", "0 for a dwell"]),
+        ([("spline", 180, 0.5), ("cycloidal", 180, -0.5)], ["[0].law", "'spline'"]),
+    ],
+)
 def test_bad_programs_name_the_segment(segments, words):
     with pytest.raises(InputError) as e:
         Program([Segment(law, d(a), lift) for law, a, lift in segments], "mechanism.segments")
@@ -196,7 +211,7 @@ def test_pressure_angle_against_the_outline_normal_found_by_shapely(name):
         if cp.follower.motion == "translating":
             move = np.asarray(cp.follower.axis, float) / np.hypot(*cp.follower.axis)
         else:
-            psi = cp.follower_output(th[k:k + 1])[0][0]
+            psi = cp.follower_output(th[k : k + 1])[0][0]
             move = np.array([-math.sin(psi), math.cos(psi)])
         expect = math.acos(min(1.0, abs(float(nw @ move))))
         assert abs(expect - phi[k]) < 1e-3, (k, expect, phi[k])
@@ -214,8 +229,9 @@ def test_translating_pressure_angle_is_the_textbook_formula():
 
 
 def test_undercut_is_refused_naming_the_segment():
-    prog = Program([Segment("cycloidal", d(50), 1.0), Segment("cycloidal", d(50), -1.0), Segment("dwell", d(260))],
-                   "mechanism.segments")
+    prog = Program(
+        [Segment("cycloidal", d(50), 1.0), Segment("cycloidal", d(50), -1.0), Segment("dwell", d(260))], "mechanism.segments"
+    )
     cp = CamProfile(prog, 0.6, FollowerGeometry("roller", "translating", 0.8))
     with pytest.raises(CamError) as e:
         cp.check(d(80))
@@ -230,8 +246,9 @@ def test_undercut_is_refused_naming_the_segment():
 
 
 def test_flat_face_cusp_and_pressure_angle_are_refused():
-    prog = Program([Segment("harmonic", d(50), 1.0), Segment("harmonic", d(50), -1.0), Segment("dwell", d(260))],
-                   "mechanism.segments")
+    prog = Program(
+        [Segment("harmonic", d(50), 1.0), Segment("harmonic", d(50), -1.0), Segment("dwell", d(260))], "mechanism.segments"
+    )
     with pytest.raises(CamError, match=r"mechanism\.segments\[\d\] \(harmonic .*cusp"):
         CamProfile(prog, 0.5, FollowerGeometry("flat", "translating")).check(d(30))
     with pytest.raises(CamError, match=r"segments\[0\] \(harmonic rise over 0-50 deg\): pressure angle"):
@@ -242,18 +259,26 @@ def test_flat_face_cusp_and_pressure_angle_are_refused():
 
 
 def cam_scene(follower, segments=None, **extra):
-    segs = segments or [{"law": "cycloidal", "angle": 120, "lift": 0.5}, {"law": "dwell", "angle": 60},
-                        {"law": "polynomial-345", "angle": 120, "lift": -0.5}, {"law": "dwell", "angle": 60}]
+    segs = segments or [
+        {"law": "cycloidal", "angle": 120, "lift": 0.5},
+        {"law": "dwell", "angle": 60},
+        {"law": "polynomial-345", "angle": 120, "lift": -0.5},
+        {"law": "dwell", "angle": 60},
+    ]
     mech = {"type": "cam", "base_radius": 1.5, "follower": follower, "segments": segs, **extra}
-    return build_scene(parse_scene({"angle_unit": "deg", "mechanism": mech, "driver": {"samples_per_cycle": 90}},
-                                   "c.toml"), "c.toml")
+    return build_scene(
+        parse_scene({"angle_unit": "deg", "mechanism": mech, "driver": {"samples_per_cycle": 90}}, "c.toml"), "c.toml"
+    )
 
 
-@pytest.mark.parametrize("follower", [
-    {"kind": "roller", "roller_radius": 0.4},
-    {"kind": "knife", "offset": 0.3},
-    {"kind": "flat", "axis": [0.0, -1.0]},
-])
+@pytest.mark.parametrize(
+    "follower",
+    [
+        {"kind": "roller", "roller_radius": 0.4},
+        {"kind": "knife", "offset": 0.3},
+        {"kind": "flat", "axis": [0.0, -1.0]},
+    ],
+)
 def test_scene_cam_joints_close_and_the_contact_residual_sees_a_gap(follower):
     sc = cam_scene(follower)
     m = sc.mechanism
@@ -278,23 +303,36 @@ def test_scene_errors_are_one_line_naming_the_field():
     with pytest.raises(SceneError, match=r"c\.toml: mechanism\.follower: .*roller_radius"):
         cam_scene({"kind": "roller"})
     with pytest.raises(SceneError, match=r"c\.toml: mechanism: mechanism\.segments\[\d\] \(.*\): undercut"):
-        cam_scene({"kind": "roller", "roller_radius": 1.4},
-                  [{"law": "cycloidal", "angle": 40, "lift": 1.0}, {"law": "cycloidal", "angle": 40, "lift": -1.0},
-                   {"law": "dwell", "angle": 280}], max_pressure_angle=89.0)
+        cam_scene(
+            {"kind": "roller", "roller_radius": 1.4},
+            [
+                {"law": "cycloidal", "angle": 40, "lift": 1.0},
+                {"law": "cycloidal", "angle": 40, "lift": -1.0},
+                {"law": "dwell", "angle": 280},
+            ],
+            max_pressure_angle=89.0,
+        )
     with pytest.raises(SceneError, match="pivot and arm are for an oscillating follower"):
         cam_scene({"kind": "knife", "arm": 2.0})
 
 
 def test_oscillating_follower_drives_a_lever_through_a_coupler():
     # the gallery's structure in small: the arm (input crank) drives a rocker through a coupler
-    sc = cam_scene({"kind": "roller", "roller_radius": 0.4, "motion": "oscillating", "pivot": [3.0, 1.5],
-                    "arm": 2.6, "branch": -1},
-                   [{"law": "cycloidal", "angle": 180, "lift": 12}, {"law": "cycloidal", "angle": 180, "lift": -12}],
-                   nodes=[{"name": "E", "kind": "rigid", "a": "pivot", "b": "tip", "local": [-1.0, 0.0]},
-                          {"name": "Q", "kind": "fixed", "at": [4.5, 3.0]},
-                          {"name": "H", "kind": "rrr", "a": "E", "ra": 2.0, "b": "Q", "rb": 1.0}],
-                   links=[{"name": "follower", "nodes": ["E"]}, {"name": "coupler", "nodes": ["E", "H"]},
-                          {"name": "lever", "nodes": ["Q", "H"]}], points={"H": "H"})
+    sc = cam_scene(
+        {"kind": "roller", "roller_radius": 0.4, "motion": "oscillating", "pivot": [3.0, 1.5], "arm": 2.6, "branch": -1},
+        [{"law": "cycloidal", "angle": 180, "lift": 12}, {"law": "cycloidal", "angle": 180, "lift": -12}],
+        nodes=[
+            {"name": "E", "kind": "rigid", "a": "pivot", "b": "tip", "local": [-1.0, 0.0]},
+            {"name": "Q", "kind": "fixed", "at": [4.5, 3.0]},
+            {"name": "H", "kind": "rrr", "a": "E", "ra": 2.0, "b": "Q", "rb": 1.0},
+        ],
+        links=[
+            {"name": "follower", "nodes": ["E"]},
+            {"name": "coupler", "nodes": ["E", "H"]},
+            {"name": "lever", "nodes": ["Q", "H"]},
+        ],
+        points={"H": "H"},
+    )
     m = sc.mechanism
     mo = sc.motion()
     assert mo.valid.all()
@@ -372,10 +410,15 @@ def test_gallery_cam_scene_joints_close():
 
 def test_follower_motion_in_time_matches_differences_of_the_solved_poses():
     # the solved arm angle over time (from the Motion, through the linkage) against the law's derivatives
-    sc = cam_scene({"kind": "roller", "roller_radius": 0.4, "motion": "oscillating", "pivot": [3.0, 1.5], "arm": 2.6,
-                    "branch": -1},
-                   [{"law": "harmonic", "angle": 150, "lift": 10}, {"law": "dwell", "angle": 30},
-                    {"law": "polynomial-345", "angle": 150, "lift": -10}, {"law": "dwell", "angle": 30}])
+    sc = cam_scene(
+        {"kind": "roller", "roller_radius": 0.4, "motion": "oscillating", "pivot": [3.0, 1.5], "arm": 2.6, "branch": -1},
+        [
+            {"law": "harmonic", "angle": 150, "lift": 10},
+            {"law": "dwell", "angle": 30},
+            {"law": "polynomial-345", "angle": 150, "lift": -10},
+            {"law": "dwell", "angle": 30},
+        ],
+    )
     m = sc.mechanism
     t = np.linspace(0.0, 1.0, 20001)
     mo = m.solve(m.driver.value(t), t=t)
@@ -408,10 +451,15 @@ def test_roller_rolls_on_the_cam_without_slipping(motion):
     fol = {"kind": "roller", "roller_radius": 0.4}
     if motion == "oscillating":
         fol.update(motion="oscillating", pivot=[3.0, 1.5], arm=2.6, branch=-1)
-    sc = cam_scene(fol, [{"law": "cycloidal", "angle": 150, "lift": 12 if motion == "oscillating" else 0.5},
-                         {"law": "dwell", "angle": 30},
-                         {"law": "harmonic", "angle": 150, "lift": -12 if motion == "oscillating" else -0.5},
-                         {"law": "dwell", "angle": 30}])
+    sc = cam_scene(
+        fol,
+        [
+            {"law": "cycloidal", "angle": 150, "lift": 12 if motion == "oscillating" else 0.5},
+            {"law": "dwell", "angle": 30},
+            {"law": "harmonic", "angle": 150, "lift": -12 if motion == "oscillating" else -0.5},
+            {"law": "dwell", "angle": 30},
+        ],
+    )
     m = sc.mechanism
     th = np.linspace(0.05, 4 * np.pi, 97)  # two turns: the arc length carries on
     h = 1e-6
@@ -422,8 +470,10 @@ def test_roller_rolls_on_the_cam_without_slipping(motion):
         c_local = np.array([poses_apply(_inv(pz), cz) for pz, cz in zip(pose, c)])
         plus = m.solve(th + h).poses[part]
         minus = m.solve(th - h).poses[part]
-        v = (np.array([poses_apply(p, x) for p, x in zip(plus, c_local)])
-             - np.array([poses_apply(p, x) for p, x in zip(minus, c_local)])) / (2 * h)
+        v = (
+            np.array([poses_apply(p, x) for p, x in zip(plus, c_local)])
+            - np.array([poses_apply(p, x) for p, x in zip(minus, c_local)])
+        ) / (2 * h)
         rel.append(v)
     slip = np.hypot(*(rel[0] - rel[1]).T)
     assert slip.max() < 1e-6 * np.hypot(*rel[1].T).max()
@@ -440,15 +490,28 @@ def _inv(pose):
 def test_a_follower_that_cuts_into_the_cam_is_refused():
     # a knife on a straight arm nearly along the cam's tangent: its flank crosses the outline (shapely, in
     # the cam's frame); the roller on the same arm sits in another layer and is accepted
-    segs = [{"law": "harmonic", "angle": 150, "lift": 15}, {"law": "dwell", "angle": 30},
-            {"law": "cycloidal", "angle": 150, "lift": -15}, {"law": "dwell", "angle": 30}]
+    segs = [
+        {"law": "harmonic", "angle": 150, "lift": 15},
+        {"law": "dwell", "angle": 30},
+        {"law": "cycloidal", "angle": 150, "lift": -15},
+        {"law": "dwell", "angle": 30},
+    ]
     arm = {"motion": "oscillating", "pivot": [2.6, 1.2], "arm": 2.2}
-    with pytest.raises(SceneError, match=r"mechanism\.follower: the follower's outline overlaps the cam by .* at cam "
-                                         r"angle \d+ deg"):
+    with pytest.raises(
+        SceneError,
+        match=r"mechanism\.follower: the follower's outline overlaps the cam by .* at cam "
+        r"angle \d+ deg",
+    ):
         cam_scene({"kind": "knife", **arm}, segs)
     assert cam_scene({"kind": "roller", "roller_radius": 0.3, **arm}, segs).motion().valid.all()
     # a flat face whose pivot boss would stand proud of the face: the face_offset it needs is named
     with pytest.raises(SceneError, match=r"follower\.face_offset: .* a face_offset of at least"):
-        cam_scene({"kind": "flat", "motion": "oscillating", "pivot": [2.6, 0.4], "arm": 2.0, "face_offset": 0.0},
-                  [{"law": "harmonic", "angle": 150, "lift": 10}, {"law": "dwell", "angle": 30},
-                   {"law": "cycloidal", "angle": 150, "lift": -10}, {"law": "dwell", "angle": 30}])
+        cam_scene(
+            {"kind": "flat", "motion": "oscillating", "pivot": [2.6, 0.4], "arm": 2.0, "face_offset": 0.0},
+            [
+                {"law": "harmonic", "angle": 150, "lift": 10},
+                {"law": "dwell", "angle": 30},
+                {"law": "cycloidal", "angle": 150, "lift": -10},
+                {"law": "dwell", "angle": 30},
+            ],
+        )

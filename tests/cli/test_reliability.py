@@ -47,8 +47,7 @@ def toml(d: dict[str, Any]) -> str:
     return "".join(f"{json.dumps(k)} = {val(v)}\n" for k, v in d.items())
 
 
-FOURBAR = {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0,
-           "coupler_point": [5.5, -2.0]}
+FOURBAR = {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0, "coupler_point": [5.5, -2.0]}
 
 
 def scene(mech: dict | None = None, **top: Any) -> dict[str, Any]:
@@ -67,13 +66,20 @@ def fb(**kw: Any) -> dict[str, Any]:
 
 
 def linkage(**kw: Any) -> dict[str, Any]:
-    m = {"type": "linkage",
-         "nodes": [{"name": "O", "kind": "fixed", "at": [0.0, 0.0]},
-                   {"name": "Q", "kind": "fixed", "at": [4.0, 0.0]},
-                   {"name": "A", "kind": "crank", "centre": "O", "radius": 1.0},
-                   {"name": "B", "kind": "rrr", "a": "A", "ra": 4.0, "b": "Q", "rb": 3.0}],
-         "links": [{"name": "crank", "nodes": ["O", "A"]}, {"name": "coupler", "nodes": ["A", "B"]},
-                   {"name": "rocker", "nodes": ["Q", "B"]}]}
+    m = {
+        "type": "linkage",
+        "nodes": [
+            {"name": "O", "kind": "fixed", "at": [0.0, 0.0]},
+            {"name": "Q", "kind": "fixed", "at": [4.0, 0.0]},
+            {"name": "A", "kind": "crank", "centre": "O", "radius": 1.0},
+            {"name": "B", "kind": "rrr", "a": "A", "ra": 4.0, "b": "Q", "rb": 3.0},
+        ],
+        "links": [
+            {"name": "crank", "nodes": ["O", "A"]},
+            {"name": "coupler", "nodes": ["A", "B"]},
+            {"name": "rocker", "nodes": ["Q", "B"]},
+        ],
+    }
     m.update(kw)
     return scene(m)
 
@@ -135,37 +141,71 @@ BAD_SCENES: list[tuple[str, Any, str]] = [
     ("trail-missing", fb() | {"render": {"trails": ["nope"]}}, "render.trails[0]"),
     ("sweep-missing", fb() | {"render": {"sweep": ["nope"]}}, "render.sweep[0]"),
     ("load-point", fb() | {"effects": {"loads": [{"point": "nope", "force": [0.0, 1.0]}]}}, "effects.loads[0].point"),
-    ("load-nan", fb() | {"effects": {"loads": [{"point": "coupler_point", "force": [math.nan, 1.0]}]}},
-     "effects.loads[0].force"),
+    ("load-nan", fb() | {"effects": {"loads": [{"point": "coupler_point", "force": [math.nan, 1.0]}]}}, "effects.loads[0].force"),
     ("load-short", fb() | {"effects": {"loads": [{"point": "coupler_point", "force": [1.0]}]}}, "effects.loads[0].force"),
-    ("spring-part", fb() | {"effects": {"springs": [{"a": "crank", "b": "nope", "stiffness": 1.0}]}},
-     "effects.springs[0].b"),
-    ("spring-stiff", fb() | {"effects": {"springs": [{"a": "crank", "b": "rocker", "stiffness": -1.0}]}},
-     "effects.springs[0].stiffness"),
+    ("spring-part", fb() | {"effects": {"springs": [{"a": "crank", "b": "nope", "stiffness": 1.0}]}}, "effects.springs[0].b"),
+    (
+        "spring-stiff",
+        fb() | {"effects": {"springs": [{"a": "crank", "b": "rocker", "stiffness": -1.0}]}},
+        "effects.springs[0].stiffness",
+    ),
     ("kerf-big", fb() | {"fabrication": {"kerf_mm": 5.0}}, "fabrication.kerf_mm"),
     ("sheet-inf", fb() | {"fabrication": {"sheet_mm": [math.inf, 200.0]}}, "fabrication.sheet_mm"),
     ("unit-neg", fb() | {"fabrication": {"unit_mm": -1.0}}, "fabrication.unit_mm"),
     # names
-    ("poly-dup", fb(polygons=[{"name": "foot", "part": "coupler", "points": [[0, 0], [1, 0], [1, 1]]},
-                              {"name": "foot", "part": "coupler", "points": [[0, 0], [1, 0], [1, 1]]}]),
-     "mechanism.polygons[1].name"),
-    ("poly-part", fb(polygons=[{"name": "foot", "part": "nope", "points": [[0, 0], [1, 0], [1, 1]]}]),
-     "mechanism.polygons[0].part"),
-    ("poly-2pts", fb(polygons=[{"name": "foot", "part": "coupler", "points": [[0, 0], [1, 0]]}]),
-     "mechanism.polygons[0].points"),
-    ("poly-comma", fb(polygons=[{"name": "a,b", "part": "coupler", "points": [[0, 0], [1, 0], [1, 1]]}]),
-     "mechanism.polygons[0].name"),
+    (
+        "poly-dup",
+        fb(
+            polygons=[
+                {"name": "foot", "part": "coupler", "points": [[0, 0], [1, 0], [1, 1]]},
+                {"name": "foot", "part": "coupler", "points": [[0, 0], [1, 0], [1, 1]]},
+            ]
+        ),
+        "mechanism.polygons[1].name",
+    ),
+    (
+        "poly-part",
+        fb(polygons=[{"name": "foot", "part": "nope", "points": [[0, 0], [1, 0], [1, 1]]}]),
+        "mechanism.polygons[0].part",
+    ),
+    ("poly-2pts", fb(polygons=[{"name": "foot", "part": "coupler", "points": [[0, 0], [1, 0]]}]), "mechanism.polygons[0].points"),
+    (
+        "poly-comma",
+        fb(polygons=[{"name": "a,b", "part": "coupler", "points": [[0, 0], [1, 0], [1, 1]]}]),
+        "mechanism.polygons[0].name",
+    ),
     ("name-newline", fb() | {"name": "leg\nfoot"}, "name"),
     ("name-control", fb() | {"name": "leg\u0007"}, "name"),
     ("name-quote", fb() | {"name": 'a"b'}, "name"),
-    ("link-comma", linkage(links=[{"name": "cr,ank", "nodes": ["O", "A"]}, {"name": "coupler", "nodes": ["A", "B"]},
-                                  {"name": "rocker", "nodes": ["Q", "B"]}]), "mechanism.links[0].name"),
-    ("link-newline", linkage(links=[{"name": "cr\nank", "nodes": ["O", "A"]}, {"name": "coupler", "nodes": ["A", "B"]},
-                                    {"name": "rocker", "nodes": ["Q", "B"]}]), "mechanism.links[0].name"),
+    (
+        "link-comma",
+        linkage(
+            links=[
+                {"name": "cr,ank", "nodes": ["O", "A"]},
+                {"name": "coupler", "nodes": ["A", "B"]},
+                {"name": "rocker", "nodes": ["Q", "B"]},
+            ]
+        ),
+        "mechanism.links[0].name",
+    ),
+    (
+        "link-newline",
+        linkage(
+            links=[
+                {"name": "cr\nank", "nodes": ["O", "A"]},
+                {"name": "coupler", "nodes": ["A", "B"]},
+                {"name": "rocker", "nodes": ["Q", "B"]},
+            ]
+        ),
+        "mechanism.links[0].name",
+    ),
     ("node-missing", linkage(links=[{"name": "crank", "nodes": ["O", "Z"]}]), "mechanism"),
     ("node-kind", linkage(nodes=[{"name": "O", "kind": "weld"}]), "mechanism.nodes[0].kind"),
-    ("node-needs", linkage(nodes=[{"name": "O", "kind": "fixed"}, {"name": "A", "kind": "crank", "centre": "O"}]),
-     "mechanism.nodes"),
+    (
+        "node-needs",
+        linkage(nodes=[{"name": "O", "kind": "fixed"}, {"name": "A", "kind": "crank", "centre": "O"}]),
+        "mechanism.nodes",
+    ),
     # elemental parameters: vectors of the wrong length, numbers for vectors
     ("D_jc-number", scene({"type": "elemental", "number": 1, "params": {"D_jc": 0.5}}), "params.D_jc"),
     ("D_o-short", scene({"type": "elemental", "number": 1, "params": {"D_o": [0.0]}}), "params.D_o"),
@@ -320,11 +360,19 @@ BAD_JOBS: list[tuple[str, dict, str, str]] = [
     ("holes-overlap", fb() | {"fabrication": {"unit_mm": 3.0, "pin_diameter_mm": 20.0}}, "export", "min_wall_mm"),
     ("kerf-wider-than-parts", fb() | {"fabrication": {"unit_mm": 0.05, "kerf_mm": 2.0}}, "export", "kerf"),
     ("too-many-frames", fb() | {"driver": {"samples_per_cycle": 72, "cycles": 1000.0}}, "render", "PLANAR_MAX_FRAMES"),
-    ("parts-larger-than-sheet", scene({"type": "elemental", "number": 6}, fabrication={"unit_mm": 1e20}), "export",
-     "fabrication.unit_mm"),
+    (
+        "parts-larger-than-sheet",
+        scene({"type": "elemental", "number": 6}, fabrication={"unit_mm": 1e20}),
+        "export",
+        "fabrication.unit_mm",
+    ),
     ("sheet-too-large", fb() | {"fabrication": {"sheet_mm": [1e30, 200.0]}}, "export", "fabrication.sheet_mm"),
-    ("cycle-too-slow-to-draw", scene({"type": "elemental", "number": 3}, driver={"speed": 1e-12}), "render",
-     "driver.cycles = 1.0: expected an animation of at most"),
+    (
+        "cycle-too-slow-to-draw",
+        scene({"type": "elemental", "number": 3}, driver={"speed": 1e-12}),
+        "render",
+        "driver.cycles = 1.0: expected an animation of at most",
+    ),
     ("coupler-point-1e305", fb(coupler_point=[0.75, -9.24e305]), "render", "mechanism"),
     ("frames-by-duration", fb() | {"driver": {"samples_per_cycle": 72, "duration": 1e5}}, "render", "driver.duration"),
 ]
@@ -334,9 +382,10 @@ BAD_JOBS: list[tuple[str, dict, str, str]] = [
 def test_bad_job(tmp_path: Path, capsys: pytest.CaptureFixture[str], content: dict, command: str, needle: str) -> None:
     src = tmp_path / "scene.toml"
     src.write_text(toml(content))
-    outs = {"export": ["-o", str(tmp_path / "parts.dxf"), "--svg", str(tmp_path / "parts.svg"),
-                       "--bom", str(tmp_path / "bom.csv")],
-            "render": ["-o", str(tmp_path / "parts.gif")]}[command]
+    outs = {
+        "export": ["-o", str(tmp_path / "parts.dxf"), "--svg", str(tmp_path / "parts.svg"), "--bom", str(tmp_path / "bom.csv")],
+        "render": ["-o", str(tmp_path / "parts.gif")],
+    }[command]
     (tmp_path / "parts.dxf").write_bytes(SENTINEL)
     (tmp_path / "parts.gif").write_bytes(SENTINEL)
     before = _snapshot(tmp_path)
@@ -357,8 +406,9 @@ def test_corpus_is_large_enough() -> None:
     assert len(BAD_SCENES) + len(MISUSES) + len(BAD_JOBS) >= 100
 
 
-def test_interrupted_gallery_writes_nothing(tmp_path: Path, capsys: pytest.CaptureFixture[str],
-                                            monkeypatch: pytest.MonkeyPatch) -> None:
+def test_interrupted_gallery_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
     """Ctrl-C after the first GIF is finished: one line, exit 130, the finished GIF's temporary removed."""
     import planar.app.pipeline as pipeline
 
@@ -408,8 +458,7 @@ def test_export_failure_after_some_outputs_leaves_none(tmp_path: Path, capsys: p
     assert _snapshot(tmp_path) == before
 
 
-def test_limits_are_configurable(tmp_path: Path, capsys: pytest.CaptureFixture[str],
-                                 monkeypatch: pytest.MonkeyPatch) -> None:
+def test_limits_are_configurable(tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
     """The message names the variable; raising it lets the same request through."""
     src = tmp_path / "scene.toml"
     src.write_text(toml(fb() | {"driver": {"samples_per_cycle": 12, "cycles": 10.0}}))
@@ -441,8 +490,7 @@ def test_names_are_quoted_or_refused_in_outputs(tmp_path: Path) -> None:
     from planar.linkages import Crank, Fixed, Link, Linkage
 
     def leg(point: str) -> Linkage:
-        return Linkage("leg", [Fixed("O", (0.0, 0.0)), Crank("A", "O", 1.0)], [Link("crank", ("O", "A"))],
-                       points={point: "A"})
+        return Linkage("leg", [Fixed("O", (0.0, 0.0)), Crank("A", "O", 1.0)], [Link("crank", ("O", "A"))], points={point: "A"})
 
     mech = leg("toe, left")
     write_motion_csv(tmp_path / "m.csv", mech, mech.run(8))
@@ -455,8 +503,9 @@ def test_names_are_quoted_or_refused_in_outputs(tmp_path: Path) -> None:
     assert not (tmp_path / "n.csv").exists()
 
 
-def test_internal_error_is_one_line_and_debug_shows_it(capsys: pytest.CaptureFixture[str],
-                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+def test_internal_error_is_one_line_and_debug_shows_it(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
     import planar.windup.table as table
 
     def boom(*a: Any, **k: Any) -> Any:
@@ -472,16 +521,17 @@ def test_internal_error_is_one_line_and_debug_shows_it(capsys: pytest.CaptureFix
 
 def _subprocess(args: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    return subprocess.run([sys.executable, "-m", "planar", *args], cwd=cwd, env=env, capture_output=True,
-                          text=True, timeout=120)
+    return subprocess.run([sys.executable, "-m", "planar", *args], cwd=cwd, env=env, capture_output=True, text=True, timeout=120)
 
 
 def test_subprocess_errors_are_one_line_without_traceback(tmp_path: Path) -> None:
     (tmp_path / "bad.toml").write_bytes(b"\xff\xfe" + "crank = = \n".encode("utf-16-le"))
     (tmp_path / "loop.toml").symlink_to(tmp_path / "loop.toml")
-    for args, needle in ((["render", "bad.toml", "-o", "x.gif"], "bad.toml"),
-                         (["motion", "loop.toml", "-o", "x.csv"], "loop.toml"),
-                         (["render", "bad.toml"], "-o/--output")):
+    for args, needle in (
+        (["render", "bad.toml", "-o", "x.gif"], "bad.toml"),
+        (["motion", "loop.toml", "-o", "x.csv"], "loop.toml"),
+        (["render", "bad.toml"], "-o/--output"),
+    ):
         r = _subprocess(args, tmp_path)
         assert r.returncode == 2, r.stderr
         assert len(r.stderr.splitlines()) == 1 and needle in r.stderr and "Traceback" not in r.stderr, r.stderr
@@ -504,13 +554,14 @@ def test_awkward_names_survive_every_format_or_are_refused(tmp_path: Path) -> No
     spec = parse_scene(linkage())
 
     def leg(name: str) -> Scene:
-        mech = Linkage("leg", [Fixed("O", (0.0, 0.0)), Fixed("Q", (4.0, 0.0)), Crank("A", "O", 1.0),
-                               RRR("B", "A", 4.0, "Q", 3.0)],
-                       [Link(name, ("O", "A")), Link("coupler", ("A", "B")), Link("rocker", ("Q", "B"))])
+        mech = Linkage(
+            "leg",
+            [Fixed("O", (0.0, 0.0)), Fixed("Q", (4.0, 0.0)), Crank("A", "O", 1.0), RRR("B", "A", 4.0, "Q", 3.0)],
+            [Link(name, ("O", "A")), Link("coupler", ("A", "B")), Link("rocker", ("Q", "B"))],
+        )
         return Scene(spec, mech, "leg.toml")
 
-    outs = {"dxf": tmp_path / "p.dxf", "svg": tmp_path / "p.svg", "bom": tmp_path / "b.csv",
-            "assembly": tmp_path / "a.svg"}
+    outs = {"dxf": tmp_path / "p.dxf", "svg": tmp_path / "p.svg", "bom": tmp_path / "b.csv", "assembly": tmp_path / "a.svg"}
     export_scene(leg('cr,ank "x" <&>'), **outs)
     groups = [g for g, _ in ezdxf.readfile(outs["dxf"]).groups]
     assert 'cr,ank_"x"_<&>' in groups

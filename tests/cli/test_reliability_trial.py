@@ -113,8 +113,9 @@ def test_schema_to_a_closed_stdout(tmp_path):
     import subprocess
     import sys
 
-    r = subprocess.run([sys.executable, "-m", "planar", "schema"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                       text=True, check=False)
+    r = subprocess.run(
+        [sys.executable, "-m", "planar", "schema"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, check=False
+    )
     assert r.returncode == 0
     r = subprocess.run(f"{sys.executable} -m planar schema >&-", shell=True, stderr=subprocess.PIPE, text=True)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "standard output" in r.stderr

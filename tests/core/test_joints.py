@@ -236,8 +236,10 @@ def test_size_is_the_largest_part_diameter(name):
     assert mech.size == pytest.approx(best, rel=2e-3)
 
 
-@pytest.mark.parametrize("start, stop, n", [(0.0, 2 * np.pi, 73), (np.pi, 3 * np.pi, 73), (4.0, 4.0 + 2 * np.pi, 73),
-                                            (2 * np.pi, 0.0, 361), (0.0, -2 * np.pi, 361)])
+@pytest.mark.parametrize(
+    "start, stop, n",
+    [(0.0, 2 * np.pi, 73), (np.pi, 3 * np.pi, 73), (4.0, 4.0 + 2 * np.pi, 73), (2 * np.pi, 0.0, 361), (0.0, -2 * np.pi, 361)],
+)
 def test_parallelogram_is_a_parallelogram_whatever_sample_the_motion_starts_from(start, stop, n):
     # the circuit is declared with the crank at pi/2 and carried from there, so the assembly does not
     # depend on the phase or the direction of the driver (a singular first sample included)
@@ -256,8 +258,7 @@ def test_a_node_no_link_holds_is_refused():
     from planar.linkages import RRP
 
     # P is placed 1.5 from T, but no link carries both: nothing would hold that distance
-    nodes = [Fixed("O", (0, 0)), Fixed("G1", (2, -1)), Fixed("G2", (4, -1)), Crank("T", "O", 0.5),
-             RRP("P", "T", 1.5, "G1", "G2")]
+    nodes = [Fixed("O", (0, 0)), Fixed("G1", (2, -1)), Fixed("G2", (4, -1)), Crank("T", "O", 0.5), RRP("P", "T", 1.5, "G1", "G2")]
     links = [Link("crank", ("O", "T")), Link("plunger", ("P",), guide=("G1", "G2"))]
     with pytest.raises(InputError, match=r"nodes.P .*a link carrying 'P' with 'T'"):
         Linkage("pump", nodes, links)
@@ -266,9 +267,12 @@ def test_a_node_no_link_holds_is_refused():
 
 def test_a_point_named_like_a_part_is_refused():
     with pytest.raises(InputError, match="points"):
-        Linkage("l", [Fixed("O", (0, 0)), Fixed("Q", (3, 0)), Crank("A", "O", 1.0), RRR("B", "A", 3.0, "Q", 2.0)],
-                [Link("crank", ("O", "A")), Link("coupler", ("A", "B")), Link("rocker", ("Q", "B"))],
-                points={"coupler": "B"})
+        Linkage(
+            "l",
+            [Fixed("O", (0, 0)), Fixed("Q", (3, 0)), Crank("A", "O", 1.0), RRR("B", "A", 3.0, "Q", 2.0)],
+            [Link("crank", ("O", "A")), Link("coupler", ("A", "B")), Link("rocker", ("Q", "B"))],
+            points={"coupler": "B"},
+        )
 
 
 def test_parallelogram_path_that_starts_past_a_flat_position_stays_a_parallelogram():

@@ -39,17 +39,20 @@ def test_a_link_whose_nodes_move_apart_is_refused_naming_link_nodes_and_change()
     from planar.errors import InputError
     from planar.linkages import RRR, Crank, Fixed, Link, Linkage
 
-    nodes = [Fixed("O", (0, 0)), Fixed("Z", (-38, -7.8)), Crank("A", "O", 15),
-             RRR("B", "A", 50, "Z", 41.5, -1), RRR("D", "A", 55.8, "Z", 40.1, -1)]
-    links = [Link("crank", ("O", "A")), Link("j", ("A", "B")), Link("upper", ("Z", "B", "D")),
-             Link("e", ("A", "D"))]
+    nodes = [
+        Fixed("O", (0, 0)),
+        Fixed("Z", (-38, -7.8)),
+        Crank("A", "O", 15),
+        RRR("B", "A", 50, "Z", 41.5, -1),
+        RRR("D", "A", 55.8, "Z", 40.1, -1),
+    ]
+    links = [Link("crank", ("O", "A")), Link("j", ("A", "B")), Link("upper", ("Z", "B", "D")), Link("e", ("A", "D"))]
     with pytest.raises(InputError) as e:
         Linkage("bad", nodes, links)
     msg = str(e.value)
     assert "bad.links.upper" in msg and "'B' and 'D'" in msg and "changes by" in msg
     # the change it names is the true one (independent: the distance B-D over the cycle)
-    ok = Linkage("ok", nodes, links[:2] + [Link("upper", ("Z", "B")), Link("e", ("A", "D")),
-                                            Link("zd", ("Z", "D"))])
+    ok = Linkage("ok", nodes, links[:2] + [Link("upper", ("Z", "B")), Link("e", ("A", "D")), Link("zd", ("Z", "D"))])
     pos = ok.node_positions(np.linspace(0, 2 * np.pi, 721))
     d = np.hypot(*(pos["B"] - pos["D"]).T)
     assert f"{np.ptp(d):.4g}" in msg

@@ -12,7 +12,7 @@ def test_samples_per_cycle_follows_the_documented_limit(tmp_path, capsys, monkey
     out = tmp_path / "m.csv"
     scene.write_text(SCENE.format(n=150_000))
     monkeypatch.delenv("PLANAR_MAX_SAMPLES", raising=False)
-    assert main(["motion", str(scene), "-o", str(out)]) == 0                   # was refused at 100000
+    assert main(["motion", str(scene), "-o", str(out)]) == 0  # was refused at 100000
     assert sum(1 for _ in out.open()) == 150_001
     out.unlink()
     monkeypatch.setenv("PLANAR_MAX_SAMPLES", "100000")

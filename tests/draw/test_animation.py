@@ -102,8 +102,7 @@ def test_frames_are_the_motion_at_the_frame_instants(tmp_path):
     assert len(fine) >= 100 and len(frames) == plan.frames == 25
     # an overlay interpolated to the frames: exact for a linear motion
     back = resample(fine, t)
-    np.testing.assert_allclose(back.poses["crank"][:, 2] % (2 * np.pi), direct.poses["crank"][:, 2] % (2 * np.pi),
-                               atol=1e-9)
+    np.testing.assert_allclose(back.poses["crank"][:, 2] % (2 * np.pi), direct.poses["crank"][:, 2] % (2 * np.pi), atol=1e-9)
 
 
 def test_streamed_gif_decodes_to_the_drawn_frames(tmp_path):

@@ -27,7 +27,13 @@ def test_figure_lines_hold_the_motion_and_independent_formulas() -> None:
     sc = load_scene(KANGAROO)
     fig = scene_figure(sc)
     assert [ax.get_gid() for ax in fig.axes if ax.get_gid()] == [
-        "chart-curve", "chart-transmission", "chart-velocity", "chart-speed", "chart-acceleration", "chart-torque"]
+        "chart-curve",
+        "chart-transmission",
+        "chart-velocity",
+        "chart-speed",
+        "chart-acceleration",
+        "chart-torque",
+    ]
     mo = sc.motion()
     curve = _line(fig, "curve:coupler_point")
     xy = np.column_stack([curve.get_xdata(), curve.get_ydata()])
@@ -66,8 +72,13 @@ def test_svg_read_back_with_svgelements_keeps_the_curve_shape(tmp_path) -> None:
     assert len(pts) == n + 1
     drawn = pts[:n]
     # an affine map with a uniform scale and y flipped: fit drawn = s * (x, -y) + c by least squares
-    A = np.column_stack([np.concatenate([data[:, 0], -data[:, 1]]),
-                         np.concatenate([np.ones(n), np.zeros(n)]), np.concatenate([np.zeros(n), np.ones(n)])])
+    A = np.column_stack(
+        [
+            np.concatenate([data[:, 0], -data[:, 1]]),
+            np.concatenate([np.ones(n), np.zeros(n)]),
+            np.concatenate([np.zeros(n), np.ones(n)]),
+        ]
+    )
     b = np.concatenate([drawn[:, 0], drawn[:, 1]])
     coef, *_ = np.linalg.lstsq(A, b, rcond=None)
     assert coef[0] > 0
@@ -82,11 +93,14 @@ def test_plot_bytes_reproducible(tmp_path) -> None:
         assert a.read_bytes() == b.read_bytes()
 
 
-@pytest.mark.parametrize("args, msg", [
-    (["-o", "x.pdf"], "a .png or .svg"),
-    (["-o", "x.png", "--what", "jerk"], "one of curve"),
-    (["-o", "x.png", "--what", "transmission"], "no RRR dyad"),
-])
+@pytest.mark.parametrize(
+    "args, msg",
+    [
+        (["-o", "x.pdf"], "a .png or .svg"),
+        (["-o", "x.png", "--what", "jerk"], "one of curve"),
+        (["-o", "x.png", "--what", "transmission"], "no RRR dyad"),
+    ],
+)
 def test_plot_user_errors_exit_2_and_write_nothing(tmp_path, capsys, monkeypatch, args, msg) -> None:
     monkeypatch.chdir(tmp_path)
     import shutil

@@ -45,10 +45,14 @@ def test_bunny_panels_beside_the_front_view_never_a_line():
     toy = bunny(rate=math.pi)
     view, vm, marks = assembled(toy, toy.run(samples_per_cycle=12))
     boxes = {}
-    for plane, names in (("xy", ("cam.left", "s0.follower+s1.driver")), ("xz", ("frame.xz", "s2.driver", "s2.follower")),
-                         ("yz", ("s1.follower",))):
-        pts = np.concatenate([poses_apply(vm.poses[n], np.asarray(view.part(n).outline.exterior.coords)).reshape(-1, 2)
-                              for n in names])
+    for plane, names in (
+        ("xy", ("cam.left", "s0.follower+s1.driver")),
+        ("xz", ("frame.xz", "s2.driver", "s2.follower")),
+        ("yz", ("s1.follower",)),
+    ):
+        pts = np.concatenate(
+            [poses_apply(vm.poses[n], np.asarray(view.part(n).outline.exterior.coords)).reshape(-1, 2) for n in names]
+        )
         lo, hi = pts.min(0), pts.max(0)
         assert (hi - lo).min() > 0.05 * view.size, (plane, hi - lo)  # drawn in its own plane, not a line
         boxes[plane] = (lo, hi)
@@ -76,7 +80,7 @@ def test_eight_tab_stands_in_its_tapered_window():
         band = T.intersection(box(-10, a[1] - 0.005, 10, a[1] + 0.005))
         assert band.area > 0 and band.difference(W).area < 1e-2 * band.area, i  # the tilted face over the band: a sliver
     _, vm, marks = assembled(m, mo)
-    (taper, _), = marks.lines
+    ((taper, _),) = marks.lines
     w = taper[0]
     # straight contact edge, far side D_w1 at the bottom and D_w2 at the top
     P = m.world
@@ -92,8 +96,8 @@ def test_spatial_pin_oval_touches_the_edge(number):
     m = elemental(number)
     mo = m.run(samples_per_cycle=12)
     _, _, marks = assembled(m, mo)
-    (ring, _), = marks.rings
-    (contact, _), = marks.dots
+    ((ring, _),) = marks.rings
+    ((contact, _),) = marks.dots
     j = next(j for j in m.joints if type(j).__name__ == "SkewContact")
     for i in range(len(mo)):
         e0 = poses_apply(mo.poses["driver"][i], j.edge_point)

@@ -130,18 +130,17 @@ def test_slot_kerf_and_arc_slots():
         assert p0.is_valid and p1.is_valid and p0.contains(p1)
         assert p1.hausdorff_distance(p0.buffer(-0.2, quad_segs=64)) < 5e-3
     slot = Polygon(bulge_points(a.inner[0], math.radians(0.25)))
-    assert abs(slot.area - (30 * 4 + math.pi * 2 ** 2)) < 0.05
+    assert abs(slot.area - (30 * 4 + math.pi * 2**2)) < 0.05
     # end margin: 1.5 mm past each end of the travel
     c = part_cuts(part, FabSettings(unit_mm=10.0, kerf=0.0, clearance=0.0, slot_end=1.5), 1)
     slot = Polygon(bulge_points(c.inner[0], math.radians(0.25)))
-    assert abs(slot.area - (33 * 4 + math.pi * 2 ** 2)) < 0.05
+    assert abs(slot.area - (33 * 4 + math.pi * 2**2)) < 0.05
 
 
 @pytest.mark.parametrize("path", gallery_scenes(GALLERY), ids=lambda p: p.stem)
 def test_every_gallery_scene_exports_checked_files(tmp_path, path):
     scene = load_scene(path)
-    fab = export_scene(scene, tmp_path / "p.dxf", tmp_path / "p.svg", bom=tmp_path / "b.csv",
-                       assembly=tmp_path / "a.svg")
+    fab = export_scene(scene, tmp_path / "p.dxf", tmp_path / "p.svg", bom=tmp_path / "b.csv", assembly=tmp_path / "a.svg")
     s = fab.settings
     dxfs = _sheets(tmp_path, "p", "dxf")
     assert len(dxfs) == fab.layout.sheets == len(_sheets(tmp_path, "p", "svg"))
@@ -170,9 +169,13 @@ def test_every_gallery_scene_exports_checked_files(tmp_path, path):
         if asm.plane[a_name] != asm.plane[b_name]:
             continue
         for i in np.flatnonzero(motion.valid):
-            ga, gb = [affinity.affine_transform(fab.own[n], [math.cos(q[2]), -math.sin(q[2]), math.sin(q[2]),
-                                                            math.cos(q[2]), q[0] * s.unit_mm, q[1] * s.unit_mm])
-                      for n, q in ((a_name, motion.poses[a_name][i]), (b_name, motion.poses[b_name][i]))]
+            ga, gb = [
+                affinity.affine_transform(
+                    fab.own[n],
+                    [math.cos(q[2]), -math.sin(q[2]), math.sin(q[2]), math.cos(q[2]), q[0] * s.unit_mm, q[1] * s.unit_mm],
+                )
+                for n, q in ((a_name, motion.poses[a_name][i]), (b_name, motion.poses[b_name][i]))
+            ]
             assert ga.intersection(gb).area < 1.0, (a_name, b_name, i)
     # the motor sits under the ground plate: no part of the ground's plane lies below it
     for g in fab.grounds:
@@ -216,8 +219,23 @@ def test_svg_conventions(tmp_path):
 def test_export_is_reproducible_and_cli(tmp_path):
     scene = GALLERY / "jansen-leg.toml"
     for name in ("a", "b"):
-        assert main(["export", str(scene), "-o", str(tmp_path / f"{name}.dxf"), "--svg", str(tmp_path / f"{name}.svg"),
-                     "--kerf", "0.2", "--sheet", "250x150"]) == 0
+        assert (
+            main(
+                [
+                    "export",
+                    str(scene),
+                    "-o",
+                    str(tmp_path / f"{name}.dxf"),
+                    "--svg",
+                    str(tmp_path / f"{name}.svg"),
+                    "--kerf",
+                    "0.2",
+                    "--sheet",
+                    "250x150",
+                ]
+            )
+            == 0
+        )
     for ext in ("dxf", "svg"):
         assert (tmp_path / f"a.{ext}").read_bytes() == (tmp_path / f"b.{ext}").read_bytes()
     doc = ezdxf.readfile(tmp_path / "a.dxf")
@@ -229,25 +247,35 @@ def test_export_is_reproducible_and_cli(tmp_path):
 def _scene_file(tmp_path, src, extra):
     text = (GALLERY / src).read_text()
     p = tmp_path / "s.toml"
-    p.write_text(text.replace("[fabrication]\n", "[fabrication]\n" + extra + "\n") if "[fabrication]" in text
-                 else text + "\n[fabrication]\n" + extra + "\n")
+    p.write_text(
+        text.replace("[fabrication]\n", "[fabrication]\n" + extra + "\n")
+        if "[fabrication]" in text
+        else text + "\n[fabrication]\n" + extra + "\n"
+    )
     return p
 
 
 def test_export_errors_are_user_errors(tmp_path, capsys):
     scene = GALLERY / "jansen-leg.toml"
-    cases = [(scene, ["--sheet", "30x20"]), (scene, ["--sheet", "big"]), (scene, ["--kerf", "-1"]),
-             (scene, ["--sheet", "infx200"]),
-             (_scene_file(tmp_path, "paddle-boat.toml", "widen = false"), []),
-             (_scene_file(tmp_path, "jansen-leg.toml", "pin_diameter_mm = 0.3\nkerf_mm = 0.5"), [])]
+    cases = [
+        (scene, ["--sheet", "30x20"]),
+        (scene, ["--sheet", "big"]),
+        (scene, ["--kerf", "-1"]),
+        (scene, ["--sheet", "infx200"]),
+        (_scene_file(tmp_path, "paddle-boat.toml", "widen = false"), []),
+        (_scene_file(tmp_path, "jansen-leg.toml", "pin_diameter_mm = 0.3\nkerf_mm = 0.5"), []),
+    ]
     for sc, args in cases:
         assert main(["export", str(sc), "-o", str(tmp_path / "x.dxf"), "--bom", str(tmp_path / "x.csv"), *args]) == 2
         err = capsys.readouterr().err
         assert len(err.strip().splitlines()) == 1 and err.startswith("planar: error:"), (args, err)
         assert not (tmp_path / "x.dxf").exists() and not (tmp_path / "x.csv").exists()
     # no traceback from the command itself either
-    r = subprocess.run([sys.executable, "-m", "planar", "export", str(scene), "-o", str(tmp_path / "x.dxf"),
-                        "--sheet", "infx200"], capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-m", "planar", "export", str(scene), "-o", str(tmp_path / "x.dxf"), "--sheet", "infx200"],
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == 2 and "Traceback" not in r.stderr and len(r.stderr.strip().splitlines()) == 1
 
 
@@ -255,8 +283,19 @@ def test_narrow_links_are_widened_or_refused(tmp_path):
     scene = load_scene(GALLERY / "paddle-boat.toml")
     fab = build(scene, FabSettings.from_spec(scene.spec.fabrication))
     assert any("crank: widened" in n for n in fab.notes)
-    r = subprocess.run([sys.executable, "-m", "planar", "export", str(_scene_file(tmp_path, "paddle-boat.toml",
-                        "widen = false")), "-o", str(tmp_path / "x.dxf")], capture_output=True, text=True)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "planar",
+            "export",
+            str(_scene_file(tmp_path, "paddle-boat.toml", "widen = false")),
+            "-o",
+            str(tmp_path / "x.dxf"),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == 2 and "wall" in r.stderr and "min_wall_mm" in r.stderr
 
 
@@ -318,8 +357,10 @@ def test_nesting_horse_on_one_sheet_and_several_files(tmp_path):
     # the Horse is cut as its assembly (one 182 x 142 mm frame, merged parts): one 400 x 300 mm sheet
     fab = export_scene(scene, tmp_path / "h.dxf", sheet=(400, 300))
     assert fab.layout.sheets == 1 and (tmp_path / "h.dxf").exists()
-    area = sum(Polygon(bulge_points(p.outer, math.radians(1))).area if isinstance(p.outer, Contour)
-               else math.pi * p.outer.radius ** 2 for p in fab.layout.parts)
+    area = sum(
+        Polygon(bulge_points(p.outer, math.radians(1))).area if isinstance(p.outer, Contour) else math.pi * p.outer.radius**2
+        for p in fab.layout.parts
+    )
     assert abs(fab.layout.utilisation[0] - area / (400 * 300)) < 1e-3
     fab = export_scene(scene, tmp_path / "s.dxf", tmp_path / "s.svg", sheet=(200, 160))
     n = fab.layout.sheets
@@ -345,8 +386,7 @@ def test_drive_and_mounting_holes(tmp_path):
 
 
 def test_kerf_test_piece(tmp_path):
-    assert main(["export", str(GALLERY / "jansen-leg.toml"), "--kerf", "0.2", "--kerf-test",
-                 str(tmp_path / "k.dxf")]) == 0
+    assert main(["export", str(GALLERY / "jansen-leg.toml"), "--kerf", "0.2", "--kerf-test", str(tmp_path / "k.dxf")]) == 0
     doc = ezdxf.readfile(tmp_path / "k.dxf")
     outer = [e for e in doc.modelspace() if e.dxf.layer == "CUT_OUTER"]
     x0, y0, x1, y1 = _shape(outer[0]).bounds
@@ -356,8 +396,10 @@ def test_kerf_test_piece(tmp_path):
 
 
 def test_preview_png(tmp_path):
-    assert main(["export", str(GALLERY / "windup-03.toml"), "-o", str(tmp_path / "p.dxf"),
-                 "--preview", str(tmp_path / "p.png")]) == 0
+    assert (
+        main(["export", str(GALLERY / "windup-03.toml"), "-o", str(tmp_path / "p.dxf"), "--preview", str(tmp_path / "p.png")])
+        == 0
+    )
     from PIL import Image
 
     im = np.asarray(Image.open(tmp_path / "p.png").convert("RGB"))
@@ -396,8 +438,9 @@ def test_holes_running_into_each_other_are_refused(tmp_path, capsys):
     # at 1 mm per unit a 2.5 mm crank's D-shaped drive hole and its pin hole overlap: widening the outline
     # cannot mend that, so the export stops with one line naming the part and the two cuts
     scene = tmp_path / "small.toml"
-    scene.write_text('[mechanism]\ntype = "fourbar"\nground = 8.0\ncrank = 2.5\ncoupler = 7.0\nrocker = 6.0\n'
-                     '[fabrication]\nunit_mm = 1.0\n')
+    scene.write_text(
+        '[mechanism]\ntype = "fourbar"\nground = 8.0\ncrank = 2.5\ncoupler = 7.0\nrocker = 6.0\n[fabrication]\nunit_mm = 1.0\n'
+    )
     out = tmp_path / "p.dxf"
     assert main(["export", str(scene), "-o", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()

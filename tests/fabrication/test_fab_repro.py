@@ -12,9 +12,24 @@ def _export(out: Path, seed: str, extra: list[str]) -> dict[str, bytes]:
     """Export in a fresh interpreter with the given hash seed; every file's bytes."""
     out.mkdir()
     env = dict(os.environ, PYTHONHASHSEED=seed, PYTHONPATH=str(ROOT))
-    r = subprocess.run([sys.executable, "-m", "planar", "export", str(ROOT / "gallery" / "jansen-leg.toml"),
-                        "-o", str(out / "p.dxf"), "--svg", str(out / "p.svg"), *extra],
-                       capture_output=True, text=True, env=env, cwd=out)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "planar",
+            "export",
+            str(ROOT / "gallery" / "jansen-leg.toml"),
+            "-o",
+            str(out / "p.dxf"),
+            "--svg",
+            str(out / "p.svg"),
+            *extra,
+        ],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=out,
+    )
     assert r.returncode == 0, r.stderr
     return {p.name: p.read_bytes() for p in sorted(out.iterdir())}
 
@@ -27,4 +42,3 @@ def test_bytes_do_not_depend_on_the_hash_seed(tmp_path):
     assert a.keys() == b.keys() and len(a) >= 2
     for name in a:
         assert a[name] == b[name], name
-

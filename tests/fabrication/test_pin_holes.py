@@ -126,8 +126,10 @@ def _check_pin_holes(scene, fab, dxf, rows) -> int:
             want = [xy for xy, dd in holes if dd == d]
             got = [(x, y) for x, y, dia in _circles(inner[piece], kerf) if abs(dia - (d + clearance)) < 2e-3]
             sizes = sorted(round(dia, 3) for *_, dia in _circles(inner[piece], kerf))
-            assert len(got) == len(want), (f"{piece}: {len(want)} pin(s) of {d} mm want holes of {d + clearance:g} "
-                                           f"mm, the DXF has {len(got)} (round cuts {sizes})")
+            assert len(got) == len(want), (
+                f"{piece}: {len(want)} pin(s) of {d} mm want holes of {d + clearance:g} "
+                f"mm, the DXF has {len(got)} (round cuts {sizes})"
+            )
             # placed on the sheet by a rigid motion: the holes' pairwise distances are the pins' ones
             assert np.allclose(_dists(got), _dists(want), atol=1e-3), piece
             n += len(want)
@@ -174,7 +176,8 @@ def test_cam_d_hole_has_the_running_clearance(bunny):
     f = scene.spec.fabrication
     (d_cut,) = [e for e in _inner(dxf)["cam.left"] if e.dxftype() != "CIRCLE"]
     poly = Polygon([(v.x, v.y) for v in ezpath.make_path(d_cut).flattening(1e-4)]).buffer(
-        fab.settings.kerf / 2, join_style="mitre")
+        fab.settings.kerf / 2, join_style="mitre"
+    )
     rect = np.asarray(poly.minimum_rotated_rectangle.exterior.coords)[:3]
     sides = sorted(float(np.hypot(*(rect[k + 1] - rect[k]))) for k in (0, 1))
     assert sides[0] == pytest.approx(f.shaft_flat_mm + f.clearance_mm, abs=2e-3)
@@ -196,11 +199,15 @@ def test_a_pin_hole_swallowed_by_a_larger_hole_is_refused():
     from planar.fabrication.joints import FabricationError
     from planar.fabrication.parts import FabSettings, part_cuts
 
-    part = Part("slider", ((0.0, 0.0, 1.0), (3.0, 0.0, 1.0)),
-                (Hole((0.0, 0.0), 0.3), Hole((2.0, 0.0), 0.3), Hole((0.0, 0.0), 0.6)))
+    part = Part(
+        "slider", ((0.0, 0.0, 1.0), (3.0, 0.0, 1.0)), (Hole((0.0, 0.0), 0.3), Hole((2.0, 0.0), 0.3), Hole((0.0, 0.0), 0.6))
+    )
     s = FabSettings(unit_mm=10.0)
     ok = part_cuts(part, s, 1, {0, 1, 2})  # all three pinned: the two at (0, 0) are one 3.1 mm hole
     assert sorted(round(2 * r, 3) for _, r in ok.nominal_holes) == [3.1, 3.1]
-    with pytest.raises(FabricationError, match=r"'slider': its pin hole 3\.10 mm at \(0\.0, 0\.0\) mm lies inside "
-                                               r"its hole 6\.10 mm wide"):
+    with pytest.raises(
+        FabricationError,
+        match=r"'slider': its pin hole 3\.10 mm at \(0\.0, 0\.0\) mm lies inside "
+        r"its hole 6\.10 mm wide",
+    ):
         part_cuts(part, s, 1, {0, 1})

@@ -58,8 +58,7 @@ def _part_contours(polys, pc):
     from planar.fabrication.sheet import cut_polygon
 
     ref = cut_polygon(pc.outer)
-    outer = min((p for p in polys if abs(p.area - ref.area) < 0.02 * ref.area),
-                key=lambda p: p.centroid.distance(ref.centroid))
+    outer = min((p for p in polys if abs(p.area - ref.area) < 0.02 * ref.area), key=lambda p: p.centroid.distance(ref.centroid))
     inner = [p for p in polys if p is not outer and outer.contains(p)]
     return _inverse(outer, pc.placed), [_inverse(p, pc.placed) for p in inner]
 
@@ -152,14 +151,14 @@ def test_walls_nesting_and_bom(bunny):
         # every cut keeps min_wall to the outline and to every other cut (nominal: the file's gaps less the kerf)
         for i, a in enumerate(inner):
             assert outer.exterior.distance(a) - s.kerf >= s.min_wall - 5e-3, (pc.name, a.bounds)
-            for b in inner[i + 1:]:
+            for b in inner[i + 1 :]:
                 assert a.distance(b) - s.kerf >= s.min_wall - 5e-3, (pc.name, a.bounds, b.bounds)
     # nested: every outline on the sheet, none overlapping (the file's own contours)
     files = [p for p in polys if not any(q is not p and q.contains(p) for q in polys)]
     assert len(files) == len(fab.layout.parts)
     assert all(sheet.contains(p) for p in files)
     for i, a in enumerate(files):
-        for b in files[i + 1:]:
+        for b in files[i + 1 :]:
             assert a.intersection(b).area < 1e-6
     # the BOM says which tabs go into which slots
     rows = [r for r in csv.DictReader((tmp / "b.csv").open()) if r["item"] == "tabs"]

@@ -11,13 +11,19 @@ from planar.linkages import FourBar
 
 
 def _one_by_one(fb, q):
-    return np.array([fb.solve(q[i:i + 1]).points["coupler_point"][0] for i in range(q.shape[0])])
+    return np.array([fb.solve(q[i : i + 1]).points["coupler_point"][0] for i in range(q.shape[0])])
 
 
 @pytest.mark.parametrize("n", [4, 7])
 def test_the_reported_crossed_crank_rocker(n):
-    fb = FourBar(5.555758555658564, 1.5003548841540635, 5.156900654685513, 1.9274335137160765,
-                 coupler_point=(3.0140839693395267, 0.5662632134012724), circuit="crossed")
+    fb = FourBar(
+        5.555758555658564,
+        1.5003548841540635,
+        5.156900654685513,
+        1.9274335137160765,
+        coupler_point=(3.0140839693395267, 0.5662632134012724),
+        circuit="crossed",
+    )
     q = np.arange(n) * 2 * np.pi / n
     np.testing.assert_allclose(fb.solve(q).points["coupler_point"], _one_by_one(fb, q), atol=1e-12)
 

@@ -25,18 +25,34 @@ GALLERY = Path(__file__).resolve().parents[2] / "gallery"
 
 def _actuated() -> Linkage:
     """A linear actuator pushing a rod against a rocker (translation driver, invalid past its reach)."""
-    nodes = [Fixed("O", (0.0, 0.0)), Fixed("O2", (1.0, 0.2)), Fixed("R", (3.0, 2.0)),
-             Actuator("S", "O", (1.0, 0.2), 0.5), RRR("C", "S", 2.0, "R", 1.8, 1), Rigid("P", "S", "C", (1.0, 0.4))]
+    nodes = [
+        Fixed("O", (0.0, 0.0)),
+        Fixed("O2", (1.0, 0.2)),
+        Fixed("R", (3.0, 2.0)),
+        Actuator("S", "O", (1.0, 0.2), 0.5),
+        RRR("C", "S", 2.0, "R", 1.8, 1),
+        Rigid("P", "S", "C", (1.0, 0.4)),
+    ]
     links = [Link("block", ("S",), guide=("O", "O2")), Link("rod", ("S", "C", "P")), Link("rocker", ("R", "C"))]
     return Linkage("actuated", nodes, links, points={"tip": "P"}, amplitude=1.0)
 
 
 def _slotted() -> Linkage:
     """Crank and slotted lever, with a second pin (an ``rrp`` node) running in the moving lever's slot."""
-    nodes = [Fixed("O", (0.0, 0.0)), Fixed("Q", (0.0, -2.0)), Fixed("F", (0.5, -0.5)), Crank("A", "O", 1.0),
-             Rigid("L", "Q", "A", (4.0, 0.0)), RRP("X", "F", 2.0, "Q", "L", 1, 0.1)]
-    links = [Link("crank", ("O", "A")), Link("block", ("A",), guide=("Q", "L")), Link("lever", ("Q", "L")),
-             Link("rod", ("F", "X"))]
+    nodes = [
+        Fixed("O", (0.0, 0.0)),
+        Fixed("Q", (0.0, -2.0)),
+        Fixed("F", (0.5, -0.5)),
+        Crank("A", "O", 1.0),
+        Rigid("L", "Q", "A", (4.0, 0.0)),
+        RRP("X", "F", 2.0, "Q", "L", 1, 0.1),
+    ]
+    links = [
+        Link("crank", ("O", "A")),
+        Link("block", ("A",), guide=("Q", "L")),
+        Link("lever", ("Q", "L")),
+        Link("rod", ("F", "X")),
+    ]
     return Linkage("slotted", nodes, links, points={"pin": "X", "tip": "L"}, placement=(0.3, -0.2, 0.4))
 
 
@@ -47,9 +63,15 @@ def _random_fourbars(k: int) -> dict[str, FourBar]:
     while len(out) < k:
         g, a, b, c = rng.uniform(0.5, 4.0, 4)
         try:
-            fb = FourBar(g, a, b, c, coupler_point=tuple(rng.uniform(-1, 1, 2)),
-                         circuit=("open", "crossed")[len(out) % 2],
-                         placement=(0.0, 0.0, 0.0) if len(out) % 3 else (0.5, -1.0, 2.0))
+            fb = FourBar(
+                g,
+                a,
+                b,
+                c,
+                coupler_point=tuple(rng.uniform(-1, 1, 2)),
+                circuit=("open", "crossed")[len(out) % 2],
+                placement=(0.0, 0.0, 0.0) if len(out) % 3 else (0.5, -1.0, 2.0),
+            )
         except PlanarError:
             continue
         out[f"random-{len(out)}"] = fb
@@ -57,8 +79,7 @@ def _random_fourbars(k: int) -> dict[str, FourBar]:
 
 
 def _linkages() -> dict[str, Linkage]:
-    out = {k: m for k in CATALOG if not k.startswith(("windup", "horse", "bunny"))
-           for m in [get(k)] if isinstance(m, Linkage)}
+    out = {k: m for k in CATALOG if not k.startswith(("windup", "horse", "bunny")) for m in [get(k)] if isinstance(m, Linkage)}
     for f in sorted(glob.glob(str(GALLERY / "*.toml"))):
         m = load_scene(f).mechanism
         if isinstance(m, Linkage):
@@ -167,9 +188,11 @@ def test_node_kind_without_encoder_uses_the_numpy_kernels(monkeypatch):
 
 
 def test_compiled_results_do_not_depend_on_threads_or_chunk_size():
-    cases = [(get("jansen"), 2 * np.pi / 3600 * np.arange(1, 9001)),
-             # steps alternating in sign (no path), with invalid samples
-             (LINKAGES["actuated"], np.where(np.arange(9000) % 2, 1.0, -1.0) * np.random.default_rng(1).uniform(0, 4, 9000))]
+    cases = [
+        (get("jansen"), 2 * np.pi / 3600 * np.arange(1, 9001)),
+        # steps alternating in sign (no path), with invalid samples
+        (LINKAGES["actuated"], np.where(np.arange(9000) % 2, 1.0, -1.0) * np.random.default_rng(1).uniform(0, 4, 9000)),
+    ]
     for lk, q in cases:
         a = fast_solve(lk, q, threads=1, chunk=2048, jit=True)
         b = fast_solve(lk, q, threads=2, chunk=300, jit=True)
@@ -195,8 +218,12 @@ def test_compiled_branch_screen_sends_singular_paths_to_the_reference():
 
 def test_angles_and_crank_agree_with_the_c_library():
     """Every direction of a crank (the atan2 and sincos kernels) against math.atan2 / cos / sin."""
-    lk = Linkage("crank", [Fixed("O", (0.0, 0.0)), Crank("B", "O", 1.0), Rigid("P", "O", "B", (0.5, 0.3))],
-                 [Link("crank", ("O", "B", "P"))], points={"B": "B"})
+    lk = Linkage(
+        "crank",
+        [Fixed("O", (0.0, 0.0)), Crank("B", "O", 1.0), Rigid("P", "O", "B", (0.5, 0.3))],
+        [Link("crank", ("O", "B", "P"))],
+        points={"B": "B"},
+    )
     special = [0.0, np.pi / 2, np.pi, 3 * np.pi / 2, 2 * np.pi, -np.pi, -np.pi / 2, 1e5, -823549.0]
     picks = np.random.default_rng(3).uniform(-7.0, 7.0, 300).tolist()
     # the polynomial sine and cosine (|angle| <= 2**19 pi / 2), and the C library's beyond

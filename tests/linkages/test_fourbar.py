@@ -15,10 +15,11 @@ length = st.floats(0.2, 10.0)
 
 def _numeric_fourbar(a, b, c, d, theta, guess):
     """Independent solution: Newton on the loop-closure equations."""
+
     def f(x):
         t3, t4 = x
-        return [a * np.cos(theta) + b * np.cos(t3) - c * np.cos(t4) - d,
-                a * np.sin(theta) + b * np.sin(t3) - c * np.sin(t4)]
+        return [a * np.cos(theta) + b * np.cos(t3) - c * np.cos(t4) - d, a * np.sin(theta) + b * np.sin(t3) - c * np.sin(t4)]
+
     return fsolve(f, guess, xtol=1e-13)
 
 
@@ -53,8 +54,13 @@ def test_half_angle_agrees_with_circle_circle(a, b, c, d, circuit):
     order = np.random.default_rng(0).permutation(th.size)
     m_shuffled = fb.solve(th[order])
     inv = np.argsort(order)
-    m = type(m_shuffled)(th, {k: v[inv] for k, v in m_shuffled.poses.items()}, m_shuffled.valid[inv],
-                         m_shuffled.fail_code[inv], m_shuffled.fail_table)
+    m = type(m_shuffled)(
+        th,
+        {k: v[inv] for k, v in m_shuffled.poses.items()},
+        m_shuffled.valid[inv],
+        m_shuffled.fail_code[inv],
+        m_shuffled.fail_table,
+    )
     t3, t4, ok = fb.angles(th)
     # away from the toggle positions both methods agree tightly
     mu = fb.transmission_angle(th)
@@ -65,15 +71,18 @@ def test_half_angle_agrees_with_circle_circle(a, b, c, d, circuit):
     assert np.all(np.abs(wrap_angle(t4 - m.poses["rocker"][:, 2]))[good] < 1e-8 * scale / min(a, b, c, d) / np.sin(mu[good]))
 
 
-@pytest.mark.parametrize("dims,expected", [
-    ((1, 4, 3, 4), "crank-rocker"),
-    ((3, 3.5, 3.2, 1), "double-crank"),
-    ((3, 1, 3.2, 3.5), "double-rocker"),
-    ((3, 3.5, 1, 3.2), "rocker-crank"),
-    ((2, 2, 2, 2), "change-point"),
-    ((1, 3, 2, 4), "change-point"),
-    ((3, 3, 3, 4.5), "non-Grashof"),
-])
+@pytest.mark.parametrize(
+    "dims,expected",
+    [
+        ((1, 4, 3, 4), "crank-rocker"),
+        ((3, 3.5, 3.2, 1), "double-crank"),
+        ((3, 1, 3.2, 3.5), "double-rocker"),
+        ((3, 3.5, 1, 3.2), "rocker-crank"),
+        ((2, 2, 2, 2), "change-point"),
+        ((1, 3, 2, 4), "change-point"),
+        ((3, 3, 3, 4.5), "non-Grashof"),
+    ],
+)
 def test_grashof_classes(dims, expected):
     assert grashof_class(*dims) == expected
 
@@ -130,13 +139,16 @@ def test_change_point_passes_the_flat_position():
     assert all(np.isfinite(p).all() for p in m.poses.values())
 
 
-@pytest.mark.parametrize("kw,field", [
-    (dict(ground=4, crank=-1, coupler=4, rocker=3), "crank"),
-    (dict(ground=4, crank=0, coupler=4, rocker=3), "crank"),
-    (dict(ground=4, crank=float("nan"), coupler=4, rocker=3), "crank"),
-    (dict(ground=10, crank=1, coupler=2, rocker=3), "links"),
-    (dict(ground=4, crank=1, coupler=4, rocker=3, circuit="sideways"), "circuit"),
-])
+@pytest.mark.parametrize(
+    "kw,field",
+    [
+        (dict(ground=4, crank=-1, coupler=4, rocker=3), "crank"),
+        (dict(ground=4, crank=0, coupler=4, rocker=3), "crank"),
+        (dict(ground=4, crank=float("nan"), coupler=4, rocker=3), "crank"),
+        (dict(ground=10, crank=1, coupler=2, rocker=3), "links"),
+        (dict(ground=4, crank=1, coupler=4, rocker=3, circuit="sideways"), "circuit"),
+    ],
+)
 def test_bad_dimensions_are_named(kw, field):
     with pytest.raises(InputError) as e:
         FourBar(**kw)
@@ -160,6 +172,7 @@ def test_placement_moves_everything_rigidly():
 
 def test_coupler_pose_sweeps_a_foot_polygon():
     from planar.core.geometry import poses_apply
+
     fb = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0))
     th = np.linspace(0, 2 * np.pi, 90)
     m = fb.solve(th)

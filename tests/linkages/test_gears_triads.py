@@ -23,8 +23,13 @@ R = 0.9  # crank radius: inside both pitch circles for the ratios tested
 
 
 def _five_bar(ratio: float = -1.0, phase: float = 0.5, radius: float = R) -> Linkage:
-    nodes = [Fixed("O1", (0.0, 0.0)), Fixed("O2", (4.0, 0.0)), Crank("A", "O1", radius),
-             Geared("B", "O2", radius, "A", ratio, phase), RRR("P", "A", 4.0, "B", 4.0, 1)]
+    nodes = [
+        Fixed("O1", (0.0, 0.0)),
+        Fixed("O2", (4.0, 0.0)),
+        Crank("A", "O1", radius),
+        Geared("B", "O2", radius, "A", ratio, phase),
+        RRR("P", "A", 4.0, "B", 4.0, 1),
+    ]
     links = [Link("ga", ("O1", "A")), Link("gb", ("O2", "B")), Link("ca", ("A", "P")), Link("cb", ("B", "P"))]
     return Linkage("five", nodes, links, points={"pen": "P"}, width=0.3)
 
@@ -49,8 +54,9 @@ def test_gear_ratio_held_exactly(ratio: float) -> None:
     assert gear.radius_a + gear.radius_b == pytest.approx(4.0)
     assert gear.radius_a / gear.radius_b == pytest.approx(abs(ratio))
     # a wrong ratio shows in the residual
-    worse = type(gear)(gear.name, gear.a, gear.b, gear.ratio * 1.01, gear.phase, gear.centre_a, gear.centre_b,
-                       gear.radius_a, gear.radius_b)
+    worse = type(gear)(
+        gear.name, gear.a, gear.b, gear.ratio * 1.01, gear.phase, gear.centre_a, gear.centre_b, gear.radius_a, gear.radius_b
+    )
     assert float(worse.residual(m.poses).max()) > 1e-3
 
 
@@ -94,10 +100,21 @@ def test_geared_refusals() -> None:
     # a crank pin past the small gear's pitch circle (4 / 3 for ratio -0.5): the gears could not share a layer
     with pytest.raises(InputError, match="pitch circle"):
         _five_bar(ratio=-0.5, radius=1.2)
-    nodes = [Fixed("O1", (0.0, 0.0)), Fixed("O2", (4.0, 0.0)), Crank("A", "O1", 1.2),
-             RRR("M", "A", 3.0, "O2", 3.0), Geared("B", "M", 1.0, "A", -1.0), RRR("P", "A", 4.0, "B", 4.0)]
-    links = [Link("ga", ("O1", "A")), Link("m", ("A", "M", "O2")), Link("gb", ("M", "B")),
-             Link("ca", ("A", "P")), Link("cb", ("B", "P"))]
+    nodes = [
+        Fixed("O1", (0.0, 0.0)),
+        Fixed("O2", (4.0, 0.0)),
+        Crank("A", "O1", 1.2),
+        RRR("M", "A", 3.0, "O2", 3.0),
+        Geared("B", "M", 1.0, "A", -1.0),
+        RRR("P", "A", 4.0, "B", 4.0),
+    ]
+    links = [
+        Link("ga", ("O1", "A")),
+        Link("m", ("A", "M", "O2")),
+        Link("gb", ("M", "B")),
+        Link("ca", ("A", "P")),
+        Link("cb", ("B", "P")),
+    ]
     with pytest.raises(InputError, match="fixed nodes"):
         Linkage("bad", nodes, links)
 
@@ -133,8 +150,16 @@ def _two_input_scene() -> dict:
     d = tomllib.loads((GALLERY / "geared-five-bar.toml").read_text())
     nodes = d["mechanism"]["nodes"]
     nodes[2] = {"name": "A", "kind": "driven", "centre": "O1", "radius": 1.2, "amplitude": 40.0, "mean": 60.0}
-    nodes[3] = {"name": "B", "kind": "driven", "centre": "O2", "radius": 1.2, "cycles": 2.0, "phase": 30.0,
-                "amplitude": 30.0, "mean": 120.0}
+    nodes[3] = {
+        "name": "B",
+        "kind": "driven",
+        "centre": "O2",
+        "radius": 1.2,
+        "cycles": 2.0,
+        "phase": 30.0,
+        "amplitude": 30.0,
+        "mean": 120.0,
+    }
     d["driver"] = {"speed": 0.5, "samples_per_cycle": 48}
     return d
 
@@ -269,8 +294,9 @@ def test_triad_failures_are_invalid_samples_with_reason() -> None:
 
     def g(u: np.ndarray) -> list[float]:
         c, s = np.cos(u[2]), np.sin(u[2])
-        return [float(np.hypot(*(u[:2] + [c * S[i, 0] - s * S[i, 1], s * S[i, 0] + c * S[i, 1]] - K[i])) - L[i])
-                for i in range(3)]
+        return [
+            float(np.hypot(*(u[:2] + [c * S[i, 0] - s * S[i, 1], s * S[i, 0] + c * S[i, 1]] - K[i])) - L[i]) for i in range(3)
+        ]
 
     rng = np.random.default_rng(0)
     best = min(least_squares(g, rng.uniform([-5, -5, -np.pi], [10, 10, np.pi])).cost for _ in range(25))
@@ -299,15 +325,27 @@ def test_triad_declaration_errors() -> None:
 def _dead_centre_six_bar() -> Linkage:
     """A Stephenson six-bar whose triad reaches a dead centre near crank angle 1.99 rad (found by a search)."""
     G2, G3, r = (6.312451035078426, -0.4134985153095454), (-0.45359010799997446, 5.930763662478237), 0.8286678037109922
-    T = np.array([[2.4080079945914776, 3.223385904964576], [5.0476084374687495, 3.3911156677558036],
-                  [3.7776357488676, 4.723780354556157]])
+    T = np.array(
+        [[2.4080079945914776, 3.223385904964576], [5.0476084374687495, 3.3911156677558036], [3.7776357488676, 4.723780354556157]]
+    )
     S = T - T[0]
     L = [float(np.hypot(*(T[0] - (r, 0.0)))), float(np.hypot(*(T[1] - G2))), float(np.hypot(*(T[2] - G3)))]
-    nodes = [Fixed("G1", (0.0, 0.0)), Fixed("G2", G2), Fixed("G3", G3), Crank("C", "G1", r),
-             Triad("T1", "C", L[0], (0.0, 0.0), tuple(T[0]), ("T2", "T3")),
-             Triad("T2", "G2", L[1], tuple(S[1]), tuple(T[1])), Triad("T3", "G3", L[2], tuple(S[2]), tuple(T[2]))]
-    links = [Link("crank", ("G1", "C")), Link("rod", ("C", "T1")), Link("ternary", ("T1", "T2", "T3")),
-             Link("rocker", ("G2", "T2")), Link("hanger", ("G3", "T3"))]
+    nodes = [
+        Fixed("G1", (0.0, 0.0)),
+        Fixed("G2", G2),
+        Fixed("G3", G3),
+        Crank("C", "G1", r),
+        Triad("T1", "C", L[0], (0.0, 0.0), tuple(T[0]), ("T2", "T3")),
+        Triad("T2", "G2", L[1], tuple(S[1]), tuple(T[1])),
+        Triad("T3", "G3", L[2], tuple(S[2]), tuple(T[2])),
+    ]
+    links = [
+        Link("crank", ("G1", "C")),
+        Link("rod", ("C", "T1")),
+        Link("ternary", ("T1", "T2", "T3")),
+        Link("rocker", ("G2", "T2")),
+        Link("hanger", ("G3", "T3")),
+    ]
     return Linkage("dead-centre", nodes, links)
 
 
@@ -357,15 +395,14 @@ def test_blocked_continuation_equals_sample_by_sample() -> None:
     S, L, u_ref, scale = t1._data()
     n = 400
     q = np.linspace(0.0, 6 * np.pi, n)
-    K = np.stack([0.7 * np.c_[np.cos(q), np.sin(q)], np.broadcast_to([6.0, 0.0], (n, 2)),
-                  np.broadcast_to([1.0, 7.5], (n, 2))], 1)
+    K = np.stack([0.7 * np.c_[np.cos(q), np.sin(q)], np.broadcast_to([6.0, 0.0], (n, 2)), np.broadcast_to([1.0, 7.5], (n, 2))], 1)
     cont = np.ones(n, bool)
     cont[0] = False
     u, ok, code = solve_triad(K, L, S, u_ref, cont, scale)
     seq = np.empty((n, 3))
     prev = u_ref
     for k in range(n):  # the definition: Newton from the previous sample's assembly
-        w, _, _ = _newton(K[k:k + 1], prev[None], L, S, scale)
+        w, _, _ = _newton(K[k : k + 1], prev[None], L, S, scale)
         seq[k] = prev = w[0]
     assert ok.all() and np.abs(u - seq).max() < 1e-9
 
@@ -379,11 +416,22 @@ def test_random_triads_never_silently_wrong() -> None:
         T = np.array([[2, 3], [5, 3], [3.5, 4.5]]) + rng.normal(0, 0.3, (3, 2))
         S = T - T[0]
         L = [float(np.hypot(*(T[0] - (r, 0.0)))), float(np.hypot(*(T[1] - G2))), float(np.hypot(*(T[2] - G3)))]
-        nodes = [Fixed("G1", (0.0, 0.0)), Fixed("G2", tuple(G2)), Fixed("G3", tuple(G3)), Crank("C", "G1", r),
-                 Triad("T1", "C", L[0], (0.0, 0.0), tuple(T[0]), ("T2", "T3")),
-                 Triad("T2", "G2", L[1], tuple(S[1]), tuple(T[1])), Triad("T3", "G3", L[2], tuple(S[2]), tuple(T[2]))]
-        links = [Link("crank", ("G1", "C")), Link("rod", ("C", "T1")), Link("ternary", ("T1", "T2", "T3")),
-                 Link("rocker", ("G2", "T2")), Link("hanger", ("G3", "T3"))]
+        nodes = [
+            Fixed("G1", (0.0, 0.0)),
+            Fixed("G2", tuple(G2)),
+            Fixed("G3", tuple(G3)),
+            Crank("C", "G1", r),
+            Triad("T1", "C", L[0], (0.0, 0.0), tuple(T[0]), ("T2", "T3")),
+            Triad("T2", "G2", L[1], tuple(S[1]), tuple(T[1])),
+            Triad("T3", "G3", L[2], tuple(S[2]), tuple(T[2])),
+        ]
+        links = [
+            Link("crank", ("G1", "C")),
+            Link("rod", ("C", "T1")),
+            Link("ternary", ("T1", "T2", "T3")),
+            Link("rocker", ("G2", "T2")),
+            Link("hanger", ("G3", "T3")),
+        ]
         lk = Linkage("random", nodes, links)
         q = np.linspace(0.0, 2 * np.pi, 360)
         pos, checks = lk.solve_nodes(q)
@@ -398,12 +446,16 @@ def test_random_triads_never_silently_wrong() -> None:
     assert checked > 700
 
 
-@pytest.mark.parametrize("edit,expect", [
-    (("ratio = -1.0", "ratio = 0.5"), "nodes.B.ratio"),
-    (('mesh = "A"', 'mesh = "O1"'), "nodes.B.mesh"),
-])
-def test_bad_gear_scene_is_one_line_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str],
-                                           edit: tuple[str, str], expect: str) -> None:
+@pytest.mark.parametrize(
+    "edit,expect",
+    [
+        (("ratio = -1.0", "ratio = 0.5"), "nodes.B.ratio"),
+        (('mesh = "A"', 'mesh = "O1"'), "nodes.B.mesh"),
+    ],
+)
+def test_bad_gear_scene_is_one_line_exit_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], edit: tuple[str, str], expect: str
+) -> None:
     from planar.cli.main import main
 
     text = (GALLERY / "geared-five-bar.toml").read_text()
@@ -419,9 +471,11 @@ def test_bad_gear_scene_is_one_line_exit_2(tmp_path: Path, capsys: pytest.Captur
 
 def test_accelerations_match_differences_of_velocities() -> None:
     """Gears, a second input and a triad: the closure differentiated twice against central differences."""
-    cases = [(_five_bar(-0.5), np.linspace(0.2, 2.0, 6), ("B", "P")),
-             (_six_bar(), np.linspace(0.3, 2.5, 6), ("T1", "T2", "T3", "E")),
-             (build_scene(parse_scene(_two_input_scene())).mechanism, np.linspace(0.2, 3.0, 6), ("A", "B", "P"))]
+    cases = [
+        (_five_bar(-0.5), np.linspace(0.2, 2.0, 6), ("B", "P")),
+        (_six_bar(), np.linspace(0.3, 2.5, 6), ("T1", "T2", "T3", "E")),
+        (build_scene(parse_scene(_two_input_scene())).mechanism, np.linspace(0.2, 3.0, 6), ("A", "B", "P")),
+    ]
     h = 1e-5
     for lk, q, names in cases:
         assert isinstance(lk, Linkage)

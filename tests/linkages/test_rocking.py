@@ -24,10 +24,14 @@ def _line_deviation(pts: np.ndarray) -> tuple[float, float]:
 
 def test_driver_amplitude_and_centre_in_the_scene_angle_unit():
     fourbar = {"type": "fourbar", "ground": 4.0, "crank": 3.0, "coupler": 1.5, "rocker": 3.5}
-    deg = build_scene(parse_scene({"angle_unit": "deg", "mechanism": fourbar,
-                                   "driver": {"amplitude": 20.0, "centre": 60.0, "phase": 30.0}}))
-    rad = build_scene(parse_scene({"mechanism": fourbar, "driver": {"amplitude": math.radians(20.0),
-                                                                    "centre": math.pi / 3, "phase": math.pi / 6}}))
+    deg = build_scene(
+        parse_scene({"angle_unit": "deg", "mechanism": fourbar, "driver": {"amplitude": 20.0, "centre": 60.0, "phase": 30.0}})
+    )
+    rad = build_scene(
+        parse_scene(
+            {"mechanism": fourbar, "driver": {"amplitude": math.radians(20.0), "centre": math.pi / 3, "phase": math.pi / 6}}
+        )
+    )
     for sc in (deg, rad):
         d = sc.mechanism.driver
         assert d.amplitude == pytest.approx(math.radians(20.0)) and d.centre == pytest.approx(math.pi / 3)
@@ -39,23 +43,32 @@ def test_driver_amplitude_and_centre_in_the_scene_angle_unit():
 
 
 def test_rocking_actuator_amplitude_is_a_length():
-    lk = {"type": "linkage", "nodes": [
-        {"name": "O", "kind": "fixed", "at": [0.0, 0.0]},
-        {"name": "S", "kind": "actuator", "origin": "O", "axis": [1.0, 0.0]}],
-        "links": [{"name": "slider", "nodes": ["S"], "guide": ["O", "O2"]}]}
+    lk = {
+        "type": "linkage",
+        "nodes": [
+            {"name": "O", "kind": "fixed", "at": [0.0, 0.0]},
+            {"name": "S", "kind": "actuator", "origin": "O", "axis": [1.0, 0.0]},
+        ],
+        "links": [{"name": "slider", "nodes": ["S"], "guide": ["O", "O2"]}],
+    }
     lk["nodes"].insert(1, {"name": "O2", "kind": "fixed", "at": [1.0, 0.0]})
     sc = build_scene(parse_scene({"angle_unit": "deg", "mechanism": lk, "driver": {"amplitude": 2.0, "centre": 1.0}}))
     assert sc.mechanism.driver.amplitude == 2.0 and sc.mechanism.driver.centre == 1.0
 
 
-@pytest.mark.parametrize("driver, words", [
-    ({"amplitude": 0.0}, ["driver.amplitude", "greater than 0"]),
-    ({"centre": 10.0}, ["driver", "give amplitude too"]),
-])
+@pytest.mark.parametrize(
+    "driver, words",
+    [
+        ({"amplitude": 0.0}, ["driver.amplitude", "greater than 0"]),
+        ({"centre": 10.0}, ["driver", "give amplitude too"]),
+    ],
+)
 def test_bad_rocking_driver_names_the_field(driver, words):
     with pytest.raises(SceneError) as e:
-        parse_scene({"mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0,
-                                   "rocker": 3.0}, "driver": driver}, "s.toml")
+        parse_scene(
+            {"mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0}, "driver": driver},
+            "s.toml",
+        )
     assert all(w in str(e.value) for w in words), str(e.value)
 
 
@@ -114,8 +127,15 @@ def test_peaucellier_output_moves_on_an_exact_straight_line():
 
 
 def test_rocking_slider_crank_stays_on_its_side():
-    sc = build_scene(parse_scene({"angle_unit": "deg", "mechanism": {"type": "slidercrank", "crank": 1.0, "rod": 3.0},
-                                  "driver": {"amplitude": 30.0, "centre": 90.0}}))
+    sc = build_scene(
+        parse_scene(
+            {
+                "angle_unit": "deg",
+                "mechanism": {"type": "slidercrank", "crank": 1.0, "rod": 3.0},
+                "driver": {"amplitude": 30.0, "centre": 90.0},
+            }
+        )
+    )
     m = sc.motion()
     assert m.valid.all()
     x = m.points["slider_pin"][:, 0]

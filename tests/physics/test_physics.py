@@ -72,7 +72,7 @@ def test_change_point_fourbar_switching_branch_is_reported_as_such():
 
 def test_rocker_driven_to_its_toggle_is_caught_there():
     fb0 = FourBar(4.5, 3.0, 3.0, 3.0)
-    (lo, hi), = fb0.input_range()
+    ((lo, hi),) = fb0.input_range()
     fb = FourBar(4.5, 3.0, 3.0, 3.0, amplitude=0.5 * (hi - lo), centre=0.5 * (lo + hi))
     t = fb.driver.times(144)
     sim = simulate(fb, t)
@@ -99,25 +99,40 @@ def test_compare_exit_status_3_when_the_error_passes_the_threshold():
 
 
 def test_compare_exit_status_3_on_a_branch_flip():
-    r = run_cli("compare", str(GALLERY / "jansen-leg.toml"), "--error-bias", "0", "--iterations", "40",
-                "--substeps", "64")
+    r = run_cli("compare", str(GALLERY / "jansen-leg.toml"), "--error-bias", "0", "--iterations", "40", "--substeps", "64")
     assert r.returncode == EXIT_MISMATCH, r.stdout + r.stderr
     assert "simulation failed" in r.stdout and "sample" in r.stdout
 
 
 # ---------------------------------------------------------------- 2. torque with every effect
 
-LEG = {"mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0,
-                     "coupler_point": [2.0, 1.0]}, "driver": {"samples_per_cycle": 36}}
+LEG = {
+    "mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0, "coupler_point": [2.0, 1.0]},
+    "driver": {"samples_per_cycle": 36},
+}
 
 
-@pytest.mark.parametrize("effects", [
-    {"springs": [{"a": "crank", "b": "rocker", "stiffness": 20.0, "anchor_b": [3.0, 0.0]}]},
-    {"springs": [{"a": "ground", "b": "coupler", "stiffness": 5.0, "damping": 2.0, "anchor_b": [2.0, 1.0],
-                  "anchor_a": [0.0, 3.0], "rest_length": 2.0}]},
-    {"damping": 0.5},
-    {"gravity": [0.0, -9.81], "loads": [{"point": "coupler_point", "force": [0.0, 3.0]}]},
-])
+@pytest.mark.parametrize(
+    "effects",
+    [
+        {"springs": [{"a": "crank", "b": "rocker", "stiffness": 20.0, "anchor_b": [3.0, 0.0]}]},
+        {
+            "springs": [
+                {
+                    "a": "ground",
+                    "b": "coupler",
+                    "stiffness": 5.0,
+                    "damping": 2.0,
+                    "anchor_b": [2.0, 1.0],
+                    "anchor_a": [0.0, 3.0],
+                    "rest_length": 2.0,
+                }
+            ]
+        },
+        {"damping": 0.5},
+        {"gravity": [0.0, -9.81], "loads": [{"point": "coupler_point", "force": [0.0, 3.0]}]},
+    ],
+)
 def test_torque_with_springs_damping_gravity_loads_within_one_percent(effects):
     from planar.physics.simulate import torque_comparison
 
@@ -131,8 +146,7 @@ def test_inverse_dynamics_matches_an_independent_newton_euler_solve():
     """Joint forces of every link from F = m a, M = I alpha (a linear system), motor torque from the crank."""
     from planar.analysis.dynamics import inverse_dynamics_torque, mass_properties
 
-    sc = scene_of(dict(LEG, effects={"gravity": [0.0, -9.81], "loads": [{"point": "coupler_point",
-                                                                         "force": [1.0, 2.0]}]}))
+    sc = scene_of(dict(LEG, effects={"gravity": [0.0, -9.81], "loads": [{"point": "coupler_point", "force": [1.0, 2.0]}]}))
     mech, e = sc.mechanism, sc.effects
     t = np.linspace(0.0, mech.driver.period, 9)[:-1]
     ours = inverse_dynamics_torque(mech, t, e)
@@ -177,7 +191,7 @@ def test_inverse_dynamics_matches_an_independent_newton_euler_solve():
                 A[3 * bi + 2, 2 * ji + 1] += sign * r[0]
             if body == "crank":
                 A[3 * bi + 2, -1] = 1.0
-            b[3 * bi:3 * bi + 2] = mass * acc - ext
+            b[3 * bi : 3 * bi + 2] = mass * acc - ext
             b[3 * bi + 2] = inertia * alpha - mom
         sol, *_ = np.linalg.lstsq(A, b, rcond=None)
         assert sol[-1] == pytest.approx(ours[k], rel=1e-5, abs=1e-6 * np.abs(ours).max()), (k, sol[-1], ours[k])
@@ -192,8 +206,11 @@ def test_motor_saturation_is_reported_with_its_samples_and_fails_compare(tmp_pat
     text = (GALLERY / "kangaroo-leg.toml").read_text()
     limit = 0.4 * need
     path = tmp_path / "weak.toml"
-    path.write_text(text.replace("[effects]", f"[effects]\nmotor_force_limit = {limit:.6g}")
-                    if "[effects]" in text else text + f"\n[effects]\nmotor_force_limit = {limit:.6g}\n")
+    path.write_text(
+        text.replace("[effects]", f"[effects]\nmotor_force_limit = {limit:.6g}")
+        if "[effects]" in text
+        else text + f"\n[effects]\nmotor_force_limit = {limit:.6g}\n"
+    )
     weak = load_scene(path)
     tc = torque_comparison(weak.mechanism, weak.motion().t, weak.effects)
     assert tc["saturated"], tc
@@ -208,8 +225,9 @@ def test_contact_and_friction_keys_are_refused_in_one_line(tmp_path, key):
     # collisions were removed (parts sit on layers and never touch): the scene is refused when read, exit 2,
     # one line naming the key, nothing written
     p = tmp_path / "c.toml"
-    p.write_text('name = "c"\n[mechanism]\ntype = "fourbar"\nground = 4.0\ncrank = 1.0\ncoupler = 4.0\n'
-                 f'rocker = 3.0\n[effects]\n{key}\n')
+    p.write_text(
+        f'name = "c"\n[mechanism]\ntype = "fourbar"\nground = 4.0\ncrank = 1.0\ncoupler = 4.0\nrocker = 3.0\n[effects]\n{key}\n'
+    )
     for cmd in (["compare", str(p)], ["render", str(p), "-o", str(tmp_path / "c.gif")]):
         r = run_cli(*cmd)
         assert r.returncode == 2 and "Traceback" not in r.stderr

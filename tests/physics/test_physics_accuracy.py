@@ -48,12 +48,18 @@ def test_gallery_within_1e4_of_size_both_modes_and_torque_within_1_percent(name)
         assert tc["max_rel_diff"] < 1e-2
 
 
-@pytest.mark.parametrize("effects", [
-    {"damping": 0.5},
-    # a spring on the foot whose force is of the order of the inertial forces
-    {"springs": [{"a": "ground", "b": "lower", "stiffness": 2e5, "damping": 5e3, "anchor_a": [0.0, -80.0],
-                  "anchor_b": [0.0, 0.0]}]},
-])
+@pytest.mark.parametrize(
+    "effects",
+    [
+        {"damping": 0.5},
+        # a spring on the foot whose force is of the order of the inertial forces
+        {
+            "springs": [
+                {"a": "ground", "b": "lower", "stiffness": 2e5, "damping": 5e3, "anchor_a": [0.0, -80.0], "anchor_b": [0.0, 0.0]}
+            ]
+        },
+    ],
+)
 def test_jansen_spring_loaded_and_damped_torque_within_1_percent(effects):
     import tomllib
 
@@ -95,10 +101,8 @@ def test_substeps_rise_only_where_the_drift_demands():
         poses, vel, _ = _analytic_pose_velocity(sc.mechanism, t)
         k[name] = substeps_for(sc.mechanism, poses, vel, float(t[1] - t[0]), DEFAULT_SETTINGS)
         # fixed when asked, and never above the cap
-        assert substeps_for(sc.mechanism, poses, vel, float(t[1] - t[0]),
-                            SimSettings(substeps=7, step_drift=None)) == 7
-        assert substeps_for(sc.mechanism, poses, vel, float(t[1] - t[0]),
-                            SimSettings(substeps=2, step_drift=1e-30)) == 16
+        assert substeps_for(sc.mechanism, poses, vel, float(t[1] - t[0]), SimSettings(substeps=7, step_drift=None)) == 7
+        assert substeps_for(sc.mechanism, poses, vel, float(t[1] - t[0]), SimSettings(substeps=2, step_drift=1e-30)) == 16
     assert k["crank"] == DEFAULT_SETTINGS.substeps and k["jansen"] >= 2 * DEFAULT_SETTINGS.substeps
     # twice the samples per cycle: about half the substeps (the step, not the sample, sets the drift; the finer
     # sampling finds a slightly higher peak drift)
@@ -108,8 +112,10 @@ def test_substeps_rise_only_where_the_drift_demands():
     assert k["jansen"] / 2 <= k2 < 0.6 * k["jansen"]
 
 
-LEG = {"mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0,
-                     "coupler_point": [2.0, 1.0]}, "driver": {"samples_per_cycle": 36}}
+LEG = {
+    "mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0, "coupler_point": [2.0, 1.0]},
+    "driver": {"samples_per_cycle": 36},
+}
 
 
 def _leg():

@@ -16,16 +16,19 @@ from planar.scene.load import build_scene, load_scene, parse_scene
 from planar.windup import elemental
 
 GALLERY = Path(__file__).resolve().parents[2] / "gallery"
-SIMULATED = ["horse", "jansen-leg", "kangaroo-leg", "paddle-boat", "slider-crank"] + \
-    [f"windup-{k:02d}" for k in (1, 2, 3, 4, 5, 7, 8, 10, 11)]
+SIMULATED = ["horse", "jansen-leg", "kangaroo-leg", "paddle-boat", "slider-crank"] + [
+    f"windup-{k:02d}" for k in (1, 2, 3, 4, 5, 7, 8, 10, 11)
+]
 
 
 def scene_of(data):
     return build_scene(parse_scene(data))
 
 
-LEG = {"mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0,
-                     "coupler_point": [2.0, 1.0]}, "driver": {"samples_per_cycle": 36}}
+LEG = {
+    "mechanism": {"type": "fourbar", "ground": 4.0, "crank": 1.0, "coupler": 4.0, "rocker": 3.0, "coupler_point": [2.0, 1.0]},
+    "driver": {"samples_per_cycle": 36},
+}
 
 
 def test_mass_properties_match_shapely_and_integration():
@@ -63,10 +66,20 @@ def test_only_the_named_effects_are_built():
     explicit_none = simulate_scene(scene_of(dict(LEG, effects={"springs": [], "loads": []})))
     assert {k: v for k, v in explicit_none.built.items()} == {k: v for k, v in bare.built.items()}
     # what is built does not depend on how long it runs: a tenth of a cycle
-    full = simulate_scene(scene_of(dict(LEG, driver={"samples_per_cycle": 36, "duration": 0.1}, effects={
-        "gravity": [0.0, -9.81], "damping": 0.9,
-        "springs": [{"a": "crank", "b": "rocker", "stiffness": 10.0}],
-        "loads": [{"point": "coupler_point", "force": [0.0, 1.0]}]})))
+    full = simulate_scene(
+        scene_of(
+            dict(
+                LEG,
+                driver={"samples_per_cycle": 36, "duration": 0.1},
+                effects={
+                    "gravity": [0.0, -9.81],
+                    "damping": 0.9,
+                    "springs": [{"a": "crank", "b": "rocker", "stiffness": 10.0}],
+                    "loads": [{"point": "coupler_point", "force": [0.0, 1.0]}],
+                },
+            )
+        )
+    )
     b = full.built
     assert b["gravity"] == (0.0, -9.81) and b["springs"] == 1
     assert b["damping"] == 0.9 and b["loads"] == 1
@@ -88,8 +101,9 @@ def test_spatial_mechanisms_are_refused_with_a_clear_message():
         m = elemental(k)
         with pytest.raises(SimulationError, match="spatial"):
             simulate(m, m.driver.times(12))
-    r = subprocess.run([sys.executable, "-m", "planar", "compare", str(GALLERY / "windup-06.toml")],
-                       capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-m", "planar", "compare", str(GALLERY / "windup-06.toml")], capture_output=True, text=True
+    )
     assert r.returncode == 2 and "spatial" in r.stderr and "Traceback" not in r.stderr
 
 
@@ -100,8 +114,9 @@ def test_contact_held_by_gravity_needs_the_effect():
 
 
 def test_compare_json_has_max_rel_error_per_part():
-    r = subprocess.run([sys.executable, "-m", "planar", "compare", str(GALLERY / "kangaroo-leg.toml"), "--json"],
-                       capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-m", "planar", "compare", str(GALLERY / "kangaroo-leg.toml"), "--json"], capture_output=True, text=True
+    )
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
     assert set(d["parts"]) == {"ground", "crank", "coupler", "rocker"}
@@ -122,6 +137,7 @@ def test_motor_torque_from_impulses_matches_inverse_dynamics(name):
     # and the quasi-static part is the analysis module's virtual work torque: with negligible mass,
     # the simulated torque approaches it
     from planar.analysis import statics as analysis
+
     if scene.spec.effects.loads:
         light = eff.model_copy(update={"density": 1e-4})
         tq = torque_comparison(mech, t, light)
@@ -215,7 +231,7 @@ def test_assembly_check_fails_a_garbage_motion():
 
 def test_rocker_driven_to_its_toggles():
     fb0 = FourBar(4.5, 3.0, 3.0, 3.0)
-    (lo, hi), = fb0.input_range()
+    ((lo, hi),) = fb0.input_range()
     mid, amp = 0.5 * (lo + hi), 0.5 * (hi - lo)
     fb = FourBar(4.5, 3.0, 3.0, 3.0, amplitude=amp, centre=mid)
     t = fb.driver.times(144)
@@ -272,7 +288,7 @@ def test_long_run_simulated_has_no_drift_growth():
     assert sim.blowup is None
     analytic = fb.solve(fb.driver.value(t), t=t)
     err = np.hypot(*(sim.motion.poses["rocker"][:, :2] - analytic.poses["rocker"][:, :2]).T)
-    early, late = err[: 8 * 100].max(), err[-8 * 100:].max()
+    early, late = err[: 8 * 100].max(), err[-8 * 100 :].max()
     assert np.isfinite(err).all()
     assert late < 2.0 * early + 1e-12  # no drift growth
     assert err.max() < 1e-2 * fb.size
@@ -337,16 +353,30 @@ def test_accuracy_benchmark_quick_run(tmp_path, monkeypatch):
     import csv
 
     rows = list(csv.DictReader(open(out / "accuracy.csv")))
-    assert {"mechanism", "substeps", "iterations", "correction", "error", "motor_error", "torque_error",
-            "step_drift", "seconds_per_sim_second"} <= set(rows[0])
+    assert {
+        "mechanism",
+        "substeps",
+        "iterations",
+        "correction",
+        "error",
+        "motor_error",
+        "torque_error",
+        "step_drift",
+        "seconds_per_sim_second",
+    } <= set(rows[0])
 
 
 @pytest.mark.parametrize("args", [[], ["--scenes", "no-such-folder"]])
 def test_accuracy_benchmark_needs_a_scenes_folder(tmp_path, args):
     # from a folder without gallery/: one line naming the folder, exit 2, no traceback, nothing written
     root = str(Path(__file__).resolve().parents[2])
-    r = subprocess.run([sys.executable, "-m", "planar", "bench", "accuracy", "--quick", "-o", "out", *args],
-                       capture_output=True, text=True, cwd=tmp_path, env={"PYTHONPATH": root, "PATH": ""})
+    r = subprocess.run(
+        [sys.executable, "-m", "planar", "bench", "accuracy", "--quick", "-o", "out", *args],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        env={"PYTHONPATH": root, "PATH": ""},
+    )
     assert r.returncode == 2, r.stderr
     assert "Traceback" not in r.stderr and len(r.stderr.strip().splitlines()) == 1
     assert "scenes folder" in r.stderr and (args[-1] if args else "gallery") in r.stderr

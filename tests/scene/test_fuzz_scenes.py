@@ -48,10 +48,19 @@ def _get(d: Any, path: tuple) -> Any:
     return d
 
 
-numbers = st.one_of(st.integers(-10**20, 10**20), st.floats(allow_nan=True, allow_infinity=True),
-                    st.sampled_from([0.0, -0.0, 1e-320, 1e308, -1e308, 1e154, 1e-170, 2.0**53]))
-values = st.one_of(numbers, st.booleans(), st.text(max_size=6), st.none(),
-                   st.lists(numbers, max_size=4), st.dictionaries(st.text(max_size=3), numbers, max_size=2))
+numbers = st.one_of(
+    st.integers(-(10**20), 10**20),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([0.0, -0.0, 1e-320, 1e308, -1e308, 1e154, 1e-170, 2.0**53]),
+)
+values = st.one_of(
+    numbers,
+    st.booleans(),
+    st.text(max_size=6),
+    st.none(),
+    st.lists(numbers, max_size=4),
+    st.dictionaries(st.text(max_size=3), numbers, max_size=2),
+)
 
 
 @st.composite
@@ -87,8 +96,13 @@ def _none_to_missing(d: Any) -> Any:
     return d
 
 
-@settings(max_examples=250, deadline=None, derandomize=True, database=None,
-          suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@settings(
+    max_examples=250,
+    deadline=None,
+    derandomize=True,
+    database=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
+)
 @given(mutated())
 def test_mutated_gallery_scenes_fail_only_with_planar_errors(case: tuple[str, dict]) -> None:
     name, data = case

@@ -55,17 +55,20 @@ def test_good_scene_builds_and_moves(tmp_path):
     assert "foot" in scene.polygons
 
 
-@pytest.mark.parametrize("edit,expect", [
-    (("crank = 1.0", "crank = -1.0"), "mechanism.crank"),
-    (("crank = 1.0", "crank = 1.0\ncrankk = 2"), "crankk"),
-    (("type = \"fourbar\"", "type = \"sixbar\""), "mechanism"),
-    (("samples_per_cycle = 24", "samples_per_cycle = 2"), "driver.samples_per_cycle"),
-    (("speed = 2.0", "speed = \"fast\""), "driver.speed"),
-    (("sweep = [\"foot\"]", "sweep = [\"hand\"]"), "render.sweep"),
-    (("part = \"coupler\"", "part = \"tail\""), "polygons[0].part"),
-    (("rocker = 3.0", "rocker = 30.0"), "mechanism"),
-    (("width = 200", "width = 200\nwidht = 3"), "widht"),
-])
+@pytest.mark.parametrize(
+    "edit,expect",
+    [
+        (("crank = 1.0", "crank = -1.0"), "mechanism.crank"),
+        (("crank = 1.0", "crank = 1.0\ncrankk = 2"), "crankk"),
+        (('type = "fourbar"', 'type = "sixbar"'), "mechanism"),
+        (("samples_per_cycle = 24", "samples_per_cycle = 2"), "driver.samples_per_cycle"),
+        (("speed = 2.0", 'speed = "fast"'), "driver.speed"),
+        (('sweep = ["foot"]', 'sweep = ["hand"]'), "render.sweep"),
+        (('part = "coupler"', 'part = "tail"'), "polygons[0].part"),
+        (("rocker = 3.0", "rocker = 30.0"), "mechanism"),
+        (("width = 200", "width = 200\nwidht = 3"), "widht"),
+    ],
+)
 def test_bad_scenes_name_file_field_and_value(tmp_path, edit, expect):
     text = FOURBAR.replace(*edit)
     assert text != FOURBAR
@@ -87,8 +90,7 @@ def test_not_toml_and_missing_file(tmp_path):
 def test_bad_scene_from_cli_exit_2_no_output(tmp_path):
     p = write(tmp_path, FOURBAR.replace("crank = 1.0", "crank = 0"))
     out = tmp_path / "o.gif"
-    r = subprocess.run([sys.executable, "-m", "planar", "render", str(p), "-o", str(out)],
-                       capture_output=True, text=True)
+    r = subprocess.run([sys.executable, "-m", "planar", "render", str(p), "-o", str(out)], capture_output=True, text=True)
     assert r.returncode == 2 and "Traceback" not in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and "mechanism.crank" in r.stderr
     assert not out.exists() and not list(tmp_path.glob("*.part"))
@@ -106,8 +108,11 @@ def test_motion_csv_columns(tmp_path):
     assert main(["motion", str(p), "-o", str(out)]) == 0
     header = out.read_text().splitlines()[0].split(",")
     parts = ["ground", "crank", "coupler", "rocker"]
-    expected = ["t", "driver"] + [f"{q}.{c}" for q in parts for c in ("x", "y", "angle")] + \
-        ["coupler_point.x", "coupler_point.y", "valid"]
+    expected = (
+        ["t", "driver"]
+        + [f"{q}.{c}" for q in parts for c in ("x", "y", "angle")]
+        + ["coupler_point.x", "coupler_point.y", "valid"]
+    )
     assert header == expected
     data = np.genfromtxt(out, delimiter=",", skip_header=1)
     assert data.shape == (24, len(expected))
@@ -146,8 +151,12 @@ def test_gif_properties_and_reproducibility(tmp_path):
 
 def test_render_marks_invalid_samples(tmp_path):
     # a non-Grashof linkage driven through a full turn: the samples past the toggles are drawn, in red
-    text = FOURBAR.replace("ground = 4.0", "ground = 4.5").replace("crank = 1.0", "crank = 3.0") \
-        .replace("coupler = 4.0", "coupler = 3.0").replace("rocker = 3.0", "rocker = 3.0")
+    text = (
+        FOURBAR.replace("ground = 4.0", "ground = 4.5")
+        .replace("crank = 1.0", "crank = 3.0")
+        .replace("coupler = 4.0", "coupler = 3.0")
+        .replace("rocker = 3.0", "rocker = 3.0")
+    )
     p = write(tmp_path, text)
     scene = load_scene(p)
     m = scene.motion()

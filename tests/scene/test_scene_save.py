@@ -40,16 +40,19 @@ def test_gallery_scene_save_load_round_trip(path: Path, tmp_path: Path) -> None:
     _same_motion(sc.motion(), back.motion())
 
 
-@pytest.mark.parametrize("make", [
-    lambda: FourBar(4, 1, 4, 3, coupler_point=(5.5, -2), placement=(1, 2, 0.3), rate=3.0, phase=0.2,
-                    circuit="crossed"),
-    lambda: FourBar(4, 1, 4, 3, amplitude=0.5, centre=1.2),
-    lambda: SliderCrank(1, 3, offset=0.4, branch=-1),
-    lambda: get("jansen"),
-    lambda: elemental(2, D_jc=(0.0, 0.08)),
-    lambda: elemental(10),
-    lambda: horse(phase=1.0),
-], ids=["fourbar", "rocking", "slidercrank", "jansen", "elemental-2", "elemental-10", "horse"])
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: FourBar(4, 1, 4, 3, coupler_point=(5.5, -2), placement=(1, 2, 0.3), rate=3.0, phase=0.2, circuit="crossed"),
+        lambda: FourBar(4, 1, 4, 3, amplitude=0.5, centre=1.2),
+        lambda: SliderCrank(1, 3, offset=0.4, branch=-1),
+        lambda: get("jansen"),
+        lambda: elemental(2, D_jc=(0.0, 0.08)),
+        lambda: elemental(10),
+        lambda: horse(phase=1.0),
+    ],
+    ids=["fourbar", "rocking", "slidercrank", "jansen", "elemental-2", "elemental-10", "horse"],
+)
 def test_python_mechanism_saved_as_scene_moves_the_same(make, tmp_path: Path) -> None:
     mech = make()
     sc = scene_from_mechanism(mech, driver={"samples_per_cycle": 30})
@@ -63,8 +66,12 @@ def test_python_mechanism_saved_as_scene_moves_the_same(make, tmp_path: Path) ->
 
 
 def test_what_a_scene_cannot_say_is_refused() -> None:
-    link = Linkage("w", [Fixed("O", (0, 0)), Fixed("Z", (3, 0)), Crank("A", "O", 1.0), RRR("B", "A", 3, "Z", 2)],
-                   [Link("crank", ("O", "A")), Link("c", ("A", "B")), Link("r", ("Z", "B"))], width=0.5)
+    link = Linkage(
+        "w",
+        [Fixed("O", (0, 0)), Fixed("Z", (3, 0)), Crank("A", "O", 1.0), RRR("B", "A", 3, "Z", 2)],
+        [Link("crank", ("O", "A")), Link("c", ("A", "B")), Link("r", ("Z", "B"))],
+        width=0.5,
+    )
     with pytest.raises(InputError, match="width"):
         scene_from_mechanism(link)
     # a toy's stage overrides are scene keys now ([[mechanism.stages]]): what is saved is what runs

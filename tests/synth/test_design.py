@@ -68,16 +68,19 @@ def _same_layer_overlaps(path: Path) -> tuple[list, list]:
     bad = []
     names = sorted(fab.own)
     for i, a in enumerate(names):
-        for b in names[i + 1:]:
-            if a not in planes or b not in planes or planes[a] != planes[b] \
-                    or fab.assembly.layers[a] != fab.assembly.layers[b]:  # a bracket (planar.fabrication.tabs) stands still
+        for b in names[i + 1 :]:
+            if (
+                a not in planes or b not in planes or planes[a] != planes[b] or fab.assembly.layers[a] != fab.assembly.layers[b]
+            ):  # a bracket (planar.fabrication.tabs) stands still
                 continue
             for k in range(len(m)):
                 pa, pb = m.poses[a][k], m.poses[b][k]
-                A = affinity.affine_transform(fab.own[a], [math.cos(pa[2]), -math.sin(pa[2]), math.sin(pa[2]),
-                                                           math.cos(pa[2]), pa[0] * u, pa[1] * u])
-                B = affinity.affine_transform(fab.own[b], [math.cos(pb[2]), -math.sin(pb[2]), math.sin(pb[2]),
-                                                           math.cos(pb[2]), pb[0] * u, pb[1] * u])
+                A = affinity.affine_transform(
+                    fab.own[a], [math.cos(pa[2]), -math.sin(pa[2]), math.sin(pa[2]), math.cos(pa[2]), pa[0] * u, pa[1] * u]
+                )
+                B = affinity.affine_transform(
+                    fab.own[b], [math.cos(pb[2]), -math.sin(pb[2]), math.sin(pb[2]), math.cos(pb[2]), pb[0] * u, pb[1] * u]
+                )
                 if A.intersection(B).area > 0.5:  # mm^2: a cam polygon touching its window stays below
                     bad.append((a, b, k))
     return bad, [q for pp in fab.assembly.pins for q in pp.clashes]
@@ -109,10 +112,20 @@ def test_horse_request(tmp_path: Path, capsys) -> None:
     g = _leaf_ranges(gallery)
     rows = [
         {"name": "head", "motion": "Oz", "range": round(g[("left", ("Rz->OzT", "OzT->Oz"))], 2), "cam": "left"},
-        {"name": "legs_lift", "motion": "Ty", "range": round(g[("right", ("Rz->OzT", "OzT->Ty"))], 4),
-         "cam": "right", "phase": 0.5},
-        {"name": "legs_swing", "motion": "Oz", "range": round(g[("right", ("Rz->OzT", "OzT->Oz"))], 2),
-         "cam": "right", "phase": 0.5},
+        {
+            "name": "legs_lift",
+            "motion": "Ty",
+            "range": round(g[("right", ("Rz->OzT", "OzT->Ty"))], 4),
+            "cam": "right",
+            "phase": 0.5,
+        },
+        {
+            "name": "legs_swing",
+            "motion": "Oz",
+            "range": round(g[("right", ("Rz->OzT", "OzT->Oz"))], 2),
+            "cam": "right",
+            "phase": 0.5,
+        },
     ]
     out, text = _design(tmp_path, rows, capsys)
     _check(out, rows)
@@ -129,8 +142,10 @@ def test_bunny_request_renders_exports_and_runs(tmp_path: Path, capsys) -> None:
 
     gallery = load_scene(GALLERY / "bunny.toml").mechanism
     g = _leaf_ranges(gallery)
-    rows = [{"name": "ear_x", "motion": "Ox", "range": round(g[("left", ("Rz->Tx", "Tx->Ox"))], 2)},
-            {"name": "ear_y", "motion": "Oy", "range": round(g[("left", ("Rz->Tx", "Tx->Oy"))], 2)}]
+    rows = [
+        {"name": "ear_x", "motion": "Ox", "range": round(g[("left", ("Rz->Tx", "Tx->Ox"))], 2)},
+        {"name": "ear_y", "motion": "Oy", "range": round(g[("left", ("Rz->Tx", "Tx->Oy"))], 2)},
+    ]
     out, _ = _design(tmp_path, rows, capsys)
     _check(out, rows)
     toy = load_scene(out).mechanism
@@ -147,8 +162,10 @@ def test_bunny_request_renders_exports_and_runs(tmp_path: Path, capsys) -> None:
 
 def test_a_request_no_gallery_scene_has(tmp_path: Path, capsys) -> None:
     """A lift (Ty) on the left cam and a rocker (Oz) on the right, a quarter turn ahead (issue 15: Ty + Oz)."""
-    rows = [{"name": "lift", "motion": "Ty", "range": 0.1, "cam": "left"},
-            {"name": "head", "motion": "Oz", "range": 25.0, "cam": "right", "phase": 0.25}]
+    rows = [
+        {"name": "lift", "motion": "Ty", "range": 0.1, "cam": "left"},
+        {"name": "head", "motion": "Oz", "range": 25.0, "cam": "right", "phase": 0.25},
+    ]
     out, _ = _design(tmp_path, rows, capsys)
     _check(out, rows)
     toy = load_scene(out).mechanism

@@ -21,9 +21,19 @@ from planar.synth.design import physics_check, place_stages, placement_variables
 from planar.toys.assembly import assembly_residual, toy_assembly
 from planar.windup.chain import ToyMechanism
 
-CHAINS = {1: ("Rz->Tx",), 2: ("Rz->Oz",), 3: ("Rz->OzT",), 4: ("Rz->Oz", "Oz->Ty"), 5: ("Rz->Oz", "Oz->Oz"),
-          6: ("Rz->Oz", "Oz->Ox"), 7: ("Rz->Tx", "Tx->Oz"), 8: ("Rz->Tx", "Tx->Oy"), 9: ("Rz->Tx", "Tx->Ox"),
-          10: ("Rz->OzT", "OzT->Tx"), 11: ("Rz->OzT", "OzT->Oz")}
+CHAINS = {
+    1: ("Rz->Tx",),
+    2: ("Rz->Oz",),
+    3: ("Rz->OzT",),
+    4: ("Rz->Oz", "Oz->Ty"),
+    5: ("Rz->Oz", "Oz->Oz"),
+    6: ("Rz->Oz", "Oz->Ox"),
+    7: ("Rz->Tx", "Tx->Oz"),
+    8: ("Rz->Tx", "Tx->Oy"),
+    9: ("Rz->Tx", "Tx->Ox"),
+    10: ("Rz->OzT", "OzT->Tx"),
+    11: ("Rz->OzT", "OzT->Oz"),
+}
 
 
 def test_placement_variables_of_every_mechanism() -> None:
@@ -31,8 +41,19 @@ def test_placement_variables_of_every_mechanism() -> None:
     about its pin; #7's pin and pivot move together; #8's and #9's pivots; a pivot whose distance from its driver
     sets the motion (#2, #3, #5, #6, #11) has none.  Each found move, applied, leaves the effector's range (read
     from the assembled toy's piece poses) unchanged and the assembly's joints closed."""
-    expect = {1: {"F_o"}, 2: set(), 3: set(), 4: {"F_o-F_jc"}, 5: set(), 6: set(), 7: {"F_o+D_jc"},
-              8: {"F_o"}, 9: {"F_o"}, 10: {"F_o-F_jc"}, 11: set()}
+    expect = {
+        1: {"F_o"},
+        2: set(),
+        3: set(),
+        4: {"F_o-F_jc"},
+        5: set(),
+        6: set(),
+        7: {"F_o+D_jc"},
+        8: {"F_o"},
+        9: {"F_o"},
+        10: {"F_o-F_jc"},
+        11: set(),
+    }
     for number, chain in CHAINS.items():
         toy = ToyMechanism({"left": [chain]}, name=f"m{number}", samples=181)
         last = [v for v in placement_variables(toy) if v.key == chain]
@@ -44,8 +65,9 @@ def test_placement_variables_of_every_mechanism() -> None:
             kw = dict(toy.stage_overrides.get(("left", chain), {}))
             from planar.synth.design import _shifted
 
-            moved = ToyMechanism({"left": [chain]}, name="moved", samples=181,
-                                 overrides={("left", chain): _shifted(kw, number, v, 0.15)})
+            moved = ToyMechanism(
+                {"left": [chain]}, name="moved", samples=181, overrides={("left", chain): _shifted(kw, number, v, 0.15)}
+            )
             assert _leaf_ranges(moved)[("left", chain)] == pytest.approx(before, rel=1e-6), (number, v.label)
             assert max(assembly_residual(toy_assembly(moved), samples=24).values()) < 1e-6
 
@@ -62,8 +84,7 @@ def _footprint(toy: ToyMechanism, samples: int = 24) -> float:
         if p.plane != "xy":
             continue
         for x, y, a in np.asarray(m.poses[p.name]):
-            geoms.append(affinity.affine_transform(p.outline, [math.cos(a), -math.sin(a), math.sin(a),
-                                                                math.cos(a), x, y]))
+            geoms.append(affinity.affine_transform(p.outline, [math.cos(a), -math.sin(a), math.sin(a), math.cos(a), x, y]))
     return float(shapely.union_all(geoms).convex_hull.area)
 
 
@@ -97,8 +118,7 @@ def test_a_stage_left_unsimulated_fails_by_name(tmp_path, capsys, monkeypatch) -
     import planar.synth.design as design
     from planar.scene.load import scene_from_mechanism
 
-    monkeypatch.setattr(design, "design_scene",
-                        lambda toy, name: scene_from_mechanism(toy, name=name, **design.SCENE_TABLES))
+    monkeypatch.setattr(design, "design_scene", lambda toy, name: scene_from_mechanism(toy, name=name, **design.SCENE_TABLES))
     req = tmp_path / "r.toml"
     req.write_text('[[effector]]\nname = "ear"\nmotion = "Oy"\nrange = 20.0\n')
     out = tmp_path / "toy.toml"
@@ -135,8 +155,10 @@ def test_two_tracks_on_one_circle_are_cut_once() -> None:
 def test_two_effectors_that_would_be_one_follower_are_refused_by_name(tmp_path, capsys) -> None:
     """Two OzT effectors on the left cam: OzT has one chain (Rz->OzT), so both would be one stage's follower."""
     req = tmp_path / "r.toml"
-    req.write_text('[[effector]]\nname = "walk"\nmotion = "OzT"\nrange = 8.0\ncam = "left"\n'
-                   '[[effector]]\nname = "step"\nmotion = "OzT"\nrange = 6.0\ncam = "left"\n')
+    req.write_text(
+        '[[effector]]\nname = "walk"\nmotion = "OzT"\nrange = 8.0\ncam = "left"\n'
+        '[[effector]]\nname = "step"\nmotion = "OzT"\nrange = 6.0\ncam = "left"\n'
+    )
     out = tmp_path / "toy.toml"
     rc = main(["design", str(req), "-o", str(out)])
     err = capsys.readouterr().err.strip()

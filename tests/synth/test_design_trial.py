@@ -27,8 +27,9 @@ def _request(tmp_path: Path, body: str) -> Path:
     return p
 
 
-@pytest.mark.parametrize("phase, hint", [(90.0, "phase = 0.25 (degrees / 360)"), (1.25, "phase = 0.25"),
-                                         (-0.25, "0 <= phase < 1")])
+@pytest.mark.parametrize(
+    "phase, hint", [(90.0, "phase = 0.25 (degrees / 360)"), (1.25, "phase = 0.25"), (-0.25, "0 <= phase < 1")]
+)
 def test_a_phase_outside_one_cycle_is_refused(tmp_path, capsys, phase, hint) -> None:
     # `phase = 90.0` (degrees, as a new user wrote it) was read as 90 cycles, 1.25 as 0.25, both silently
     req = _request(tmp_path, f'[[effector]]\nname = "head"\nmotion = "Oz"\nrange = 30.0\nphase = {phase}\n')
@@ -40,8 +41,9 @@ def test_a_phase_outside_one_cycle_is_refused(tmp_path, capsys, phase, hint) -> 
     out = tmp_path / "toy.toml"
     assert main(["design", str(req), "-o", str(out)]) == 2 and not out.exists()
     assert len(capsys.readouterr().err.strip().splitlines()) == 1
-    assert load_request(_request(tmp_path, '[[effector]]\nname = "h"\nmotion = "Oz"\nrange = 30.0\nphase = 0.75\n')
-                        )[0].phase == 0.75
+    assert (
+        load_request(_request(tmp_path, '[[effector]]\nname = "h"\nmotion = "Oz"\nrange = 30.0\nphase = 0.75\n'))[0].phase == 0.75
+    )
 
 
 def test_a_missing_name_is_a_required_field(tmp_path) -> None:
@@ -95,22 +97,39 @@ def _fake_design(physics: dict, **kw) -> Design:
     """A Design around a real toy (Rz->Tx Tx->Oy: a #8 stage) with the figures a summary line reports."""
     toy = ToyMechanism({"left": [("Rz->Tx", "Tx->Oy")]}, name="t", names={("left", ("Rz->Tx", "Tx->Oy")): "ear"})
     e = Effector("ear", "Oy", 20.0)
-    base = dict(layers={"frame": 0, "cam": 1}, collisions=[], clashes=[], physics=physics,
-                placement=Placement(["v"], (1.0, 1.0), (1.0, 1.0), (0.0, 0.0), 41, 0, 0.1, kept=False, checked=0),
-                before={"layers": 2, "collisions": 0, "pin_clashes": 0, "export_refused": 0})
+    base = dict(
+        layers={"frame": 0, "cam": 1},
+        collisions=[],
+        clashes=[],
+        physics=physics,
+        placement=Placement(["v"], (1.0, 1.0), (1.0, 1.0), (0.0, 0.0), 41, 0, 0.1, kept=False, checked=0),
+        before={"layers": 2, "collisions": 0, "pin_clashes": 0, "export_refused": 0},
+    )
     base.update(kw)
-    return Design(toy, [e], [("left", ("Rz->Tx", "Tx->Oy"))], 6.0, {"ear": 20.0}, 1, 1,
-                  {"ear": ("Rz->Tx Tx->Oy", "F_jh", 0.1)}, **base)
+    return Design(
+        toy, [e], [("left", ("Rz->Tx", "Tx->Oy"))], 6.0, {"ear": 20.0}, 1, 1, {"ear": ("Rz->Tx Tx->Oy", "F_jh", 0.1)}, **base
+    )
 
 
 def test_the_summary_says_which_check_failed() -> None:
     from planar.cli.design import summary_lines
 
-    phys = {"ok": False, "torque_rel_diff": 0.0052, "failure": "left the analytic motion at sample 3",
-            "lets_go": [], "not_simulated": [], "speed": 0.5, "stages": []}
+    phys = {
+        "ok": False,
+        "torque_rel_diff": 0.0052,
+        "failure": "left the analytic motion at sample 3",
+        "lets_go": [],
+        "not_simulated": [],
+        "speed": 0.5,
+        "stages": [],
+    }
     # the export refusing the pieces is said so, not counted as a pin through a piece
-    d = _fake_design(phys, layers={}, clashes=["the export refuses it: part 'frame' is larger than the sheet"],
-                     variant="its cams grown into discs")
+    d = _fake_design(
+        phys,
+        layers={},
+        clashes=["the export refuses it: part 'frame' is larger than the sheet"],
+        variant="its cams grown into discs",
+    )
     rep = d.report()
     lines = summary_lines(d, rep, phys, "t", "t.toml")
     text = "\n".join(lines)
@@ -157,8 +176,9 @@ def test_stroke_of_a_translating_effector_is_its_range() -> None:
     from planar.fabrication.parts import FabSettings
     from planar.toys.fitcheck import motion_sizes
 
-    toy = ToyMechanism({"left": [("Rz->Ty",)]}, names={("left", ("Rz->Ty",)): "head"},
-                       overrides={("left", ("Rz->Ty",)): {"D_jc": (0.04, 0.0)}})
+    toy = ToyMechanism(
+        {"left": [("Rz->Ty",)]}, names={("left", ("Rz->Ty",)): "head"}, overrides={("left", ("Rz->Ty",)): {"D_jc": (0.04, 0.0)}}
+    )
     sizes = {m["what"]: m["mm"] for m in motion_sizes(toy, FabSettings(unit_mm=100.0))}
     assert sizes["effector 'head'"] == pytest.approx(8.0, rel=1e-3)
     assert sizes["stage s0 Rz->Ty"] == pytest.approx(8.0, rel=1e-12)
@@ -179,8 +199,10 @@ def test_the_cam_key_angle_names_the_phase_and_the_stages_own_turn() -> None:
     key = (90 + turn) % 360
     note = next(n for n in fab.notes if n.startswith("cam.right"))
     assert f"at {key} degrees = cam phase 90 + the stage's own turn {turn}" in note
-    assert _key_text("cam.right", math.radians(key), math.radians(turn)) == \
-        f"cam.right {key} deg (cam phase 90 + the stage's own turn {turn})"
+    assert (
+        _key_text("cam.right", math.radians(key), math.radians(turn))
+        == f"cam.right {key} deg (cam phase 90 + the stage's own turn {turn})"
+    )
     assert _key_text("cam.left", 0.0, 0.0) == "cam.left 0 deg"
 
 

@@ -38,8 +38,7 @@ def _loop_closure_outputs(d):
 
         def f(v, th=th):
             t3, t4 = v
-            return [a * np.cos(th) + b * np.cos(t3) - c * np.cos(t4) - g,
-                    a * np.sin(th) + b * np.sin(t3) - c * np.sin(t4)]
+            return [a * np.cos(th) + b * np.cos(t3) - c * np.cos(t4) - g, a * np.sin(th) + b * np.sin(t3) - c * np.sin(t4)]
 
         roots = []
         for t4 in np.linspace(0, 2 * np.pi, 8, endpoint=False):
@@ -50,7 +49,7 @@ def _loop_closure_outputs(d):
                 if np.sign((g - Bx) * (Cy - By) - (0 - By) * (Cx - Bx)) == want:
                     roots.append(float(sol[1]))
         assert roots, "no root on the design's circuit"
-        assert np.ptp(np.unwrap(roots)) < 1e-7           # one root on each circuit
+        assert np.ptp(np.unwrap(roots)) < 1e-7  # one root on each circuit
         out.append(roots[0] + d.ground_angle)
     return np.array(out)
 
@@ -71,16 +70,16 @@ def test_arc_margin_matches_dense_sampling():
     L2 = a[:, None] ** 2 + 1 - 2 * a[:, None] * np.cos(T)
     cmu = (b[:, None] ** 2 + c[:, None] ** 2 - L2) / (2 * b[:, None] * c[:, None])
     closes = (np.abs(cmu) <= 1).all(1)
-    assert (closes == (m >= 0)).mean() > 0.97          # both sides occur, and agree
+    assert (closes == (m >= 0)).mean() > 0.97  # both sides occur, and agree
     assert 30 < closes.sum() < 270
     both = closes & (m > 1e-3)
     mu = np.arccos(cmu[both])
     dense = np.minimum(mu.min(1), np.pi - mu.max(1))
-    assert np.abs(dense - m[both]).max() < 2e-3        # sampled margin (upper bound) close to the exact one
+    assert np.abs(dense - m[both]).max() < 2e-3  # sampled margin (upper bound) close to the exact one
 
 
 def test_known_fourbar_recovered_fixed_offsets():
-    fb = FourBar(5.0, 1.5, 4.0, 3.5)               # crank-rocker
+    fb = FourBar(5.0, 1.5, 4.0, 3.5)  # crank-rocker
     phi = np.linspace(0.4, 2.4, 7)
     _, psi, ok = fb.angles(phi)
     assert ok.all()
@@ -126,16 +125,21 @@ def test_cli_finds_valid_linkage_where_closed_form_is_not_one(tmp_path, capsys):
     want = np.radians(psi) + r["output_offset_rad"] + r["ground_angle"]
     assert np.abs(_wrap(world - want) - r["output_error_rad"]).max() < 1e-9
     # and so does scipy's root finder on the loop-closure equations of the written lengths
-    d = SimpleNamespace(phi=np.radians(phi), input_offset=r["input_offset_rad"], **{
-        k: r[k] for k in ("crank", "coupler", "rocker", "ground", "circuit", "ground_angle")})
+    d = SimpleNamespace(
+        phi=np.radians(phi),
+        input_offset=r["input_offset_rad"],
+        **{k: r[k] for k in ("crank", "coupler", "rocker", "ground", "circuit", "ground_angle")},
+    )
     assert np.abs(_wrap(_loop_closure_outputs(d) - want) - r["output_error_rad"]).max() < 1e-9
 
 
 def test_cli_free_offsets_three_pairs_exact_with_good_transmission(tmp_path, capsys):
     pairs = _pairs_csv(tmp_path / "p.csv", [45, 75, 105], [135, 160, 225])
     out = tmp_path / "f.toml"
-    assert main(["synth", "function", str(pairs), "-o", str(out), "--deg", "--json", "--free-offsets",
-                 "--min-transmission", "30"]) == 0
+    assert (
+        main(["synth", "function", str(pairs), "-o", str(out), "--deg", "--json", "--free-offsets", "--min-transmission", "30"])
+        == 0
+    )
     r = json.loads(capsys.readouterr().out)
     assert r["max_output_error_rad"] < 1e-9 and r["checks"]["min_transmission_deg"] >= 30
     fb = load_scene(out).mechanism
@@ -148,10 +152,25 @@ def test_cli_full_turn_is_a_grashof_crank(tmp_path, capsys):
     fb = FourBar(5.0, 1.5, 4.0, 3.5)
     phi = np.linspace(0.0, 3.0, 6)
     _, psi, _ = fb.angles(phi)
-    pairs = _pairs_csv(tmp_path / "p.csv", phi + 1.0, psi + 2.0)     # other zeros than the linkage's
+    pairs = _pairs_csv(tmp_path / "p.csv", phi + 1.0, psi + 2.0)  # other zeros than the linkage's
     out = tmp_path / "f.toml"
-    assert main(["synth", "function", str(pairs), "-o", str(out), "--json", "--free-offsets", "--full-turn",
-                 "--min-transmission", "30"]) == 0
+    assert (
+        main(
+            [
+                "synth",
+                "function",
+                str(pairs),
+                "-o",
+                str(out),
+                "--json",
+                "--free-offsets",
+                "--full-turn",
+                "--min-transmission",
+                "30",
+            ]
+        )
+        == 0
+    )
     r = json.loads(capsys.readouterr().out)
     assert r["grashof"] in ("crank-rocker", "double-crank") and r["checks"]["crank_turns_fully"]
     assert r["max_output_error_rad"] < 1e-6
@@ -169,16 +188,20 @@ def test_nothing_valid_exits_3_names_the_constraint_writes_nothing(tmp_path, cap
     # impossible with links within a ratio of 10 (|B - O4|^2 changes by 2 a d (cos t1 - cos t0))
     pairs = _pairs_csv(tmp_path / "p.csv", [60, 90, 120], [100, 120, 130])
     out = tmp_path / "f.toml"
-    assert main(["synth", "function", str(pairs), "-o", str(out), "--deg", "--free-offsets",
-                 "--min-transmission", "89"]) == 3
+    assert main(["synth", "function", str(pairs), "-o", str(out), "--deg", "--free-offsets", "--min-transmission", "89"]) == 3
     text = capsys.readouterr().out
     assert "no four-bar keeps the transmission angle >= 89 deg" in text and "nothing written" in text
     assert not out.exists()
 
 
-@pytest.mark.parametrize("argv, field", [
-    (["--max-ratio", "1"], "--max-ratio"), (["--min-transmission", "90"], "--min-transmission"),
-    (["--tolerance", "0"], "--tolerance")])
+@pytest.mark.parametrize(
+    "argv, field",
+    [
+        (["--max-ratio", "1"], "--max-ratio"),
+        (["--min-transmission", "90"], "--min-transmission"),
+        (["--tolerance", "0"], "--tolerance"),
+    ],
+)
 def test_cli_function_bad_options(tmp_path, capsys, argv, field):
     pairs = _pairs_csv(tmp_path / "p.csv", [10, 40, 70], [60, 75, 95])
     out = tmp_path / "f.toml"

@@ -30,7 +30,7 @@ def test_angles_are_from_the_world_x_axis(tmp_path, capsys):
     assert main(["synth", "function", str(pairs), "-o", str(tmp_path / "n.toml"), "--json"]) == 0
     rep = json.loads(capsys.readouterr().out)
     assert rep["max_output_error_rad"] < 1e-9
-    assert abs(rep["ground_angle"] - np.pi) < 1e-12          # placed turned by pi: the angles are world angles
+    assert abs(rep["ground_angle"] - np.pi) < 1e-12  # placed turned by pi: the angles are world angles
     sub = build_parser()._subparsers._group_actions[0].choices["synth"]  # type: ignore[union-attr]
     helptext = sub._subparsers._group_actions[0].choices["function"].format_help()
     assert "world +x axis" in " ".join(helptext.split()) and "from the ground line" not in helptext
@@ -44,8 +44,7 @@ def test_json_full_turn_only_when_asked_and_no_negative_zero(tmp_path, capsys):
     rep = json.loads(text)
     assert "ok_full_turn" not in rep["checks"] and rep["checks"]["crank_turns_fully"] is False
     assert "-0.0," not in text and "-0.0\n" not in text
-    main(["synth", "function", str(pairs), "--deg", "--full-turn", "--free-offsets", "-o", str(tmp_path / "b.toml"),
-          "--json"])
+    main(["synth", "function", str(pairs), "--deg", "--full-turn", "--free-offsets", "-o", str(tmp_path / "b.toml"), "--json"])
     rep = json.loads(capsys.readouterr().out)
     assert rep["checks"]["ok_full_turn"] is rep["checks"]["crank_turns_fully"]
 

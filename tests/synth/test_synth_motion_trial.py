@@ -56,7 +56,7 @@ def test_old_p0_design_crosses_a_dead_zone():
 
 
 def test_crank_order_full_turn_cyclic_either_direction():
-    L = [np.array([v]) for v in (3.0, 1.0, 3.5, 2.5)]        # crank-rocker: the crank turns fully
+    L = [np.array([v]) for v in (3.0, 1.0, 3.5, 2.5)]  # crank-rocker: the crank turns fully
     good = [[0.1, 1.0, 2.0, 3.0], [3.0, 5.0, 0.5, 1.0], [3.0, 2.0, 1.0, -2.5]]
     bad = [[1.0, 0.1, 2.0, 3.0], [0.1, 2.0, 1.0, 3.0]]
     for t in good:

@@ -17,8 +17,10 @@ ELL = np.column_stack([2 + 1.5 * np.cos(np.radians(T_DEG)), 3 + 0.8 * np.sin(np.
 
 
 def _csv(path, pts, theta=None, header="x,y"):
-    rows = [f"{float(x)!r},{float(y)!r}" + ("" if theta is None else f",{float(t)!r}")
-            for (x, y), t in zip(pts, theta if theta is not None else [None] * len(pts))]
+    rows = [
+        f"{float(x)!r},{float(y)!r}" + ("" if theta is None else f",{float(t)!r}")
+        for (x, y), t in zip(pts, theta if theta is not None else [None] * len(pts))
+    ]
     path.write_text(header + "\n" + "\n".join(rows) + "\n")
     return str(path)
 
@@ -27,8 +29,26 @@ def _csv(path, pts, theta=None, header="x,y"):
 def test_unusable_pivots_box_is_exit_3_with_reason_nothing_written(tmp_path, capsys, seed, kind):
     src = _csv(tmp_path / "ell6.csv", ELL)
     out = tmp_path / "far.toml"
-    assert main(["synth", "path", src, "--pivots=100,100,100.1,100.1", "-o", str(out), "--budget", "quick",
-                 "--seed", str(seed), "--json", "--type", kind]) == 3
+    assert (
+        main(
+            [
+                "synth",
+                "path",
+                src,
+                "--pivots=100,100,100.1,100.1",
+                "-o",
+                str(out),
+                "--budget",
+                "quick",
+                "--seed",
+                str(seed),
+                "--json",
+                "--type",
+                kind,
+            ]
+        )
+        == 3
+    )
     rep = json.loads(capsys.readouterr().out)
     assert rep["ok"] is False and "--pivots box" in rep["reason"] and "outside" in rep["reason"]
     assert not out.exists()
@@ -41,7 +61,7 @@ def test_same_relative_error_at_any_scale_and_refusal_of_unrepresentable(tmp_pat
         d = synthesise_path(ELL * k, th, budget="quick", seed=0)
         assert d.ok, d.checks
         rel.append(d.sse / k**2)
-    assert max(rel) < 1.01 * min(rel), rel           # timed: a real (non-zero) error, the same at every scale
+    assert max(rel) < 1.01 * min(rel), rel  # timed: a real (non-zero) error, the same at every scale
     # planar's own solver of the mapped-back design at scale 1e-6, not the search, gives that error
     d = synthesise_path(ELL * 1e-6, th, budget="quick", seed=0)
     got = d.fourbar().solve(th).points["coupler_point"]
@@ -62,8 +82,7 @@ def test_tolerance_decides_the_exit_status(tmp_path, capsys):
     # RMS distance over the targets' RMS radius about their centroid, from the sse
     size = np.sqrt(np.mean(np.sum((ELL - ELL.mean(0)) ** 2, axis=1)))
     assert e == pytest.approx(np.sqrt(rep["sse"] / len(ELL)) / size, rel=1e-12) and 0 < e < 0.01
-    assert main(["synth", "path", src, "--deg", "-o", str(out), "--budget", "quick", "--tolerance",
-                 f"{e / 2}"]) == 3
+    assert main(["synth", "path", src, "--deg", "-o", str(out), "--budget", "quick", "--tolerance", f"{e / 2}"]) == 3
     text = capsys.readouterr().out
     assert "over --tolerance" in text and out.exists()
 
@@ -72,7 +91,7 @@ def test_bad_target_files_are_refused(tmp_path, capsys):
     out = tmp_path / "o.toml"
     cases = [
         (_csv(tmp_path / "a.csv", ELL, T_DEG, "x,y,angle"), [], ["angle", "theta"]),
-        (_csv(tmp_path / "d.csv", ELL, T_DEG, "x,y,theta"), [], ["--deg"]),       # degrees given as radians
+        (_csv(tmp_path / "d.csv", ELL, T_DEG, "x,y,theta"), [], ["--deg"]),  # degrees given as radians
         (_csv(tmp_path / "s.csv", ELL, [0.1, 0.5, 0.9, 0.5, 1.3, 1.6], "x,y,theta"), [], ["targets 2 and 4"]),
         (_csv(tmp_path / "p.csv", ELL), ["--points", "20"], ["--points"]),
         (_csv(tmp_path / "q.csv", ELL), ["--topology", "watt"], ["--topology", "sixbar"]),
@@ -87,16 +106,16 @@ def test_bad_target_files_are_refused(tmp_path, capsys):
 def test_bom_csv_is_read(tmp_path, capsys):
     p = tmp_path / "bom.csv"
     _csv(tmp_path / "plain.csv", ELL)
-    p.write_bytes(b"\xef\xbb\xbf" + (tmp_path / "plain.csv").read_bytes())   # as Excel's "CSV UTF-8" writes
+    p.write_bytes(b"\xef\xbb\xbf" + (tmp_path / "plain.csv").read_bytes())  # as Excel's "CSV UTF-8" writes
     assert main(["synth", "path", str(p), "-o", str(tmp_path / "b.toml"), "--budget", "quick"]) == 0
     capsys.readouterr()
 
 
 def test_constraints_named_with_value_and_limit_and_rounding_passes():
     row = np.array([1.21 * 5 * (1 + 1.1e-9 / 2), 1.21, 4.0, 5.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-    assert constraint_failures(row, Constraints(max_ratio=5.0)) == []          # ratio 5.0000000028: rounding
+    assert constraint_failures(row, Constraints(max_ratio=5.0)) == []  # ratio 5.0000000028: rounding
     row[0] = 1.21 * 5 * (1 + 3e-9)
-    assert len(constraint_failures(row, Constraints(max_ratio=5.0))) == 1       # past the 1e-9 tolerance
+    assert len(constraint_failures(row, Constraints(max_ratio=5.0))) == 1  # past the 1e-9 tolerance
     row[0] = 1.21 * 5.01
     (f,) = constraint_failures(row, Constraints(max_ratio=5.0))
     assert "link ratio 5.01" in f and "ground" in f and "crank" in f and "--max-ratio 5" in f
@@ -110,7 +129,7 @@ def test_sixbar_ratio_counts_the_ground_sides():
 
     assert sixbar_constraint_failures(ROW6, Constraints(max_ratio=10.0), "watt") == []
     far = ROW6.copy()
-    far[9:11] = (27.0, 4.0)                     # O6 29 from O2, 23 from O4, the crank 1 long
+    far[9:11] = (27.0, 4.0)  # O6 29 from O2, 23 from O4, the crank 1 long
     (f,) = sixbar_constraint_failures(far, Constraints(max_ratio=10.0), "watt")
     assert "longest ground O2-O6" in f and "shortest crank" in f
 
@@ -119,7 +138,7 @@ def test_sixbar_says_where_it_cannot_be_assembled():
     from planar.synth.sixbar import SixBarDesign, check_sixbar, sixbar_points
 
     row = ROW6.copy()
-    row[11:13] = (2.5, 3.0)                     # the second dyad opens for part of the turn
+    row[11:13] = (2.5, 3.0)  # the second dyad opens for part of the turn
     th = np.linspace(0.2, 2.6, 5)
     x, y, _ = sixbar_points(row[None], th, "watt")
     d = SixBarDesign("watt", row, th, np.column_stack([x[0], y[0]]), True, 0.0, 0.0)

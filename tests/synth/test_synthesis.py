@@ -28,8 +28,9 @@ def _poses(fb: FourBar, theta: np.ndarray) -> np.ndarray:
 def test_kernel_matches_fourbar_solve(circuit):
     fb = FourBar(4, 1, 4, 3, coupler_point=(1.5, -2.0), circuit=circuit, placement=(0.3, -0.2, 0.7))
     th = np.linspace(0, 2 * np.pi, 64, endpoint=False)
-    x, y, ok = coupler_points(np.array([[4, 1, 4, 3, 1.5, -2.0, 0.3, -0.2, 0.7]], float), th,
-                              np.array([1.0 if circuit == "open" else -1.0]))
+    x, y, ok = coupler_points(
+        np.array([[4, 1, 4, 3, 1.5, -2.0, 0.3, -0.2, 0.7]], float), th, np.array([1.0 if circuit == "open" else -1.0])
+    )
     ref = fb.solve(th).points["coupler_point"]
     assert ok.all()
     assert np.abs(np.column_stack([x[0], y[0]]) - ref).max() < 1e-12
@@ -146,12 +147,11 @@ def test_svg_target_read_by_svgelements(tmp_path):
     from planar.synth.targets import read_path_targets
 
     svg = tmp_path / "t.svg"
-    svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100">'
-                   '<path d="M 10 10 L 50 10 L 50 50 Z"/></svg>')
+    svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100"><path d="M 10 10 L 50 10 L 50 50 Z"/></svg>')
     pts, theta = read_path_targets(svg, 8)
     assert theta is None and pts.shape == (8, 2)
-    assert np.allclose(pts[0], (10, -10))          # y up
-    x, y = pts.T   # every point on the triangle (10,10)-(50,10)-(50,50), y negated
+    assert np.allclose(pts[0], (10, -10))  # y up
+    x, y = pts.T  # every point on the triangle (10,10)-(50,10)-(50,50), y negated
     on = (np.abs(y + 10) < 1e-9) | (np.abs(x - 50) < 1e-9) | (np.abs(x + y) < 1e-9)
     assert on.all()
     step = np.hypot(*np.diff(np.vstack([pts, pts[:1]]), axis=0).T)
@@ -166,7 +166,7 @@ def test_bench_synthesis_quick_timed_problem():
     assert c["planar"]["ok"] and c["planar"]["sse_min"] < 1e-3
     assert "pylinkage" in c["pylinkage"]["call"] and c["published_best_error"]
     assert r["kernel_candidates_per_s"]["median"] > 0
-    o = c["pylinkage_optimisers"]   # timed: pylinkage's own sse and planar's, at the same crank angles
+    o = c["pylinkage_optimisers"]  # timed: pylinkage's own sse and planar's, at the same crank angles
     # (pylinkage's swarm is unseeded: whether its best also passes planar's design checks, e.g. the link-ratio
     # bound, varies from run to run; the two scorings of the same linkage must agree every time)
     assert np.isfinite(o["sse_min"]) and o["sse_min"] == pytest.approx(o["pylinkage_sse_of_best"], rel=1e-9)
@@ -208,8 +208,9 @@ def test_failed_checks_are_loud(tmp_path, capsys):
     from planar.synth.path import FourBarDesign, check_design
 
     # a double-rocker's crank cannot turn: the design's own check fails
-    d = FourBarDesign(4, 3, 1.5, 3.5, (0.5, 0.2), "open", (0, 0, 0), np.array([0.5, 1.0, 1.5]), float("nan"),
-                      np.zeros((3, 2)), True, 0.0)
+    d = FourBarDesign(
+        4, 3, 1.5, 3.5, (0.5, 0.2), "open", (0, 0, 0), np.array([0.5, 1.0, 1.5]), float("nan"), np.zeros((3, 2)), True, 0.0
+    )
     check_design(d)
     assert not d.ok and not d.checks["ok_crank_turns_fully"]
     # four pairs no four-bar follows within 0.01 rad: written, reported, exit 3

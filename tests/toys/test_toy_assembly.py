@@ -34,7 +34,7 @@ def test_piece_count_is_the_rigid_bodies(toys):
         for plane in ("xy", "xz"):
             names = [p.name for p in asm.parts if p.plane == plane]
             for i, a in enumerate(names):
-                for b in names[i + 1:]:
+                for b in names[i + 1 :]:
                     rel = poses_compose(poses_invert(m.poses[a]), m.poses[b])
                     rel[:, 2] = np.unwrap(rel[:, 2])
                     rigid = float(np.ptp(rel, axis=0).max()) < 1e-9
@@ -232,4 +232,3 @@ def test_a_slide_repeated_on_one_line_is_cut_once(toys):
     slides = [j for j in asm.joints if isinstance(j, Slide)]
     pairs = [(j.a, j.b) for j in slides]
     assert len(pairs) == len(set(pairs))
-

@@ -86,9 +86,11 @@ def test_table_torque_is_the_toys_inverse_dynamics_with_gravity_in_each_plane(gr
 
 def test_a_toy_that_cannot_be_assembled_gets_its_panels_and_a_note(tmp_path: Path, capsys) -> None:
     scene = tmp_path / "turned8.toml"
-    scene.write_text('name = "ns"\nangle_unit = "deg"\n[mechanism]\ntype = "toy"\nleft = [["Rz->Ty"]]\n'
-                     'right = [["Rz->Ty", "Ty->Ox"]]\n[driver]\nspeed = 0.5\nsamples_per_cycle = 36\n'
-                     '[effects]\ngravity = [9.81, 0.0]\n')
+    scene.write_text(
+        'name = "ns"\nangle_unit = "deg"\n[mechanism]\ntype = "toy"\nleft = [["Rz->Ty"]]\n'
+        'right = [["Rz->Ty", "Ty->Ox"]]\n[driver]\nspeed = 0.5\nsamples_per_cycle = 36\n'
+        "[effects]\ngravity = [9.81, 0.0]\n"
+    )
     out = tmp_path / "m.csv"
     assert main(["motion", str(scene), "-o", str(out)]) == 0
     text = capsys.readouterr().out

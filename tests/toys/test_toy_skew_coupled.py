@@ -66,8 +66,9 @@ def test_the_ears_share_of_inverse_dynamics_is_its_power_balance(gravity):
     eff = Effects(gravity=gravity)
     w = toy.driver.rate
     t = np.linspace(0.0, toy.driver.period, 2001)
-    share = (inverse_dynamics_torque(mech, t, eff, {"s1.follower": 3.0})
-             - inverse_dynamics_torque(mech, t, eff, {"s1.follower": 1e-12}))
+    share = inverse_dynamics_torque(mech, t, eff, {"s1.follower": 3.0}) - inverse_dynamics_torque(
+        mech, t, eff, {"s1.follower": 1e-12}
+    )
     part = mech.part("s1.follower")
     m, cog, ic = mass_properties(part, 3.0)
     pose = mech.solve(toy.driver.value(t)).poses["s1.follower"]
@@ -88,8 +89,12 @@ def test_a_six_on_a_turning_driver_with_gravity_in_the_followers_plane():
     # #6 (Oz->Ox): the edge on a turning piece; gravity along -y acts in the follower's plane
     from planar.scene.load import build_scene, parse_scene
 
-    data = {"name": "six", "mechanism": {"type": "toy", "left": [["Rz->Oz", "Oz->Ox"]]}, "driver": {"speed": 0.5},
-            "effects": {"gravity": [0.0, -9.81]}}
+    data = {
+        "name": "six",
+        "mechanism": {"type": "toy", "left": [["Rz->Oz", "Oz->Ox"]]},
+        "driver": {"speed": 0.5},
+        "effects": {"gravity": [0.0, -9.81]},
+    }
     sc = build_scene(parse_scene(data, "six.toml"), "six.toml")
     toy = sc.mechanism
     mech = coupled_mechanism(toy_assembly(toy))

@@ -130,8 +130,7 @@ def test_gravity_in_the_followers_plane_holds_slow_and_lets_go_fast_as_pymunk_sa
     assert skew_hold(mech, (9.81, 0.0), 0.1, drive=drive).critical_speed == 0.0
 
 
-@pytest.mark.parametrize("gravity, holds", [("[9.81, 0.0]", False), ("[9.81, -9.81]", True),
-                                            ("[69.367175, -69.367175]", True)])
+@pytest.mark.parametrize("gravity, holds", [("[9.81, 0.0]", False), ("[9.81, -9.81]", True), ("[69.367175, -69.367175]", True)])
 def test_bunny_ear_needs_gravity_in_its_plane(tmp_path: Path, gravity: str, holds: bool) -> None:
     """The gallery Bunny's #9 ear turns in yz: gx (the old gallery gravity) is normal to it and holds nothing; the
     gallery's gravity has a -y part that holds the pin on the slider's edge at its speed."""

@@ -44,8 +44,9 @@ def test_table_has_30_patterns_each_realised_by_a_rotated_mechanism():
 def test_chain_counts_match_the_supplement():
     assert chain_counts(3) == {"Ox": 17, "Oy": 14, "Oz": 19, "Tx": 10, "Ty": 10, "Tz": 6, "OzT": 1}
     assert chain_counts(3, optional=True)["Oy"] == 17
-    assert {k: v for k, v in chain_counts(3, optional=True).items() if k != "Oy"} == \
-        {k: v for k, v in chain_counts(3).items() if k != "Oy"}
+    assert {k: v for k, v in chain_counts(3, optional=True).items() if k != "Oy"} == {
+        k: v for k, v in chain_counts(3).items() if k != "Oy"
+    }
 
 
 def test_chains_are_valid_paths_from_the_motor():
@@ -104,8 +105,7 @@ def test_rotated_stage_carries_signs():
     base = st0.mech.forward(q).out
     np.testing.assert_allclose(outs[0], st0.realisation.sign_out * base)
     st1 = m.stages[1]
-    np.testing.assert_allclose(outs[1], st1.realisation.sign_out *
-                               st1.mech.forward(st1.realisation.sign_in * outs[0]).out)
+    np.testing.assert_allclose(outs[1], st1.realisation.sign_out * st1.mech.forward(st1.realisation.sign_in * outs[0]).out)
 
 
 @pytest.mark.parametrize("factory", [horse, bunny])

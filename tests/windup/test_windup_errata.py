@@ -116,9 +116,11 @@ def _six(k):
             kk, c = np.tan(u), (p0[1] - q[1] - r) / np.cos(u)
             return r * r * kk * kk, kk * (p0[0] - q[0]) + c + q[1] - p0[1], N
     else:  # red frame centred at p0, s on the pivot axis under p0
+
         def LMN(u):
             kk, c = -np.tan(P.phi), -r / np.cos(P.phi) + u * np.tan(P.phi)
             return r * r * kk * kk, c, N
+
     return P, r, LMN
 
 

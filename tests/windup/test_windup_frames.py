@@ -51,20 +51,21 @@ def test_moving_D_o_moves_every_part(k):
     for part in base.parts:
         d = _plane_shift(part, v) if not part.ground else np.zeros(2)
         pa, pb = ma.poses[part.name], mb.poses[part.name]
-        np.testing.assert_allclose(pb[:, :2] - pa[:, :2], np.broadcast_to(d, pa[:, :2].shape), rtol=0, atol=1e-12,
-                                   err_msg=f"#{k} {part.name}")
+        np.testing.assert_allclose(
+            pb[:, :2] - pa[:, :2], np.broadcast_to(d, pa[:, :2].shape), rtol=0, atol=1e-12, err_msg=f"#{k} {part.name}"
+        )
         np.testing.assert_allclose(pb[:, 2], pa[:, 2], rtol=0, atol=1e-12, err_msg=f"#{k} {part.name} angle")
         other = moved.part(part.name)
         if part.ground:  # the ground's features are in world: they move with D_o
             h0, h1 = np.array(part.hull), np.array(other.hull)
-            np.testing.assert_allclose(h1[:, :2] - h0[:, :2], np.broadcast_to(_plane_shift(part, v), h0[:, :2].shape),
-                                       atol=1e-12)
+            np.testing.assert_allclose(h1[:, :2] - h0[:, :2], np.broadcast_to(_plane_shift(part, v), h0[:, :2].shape), atol=1e-12)
         else:  # moving parts are drawn in their own frames: identical outlines
             assert abs(other.outline.symmetric_difference(part.outline).area) < 1e-12
         # a part moving in "yz" (#6, #9 follower) sits at x = offset: it moves by the shift's x
         axis = ({"x", "y", "z"} - set(part.plane)).pop()
-        assert other.offset - part.offset == pytest.approx(v[AXES[axis]] if AXES[axis] < v.size and part.offset else 0.0,
-                                                           abs=1e-12)
+        assert other.offset - part.offset == pytest.approx(
+            v[AXES[axis]] if AXES[axis] < v.size and part.offset else 0.0, abs=1e-12
+        )
     # every joint of the moved mechanism still closes (its own residual, in world)
     for j in moved.joints:
         assert float(np.max(j.residual(mb.poses))) < 1e-9 * moved.size, f"#{k} {j.name}"

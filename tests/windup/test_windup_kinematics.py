@@ -34,10 +34,12 @@ def residual_fn(k, P, u):
         return lambda dx: m[0] - (P.D_jc[0] + dx)
     if k == 2:
         s, m0 = xy(P.F_o), xy(P.D_jc)
+
         def g(a):
             L0 = s + R(a) @ (m0 - s)
             d = R(a) @ [1.0, 0.0]
             return d[0] * (m - L0)[1] - d[1] * (m - L0)[0]
+
         return g
     if k == 3:
         p0, m0 = xy(P.F_o), xy(P.D_jc)
@@ -57,9 +59,11 @@ def residual_fn(k, P, u):
     if k == 7:
         s, p0 = xy(P.F_o), xy(P.D_jc)
         p = p0 + [u, 0.0]
+
         def g(a):
             d = R(a) @ (p0 - s)
             return d[0] * (p - s)[1] - d[1] * (p - s)[0]
+
         return g
     if k == 8:
         B = np.array([P.F_o[0], P.F_o[2]])
@@ -108,8 +112,12 @@ def _cylinder_clearance(k, P, u, a):
     vals = dist(phis)
     sign = 1.0 if np.median(vals) > 0 else -1.0
     i = int(np.argmin(sign * vals))
-    res = minimize_scalar(lambda p: float(sign * dist(np.asarray(p, float))), bounds=(phis[i] - 0.01, phis[i] + 0.01),
-                          method="bounded", options={"xatol": 1e-14})
+    res = minimize_scalar(
+        lambda p: float(sign * dist(np.asarray(p, float))),
+        bounds=(phis[i] - 0.01, phis[i] + 0.01),
+        method="bounded",
+        options={"xatol": 1e-14},
+    )
     return res.fun
 
 
@@ -160,6 +168,7 @@ def _perturbed(k, rng):
     base = params_for(k)
     kw = {}
     from dataclasses import fields
+
     for f in fields(base):
         v = getattr(base, f.name)
         if f.name in ("D_o", "D_theta", "path", "amplitude") or f.name.endswith(("r", "w1", "w2")):

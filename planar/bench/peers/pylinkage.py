@@ -50,8 +50,10 @@ STEPS = 360
 POLISH_STEPS = 3600
 
 #: the swarm and polish budgets: pylinkage's defaults (100 particles, 200 iterations) and a quick one
-BUDGETS = {"quick": {"n_particles": 40, "iterations": 50, "polish": 300},
-           "normal": {"n_particles": 100, "iterations": 200, "polish": 1000}}
+BUDGETS = {
+    "quick": {"n_particles": 40, "iterations": 50, "polish": 300},
+    "normal": {"n_particles": 100, "iterations": 200, "polish": 1000},
+}
 
 
 def place(p: Array, circuit: float) -> tuple[Array, Array, Array, Array, Array] | None:
@@ -86,8 +88,10 @@ class PylinkageFourBar:
         if theta is not None:
             k = np.asarray(theta, float) / (2 * np.pi / steps)
             if np.max(np.abs(k - np.rint(k))) > 1e-6:
-                raise PlanarError(f"pylinkage peer: prescribed crank angles must be whole multiples of "
-                                  f"{360 / steps:g} degrees, got {np.degrees(theta).tolist()}")
+                raise PlanarError(
+                    f"pylinkage peer: prescribed crank angles must be whole multiples of "
+                    f"{360 / steps:g} degrees, got {np.degrees(theta).tolist()}"
+                )
             self.rows = (np.rint(k).astype(np.int64) - 1) % steps
         joints = place(np.array([3.0, 1.0, 3.0, 2.5, 1.0, 0.5, 0.0, 0.0, 0.0]), 1.0)
         assert joints is not None
@@ -153,9 +157,16 @@ def optimise(targets: Array, theta: Array | None, budget: str = "normal") -> dic
         x = np.asarray(dims, float)
         return peer.sse(x[:9], x[9])
 
-    ens = particle_swarm_optimization(swarm_fitness, peer.linkage, dimensions=10, bounds=(lo, hi),
-                                      n_particles=b["n_particles"], iterations=b["iterations"],
-                                      order_relation=min, verbose=False)
+    ens = particle_swarm_optimization(
+        swarm_fitness,
+        peer.linkage,
+        dimensions=10,
+        bounds=(lo, hi),
+        n_particles=b["n_particles"],
+        iterations=b["iterations"],
+        order_relation=min,
+        verbose=False,
+    )
     x = np.asarray(ens.dimensions[0], float)
     swarm_sse = float(ens.scores["score"][0])
     circ = 1.0 if x[9] >= 0 else -1.0
@@ -171,16 +182,25 @@ def optimise(targets: Array, theta: Array | None, budget: str = "normal") -> dic
     polished_sse = swarm_sse = fine.sse(x[:9], circ) if fine is not peer else swarm_sse
     if math.isfinite(swarm_sse):
         x0 = [x[1], x[2], x[3], float(np.hypot(x[4], x[5])), math.atan2(x[5], x[4])]
-        pol = minimize_linkage(polish_fitness, fine.linkage, x0=x0, order_relation=min, method="Nelder-Mead",
-                               maxiter=b["polish"], verbose=False)
+        pol = minimize_linkage(
+            polish_fitness, fine.linkage, x0=x0, order_relation=min, method="Nelder-Mead", maxiter=b["polish"], verbose=False
+        )
         polished_sse = float(pol.scores["score"][0])
         if polished_sse < swarm_sse:
             r2, r3, r4, dist, ang = (float(v) for v in pol.dimensions[0])
             x[1:6] = [r2, r3, r4, dist * math.cos(ang), dist * math.sin(ang)]
         else:
             polished_sse = swarm_sse
-    return {"params": x[:9], "circuit": circ, "swarm_sse": swarm_sse, "pylinkage_sse": polished_sse,
-            "evaluations": peer.evaluations + (fine.evaluations if fine is not peer else 0), "time_s": time.perf_counter() - t0,
-            "calls": (f"optimization.particle_swarm_optimization(dimensions=10, n_particles={b['n_particles']}, "
-                      f"iterations={b['iterations']}, order_relation=min), then "
-                      f"optimization.minimize_linkage(method='Nelder-Mead', maxiter={b['polish']}, order_relation=min)")}
+    return {
+        "params": x[:9],
+        "circuit": circ,
+        "swarm_sse": swarm_sse,
+        "pylinkage_sse": polished_sse,
+        "evaluations": peer.evaluations + (fine.evaluations if fine is not peer else 0),
+        "time_s": time.perf_counter() - t0,
+        "calls": (
+            f"optimization.particle_swarm_optimization(dimensions=10, n_particles={b['n_particles']}, "
+            f"iterations={b['iterations']}, order_relation=min), then "
+            f"optimization.minimize_linkage(method='Nelder-Mead', maxiter={b['polish']}, order_relation=min)"
+        ),
+    }
