@@ -16,13 +16,13 @@ from __future__ import annotations
 
 import os
 import struct
-from typing import Iterable, Sequence
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 
 from planar.fileio import atomic_write
 
-__all__ = ["write_gif", "indexer", "frame_delay_ms", "MIN_DELAY_MS"]
+__all__ = ["MIN_DELAY_MS", "frame_delay_ms", "indexer", "write_gif"]
 
 MIN_DELAY_MS = 20
 

@@ -11,14 +11,14 @@ from __future__ import annotations
 
 import contextlib
 import os
+from collections.abc import Iterable
 from pathlib import Path
-from typing import Iterable
 
 import numpy as np
 
 from planar.errors import InputError
 
-__all__ = ["write_video", "VIDEO_CODECS", "video_available"]
+__all__ = ["VIDEO_CODECS", "video_available", "write_video"]
 
 #: container suffix -> (codec, extra ffmpeg output arguments)
 VIDEO_CODECS: dict[str, tuple[str, list[str]]] = {

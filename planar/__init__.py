@@ -18,14 +18,14 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = [
     "AssemblyError",
+    "Driver",
     "InputError",
     "LimitError",
-    "PlanarError",
-    "SceneError",
-    "Driver",
     "Mechanism",
     "Motion",
     "Part",
+    "PlanarError",
+    "SceneError",
     "joint_residuals",
 ]
 __version__ = "0.1.0"

@@ -10,7 +10,7 @@ either; so are :class:`AssemblyError` and :class:`SceneError`.
 
 from __future__ import annotations
 
-__all__ = ["PlanarError", "InputError", "AssemblyError", "SceneError", "LimitError", "short_repr"]
+__all__ = ["AssemblyError", "InputError", "LimitError", "PlanarError", "SceneError", "short_repr"]
 
 
 class PlanarError(Exception):

@@ -16,16 +16,16 @@ import csv
 import io
 import os
 import tempfile
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
-from typing import IO, Any, Iterator
+from typing import IO, Any
 
 import numpy as np
 
 from planar.core.model import Mechanism, Motion
 from planar.errors import InputError
 
-__all__ = ["atomic_write", "output_transaction", "check_output", "check_name", "motion_columns", "write_motion_csv"]
+__all__ = ["atomic_write", "check_name", "check_output", "motion_columns", "output_transaction", "write_motion_csv"]
 
 #: the temporaries ``(tmp, target)`` of the innermost :func:`output_transaction`, renamed at its end
 _PENDING: contextvars.ContextVar[list[tuple[str, Path]] | None] = contextvars.ContextVar("_PENDING", default=None)

@@ -43,16 +43,16 @@ if TYPE_CHECKING:
     from planar.core.model import Driver, Mechanism, Motion
 
 __all__ = [
-    "PartRates",
     "Derivatives",
+    "PartRates",
+    "derivative_columns",
     "driver_rates",
-    "rates_method",
     "mechanism_rates",
     "motion_derivatives",
     "motor_torque",
     "point_rates",
+    "rates_method",
     "transmission_angles",
-    "derivative_columns",
 ]
 
 Array = NDArray[np.float64]
@@ -107,7 +107,7 @@ def _node_solve(mech: Any, q: Array) -> Any:
     return solved
 
 
-def driver_rates(driver: "Driver", t: ArrayLike) -> tuple[Array, Array]:
+def driver_rates(driver: Driver, t: ArrayLike) -> tuple[Array, Array]:
     """The driver's rate and its rate of change at times ``t`` (s): ``(dq/dt, d2q/dt2)``."""
     tt = np.asarray(t, float)
     if driver.amplitude is None:
@@ -117,7 +117,7 @@ def driver_rates(driver: "Driver", t: ArrayLike) -> tuple[Array, Array]:
 
 
 def mechanism_rates(
-    mech: "Mechanism", q: ArrayLike, qd: ArrayLike = 1.0, qdd: ArrayLike = 0.0
+    mech: Mechanism, q: ArrayLike, qd: ArrayLike = 1.0, qdd: ArrayLike = 0.0
 ) -> tuple[dict[str, PartRates], Mask, str]:
     """Rates of every part for driver values ``q``, rates ``qd`` and ``qdd`` per sample.
 
@@ -182,7 +182,7 @@ def _cam_rates(mech: Any, q: Array, qd: Array, qdd: Array) -> tuple[dict[str, Pa
     return parts, valid, "cam motion law (closed form) through the linkage's closure equations, differentiated twice"
 
 
-def rates_method(mech: "Mechanism") -> str:
+def rates_method(mech: Mechanism) -> str:
     """How :func:`mechanism_rates` finds ``mech``'s rates (one line, for reports), from one sample."""
     q = np.zeros(1)
     return mechanism_rates(mech, mech.driver.value(q), 1.0, 0.0)[2]
@@ -199,7 +199,7 @@ def point_rates(poses: ArrayLike, rates: PartRates, world_points: ArrayLike) -> 
     return v, a
 
 
-def transmission_angles(mech: "Mechanism", q: ArrayLike) -> dict[str, Array]:
+def transmission_angles(mech: Mechanism, q: ArrayLike) -> dict[str, Array]:
     """Transmission angle (rad, ``[0, pi]``) of every RRR dyad of a linkage, keyed by its node.
 
     The angle between the two links meeting at the dyad's joint (a four-bar's
@@ -219,7 +219,7 @@ def transmission_angles(mech: "Mechanism", q: ArrayLike) -> dict[str, Array]:
     return {n.name: n.transmission(pos) for n in rrr}
 
 
-def motion_derivatives(mech: "Mechanism", motion: "Motion") -> Derivatives:
+def motion_derivatives(mech: Mechanism, motion: Motion) -> Derivatives:
     """Rates of a solved motion whose sample times ``motion.t`` are set (the driver's law gives the rates)."""
     if motion.t is None:
         raise InputError(f"{mech.name}.motion.t", None, "sample times (solve with t=..., or Mechanism.run)")
@@ -228,7 +228,7 @@ def motion_derivatives(mech: "Mechanism", motion: "Motion") -> Derivatives:
     return _derivatives(mech, motion, parts, ok, method)
 
 
-def _derivatives(mech: "Mechanism", motion: "Motion", parts: dict[str, PartRates], ok: Mask, method: str = "") -> Derivatives:
+def _derivatives(mech: Mechanism, motion: Motion, parts: dict[str, PartRates], ok: Mask, method: str = "") -> Derivatives:
     points = {}
     for name, (part, _) in mech.points.items():
         points[name] = point_rates(motion.poses[part], parts[part], motion.points[name])
@@ -236,8 +236,8 @@ def _derivatives(mech: "Mechanism", motion: "Motion", parts: dict[str, PartRates
 
 
 def motor_torque(
-    mech: "Mechanism",
-    motion: "Motion",
+    mech: Mechanism,
+    motion: Motion,
     effects: Any = None,
     t_rest: float | None = None,
     densities: dict[str, float] | None = None,
@@ -254,7 +254,7 @@ def motor_torque(
     return _torque(mech, motion, rates, coef, effects, t_rest, densities), ok
 
 
-def _rates_and_coefficients(mech: "Mechanism", motion: "Motion") -> tuple[dict[str, PartRates], dict[str, PartRates], Mask]:
+def _rates_and_coefficients(mech: Mechanism, motion: Motion) -> tuple[dict[str, PartRates], dict[str, PartRates], Mask]:
     """Rates at the driver's law and at unit driver speed (the velocity coefficients ``d/dq``)."""
     if motion.t is None:
         raise InputError(f"{mech.name}.motion.t", None, "sample times (solve with t=..., or Mechanism.run)")
@@ -265,8 +265,8 @@ def _rates_and_coefficients(mech: "Mechanism", motion: "Motion") -> tuple[dict[s
 
 
 def _torque(
-    mech: "Mechanism",
-    motion: "Motion",
+    mech: Mechanism,
+    motion: Motion,
     rates: dict[str, PartRates],
     coef: dict[str, PartRates],
     effects: Any,
@@ -313,7 +313,7 @@ def _dot(a: Array, b: Array) -> Array:
     return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]
 
 
-def derivative_columns(mech: "Mechanism", motion: "Motion", effects: Any = None) -> tuple[list[str], list[Array]]:
+def derivative_columns(mech: Mechanism, motion: Motion, effects: Any = None) -> tuple[list[str], list[Array]]:
     """The ``--derivatives`` columns of a motion table.
 
     ``<point>.vx .vy .ax .ay`` for every named point, ``<part>.omega .alpha``

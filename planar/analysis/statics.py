@@ -29,7 +29,8 @@ speeds in rad/s, torques in force x model-unit.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Mapping
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -42,22 +43,22 @@ if TYPE_CHECKING:
 
 __all__ = [
     "TOGGLE_SINE",
-    "fourbar_velocities",
-    "fourbar_accelerations",
-    "node_velocities",
-    "point_velocities",
     "finite_difference",
-    "instant_centre",
-    "velocity_about_centre",
+    "fourbar_accelerations",
     "fourbar_instant_centre",
-    "world_velocity",
-    "input_torque",
-    "virtual_work_torque",
-    "motor_torque",
-    "static_foot_loads",
+    "fourbar_velocities",
     "fourier_acceleration",
     "fourier_peak_bound",
     "friction_limit",
+    "input_torque",
+    "instant_centre",
+    "motor_torque",
+    "node_velocities",
+    "point_velocities",
+    "static_foot_loads",
+    "velocity_about_centre",
+    "virtual_work_torque",
+    "world_velocity",
 ]
 
 Array = NDArray[np.float64]
@@ -82,7 +83,7 @@ def _perp(v: Array) -> Array:
 TOGGLE_SINE = 1e-6
 
 
-def fourbar_velocities(fb: "FourBar", theta: ArrayLike, omega2: ArrayLike = 1.0) -> tuple[Array, Array, NDArray[np.bool_]]:
+def fourbar_velocities(fb: FourBar, theta: ArrayLike, omega2: ArrayLike = 1.0) -> tuple[Array, Array, NDArray[np.bool_]]:
     """Coupler and rocker angular velocities ``(omega3, omega4, valid)``.
 
     Notes eqs. (6)-(7), corrected (no ``r_1`` term), solved per sample with
@@ -114,7 +115,7 @@ def fourbar_velocities(fb: "FourBar", theta: ArrayLike, omega2: ArrayLike = 1.0)
 
 
 def fourbar_accelerations(
-    fb: "FourBar", theta: ArrayLike, omega2: ArrayLike = 1.0, alpha2: ArrayLike = 0.0
+    fb: FourBar, theta: ArrayLike, omega2: ArrayLike = 1.0, alpha2: ArrayLike = 0.0
 ) -> tuple[Array, Array, NDArray[np.bool_]]:
     """Coupler and rocker angular accelerations ``(alpha3, alpha4, valid)`` (rad/s^2).
 
@@ -145,7 +146,7 @@ def fourbar_accelerations(
     return al3, al4, ok & okv & ~sing
 
 
-def node_velocities(link: "Linkage", q: ArrayLike, qdot: ArrayLike = 1.0) -> tuple[dict[str, Array], NDArray[np.bool_]]:
+def node_velocities(link: Linkage, q: ArrayLike, qdot: ArrayLike = 1.0) -> tuple[dict[str, Array], NDArray[np.bool_]]:
     """Velocity ``(N, 2)`` of every node of a :class:`~planar.linkages.Linkage`.
 
     Each dyad's closure conditions are differentiated and solved as a 2x2
@@ -170,7 +171,7 @@ def node_velocities(link: "Linkage", q: ArrayLike, qdot: ArrayLike = 1.0) -> tup
     return {k: np.where(ok[:, None], v, 0.0) for k, v in vel.items()}, ok
 
 
-def _dyad_mask(link: "Linkage", q: ArrayLike) -> NDArray[np.bool_]:
+def _dyad_mask(link: Linkage, q: ArrayLike) -> NDArray[np.bool_]:
     """The one validity rule for a linkage's velocities: no dyad within :data:`TOGGLE_SINE` of its toggle.
 
     An RRR node ``P`` (links from ``A`` and ``B``) toggles where ``P - A`` and ``P - B`` fall into
@@ -197,7 +198,7 @@ def _dyad_mask(link: "Linkage", q: ArrayLike) -> NDArray[np.bool_]:
     return ok
 
 
-def point_velocities(link: "Linkage", q: ArrayLike, qdot: ArrayLike = 1.0) -> tuple[dict[str, Array], NDArray[np.bool_]]:
+def point_velocities(link: Linkage, q: ArrayLike, qdot: ArrayLike = 1.0) -> tuple[dict[str, Array], NDArray[np.bool_]]:
     """World velocities ``(N, 2)`` of the linkage's named points (placement applied)."""
     vel, valid = node_velocities(link, q, qdot)
     ang = link.placement[2]
@@ -253,7 +254,7 @@ def velocity_about_centre(point: ArrayLike, centre: ArrayLike, omega: ArrayLike)
     return np.asarray(omega, float)[..., None] * _perp(point - centre)
 
 
-def fourbar_instant_centre(fb: "FourBar", theta: ArrayLike, omega2: float = 1.0) -> tuple[Array, Array, NDArray[np.bool_]]:
+def fourbar_instant_centre(fb: FourBar, theta: ArrayLike, omega2: float = 1.0) -> tuple[Array, Array, NDArray[np.bool_]]:
     """The coupler's instant centre (intersection of lines O2-B and O4-C) and its omega.
 
     Graphical method of notes 2.1.1, in the linkage's own frame.  ``valid``
@@ -378,7 +379,7 @@ def virtual_work_torque(
 
 
 def motor_torque(
-    link: "Linkage",
+    link: Linkage,
     q: ArrayLike,
     loads: Mapping[str, ArrayLike],
     eta_trans: float = 1.0,

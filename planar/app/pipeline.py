@@ -112,7 +112,7 @@ def overlay_motion(scene: Scene) -> Motion:
 ANIMATION_SUFFIXES = (".gif", ".mp4", ".webm")
 
 
-def animation_plan(scene: Scene, out: str | Path, fps: float | None = None) -> "FramePlan":
+def animation_plan(scene: Scene, out: str | Path, fps: float | None = None) -> FramePlan:
     """The frames ``render_scene`` draws for ``out`` (GIF delays are whole 10 ms ticks; video any rate)."""
     from planar.draw.timing import plan_frames, scene_duration
 
@@ -373,7 +373,7 @@ def export_scene(
     bom: str | Path | None = None,
     assembly: str | Path | None = None,
     kerf_test: str | Path | None = None,
-) -> "Fabrication":
+) -> Fabrication:
     """Check, layer and nest a scene's parts and write the requested files (see :mod:`planar.app.export`).
 
     ``kerf`` (mm) and ``sheet`` (width, height in mm) default to the scene's
@@ -442,7 +442,7 @@ def export_mechanism(
     svg: str | Path | None = None,
     fabrication: dict[str, Any] | None = None,
     **files: Any,
-) -> "Fabrication":
+) -> Fabrication:
     """Lay out a mechanism built in Python for cutting, as ``planar export`` would its scene.
 
     ``fabrication``: ``[fabrication]`` keys (``unit_mm``, ``kerf_mm``, ...);

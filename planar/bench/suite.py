@@ -27,7 +27,7 @@ if TYPE_CHECKING:
 
     Array = NDArray[np.float64]
 
-__all__ = ["bench_kinematics", "BENCHMARKS"]
+__all__ = ["BENCHMARKS", "bench_kinematics"]
 
 
 def _best_time(fn: Callable[[], Any], repeats: int) -> float:
@@ -378,7 +378,7 @@ BENCHMARKS["render"] = (bench_render, format_render)
 # --------------------------------------------------------------------------- accuracy
 
 
-def _times(m: "Motion") -> "Array":
+def _times(m: Motion) -> Array:
     """The sample times of a motion solved over time (a scene's motion always has them)."""
     if m.t is None:
         raise PlanarError("benchmark: a motion without sample times")
@@ -514,7 +514,7 @@ def bench_accuracy(
     settings = accuracy_settings(quick, grid)
     d = replace(DEFAULT_SETTINGS, tolerance=1.0)
     prev = _previous_defaults()
-    measured: list["Scene"] = []
+    measured: list[Scene] = []
     skipped: dict[str, str] = {}
     for path in scene_files:
         if quick and len(measured) == 3:

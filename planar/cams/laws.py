@@ -23,15 +23,15 @@ radians for an oscillating one.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from planar.errors import InputError
 
-__all__ = ["LAWS", "Law", "Segment", "Program"]
+__all__ = ["LAWS", "Law", "Program", "Segment"]
 
 Array = NDArray[np.float64]
 TWO_PI = 2.0 * math.pi

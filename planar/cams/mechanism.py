@@ -23,7 +23,8 @@ over its radius (its angle at cam angle 0 is the follower's).
 from __future__ import annotations
 
 import math
-from typing import Any, Mapping, Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -36,7 +37,7 @@ from planar.errors import InputError
 from planar.linkages import Link, Linkage
 from planar.linkages.dyads import Actuator, Crank, Fixed, NodeKind
 
-__all__ = ["CamMechanism", "RESERVED"]
+__all__ = ["RESERVED", "CamMechanism"]
 
 Array = NDArray[np.float64]
 #: names the cam mechanism gives its own nodes and parts

@@ -234,7 +234,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
             "error_bias": settings.error_bias,
         }
         d["wall_time_s"] = sim.wall_time
-        d["built"] = {k: v for k, v in sim.built.items()}
+        d["built"] = dict(sim.built.items())
         print(json.dumps(d, indent=2, default=str))
     else:
         print(format_comparison(result))

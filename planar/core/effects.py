@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["Effects", "Spring", "Load", "NO_EFFECTS"]
+__all__ = ["NO_EFFECTS", "Effects", "Load", "Spring"]
 
 Vec = tuple[float, float]
 

@@ -25,7 +25,7 @@ import os
 
 from planar.errors import InputError, LimitError
 
-__all__ = ["DEFAULTS", "limit", "check_count", "check_memory", "sample_count"]
+__all__ = ["DEFAULTS", "check_count", "check_memory", "limit", "sample_count"]
 
 #: name -> (environment variable, default)
 DEFAULTS: dict[str, tuple[str, int]] = {

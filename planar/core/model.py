@@ -13,9 +13,10 @@ are radians, counter-clockwise positive.
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import TYPE_CHECKING, Any, ClassVar, Literal, Mapping, Protocol, Sequence, TypeVar
+from typing import TYPE_CHECKING, Any, ClassVar, Literal, Protocol, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -28,26 +29,26 @@ if TYPE_CHECKING:  # shapely is imported only when an outline is asked for
     import shapely
 
 __all__ = [
-    "Hole",
-    "Slot",
+    "JOINT_KINDS",
     "ArcSlot",
-    "Part",
-    "Pivot",
-    "PinInSlot",
-    "PinInArcSlot",
-    "Slide",
     "CamOnLine",
+    "Driver",
+    "FinitePoses",
+    "Hole",
     "Joint",
     "JointProtocol",
-    "JOINT_KINDS",
-    "joint_kind",
-    "Driver",
-    "Motion",
     "Mechanism",
-    "joint_residuals",
-    "check_positive",
+    "Motion",
+    "Part",
+    "PinInArcSlot",
+    "PinInSlot",
+    "Pivot",
+    "Slide",
+    "Slot",
     "check_finite",
-    "FinitePoses",
+    "check_positive",
+    "joint_kind",
+    "joint_residuals",
 ]
 
 Vec = tuple[float, float]
@@ -76,7 +77,7 @@ class FinitePoses(dict[str, "NDArray[np.float64]"]):
 
 def check_positive(field_name: str, value: float) -> float:
     """Return ``value`` as float or raise :class:`InputError` unless a finite number > 0 (not a bool or a string)."""
-    if isinstance(value, (bool, str, bytes)) or isinstance(value, np.bool_):
+    if isinstance(value, (bool, str, bytes, np.bool_)):
         raise InputError(field_name, value, "a positive number")
     try:
         v = float(value)
@@ -124,7 +125,7 @@ class Part:
     polygon: tuple[Vec, ...] | None = None
 
     @cached_property
-    def outline(self) -> "shapely.Polygon":
+    def outline(self) -> shapely.Polygon:
         """The outline as a shapely polygon with holes and slots cut out."""
         from planar.core.outlines import part_outline
 

@@ -33,7 +33,7 @@ class Outlined(Protocol):
     def features(self) -> Sequence[Hole | Slot | ArcSlot]: ...
 
 
-__all__ = ["part_outline", "feature_shape", "QUAD_SEGS"]
+__all__ = ["QUAD_SEGS", "feature_shape", "part_outline"]
 
 #: segments per quarter circle for shapely approximations
 QUAD_SEGS = 16

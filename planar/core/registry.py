@@ -18,7 +18,8 @@ the kind; registering a kind twice raises :class:`TypeError`.
 
 from __future__ import annotations
 
-from typing import Callable, Generic, Iterator, TypeVar
+from collections.abc import Callable, Iterator
+from typing import Generic, TypeVar
 
 from planar.errors import PlanarError
 

@@ -32,7 +32,8 @@ from __future__ import annotations
 import io
 import math
 import os
-from typing import TYPE_CHECKING, Any, Sequence
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -44,7 +45,7 @@ if TYPE_CHECKING:
     from planar.core.model import Motion
     from planar.scene.load import Scene
 
-__all__ = ["CHARTS", "scene_figure", "write_plot", "available_charts"]
+__all__ = ["CHARTS", "available_charts", "scene_figure", "write_plot"]
 
 #: every chart :func:`scene_figure` can draw, in drawing order
 CHARTS = ("curve", "follower", "pressure", "transmission", "velocity", "speed", "acceleration", "torque")
@@ -52,7 +53,7 @@ CHARTS = ("curve", "follower", "pressure", "transmission", "velocity", "speed", 
 GOOD_TRANSMISSION = (40.0, 140.0)
 
 
-def available_charts(scene: "Scene") -> list[str]:
+def available_charts(scene: Scene) -> list[str]:
     """The charts that apply to ``scene`` (``transmission`` only where the mechanism has dyads)."""
     from planar.analysis.rates import transmission_angles
 
@@ -73,7 +74,7 @@ def _is_cam(mech: Any) -> bool:
     return isinstance(mech, CamMechanism)
 
 
-def _parse_what(scene: "Scene", what: Sequence[str] | None) -> list[str]:
+def _parse_what(scene: Scene, what: Sequence[str] | None) -> list[str]:
     avail = available_charts(scene)
     if what is None:
         return avail
@@ -97,7 +98,7 @@ def _parse_what(scene: "Scene", what: Sequence[str] | None) -> list[str]:
     return chosen
 
 
-def _motion(scene: "Scene", samples_per_cycle: int | None) -> "Motion":
+def _motion(scene: Scene, samples_per_cycle: int | None) -> Motion:
     """The scene's motion, over its own cycles or duration, at ``samples_per_cycle`` (default: the scene's)."""
     if samples_per_cycle is None:
         return scene.motion()
@@ -130,8 +131,8 @@ def _motion(scene: "Scene", samples_per_cycle: int | None) -> "Motion":
 
 
 def scene_figure(
-    scene: "Scene", what: Sequence[str] | None = None, width_in: float = 6.4, samples_per_cycle: int | None = None
-) -> "Figure":
+    scene: Scene, what: Sequence[str] | None = None, width_in: float = 6.4, samples_per_cycle: int | None = None
+) -> Figure:
     """The charts ``what`` (default: every chart that applies) of ``scene``, stacked in one figure.
 
     ``samples_per_cycle``: sample the motion this finely instead of the
@@ -240,7 +241,7 @@ def scene_figure(
     return fig
 
 
-def _follower_panel(ax: Any, mech: Any, motion: "Motion", x: np.ndarray, k: int) -> None:
+def _follower_panel(ax: Any, mech: Any, motion: Motion, x: np.ndarray, k: int) -> None:
     """Panel ``k`` (0 displacement, 1 velocity, 2 acceleration) of a cam's follower, from the motion law."""
     ax.set_gid(f"chart-follower-{('displacement', 'velocity', 'acceleration')[k]}")
     ax.grid(True, lw=0.4, alpha=0.5)
@@ -269,7 +270,7 @@ def _render(fig: Any, fmt: str) -> bytes:
 
 
 def write_plot(
-    scene: "Scene", out: str | os.PathLike[str], what: Sequence[str] | None = None, samples_per_cycle: int | None = None
+    scene: Scene, out: str | os.PathLike[str], what: Sequence[str] | None = None, samples_per_cycle: int | None = None
 ) -> list[str]:
     """Write the charts of ``scene`` to ``out`` (``.png`` or ``.svg``, reproducible bytes); returns the charts.
 

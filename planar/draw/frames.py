@@ -19,8 +19,8 @@ loop only issues drawing calls.
 
 from __future__ import annotations
 
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Iterator, Mapping, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from planar.core.geometry import poses_apply
 from planar.core.model import Mechanism, Motion, Part
 
-__all__ = ["Style", "Renderer", "project", "palette_colors"]
+__all__ = ["Renderer", "Style", "palette_colors", "project"]
 
 Array = NDArray[np.float64]
 RGB = tuple[int, int, int]

@@ -27,7 +27,7 @@ from planar.errors import InputError
 if TYPE_CHECKING:  # pragma: no cover
     from planar.scene.load import Scene
 
-__all__ = ["FramePlan", "plan_frames", "scene_duration", "animation_motion", "resample", "MAX_FRAMES", "DEFAULT_DELAY_MS"]
+__all__ = ["DEFAULT_DELAY_MS", "MAX_FRAMES", "FramePlan", "animation_motion", "plan_frames", "resample", "scene_duration"]
 
 #: default frame delay: 25 frames per second
 DEFAULT_DELAY_MS = 40

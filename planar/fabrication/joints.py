@@ -12,8 +12,9 @@ no rule is an error naming it.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 from planar.cams.joint import CamContact
 from planar.core.model import ArcSlot, CamOnLine, Hole, Mechanism, Part, PinInArcSlot, PinInSlot, Pivot, Slide, Slot
@@ -23,7 +24,7 @@ from planar.linkages.gears import GearMesh
 from planar.toys.assembly import KeyedShaft
 from planar.windup.mechanisms import SkewContact
 
-__all__ = ["Contact", "FabricationError", "PIN_RULES", "PinSpec", "joint_pins", "pin_features", "register_contact"]
+__all__ = ["PIN_RULES", "Contact", "FabricationError", "PinSpec", "joint_pins", "pin_features", "register_contact"]
 
 TOL = 1e-7
 

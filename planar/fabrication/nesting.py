@@ -53,7 +53,7 @@ def nest(
     import rectpack
 
     W, H = sheet
-    if not (math.isfinite(W) and math.isfinite(H)) or W <= 2 * margin or H <= 2 * margin:
+    if not (math.isfinite(W) and math.isfinite(H)) or 2 * margin >= W or 2 * margin >= H:
         raise InputError("sheet", f"{W:g} x {H:g}", f"a finite sheet larger than the {margin:g} mm margins")
     binw, binh = int(math.floor((W - 2 * margin + spacing) * _Q)), int(math.floor((H - 2 * margin + spacing) * _Q))
     parts = [_upright(pc) for pc in cuts]

@@ -312,8 +312,7 @@ def _drop_contained(feats: list[Feature]) -> list[Feature]:
         inside = any(
             j != i
             and (
-                polys[j].buffer(1e-6).contains(p)
-                and (polys[j].area > p.area or j < i)
+                (polys[j].buffer(1e-6).contains(p) and (polys[j].area > p.area or j < i))
                 or _same_guide(feats[i], feats[j], j < i)
                 or _same_arc(feats[i], feats[j], j < i)
             )
@@ -352,7 +351,7 @@ def _same_guide(f: Feature, g: Feature, g_first: bool, tol: float = 1e-6) -> boo
         return False
     a, b = np.asarray(g.a), np.asarray(g.b)
     L = float(np.hypot(*(b - a)))
-    if L <= tol:
+    if tol >= L:
         return False
     e = (b - a) / L
     ends = [np.asarray(f.a) - a, np.asarray(f.b) - a]
@@ -361,7 +360,7 @@ def _same_guide(f: Feature, g: Feature, g_first: bool, tol: float = 1e-6) -> boo
     if max(off) > tol or min(along) < -tol or max(along) > L + tol:
         return False
     flen = float(np.hypot(*(np.asarray(f.b) - np.asarray(f.a))))
-    return L > flen + tol or (abs(L - flen) <= tol and g_first)
+    return flen + tol < L or (abs(L - flen) <= tol and g_first)
 
 
 def _same_arc(f: Feature, g: Feature, g_first: bool, tol: float = 1e-6) -> bool:

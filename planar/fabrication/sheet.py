@@ -150,7 +150,7 @@ def _outer_tangent(c1, r1, c2, r2) -> tuple[np.ndarray, np.ndarray, np.ndarray] 
     """
     d = np.asarray(c2, float) - np.asarray(c1, float)
     L = float(np.hypot(*d))
-    if L <= abs(r1 - r2) + EPS:
+    if abs(r1 - r2) + EPS >= L:
         return None
     u = d / L
     cphi = (r1 - r2) / L

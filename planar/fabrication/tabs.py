@@ -179,7 +179,7 @@ def fab_view(mech: Any, samples: int = 48) -> Any:
             joints.append(j)
     notes: list[str] = []
     if dropped:
-        parts, removed = _without_cuts_of(parts, dropped, joints)
+        parts, _removed = _without_cuts_of(parts, dropped, joints)
         for j in dropped:
             notes.append(
                 f"{j.b}: its slide {j.name!r} in {j.a} is not cut: both pieces stand on the xy stack, "

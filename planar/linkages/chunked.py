@@ -524,7 +524,7 @@ def fast_solve(
         return _solve_compiled(lk, plan, prog, q, tols, nthreads, chunk or JIT_CHUNK)
     chunk = chunk or CHUNK
     poses: dict[str, Array] = {}
-    px, py, pa = plan.placement
+    _px, _py, _pa = plan.placement
     for name, o, _, _ in plan.links:
         if o < 0:
             poses[name] = _ground_pose(n, plan.placement)

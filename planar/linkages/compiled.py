@@ -395,7 +395,7 @@ def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts,
                 nf = _k_rrp(p, L, X[r[0]], Y[r[0]], X[r[1]], Y[r[1]], X[r[2]], Y[r[2]], xo, yo, ok, sep)
             else:
                 nf = _k_rigid(p, L, X[r[0]], Y[r[0]], X[r[1]], Y[r[1]], xo, yo, ok)
-            if (k == RRR or k == RRP) and _may_switch(xo, yo, ok, sep, tols[nd], qw, first, L):
+            if (k in (RRR, RRP)) and _may_switch(xo, yo, ok, sep, tols[nd], qw, first, L):
                 return -1
             if nf and check_row[nd] >= 0:
                 okw = ok[off:]

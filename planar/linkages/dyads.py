@@ -53,8 +53,9 @@ may switch by continuity.
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import ClassVar, Mapping, Sequence
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -65,20 +66,20 @@ from planar.errors import AssemblyError, InputError
 from planar.linkages.chunked import Solved, _Plan, fast_solve, plan_for
 
 __all__ = [
-    "Fixed",
-    "Crank",
-    "Actuator",
-    "RRR",
+    "NODE_KINDS",
     "RRP",
-    "Rigid",
+    "RRR",
+    "Actuator",
+    "Crank",
+    "Fixed",
     "Link",
     "Linkage",
     "Node",
     "NodeKind",
-    "NODE_KINDS",
-    "node_kind",
+    "Rigid",
     "carry_branch",
     "frame_rates",
+    "node_kind",
 ]
 
 Vec = tuple[float, float]
@@ -87,10 +88,10 @@ Mask = NDArray[np.bool_]
 Check = tuple[Mask, str]
 
 #: every node kind, by its scene name (filled by :func:`node_kind`)
-NODE_KINDS: dict[str, type["NodeKind"]] = {}
+NODE_KINDS: dict[str, type[NodeKind]] = {}
 
 
-def node_kind(cls: type["NodeKind"]) -> type["NodeKind"]:
+def node_kind(cls: type[NodeKind]) -> type[NodeKind]:
     """Class decorator: register a node kind under its ``kind`` name (a double is a :class:`TypeError`)."""
     name = cls.__dict__.get("kind")
     if not isinstance(name, str):
@@ -259,7 +260,7 @@ class NodeKind:
         """Which branch (+1 or -1) the node's last position in ``pos`` is on; ``None`` for kinds without one."""
         return None
 
-    def bind(self, where: str, nodes: Mapping[str, "NodeKind"]) -> "NodeKind":
+    def bind(self, where: str, nodes: Mapping[str, NodeKind]) -> NodeKind:
         """This node, given every node of its linkage (those before it bound): a kind that needs another node's
         declaration (a gear's partner, a triad's members) returns a copy holding it, or raises :class:`InputError`."""
         return self
@@ -274,7 +275,7 @@ class NodeKind:
         """:meth:`acceleration` for kinds that also need the driver values ``q``."""
         return self.acceleration(pos, vel, acc, qd, qdd)
 
-    def extra_joints(self, lk: "Linkage", hulls: dict[str, list[tuple[float, float, float]]]) -> list:
+    def extra_joints(self, lk: Linkage, hulls: dict[str, list[tuple[float, float, float]]]) -> list:
         """Joints this node adds beyond those its links imply (a gear mesh); may add hull circles."""
         return []
 
@@ -897,10 +898,7 @@ class Linkage(Mechanism):
                 poses[lk.name] = np.zeros((n, 3))
                 continue
             o = pos[lk.nodes[0]]
-            if lk.guide is not None:
-                d = pos[lk.guide[1]] - pos[lk.guide[0]]
-            else:
-                d = pos[lk.nodes[1]] - o
+            d = pos[lk.guide[1]] - pos[lk.guide[0]] if lk.guide is not None else pos[lk.nodes[1]] - o
             poses[lk.name] = np.column_stack([o[:, 0], o[:, 1], np.arctan2(d[:, 1], d[:, 0])])
         return poses
 

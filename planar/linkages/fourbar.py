@@ -16,8 +16,9 @@ degenerates), so a fixed side is branch continuity.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal, Sequence
+from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -26,7 +27,7 @@ from planar.core.model import check_finite, check_positive
 from planar.errors import InputError
 from planar.linkages.dyads import RRR, Crank, Fixed, Link, Linkage, Rigid
 
-__all__ = ["FourBar", "grashof_class", "freudenstein_angles"]
+__all__ = ["FourBar", "freudenstein_angles", "grashof_class"]
 
 Array = NDArray[np.float64]
 Circuit = Literal["open", "crossed"]
@@ -201,7 +202,7 @@ class FourBar(Linkage):
         ends = [e for iv in self.input_range() for e in iv]
         if ends == [0.0, 2 * np.pi]:
             return np.array([])
-        return np.array(sorted(set(float(np.mod(e, 2 * np.pi)) for e in ends)))
+        return np.array(sorted({float(np.mod(e, 2 * np.pi)) for e in ends}))
 
     def angles(self, theta: ArrayLike) -> tuple[Array, Array, NDArray[np.bool_]]:
         """``(theta3, theta4, valid)``: coupler and rocker angles by the tangent half-angle method."""

@@ -24,9 +24,10 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
-from typing import TYPE_CHECKING, Any, ClassVar, Mapping
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -38,7 +39,7 @@ from planar.linkages.dyads import Check, Crank, Fixed, Mask, NodeKind, _perp, fr
 if TYPE_CHECKING:
     from planar.linkages.dyads import Linkage
 
-__all__ = ["Geared", "Driven", "GearMesh", "input_angle"]
+__all__ = ["Driven", "GearMesh", "Geared", "input_angle"]
 
 Array = NDArray[np.float64]
 
@@ -129,7 +130,7 @@ class Geared(NodeKind):
         w, al = frame_rates(pos[m] - pos[c], vel[m] - vel[c], acc[m] - acc[c])
         return _turning(pos, vel, acc, self.name, self.centre, self.ratio * w, self.ratio * al), None
 
-    def extra_joints(self, lk: "Linkage", hulls: dict[str, list[tuple[float, float, float]]]) -> list[Any]:
+    def extra_joints(self, lk: Linkage, hulls: dict[str, list[tuple[float, float, float]]]) -> list[Any]:
         """The gear pair: pitch-circle discs on both crank links and the :class:`GearMesh` joint."""
         assert self.base is not None
         mesh_centre = self.base.centre  # type: ignore[attr-defined]
@@ -171,7 +172,7 @@ def _turning(
     return acc[centre] + al[:, None] * _perp(r) - (w * w)[:, None] * r
 
 
-def _crank_link(lk: "Linkage", node: str, centre: str) -> str:
+def _crank_link(lk: Linkage, node: str, centre: str) -> str:
     for link in lk.links:
         if link.name != lk.ground_name and node in link.nodes and centre in link.nodes:
             return link.name

@@ -8,7 +8,7 @@ cancellation).  ``branch=+1`` puts the slider on the +x side.
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 

@@ -37,8 +37,9 @@ valid pose.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from typing import ClassVar, Mapping, cast
+from typing import ClassVar, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -173,7 +174,7 @@ def solve_triad(
             slope = u[base] - u[base - 1]  # one sample's step
             slope[2] = np.remainder(slope[2] + np.pi, 2 * np.pi) - np.pi
         seed = ub[None, :] + np.arange(1, rows.size + 1)[:, None] * slope[None, :]
-        w, wok, wsing = _newton(K[rows], seed, L, S, scale)
+        w, wok, _wsing = _newton(K[rows], seed, L, S, scale)
         # each sample must be what Newton from its predecessor gives
         prev = np.vstack([ub[None, :], w[:-1]])
         y, yok, ysing = _newton(K[rows], prev, L, S, scale)
@@ -242,7 +243,7 @@ class Triad(NodeKind):
     at: Vec
     members: tuple[str, ...] | None = None
     #: on the first node, once bound: the three nodes, itself first
-    group: tuple["Triad", ...] = field(default=(), compare=False, repr=False)
+    group: tuple[Triad, ...] = field(default=(), compare=False, repr=False)
 
     def refs(self) -> tuple[str, ...]:
         return (self.a,)

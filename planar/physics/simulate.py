@@ -74,10 +74,10 @@ __all__ = [
     "SimSettings",
     "SimulationError",
     "inverse_dynamics_torque",
+    "joint_drift",
     "mass_properties",
     "simulate",
     "simulate_scene",
-    "joint_drift",
     "substeps_for",
     "torque_comparison",
 ]
@@ -557,9 +557,13 @@ class _Rebuild:
         self.correction = settings.step_correction(dt)
         if settings.adaptive and self.iterations > settings.iterations:
             self.correction = min(self.correction, _MASS_RATIO_CORRECTION)
-        if settings.adaptive and mode == "motor" and mech.driver.rate != 0.0:
-            if 2.0 * math.pi / (abs(mech.driver.rate) * dt) > _MOTOR_STEPS_PER_TURN:
-                self.correction = min(self.correction, _MOTOR_FINE_CORRECTION)
+        if (
+            settings.adaptive
+            and mode == "motor"
+            and mech.driver.rate != 0.0
+            and 2.0 * math.pi / (abs(mech.driver.rate) * dt) > _MOTOR_STEPS_PER_TURN
+        ):
+            self.correction = min(self.correction, _MOTOR_FINE_CORRECTION)
         built["correction"] = self.correction
         bias = 1.0 - self.correction  # error left per step = per time unit here
         for j in mech.joints:
@@ -810,7 +814,7 @@ class _PoseCheck:
         self.ref = {n: poses_apply(analytic[n], self.pts[n]) for n in names}  # (N, M, 2)
         self.size = mech.size
         self.tol = settings.tolerance * self.size
-        self.worst = {n: 0.0 for n in names}
+        self.worst = dict.fromkeys(names, 0.0)
 
     def part_poses(self, raw: Array) -> Array:
         """``(N, B, 3)`` body states (centre of gravity, angle) -> part frame poses."""

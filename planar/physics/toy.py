@@ -36,8 +36,9 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Callable, ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -49,6 +50,7 @@ from planar.windup.mechanisms import SkewContact
 
 __all__ = [
     "ContactRun",
+    "SkewHold",
     "StageReport",
     "ToyPhysics",
     "contact_hold",
@@ -58,7 +60,6 @@ __all__ = [
     "simulate_toy",
     "skew_hold",
     "skew_stage",
-    "SkewHold",
 ]
 
 Array = NDArray[np.float64]
@@ -850,7 +851,7 @@ def _skew_load(rb: Any, j: SkewContact, effects: Any) -> list[Any]:
     hold.error_bias = 1.0 - rb.correction
     yz.add(fol, turn, hold)
     m, ic = fol.mass, fol.moment
-    ip = ic + m * float((fcog[0] ** 2 + fcog[1] ** 2))  # the follower's moment about its pivot
+    ip = ic + m * float(fcog[0] ** 2 + fcog[1] ** 2)  # the follower's moment about its pivot
     m0, i0 = drv.mass, drv.moment
     hq = 1e-6 * max(rb.mech.size, 1e-12)
     prev: list[tuple[float, float, float]] = []
@@ -940,7 +941,7 @@ def _skew_load(rb: Any, j: SkewContact, effects: Any) -> list[Any]:
         # (a NaN velocity: the pose check stops the run there and reports it)
         try:
             step(c_, space_)
-        except Exception as exc:  # noqa: BLE001 - reported through the run's failure
+        except Exception as exc:
             if not failed:
                 warnings.warn(f"{j.name}: the co-simulated follower {j.b!r} failed: {exc}", stacklevel=1)
             failed.append(str(exc))

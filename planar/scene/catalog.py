@@ -7,12 +7,12 @@ export) run over all of them.
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 from planar.core.model import Mechanism
 from planar.linkages import RRR, Crank, Fixed, FourBar, Link, Linkage, SliderCrank
 
-__all__ = ["CATALOG", "jansen_leg", "kangaroo_leg", "paddle_boat", "get"]
+__all__ = ["CATALOG", "get", "jansen_leg", "kangaroo_leg", "paddle_boat"]
 
 
 def jansen_leg(crank: float = 15.0) -> Linkage:

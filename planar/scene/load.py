@@ -89,10 +89,7 @@ def _read_text(p: str) -> str:
         raise SceneError(f"{p}: cannot be read ({e.strerror or e})") from None
     if len(raw) > 64 * 2**20:
         raise SceneError(f"{p}: larger than 64 MiB; a scene file is a short TOML text")
-    if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
-        codec = "utf-16"
-    else:
-        codec = "utf-8-sig"
+    codec = "utf-16" if raw[:2] in (b"\xff\xfe", b"\xfe\xff") else "utf-8-sig"
     try:
         text = raw.decode(codec)
     except UnicodeDecodeError as e:

@@ -7,7 +7,7 @@ model units (``[fabrication] unit_mm`` says what one unit is in millimetres).
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any, Literal, Union
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, Strict, StrictBool, model_validator
 
@@ -188,7 +188,7 @@ class NodeSpec(_Strict):
     ``["T2", "T3"]``."""
 
     @model_validator(mode="after")
-    def _needs(self) -> "NodeSpec":
+    def _needs(self) -> NodeSpec:
         from planar.linkages import NODE_KINDS
 
         # the kind's own scene keys; those with a default here (phase, axis, branch, offset) are never None
@@ -240,7 +240,7 @@ class ElementalSpec(_Strict):
     """``"elemental"``."""
     number: Annotated[int, Strict(), Field(ge=1, le=11)]
     """Which mechanism, 1-11 (the supplement's numbering; README's table of parameters), e.g. ``5``."""
-    params: dict[Name, Union[Real, list[Real]]] = {}
+    params: dict[Name, Real | list[Real]] = {}
     """Parameters overriding the supplement's defaults, by name (README: "Elemental parameters"), e.g.
     ``{ F_jc = [-0.5, 0.0], amplitude = 20 }``; angles (``phi``, ``D_theta``, an Oz ``amplitude``) in the
     scene's angle unit."""
@@ -264,7 +264,7 @@ class ToyStageSpec(_Strict):
     """The cam whose tree holds the stage, ``"left"`` or ``"right"``."""
     chain: Annotated[list[str], Field(min_length=1)]
     """The patterns from the motor to this stage (a prefix of one of the cam's chains), e.g. ``["Rz->Tx"]``."""
-    params: dict[str, Union[Real, list[Real]]] = {}
+    params: dict[str, Real | list[Real]] = {}
     """The stage mechanism's parameters overriding its defaults (angles in the scene's angle unit)."""
     name: str | None = None
     """A name for the stage's end effector: a point at its follower's origin (trails, motion tables)."""
@@ -285,7 +285,7 @@ class ToySpec(_Strict):
     """Stages with their own parameters or end-effector names (``[[mechanism.stages]]``)."""
 
     @model_validator(mode="after")
-    def _some(self) -> "ToySpec":
+    def _some(self) -> ToySpec:
         if not self.left and not self.right:
             raise ValueError("a toy needs at least one chain on the left or right cam")
         return self
@@ -336,7 +336,7 @@ class CamFollowerSpec(_Strict):
     """Which of the two arm positions touching the base circle (oscillating), ``1`` or ``-1``."""
 
     @model_validator(mode="after")
-    def _needs(self) -> "CamFollowerSpec":
+    def _needs(self) -> CamFollowerSpec:
         if (self.kind == "roller") != (self.roller_radius is not None):
             raise ValueError("roller_radius is given for a roller follower, and only for one")
         if self.motion == "oscillating" and (self.pivot is None or self.arm is None):
@@ -372,7 +372,7 @@ class CamSpec(_Strict):
 
 
 MechanismSpec = Annotated[
-    Union[FourBarSpec, SliderCrankSpec, LinkageSpec, ElementalSpec, ChainSpec, ToySpec, CatalogSpec, CamSpec],
+    FourBarSpec | SliderCrankSpec | LinkageSpec | ElementalSpec | ChainSpec | ToySpec | CatalogSpec | CamSpec,
     Field(discriminator="type"),
 ]
 
@@ -409,7 +409,7 @@ class DriverSpec(_Strict):
     """Middle of a rocking input (needs ``amplitude``), e.g. ``60``."""
 
     @model_validator(mode="after")
-    def _one(self) -> "DriverSpec":
+    def _one(self) -> DriverSpec:
         if self.cycles is not None and self.duration is not None:
             raise ValueError("give cycles or duration, not both")
         if self.amplitude is None and "centre" in self.model_fields_set:
@@ -578,7 +578,7 @@ class SceneSpec(_Strict):
     ``unit_mm`` says otherwise (the supplement's units: a toy about 9 cm across)."""
 
     @model_validator(mode="after")
-    def _windup_unit(self) -> "SceneSpec":
+    def _windup_unit(self) -> SceneSpec:
         if self.mechanism.type in ("elemental", "chain", "toy") and "unit_mm" not in self.fabrication.model_fields_set:
             self.fabrication = self.fabrication.model_copy(update={"unit_mm": WINDUP_UNIT_MM})
         return self

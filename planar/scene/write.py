@@ -19,8 +19,9 @@ from __future__ import annotations
 import json
 import math
 import os
+from collections.abc import Mapping
 from dataclasses import fields
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -30,7 +31,7 @@ if TYPE_CHECKING:
     from planar.core.model import Mechanism
     from planar.scene.schema import SceneSpec
 
-__all__ = ["mechanism_table", "driver_table", "scene_data", "scene_toml", "write_scene"]
+__all__ = ["driver_table", "mechanism_table", "scene_data", "scene_toml", "write_scene"]
 
 
 def _f(v: Any) -> Any:
@@ -49,7 +50,7 @@ def _placement(mech: Any) -> list[float]:
     return [float(x) for x in mech.placement]
 
 
-def mechanism_table(mech: "Mechanism") -> dict[str, Any]:
+def mechanism_table(mech: Mechanism) -> dict[str, Any]:
     """The ``[mechanism]`` table that rebuilds ``mech`` (angles in radians)."""
     from planar.linkages import RRP, FourBar, Linkage, SliderCrank
     from planar.windup import ElementalMechanism, params_for
@@ -142,7 +143,7 @@ def mechanism_table(mech: "Mechanism") -> dict[str, Any]:
     )
 
 
-def driver_table(mech: "Mechanism") -> dict[str, Any]:
+def driver_table(mech: Mechanism) -> dict[str, Any]:
     """The ``[driver]`` keys of ``mech``'s driver law (``speed``, ``phase``, a rocking input's ``amplitude`` and
     ``centre``), radians."""
     from planar.linkages import Linkage
@@ -160,7 +161,7 @@ def driver_table(mech: "Mechanism") -> dict[str, Any]:
 
 
 def scene_data(
-    mech: "Mechanism",
+    mech: Mechanism,
     name: str | None = None,
     driver: Mapping[str, Any] | None = None,
     effects: Mapping[str, Any] | None = None,
@@ -236,7 +237,7 @@ def _table(path: str, d: Mapping[str, Any], lines: list[str]) -> None:
             _table(sub, v, lines)
 
 
-def scene_toml(spec: "SceneSpec") -> str:
+def scene_toml(spec: SceneSpec) -> str:
     """A scene's keys as TOML text: the keys it was given (defaults left out), tables in schema order."""
     data = spec.model_dump(mode="json", exclude_unset=True, exclude_none=True)
     data.setdefault("mechanism", {})["type"] = spec.mechanism.type
@@ -251,7 +252,7 @@ def scene_toml(spec: "SceneSpec") -> str:
     return "\n".join(lines).lstrip("\n") + "\n"
 
 
-def write_scene(spec: "SceneSpec", path: str | os.PathLike[str]) -> None:
+def write_scene(spec: SceneSpec, path: str | os.PathLike[str]) -> None:
     """Write ``spec`` to ``path`` as a scene file (atomically; ``planar.scene.load.load_scene`` reads it back)."""
     from planar.fileio import atomic_write
 

@@ -61,7 +61,7 @@ from planar.windup.mechanisms import ELEMENTAL, check_params, params_for
 from planar.windup.sizing import DESIGN_PARAMETER
 from planar.windup.table import MOTION_TYPES, enumerate_chains, realise
 
-__all__ = ["Effector", "Design", "load_request", "design_toy", "effector_ranges", "layer_collisions"]
+__all__ = ["Design", "Effector", "design_toy", "effector_ranges", "layer_collisions", "load_request"]
 
 Array = NDArray[np.float64]
 CAMS = ("left", "right")
@@ -109,7 +109,7 @@ class Design:
     layers: dict[str, int] = field(default_factory=dict)
     collisions: list[tuple[str, str, float]] = field(default_factory=list)
     seconds: dict[str, float] = field(default_factory=dict)
-    placement: "Placement | None" = None
+    placement: Placement | None = None
     layers_before: int | None = None  # layers of the toy before placement
     clashes: list[str] = field(default_factory=list)  # pins crossing a piece between their layers
     rejected: list[str] = field(default_factory=list)  # cheaper trees whose fabrication collided
@@ -1163,7 +1163,7 @@ def design_toy(
         made = False
         for how, variant in _variants(cams, phase, name, overrides, names):
             try:
-                toy = ToyMechanism({k: v for k, v in cams.items()}, phase=phase, name=name, overrides=variant, names=names)
+                toy = ToyMechanism(dict(cams.items()), phase=phase, name=name, overrides=variant, names=names)
                 from planar.toys.assembly import toy_assembly
 
                 toy_assembly(toy)

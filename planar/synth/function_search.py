@@ -110,7 +110,7 @@ def output_errors(X: Array, circuit: Array, phi: Array, psi: Array) -> tuple[Arr
     ``(coupler, 0)`` in the coupler's frame), the rocker angle is
     ``atan2(C - O4)`` with ``O4 = (1, 0)``.
     """
-    a, b, c, A, B = (X[:, i : i + 1] for i in range(5))
+    _a, _b, _c, A, B = (X[:, i : i + 1] for i in range(5))
     K = np.zeros((len(X), 9))
     K[:, 0], K[:, 1], K[:, 2], K[:, 3], K[:, 4] = 1.0, X[:, 0], X[:, 1], X[:, 2], X[:, 1]
     cx, cy, ok = coupler_points(K, phi[None, :] + A, circuit)

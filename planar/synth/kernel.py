@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from planar.linkages.chunked import threads_default
 
-__all__ = ["N_PARAMS", "coupler_points", "PARAM_NAMES"]
+__all__ = ["N_PARAMS", "PARAM_NAMES", "coupler_points"]
 
 Array = NDArray[np.float64]
 Mask = NDArray[np.bool_]

@@ -41,7 +41,7 @@ from numpy.typing import NDArray
 from planar.errors import InputError, PlanarError
 from planar.synth.designs import Checked, PlacedFourBar
 
-__all__ = ["MotionDesign", "burmester", "circle_point_curve", "burmester_points", "dyad_rows"]
+__all__ = ["MotionDesign", "burmester", "burmester_points", "circle_point_curve", "dyad_rows"]
 
 Array = NDArray[np.float64]
 

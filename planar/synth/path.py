@@ -140,9 +140,9 @@ def synthesise_path(
     if np.ptp(t, axis=0).max() <= 0:
         raise InputError("targets", t[0].tolist(), "targets that are not all the same point")
     kw = {
-        "quick": dict(n_sample=20_000, maxiter=60, popsize=15, refine=3),
-        "normal": dict(n_sample=100_000, maxiter=200, popsize=30, refine=8),
-        "thorough": dict(n_sample=500_000, maxiter=600, popsize=40, refine=16),
+        "quick": {"n_sample": 20_000, "maxiter": 60, "popsize": 15, "refine": 3},
+        "normal": {"n_sample": 100_000, "maxiter": 200, "popsize": 30, "refine": 8},
+        "thorough": {"n_sample": 500_000, "maxiter": 600, "popsize": 40, "refine": 16},
     }
     if budget not in kw:
         raise InputError("budget", budget, f"one of {', '.join(kw)}")

@@ -10,8 +10,9 @@ the same design gives the same bytes.
 from __future__ import annotations
 
 import tomllib
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 __all__ = ["fourbar_scene_text", "linkage_scene_text", "write_scene"]
 

@@ -34,14 +34,14 @@ from numpy.typing import NDArray
 from planar.synth.kernel import N_PARAMS, coupler_points
 
 __all__ = [
+    "REL_TOL",
     "Constraints",
     "PathObjective",
-    "search_fourbar",
     "SearchResult",
-    "violation",
     "constraint_failures",
     "region_failures",
-    "REL_TOL",
+    "search_fourbar",
+    "violation",
 ]
 
 Array = NDArray[np.float64]

@@ -38,7 +38,7 @@ from planar.synth.path import DEFAULT_TOLERANCE, normalised
 from planar.synth.search import GRASHOF_MARGIN, Constraints, violation
 from planar.synth.targets import normalisation
 
-__all__ = ["SixBarDesign", "synthesise_sixbar", "sixbar_points", "TOPOLOGIES"]
+__all__ = ["TOPOLOGIES", "SixBarDesign", "sixbar_points", "synthesise_sixbar"]
 
 Array = NDArray[np.float64]
 TOPOLOGIES = ("stephenson", "watt")
@@ -125,7 +125,7 @@ def sixbar_constraint_failures(row: Array, cons: Constraints, topology: str) -> 
     """The constraints a six-bar (``row``, world units) breaks, each named with its value and limit."""
     from planar.synth.search import constraint_failures, ratio_failures, region_failures
 
-    out = [f for f in constraint_failures(row[:9], Constraints(cons.full_turn, np.inf, cons.region))]
+    out = list(constraint_failures(row[:9], Constraints(cons.full_turn, np.inf, cons.region)))
     out += ratio_failures({k: float(v[0]) for k, v in link_lengths(row[None, :], topology).items()}, cons.max_ratio)
     out += region_failures({"O6": (float(row[9]), float(row[10]))}, cons)
     return out

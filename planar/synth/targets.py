@@ -15,7 +15,7 @@ from numpy.typing import NDArray
 
 from planar.errors import InputError
 
-__all__ = ["read_table", "read_path_targets", "read_svg_points", "normalisation", "check_theta", "SIZE_RANGE"]
+__all__ = ["SIZE_RANGE", "check_theta", "normalisation", "read_path_targets", "read_svg_points", "read_table"]
 
 #: the targets' size (RMS distance from their centroid) and coordinates planar synthesises at: the search's
 #: kernel multiplies four lengths together, so 1e60 keeps every such product finite and normal (the search

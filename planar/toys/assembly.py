@@ -32,8 +32,9 @@ exact composition; :func:`assembly_residual` checks every joint on them.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
-from typing import Any, Callable, ClassVar, Mapping
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -58,7 +59,7 @@ from planar.core.registry import Registry
 from planar.errors import InputError
 from planar.windup.mechanisms import SkewContact
 
-__all__ = ["KeyedShaft", "ToyAssembly", "toy_assembly", "assembly_residual", "PLACERS"]
+__all__ = ["PLACERS", "KeyedShaft", "ToyAssembly", "assembly_residual", "toy_assembly"]
 
 Array = NDArray[np.float64]
 Vec = tuple[float, float]
@@ -557,7 +558,7 @@ def _without_cuts_of(
                     continue
                 kept_at.append(at_kept)
             if isinstance(f, Slot) and any(
-                near(f.start, a) and near(f.end, b) or near(f.start, b) and near(f.end, a)
+                (near(f.start, a) and near(f.end, b)) or (near(f.start, b) and near(f.end, a))
                 for a, b in drop_slots.get(part.name, ())
             ):
                 removed.append((part.name, f))

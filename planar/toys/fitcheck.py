@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["FIT_MARGIN", "CAM_STAGES", "fit_play", "small_motions", "small_motion_text"]
+__all__ = ["CAM_STAGES", "FIT_MARGIN", "fit_play", "small_motion_text", "small_motions"]
 
 #: a motion must be at least this many times the fit's play (mm) to survive the cut parts
 FIT_MARGIN = 3.0

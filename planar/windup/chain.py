@@ -18,8 +18,9 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
-from typing import Any, Callable, Iterable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -30,7 +31,7 @@ from planar.errors import InputError
 from planar.windup.mechanisms import ELEMENTAL, ElementalMechanism, SkewContact
 from planar.windup.table import MOTION_TYPES, Realisation, enumerate_chains, realise
 
-__all__ = ["ToyMechanism", "chain_mechanism", "tree_cost", "rank_trees", "horse", "bunny", "Chain"]
+__all__ = ["Chain", "ToyMechanism", "bunny", "chain_mechanism", "horse", "rank_trees", "tree_cost"]
 
 Array = NDArray[np.float64]
 Chain = tuple[str, ...]
@@ -136,10 +137,7 @@ class ToyMechanism(Mechanism):
                         continue
                     parent = index.get((cam, key[:-1])) if depth > 1 else None
                     r = realise(key[-1])
-                    if parent is None:
-                        u = _to_base(r, q + self.cam_phase[cam])
-                    else:
-                        u = _to_base(r, world_out[parent])
+                    u = _to_base(r, q + self.cam_phase[cam]) if parent is None else _to_base(r, world_out[parent])
                     kw = dict(overrides.get((cam, key)) or overrides.get(key) or {})
                     if kw:
                         self.stage_overrides[(cam, key)] = dict(kw)
@@ -217,7 +215,7 @@ class ToyMechanism(Mechanism):
         joints: list = []
         children: dict[int, list[int]] = {}
         for st in self.stages:
-            ox, oy = st.offset
+            ox, _oy = st.offset
             for p in st.mech.parts:
                 name = f"{st.label}.{p.name}"
                 off = p.offset + ox if p.plane == "yz" else p.offset
@@ -370,7 +368,7 @@ def rank_trees(
     # drop mirror images (left/right swapped) with equal cost
     out, seen = [], set()
     for cost, tree in scored:
-        sig = frozenset((tuple(sorted(v)) for v in tree.values()))
+        sig = frozenset(tuple(sorted(v)) for v in tree.values())
         if sig in seen:
             continue
         seen.add(sig)

@@ -20,8 +20,9 @@ is its x); drawings project orthographically onto xy.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable, ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -48,16 +49,16 @@ from planar.windup import params as P_
 from planar.windup.kinematics import Stage
 
 __all__ = [
-    "ElementalMechanism",
-    "ElementalRecord",
+    "CONTACT_JOINT",
     "ELEMENTAL",
     "MOTIONS",
-    "CONTACT_JOINT",
+    "ElementalMechanism",
+    "ElementalRecord",
     "SkewContact",
+    "check_params",
     "elemental",
     "params_for",
     "register_elemental",
-    "check_params",
     "standalone_driver",
     "standalone_motion",
 ]

@@ -34,7 +34,7 @@ from typing import Any, TypeVar
 
 from planar.errors import InputError
 
-__all__ = ["in_world", "coerce", "check_shapes", "Params", "P1", "P2", "P3", "P4", "P5", "P6", "P7", "P8", "P9", "P10", "P11"]
+__all__ = ["P1", "P2", "P3", "P4", "P5", "P6", "P7", "P8", "P9", "P10", "P11", "Params", "check_shapes", "coerce", "in_world"]
 
 V2 = tuple[float, float]
 V3 = tuple[float, float, float]
@@ -44,7 +44,7 @@ V3 = tuple[float, float, float]
 class Params:
     """Base class: parameters of one elemental mechanism."""
 
-    def replace(self, **kw: Any) -> "Params":
+    def replace(self, **kw: Any) -> Params:
         """A copy with ``kw`` replaced; each value checked against the field's shape (see :func:`coerce`)."""
         names = {f.name for f in fields(self)}
         for k in kw:
@@ -70,7 +70,7 @@ def coerce(field: str, default: Any, value: Any) -> Any:
 
 
 def _real(field: str, v: Any) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)) and not hasattr(v, "__float__"):
+    if isinstance(v, bool) or (not isinstance(v, (int, float)) and not hasattr(v, "__float__")):
         raise InputError(field, v, "a number")
     try:
         x = float(v)
@@ -81,7 +81,7 @@ def _real(field: str, v: Any) -> float:
     return x
 
 
-def check_shapes(number: int, P: "Params") -> None:
+def check_shapes(number: int, P: Params) -> None:
     """:class:`InputError` unless every field of ``P`` has its default's shape (a number or a vector of k)."""
     defaults = type(P)()
     for f in fields(P):

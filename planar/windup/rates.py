@@ -37,7 +37,7 @@ from planar.windup.mechanisms import ELEMENTAL, ElementalMechanism
 if TYPE_CHECKING:
     from planar.core.model import Mechanism
 
-__all__ = ["forward_rates", "driver_motion_rates", "elemental_rates", "windup_rates"]
+__all__ = ["driver_motion_rates", "elemental_rates", "forward_rates", "windup_rates"]
 
 Array = NDArray[np.float64]
 Mask = NDArray[np.bool_]
@@ -314,7 +314,7 @@ def toy_rates(toy: Any, q: Array, qd: Array, qdd: Array) -> tuple[dict[str, tupl
     return parts, valid
 
 
-def windup_rates(mech: "Mechanism", q: Array, qd: Array, qdd: Array) -> tuple[dict[str, tuple[Array, ...]], Mask, str]:
+def windup_rates(mech: Mechanism, q: Array, qd: Array, qdd: Array) -> tuple[dict[str, tuple[Array, ...]], Mask, str]:
     """Part rates ``(v, a, omega, alpha)`` of an elemental mechanism or a toy (see the module's note), with the
     validity and the method's name; other mechanisms are refused by name."""
     from planar.windup.chain import ToyMechanism

@@ -14,14 +14,14 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache, lru_cache
 
 import numpy as np
 
 from planar.errors import InputError
 from planar.windup.mechanisms import MOTIONS
 
-__all__ = ["TABLE", "OPTIONAL", "MOTION_TYPES", "Realisation", "realise", "patterns", "enumerate_chains", "chain_counts"]
+__all__ = ["MOTION_TYPES", "OPTIONAL", "TABLE", "Realisation", "chain_counts", "enumerate_chains", "patterns", "realise"]
 
 #: driver motion -> follower motions (30 patterns)
 TABLE: dict[str, tuple[str, ...]] = {
@@ -98,7 +98,7 @@ def _maps(R: np.ndarray, base: str, world: str) -> int:
     return int(v[aw])
 
 
-@lru_cache(maxsize=None)
+@cache
 def realise(pattern: str) -> Realisation:
     """The elemental mechanism and rotation that realise ``pattern`` (e.g. ``"Ox->Tz"``).
 

@@ -13,7 +13,7 @@ TH = np.linspace(0, 2 * np.pi, N, endpoint=False)
 STEP = TH[1] - TH[0]
 
 
-@pytest.fixture(params=[dict(placement=(0, 0, 0)), dict(placement=(1.0, 2.0, 0.3))])
+@pytest.fixture(params=[{"placement": (0, 0, 0)}, {"placement": (1.0, 2.0, 0.3)}])
 def fb(request):
     return FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0), **request.param)
 
@@ -101,7 +101,7 @@ def test_moving_frame_adds_machine_velocity():
 def test_torque_times_speed_equals_load_power_over_efficiency(fb):
     omega = 3.0
     forces = {"coupler_point": np.stack([0.2 * np.sin(TH), -1.0 + 0 * TH], -1)}
-    tau, ok = an.motor_torque(fb, TH, forces, eta_trans=0.8, eta_link=0.9)
+    tau, _ok = an.motor_torque(fb, TH, forces, eta_trans=0.8, eta_link=0.9)
     v, _ = an.point_velocities(fb, TH, omega)
     power = (forces["coupler_point"] * v["coupler_point"]).sum(-1)
     # the motor supplies the losses where it drives; where the load drives it (power < 0), the losses

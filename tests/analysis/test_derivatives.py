@@ -148,7 +148,7 @@ def test_torque_of_a_rocking_driver_divides_power_by_its_own_speed() -> None:
     mech = sc.mechanism
     t = np.linspace(0, mech.driver.period, 40, endpoint=False)
     mo = mech.solve(mech.driver.value(t), t=t)
-    tau, ok = motor_torque(mech, mo, sc.effects)
+    tau, _ok = motor_torque(mech, mo, sc.effects)
     power_over_rate = inverse_dynamics_torque(mech, t, sc.effects)
     qd, _ = driver_rates(mech.driver, t)
     keep = np.abs(qd) > 0.2 * np.abs(qd).max()

@@ -35,7 +35,7 @@ def test_untimed_sse_matches_pylinkage_simulation():
 
 
 def test_place_closes_the_loop():
-    A, D, B, C, P = place(FOURBAR, -1.0)
+    A, D, B, C, _P = place(FOURBAR, -1.0)
     r1, r2, r3, r4 = FOURBAR[:4]
     assert np.hypot(*(D - A)) == pytest.approx(r1) and np.hypot(*(B - A)) == pytest.approx(r2)
     assert np.hypot(*(C - B)) == pytest.approx(r3) and np.hypot(*(C - D)) == pytest.approx(r4)

@@ -397,7 +397,7 @@ def test_bad_job(tmp_path: Path, capsys: pytest.CaptureFixture[str], content: di
 def test_utf16_scene_with_a_byte_order_mark_is_read(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     src = tmp_path / "scene.toml"
     src.write_bytes(GOOD.encode("utf-16"))
-    rc, out, err = _run(["motion", str(src), "-o", str(tmp_path / "m.csv")], capsys)
+    rc, _out, err = _run(["motion", str(src), "-o", str(tmp_path / "m.csv")], capsys)
     assert rc == 0, err
     assert (tmp_path / "m.csv").read_text().count("\n") == 13
 
@@ -467,7 +467,7 @@ def test_limits_are_configurable(tmp_path: Path, capsys: pytest.CaptureFixture[s
     _check_one_line(rc, err, "PLANAR_MAX_SAMPLES")
     assert "driver.cycles = 10.0" in err
     monkeypatch.setenv("PLANAR_MAX_SAMPLES", "200")
-    rc, out, err = _run(["motion", str(src), "-o", str(tmp_path / "m.csv")], capsys)
+    rc, _out, err = _run(["motion", str(src), "-o", str(tmp_path / "m.csv")], capsys)
     assert rc == 0, err
     assert len((tmp_path / "m.csv").read_text().splitlines()) == 121
     monkeypatch.setenv("PLANAR_MAX_MEMORY", "1")  # MiB: 120 samples fit, 12 000 do not

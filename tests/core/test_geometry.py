@@ -120,7 +120,7 @@ def test_line_circle(px, py, ang, cx, cy, r, br):
         assert abs(np.hypot(p[0] - cx, p[1] - cy) - r) < 1e-9 * scale
         # on the line
         assert abs(u[0] * (p[1] - py) - u[1] * (p[0] - px)) < 1e-9 * scale
-        other, _, s2 = g.line_circle([px, py], u, [cx, cy], r, -br)
+        _other, _, s2 = g.line_circle([px, py], u, [cx, cy], r, -br)
         assert (s - s2) * br >= -1e-12
 
 

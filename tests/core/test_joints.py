@@ -100,7 +100,7 @@ def test_a_guide_no_other_link_carries_is_refused():
     links = [Link("crank", ("O", "A")), Link("lever", ("Q",)), Link("block", ("A",), guide=("Q", "T"))]
     with pytest.raises(InputError, match=r"qr.links.lever .*'Q' and 'A' move relative.*changes by 2\b"):
         Linkage("qr", nodes, links[:1] + [Link("lever", ("Q", "A", "T"))] + links[2:])  # A slides: not rigid
-    with pytest.raises(InputError, match="qr.links.block.guide"):
+    with pytest.raises(InputError, match=r"qr\.links\.block\.guide"):
         Linkage("qr", nodes, [links[0], Link("lever2", ("O", "Q")), links[2]])
 
 
@@ -148,7 +148,7 @@ def test_a_registered_kind_a_consumer_lacks_is_an_error_naming_it():
             simulate(mech, np.linspace(0, 1, 5))
         from planar.windup.chain import _rename_joint
 
-        with pytest.raises(UnsupportedError, match="chain composition.*'test-weld'"):
+        with pytest.raises(UnsupportedError, match=r"chain composition.*'test-weld'"):
             _rename_joint(Weld("w", "a", "b"), "s0", 0.0)
         with pytest.raises(TypeError, match="double registration"):
             joint_kind(Weld)

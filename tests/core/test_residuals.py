@@ -28,7 +28,7 @@ def test_every_part_has_a_real_outline(name):
     for part in mech.parts:
         poly = part.outline
         assert poly.is_valid and poly.area > 0, f"{name}.{part.name}"
-        holes = [f for f in part.features]
+        holes = list(part.features)
         # each hole or slot is cut inside the outline
         assert len(poly.interiors) == len(holes), f"{name}.{part.name}: {len(poly.interiors)} vs {len(holes)}"
 

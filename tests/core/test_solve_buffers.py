@@ -9,10 +9,10 @@ import pytest
 
 pytest.importorskip("numba")
 
-from planar.core import buffers  # noqa: E402
-from planar.linkages import FourBar  # noqa: E402
-from planar.linkages.chunked import JIT_MIN, solver_for  # noqa: E402
-from planar.scene.catalog import get  # noqa: E402
+from planar.core import buffers
+from planar.linkages import FourBar
+from planar.linkages.chunked import JIT_MIN, solver_for
+from planar.scene.catalog import get
 
 N = max(JIT_MIN, 40_000)  # large enough for the compiled path and for blocks the pool takes
 needs_pool = pytest.mark.skipif(buffers._FREE < 0, reason="reference counts do not tell on this interpreter")

@@ -19,7 +19,7 @@ def test_cam_follower_and_pressure_charts():
     scene = load_scene("gallery/cam-automaton.toml")
     assert {"follower", "pressure"} <= set(available_charts(scene))
     fig = scene_figure(scene, ["follower", "pressure"], samples_per_cycle=720)
-    x, s, ax = _line(fig, "follower:displacement")
+    _x, s, ax = _line(fig, "follower:displacement")
     assert ax.get_xlabel() == "cam angle (deg)"
     # independent of the motion law's code: the follower arm's angle in the solved poses (degrees, mod 360)
     mech = scene.mechanism

@@ -79,7 +79,7 @@ def test_eight_tab_stands_in_its_tapered_window():
         a = poses_apply(mo.poses["driver"][i], m.joints[2].centre)
         band = T.intersection(box(-10, a[1] - 0.005, 10, a[1] + 0.005))
         assert band.area > 0 and band.difference(W).area < 1e-2 * band.area, i  # the tilted face over the band: a sliver
-    _, vm, marks = assembled(m, mo)
+    _, _vm, marks = assembled(m, mo)
     ((taper, _),) = marks.lines
     w = taper[0]
     # straight contact edge, far side D_w1 at the bottom and D_w2 at the top

@@ -80,7 +80,7 @@ def test_a_same_layer_contact_that_overlaps_is_refused(tmp_path):
 
     fj.PIN_RULES.get = rules  # type: ignore[method-assign]
     try:
-        with pytest.raises(FabricationError, match="joint 'axle'.*must touch.*in one layer"):
+        with pytest.raises(FabricationError, match=r"joint 'axle'.*must touch.*in one layer"):
             export_scene(scene, tmp_path / "x.dxf")
     finally:
         fj.PIN_RULES.get = orig  # type: ignore[method-assign]

@@ -68,7 +68,8 @@ def _export(tmp_path: Path, scene_path: Path):
 
     scene = load_scene(scene_path)
     fab = export_scene(scene, tmp_path / "p.dxf", bom=tmp_path / "p.csv")
-    rows = list(csv.DictReader(open(tmp_path / "p.csv", newline="")))
+    with open(tmp_path / "p.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
     return scene, fab, tmp_path / "p.dxf", rows
 
 
@@ -172,7 +173,7 @@ def test_cam_d_hole_has_the_running_clearance(bunny):
     from ezdxf import path as ezpath
     from shapely.geometry import Polygon
 
-    scene, fab, dxf, rows = bunny
+    scene, fab, dxf, _rows = bunny
     f = scene.spec.fabrication
     (d_cut,) = [e for e in _inner(dxf)["cam.left"] if e.dxftype() != "CIRCLE"]
     poly = Polygon([(v.x, v.y) for v in ezpath.make_path(d_cut).flattening(1e-4)]).buffer(
@@ -186,7 +187,7 @@ def test_cam_d_hole_has_the_running_clearance(bunny):
 
 
 def test_widened_note_has_no_negative_wall(bunny):
-    scene, fab, dxf, rows = bunny
+    _scene, fab, _dxf, _rows = bunny
     widened = [n for n in fab.notes if "widened" in n]
     assert widened, fab.notes
     for n in widened:

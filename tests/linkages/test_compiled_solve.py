@@ -10,15 +10,15 @@ import pytest
 
 pytest.importorskip("numba")
 
-from scipy.optimize import root  # noqa: E402
+from scipy.optimize import root
 
-from planar.core.geometry import poses_apply  # noqa: E402
-from planar.core.model import merge_failures  # noqa: E402
-from planar.errors import PlanarError  # noqa: E402
-from planar.linkages import RRP, RRR, Actuator, Crank, Fixed, FourBar, Link, Linkage, Rigid, chunked  # noqa: E402
-from planar.linkages.chunked import fast_solve  # noqa: E402
-from planar.scene.catalog import CATALOG, get  # noqa: E402
-from planar.scene.load import load_scene  # noqa: E402
+from planar.core.geometry import poses_apply
+from planar.core.model import merge_failures
+from planar.errors import PlanarError
+from planar.linkages import RRP, RRR, Actuator, Crank, Fixed, FourBar, Link, Linkage, Rigid, chunked
+from planar.linkages.chunked import fast_solve
+from planar.scene.catalog import CATALOG, get
+from planar.scene.load import load_scene
 
 GALLERY = Path(__file__).resolve().parents[2] / "gallery"
 

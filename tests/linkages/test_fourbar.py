@@ -142,11 +142,11 @@ def test_change_point_passes_the_flat_position():
 @pytest.mark.parametrize(
     "kw,field",
     [
-        (dict(ground=4, crank=-1, coupler=4, rocker=3), "crank"),
-        (dict(ground=4, crank=0, coupler=4, rocker=3), "crank"),
-        (dict(ground=4, crank=float("nan"), coupler=4, rocker=3), "crank"),
-        (dict(ground=10, crank=1, coupler=2, rocker=3), "links"),
-        (dict(ground=4, crank=1, coupler=4, rocker=3, circuit="sideways"), "circuit"),
+        ({"ground": 4, "crank": -1, "coupler": 4, "rocker": 3}, "crank"),
+        ({"ground": 4, "crank": 0, "coupler": 4, "rocker": 3}, "crank"),
+        ({"ground": 4, "crank": float("nan"), "coupler": 4, "rocker": 3}, "crank"),
+        ({"ground": 10, "crank": 1, "coupler": 2, "rocker": 3}, "links"),
+        ({"ground": 4, "crank": 1, "coupler": 4, "rocker": 3, "circuit": "sideways"}, "circuit"),
     ],
 )
 def test_bad_dimensions_are_named(kw, field):

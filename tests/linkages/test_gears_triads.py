@@ -125,7 +125,7 @@ def test_geared_five_bar_scene_export_and_compare(tmp_path: Path) -> None:
     scene = load_scene(GALLERY / "geared-five-bar.toml")
     m = scene.motion()
     assert m.valid.all()
-    names, table = motion_columns(scene.mechanism, m)
+    names, _table = motion_columns(scene.mechanism, m)
     assert names[:4] == ["t", "driver", "driver.A", "driver.B"]
     result, sim = compare_scene(scene)
     assert sim.failure is None
@@ -364,7 +364,7 @@ def test_triad_dead_centre_jump_is_flagged() -> None:
     # scipy, continued from the last valid sample, finds no assembly near it either: the branch ends
     f = _loop_equations_general(lk, float(q[k]))
     prev = np.concatenate([pos[n][bad[0] - 1] for n in ("T1", "T2", "T3")])
-    x, info, ier, msg = fsolve(f, prev, full_output=True)
+    x, _info, ier, _msg = fsolve(f, prev, full_output=True)
     near = ier == 1 and np.max(np.abs(f(x))) < 1e-9 and np.abs(x - prev).max() < 0.2
     assert not near
 
@@ -398,7 +398,7 @@ def test_blocked_continuation_equals_sample_by_sample() -> None:
     K = np.stack([0.7 * np.c_[np.cos(q), np.sin(q)], np.broadcast_to([6.0, 0.0], (n, 2)), np.broadcast_to([1.0, 7.5], (n, 2))], 1)
     cont = np.ones(n, bool)
     cont[0] = False
-    u, ok, code = solve_triad(K, L, S, u_ref, cont, scale)
+    u, ok, _code = solve_triad(K, L, S, u_ref, cont, scale)
     seq = np.empty((n, 3))
     prev = u_ref
     for k in range(n):  # the definition: Newton from the previous sample's assembly
@@ -480,7 +480,7 @@ def test_accelerations_match_differences_of_velocities() -> None:
     for lk, q, names in cases:
         assert isinstance(lk, Linkage)
         qd, qdd = 1.7, -0.4  # a driver speeding down: both terms of the chain rule count
-        pos, vel, acc, ok = lk.node_accelerations(q, qd, qdd)
+        _pos, _vel, acc, ok = lk.node_accelerations(q, qd, qdd)
         assert ok.all()
         vp, _ = lk.node_velocities(q + h, 1.0)
         vm, _ = lk.node_velocities(q - h, 1.0)

@@ -47,7 +47,7 @@ def test_mass_properties_match_shapely_and_integration():
         inside = shapely.contains_xy(poly, xs, ys)
         cell = (x1 - x0) / (n - 1) * (y1 - y0) / (n - 1)
         r2 = (xs - cog[0]) ** 2 + (ys - cog[1]) ** 2
-        assert I == pytest.approx(2.0 * (r2[inside] * cell).sum(), rel=2e-2)
+        assert pytest.approx(2.0 * (r2[inside] * cell).sum(), rel=2e-2) == I
 
 
 @pytest.mark.parametrize("name", SIMULATED)
@@ -64,7 +64,7 @@ def test_only_the_named_effects_are_built():
     assert bare.built["gravity"] is None and bare.built["springs"] == 0
     assert bare.built["damping"] is None and bare.built["loads"] == 0
     explicit_none = simulate_scene(scene_of(dict(LEG, effects={"springs": [], "loads": []})))
-    assert {k: v for k, v in explicit_none.built.items()} == {k: v for k, v in bare.built.items()}
+    assert dict(explicit_none.built.items()) == dict(bare.built.items())
     # what is built does not depend on how long it runs: a tenth of a cycle
     full = simulate_scene(
         scene_of(
@@ -352,7 +352,8 @@ def test_accuracy_benchmark_quick_run(tmp_path, monkeypatch):
     assert r["effects_cost"]["unused"] > 0 and r["effects_cost"]["none"] > 0
     import csv
 
-    rows = list(csv.DictReader(open(out / "accuracy.csv")))
+    with open(out / "accuracy.csv") as fh:
+        rows = list(csv.DictReader(fh))
     assert {
         "mechanism",
         "substeps",

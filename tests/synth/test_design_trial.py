@@ -97,14 +97,14 @@ def _fake_design(physics: dict, **kw) -> Design:
     """A Design around a real toy (Rz->Tx Tx->Oy: a #8 stage) with the figures a summary line reports."""
     toy = ToyMechanism({"left": [("Rz->Tx", "Tx->Oy")]}, name="t", names={("left", ("Rz->Tx", "Tx->Oy")): "ear"})
     e = Effector("ear", "Oy", 20.0)
-    base = dict(
-        layers={"frame": 0, "cam": 1},
-        collisions=[],
-        clashes=[],
-        physics=physics,
-        placement=Placement(["v"], (1.0, 1.0), (1.0, 1.0), (0.0, 0.0), 41, 0, 0.1, kept=False, checked=0),
-        before={"layers": 2, "collisions": 0, "pin_clashes": 0, "export_refused": 0},
-    )
+    base = {
+        "layers": {"frame": 0, "cam": 1},
+        "collisions": [],
+        "clashes": [],
+        "physics": physics,
+        "placement": Placement(["v"], (1.0, 1.0), (1.0, 1.0), (0.0, 0.0), 41, 0, 0.1, kept=False, checked=0),
+        "before": {"layers": 2, "collisions": 0, "pin_clashes": 0, "export_refused": 0},
+    }
     base.update(kw)
     return Design(
         toy, [e], [("left", ("Rz->Tx", "Tx->Oy"))], 6.0, {"ear": 20.0}, 1, 1, {"ear": ("Rz->Tx Tx->Oy", "F_jh", 0.1)}, **base

@@ -105,9 +105,9 @@ def test_gravity_in_the_followers_plane_holds_slow_and_lets_go_fast_as_pymunk_sa
 
     def pulls(sp: float) -> bool:
         rec: list[tuple[float, float]] = []
-        err, why = skew_stage(mech, sp, samples_per_cycle=72, substeps=32, drive=drive, gravity=g, record=rec)
+        _err, why = skew_stage(mech, sp, samples_per_cycle=72, substeps=32, drive=drive, gravity=g, record=rec)
         assert why is None
-        t, m = np.array(rec).T
+        _t, m = np.array(rec).T
         m = m[32:]  # the first sample interval: the start transient
         return bool((h.push[0] * m < 0).any())
 

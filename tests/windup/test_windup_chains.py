@@ -1,5 +1,6 @@
 """Motion transfer table, chain counts, composition, trees, failure boundaries, inverse sizing."""
 
+import itertools
 import json
 import subprocess
 import sys
@@ -54,7 +55,7 @@ def test_chains_are_valid_paths_from_the_motor():
         assert len(set(chains)) == len(chains)
         for c in chains:
             assert c[0].startswith("Rz->") and c[-1].endswith("->" + target) and len(c) <= 3
-            for p, nxt in zip(c, c[1:]):
+            for p, nxt in itertools.pairwise(c):
                 assert p.split("->")[1] == nxt.split("->")[0]
                 a, b = nxt.split("->")
                 assert b in TABLE[a]
@@ -121,7 +122,7 @@ def test_toys_build_and_close_their_joints(factory):
     for group in toy.merged:
         parent = int(group[0][1:].split(".")[0])
         pst = toy.stages[parent]
-        pu, pres = toy._last_bases[parent]
+        _pu, pres = toy._last_bases[parent]
         pt, pr = _world_displacement(pst, pst.mech._follower_pose(pres.out), pst.mech.part("follower"))
         for child in group[1:]:
             k = int(child[1:].split(".")[0])
@@ -225,7 +226,7 @@ def test_3_fails_where_circles_part_and_stays_finite_at_the_boundary():
     far = np.abs(gv) > 1e-9
     assert np.array_equal(st.valid[far], (gv <= 0)[far])
     i = int(np.flatnonzero(np.diff(np.sign(gv)))[0])
-    qs, q, near = _boundary(mech, g, th[i], th[i + 1])
+    _qs, _q, near = _boundary(mech, g, th[i], th[i + 1])
     assert np.all(np.isfinite(near.out))
     # continuous: within round-off of tangency the position moves by at most sqrt(eps) scale
     assert np.ptp(near.out[near.valid], axis=0).max() < 1e-6
