@@ -135,6 +135,7 @@ def test_no_import_cycles_in_the_package():
     assert find_cycle(graph) is None, " -> ".join(find_cycle(graph) or [])
 
 
+@pytest.mark.slow
 def test_every_module_imports_on_its_own_in_a_fresh_interpreter():
     names = sorted(m for m in _modules(ROOT, PACKAGES) if not m.endswith("__main__"))  # that one runs the CLI
     code = (

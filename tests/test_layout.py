@@ -9,6 +9,8 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 
 # The rooms in the order data flows: a room may import only rooms before it
@@ -118,6 +120,7 @@ def test_no_import_cycles() -> None:
     assert cycles == []
 
 
+@pytest.mark.slow
 def test_data_flows_one_way() -> None:
     rank = {room: i for i, room in enumerate(ORDER)}
     back = []

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, ClassVar, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -22,8 +22,10 @@ __all__ = ["Linkage", "NodeKind", "_Plan"]
 class NodeKind(Protocol):
     """A node kind as the fast solve reads it (:class:`planar.linkages.dyads.NodeKind`)."""
 
-    kind: str
-    name: str
+    kind: ClassVar[str]
+
+    @property
+    def name(self) -> str: ...
 
     def refs(self) -> Sequence[str]: ...
 
@@ -31,12 +33,28 @@ class NodeKind(Protocol):
 class Linkage(Protocol):
     """A linkage as the fast solve reads it (:class:`planar.linkages.dyads.Linkage`)."""
 
-    name: str
-    nodes: Sequence[Any]
-    links: Sequence[Any]
-    ground_name: str
-    point_nodes: Mapping[str, str]
-    placement: tuple[float, float, float]
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def nodes(self) -> Sequence[Any]: ...
+
+    @property
+    def links(self) -> Sequence[Any]: ...
+
+    @property
+    def ground_name(self) -> str: ...
+
+    @property
+    def point_nodes(self) -> Mapping[str, str]: ...
+
+    @property
+    def points(self) -> Mapping[str, Any]: ...
+
+    @property
+    def placement(self) -> tuple[float, ...]: ...
+
+    def _fast_plan(self) -> Any: ...
 
     def solve_nodes(self, q: NDArray[np.float64]) -> tuple[Any, Any]: ...
 

@@ -923,8 +923,8 @@ def simulate(
     if mode == "motor" and getattr(mech, "extra_driven_parts", []):
         raise SimulationError(
             f"{mech.name}: motor mode drives one part; this linkage has more inputs "
-            f"({', '.join(mech.extra_driven_parts)}), each imposed kinematically"
-        )  # type: ignore[attr-defined]
+            f"({', '.join(mech.extra_driven_parts)}), each imposed kinematically"  # type: ignore[attr-defined]
+        )
     if mode == "motor" and len(_driven_parts(mech)) > 1:
         raise SimulationError(
             f"{mech.name}: motor mode drives one part; this toy's stages are drawn apart, "

@@ -37,7 +37,7 @@ class PlacedFourBar:
             self.coupler,
             self.rocker,
             coupler_point=self.coupler_point,
-            circuit=self.circuit,
+            circuit=self.circuit,  # type: ignore[arg-type]
             placement=self.placement,
             **kw,
-        )  # type: ignore[arg-type]
+        )

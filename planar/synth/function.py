@@ -77,10 +77,10 @@ class FunctionDesign(Checked):
             self.coupler,
             self.rocker,
             coupler_point=(0.5 * self.coupler, 0.0),
-            circuit=self.circuit,
+            circuit=self.circuit,  # type: ignore[arg-type]
             placement=(0.0, 0.0, self.ground_angle),
             **kw,
-        )  # type: ignore[arg-type]
+        )
 
     def to_dict(self) -> dict[str, Any]:
         return {

@@ -30,6 +30,7 @@ def test_readme_opens_with_two_commands_and_ci_runs_the_test_one():
     assert cmds[1].strip() in ci.splitlines()
 
 
+@pytest.mark.slow
 def test_demo_writes_outputs(tmp_path):
     import time
 
@@ -70,6 +71,7 @@ def test_motion_csv_round_trips(tmp_path):
     assert data["valid"].all()
 
 
+@pytest.mark.slow
 def test_bench_kinematics_json_has_ratio_and_agrees_with_peer():
     pytest.importorskip("pylinkage")
     from planar.bench.suite import bench_kinematics

@@ -265,6 +265,7 @@ def _snapshot(folder: Path) -> dict[str, bytes]:
     return {p.name: p.read_bytes() for p in folder.iterdir() if p.is_file()}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("content,needle", [c[1:] for c in BAD_SCENES], ids=[c[0] for c in BAD_SCENES])
 def test_bad_scene(tmp_path: Path, capsys: pytest.CaptureFixture[str], content: Any, needle: str) -> None:
     src = tmp_path / "scene.toml"
@@ -341,6 +342,7 @@ MISUSES: list[tuple[str, list[str], str]] = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("argv,needle", [c[1:] for c in MISUSES], ids=[c[0] for c in MISUSES])
 def test_cli_misuse(tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: list[str], needle: str) -> None:
     src = tmp_path / "scene.toml"
@@ -378,6 +380,7 @@ BAD_JOBS: list[tuple[str, dict, str, str]] = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("content,command,needle", [c[1:] for c in BAD_JOBS], ids=[c[0] for c in BAD_JOBS])
 def test_bad_job(tmp_path: Path, capsys: pytest.CaptureFixture[str], content: dict, command: str, needle: str) -> None:
     src = tmp_path / "scene.toml"
@@ -524,6 +527,7 @@ def _subprocess(args: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:
     return subprocess.run([sys.executable, "-m", "planar", *args], cwd=cwd, env=env, capture_output=True, text=True, timeout=120)
 
 
+@pytest.mark.slow
 def test_subprocess_errors_are_one_line_without_traceback(tmp_path: Path) -> None:
     (tmp_path / "bad.toml").write_bytes(b"\xff\xfe" + "crank = = \n".encode("utf-16-le"))
     (tmp_path / "loop.toml").symlink_to(tmp_path / "loop.toml")

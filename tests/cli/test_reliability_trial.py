@@ -109,6 +109,7 @@ def test_ctrl_c_while_numpy_loads_is_one_line(tmp_path):
     assert out.strip() == "False"
 
 
+@pytest.mark.slow
 def test_schema_to_a_closed_stdout(tmp_path):
     import subprocess
     import sys

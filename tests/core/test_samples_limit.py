@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import pytest
+
 from planar.cli.main import main
 
 SCENE = '[mechanism]\ntype = "fourbar"\nground = 4\ncrank = 1\ncoupler = 4\nrocker = 3\n[driver]\nsamples_per_cycle = {n}\n'
 
 
+@pytest.mark.slow
 def test_samples_per_cycle_follows_the_documented_limit(tmp_path, capsys, monkeypatch):
     scene = tmp_path / "s.toml"
     out = tmp_path / "m.csv"

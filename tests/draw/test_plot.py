@@ -85,6 +85,7 @@ def test_svg_read_back_with_svgelements_keeps_the_curve_shape(tmp_path) -> None:
     assert np.abs(A @ coef - b).max() < 0.05  # SVG coordinates are written to 6 digits: hundredths of a point
 
 
+@pytest.mark.slow
 def test_plot_bytes_reproducible(tmp_path) -> None:
     for ext in ("svg", "png"):
         a, b = tmp_path / f"a.{ext}", tmp_path / f"b.{ext}"

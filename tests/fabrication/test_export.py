@@ -26,6 +26,7 @@ from planar.scene.load import load_scene
 GALLERY = Path(__file__).resolve().parents[2] / "gallery"
 
 
+@pytest.mark.slow
 @given(st.lists(st.tuples(st.floats(-50, 50), st.floats(-50, 50), st.floats(0.1, 20)), min_size=1, max_size=7))
 @settings(max_examples=150, deadline=None)
 def test_hull_of_circles_is_the_convex_hull_of_the_discs(circles):
@@ -137,6 +138,7 @@ def test_slot_kerf_and_arc_slots():
     assert abs(slot.area - (33 * 4 + math.pi * 2**2)) < 0.05
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", gallery_scenes(GALLERY), ids=lambda p: p.stem)
 def test_every_gallery_scene_exports_checked_files(tmp_path, path):
     scene = load_scene(path)
@@ -216,6 +218,7 @@ def test_svg_conventions(tmp_path):
     assert widths == {0.025}
 
 
+@pytest.mark.slow
 def test_export_is_reproducible_and_cli(tmp_path):
     scene = GALLERY / "jansen-leg.toml"
     for name in ("a", "b"):
@@ -255,6 +258,7 @@ def _scene_file(tmp_path, src, extra):
     return p
 
 
+@pytest.mark.slow
 def test_export_errors_are_user_errors(tmp_path, capsys):
     scene = GALLERY / "jansen-leg.toml"
     cases = [
@@ -299,6 +303,7 @@ def test_narrow_links_are_widened_or_refused(tmp_path):
     assert r.returncode == 2 and "wall" in r.stderr and "min_wall_mm" in r.stderr
 
 
+@pytest.mark.slow
 def test_thickness_and_pin_diameter_have_effect(tmp_path):
     import csv
 
@@ -352,6 +357,7 @@ def test_slots_leave_margin_past_the_pins_travel():
             assert t.min() >= s.slot_end - 1e-6 and t.max() <= L - s.slot_end + 1e-6, (name, j.name, t.min(), L - t.max())
 
 
+@pytest.mark.slow
 def test_nesting_horse_on_one_sheet_and_several_files(tmp_path):
     scene = load_scene(GALLERY / "horse.toml")
     # the Horse is cut as its assembly (one 182 x 142 mm frame, merged parts): one 400 x 300 mm sheet
@@ -395,6 +401,7 @@ def test_kerf_test_piece(tmp_path):
     assert len([e for e in doc.modelspace() if e.dxf.layer == "ENGRAVE"]) > 3
 
 
+@pytest.mark.slow
 def test_preview_png(tmp_path):
     assert (
         main(["export", str(GALLERY / "windup-03.toml"), "-o", str(tmp_path / "p.dxf"), "--preview", str(tmp_path / "p.png")])

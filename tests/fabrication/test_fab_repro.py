@@ -5,6 +5,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[2]
 
 
@@ -34,6 +36,7 @@ def _export(out: Path, seed: str, extra: list[str]) -> dict[str, bytes]:
     return {p.name: p.read_bytes() for p in sorted(out.iterdir())}
 
 
+@pytest.mark.slow
 def test_bytes_do_not_depend_on_the_hash_seed(tmp_path):
     # seeds 1 and 4 ordered ezdxf's CLASSES section differently before the fix
     extra = ["--bom", "p.csv", "--assembly", "a.svg", "--preview", "p.png"]

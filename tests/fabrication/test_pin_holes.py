@@ -142,6 +142,7 @@ def bunny(tmp_path_factory):
     return _export(tmp_path_factory.mktemp("bunny"), ROOT / "gallery" / "bunny.toml")
 
 
+@pytest.mark.slow
 def test_bunny_every_pin_hole_is_pin_plus_clearance(bunny):
     scene, fab, dxf, rows = bunny
     assert _check_pin_holes(scene, fab, dxf, rows) >= 5  # B and C on the slider, D, E twice
@@ -150,6 +151,7 @@ def test_bunny_every_pin_hole_is_pin_plus_clearance(bunny):
     assert dias == [3.1, 3.1], dias
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("text, least", [(SLIDER_TOY, 2), (NOD_TOY, 7)], ids=["Rz-Tx-Ox", "Rz-Tx-Oz-Oz"])
 def test_toy_every_pin_hole_is_pin_plus_clearance(tmp_path, text, least):
     path = tmp_path / "toy.toml"

@@ -76,6 +76,7 @@ def _sides(r):
     return max(a, b), min(a, b), math.atan2(long[1], long[0])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("reader", ["dxf", "svg"])
 def test_slots_and_tabs_meet_in_the_assembled_pose(bunny, reader):
     fab, tmp, pose = bunny

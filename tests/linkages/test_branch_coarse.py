@@ -28,6 +28,7 @@ def test_the_reported_crossed_crank_rocker(n):
     np.testing.assert_allclose(fb.solve(q).points["coupler_point"], _one_by_one(fb, q), atol=1e-12)
 
 
+@pytest.mark.slow
 def test_random_grashof_cranks_at_any_sampling():
     rng = np.random.default_rng(7)
     done = 0

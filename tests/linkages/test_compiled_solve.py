@@ -117,6 +117,7 @@ def _reference(lk, q):
     return poses, valid, code, table, pts
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(LINKAGES))
 def test_compiled_solve_matches_numpy_kernels_and_reference(name, monkeypatch):
     lk = LINKAGES[name]

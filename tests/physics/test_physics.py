@@ -84,6 +84,7 @@ def test_rocker_driven_to_its_toggle_is_caught_there():
     assert max(float(r[f.sample]) for r in sim.residuals.values()) < 0.1 * f.error * fb.size
 
 
+@pytest.mark.slow
 def test_compare_exit_status_3_when_the_error_passes_the_threshold():
     path = str(GALLERY / "slider-crank.toml")
     ok = run_cli("compare", path, "--json")
@@ -220,6 +221,7 @@ def test_motor_saturation_is_reported_with_its_samples_and_fails_compare(tmp_pat
     assert r.returncode == EXIT_MISMATCH and "motor saturated" in r.stdout, r.stdout
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("key", ["contact = true", "contact = false", "friction = 0.3"])
 def test_contact_and_friction_keys_are_refused_in_one_line(tmp_path, key):
     # collisions were removed (parts sit on layers and never touch): the scene is refused when read, exit 2,

@@ -31,6 +31,7 @@ def _simulable(name):
     return sc
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", SCENES)
 def test_gallery_within_1e4_of_size_both_modes_and_torque_within_1_percent(name):
     sc = _simulable(name)

@@ -322,6 +322,7 @@ def test_scaled_mechanisms_keep_their_relative_accuracy(scale):
     assert c.max_rel_error < 1e-3, (scale, c.max_rel_error)
 
 
+@pytest.mark.slow
 def test_accuracy_benchmark_quick_run(tmp_path, monkeypatch):
     pytest.importorskip("matplotlib")
     from planar.bench.suite import bench_accuracy
@@ -367,6 +368,7 @@ def test_accuracy_benchmark_quick_run(tmp_path, monkeypatch):
     } <= set(rows[0])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("args", [[], ["--scenes", "no-such-folder"]])
 def test_accuracy_benchmark_needs_a_scenes_folder(tmp_path, args):
     # from a folder without gallery/: one line naming the folder, exit 2, no traceback, nothing written

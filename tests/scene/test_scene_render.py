@@ -132,6 +132,7 @@ def _gif_frames(path):
     return im, frames, delays
 
 
+@pytest.mark.slow
 def test_gif_properties_and_reproducibility(tmp_path):
     p = write(tmp_path, FOURBAR)
     a, b = tmp_path / "a.gif", tmp_path / "b.gif"

@@ -105,6 +105,7 @@ def _check(path: Path, rows: list[dict]) -> dict:
     return by_name
 
 
+@pytest.mark.slow
 def test_horse_request(tmp_path: Path, capsys) -> None:
     """The paper's Horse: head (Oz) on one cam, the legs (Ty lift, Oz swing) on the other, half a turn behind;
     ranges taken from the gallery Horse."""
@@ -135,6 +136,7 @@ def test_horse_request(tmp_path: Path, capsys) -> None:
     assert toy.cost < gallery.cost and f"cost {toy.cost:g}" in text
 
 
+@pytest.mark.slow
 def test_bunny_request_renders_exports_and_runs(tmp_path: Path, capsys) -> None:
     """The paper's Bunny: two ears (Ox, Oy) with the gallery Bunny's ranges; the written toy renders,
     exports (read back with ezdxf) and runs coupled with its motor torque checked (planar toy)."""
@@ -160,6 +162,7 @@ def test_bunny_request_renders_exports_and_runs(tmp_path: Path, capsys) -> None:
     assert main(["toy", str(out)]) == 0
 
 
+@pytest.mark.slow
 def test_a_request_no_gallery_scene_has(tmp_path: Path, capsys) -> None:
     """A lift (Ty) on the left cam and a rocker (Oz) on the right, a quarter turn ahead (issue 15: Ty + Oz)."""
     rows = [
@@ -178,6 +181,7 @@ def test_a_request_no_gallery_scene_has(tmp_path: Path, capsys) -> None:
     assert float(np.hypot(*np.ptp(m.points["lift"], axis=0))) == pytest.approx(0.1, rel=0.01)
 
 
+@pytest.mark.slow
 def test_unreachable_and_bad_requests_are_refused(tmp_path: Path, capsys) -> None:
     out = tmp_path / "toy.toml"
     # OzT has one chain (Rz->OzT, #3): its rotation reaches about 13 degrees
@@ -200,6 +204,7 @@ def test_unreachable_and_bad_requests_are_refused(tmp_path: Path, capsys) -> Non
     assert rc == 2 and "effector 'head'.motion" in err and not out.exists()
 
 
+@pytest.mark.slow
 def test_a_tree_whose_physics_fails_is_passed_over(tmp_path, capsys) -> None:
     # a nodding head of 110 degrees: the cheapest tree (Rz->Tx Tx->Oz Oz->Oz) sizes and places, but pymunk's
     # motor torque strays 4.2-4.8 % from inverse dynamics (a new user found design saying [ok] where `planar toy`

@@ -88,6 +88,7 @@ def _footprint(toy: ToyMechanism, samples: int = 24) -> float:
     return float(shapely.union_all(geoms).convex_hull.area)
 
 
+@pytest.mark.slow
 def test_placement_moves_a_pin_and_pivot_together(tmp_path) -> None:
     """A slider turning a rocker (#1 then #7): the annealing moves #7's pin and pivot, not only #1's slider; the
     placed toy is smaller, its rocker swings as far, and its export has no same-layer overlap."""
@@ -112,6 +113,7 @@ def test_placement_moves_a_pin_and_pivot_together(tmp_path) -> None:
     assert overlaps == [] and clashes == []
 
 
+@pytest.mark.slow
 def test_a_stage_left_unsimulated_fails_by_name(tmp_path, capsys, monkeypatch) -> None:
     """A #8 stage with nothing holding its tab is not simulated: the design names the stage, its effector and
     why, in the text and the JSON, and exits 3 (here the scene is written without the gravity the design adds)."""

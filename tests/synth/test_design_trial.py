@@ -59,6 +59,7 @@ def _reach(text: str) -> tuple[float, float]:
     return float(m.group(1)), float(m.group(2))
 
 
+@pytest.mark.slow
 def test_an_unreachable_range_names_the_file_and_the_reach_of_buildable_chains() -> None:
     # Oy 70 deg: the trial's message said Oy reaches up to 98.47 deg (counting Rz->Ty Ty->Oy, a stage the
     # assembly refuses) and then failed with "chain.stage Rz->Ty Ty->Oy = ((0,-1,0),...)"
@@ -83,6 +84,7 @@ def test_an_unreachable_range_names_the_file_and_the_reach_of_buildable_chains()
     assert math.degrees(got) == pytest.approx(0.99 * hi, rel=1e-3)
 
 
+@pytest.mark.slow
 def test_a_range_just_past_the_scan_names_the_reach_not_an_empty_tree_list() -> None:
     # Ox 100 deg: the trial got "request = ['e']: expected a tree that can be sized and assembled (none of the 1
     # cheapest ...)" with no reason; the buildable chains' reach ends short of 100 deg
@@ -152,6 +154,7 @@ def test_the_summary_says_which_check_failed() -> None:
     assert any(ln.startswith("  written although it failed a check") for ln in lines)
 
 
+@pytest.mark.slow
 def test_a_motion_lost_in_the_fit_fails_the_design_and_warns_the_export(tmp_path, capsys) -> None:
     # Oz 0.3 deg: a cam offset of 0.105 mm, about the fit's clearance; the trial saw [ok] everywhere
     req = _request(tmp_path, '[[effector]]\nname = "twitch"\nmotion = "Oz"\nrange = 0.3\n')

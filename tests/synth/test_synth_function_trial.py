@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 
 from planar.cli.main import build_parser, main
 
@@ -36,6 +37,7 @@ def test_angles_are_from_the_world_x_axis(tmp_path, capsys):
     assert "world +x axis" in " ".join(helptext.split()) and "from the ground line" not in helptext
 
 
+@pytest.mark.slow
 def test_json_full_turn_only_when_asked_and_no_negative_zero(tmp_path, capsys):
     pairs = tmp_path / "log5.csv"
     pairs.write_text(LOG5)

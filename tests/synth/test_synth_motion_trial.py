@@ -105,6 +105,7 @@ def test_no_design_exits_3_with_reason(tmp_path, capsys):
         burmester(np.loadtxt(_write(tmp_path, five), delimiter=",", skiprows=1))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("ratio", ["0", "1", "inf", "nan"])
 def test_motion_max_ratio_refused_like_function(tmp_path, capsys, ratio):
     out = tmp_path / "m.toml"

@@ -25,6 +25,7 @@ def _csv(path, pts, theta=None, header="x,y"):
     return str(path)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed, kind", [(0, "fourbar"), (1, "fourbar"), (0, "sixbar")])
 def test_unusable_pivots_box_is_exit_3_with_reason_nothing_written(tmp_path, capsys, seed, kind):
     src = _csv(tmp_path / "ell6.csv", ELL)
@@ -54,6 +55,7 @@ def test_unusable_pivots_box_is_exit_3_with_reason_nothing_written(tmp_path, cap
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_same_relative_error_at_any_scale_and_refusal_of_unrepresentable(tmp_path, capsys):
     th = np.radians(T_DEG)
     rel = []
@@ -73,6 +75,7 @@ def test_same_relative_error_at_any_scale_and_refusal_of_unrepresentable(tmp_pat
     assert not (tmp_path / "h.toml").exists()
 
 
+@pytest.mark.slow
 def test_tolerance_decides_the_exit_status(tmp_path, capsys):
     src = _csv(tmp_path / "t.csv", ELL, T_DEG, "x,y,theta")
     out = tmp_path / "t.toml"
@@ -87,6 +90,7 @@ def test_tolerance_decides_the_exit_status(tmp_path, capsys):
     assert "over --tolerance" in text and out.exists()
 
 
+@pytest.mark.slow
 def test_bad_target_files_are_refused(tmp_path, capsys):
     out = tmp_path / "o.toml"
     cases = [

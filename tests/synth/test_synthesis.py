@@ -158,6 +158,7 @@ def test_svg_target_read_by_svgelements(tmp_path):
     assert step.max() < 136.57 / 8 + 1e-6  # evenly spaced by arc length (chords no longer than the arcs)
 
 
+@pytest.mark.slow
 def test_bench_synthesis_quick_timed_problem():
     from planar.bench.synthesis import bench_synthesis
 
@@ -204,6 +205,7 @@ def test_function_rocker_pivot_on_negative_axis():
     assert d.max_error < 1e-9 and abs(d.crank - 1.5) < 1e-9
 
 
+@pytest.mark.slow
 def test_failed_checks_are_loud(tmp_path, capsys):
     from planar.synth.path import FourBarDesign, check_design
 

@@ -74,6 +74,7 @@ def test_merged_part_keeps_every_feature(toys):
                     assert shapely.union_all([material, placed]).area > material.area  # inside the outline's reach
 
 
+@pytest.mark.slow
 def test_export_cuts_the_assembly_once(tmp_path, toys):
     import ezdxf
     from fabcheck import dxf_cut_polygons
@@ -139,6 +140,7 @@ def test_horse_motor_torque_matches_inverse_dynamics(toys):
     assert r["pose_error"] < 1e-3
 
 
+@pytest.mark.slow
 def test_bunny_simulates_every_stage_with_its_scene():
     from planar.physics.toy import simulate_toy
     from planar.scene.load import load_scene
@@ -187,6 +189,7 @@ def test_eight_holds_at_its_gallery_speed_and_lets_go_faster():
     assert hold_margin(mech, (-g[0], -g[1])) == 0.0
 
 
+@pytest.mark.slow
 def test_cli_toy(capsys):
     import json
 

@@ -6,6 +6,7 @@ import re
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from planar.analysis.dynamics import plane_gravity
 from planar.cli.main import main
@@ -29,6 +30,7 @@ def test_plane_gravity_takes_each_planes_components() -> None:
     np.testing.assert_array_equal(plane_gravity("yz", g), [-5.0, 0.0])
 
 
+@pytest.mark.slow
 def test_gravity_along_y_does_not_hold_or_move_an_xz_tab(tmp_path: Path) -> None:
     """gy is normal to the #8 stage's plane: its hold and lift-off are those of gx alone, while the motor
     torque (xy pieces) changes with gy and pymunk still agrees with inverse dynamics."""
@@ -50,6 +52,7 @@ def test_gravity_along_y_does_not_hold_or_move_an_xz_tab(tmp_path: Path) -> None
     assert np.max(np.abs(ta - tb)) > 0.02 * a.torque["peak"]
 
 
+@pytest.mark.slow
 def test_a_toy_lying_with_gravity_along_y_cannot_hold_its_tab_and_says_so(tmp_path: Path, capsys) -> None:
     code = main(["toy", str(_bunny(tmp_path, "[0.0, -9.81]"))])
     out = capsys.readouterr().out

@@ -77,6 +77,7 @@ def _push_in_plane(mech, drive, samples: int) -> np.ndarray:
     return side * np.sign(h)
 
 
+@pytest.mark.slow
 def test_flapper_without_gravity_lets_go_and_planar_toy_fails(tmp_path: Path, capsys) -> None:
     """The trial's flapper: no gravity at 5 cycles/s; nothing holds the wing's pin on its driver's edge."""
     path = _flapper(tmp_path, 5.0, "[0.0, 0.0]")

@@ -272,6 +272,7 @@ def test_mechanisms_without_failure_cases_are_valid_over_the_cycle(k):
 # ---------------------------------------------------------------- inverse sizing
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k", range(1, 12))
 def test_inverse_sizing_reaches_the_requested_range(k):
     base = motion_range(elemental(k))

@@ -159,6 +159,7 @@ def _check(mech, n=121):
     return err.max()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k", range(1, 12))
 def test_closed_form_matches_numerical_solution_at_defaults(k):
     _check(elemental(k))
@@ -179,6 +180,7 @@ def _perturbed(k, rng):
     return kw
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k", range(1, 12))
 def test_closed_form_matches_numerical_solution_at_random_parameters(k):
     rng = np.random.default_rng(1000 + k)

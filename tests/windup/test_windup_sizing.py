@@ -57,6 +57,7 @@ def test_one_and_a_half_times_the_default_range(k):
     assert _numeric_range(s.mechanism) == pytest.approx(1.5 * base, rel=1e-8)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k", sorted(DESIGN_PARAMETER))
 def test_every_mechanism_sizes_within_a_second(k):
     base = motion_range(elemental(k))
@@ -73,6 +74,7 @@ def test_every_mechanism_sizes_within_a_second(k):
     assert any(lo <= base <= hi for lo, hi in reachable_ranges(k))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("k", [7, 11])
 def test_reachable_range_is_the_true_one(k):
     # a brute-force scan over built mechanisms never beats the reported extremes, and gets close
