@@ -12,11 +12,12 @@ from __future__ import annotations
 import argparse
 import json
 import math
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from planar.errors import InputError
+
+if TYPE_CHECKING:
+    import numpy as np
 
 __all__ = ["add_parser"]
 
@@ -38,6 +39,8 @@ def _region(text: str | None) -> tuple[float, float, float, float] | None:
 
 def _rocking(fb: Any, theta: np.ndarray) -> tuple[float | None, float]:
     """``(amplitude, centre)`` of a rocking driver over the crank angles ``theta``, or ``(None, 0)`` for a full turn."""
+    import numpy as np
+
     if fb.grashof in ("crank-rocker", "double-crank"):
         return None, 0.0
     t = theta[0] + (np.asarray(theta) - theta[0] + np.pi) % (2 * np.pi) - np.pi
@@ -107,6 +110,8 @@ def _unusable(d: Any, kind: str, region: bool) -> str | None:
 
 
 def _cmd_path(args: argparse.Namespace) -> int:
+    import numpy as np
+
     _check_output(args, args.target)
     from planar.synth.path import synthesise_path
     from planar.synth.scene_out import fourbar_scene_text
@@ -243,6 +248,8 @@ def _free_hint(phi: np.ndarray, psi: np.ndarray, args: argparse.Namespace, cons:
 
 
 def _cmd_function(args: argparse.Namespace) -> int:
+    import numpy as np
+
     _check_output(args, args.pairs)
     from planar.synth.function import synthesise_function
     from planar.synth.function_search import FunctionConstraints
@@ -346,6 +353,8 @@ def _no_design(args: argparse.Namespace, command: str, count: dict[str, int], wh
 
 def _check_poses(name: str, poses: np.ndarray) -> None:
     """Refuse poses Burmester synthesis cannot use: duplicates, or a body that never turns."""
+    import numpy as np
+
     L = max(float(np.hypot(*np.ptp(poses[:, :2], axis=0))), 1e-3)
     ang = poses[:, 2]
     for i in range(len(poses)):
@@ -365,6 +374,8 @@ def _check_poses(name: str, poses: np.ndarray) -> None:
 
 
 def _cmd_motion(args: argparse.Namespace) -> int:
+    import numpy as np
+
     _check_output(args, args.poses)
     from planar.synth.motion import NoMotionDesign, burmester
     from planar.synth.scene_out import fourbar_scene_text

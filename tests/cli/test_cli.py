@@ -74,7 +74,7 @@ def test_motion_csv_round_trips(tmp_path):
 @pytest.mark.slow
 def test_bench_kinematics_json_has_ratio_and_agrees_with_peer():
     pytest.importorskip("pylinkage")
-    from planar.bench.suite import bench_kinematics
+    from planar.bench.kinematics import bench_kinematics
 
     r = bench_kinematics(n=20_000, repeats=2)
     assert [c["linkage"] for c in r["cases"]] == ["fourbar-crank-rocker", "jansen"]
@@ -103,8 +103,8 @@ def test_output_piped_into_a_closed_reader_gives_no_traceback():
 
 def test_bench_kinematics_disagreement_changes_the_exit_status(monkeypatch, capsys):
     pytest.importorskip("pylinkage")
-    import planar.bench.suite
+    import planar.bench.kinematics
 
-    monkeypatch.setattr(planar.bench.suite, "AGREEMENT", -1.0)  # no difference can pass
+    monkeypatch.setattr(planar.bench.kinematics, "AGREEMENT", -1.0)  # no difference can pass
     assert main(["bench", "kinematics", "-n", "2000", "--repeats", "1"]) == 1
     assert "DISAGREES" in capsys.readouterr().out

@@ -325,14 +325,14 @@ def test_scaled_mechanisms_keep_their_relative_accuracy(scale):
 @pytest.mark.slow
 def test_accuracy_benchmark_quick_run(tmp_path, monkeypatch):
     pytest.importorskip("matplotlib")
-    from planar.bench.suite import bench_accuracy
+    from planar.bench.accuracy import bench_accuracy
 
     # run away from the repository: the scenes folder is the one given, never looked up beside the code
     monkeypatch.chdir(tmp_path)
     r = bench_accuracy(GALLERY, out_dir="out", quick=True, repeats=1, progress=False, effects_fraction=0.1)
     out = tmp_path / "out"
     assert (out / "accuracy.csv").exists() and (out / "accuracy.png").stat().st_size > 1000
-    from planar.bench.suite import ACCURACY_QUICK_GRID
+    from planar.bench.accuracy import ACCURACY_QUICK_GRID
     from planar.physics.simulate import DEFAULT_SETTINGS as D
 
     g = ACCURACY_QUICK_GRID
@@ -387,7 +387,7 @@ def test_accuracy_benchmark_needs_a_scenes_folder(tmp_path, args):
 
 
 def test_pareto_frontier():
-    from planar.bench.suite import _pareto
+    from planar.bench.accuracy import _pareto
 
     pts = [(1.0, 1.0), (2.0, 0.5), (3.0, 0.6), (0.5, 2.0), (2.0, 0.5)]
     assert _pareto(pts) == [True, True, False, True, True]

@@ -1,0 +1,100 @@
+"""``planar compare SCENE``: the pymunk rebuild against the analytic motion."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from typing import Any
+
+from planar.cli.common import positive
+from planar.errors import InputError
+
+__all__ = ["add_parser"]
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from dataclasses import replace
+
+    from planar.app.pipeline import compare_scene
+    from planar.physics.compare import EXIT_MISMATCH, format_comparison
+    from planar.physics.simulate import SimSettings
+    from planar.scene.load import load_scene
+
+    for option, v in (("--threshold", args.threshold), ("--torque-threshold", args.torque_threshold)):
+        positive(option, v)
+    positive("--substeps", args.substeps, integer=True)
+    positive("--iterations", args.iterations, integer=True)
+    for option, v, cap in (("--substeps", args.substeps, 100_000), ("--iterations", args.iterations, 100_000)):
+        if v is not None and v > cap:  # checked before pymunk allocates steps x samples
+            raise InputError(option, v, f"at most {cap:,} (more gains nothing in float64 and runs for hours)")
+    if args.step_drift is not None and not (math.isfinite(args.step_drift) and args.step_drift >= 0):
+        raise InputError("--step-drift", args.step_drift, "a drift fraction >= 0 (0 keeps --substeps fixed)")
+    if args.error_bias is not None and not (0 <= args.error_bias <= 1):
+        raise InputError("--error-bias", args.error_bias, "a number between 0 and 1")
+    scene = load_scene(args.scene)
+    settings = SimSettings(
+        **{
+            k: v
+            for k, v in (("substeps", args.substeps), ("iterations", args.iterations), ("error_bias", args.error_bias))
+            if v is not None
+        }
+    )
+    if args.step_drift is not None:  # 0: fixed substeps
+        settings = replace(settings, step_drift=args.step_drift or None)
+    result, sim = compare_scene(scene, settings, args.threshold, args.torque_threshold, with_series=args.json)
+    t = sim.motion.t
+    assert t is not None  # a simulation records its output times
+    if args.json:
+        d = result.to_dict()
+        d["settings"] = {
+            "substeps": sim.built.get("substeps"),
+            "iterations": sim.built.get("iterations"),
+            "step_drift": settings.step_drift,
+            "correction": sim.built.get("correction"),
+            "error_bias": settings.error_bias,
+        }
+        d["wall_time_s"] = sim.wall_time
+        d["built"] = dict(sim.built.items())
+        print(json.dumps(d, indent=2, default=str))
+    else:
+        print(format_comparison(result))
+        print(
+            f"  simulated in {sim.wall_time:.3f} s ({sim.steps} steps; substeps {sim.built.get('substeps')}, "
+            f"iterations {sim.built.get('iterations')}, correction per step {sim.built.get('correction'):.3g})"
+        )
+    return 0 if result.passed else EXIT_MISMATCH
+
+
+def add_parser(sub: Any) -> None:
+    """Add ``planar compare`` to the subcommands ``sub``."""
+
+    cp = sub.add_parser("compare", help="simulate a scene in pymunk and compare with the analytic motion")
+    cp.add_argument("scene", help="scene file (TOML)")
+    cp.add_argument("--json", action="store_true", help="print JSON (each part carries max_rel_error)")
+    cp.add_argument(
+        "--threshold", type=float, default=1e-3, help="error threshold, fraction of size (1e-3); exit status 3 when a check fails"
+    )
+    cp.add_argument(
+        "--torque-threshold", type=float, default=0.01, help="motor torque vs inverse dynamics, fraction of its peak (0.01)"
+    )
+    cp.add_argument(
+        "--substeps",
+        type=int,
+        default=None,
+        help="physics steps per sample, at least (28); raised where joints turn fast, see --step-drift",
+    )
+    cp.add_argument(
+        "--step-drift",
+        type=float,
+        default=None,
+        help="largest predicted joint drift per step, fraction of size (3.5e-6); 0 keeps --substeps fixed",
+    )
+    cp.add_argument("--iterations", type=int, default=None, help="solver iterations per step, at least (40)")
+    cp.add_argument(
+        "--error-bias",
+        type=float,
+        default=None,
+        help="joint error left after one second (replaces the correction of 0.2 per step)",
+    )
+    cp.set_defaults(func=_cmd_compare)

@@ -1,0 +1,63 @@
+"""``planar export SCENE``: every part laid flat for a laser cutter."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from planar.cli.common import outputs, sheet
+from planar.errors import InputError
+
+__all__ = ["add_parser"]
+
+
+#: export's outputs: (option, attribute, suffixes)
+_EXPORT_OUTPUTS = (
+    ("-o", "output", (".dxf",)),
+    ("--svg", "svg", (".svg",)),
+    ("--preview", "preview", (".png",)),
+    ("--bom", "bom", (".csv",)),
+    ("--assembly", "assembly", (".svg",)),
+    ("--kerf-test", "kerf_test", (".dxf", ".svg")),
+)
+
+
+def _cmd_export(args: argparse.Namespace) -> int:
+    from planar.app.pipeline import export_scene
+    from planar.fabrication.build import summary
+    from planar.scene.load import load_scene
+
+    if all(getattr(args, attr) is None for _, attr, _ in _EXPORT_OUTPUTS):
+        raise InputError(
+            "export",
+            args.scene,
+            "an output: -o parts.dxf, --svg, --preview, --bom, --assembly or --kerf-test (nothing would be written)",
+        )
+    outputs(args, (args.scene,), *_EXPORT_OUTPUTS)
+    if args.kerf is not None and not (0 <= args.kerf <= 2):
+        raise InputError("--kerf", args.kerf, "a kerf between 0 and 2 mm")
+    scene = load_scene(args.scene)
+    size = sheet(args.sheet) if args.sheet else None
+    fab = export_scene(scene, args.output, args.svg, args.kerf, size, args.preview, args.bom, args.assembly, args.kerf_test)
+    for note in fab.notes:
+        print(f"note: {note}")
+    for w in fab.warnings:  # a toy's motion the cut parts will not make (the design exits 3 for it; cut anyway)
+        print(f"warning: {w}")
+    print(f"{summary(fab)} -> {', '.join(map(str, fab.written)) or 'nothing written'}")
+    return 0
+
+
+def add_parser(sub: Any) -> None:
+    """Add ``planar export`` to the subcommands ``sub``."""
+
+    ex = sub.add_parser("export", help="every part laid flat for a laser cutter (DXF, SVG)")
+    ex.add_argument("scene", help="scene file (TOML)")
+    ex.add_argument("-o", "--output", default=None, help="DXF file to write")
+    ex.add_argument("--svg", default=None, help="SVG file to write")
+    ex.add_argument("--kerf", type=float, default=None, help="beam width in mm (default: the scene's kerf_mm)")
+    ex.add_argument("--sheet", default=None, help="sheet size WIDTHxHEIGHT in mm (default: the scene's)")
+    ex.add_argument("--preview", default=None, help="PNG preview of each sheet (photo-like)")
+    ex.add_argument("--bom", default=None, help="bill of materials (CSV): parts, layers, pins, spacers, tab joints")
+    ex.add_argument("--assembly", default=None, help="assembly drawing (SVG): parts in place, layers, letters")
+    ex.add_argument("--kerf-test", default=None, help="a kerf calibration piece (.dxf or .svg)")
+    ex.set_defaults(func=_cmd_export)
