@@ -53,6 +53,7 @@ may switch by continuity.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import ClassVar
@@ -60,10 +61,25 @@ from typing import ClassVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from planar.core.buffers import MIN_BYTES
+from planar.core.buffers import block as new_block
 from planar.core.geometry import circle_circle, line_circle, poses_apply, poses_compose, poses_invert
-from planar.core.model import Driver, Mechanism, Part, PinInSlot, Pivot, Slide, check_finite, check_positive
+from planar.core.limits import limit
+from planar.core.model import (
+    Driver,
+    FinitePoses,
+    Mechanism,
+    Motion,
+    Part,
+    PinInSlot,
+    Pivot,
+    Slide,
+    check_finite,
+    check_positive,
+    merge_failures,
+)
 from planar.errors import AssemblyError, InputError
-from planar.linkages.chunked import Solved, _Plan, fast_solve, plan_for
+from planar.linkages.chunked import Solved, _Plan, compiled_ready, fast_solve, plan_for, solve_compiled
 
 __all__ = [
     "NODE_KINDS",
@@ -597,6 +613,36 @@ def path_mask(q: Array) -> Mask:
     return out
 
 
+#: most steps of a lead-in (:meth:`Linkage._lead_in`)
+LEAD_MAX = 4096
+
+
+def _lead_steps(h: float, h_max: float, span: float) -> Array:
+    """Distances before the path's first sample of a lead-in's samples, farthest first.
+
+    The steps start at ``h`` and grow 1.4x per sample up to ``h_max``; they
+    stop once they cover ``span`` (or after :data:`LEAD_MAX` steps).  Array
+    operations only, with the same products and sums, in the same order, as
+    the sample-by-sample recurrence ``step = min(1.4 step, h_max)``, ``total
+    += step`` (a running product and a running sum are sequential in numpy).
+    """
+    # steps while growing: h 1.4^k < h_max; then h_max until the span is covered
+    grow = 1 if h >= h_max else min(LEAD_MAX, 2 + int(math.log(h_max / h) / math.log(1.4)))
+    size = min(LEAD_MAX, grow + 1 + int(span / h_max))
+    while True:
+        factors = np.full(size, 1.4)
+        factors[0] = h
+        with np.errstate(over="ignore"):  # the running product may pass float64's range: capped at h_max
+            steps = np.minimum(np.multiply.accumulate(factors), h_max)
+        total = np.add.accumulate(steps)
+        if total[-1] >= span or size == LEAD_MAX:
+            break
+        size = min(LEAD_MAX, 2 * size)  # rounding left the estimate short
+    k = int(np.searchsorted(total, span, side="left")) + 1  # the first step that reaches the span, included
+    back = total[: min(k, size)]  # distances before q[0], nearest first
+    return back[::-1]
+
+
 class Linkage(Mechanism):
     """A single-input planar linkage of pivots and slots, solved in closed form.
 
@@ -840,7 +886,7 @@ class Linkage(Mechanism):
         included even where it is singular.
         """
         ref = self.branch_reference
-        if ref is None or q.shape[0] < 4 or not path_mask(q[:4])[3]:
+        if ref is None or q.shape[0] < 4 or not self._carries_branches() or not self._path(q[:4])[3]:
             return q[:0]
         q0, h = float(q[0]), float(q[1] - q[0])
         direction = 1.0 if h > 0 else -1.0
@@ -850,15 +896,9 @@ class Linkage(Mechanism):
         span = (q0 - ref) * direction
         if span <= 0:
             return q[:0]
-        h_max = max(abs(h), 2 * np.pi / 360 if self.driver.kind == "rotation" else abs(h))
-        steps: list[float] = []
-        step, total = abs(h), 0.0
-        while total < span and len(steps) < 4096:
-            step = min(step * 1.4, h_max) if steps else abs(h)
-            steps.append(step)
-            total += step
-        back = np.cumsum(steps)  # distances before q[0], nearest first
-        return q0 - direction * back[::-1]
+        return q0 - direction * _lead_steps(
+            abs(h), max(abs(h), 2 * np.pi / 360 if self.driver.kind == "rotation" else abs(h)), span
+        )
 
     def solve_nodes(self, q: Array, lead: Array | None = None) -> tuple[dict[str, Array], list[tuple[Mask, str, str]]]:
         """World positions ``(N, 2)`` of every node (before placement) and validity checks.
@@ -874,6 +914,10 @@ class Linkage(Mechanism):
         k = lead.shape[0]
         pos, checks = self._solve_nodes(np.concatenate([lead, q]), self.nodes)
         return {n: v[k:] for n, v in pos.items()}, [(m[k:], j, w) for m, j, w in checks]
+
+    def _carries_branches(self) -> bool:
+        """Whether the motion may carry a branch by continuity at all (see :meth:`_path`)."""
+        return True
 
     def _path(self, q: Array) -> Mask:
         """Where the samples are a path along which a branch may be carried (:func:`path_mask`); a subclass
@@ -927,6 +971,48 @@ class Linkage(Mechanism):
             if b is not None and b != getattr(node, "branch", b):
                 return False
         return True
+
+    def solve(self, q: ArrayLike, t: ArrayLike | None = None) -> Motion:
+        """Solve all samples at once for driver values ``q`` (scalar or array); see :meth:`Mechanism.solve`.
+
+        A plain 1-D float64 array on the compiled path takes a warm path with the
+        same result: the same checks (a limit, finite values) made cheaply, and
+        the motion built straight from the compiled kernels' output (their
+        poses and points screened finite as they are written).  Anything else,
+        and any batch the warm path cannot finish (a branch that may switch,
+        a non-finite number), goes through :meth:`Mechanism.solve`.
+        """
+        if t is None and type(q) is np.ndarray and q.dtype == np.float64 and q.ndim == 1:
+            warm = self._solve_warm(q)
+            if warm is not None:
+                return warm
+        return super().solve(q, t)
+
+    def _solve_warm(self, q: Array) -> Motion | None:
+        n = q.shape[0]
+        if n > limit("samples") or not math.isfinite(np.add.reduce(q)):
+            return None  # Mechanism.solve raises the error (a sum of finite numbers may overflow: it looks closer)
+        plan = self._fast_plan()
+        prog = None if plan is None else compiled_ready(plan, n)
+        if plan is None or prog is None:
+            return None
+        qa = np.empty(n) if n * 8 < MIN_BYTES else new_block((n,))  # the motion's own copy
+        qa[...] = q
+        lead = self._lead_in(qa)
+        if lead.size and not self._declared_branches_hold(qa, lead):
+            return None
+        solved = solve_compiled(self, plan, prog, qa)
+        if solved is None or not isinstance(solved[0], FinitePoses):
+            return None
+        poses, checks, pts = solved
+        if checks is None:  # every sample closes
+            table: list[tuple[str, str]] = []
+            valid, code = np.empty(n, dtype=bool), np.empty(n, dtype=np.int16)
+            valid.fill(True)
+            code.fill(-1)
+        else:
+            valid, code, table = merge_failures(n, checks)
+        return Motion(driver=qa, poses=poses, valid=valid, fail_code=code, fail_table=table, points=pts or {})
 
     def _solve_points(self, q: Array) -> Solved:
         """The chunked, threaded path (:mod:`planar.linkages.chunked`), else the reference path.

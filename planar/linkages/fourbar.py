@@ -164,9 +164,18 @@ class FourBar(Linkage):
         meet there), so only its circuit is carried by continuity; any other keeps its declared circuit at
         every sample, however coarse the sampling (a crossed crank-rocker sampled 4 or 7 times a turn was
         carried onto the open circuit by an extrapolation that coarse samples cannot support)."""
-        if self.grashof != "change-point":
+        if not self._carries_branches():
             return np.zeros(np.shape(q), dtype=bool)
         return super()._path(q)
+
+    def _carries_branches(self) -> bool:
+        """Only a change-point four-bar carries its circuit (see :meth:`_path`); kept with the dimensions it was
+        found for, as every solve asks."""
+        known = self.__dict__.get("_change_point_of")
+        if known is None or known[0] is not self.dims:
+            known = (self.dims, self.grashof == "change-point")
+            self.__dict__["_change_point_of"] = known
+        return bool(known[1])
 
     # -- classification and limits -----------------------------------------
     @property
