@@ -42,7 +42,7 @@ def _pylinkage_of(lk: Any, step: float) -> Any:
         from pylinkage.simulation import Linkage as PlLinkage
     except ImportError as e:  # pragma: no cover - depends on the environment
         raise PlanarError("planar bench kinematics needs the peer library pylinkage: pip install 'planar[bench]'") from e
-    from planar.linkages.dyads import RRR, Crank, Fixed, Rigid
+    from planar.linkages.nodes import RRR, Crank, Fixed, Rigid
 
     start = lk.node_positions(np.array([0.0]))
     comps: dict[str, Any] = {}

@@ -2,7 +2,7 @@
 
 The reference solve (:meth:`Linkage.solve_nodes`) places each node for all
 samples at once and carries every two-root node's branch by continuity
-(:func:`~planar.linkages.dyads.carry_branch`).  This module gives the same
+(:func:`~planar.linkages.nodes.carry_branch`).  This module gives the same
 motion faster:
 
 * samples are processed in chunks of :data:`CHUNK` (cache-sized) with
@@ -129,12 +129,12 @@ def _kernel(kind: str) -> Callable[[Kernel], Kernel]:
 
 
 @_kernel("fixed")
-def _fixed(node, pos, q, w, ox, oy) -> Placed:
+def _fixed(node: Any, pos: dict[str, tuple[Coord, Coord]], q: Array, w: Scratch, ox: Array, oy: Array) -> Placed:
     return float(node.xy[0]), float(node.xy[1]), None, None
 
 
 @_kernel("crank")
-def _crank(node, pos, q, w, ox, oy) -> Placed:
+def _crank(node: Any, pos: dict[str, tuple[Coord, Coord]], q: Array, w: Scratch, ox: Array, oy: Array) -> Placed:
     # cos and sin by the tangent half-angle: t = tan(a/2), cos = (1 - t^2)/(1 + t^2),
     # sin = 2t/(1 + t^2); tan of a double stays finite (at most ~1e16 near pi/2)
     cx, cy = pos[node.centre]
@@ -162,7 +162,7 @@ def _crank(node, pos, q, w, ox, oy) -> Placed:
 
 
 @_kernel("actuator")
-def _actuator(node, pos, q, w, ox, oy) -> Placed:
+def _actuator(node: Any, pos: dict[str, tuple[Coord, Coord]], q: Array, w: Scratch, ox: Array, oy: Array) -> Placed:
     ux, uy = (float(v) for v in node.unit_axis)
     sx, sy = pos[node.origin]
     s = w.get()
@@ -175,7 +175,7 @@ def _actuator(node, pos, q, w, ox, oy) -> Placed:
 
 
 @_kernel("rrr")
-def _rrr(node, pos, q, w, ox, oy) -> Placed:
+def _rrr(node: Any, pos: dict[str, tuple[Coord, Coord]], q: Array, w: Scratch, ox: Array, oy: Array) -> Placed:
     """Circle-circle as :func:`planar.core.geometry.circle_circle` (same validity, bit for bit)."""
     ax, ay = pos[node.a]
     bx, by = pos[node.b]
@@ -235,7 +235,7 @@ def _column(v: Coord, n: int) -> Array:
 
 
 @_kernel("rrp")
-def _rrp(node, pos, q, w, ox, oy) -> Placed:
+def _rrp(node: Any, pos: dict[str, tuple[Coord, Coord]], q: Array, w: Scratch, ox: Array, oy: Array) -> Placed:
     """Line-circle through the reference functions (not on the benchmarked paths)."""
     n = q.shape[0]
     st = {k: np.column_stack([_column(pos[k][0], n), _column(pos[k][1], n)]) for k in (node.a, node.p, node.q)}
@@ -252,7 +252,7 @@ def _rrp(node, pos, q, w, ox, oy) -> Placed:
 
 
 @_kernel("rigid")
-def _rigid(node, pos, q, w, ox, oy) -> Placed:
+def _rigid(node: Any, pos: dict[str, tuple[Coord, Coord]], q: Array, w: Scratch, ox: Array, oy: Array) -> Placed:
     ax, ay = pos[node.a]
     bx, by = pos[node.b]
     ex, ey, en, m = w.get(), w.get(), w.get(), w.get()
@@ -690,8 +690,7 @@ def _solve_compiled(
     allocations and one compiled call; the plan's constant arrays are built
     once (:func:`~planar.linkages.compiled.program_for`).
     """
-    from planar.linkages.compiled import solve_range
-
+    solve_range = _compiled().solve_range
     n = q.shape[0]
     if q.dtype != np.float64 or not q.flags.c_contiguous:
         q = np.ascontiguousarray(q, dtype=float)
@@ -704,9 +703,9 @@ def _solve_compiled(
     nchunks = -(-n // chunk)
     bad_chunks = np.zeros(nchunks, dtype=bool)
     if nthreads <= 1 or nchunks <= 1:
-        fails = np.zeros((1, prog.n_checks), dtype=np.int64)
+        fails = np.zeros(prog.n_checks, dtype=np.int64)
         found = [int(solve_range(q, 0, n, chunk, prog.kinds, prog.refs, prog.par, tol, prog.check_row, prog.links,
-                                 prog.pts, prog.pl, block, pblock, oks, fails[0], bad_chunks))]  # fmt: skip
+                                 prog.pts, prog.pl, block, pblock, oks, fails, bad_chunks))]  # fmt: skip
     else:
         fails, found = _solve_threaded(prog, q, tol, nthreads, chunk, block, pblock, oks, bad_chunks)
     if min(found, default=0) < 0:
@@ -716,11 +715,25 @@ def _solve_compiled(
     for name, row in prog.parts:
         poses[name] = ground if row < 0 else block[row]
     points = {name: pblock[i] for i, name in enumerate(prog.pt_names)}
-    if not any(fails.ravel().tolist()):  # every sample closes
+    if not any(fails.ravel().tolist()):  # every sample closes (fails: per range and check, or per check)
         return poses, None, points
     oks[:, ~np.repeat(bad_chunks, chunk)[:n]] = True  # chunks where every sample closes
     checks = [(oks[row], node, why) for row, (_, node, why) in enumerate(plan.checks)]
     return _finish(lk, poses, checks, points)
+
+
+def _compiled() -> Any:
+    """The compiled kernels' module (imported on first use: it imports numba)."""
+    mod = _COMPILED[0]
+    if mod is None:
+        from planar.linkages import compiled as mod
+
+        _COMPILED[0] = mod
+    return mod
+
+
+#: :mod:`planar.linkages.compiled` once imported
+_COMPILED: list[Any] = [None]
 
 
 def _solve_threaded(

@@ -42,6 +42,7 @@ __all__ = ["ENCODERS", "Program", "program_for", "solve_range"]
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
 
 FIXED, CRANK, ACTUATOR, RRR, RRP, RIGID = range(6)
 #: kinds whose node has two roots (the branch screen runs on them)
@@ -133,7 +134,7 @@ def _atan2(y: float, x: float) -> float:
 
 
 @njit(**_JIT)
-def _k_fixed(par, L, xo, yo):
+def _k_fixed(par: FloatArray, L: int, xo: FloatArray, yo: FloatArray) -> None:
     x, y = par[0], par[1]
     for i in range(L):
         xo[i] = x
@@ -141,7 +142,7 @@ def _k_fixed(par, L, xo, yo):
 
 
 @njit(**_JIT)
-def _k_crank(par, q, L, xc, yc, xo, yo):
+def _k_crank(par: FloatArray, q: FloatArray, L: int, xc: FloatArray, yc: FloatArray, xo: FloatArray, yo: FloatArray) -> None:
     r, phase = par[0], par[1]
     big = 0
     for i in range(L):
@@ -158,7 +159,7 @@ def _k_crank(par, q, L, xc, yc, xo, yo):
 
 
 @njit(**_JIT)
-def _k_actuator(par, q, L, xs, ys, xo, yo):
+def _k_actuator(par: FloatArray, q: FloatArray, L: int, xs: FloatArray, ys: FloatArray, xo: FloatArray, yo: FloatArray) -> None:
     ux, uy, off = par[0], par[1], par[2]
     for i in range(L):
         s = q[i] + off
@@ -167,7 +168,18 @@ def _k_actuator(par, q, L, xs, ys, xo, yo):
 
 
 @njit(**_JIT)
-def _k_rrr(par, L, xa, ya, xb, yb, xo, yo, ok, sep):
+def _k_rrr(
+    par: FloatArray,
+    L: int,
+    xa: FloatArray,
+    ya: FloatArray,
+    xb: FloatArray,
+    yb: FloatArray,
+    xo: FloatArray,
+    yo: FloatArray,
+    ok: BoolArray,
+    sep: FloatArray,
+) -> int:
     """Circle-circle as the numpy path (``chunked._rrr``); returns the number of samples that fail."""
     ra, rb, branch = par[0], par[1], par[2]
     # scale-free as the numpy path: outside 1e-60..1e60 lengths are taken times k, a power of two
@@ -224,7 +236,20 @@ def _k_rrr(par, L, xa, ya, xb, yb, xo, yo, ok, sep):
 
 
 @njit(**_JIT)
-def _k_rrp(par, L, xa, ya, xp, yp, xq, yq, xo, yo, ok, sep):
+def _k_rrp(
+    par: FloatArray,
+    L: int,
+    xa: FloatArray,
+    ya: FloatArray,
+    xp: FloatArray,
+    yp: FloatArray,
+    xq: FloatArray,
+    yq: FloatArray,
+    xo: FloatArray,
+    yo: FloatArray,
+    ok: BoolArray,
+    sep: FloatArray,
+) -> int:
     """Line-circle as :func:`planar.core.geometry.line_circle` (the numpy path's ``chunked._rrp``)."""
     ra, branch, off = par[0], par[1], par[2]
     fails = 0
@@ -259,7 +284,17 @@ def _k_rrp(par, L, xa, ya, xp, yp, xq, yq, xo, yo, ok, sep):
 
 
 @njit(**_JIT)
-def _k_rigid(par, L, xa, ya, xb, yb, xo, yo, ok):
+def _k_rigid(
+    par: FloatArray,
+    L: int,
+    xa: FloatArray,
+    ya: FloatArray,
+    xb: FloatArray,
+    yb: FloatArray,
+    xo: FloatArray,
+    yo: FloatArray,
+    ok: BoolArray,
+) -> int:
     u, v = par[0], par[1]
     fails = 0
     for i in range(L):
@@ -291,7 +326,9 @@ def _k_rigid(par, L, xa, ya, xb, yb, xo, yo, ok):
 
 
 @njit(**_JIT)
-def _may_switch(x, y, ok, sep, tol, q, first, L):
+def _may_switch(
+    x: FloatArray, y: FloatArray, ok: BoolArray, sep: FloatArray, tol: float, q: FloatArray, first: int, L: int
+) -> bool:
     """``chunked._may_switch`` on one window: a vectorised count, then the path test where it is not zero.
 
     (Indices are offsets from slices, never ``k - 1``: a possibly negative index costs numba a
@@ -327,7 +364,9 @@ def _may_switch(x, y, ok, sep, tol, q, first, L):
 
 
 @njit(**_JIT)
-def _may_switch_closed(x, y, ok, sep, tol, q, first, L):
+def _may_switch_closed(
+    x: FloatArray, y: FloatArray, ok: BoolArray, sep: FloatArray, tol: float, q: FloatArray, first: int, L: int
+) -> bool:
     """:func:`_may_switch` for a window where every sample closes (no validity to read): the count
     of candidates alone, then :func:`_may_switch` itself where it is not zero."""
     t2 = tol * tol
@@ -346,7 +385,17 @@ def _may_switch_closed(x, y, ok, sep, tol, q, first, L):
 
 
 @njit(**_JIT)
-def _k_pose(xo, yo, xa, ya, xb, yb, m, pl, P):
+def _k_pose(
+    xo: FloatArray,
+    yo: FloatArray,
+    xa: FloatArray,
+    ya: FloatArray,
+    xb: FloatArray,
+    yb: FloatArray,
+    m: int,
+    pl: FloatArray,
+    P: FloatArray,
+) -> int:
     """Pose rows ``P[:m]`` from node windows of length ``m``: origin, ``atan2`` of ``a -> b``, placement.
 
     Returns how many rows hold a non-finite number (counted as they are written: the
@@ -375,7 +424,7 @@ def _k_pose(xo, yo, xa, ya, xb, yb, m, pl, P):
 
 
 @njit(**_JIT)
-def _k_point(x, y, m, pl, out):
+def _k_point(x: FloatArray, y: FloatArray, m: int, pl: FloatArray, out: FloatArray) -> int:
     """Named point rows ``out[:m]``; returns how many hold a non-finite number."""
     px, py, pa, c, s = pl[0], pl[1], pl[2], pl[3], pl[4]
     F = out.ravel()
@@ -397,7 +446,25 @@ def _k_point(x, y, m, pl, out):
 
 
 @njit(**_JIT)
-def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts, pl, poses, points, oks, fails, bad_chunks):
+def solve_range(
+    q: FloatArray,
+    lo: int,
+    hi: int,
+    chunk: int,
+    kinds: IntArray,
+    refs: IntArray,
+    par: FloatArray,
+    tols: FloatArray,
+    check_row: IntArray,
+    links: IntArray,
+    pts: IntArray,
+    pl: FloatArray,
+    poses: FloatArray,
+    points: FloatArray,
+    oks: BoolArray,
+    fails: IntArray,
+    bad_chunks: BoolArray,
+) -> int:
     """Solve samples ``lo:hi`` chunk by chunk; returns -1 where a branch may switch (then it stops
     early), else the number of pose and point rows holding a non-finite number.
 

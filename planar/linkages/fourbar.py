@@ -18,14 +18,15 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from planar.core.model import check_finite, check_positive
 from planar.errors import InputError
-from planar.linkages.dyads import RRR, Crank, Fixed, Link, Linkage, Rigid
+from planar.linkages.linkage import Link, Linkage
+from planar.linkages.nodes import RRR, Crank, Fixed, Rigid
 
 __all__ = ["FourBar", "freudenstein_angles", "grashof_class"]
 
@@ -124,7 +125,7 @@ class FourBar(Linkage):
         circuit: Circuit = "open",
         placement: Sequence[float] = (0.0, 0.0, 0.0),
         name: str = "fourbar",
-        **kw,
+        **kw: Any,
     ) -> None:
         a = check_positive(f"{name}.crank", crank)
         b = check_positive(f"{name}.coupler", coupler)

@@ -333,3 +333,33 @@ def _residual(nd, pos):
 
 def _cross(a, b):
     return a[0] * b[1] - a[1] * b[0]
+
+
+@pytest.mark.slow
+def test_compiled_kernels_are_cached_across_processes(tmp_path):
+    """A second process loads the kernels from numba's cache (no compilation), from a writable place."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    code = (
+        "import json, os, numpy as np\n"
+        "from planar.scene.catalog import get\n"
+        "get('jansen').solve(np.linspace(0.0, 6.0, 72))\n"
+        "from planar.linkages.compiled import solve_range\n"
+        "st = solve_range.stats\n"
+        "print(json.dumps({'hits': sum(st.cache_hits.values()), 'misses': sum(st.cache_misses.values()),"
+        " 'path': st.cache_path, 'writable': os.access(st.cache_path, os.W_OK)}))\n"
+    )
+    root = Path(__file__).resolve().parents[2]
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}  # an empty cache: the first process compiles
+    runs = []
+    for _ in range(2):
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=root, env=env, timeout=600)
+        assert r.returncode == 0, r.stderr
+        runs.append(json.loads(r.stdout.strip().splitlines()[-1]))
+    first, second = runs
+    assert first["writable"] and second["writable"]
+    assert second["misses"] == 0 and second["hits"] >= 1, runs
+    assert any(tmp_path.iterdir())  # the machine code landed in the cache

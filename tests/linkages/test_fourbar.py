@@ -216,7 +216,7 @@ def _lead_steps_loop(h, h_max, span):
 
 
 def test_vectorised_lead_in_is_the_recurrence_bit_for_bit():
-    from planar.linkages.dyads import _lead_steps
+    from planar.linkages.linkage import _lead_steps
 
     rng = np.random.default_rng(11)
     for _ in range(3000):
