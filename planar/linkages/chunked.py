@@ -42,7 +42,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from itertools import count, pairwise
 from threading import Lock
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -52,6 +52,9 @@ from planar.core.buffers import block as _pool_block
 from planar.core.geometry import CONCENTRIC, TANGENCY_RTOL, line_circle, poses_apply
 from planar.core.model import FinitePoses
 from planar.linkages.plan import Linkage, NodeKind, _Plan
+
+if TYPE_CHECKING:
+    from planar.linkages.compiled import Program
 
 __all__ = [
     "CHUNK",
@@ -517,7 +520,7 @@ def fast_solve(
     threads: int | None = None,
     chunk: int | None = None,
     jit: bool | None = None,
-    program: Any = None,
+    program: Program | None = None,
 ) -> Solved | None:
     """``(poses, checks, points)`` for driver values ``q`` by the chunked path, or ``None``.
 
@@ -643,7 +646,7 @@ def solver_for(lk: Linkage, n: int) -> str:
     return "compiled" if compiled_ready(plan, n) is not None else "numpy"
 
 
-def compiled_ready(plan: _Plan, n: int) -> Any:
+def compiled_ready(plan: _Plan, n: int) -> Program | None:
     """The compiled program :func:`fast_solve` runs for ``n`` samples of ``plan``, or ``None`` (numba off or
     missing, or a node kind without an encoder); the first call imports numba and loads the kernels."""
     return _program(plan) if _use_jit(None, n) else None
@@ -655,7 +658,7 @@ def _use_jit(jit: bool | None, n: int) -> bool:
     return jit
 
 
-def _program(plan: _Plan) -> Any:
+def _program(plan: _Plan) -> Program | None:
     """The plan's compiled program (built once), or ``None`` when a node kind has no encoder."""
     if plan.program is _NO_PROGRAM:
         from planar.linkages.compiled import program_for
@@ -665,7 +668,7 @@ def _program(plan: _Plan) -> Any:
 
 
 def solve_compiled(
-    lk: Linkage, plan: _Plan, prog: Any, q: Array, threads: int | None = None, chunk: int | None = None
+    lk: Linkage, plan: _Plan, prog: Program, q: Array, threads: int | None = None, chunk: int | None = None
 ) -> Solved | None:
     """:func:`fast_solve` by the compiled kernels, for a caller that has the plan and its program
     (:func:`compiled_ready`): the tolerances are the plan's own unless a node moves with ``|q|``, and a
@@ -682,7 +685,7 @@ def solve_compiled(
 
 
 def _solve_compiled(
-    lk: Linkage, plan: _Plan, prog: Any, q: Array, tols: list[float] | None, nthreads: int, chunk: int
+    lk: Linkage, plan: _Plan, prog: Program, q: Array, tols: list[float] | None, nthreads: int, chunk: int
 ) -> Solved | None:
     """The compiled solve: one call of :func:`~planar.linkages.compiled.solve_range` per range of chunks.
 
@@ -737,7 +740,7 @@ _COMPILED: list[Any] = [None]
 
 
 def _solve_threaded(
-    prog: Any, q: Array, tol: Array, nthreads: int, chunk: int, block: Array, pblock: Array, oks: Mask, bad_chunks: Mask
+    prog: Program, q: Array, tol: Array, nthreads: int, chunk: int, block: Array, pblock: Array, oks: Mask, bad_chunks: Mask
 ) -> tuple[NDArray[np.int64], list[int]]:
     """:func:`_solve_compiled` over ranges of chunks taken in turn by ``nthreads`` threads of the pool.
 
