@@ -207,16 +207,18 @@ def transmission_angles(mech: Mechanism, q: ArrayLike) -> dict[str, Array]:
     the linkage toggles.  Only dyads whose two links are different parts (a
     node fixed on a ternary link has none).  Empty for mechanisms without dyads.
     """
-    from planar.linkages import RRR, Linkage
+    from planar.linkages import Linkage
 
     if not isinstance(mech, Linkage):
         return {}
-    # a dyad whose two links are one part (a node on a ternary link) transmits nothing: no angle
-    rrr = [n for n in mech.nodes if isinstance(n, RRR) and not any({n.name, n.a, n.b} <= set(lk.nodes) for lk in mech.links)]
-    if not rrr:
+    # the node kinds that join two links at a transmitting angle; a node whose links are one part (a node on
+    # a ternary link) transmits nothing: no angle
+    nodes = [n for n in mech.nodes if n.transmits and not any({n.name, *n.refs()} <= set(lk.nodes) for lk in mech.links)]
+    if not nodes:
         return {}
     pos, _ = _node_solve(mech, np.atleast_1d(np.asarray(q, float)))
-    return {n.name: n.transmission(pos) for n in rrr}
+    angles = {n.name: n.transmission(pos) for n in nodes}
+    return {k: v for k, v in angles.items() if v is not None}
 
 
 def motion_derivatives(mech: Mechanism, motion: Motion) -> Derivatives:

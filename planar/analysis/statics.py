@@ -30,7 +30,7 @@ speeds in rad/s, torques in force x model-unit.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -38,8 +38,8 @@ from numpy.typing import ArrayLike, NDArray
 from planar.errors import InputError
 
 if TYPE_CHECKING:
-    from planar.linkages.dyads import Linkage
     from planar.linkages.fourbar import FourBar
+    from planar.linkages.linkage import Linkage
 
 __all__ = [
     "TOGGLE_SINE",
@@ -181,20 +181,11 @@ def _dyad_mask(link: Linkage, q: ArrayLike) -> NDArray[np.bool_]:
     qa = np.atleast_1d(np.asarray(q, float))
     pos, _ = link.solve_nodes(qa)
     ok = np.ones(qa.shape[0], bool)
-
-    def unit(v: Array) -> Array:
-        n = np.hypot(v[:, 0], v[:, 1])
-        return v / np.where(n > 0, n, 1.0)[:, None]
-
     P: dict[str, Array] = {k: np.asarray(v, float) for k, v in pos.items()}
     for node in link.nodes:
-        nd: Any = node  # an RRR carries a and b, an RRP a, p and q
-        if nd.kind == "rrr":
-            u, w = unit(P[nd.name] - P[nd.a]), unit(P[nd.name] - P[nd.b])
-            ok &= np.abs(_cross(u, w)) > TOGGLE_SINE
-        elif nd.kind == "rrp":
-            u, w = unit(P[nd.name] - P[nd.a]), unit(P[nd.q] - P[nd.p])
-            ok &= np.abs((u * w).sum(-1)) > TOGGLE_SINE
+        margin = node.toggle_margin(P)  # each kind knows its toggle (None: it has none)
+        if margin is not None:
+            ok &= margin > TOGGLE_SINE
     return ok
 
 

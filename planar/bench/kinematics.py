@@ -42,7 +42,7 @@ def _pylinkage_of(lk: Any, step: float) -> Any:
         from pylinkage.simulation import Linkage as PlLinkage
     except ImportError as e:  # pragma: no cover - depends on the environment
         raise PlanarError("planar bench kinematics needs the peer library pylinkage: pip install 'planar[bench]'") from e
-    from planar.linkages.dyads import RRR, Crank, Fixed, Rigid
+    from planar.linkages.nodes import RRR, Crank, Fixed, Rigid
 
     start = lk.node_positions(np.array([0.0]))
     comps: dict[str, Any] = {}
@@ -69,22 +69,39 @@ def _pylinkage_of(lk: Any, step: float) -> Any:
     return PlLinkage(list(comps.values()))
 
 
-def _spread(rates: list[float]) -> dict[str, float]:
-    return {"median": float(np.median(rates)), "min": float(min(rates)), "max": float(max(rates))}
+#: the sizes of the default size curve (crank angles per solve): a scene's few dozen samples to a million
+SIZES = (50, 72, 1_000, 10_000, 100_000, 1_000_000)
+#: processor time a timed measurement lasts at least (small sizes repeat the call within it)
+MIN_MEASURE_S = 0.02
 
 
-def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
-    """One linkage: planar's public ``solve`` vs pylinkage ``step_fast``, interleaved repeats."""
-    from planar.linkages.chunked import solver_for, threads_default
-    from planar.scene.catalog import get
+def _spread(values: list[float]) -> dict[str, float]:
+    return {"median": float(np.median(values)), "min": float(min(values)), "max": float(max(values))}
 
-    mech: Any = get(name)
-    step = 2 * math.pi / 3600
-    q = step * np.arange(1, n + 1)
+
+def _calls_for(fn: Any) -> int:
+    """How many calls of ``fn`` make one measurement of at least :data:`MIN_MEASURE_S` of processor time."""
+    c0 = time.process_time()
+    fn()
+    once = max(time.process_time() - c0, 1e-7)
+    return max(1, min(100_000, math.ceil(MIN_MEASURE_S / once)))
+
+
+def _measure(fn: Any, calls: int) -> tuple[float, float]:
+    """Processor and wall time of one call of ``fn`` (mean over ``calls`` calls), in seconds."""
+    c0, t0 = time.process_time(), time.perf_counter()
+    for _ in range(calls):
+        fn()
+    return (time.process_time() - c0) / calls, (time.perf_counter() - t0) / calls
+
+
+def _agreement(mech: Any, step: float, n: int) -> dict[str, Any]:
+    """Planar's joints against pylinkage's at the crank angles pylinkage reached (up to 20,000 samples).
+
+    pylinkage re-reads its crank angle from the crank's position every step
+    (it drifts by rounding over many steps), so planar solves at those angles.
+    """
     crank = next(nd for nd in mech.nodes if nd.is_input)
-
-    # agreement: pylinkage re-reads its crank angle from the crank's position every step
-    # (it drifts by rounding over many steps), so planar solves at the angles pylinkage reached
     m = min(n, 20_000)
     traj = _pylinkage_of(mech, step).step_fast(iterations=m)
     names = [nd.name for nd in mech.nodes]
@@ -96,151 +113,161 @@ def _kinematics_case(name: str, n: int, repeats: int) -> dict[str, Any]:
     motion = mech.solve(q_peer)  # the first call: numba import and kernel load (or compile) included
     first_call = time.perf_counter() - t0
     diff_points = max(float(np.max(np.abs(motion.points[p] - traj[:, names.index(nd)]))) for p, nd in mech.point_nodes.items())
+    return {"max_abs_diff_vs_peer": diff, "max_abs_diff_points_vs_peer": diff_points, "first_call_s": first_call}
 
-    # warm-up, outside the timing: pylinkage's numba compile (cached) and one call of the full size each (planar's
-    # first call of a size takes new memory, which its later calls recycle: the "new memory per call" rate below
-    # times that cost on every call)
-    _pylinkage_of(mech, step).step_fast(iterations=n)
-    mech.solve(q)
-    planar_rates: list[float] = []
-    fresh_rates: list[float] = []
-    peer_rates: list[float] = []
-    planar_cpu: list[float] = []
-    peer_cpu: list[float] = []
+
+def _size_row(mech: Any, step: float, n: int, repeats: int) -> dict[str, Any]:
+    """One linkage at one size: planar's public ``solve`` and pylinkage's ``step_fast``, interleaved repeats."""
+    from planar.linkages.chunked import solver_for
+
+    q = step * np.arange(1, n + 1)
     valid = True
+
+    def planar_call() -> None:
+        nonlocal valid
+        valid = bool(mech.solve(q).valid.all()) and valid
+
+    peer = _pylinkage_of(mech, step)
+
+    def peer_call() -> None:
+        peer.step_fast(iterations=n)
+
+    # warm-up outside the timing (pylinkage's numba compile, cached; planar's first call of a size takes new
+    # memory, which its later calls recycle), and the number of calls that make one measurement
+    calls = {"planar": _calls_for(planar_call), "peer": _calls_for(peer_call)}
+    cpu: dict[str, list[float]] = {"planar": [], "peer": []}
+    wall: dict[str, list[float]] = {"planar": [], "peer": []}
     for r in range(repeats):
-        peer = _pylinkage_of(mech, step)
-
-        def run_planar() -> None:
-            nonlocal valid
-            c0, t0 = time.process_time(), time.perf_counter()
-            mo = mech.solve(q)
-            planar_rates.append(n / (time.perf_counter() - t0))
-            planar_cpu.append(time.process_time() - c0)
-            valid = valid and bool(mo.valid.all())
-
-        def run_fresh() -> None:
-            # the same call with output recycling off (planar.core.buffers): every block is new memory
-            old = os.environ.get("PLANAR_RECYCLE")
-            os.environ["PLANAR_RECYCLE"] = "0"
-            try:
-                t0 = time.perf_counter()
-                mech.solve(q)
-                fresh_rates.append(n / (time.perf_counter() - t0))
-            finally:
-                if old is None:
-                    del os.environ["PLANAR_RECYCLE"]
-                else:
-                    os.environ["PLANAR_RECYCLE"] = old
-
-        def run_peer(peer: Any = peer) -> None:
-            c0, t0 = time.process_time(), time.perf_counter()
-            peer.step_fast(iterations=n)
-            peer_rates.append(n / (time.perf_counter() - t0))
-            peer_cpu.append(time.process_time() - c0)
-
-        for fn in (run_planar, run_peer, run_fresh) if r % 2 == 0 else (run_fresh, run_peer, run_planar):
-            fn()
-    ratios = [a / b for a, b in zip(planar_rates, peer_rates)]
+        for who in ("planar", "peer") if r % 2 == 0 else ("peer", "planar"):
+            c, w = _measure(planar_call if who == "planar" else peer_call, calls[who])
+            cpu[who].append(c)
+            wall[who].append(w)
+    cpu_ratios = [b / a for a, b in zip(cpu["planar"], cpu["peer"])]
+    wall_ratios = [b / a for a, b in zip(wall["planar"], wall["peer"])]
     return {
-        "linkage": name,
-        "nodes": len(names),
-        "parts": len(mech.parts),
-        "planar_samples_per_s": _spread(planar_rates),
-        "peer_samples_per_s": _spread(peer_rates),
-        "ratio": float(np.median(planar_rates) / np.median(peer_rates)),
-        "ratio_per_repeat": _spread(ratios),
-        # the same solve writing into new memory every call (PLANAR_RECYCLE=0), what a single call costs
-        "planar_new_memory_samples_per_s": _spread(fresh_rates),
-        "ratio_new_memory": float(np.median(fresh_rates) / np.median(peer_rates)),
-        # processor time (all threads of the process): the work each does, less sensitive to other load
-        "planar_cpu_s": _spread(planar_cpu),
-        "peer_cpu_s": _spread(peer_cpu),
-        "cpu_ratio": float(np.median(peer_cpu) / np.median(planar_cpu)) if np.median(planar_cpu) > 0 else math.inf,
-        "max_abs_diff_vs_peer": diff,
-        "max_abs_diff_points_vs_peer": diff_points,
-        "size": float(mech.size),
-        "all_valid": valid,
-        "agrees": diff <= AGREEMENT and diff_points <= AGREEMENT and valid,
-        "threads": threads_default(),
+        "n": n,
+        "calls_per_measure": calls,
+        "planar_cpu_s": _spread(cpu["planar"]),
+        "peer_cpu_s": _spread(cpu["peer"]),
+        "planar_wall_s": _spread(wall["planar"]),
+        "peer_wall_s": _spread(wall["peer"]),
+        # peer time / planar time: above 1 planar is the faster
+        "cpu_ratio": float(np.median(cpu["peer"]) / np.median(cpu["planar"])),
+        "wall_ratio": float(np.median(wall["peer"]) / np.median(wall["planar"])),
+        "cpu_ratio_per_repeat": _spread(cpu_ratios),
+        "wall_ratio_per_repeat": _spread(wall_ratios),
+        "planar_samples_per_s": n / float(np.median(wall["planar"])),
+        "peer_samples_per_s": n / float(np.median(wall["peer"])),
         "kernels": solver_for(mech, n),
-        "first_call_s": first_call,
+        "all_valid": valid,
     }
 
 
-def bench_kinematics(n: int = 1_000_000, repeats: int = 7) -> dict[str, Any]:
-    """Throughput of the public ``Mechanism.solve`` vs pylinkage's ``step_fast`` (numba) on the same linkages.
+def _kinematics_case(name: str, sizes: tuple[int, ...], repeats: int) -> dict[str, Any]:
+    """One linkage over the size curve, with the agreement check."""
+    from planar.linkages.chunked import threads_default
+    from planar.scene.catalog import get
+
+    mech: Any = get(name)
+    step = 2 * math.pi / 3600
+    agree = _agreement(mech, step, max(sizes))
+    rows = [_size_row(mech, step, n, repeats) for n in sizes]
+    valid = all(r["all_valid"] for r in rows)
+    return {
+        "linkage": name,
+        "nodes": len(mech.nodes),
+        "parts": len(mech.parts),
+        "size": float(mech.size),
+        "threads": threads_default(),
+        **agree,
+        "curve": rows,
+        "cpu_ratio": min(r["cpu_ratio"] for r in rows),
+        "ratio": min(r["wall_ratio"] for r in rows),
+        "all_valid": valid,
+        "agrees": agree["max_abs_diff_vs_peer"] <= AGREEMENT and agree["max_abs_diff_points_vs_peer"] <= AGREEMENT and valid,
+    }
+
+
+def bench_kinematics(n: int | None = None, repeats: int = 7, sizes: tuple[int, ...] | None = None) -> dict[str, Any]:
+    """The public ``Mechanism.solve`` against pylinkage's ``step_fast`` (numba) over a curve of sizes.
 
     For the four-bar (ground 4, crank 1, coupler 4, rocker 3, coupler point
     (2, 1)) and Jansen's leg, planar's ``solve`` (the path users call: poses of
     every part, validity, failure codes, named points) and pylinkage's fastest
     path (``step_fast``: every joint's position) each solve ``n`` crank angles
-    ``k * 2 pi / 3600``, ``k = 1..n``.  The two alternate, ``repeats`` times
-    each (order swapped every repeat); samples/s are reported as median, min
-    and max, and ``ratio`` is the ratio of the medians.  Agreement: planar
-    solves at the crank angles pylinkage reached and every joint is compared
-    (``max_abs_diff_vs_peer``, model units); ``ok`` is false (and the
-    command's exit status 1) unless every joint agrees within
-    :data:`AGREEMENT` and every sample is valid.  The top-level ``ratio`` is
-    the smaller of the two linkages' ratios.  Per case, ``kernels`` names the
-    kernels ``solve`` took for ``n`` samples (``"compiled"``: numba,
-    ``"numpy"``) and ``first_call_s`` the first solve's time in the process (the agreement check's, up to
-    20,000 samples, not a full-size call)
-    (importing numba and loading, or compiling, the kernels), which the timed
-    repeats do not include; ``planar_cpu_s``/``peer_cpu_s`` the processor time
-    of each call (all of planar's threads together) and ``cpu_ratio`` the
-    ratio of their medians, the work each does, which other load on the machine
-    disturbs less than the wall-clock ``ratio``.  ``solve`` writes into the
-    output blocks of results the caller has dropped
-    (:mod:`planar.core.buffers`), as each timed call drops the last;
-    ``planar_new_memory_samples_per_s`` and ``ratio_new_memory`` time the
-    same call with that off (``PLANAR_RECYCLE=0``, new pages every call),
-    interleaved with the others.
+    ``k * 2 pi / 3600``, ``k = 1..n``, for every ``n`` of ``sizes`` (default
+    :data:`SIZES`; ``n`` alone: that one size).  The two alternate,
+    ``repeats`` times each (order swapped every repeat); a measurement repeats
+    the call until it lasts :data:`MIN_MEASURE_S` of processor time and gives
+    the time of one call.  Per size: processor time (all of a process's
+    threads: the work each does, which other load on the machine disturbs
+    less) and wall time, median with min and max, and the ratios of the
+    medians, peer over planar (``cpu_ratio``, ``wall_ratio``: above 1 planar
+    is the faster).  Per linkage and at the top, ``cpu_ratio`` and ``ratio``
+    are the smallest over the sizes (the top: over both linkages).
+
+    Agreement: planar solves at the crank angles pylinkage reached (up to
+    20,000) and every joint is compared (``max_abs_diff_vs_peer``, model
+    units); ``ok`` is false (and the command's exit status 1) unless every
+    joint agrees within :data:`AGREEMENT` and every sample is valid.
+    ``first_call_s``: the process's first solve (numba import and kernel
+    load included), which the timed repeats leave out.  ``solve`` writes into
+    the output blocks of results the caller has dropped
+    (:mod:`planar.core.buffers`), as each timed call drops the last.
     """
-    if n < 1 or repeats < 1:
-        raise PlanarError("planar bench kinematics needs n >= 1 and repeats >= 1")
-    cases = [_kinematics_case(name, n, repeats) for name in KINEMATICS_CASES]
+    curve = tuple(sizes) if sizes is not None else ((n,) if n is not None else SIZES)
+    if not curve or min(curve) < 1 or repeats < 1:
+        raise PlanarError("planar bench kinematics needs sizes n >= 1 and repeats >= 1")
+    cases = [_kinematics_case(name, curve, repeats) for name in KINEMATICS_CASES]
     return {
         "benchmark": "kinematics",
-        "n": n,
+        "sizes": list(curve),
         "repeats": repeats,
         "peer": "pylinkage step_fast (numba)",
         "cores": os.cpu_count(),
         "cases": cases,
         "ratio": min(c["ratio"] for c in cases),
+        "cpu_ratio": min(c["cpu_ratio"] for c in cases),
         "ok": all(c["agrees"] for c in cases),
     }
+
+
+def _t(s: float) -> str:
+    """A time in the unit that suits it."""
+    return f"{s * 1e6:.1f} us" if s < 1e-3 else (f"{s * 1e3:.2f} ms" if s < 1.0 else f"{s:.2f} s")
 
 
 def format_kinematics(r: dict[str, Any]) -> str:
     """Human-readable table of :func:`bench_kinematics` results."""
     lines = [
         (
-            f"public solve vs {r['peer']}, {r['n']:,} crank angles, median (min-max) of {r['repeats']} "
-            f"interleaved repeats, {r['cores']} cores"
+            f"public solve vs {r['peer']}: time per call, median of {r['repeats']} interleaved repeats "
+            f"(ratio: peer / planar, the repeats' range in brackets), {r['cores']} cores"
         )
     ]
+    head = (
+        f"    {'N':>9}  {'planar cpu':>10}  {'peer cpu':>10}  {'cpu ratio':>20}  "
+        f"{'planar wall':>11}  {'peer wall':>10}  {'wall ratio':>20}"
+    )
     for c in r["cases"]:
-        p, q, k = c["planar_samples_per_s"], c["peer_samples_per_s"], c["ratio_per_repeat"]
         lines += [
-            f"  {c['linkage']} ({c['nodes']} nodes, {c['parts']} parts)",
-            (
-                f"    planar solve ({c['threads']} threads) {p['median'] / 1e6:8.2f} M samples/s "
-                f"({p['min'] / 1e6:.2f}-{p['max'] / 1e6:.2f}), {c['kernels']} kernels "
-                f"(the process's first solve, up to 20,000 samples, numba import and kernel load included: "
-                f"{c['first_call_s']:.2f} s)"
-            ),
-            (f"    pylinkage step_fast        {q['median'] / 1e6:8.2f} M samples/s ({q['min'] / 1e6:.2f}-{q['max'] / 1e6:.2f})"),
-            f"    ratio                      {c['ratio']:8.2f}  (per repeat {k['min']:.2f}-{k['max']:.2f})",
-            (
-                f"    planar, new memory per call {c['planar_new_memory_samples_per_s']['median'] / 1e6:7.2f} M samples/s "
-                f"(PLANAR_RECYCLE=0): ratio {c['ratio_new_memory']:.2f}"
-            ),
-            (
-                f"    processor time             {c['planar_cpu_s']['median'] * 1e3:8.1f} ms vs "
-                f"{c['peer_cpu_s']['median'] * 1e3:.1f} ms: ratio {c['cpu_ratio']:.2f}"
-            ),
-            f"    max |planar - peer|        {c['max_abs_diff_vs_peer']:8.1e}  (size {c['size']:.3g})"
-            + ("" if c["agrees"] else f"  DISAGREES (more than {AGREEMENT:g}, or invalid samples)"),
+            f"  {c['linkage']} ({c['nodes']} nodes, {c['parts']} parts, {c['threads']} threads; first solve in the "
+            f"process, numba import and kernel load included: {c['first_call_s']:.2f} s)",
+            head,
         ]
+        for row in c["curve"]:
+            cr, wr = row["cpu_ratio_per_repeat"], row["wall_ratio_per_repeat"]
+            lines.append(
+                f"    {row['n']:>9,}  {_t(row['planar_cpu_s']['median']):>10}  {_t(row['peer_cpu_s']['median']):>10}  "
+                f"{row['cpu_ratio']:6.2f} ({cr['min']:5.2f}-{cr['max']:5.2f})  "
+                f"{_t(row['planar_wall_s']['median']):>11}  {_t(row['peer_wall_s']['median']):>10}  "
+                f"{row['wall_ratio']:6.2f} ({wr['min']:5.2f}-{wr['max']:5.2f})"
+                + ("" if row["all_valid"] else "  INVALID SAMPLES")
+            )
+        lines.append(
+            f"    max |planar - peer|  {c['max_abs_diff_vs_peer']:.1e} joints, {c['max_abs_diff_points_vs_peer']:.1e} "
+            f"points (size {c['size']:.3g})"
+            + ("" if c["agrees"] else f"  DISAGREES (more than {AGREEMENT:g}, or invalid samples)")
+        )
+    lines.append(f"  smallest ratio over every size: processor time {r['cpu_ratio']:.2f}, wall time {r['ratio']:.2f}")
     return "\n".join(lines)

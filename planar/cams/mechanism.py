@@ -35,7 +35,7 @@ from planar.core.geometry import poses_apply
 from planar.core.model import Driver, Mechanism, Part, Pivot
 from planar.errors import InputError
 from planar.linkages import Link, Linkage
-from planar.linkages.dyads import Actuator, Crank, Fixed, NodeKind
+from planar.linkages.nodes import Actuator, Crank, Fixed, NodeKind
 
 __all__ = ["RESERVED", "CamMechanism"]
 

@@ -1,8 +1,9 @@
 """Linkages: four-bar, slider-crank, and general pivot/slot linkages from dyads."""
 
-from planar.linkages.dyads import NODE_KINDS, RRP, RRR, Actuator, Crank, Fixed, Link, Linkage, NodeKind, Rigid, node_kind
 from planar.linkages.fourbar import FourBar, freudenstein_angles, grashof_class
 from planar.linkages.gears import Driven, Geared, GearMesh
+from planar.linkages.linkage import Link, Linkage
+from planar.linkages.nodes import NODE_KINDS, RRP, RRR, Actuator, Crank, Fixed, NodeKind, Rigid, node_kind
 from planar.linkages.slidercrank import SliderCrank
 from planar.linkages.triads import Triad
 

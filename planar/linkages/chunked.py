@@ -2,7 +2,7 @@
 
 The reference solve (:meth:`Linkage.solve_nodes`) places each node for all
 samples at once and carries every two-root node's branch by continuity
-(:func:`~planar.linkages.dyads.carry_branch`).  This module gives the same
+(:func:`~planar.linkages.nodes.carry_branch`).  This module gives the same
 motion faster:
 
 * samples are processed in chunks of :data:`CHUNK` (cache-sized) with
@@ -34,6 +34,7 @@ Node kinds without a chunk kernel here (a kind registered elsewhere) make
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 from collections.abc import Callable
@@ -41,23 +42,32 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from itertools import count, pairwise
 from threading import Lock
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from planar.core.buffers import MIN_BYTES as _BLOCK_MIN
+from planar.core.buffers import block as _pool_block
 from planar.core.geometry import CONCENTRIC, TANGENCY_RTOL, line_circle, poses_apply
+from planar.core.model import FinitePoses
 from planar.linkages.plan import Linkage, NodeKind, _Plan
+
+if TYPE_CHECKING:
+    from planar.linkages.compiled import Program
 
 __all__ = [
     "CHUNK",
     "JIT_CHUNK",
     "JIT_MIN",
+    "JIT_THREADS_MIN",
     "KERNELS",
     "Solved",
+    "compiled_ready",
     "fast_solve",
     "jit_available",
     "plan_for",
+    "solve_compiled",
     "solver_for",
     "threads_default",
 ]
@@ -122,12 +132,12 @@ def _kernel(kind: str) -> Callable[[Kernel], Kernel]:
 
 
 @_kernel("fixed")
-def _fixed(node, pos, q, w, ox, oy) -> Placed:
+def _fixed(node: Any, pos: dict[str, tuple[Coord, Coord]], q: Array, w: Scratch, ox: Array, oy: Array) -> Placed:
     return float(node.xy[0]), float(node.xy[1]), None, None
 
 
 @_kernel("crank")
-def _crank(node, pos, q, w, ox, oy) -> Placed:
+def _crank(node: Any, pos: dict[str, tuple[Coord, Coord]], q: Array, w: Scratch, ox: Array, oy: Array) -> Placed:
     # cos and sin by the tangent half-angle: t = tan(a/2), cos = (1 - t^2)/(1 + t^2),
     # sin = 2t/(1 + t^2); tan of a double stays finite (at most ~1e16 near pi/2)
     cx, cy = pos[node.centre]
@@ -155,7 +165,7 @@ def _crank(node, pos, q, w, ox, oy) -> Placed:
 
 
 @_kernel("actuator")
-def _actuator(node, pos, q, w, ox, oy) -> Placed:
+def _actuator(node: Any, pos: dict[str, tuple[Coord, Coord]], q: Array, w: Scratch, ox: Array, oy: Array) -> Placed:
     ux, uy = (float(v) for v in node.unit_axis)
     sx, sy = pos[node.origin]
     s = w.get()
@@ -168,7 +178,7 @@ def _actuator(node, pos, q, w, ox, oy) -> Placed:
 
 
 @_kernel("rrr")
-def _rrr(node, pos, q, w, ox, oy) -> Placed:
+def _rrr(node: Any, pos: dict[str, tuple[Coord, Coord]], q: Array, w: Scratch, ox: Array, oy: Array) -> Placed:
     """Circle-circle as :func:`planar.core.geometry.circle_circle` (same validity, bit for bit)."""
     ax, ay = pos[node.a]
     bx, by = pos[node.b]
@@ -228,7 +238,7 @@ def _column(v: Coord, n: int) -> Array:
 
 
 @_kernel("rrp")
-def _rrp(node, pos, q, w, ox, oy) -> Placed:
+def _rrp(node: Any, pos: dict[str, tuple[Coord, Coord]], q: Array, w: Scratch, ox: Array, oy: Array) -> Placed:
     """Line-circle through the reference functions (not on the benchmarked paths)."""
     n = q.shape[0]
     st = {k: np.column_stack([_column(pos[k][0], n), _column(pos[k][1], n)]) for k in (node.a, node.p, node.q)}
@@ -245,7 +255,7 @@ def _rrp(node, pos, q, w, ox, oy) -> Placed:
 
 
 @_kernel("rigid")
-def _rigid(node, pos, q, w, ox, oy) -> Placed:
+def _rigid(node: Any, pos: dict[str, tuple[Coord, Coord]], q: Array, w: Scratch, ox: Array, oy: Array) -> Placed:
     ax, ay = pos[node.a]
     bx, by = pos[node.b]
     ex, ey, en, m = w.get(), w.get(), w.get(), w.get()
@@ -350,15 +360,21 @@ if hasattr(os, "register_at_fork"):
 def _pool() -> ThreadPoolExecutor:
     global _POOL
     if _POOL is None:
-        _POOL = ThreadPoolExecutor(max_workers=os.cpu_count() or 1, thread_name_prefix="planar-solve")
+        _POOL = ThreadPoolExecutor(max_workers=_cores(), thread_name_prefix="planar-solve")
     return _POOL
+
+
+@functools.cache
+def _cores() -> int:
+    """The machine's cores, asked once (``os.cpu_count`` reads the system's files: tens of microseconds)."""
+    return os.cpu_count() or 1
 
 
 def threads_default() -> int:
     """Threads the fast solve uses: ``PLANAR_THREADS`` if set, else the number of cores."""
     env = os.environ.get("PLANAR_THREADS", "").strip()
     if not env:
-        return os.cpu_count() or 1
+        return _cores()
     try:
         n = int(env)
     except ValueError:
@@ -499,7 +515,12 @@ def _place(x: Coord, y: Coord, ox: Array, oy: Array, placed: bool, px: float, py
 
 
 def fast_solve(
-    lk: Linkage, q: Array, threads: int | None = None, chunk: int | None = None, jit: bool | None = None
+    lk: Linkage,
+    q: Array,
+    threads: int | None = None,
+    chunk: int | None = None,
+    jit: bool | None = None,
+    program: Program | None = None,
 ) -> Solved | None:
     """``(poses, checks, points)`` for driver values ``q`` by the chunked path, or ``None``.
 
@@ -511,17 +532,18 @@ def fast_solve(
     kernels, ``None`` the compiled ones for at least :data:`JIT_MIN` samples
     when numba is installed and ``PLANAR_JIT`` is not ``0``.  ``chunk``:
     samples per chunk (default :data:`CHUNK`, compiled :data:`JIT_CHUNK`).
+    ``program``: the plan's compiled program when the caller has it already
+    (:func:`compiled_ready`): the compiled kernels are taken without asking again.
     """
     plan = lk._fast_plan()
     if plan is None:
         return None
     n = q.shape[0]
-    qmax = float(np.abs(q).max()) if n and any(plan.grows) else 0.0
-    tols = [1e-9 * (1.0 + b + (qmax if g else 0.0)) for b, g in zip(plan.bound, plan.grows)]
-    nthreads = threads if threads is not None else threads_default()
-    prog = _program(plan) if _use_jit(jit, n) else None
+    prog = program if program is not None else (_program(plan) if _use_jit(jit, n) else None)
     if prog is not None:
-        return _solve_compiled(lk, plan, prog, q, tols, nthreads, chunk or JIT_CHUNK)
+        return solve_compiled(lk, plan, prog, q, threads, chunk)
+    tols = _tols(plan, q)
+    nthreads = threads if threads is not None else threads_default()
     chunk = chunk or CHUNK
     poses: dict[str, Array] = {}
     _px, _py, _pa = plan.placement
@@ -552,6 +574,12 @@ def fast_solve(
     return _finish(lk, poses, checks, points)
 
 
+def _tols(plan: _Plan, q: Array) -> list[float]:
+    """Each node's branch-screen tolerance: 1e-9 of a bound on its coordinates over ``q``."""
+    qmax = float(np.abs(q).max()) if q.shape[0] and any(plan.grows) else 0.0
+    return [1e-9 * (1.0 + b + (qmax if g else 0.0)) for b, g in zip(plan.bound, plan.grows)]
+
+
 def _ground_pose(n: int, placement: tuple[float, float, float]) -> Array:
     """The ground never moves: one row seen ``n`` times (read-only), as :meth:`Mechanism.solve` returns it."""
     return np.broadcast_to(np.array(placement, dtype=float), (n, 3))
@@ -580,9 +608,13 @@ def _finish(lk: Linkage, poses: dict[str, Array], checks: list[tuple[Mask, str, 
 
 #: smallest batch the compiled kernels take by default (below it the numpy path is as quick
 #: as importing numba and loading the kernels once)
-JIT_MIN = 20_000
+JIT_MIN = 0
 #: samples per chunk of the compiled kernels
 JIT_CHUNK = 2048
+#: smallest batch the compiled path splits over threads by default: below it a solve takes a few
+#: milliseconds, and waking the pool's threads costs more processor time than a second core saves
+#: (measured on 2 shared cores: the four-bar at 1e5 samples 15.5 ns a sample on one thread, 19.7 on two)
+JIT_THREADS_MIN = 1 << 18
 #: ranges of chunks per thread the compiled path hands out (balancing threads slowed by other load)
 JIT_RANGES_PER_THREAD = 4
 
@@ -591,11 +623,18 @@ def jit_available() -> bool:
     """Whether the compiled kernels can be used (numba installed and ``PLANAR_JIT`` is not ``0``)."""
     if os.environ.get("PLANAR_JIT", "1") == "0":
         return False
-    try:
-        import numba  # noqa: F401
-    except ImportError:
-        return False
-    return True
+    if _NUMBA[0] is None:
+        try:
+            import numba  # noqa: F401
+        except ImportError:
+            _NUMBA[0] = False
+        else:
+            _NUMBA[0] = True
+    return bool(_NUMBA[0])
+
+
+#: whether numba imports (None: not tried yet)
+_NUMBA: list[bool | None] = [None]
 
 
 def solver_for(lk: Linkage, n: int) -> str:
@@ -604,7 +643,13 @@ def solver_for(lk: Linkage, n: int) -> str:
     plan = lk._fast_plan()
     if plan is None:
         return "reference"
-    return "compiled" if _use_jit(None, n) and _program(plan) is not None else "numpy"
+    return "compiled" if compiled_ready(plan, n) is not None else "numpy"
+
+
+def compiled_ready(plan: _Plan, n: int) -> Program | None:
+    """The compiled program :func:`fast_solve` runs for ``n`` samples of ``plan``, or ``None`` (numba off or
+    missing, or a node kind without an encoder); the first call imports numba and loads the kernels."""
+    return _program(plan) if _use_jit(None, n) else None
 
 
 def _use_jit(jit: bool | None, n: int) -> bool:
@@ -613,7 +658,7 @@ def _use_jit(jit: bool | None, n: int) -> bool:
     return jit
 
 
-def _program(plan: _Plan) -> Any:
+def _program(plan: _Plan) -> Program | None:
     """The plan's compiled program (built once), or ``None`` when a node kind has no encoder."""
     if plan.program is _NO_PROGRAM:
         from planar.linkages.compiled import program_for
@@ -622,32 +667,93 @@ def _program(plan: _Plan) -> Any:
     return plan.program
 
 
-def _solve_compiled(lk: Linkage, plan: _Plan, prog: Any, q: Array, tols: list[float], nthreads: int, chunk: int) -> Solved | None:
-    from planar.core.buffers import block as new_block
-    from planar.core.model import FinitePoses
+def solve_compiled(
+    lk: Linkage, plan: _Plan, prog: Program, q: Array, threads: int | None = None, chunk: int | None = None
+) -> Solved | None:
+    """:func:`fast_solve` by the compiled kernels, for a caller that has the plan and its program
+    (:func:`compiled_ready`): the tolerances are the plan's own unless a node moves with ``|q|``, and a
+    batch of one chunk takes one thread."""
+    chunk = chunk or JIT_CHUNK
+    tols = _tols(plan, q) if prog.grows else None
+    n = q.shape[0]
+    if threads is None:
+        nthreads = threads_default()  # read (and checked) on every call
+        nthreads = 1 if n < JIT_THREADS_MIN else nthreads
+    else:
+        nthreads = 1 if n <= chunk else threads
+    return _solve_compiled(lk, plan, prog, q, tols, nthreads, chunk)
+
+
+def _solve_compiled(
+    lk: Linkage, plan: _Plan, prog: Program, q: Array, tols: list[float] | None, nthreads: int, chunk: int
+) -> Solved | None:
+    """The compiled solve: one call of :func:`~planar.linkages.compiled.solve_range` per range of chunks.
+
+    The warm path of a small batch (one range) is a handful of array
+    allocations and one compiled call; the plan's constant arrays are built
+    once (:func:`~planar.linkages.compiled.program_for`).
+    """
+    solve_range = _compiled().solve_range
+    n = q.shape[0]
+    if q.dtype != np.float64 or not q.flags.c_contiguous:
+        q = np.ascontiguousarray(q, dtype=float)
+    nbytes = n * 8 * (3 * prog.n_links + 2 * prog.n_pts)
+    new_block = np.empty if nbytes < _BLOCK_MIN else _pool_block
+    block = new_block((prog.n_links, n, 3))
+    pblock = new_block((prog.n_pts, n, 2))
+    oks = new_block((prog.n_checks, n), bool)
+    tol = prog.tol if tols is None else np.asarray(tols, dtype=float)
+    nchunks = -(-n // chunk)
+    bad_chunks = np.zeros(nchunks, dtype=bool)
+    if nthreads <= 1 or nchunks <= 1:
+        fails = np.zeros(prog.n_checks, dtype=np.int64)
+        found = [int(solve_range(q, 0, n, chunk, prog.kinds, prog.refs, prog.par, tol, prog.check_row, prog.links,
+                                 prog.pts, prog.pl, block, pblock, oks, fails, bad_chunks))]  # fmt: skip
+    else:
+        fails, found = _solve_threaded(prog, q, tol, nthreads, chunk, block, pblock, oks, bad_chunks)
+    if min(found, default=0) < 0:
+        return None
+    ground = prog.ground_pose(n)
+    poses: dict[str, Array] = FinitePoses() if not any(found) else {}
+    for name, row in prog.parts:
+        poses[name] = ground if row < 0 else block[row]
+    points = {name: pblock[i] for i, name in enumerate(prog.pt_names)}
+    if not any(fails.ravel().tolist()):  # every sample closes (fails: per range and check, or per check)
+        return poses, None, points
+    oks[:, ~np.repeat(bad_chunks, chunk)[:n]] = True  # chunks where every sample closes
+    checks = [(oks[row], node, why) for row, (_, node, why) in enumerate(plan.checks)]
+    return _finish(lk, poses, checks, points)
+
+
+def _compiled() -> Any:
+    """The compiled kernels' module (imported on first use: it imports numba)."""
+    mod = _COMPILED[0]
+    if mod is None:
+        from planar.linkages import compiled as mod
+
+        _COMPILED[0] = mod
+    return mod
+
+
+#: :mod:`planar.linkages.compiled` once imported
+_COMPILED: list[Any] = [None]
+
+
+def _solve_threaded(
+    prog: Program, q: Array, tol: Array, nthreads: int, chunk: int, block: Array, pblock: Array, oks: Mask, bad_chunks: Mask
+) -> tuple[NDArray[np.int64], list[int]]:
+    """:func:`_solve_compiled` over ranges of chunks taken in turn by ``nthreads`` threads of the pool.
+
+    Returns the failure counts per range and check, and per range -1 where a branch may
+    switch, else its count of non-finite pose and point rows.
+    """
     from planar.linkages.compiled import solve_range
 
     n = q.shape[0]
-    q = np.ascontiguousarray(q, dtype=float)
-    poses: dict[str, Array] = {}
-    block = new_block((prog.links.shape[0], n, 3))
-    m = 0
-    for name, o, _, _ in plan.links:
-        if o < 0:
-            poses[name] = _ground_pose(n, plan.placement)
-        else:
-            poses[name] = block[m]
-            m += 1
-    pblock = new_block((prog.pts.shape[0], n, 2))
-    points = {name: pblock[i] for i, (name, _) in enumerate(plan.points)}
-    oks = new_block((len(plan.checks), n), bool)
-    tol = np.asarray(tols, dtype=float)
     # more ranges than threads, taken in turn by each thread: a thread slowed by other work on
     # the machine leaves its share to the others (the result does not depend on the ranges)
-    ranges = _cuts(n, chunk, nthreads * JIT_RANGES_PER_THREAD if nthreads > 1 else 1) if n else []
-    fails = np.zeros((len(ranges), len(plan.checks)), dtype=np.int64)
-    bad_chunks = np.zeros(-(-n // chunk), dtype=bool)
-    # per range: -1 where a branch may switch, else its count of non-finite pose and point rows
+    ranges = _cuts(n, chunk, nthreads * JIT_RANGES_PER_THREAD)
+    fails = np.zeros((len(ranges), prog.n_checks), dtype=np.int64)
     found = [0] * len(ranges)
     taken, lock = count(), Lock()
 
@@ -686,15 +792,7 @@ def _solve_compiled(lk: Linkage, plan: _Plan, prog: Any, q: Array, tols: list[fl
             f.result()
     else:
         work()
-    if min(found, default=0) < 0:
-        return None
-    if not any(found):
-        poses = FinitePoses(poses)
-    checks: list[tuple[Mask, str, str]] | None = None
-    if fails.any():
-        oks[:, ~np.repeat(bad_chunks, chunk)[:n]] = True  # chunks where every sample closes
-        checks = [(oks[row], node, why) for row, (_, node, why) in enumerate(plan.checks)]
-    return _finish(lk, poses, checks, points)
+    return fails, found
 
 
 def _chunk_bounds(n: int, chunk: int) -> list[tuple[int, int]]:

@@ -33,11 +33,16 @@ from typing import Any
 
 import numpy as np
 from numba import njit
+from numpy.typing import NDArray
 
-from planar.core.geometry import TANGENCY_RTOL
+from planar.core.geometry import CONCENTRIC, TANGENCY_RTOL
 from planar.linkages.plan import _Plan
 
 __all__ = ["ENCODERS", "Program", "program_for", "solve_range"]
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
 
 FIXED, CRANK, ACTUATOR, RRR, RRP, RIGID = range(6)
 #: kinds whose node has two roots (the branch screen runs on them)
@@ -46,6 +51,7 @@ TWO_ROOT = (RRR, RRP)
 CHECKED = (RRR, RRP, RIGID)
 
 _RTOL = TANGENCY_RTOL
+_CONCENTRIC = CONCENTRIC
 _TINY = float(np.finfo(float).tiny)
 
 # Cody-Waite pi/2 in three parts of 33 bits (fdlibm's pio2_1, pio2_2, pio2_2t): exact products
@@ -128,7 +134,7 @@ def _atan2(y: float, x: float) -> float:
 
 
 @njit(**_JIT)
-def _k_fixed(par, L, xo, yo):
+def _k_fixed(par: FloatArray, L: int, xo: FloatArray, yo: FloatArray) -> None:
     x, y = par[0], par[1]
     for i in range(L):
         xo[i] = x
@@ -136,7 +142,7 @@ def _k_fixed(par, L, xo, yo):
 
 
 @njit(**_JIT)
-def _k_crank(par, q, L, xc, yc, xo, yo):
+def _k_crank(par: FloatArray, q: FloatArray, L: int, xc: FloatArray, yc: FloatArray, xo: FloatArray, yo: FloatArray) -> None:
     r, phase = par[0], par[1]
     big = 0
     for i in range(L):
@@ -153,7 +159,7 @@ def _k_crank(par, q, L, xc, yc, xo, yo):
 
 
 @njit(**_JIT)
-def _k_actuator(par, q, L, xs, ys, xo, yo):
+def _k_actuator(par: FloatArray, q: FloatArray, L: int, xs: FloatArray, ys: FloatArray, xo: FloatArray, yo: FloatArray) -> None:
     ux, uy, off = par[0], par[1], par[2]
     for i in range(L):
         s = q[i] + off
@@ -162,37 +168,88 @@ def _k_actuator(par, q, L, xs, ys, xo, yo):
 
 
 @njit(**_JIT)
-def _k_rrr(par, L, xa, ya, xb, yb, xo, yo, ok, sep):
+def _k_rrr(
+    par: FloatArray,
+    L: int,
+    xa: FloatArray,
+    ya: FloatArray,
+    xb: FloatArray,
+    yb: FloatArray,
+    xo: FloatArray,
+    yo: FloatArray,
+    ok: BoolArray,
+    sep: FloatArray,
+) -> int:
     """Circle-circle as the numpy path (``chunked._rrr``); returns the number of samples that fail."""
     ra, rb, branch = par[0], par[1], par[2]
+    # scale-free as the numpy path: outside 1e-60..1e60 lengths are taken times k, a power of two
+    # near 1 / (ra + rb) (exact: the same bits as unscaled where nothing overflows)
+    span = ra + rb
+    k = 1.0 if 1e-60 < span < 1e60 else math.ldexp(1.0, -math.frexp(span)[1])
+    ra, rb = ra * k, rb * k
     s = ra + rb
     f = ra - rb
     s2, f2 = s * s, f * f
+    tiny = _CONCENTRIC * s2
     hb = 0.5 * branch
     hr = 0.5 * (f * s)  # (ra^2 - rb^2) without cancellation, as the numpy path
     fails = 0
+    if k == 1.0:
+        for i in range(L):
+            dx = xb[i] - xa[i]
+            dy = yb[i] - ya[i]
+            d2 = dx * dx + dy * dy
+            prod = (s2 - d2) * (d2 - f2)
+            scale = max(s2, d2)
+            good = (prod >= -_RTOL * scale * scale) & (d2 > tiny)
+            ok[i] = good
+            fails += not good
+            d2 = 1.0 if d2 <= tiny else d2
+            prod = max(prod, 0.0)
+            inv = 1.0 / d2
+            t = math.sqrt(prod) * inv * hb
+            sep[i] = prod * inv
+            fr = inv * hr + 0.5
+            xo[i] = (fr * dx + xa[i]) - t * dy
+            yo[i] = (fr * dy + ya[i]) + t * dx
+        return fails
     for i in range(L):
-        dx = xb[i] - xa[i]
-        dy = yb[i] - ya[i]
+        dx = (xb[i] - xa[i]) * k
+        dy = (yb[i] - ya[i]) * k
         d2 = dx * dx + dy * dy
         prod = (s2 - d2) * (d2 - f2)
         scale = max(s2, d2)
-        good = (prod >= -_RTOL * scale * scale) & (d2 > 0.0)
+        good = (prod >= -_RTOL * scale * scale) & (d2 > tiny)
         ok[i] = good
         fails += not good
-        d2 = 1.0 if d2 <= 0.0 else d2
+        d2 = 1.0 if d2 <= tiny else d2
         prod = max(prod, 0.0)
         inv = 1.0 / d2
         t = math.sqrt(prod) * inv * hb
-        sep[i] = prod * inv
+        sep[i] = prod * inv / (k * k)
         fr = inv * hr + 0.5
+        dx /= k  # back to model units (exact)
+        dy /= k
         xo[i] = (fr * dx + xa[i]) - t * dy
         yo[i] = (fr * dy + ya[i]) + t * dx
     return fails
 
 
 @njit(**_JIT)
-def _k_rrp(par, L, xa, ya, xp, yp, xq, yq, xo, yo, ok, sep):
+def _k_rrp(
+    par: FloatArray,
+    L: int,
+    xa: FloatArray,
+    ya: FloatArray,
+    xp: FloatArray,
+    yp: FloatArray,
+    xq: FloatArray,
+    yq: FloatArray,
+    xo: FloatArray,
+    yo: FloatArray,
+    ok: BoolArray,
+    sep: FloatArray,
+) -> int:
     """Line-circle as :func:`planar.core.geometry.line_circle` (the numpy path's ``chunked._rrp``)."""
     ra, branch, off = par[0], par[1], par[2]
     fails = 0
@@ -227,14 +284,24 @@ def _k_rrp(par, L, xa, ya, xp, yp, xq, yq, xo, yo, ok, sep):
 
 
 @njit(**_JIT)
-def _k_rigid(par, L, xa, ya, xb, yb, xo, yo, ok):
+def _k_rigid(
+    par: FloatArray,
+    L: int,
+    xa: FloatArray,
+    ya: FloatArray,
+    xb: FloatArray,
+    yb: FloatArray,
+    xo: FloatArray,
+    yo: FloatArray,
+    ok: BoolArray,
+) -> int:
     u, v = par[0], par[1]
     fails = 0
     for i in range(L):
         ex = xb[i] - xa[i]
         ey = yb[i] - ya[i]
         en = math.sqrt(ex * ex + ey * ey)
-        fails += en <= 0.0
+        fails += (en <= 0.0) | (en == math.inf)  # coincident, under- or overflow: again below
         inv = 1.0 / en
         ex *= inv
         ey *= inv
@@ -259,7 +326,9 @@ def _k_rigid(par, L, xa, ya, xb, yb, xo, yo, ok):
 
 
 @njit(**_JIT)
-def _may_switch(x, y, ok, sep, tol, q, first, L):
+def _may_switch(
+    x: FloatArray, y: FloatArray, ok: BoolArray, sep: FloatArray, tol: float, q: FloatArray, first: int, L: int
+) -> bool:
     """``chunked._may_switch`` on one window: a vectorised count, then the path test where it is not zero.
 
     (Indices are offsets from slices, never ``k - 1``: a possibly negative index costs numba a
@@ -295,7 +364,38 @@ def _may_switch(x, y, ok, sep, tol, q, first, L):
 
 
 @njit(**_JIT)
-def _k_pose(xo, yo, xa, ya, xb, yb, m, pl, P):
+def _may_switch_closed(
+    x: FloatArray, y: FloatArray, ok: BoolArray, sep: FloatArray, tol: float, q: FloatArray, first: int, L: int
+) -> bool:
+    """:func:`_may_switch` for a window where every sample closes (no validity to read): the count
+    of candidates alone, then :func:`_may_switch` itself where it is not zero."""
+    t2 = tol * tol
+    m = L - first
+    x0, x1, x2, x3 = x[first:], x[first - 1 :], x[first - 2 :], x[first - 3 :]
+    y0, y1, y2, y3 = y[first:], y[first - 1 :], y[first - 2 :], y[first - 3 :]
+    s = sep[first:]
+    cand = 0
+    for k in range(m):
+        ex = x0[k] - 3.0 * x1[k] + 3.0 * x2[k] - x3[k]
+        ey = y0[k] - 3.0 * y1[k] + 3.0 * y2[k] - y3[k]
+        cand += 4.0 * (ex * ex + ey * ey) + t2 >= s[k]
+    if cand == 0:
+        return False
+    return _may_switch(x, y, ok, sep, tol, q, first, L)
+
+
+@njit(**_JIT)
+def _k_pose(
+    xo: FloatArray,
+    yo: FloatArray,
+    xa: FloatArray,
+    ya: FloatArray,
+    xb: FloatArray,
+    yb: FloatArray,
+    m: int,
+    pl: FloatArray,
+    P: FloatArray,
+) -> int:
     """Pose rows ``P[:m]`` from node windows of length ``m``: origin, ``atan2`` of ``a -> b``, placement.
 
     Returns how many rows hold a non-finite number (counted as they are written: the
@@ -324,7 +424,7 @@ def _k_pose(xo, yo, xa, ya, xb, yb, m, pl, P):
 
 
 @njit(**_JIT)
-def _k_point(x, y, m, pl, out):
+def _k_point(x: FloatArray, y: FloatArray, m: int, pl: FloatArray, out: FloatArray) -> int:
     """Named point rows ``out[:m]``; returns how many hold a non-finite number."""
     px, py, pa, c, s = pl[0], pl[1], pl[2], pl[3], pl[4]
     F = out.ravel()
@@ -346,7 +446,25 @@ def _k_point(x, y, m, pl, out):
 
 
 @njit(**_JIT)
-def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts, pl, poses, points, oks, fails, bad_chunks):
+def solve_range(
+    q: FloatArray,
+    lo: int,
+    hi: int,
+    chunk: int,
+    kinds: IntArray,
+    refs: IntArray,
+    par: FloatArray,
+    tols: FloatArray,
+    check_row: IntArray,
+    links: IntArray,
+    pts: IntArray,
+    pl: FloatArray,
+    poses: FloatArray,
+    points: FloatArray,
+    oks: BoolArray,
+    fails: IntArray,
+    bad_chunks: BoolArray,
+) -> int:
     """Solve samples ``lo:hi`` chunk by chunk; returns -1 where a branch may switch (then it stops
     early), else the number of pose and point rows holding a non-finite number.
 
@@ -361,7 +479,7 @@ def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts,
     ``bad_chunks``, indexed by sample // chunk).
     """
     nn = kinds.shape[0]
-    W = chunk + 3
+    W = min(chunk, hi - lo) + 3
     X = np.empty((nn, W))
     Y = np.empty((nn, W))
     OK = np.ones((nn, W), dtype=np.bool_)
@@ -395,8 +513,13 @@ def solve_range(q, lo, hi, chunk, kinds, refs, par, tols, check_row, links, pts,
                 nf = _k_rrp(p, L, X[r[0]], Y[r[0]], X[r[1]], Y[r[1]], X[r[2]], Y[r[2]], xo, yo, ok, sep)
             else:
                 nf = _k_rigid(p, L, X[r[0]], Y[r[0]], X[r[1]], Y[r[1]], xo, yo, ok)
-            if (k in (RRR, RRP)) and _may_switch(xo, yo, ok, sep, tols[nd], qw, first, L):
-                return -1
+            if k in (RRR, RRP):
+                if nf == 0:
+                    switch = _may_switch_closed(xo, yo, ok, sep, tols[nd], qw, first, L)
+                else:
+                    switch = _may_switch(xo, yo, ok, sep, tols[nd], qw, first, L)
+                if switch:
+                    return -1
             if nf and check_row[nd] >= 0:
                 okw = ok[off:]
                 cnt = 0
@@ -436,11 +559,42 @@ ENCODERS: dict[str, Callable[[Any, dict[str, int]], tuple[int, tuple[int, ...], 
 
 
 class Program:
-    """A linkage's plan as arrays for :func:`solve_range`."""
+    """A linkage's plan as arrays for :func:`solve_range`, with what the warm path reuses on every call."""
 
-    def __init__(self, kinds, refs, par, check_row, links, pts, pl) -> None:
+    def __init__(
+        self,
+        kinds: IntArray,
+        refs: IntArray,
+        par: FloatArray,
+        check_row: IntArray,
+        links: IntArray,
+        pts: IntArray,
+        pl: FloatArray,
+        plan: _Plan,
+    ) -> None:
         self.kinds, self.refs, self.par, self.check_row = kinds, refs, par, check_row
         self.links, self.pts, self.pl = links, pts, pl
+        self.n_links, self.n_pts, self.n_checks = int(links.shape[0]), int(pts.shape[0]), len(plan.checks)
+        #: each part in the plan's order with its row of the pose block (-1: the ground)
+        moving = [name for name, o, _, _ in plan.links if o >= 0]
+        self.parts = [(name, moving.index(name) if o >= 0 else -1) for name, o, _, _ in plan.links]
+        self.pt_names = [name for name, _ in plan.points]
+        #: a node moves with |q| (its tolerance depends on the batch)
+        self.grows = any(plan.grows)
+        #: the branch-screen tolerances when no node moves with |q| (as ``chunked._tols``)
+        self.tol = np.array([1e-9 * (1.0 + b) for b in plan.bound])
+        row = np.array(plan.placement, dtype=float)
+        row.flags.writeable = False
+        self._ground_row = row
+        self._ground_last: FloatArray | None = None
+
+    def ground_pose(self, n: int) -> FloatArray:
+        """The ground's track: the placement row seen ``n`` times (read-only, no memory; the last one kept)."""
+        last = self._ground_last
+        if last is None or last.shape[0] != n:
+            last = np.ndarray((n, 3), dtype=float, buffer=self._ground_row, strides=(0, 8))
+            self._ground_last = last
+        return last
 
 
 def program_for(plan: _Plan) -> Program | None:
@@ -467,4 +621,4 @@ def program_for(plan: _Plan) -> Program | None:
     pts = np.array([i for _, i in plan.points], np.int64)
     px, py, pa = plan.placement
     pl = np.array([px, py, pa, float(np.cos(pa)), float(np.sin(pa))])  # as the numpy path
-    return Program(kinds, refs, par, check_row, links, pts, pl)
+    return Program(kinds, refs, par, check_row, links, pts, pl, plan)

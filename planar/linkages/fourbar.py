@@ -18,14 +18,15 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from planar.core.model import check_finite, check_positive
 from planar.errors import InputError
-from planar.linkages.dyads import RRR, Crank, Fixed, Link, Linkage, Rigid
+from planar.linkages.linkage import Link, Linkage
+from planar.linkages.nodes import RRR, Crank, Fixed, Rigid
 
 __all__ = ["FourBar", "freudenstein_angles", "grashof_class"]
 
@@ -124,7 +125,7 @@ class FourBar(Linkage):
         circuit: Circuit = "open",
         placement: Sequence[float] = (0.0, 0.0, 0.0),
         name: str = "fourbar",
-        **kw,
+        **kw: Any,
     ) -> None:
         a = check_positive(f"{name}.crank", crank)
         b = check_positive(f"{name}.coupler", coupler)
@@ -164,9 +165,18 @@ class FourBar(Linkage):
         meet there), so only its circuit is carried by continuity; any other keeps its declared circuit at
         every sample, however coarse the sampling (a crossed crank-rocker sampled 4 or 7 times a turn was
         carried onto the open circuit by an extrapolation that coarse samples cannot support)."""
-        if self.grashof != "change-point":
+        if not self._carries_branches():
             return np.zeros(np.shape(q), dtype=bool)
         return super()._path(q)
+
+    def _carries_branches(self) -> bool:
+        """Only a change-point four-bar carries its circuit (see :meth:`_path`); kept with the dimensions it was
+        found for, as every solve asks."""
+        known = self.__dict__.get("_change_point_of")
+        if known is None or known[0] is not self.dims:
+            known = (self.dims, self.grashof == "change-point")
+            self.__dict__["_change_point_of"] = known
+        return bool(known[1])
 
     # -- classification and limits -----------------------------------------
     @property

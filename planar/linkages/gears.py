@@ -34,10 +34,10 @@ from numpy.typing import NDArray
 
 from planar.core.model import Driver, check_finite, check_positive, joint_kind
 from planar.errors import InputError
-from planar.linkages.dyads import Check, Crank, Fixed, Mask, NodeKind, _perp, frame_rates, node_kind
+from planar.linkages.nodes import Check, Crank, Fixed, Mask, NodeKind, _perp, frame_rates, node_kind
 
 if TYPE_CHECKING:
-    from planar.linkages.dyads import Linkage
+    from planar.linkages.linkage import Linkage
 
 __all__ = ["Driven", "GearMesh", "Geared", "input_angle"]
 

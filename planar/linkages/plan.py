@@ -1,7 +1,7 @@
 """The plan of one linkage's fast solve, and the shape of what it is planned from.
 
 :mod:`planar.linkages.chunked` builds a :class:`_Plan` from a linkage
-(:class:`planar.linkages.dyads.Linkage`, which imports the solver); the compiled
+(:class:`planar.linkages.linkage.Linkage`, which imports the solver); the compiled
 kernels (:mod:`planar.linkages.compiled`) read it.  The linkage and its node kinds
 are described here by the members the solver reads, so this module imports
 neither.
@@ -20,7 +20,7 @@ __all__ = ["Linkage", "NodeKind", "_Plan"]
 
 
 class NodeKind(Protocol):
-    """A node kind as the fast solve reads it (:class:`planar.linkages.dyads.NodeKind`)."""
+    """A node kind as the fast solve reads it (:class:`planar.linkages.nodes.NodeKind`)."""
 
     kind: ClassVar[str]
 
@@ -31,7 +31,7 @@ class NodeKind(Protocol):
 
 
 class Linkage(Protocol):
-    """A linkage as the fast solve reads it (:class:`planar.linkages.dyads.Linkage`)."""
+    """A linkage as the fast solve reads it (:class:`planar.linkages.linkage.Linkage`)."""
 
     @property
     def name(self) -> str: ...

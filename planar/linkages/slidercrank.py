@@ -9,12 +9,15 @@ cancellation).  ``branch=+1`` puts the slider on the +x side.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from planar.core.model import check_finite, check_positive
 from planar.errors import InputError
-from planar.linkages.dyads import RRP, Crank, Fixed, Link, Linkage
+from planar.linkages.linkage import Link, Linkage
+from planar.linkages.nodes import RRP, Crank, Fixed
 
 __all__ = ["SliderCrank"]
 
@@ -34,7 +37,7 @@ class SliderCrank(Linkage):
         branch: int = 1,
         placement: Sequence[float] = (0.0, 0.0, 0.0),
         name: str = "slidercrank",
-        **kw,
+        **kw: Any,
     ) -> None:
         r = check_positive(f"{name}.crank", crank)
         l = check_positive(f"{name}.rod", rod)
@@ -62,7 +65,7 @@ class SliderCrank(Linkage):
         ]
         super().__init__(name, nodes, links, points={"slider_pin": "S"}, placement=placement, **kw)
 
-    def slider_position(self, theta) -> np.ndarray:
+    def slider_position(self, theta: ArrayLike) -> np.ndarray:
         """Slider x (before placement) by the textbook formula, for cross-checks: ``branch`` picks the root.
 
         ``r cos(theta) + branch sqrt(l^2 - (r sin(theta) - e)^2)``; where the rod cannot reach the

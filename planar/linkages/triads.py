@@ -18,7 +18,7 @@ Jacobian, ``numpy.linalg.solve`` batched over samples).
 the assembly Newton reaches from there is the declared one (a linkage with a
 triad declares its branches at driver value 0, so a path starting elsewhere
 is led in from 0, as a four-bar's is from its reference).  Along a path (see
-:func:`~planar.linkages.dyads.path_mask`) each sample takes the assembly
+:func:`~planar.linkages.nodes.path_mask`) each sample takes the assembly
 Newton reaches from the previous valid sample's: sequential continuation,
 computed in blocks (the block is solved at once from a tangent prediction,
 then every sample is checked to be what Newton from its predecessor gives;
@@ -46,7 +46,7 @@ from numpy.typing import NDArray
 
 from planar.core.model import check_finite, check_positive
 from planar.errors import InputError
-from planar.linkages.dyads import Check, Mask, NodeKind, Vec, node_kind
+from planar.linkages.nodes import Check, Mask, NodeKind, Vec, node_kind
 
 __all__ = ["Triad", "solve_triad"]
 
@@ -314,7 +314,7 @@ class Triad(NodeKind):
             if self.name not in pos:
                 raise RuntimeError(f"triad node {self.name!r} solved before its group's first node")
             return pos[self.name], None
-        from planar.linkages.dyads import path_mask
+        from planar.linkages.nodes import path_mask
 
         S, L, u_ref, scale = self._data()
         K = np.stack([np.broadcast_to(pos[g.a], (q.shape[0], 2)) for g in self.group], 1)

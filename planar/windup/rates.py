@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planar.core.registry import UnsupportedError
-from planar.linkages.dyads import RRP, RRR, frame_rates
+from planar.linkages.nodes import RRP, RRR, frame_rates
 from planar.windup import params as P_
 from planar.windup.mechanisms import ELEMENTAL, ElementalMechanism
 

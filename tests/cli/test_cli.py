@@ -76,12 +76,18 @@ def test_bench_kinematics_json_has_ratio_and_agrees_with_peer():
     pytest.importorskip("pylinkage")
     from planar.bench.kinematics import bench_kinematics
 
-    r = bench_kinematics(n=20_000, repeats=2)
+    r = bench_kinematics(sizes=(50, 20_000), repeats=3)
     assert [c["linkage"] for c in r["cases"]] == ["fourbar-crank-rocker", "jansen"]
     for c in r["cases"]:
-        s = c["planar_samples_per_s"]
-        assert 0 < s["min"] <= s["median"] <= s["max"] and c["peer_samples_per_s"]["median"] > 0
-        assert c["ratio"] == pytest.approx(s["median"] / c["peer_samples_per_s"]["median"])
+        assert [row["n"] for row in c["curve"]] == [50, 20_000]
+        for row in c["curve"]:
+            for key in ("planar_cpu_s", "peer_cpu_s", "planar_wall_s", "peer_wall_s"):
+                s = row[key]
+                assert 0 < s["min"] <= s["median"] <= s["max"]
+            assert row["cpu_ratio"] == pytest.approx(row["peer_cpu_s"]["median"] / row["planar_cpu_s"]["median"])
+            assert row["wall_ratio"] == pytest.approx(row["peer_wall_s"]["median"] / row["planar_wall_s"]["median"])
+        assert c["ratio"] == min(row["wall_ratio"] for row in c["curve"])
+        assert c["cpu_ratio"] == min(row["cpu_ratio"] for row in c["curve"])
         # every joint agrees with pylinkage (an independent solver) at the same crank angles
         assert c["max_abs_diff_vs_peer"] < 1e-9 and c["max_abs_diff_points_vs_peer"] < 1e-9
         assert c["all_valid"] and c["agrees"]

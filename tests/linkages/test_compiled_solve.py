@@ -158,19 +158,42 @@ def test_the_test_linkages_reach_every_kernel_and_invalid_samples():
     assert not LINKAGES["actuated"].solve(np.linspace(-3, 3, 500)).valid.all()
 
 
-def test_public_solve_takes_the_compiled_kernels_for_large_batches(monkeypatch):
+def test_public_solve_takes_the_compiled_kernels_at_every_size(monkeypatch):
     lk = get("jansen")
-    q = 2 * np.pi / 3600 * np.arange(1, chunked.JIT_MIN + 1)
+    q = 2 * np.pi / 3600 * np.arange(1, 30_001)
     calls = []
     real = chunked._solve_compiled
-    monkeypatch.setattr(chunked, "_solve_compiled", lambda *a: calls.append(1) or real(*a))
-    lk.solve(q)
-    assert calls == [1]
-    lk.solve(q[:1000])  # small batches: numpy kernels (no numba import for a few hundred samples)
-    assert calls == [1]
+    monkeypatch.setattr(chunked, "_solve_compiled", lambda *a: calls.append(a[3].shape[0]) or real(*a))
+    for n in (30_000, 1000, 72, 4, 1):
+        lk.solve(q[:n])
+    assert calls == [30_000, 1000, 72, 4, 1]
     monkeypatch.setenv("PLANAR_JIT", "0")
     lk.solve(q)
-    assert calls == [1]
+    assert len(calls) == 5
+
+
+@pytest.mark.parametrize("name", ["jansen", "fourbar-crank-rocker", "fourbar-placed", "slider-crank-offset", "kangaroo"])
+def test_warm_path_gives_the_general_solve(name, monkeypatch):
+    """The warm path of ``Linkage.solve`` (plain float arrays) against ``Mechanism.solve`` with the same kernels."""
+    from planar.core.model import Mechanism
+
+    lk = get(name)
+    rng = np.random.default_rng(3)
+    for q in (np.linspace(-7.0, 7.0, 50), rng.uniform(-10, 10, 300), np.linspace(0.0, 2 * np.pi, 5000)):
+        a = lk.solve(q)
+        b = Mechanism.solve(lk, q.tolist())  # a list: the general path
+        assert np.array_equal(a.driver, b.driver) and a.driver is not q
+        assert np.array_equal(a.valid, b.valid) and np.array_equal(a.fail_code, b.fail_code)
+        assert a.fail_table == b.fail_table and list(a.poses) == list(b.poses) and list(a.points) == list(b.points)
+        for k in b.poses:
+            assert np.array_equal(a.poses[k], b.poses[k])
+        for k in b.points:
+            assert np.array_equal(a.points[k], b.points[k])
+    with pytest.raises(PlanarError):
+        lk.solve(np.array([0.0, np.nan]))
+    monkeypatch.setenv("PLANAR_MAX_SAMPLES", "10")
+    with pytest.raises(PlanarError):
+        lk.solve(np.zeros(11))
 
 
 def test_node_kind_without_encoder_uses_the_numpy_kernels(monkeypatch):
@@ -310,3 +333,33 @@ def _residual(nd, pos):
 
 def _cross(a, b):
     return a[0] * b[1] - a[1] * b[0]
+
+
+@pytest.mark.slow
+def test_compiled_kernels_are_cached_across_processes(tmp_path):
+    """A second process loads the kernels from numba's cache (no compilation), from a writable place."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    code = (
+        "import json, os, numpy as np\n"
+        "from planar.scene.catalog import get\n"
+        "get('jansen').solve(np.linspace(0.0, 6.0, 72))\n"
+        "from planar.linkages.compiled import solve_range\n"
+        "st = solve_range.stats\n"
+        "print(json.dumps({'hits': sum(st.cache_hits.values()), 'misses': sum(st.cache_misses.values()),"
+        " 'path': st.cache_path, 'writable': os.access(st.cache_path, os.W_OK)}))\n"
+    )
+    root = Path(__file__).resolve().parents[2]
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}  # an empty cache: the first process compiles
+    runs = []
+    for _ in range(2):
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=root, env=env, timeout=600)
+        assert r.returncode == 0, r.stderr
+        runs.append(json.loads(r.stdout.strip().splitlines()[-1]))
+    first, second = runs
+    assert first["writable"] and second["writable"]
+    assert second["misses"] == 0 and second["hits"] >= 1, runs
+    assert any(tmp_path.iterdir())  # the machine code landed in the cache

@@ -203,3 +203,35 @@ def test_slider_crank_that_cannot_reach_the_guide():
     m = sc.solve(np.linspace(0, 2 * np.pi, 361))
     assert m.valid.any() and not m.valid.all()
     assert "S" in m.failed_joints
+
+
+def _lead_steps_loop(h, h_max, span):
+    """The lead-in's steps sample by sample (the recurrence the vectorised lead-in must reproduce)."""
+    steps, step, total = [], h, 0.0
+    while total < span and len(steps) < 4096:
+        step = min(step * 1.4, h_max) if steps else h
+        steps.append(step)
+        total += step
+    return np.cumsum(steps)[::-1]
+
+
+def test_vectorised_lead_in_is_the_recurrence_bit_for_bit():
+    from planar.linkages.linkage import _lead_steps
+
+    rng = np.random.default_rng(11)
+    for _ in range(3000):
+        h = 10 ** rng.uniform(-9, 0)
+        h_max = h if rng.random() < 0.1 else max(h, 10 ** rng.uniform(-4, 0.5))
+        span = 10 ** rng.uniform(-10, 3)
+        want, got = _lead_steps_loop(h, h_max, span), _lead_steps(h, h_max, span)
+        assert want.shape == got.shape and np.array_equal(want, got), (h, h_max, span)
+
+
+def test_lead_in_only_where_a_circuit_is_carried():
+    # a crank-rocker keeps its declared circuit at every sample: no lead-in; a change-point four-bar has one
+    q = np.linspace(0.3, 3.0, 100)
+    assert FourBar(4, 1, 4, 3)._lead_in(q).size == 0
+    cp = FourBar(2.0, 1.0, 2.0, 1.0)
+    assert cp.grashof == "change-point"
+    lead = cp._lead_in(q)
+    assert lead.size > 0 and np.all(np.diff(lead) > 0) and lead[-1] < q[0]
