@@ -174,7 +174,7 @@ def assembled(mech: Mechanism, motion: Motion) -> tuple[Mechanism, Motion, Marks
     joints = [j for j in asm.joints if j.a in poses and j.b in poses]
     points = {k: v for k, v in asm.points.items() if v[0] in poses}
     view = _ViewMechanism(f"{asm.name}", parts, joints, asm.driver, points)
-    view.view = "xy"  # type: ignore[attr-defined]
+    view.view = "xy"
     pts = {k: poses_apply(poses[part], xy) for k, (part, xy) in points.items()}
     vm = Motion(driver=m.driver, poses=poses, valid=m.valid, fail_code=m.fail_code, fail_table=m.fail_table, points=pts, t=m.t)
     return view, vm, marks

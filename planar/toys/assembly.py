@@ -55,6 +55,7 @@ from planar.core.model import (
     Slot,
     joint_kind,
 )
+from planar.core.rates import PartRates, RatesResult
 from planar.core.registry import Registry
 from planar.errors import InputError
 from planar.windup.mechanisms import SkewContact
@@ -480,6 +481,39 @@ class ToyAssembly(Mechanism):
     def stage_poses(self, q: Array) -> dict[str, Array]:
         """Every stage part's own pose track at its place (for drawing a stage's parts one by one)."""
         return self._stage_poses(np.asarray(q, float))[0]
+
+    def part_rates(self, q: Array, qd: Array, qdd: Array) -> RatesResult:
+        """Rates of every piece (see :meth:`Mechanism.part_rates`), from the rates of the toy's stages.
+
+        Each piece is a stage part (its first member) at the stage's place, then offset on its body.  The
+        place is a turn by ``a`` about z and a shift for an xy stage, a shift for xz and yz
+        (:func:`_world_track`): the stage part's velocity and acceleration turn by ``a``, its angular rates
+        do not change; the piece's origin is a point of that body (``v + omega x r``,
+        ``a + alpha x r - omega^2 r``, ``r`` from the stage part's origin to the piece's).
+        """
+        raw, ok, _ = self.toy.part_rates(q, qd, qdd)
+        stage_poses = self.stage_poses(q)
+        pieces = self.piece_poses(stage_poses)
+        out: dict[str, PartRates] = {}
+        for piece, members in self.members.items():
+            full = members[0][0]
+            r0 = raw[full]
+            v, a = np.asarray(r0.v, float), np.asarray(r0.a, float)
+            if self._stage_part(full).plane == "xy":
+                ang = self.placed[int(full.split(".")[0][1:])].place[2]
+                c, s_ = np.cos(ang), np.sin(ang)
+                v = np.column_stack([c * v[:, 0] - s_ * v[:, 1], s_ * v[:, 0] + c * v[:, 1]])
+                a = np.column_stack([c * a[:, 0] - s_ * a[:, 1], s_ * a[:, 0] + c * a[:, 1]])
+            r = pieces[piece][:, :2] - stage_poses[full][:, :2]
+            om = np.broadcast_to(np.asarray(r0.omega, float), q.shape)
+            al = np.broadcast_to(np.asarray(r0.alpha, float), q.shape)
+            pv = np.column_stack([v[:, 0] - om * r[:, 1], v[:, 1] + om * r[:, 0]])
+            pa = np.column_stack([a[:, 0] - al * r[:, 1] - om * om * r[:, 0], a[:, 1] + al * r[:, 0] - om * om * r[:, 1]])
+            out[piece] = PartRates(pv, pa, om, al)
+        method = (
+            "wind-up closed forms differentiated analytically, composed through the toy's stages, turned to each piece's place"
+        )
+        return out, ok, method
 
     def piece_count(self) -> dict[str, int]:
         """Cut pieces per plane."""
