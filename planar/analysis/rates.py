@@ -39,7 +39,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from planar.core.geometry import poses_apply
 from planar.core.rates import PartRates, RatesResult, point_rates
 from planar.errors import InputError
 
@@ -183,44 +182,9 @@ def _torque(
     t_rest: float | None,
     densities: dict[str, float] | None,
 ) -> Array:
-    from planar.analysis.dynamics import gravity_and_damping, part_mass_table, plane_gravity
+    from planar.analysis.dynamics import motor_torque_from_rates
 
-    assert motion.t is not None
-    g3, lam = gravity_and_damping(effects)
-    tau = np.zeros(len(motion))
-    for name, (mass, cog, inertia) in part_mass_table(mech, effects, densities).items():
-        if mass == 0.0 and inertia == 0.0:
-            continue
-        g = plane_gravity(getattr(mech.part(name), "plane", "xy"), g3)  # a toy's piece: gravity in its plane
-        G = poses_apply(motion.poses[name], np.asarray(cog, float))
-        vG, aG = point_rates(motion.poses[name], rates[name], G)
-        cG, _ = point_rates(motion.poses[name], coef[name], G)
-        r, c = rates[name], coef[name]
-        tau += mass * _dot(aG - g + lam * vG, cG) + inertia * (r.alpha + lam * r.omega) * c.omega
-    if effects is not None:
-        for load in effects.loads:
-            part, _ = mech.points[load.point]
-            cX, _ = point_rates(motion.poses[part], coef[part], motion.points[load.point])
-            tau += cX @ np.asarray(load.force, float)
-        i0 = 0 if t_rest is None else int(np.argmin(np.abs(motion.t - t_rest)))
-        for s in effects.springs:
-            pa = poses_apply(motion.poses[s.a], np.asarray(s.anchor_a, float))
-            pb = poses_apply(motion.poses[s.b], np.asarray(s.anchor_b, float))
-            va, _ = point_rates(motion.poses[s.a], rates[s.a], pa)
-            vb, _ = point_rates(motion.poses[s.b], rates[s.b], pb)
-            ca, _ = point_rates(motion.poses[s.a], coef[s.a], pa)
-            cb, _ = point_rates(motion.poses[s.b], coef[s.b], pb)
-            d = pb - pa
-            L = np.hypot(d[:, 0], d[:, 1])
-            Ls = np.where(L > 0, L, 1.0)
-            rest = float(L[i0]) if s.rest_length is None else s.rest_length
-            f = s.stiffness * (L - rest) + s.damping * _dot(d, vb - va) / Ls
-            tau += f * _dot(d, cb - ca) / Ls
-    return tau
-
-
-def _dot(a: Array, b: Array) -> Array:
-    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]
+    return motor_torque_from_rates(mech, motion, rates, coef, effects, t_rest, densities)
 
 
 def derivative_columns(mech: Mechanism, motion: Motion, effects: Any = None) -> tuple[list[str], list[Array]]:

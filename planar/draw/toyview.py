@@ -133,7 +133,7 @@ def assembled(mech: Mechanism, motion: Motion) -> tuple[Mechanism, Motion, Marks
         m = asm.solve(motion.driver, t=motion.t)
         m.valid, m.fail_code, m.fail_table = motion.valid, motion.fail_code, motion.fail_table
         front_plane = "xy"
-    elif isinstance(mech, ElementalMechanism) and mech.number in (6, 8, 9):
+    elif isinstance(mech, ElementalMechanism) and (mech.spatial or mech.view != "xy"):  # #6, #9; #8
         asm, m, front_plane = mech, motion, mech.view
     else:
         return mech, motion, Marks()
@@ -195,7 +195,7 @@ class _FrontOnly(Mechanism):
         return {p.name: poses[p.name] for p in self.parts}, checks
 
 
-def _stage_params(mech: Any, joint: str) -> Any:
+def _stage_params(mech: Mechanism, joint: str) -> Any:
     """The parameters (world frame) of the elemental mechanism a joint belongs to."""
     from planar.windup.chain import ToyMechanism
 

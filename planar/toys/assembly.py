@@ -58,6 +58,7 @@ from planar.core.model import (
 from planar.core.rates import PartRates, RatesResult
 from planar.core.registry import Registry
 from planar.errors import InputError
+from planar.windup.chain import ToyMechanism
 from planar.windup.mechanisms import SkewContact
 
 __all__ = ["PLACERS", "KeyedShaft", "ToyAssembly", "assembly_residual", "toy_assembly"]
@@ -322,15 +323,48 @@ class ToyAssembly(Mechanism):
     the piece's frame; ``keyed`` maps each cam to its phase (rad).
     """
 
-    def __init__(self, toy: Any) -> None:
+    def __init__(self, toy: ToyMechanism) -> None:
         self.toy = toy
         self.placed = _placements(toy)
         self.notes: list[str] = []
-        # which piece each stage part belongs to
-        merged_of: dict[str, str] = {}
-        for group in toy.merged:
-            for n in group:
-                merged_of[n] = group[0]
+        cam_name = self._cam_names()
+        # rest poses (world, per plane) of every stage part, from the toy's own solve at q = 0
+        poses0 = self._stage_poses(np.zeros(1))[0]
+        piece_of, body_of, rename = self._pieces_and_bodies(cam_name)
+        members, frames = self._piece_frames(piece_of, poses0)
+        self.members = members
+        self.piece_of = piece_of
+        self.bodies: dict[str, list[str]] = {}
+        for full, body in body_of.items():
+            lst = self.bodies.setdefault(body, [])
+            if piece_of[full] not in lst:
+                lst.append(piece_of[full])
+        self._frames = frames
+        parts = self._merged_parts()
+        # joints
+        xf = {full: m for mem in members.values() for full, m in mem}
+        main_cam = cam_name[min(cam_name)]
+        self.keyed: dict[str, float] = {main_cam: 0.0}
+        #: each keyed cam's own part of its key angle (rad): its root stage's turn relative to the first cam's
+        #: (``keyed`` = cam phase difference + this; a Ty cam is #1 turned a quarter)
+        self.key_turn: dict[str, float] = {main_cam: 0.0}
+        joints, dropped = _without_redundant_slides(self._placed_joints(cam_name, main_cam, xf))
+        #: slides dropped as repeats of another (same pieces, same line) and the cuts they took with them
+        self.redundant: list[Any] = dropped
+        self.removed_features: list[tuple[str, Any]] = []
+        if dropped:  # the dropped slides' own cuts go too: their slot on the guide, their pin holes on the body
+            parts, self.removed_features = _without_cuts_of(parts, dropped, joints)
+        joints += self._keyed_shafts(cam_name, main_cam)
+        self.main_cam = main_cam
+        d = toy.driver
+        driver = Driver(main_cam, "rotation", origin=(0.0, 0.0), rate=d.rate, phase=d.phase)
+        named = set(rename.values()) & set(piece_of.values())  # effector pieces carry the name themselves
+        points = {k: (piece_of[v[0]], _xf_point(xf[v[0]], v[1])) for k, v in toy.points.items() if k not in named}
+        super().__init__(f"{toy.name} (assembled)", parts, joints, driver, points)
+
+    # -- construction, one seam each -------------------------------------------------------------
+    def _cam_names(self) -> dict[int, str]:
+        """Each root stage's cam piece name (``cam.left``, ``cam.right``, numbered when a side has several)."""
         cams: dict[str, list[int]] = {}
         for p in self.placed:
             if p.stage.parent is None:
@@ -339,9 +373,15 @@ class ToyAssembly(Mechanism):
         for side, idx in cams.items():
             for k, i in enumerate(idx):
                 cam_name[i] = f"cam.{side}" + (f"{k + 1}" if len(idx) > 1 else "")
-        # rest poses (world, per plane) of every stage part, from the toy's own solve at q = 0
-        q0 = np.zeros(1)
-        poses0 = self._stage_poses(q0)[0]
+        return cam_name
+
+    def _pieces_and_bodies(self, cam_name: dict[int, str]) -> tuple[dict[str, str], dict[str, str], dict[str, str]]:
+        """Which piece and which rigid body each stage part belongs to, and the named effectors' renames."""
+        toy = self.toy
+        merged_of: dict[str, str] = {}
+        for group in toy.merged:
+            for n in group:
+                merged_of[n] = group[0]
         piece_of: dict[str, str] = {}
         body_of: dict[str, str] = {}
         for p in self.placed:
@@ -362,13 +402,19 @@ class ToyAssembly(Mechanism):
                 body_of[full] = body
         # a named end effector's follower that is a piece of its own takes the effector's name
         label_of = {(st.cam, st.key): st.label for st in toy.stages}
-        rename = {f"{label_of[k]}.follower": n for k, n in getattr(toy, "names", {}).items()}
+        rename = {f"{label_of[k]}.follower": n for k, n in toy.names.items()}
         for full, n in rename.items():
             if piece_of.get(full) == full:
                 piece_of[full] = n
                 if body_of.get(full) == full:
                     body_of[full] = n
-        # each piece's frame: world for frames, else its first member's frame
+        return piece_of, body_of, rename
+
+    def _piece_frames(
+        self, piece_of: dict[str, str], poses0: dict[str, Array]
+    ) -> tuple[dict[str, list[tuple[str, XForm]]], dict[str, Array]]:
+        """Each piece's members with their transforms into its frame (world for frames, else its first
+        member's frame at rest), and the frames."""
         members: dict[str, list[tuple[str, XForm]]] = {}
         for full, piece in piece_of.items():
             members.setdefault(piece, []).append((full, (0.0, 0.0, 0.0)))
@@ -383,16 +429,12 @@ class ToyAssembly(Mechanism):
                 rel = poses_compose(poses_invert(frames[piece]), poses0[full][0])
                 xs.append((full, (float(rel[0]), float(rel[1]), float(rel[2]))))
             members[piece] = xs
-        self.members = members
-        self.piece_of = piece_of
-        self.bodies: dict[str, list[str]] = {}
-        for full, body in body_of.items():
-            lst = self.bodies.setdefault(body, [])
-            if piece_of[full] not in lst:
-                lst.append(piece_of[full])
-        self._frames = frames
+        return members, frames
+
+    def _merged_parts(self) -> list[Part]:
+        """One part per piece: its members' outlines merged (:func:`_merge`); its notes go to :attr:`notes`."""
         parts: list[Part] = []
-        for piece, mem in members.items():
+        for piece, mem in self.members.items():
             p0 = self._stage_part(mem[0][0])
             part, notes = _merge(piece, [(self._stage_part(f), m) for f, m in mem], p0.plane, p0.ground)
             if p0.plane == "yz":  # its x offset moves with its stage
@@ -400,14 +442,11 @@ class ToyAssembly(Mechanism):
                 part = replace(part, offset=p0.offset + st.place[0])
             self.notes += notes
             parts.append(part)
-        # joints
-        xf = {full: m for mem in members.values() for full, m in mem}
+        return parts
+
+    def _placed_joints(self, cam_name: dict[int, str], main_cam: str, xf: dict[str, XForm]) -> list[Any]:
+        """Every stage joint placed between pieces (:data:`PLACERS`), but the axles of the second cams."""
         joints: list[Any] = []
-        main_cam = cam_name[min(cam_name)]
-        self.keyed: dict[str, float] = {main_cam: 0.0}
-        #: each keyed cam's own part of its key angle (rad): its root stage's turn relative to the first cam's
-        #: (``keyed`` = cam phase difference + this; a Ty cam is #1 turned a quarter)
-        self.key_turn: dict[str, float] = {main_cam: 0.0}
         for p in self.placed:
             for j in p.stage.mech.joints:
                 a, b = f"{p.label}.{j.a}", f"{p.label}.{j.b}"
@@ -419,31 +458,26 @@ class ToyAssembly(Mechanism):
                 ):
                     continue  # the axle of a second cam: it is keyed to the first instead (below)
                 placer = PLACERS.get(j, f"joint {j.name!r} of stage {p.label}")
-                joints.append(placer(j, f"{p.label}.{j.name}", piece_of[a], piece_of[b], xf[a], xf[b], p))
-        joints, dropped = _without_redundant_slides(joints)
-        #: slides dropped as repeats of another (same pieces, same line) and the cuts they took with them
-        self.redundant: list[Any] = dropped
-        self.removed_features: list[tuple[str, Any]] = []
-        if dropped:  # the dropped slides' own cuts go too: their slot on the guide, their pin holes on the body
-            parts, self.removed_features = _without_cuts_of(parts, dropped, joints)
+                joints.append(placer(j, f"{p.label}.{j.name}", self.piece_of[a], self.piece_of[b], xf[a], xf[b], p))
+        return joints
+
+    def _keyed_shafts(self, cam_name: dict[int, str], main_cam: str) -> list[Any]:
+        """Every cam but the first keyed to it at its phase (fills :attr:`keyed` and :attr:`key_turn`)."""
+        toy = self.toy
+        out: list[Any] = []
         size = 1.0
+        first = self.placed[min(cam_name)]
         for i, name in sorted(cam_name.items()):
             if name == main_cam:
                 continue
-            ph = toy.cam_phase[self.placed[i].stage.cam] - toy.cam_phase[self.placed[min(cam_name)].stage.cam]
+            ph = toy.cam_phase[self.placed[i].stage.cam] - toy.cam_phase[first.stage.cam]
             # a root stage turned by its realisation (Rz->Ty is #1 turned a quarter) turns its cam as much
-            turn = self.placed[i].place[2] - self.placed[min(cam_name)].place[2]
+            turn = self.placed[i].place[2] - first.place[2]
             self.key_turn[name] = float(wrap_angle(np.array([turn]))[0])
             ph = float(wrap_angle(np.array([ph + turn]))[0])
             self.keyed[name] = float(ph)
-            joints.append(KeyedShaft(f"{name}.key", main_cam, name, (0.0, 0.0), (0.0, 0.0), float(ph), size))
-        self.main_cam = main_cam
-        d = toy.driver
-        driver = Driver(main_cam, "rotation", origin=(0.0, 0.0), rate=d.rate, phase=d.phase)
-        named = set(rename.values()) & set(piece_of.values())  # effector pieces carry the name themselves
-        points = {k: (piece_of[v[0]], _xf_point(xf[v[0]], v[1])) for k, v in toy.points.items() if k not in named}
-        super().__init__(f"{toy.name} (assembled)", parts, joints, driver, points)
-        self.spatial = False
+            out.append(KeyedShaft(f"{name}.key", main_cam, name, (0.0, 0.0), (0.0, 0.0), float(ph), size))
+        return out
 
     def _stage_part(self, full: str) -> Part:
         label, name = full.split(".", 1)

@@ -119,7 +119,7 @@ class SkewContact:
 
 
 class ElementalMechanism(Mechanism):
-    """Elemental mechanism ``number`` (1-11) with parameters ``params``."""
+    """Elemental mechanism ``number`` (a key of :data:`ELEMENTAL`, 1-11) with parameters ``params``."""
 
     def __init__(
         self,
