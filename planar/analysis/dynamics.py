@@ -30,7 +30,7 @@ from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from planar.core.geometry import poses_apply
 from planar.core.model import Mechanism, Motion
@@ -39,6 +39,7 @@ from planar.core.rates import PartRates, point_rates
 __all__ = [
     "gravity_and_damping",
     "inverse_dynamics_torque",
+    "load_torque",
     "mass_properties",
     "motor_torque_from_rates",
     "part_mass_table",
@@ -190,7 +191,6 @@ def motor_torque_from_rates(
     no sample is solved for).  Force x model unit, counter-clockwise positive, the torque the motor
     applies to the driven part (a force along the axis for a translating input).
     """
-    assert motion.t is not None
     g3, lam = gravity_and_damping(effects)
     tau = np.zeros(len(motion))
     for name, (mass, cog, inertia) in part_mass_table(mech, effects, densities).items():
@@ -204,9 +204,7 @@ def motor_torque_from_rates(
         tau += mass * _dot(aG - g + lam * vG, cG) + inertia * (r.alpha + lam * r.omega) * c.omega
     if effects is not None:
         for load in effects.loads:
-            part, _ = mech.points[load.point]
-            cX, _ = point_rates(motion.poses[part], coef[part], motion.points[load.point])
-            tau += cX @ np.asarray(load.force, float)
+            tau += load_torque(mech, motion, coef, load.point, load.force)
         rest_poses = _rest_poses(mech, motion, t_rest)
         for s in effects.springs:
             pa = poses_apply(motion.poses[s.a], np.asarray(s.anchor_a, float))
@@ -222,6 +220,16 @@ def motor_torque_from_rates(
             f = s.stiffness * (L - rest) + s.damping * _dot(d, vb - va) / Ls
             tau += f * _dot(d, cb - ca) / Ls
     return tau
+
+
+def load_torque(mech: Mechanism, motion: Motion, coef: Mapping[str, PartRates], point: str, force: ArrayLike) -> Array:
+    """One load's share of the motor torque, ``F . dX/dq`` per sample: ``force`` ``(2,)`` or ``(N, 2)`` (the
+    force the mechanism exerts at the named ``point``, world frame), ``coef`` the parts' velocity
+    coefficients.  Ideal (no losses); force x model unit."""
+    part, _ = mech.points[point]
+    cX, _ = point_rates(motion.poses[part], coef[part], motion.points[point])
+    f = np.asarray(force, float)
+    return cX @ f if f.ndim == 1 else _dot(cX, f)
 
 
 def _rest_poses(mech: Mechanism, motion: Motion, t_rest: float | None) -> dict[str, Array]:

@@ -21,9 +21,9 @@ rad/s^2, counter-clockwise positive).  A point fixed to the part at world
 position ``P`` moves with ``v = v_O + omega perp(P - O)`` and
 ``a = a_O + alpha perp(P - O) - omega^2 (P - O)`` (:mod:`planar.core.rates`).
 
-The motor torque (:func:`motor_torque`) is the inverse dynamics of
-:mod:`planar.analysis.dynamics` (inertia, gravity, loads, springs, space damping) with
-these exact rates in place of its differences: by virtual work,
+The motor torque (:func:`motor_torque`) is the one virtual-work sum of
+:func:`planar.analysis.dynamics.motor_torque_from_rates` (inertia, gravity, loads,
+springs, space damping) fed these exact rates in place of differences:
 ``tau = sum_parts [m (a_G - g + lam v_G) . dX_G/dq + I (alpha + lam omega) dphi/dq]
 + sum_loads F . dX/dq + sum_springs f dL/dq`` with ``d/dq`` the velocity
 coefficients (the rates at unit driver speed), so it holds for a rocking

@@ -74,3 +74,36 @@ def test_record_rates_are_the_time_derivatives_of_its_forward_kinematics(number:
     scale2 = 1.0 + np.abs(d2[good]).max()
     assert np.abs(out1[good] - d1[good]).max() < 1e-7 * scale1
     assert np.abs(out2[good] - d2[good]).max() < 1e-5 * scale2
+
+
+def test_one_motor_torque_three_doors() -> None:
+    """The linkage loads torque (statics), the exact-rates torque and the differenced one are one sum: on a
+    four-bar of random dimensions with a load, a spring to the ground and gravity they agree with each other
+    (exactly for the first two, to the differences' truncation for the third)."""
+    from planar.analysis import statics
+    from planar.analysis.dynamics import inverse_dynamics_torque
+    from planar.analysis.rates import motor_torque
+    from planar.core.effects import Effects, Load, Spring
+
+    rng = np.random.default_rng(20)
+    crank = rng.uniform(0.5, 1.0)
+    fb = FourBar(rng.uniform(3.0, 4.0), crank, rng.uniform(3.0, 4.0), rng.uniform(2.5, 3.5), coupler_point=(0.4, 0.7))
+    motion = fb.run(samples_per_cycle=90)
+    assert motion.t is not None and motion.valid.all()
+    F = (float(rng.normal()), float(rng.normal()))
+    loads_only = Effects(loads=(Load("coupler_point", F),))
+    ideal, ok = statics.motor_torque(fb, motion.driver, {"coupler_point": F})
+    exact, ok2 = motor_torque(fb, motion, loads_only, densities={p.name: 0.0 for p in fb.parts})
+    assert ok.all() and ok2.all()
+    np.testing.assert_allclose(ideal, exact, rtol=1e-10, atol=1e-10 * np.abs(exact).max())
+    lossy, _ = statics.motor_torque(fb, motion.driver, {"coupler_point": F}, eta_trans=0.8)
+    np.testing.assert_allclose(lossy, np.where(exact >= 0, exact / 0.8, exact * 0.8), rtol=1e-10, atol=1e-12)
+    full = Effects(
+        gravity=(0.0, -9.81),
+        loads=(Load("coupler_point", F),),
+        springs=(Spring(fb.parts[-1].name, next(p.name for p in fb.parts if p.ground), 5.0),),
+    )
+    tau, ok3 = motor_torque(fb, motion, full)
+    ref = inverse_dynamics_torque(fb, motion.t, full)
+    assert ok3.all()
+    np.testing.assert_allclose(tau, ref, rtol=1e-5, atol=1e-6 * np.abs(ref).max())
