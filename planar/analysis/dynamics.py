@@ -14,22 +14,37 @@ the spring's tension ``k (L - rest) + c dL/dt`` and ``L`` its length.
 Torque in model force units x model units, counter-clockwise positive, the
 torque the motor applies to the driven part.
 
-Derivatives are central differences in time of the closed-form solve
-(step ``1e-4`` of the period), so any sample times work, not only a whole
-cycle.  Nothing here imports pymunk.
+The sum is written once, :func:`motor_torque_from_rates`; it takes the rates
+and velocity coefficients from its caller: exact ones from the kinds' closed
+forms (:func:`planar.analysis.rates.motor_torque`, the motion tables'
+``torque`` column) or central differences in time of the closed-form solve
+(:func:`inverse_dynamics_torque`, step ``1e-4`` of the period, for any
+mechanism and any sample times; the physics comparison uses it).  Nothing
+here imports pymunk.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from planar.core.geometry import poses_apply
+from planar.core.model import Mechanism, Motion
+from planar.core.rates import PartRates, point_rates
 
-__all__ = ["gravity_and_damping", "inverse_dynamics_torque", "mass_properties", "part_mass_table", "plane_gravity"]
+__all__ = [
+    "gravity_and_damping",
+    "inverse_dynamics_torque",
+    "load_torque",
+    "mass_properties",
+    "motor_torque_from_rates",
+    "part_mass_table",
+    "plane_gravity",
+]
 
 Array = NDArray[np.float64]
 
@@ -102,7 +117,7 @@ def mass_properties(part: Any, density: float) -> tuple[float, tuple[float, floa
 
 
 def part_mass_table(
-    mech: Any, effects: Any, densities: dict[str, float] | None = None
+    mech: Mechanism, effects: Any, densities: dict[str, float] | None = None
 ) -> dict[str, tuple[float, tuple[float, float], float]]:
     """``mass_properties`` of every moving part at the scene's (or the per-part) density."""
     density = effects.density if effects is not None else 1.0
@@ -113,16 +128,21 @@ def _wrapped(d: Array) -> Array:
     return np.remainder(d + np.pi, 2 * np.pi) - np.pi
 
 
-def _spring_length(s: Any, m: Any) -> Array:
-    pa = poses_apply(m.poses[s.a], np.asarray(s.anchor_a, float))
-    pb = poses_apply(m.poses[s.b], np.asarray(s.anchor_b, float))
+def _spring_length(s: Any, poses: Mapping[str, Array]) -> Array:
+    pa = poses_apply(poses[s.a], np.asarray(s.anchor_a, float))
+    pb = poses_apply(poses[s.b], np.asarray(s.anchor_b, float))
     return np.hypot(*(pb - pa).T)
 
 
 def inverse_dynamics_torque(
-    mech: Any, t: Array, effects: Any = None, densities: dict[str, float] | None = None, t_rest: float | None = None
+    mech: Mechanism, t: Array, effects: Any = None, densities: dict[str, float] | None = None, t_rest: float | None = None
 ) -> Array:
-    """Motor torque needed at times ``t`` (s) for a driver turning at its constant rate.
+    """Motor torque needed at times ``t`` (s) for a driver turning at its constant rate, for any mechanism.
+
+    The one virtual-work sum (:func:`motor_torque_from_rates`) with every part's rates taken by central
+    differences in time of the closed-form solve (step ``1e-4`` of the period), and the velocity
+    coefficients as those rates over the driver's rate: this works for a mechanism kind without
+    closed-form rates too.  :func:`planar.analysis.rates.motor_torque` feeds the same sum exact rates.
 
     ``effects``: an :class:`~planar.core.effects.Effects`-like record (gravity,
     loads, springs, damping, density) or ``None``; ``densities`` overrides
@@ -133,34 +153,93 @@ def inverse_dynamics_torque(
     drv = mech.driver
     w = float(drv.rate)
     h = 1e-4 * drv.period
-    m0 = mech.solve(drv.value(t))
+    m0 = mech.solve(drv.value(t), t=t)
     mp = mech.solve(drv.value(t + h))
     mm = mech.solve(drv.value(t - h))
-    g, lam = gravity_and_damping(effects)
-    tau = np.zeros(t.size)
+    rates: dict[str, PartRates] = {}
+    coef: dict[str, PartRates] = {}
+    for name in m0.poses:
+        P0, Pp, Pm = m0.poses[name], mp.poses[name], mm.poses[name]
+        fwd = _wrapped(Pp[:, 2] - P0[:, 2])
+        back = _wrapped(P0[:, 2] - Pm[:, 2])
+        r = PartRates(
+            (Pp[:, :2] - Pm[:, :2]) / (2 * h),
+            (Pp[:, :2] - 2 * P0[:, :2] + Pm[:, :2]) / (h * h),
+            (fwd + back) / (2 * h),
+            (fwd - back) / (h * h),
+        )
+        rates[name] = r
+        coef[name] = PartRates(r.v / w, r.a / w, r.omega / w, r.alpha / w)
+    return motor_torque_from_rates(mech, m0, rates, coef, effects, t_rest, densities)
+
+
+def motor_torque_from_rates(
+    mech: Mechanism,
+    motion: Motion,
+    rates: Mapping[str, PartRates],
+    coef: Mapping[str, PartRates],
+    effects: Any = None,
+    t_rest: float | None = None,
+    densities: dict[str, float] | None = None,
+) -> Array:
+    """The motor torque per sample by virtual work (see the module's note): the one definition.
+
+    ``rates``: every part's rates at the motion's samples; ``coef``: its velocity coefficients
+    ``d/dq`` (the rates at unit driver speed; only ``v`` and ``omega`` are read); ``motion``: the
+    solved motion with its sample times.  ``effects``, ``densities`` as :func:`part_mass_table`;
+    ``t_rest``: when a spring without a rest length has it (default the first sample; a time that is
+    no sample is solved for).  Force x model unit, counter-clockwise positive, the torque the motor
+    applies to the driven part (a force along the axis for a translating input).
+    """
+    g3, lam = gravity_and_damping(effects)
+    tau = np.zeros(len(motion))
     for name, (mass, cog, inertia) in part_mass_table(mech, effects, densities).items():
-        gp = plane_gravity(getattr(mech.part(name), "plane", "xy"), g)
-        c = np.asarray(cog, float)
-        X0, Xp, Xm = (poses_apply(m.poses[name], c) for m in (m0, mp, mm))
-        v = (Xp - Xm) / (2 * h)  # d X_G / dt
-        a = (Xp - 2 * X0 + Xm) / (h * h)
-        fwd = _wrapped(mp.poses[name][:, 2] - m0.poses[name][:, 2])
-        back = _wrapped(m0.poses[name][:, 2] - mm.poses[name][:, 2])
-        om = (fwd + back) / (2 * h)
-        al = (fwd - back) / (h * h)
-        # power balance divided by the driver rate: tau w = sum (m a - m g + lam m v) . v + I (alpha + lam om) om
-        tau += (mass * ((a - gp + lam * v) * v).sum(-1) + inertia * (al + lam * om) * om) / w
+        if mass == 0.0 and inertia == 0.0:
+            continue
+        g = plane_gravity(mech.part(name).plane, g3)  # a toy's piece: gravity in its plane
+        G = poses_apply(motion.poses[name], np.asarray(cog, float))
+        vG, aG = point_rates(motion.poses[name], rates[name], G)
+        cG, _ = point_rates(motion.poses[name], coef[name], G)
+        r, c = rates[name], coef[name]
+        tau += mass * _dot(aG - g + lam * vG, cG) + inertia * (r.alpha + lam * r.omega) * c.omega
     if effects is not None:
         for load in effects.loads:
-            vp = (mp.points[load.point] - mm.points[load.point]) / (2 * h)
-            tau += (np.asarray(load.force, float) * vp).sum(-1) / w
-        t_r = float(t[0]) if t_rest is None else float(t_rest)
+            tau += load_torque(mech, motion, coef, load.point, load.force)
+        rest_poses = _rest_poses(mech, motion, t_rest)
         for s in effects.springs:
-            L0, Lp, Lm = (_spring_length(s, m) for m in (m0, mp, mm))
-            rest = s.rest_length
-            if rest is None:
-                rest = float(_spring_length(s, mech.solve(drv.value(np.array([t_r]))))[0])
-            dL = (Lp - Lm) / (2 * h)
-            f = s.stiffness * (L0 - rest) + s.damping * dL
-            tau += f * dL / w
+            pa = poses_apply(motion.poses[s.a], np.asarray(s.anchor_a, float))
+            pb = poses_apply(motion.poses[s.b], np.asarray(s.anchor_b, float))
+            va, _ = point_rates(motion.poses[s.a], rates[s.a], pa)
+            vb, _ = point_rates(motion.poses[s.b], rates[s.b], pb)
+            ca, _ = point_rates(motion.poses[s.a], coef[s.a], pa)
+            cb, _ = point_rates(motion.poses[s.b], coef[s.b], pb)
+            d = pb - pa
+            L = np.hypot(d[:, 0], d[:, 1])
+            Ls = np.where(L > 0, L, 1.0)
+            rest = float(_spring_length(s, rest_poses)[0]) if s.rest_length is None else s.rest_length
+            f = s.stiffness * (L - rest) + s.damping * _dot(d, vb - va) / Ls
+            tau += f * _dot(d, cb - ca) / Ls
     return tau
+
+
+def load_torque(mech: Mechanism, motion: Motion, coef: Mapping[str, PartRates], point: str, force: ArrayLike) -> Array:
+    """One load's share of the motor torque, ``F . dX/dq`` per sample: ``force`` ``(2,)`` or ``(N, 2)`` (the
+    force the mechanism exerts at the named ``point``, world frame), ``coef`` the parts' velocity
+    coefficients.  Ideal (no losses); force x model unit."""
+    part, _ = mech.points[point]
+    cX, _ = point_rates(motion.poses[part], coef[part], motion.points[point])
+    f = np.asarray(force, float)
+    return cX @ f if f.ndim == 1 else _dot(cX, f)
+
+
+def _rest_poses(mech: Mechanism, motion: Motion, t_rest: float | None) -> dict[str, Array]:
+    """The poses (one row each) at ``t_rest``: the first sample by default or when it is a sample time, else solved."""
+    assert motion.t is not None
+    if t_rest is None or np.any(motion.t == t_rest):
+        i0 = 0 if t_rest is None else int(np.argmax(motion.t == t_rest))
+        return {k: v[i0 : i0 + 1] for k, v in motion.poses.items()}
+    return mech.solve(mech.driver.value(np.array([float(t_rest)]))).poses
+
+
+def _dot(a: Array, b: Array) -> Array:
+    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]

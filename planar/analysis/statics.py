@@ -325,7 +325,7 @@ def input_torque(coefficients: ArrayLike, forces: ArrayLike, eta_trans: float = 
     except ValueError:
         raise InputError("forces", f"an array of shape {f.shape}", f"shape (k, 2) or (N, k, 2) with {c.shape}") from None
     p = (c * f).sum(axis=(-1, -2))
-    return np.where(p >= 0, p / eta, p * eta)
+    return _with_losses(p, eta)
 
 
 def virtual_work_torque(
@@ -379,34 +379,51 @@ def motor_torque(
     """Input torque a linkage needs for forces at its named points (several feet, one motor).
 
     ``loads`` maps a named point to the force ``(2,)`` or ``(N, 2)`` the
-    mechanism exerts there (world frame).  Returns ``(tau, valid)``; losses
-    as :func:`input_torque` (divided by the efficiency where the motor
-    drives, multiplied where the load drives the motor).  ``valid`` is the
-    velocity analysis' mask and false where the torque is not finite.
+    mechanism exerts there (world frame).  Returns ``(tau, valid)``; each
+    load's ideal share is the one load term of the motor torque
+    (:func:`planar.analysis.dynamics.load_torque`, with the linkage's exact
+    velocity coefficients), losses as :func:`input_torque` (divided by the
+    efficiency where the motor drives, multiplied where the load drives the
+    motor).  ``valid`` is the velocity analysis' mask (:func:`point_velocities`) and false where
+    the torque is not finite.
     """
-    vel, valid = point_velocities(link, q, 1.0)
-    for name in loads:
-        if name not in vel:
-            raise InputError(f"{link.name}.loads", name, f"a named point, one of {sorted(vel)}")
-    names = list(loads)
+    from planar.analysis.dynamics import load_torque
+    from planar.analysis.rates import mechanism_rates
+
+    eta = _check_eff("eta_trans", eta_trans) * _check_eff("eta_link", eta_link)
     qa = np.atleast_1d(np.asarray(q, float))
-    forces = []
-    for n in names:
-        f = np.asarray(loads[n], float)
+    for name in loads:
+        if name not in link.points:
+            raise InputError(f"{link.name}.loads", name, f"a named point, one of {sorted(link.points)}")
+    forces = {}
+    for n, f0 in loads.items():
+        f = np.asarray(f0, float)
         if not np.isfinite(f).all():
-            raise InputError(f"{link.name}.loads[{n!r}]", loads[n], "a finite force (x, y)")
+            raise InputError(f"{link.name}.loads[{n!r}]", f0, "a finite force (x, y)")
         try:
-            forces.append(np.broadcast_to(f, qa.shape + (2,)))
+            forces[n] = np.broadcast_to(f, qa.shape + (2,))
         except ValueError:
             raise InputError(
                 f"{link.name}.loads[{n!r}]", f"an array of shape {f.shape}", f"a force of shape (2,) or ({len(qa)}, 2)"
             ) from None
-    if not names:
+    coef, ok_rates, _ = mechanism_rates(link, qa, 1.0, 0.0)
+    _, valid = point_velocities(link, qa, 1.0)  # the velocity analysis' rule near toggles (as fourbar_velocities)
+    valid = np.asarray(valid, bool) & ok_rates
+    if not forces:
         return np.zeros(qa.shape), np.asarray(valid, bool)
-    coeff = np.stack([vel[n] for n in names], axis=1)
-    tau = input_torque(coeff, np.stack(forces, axis=1), eta_trans, eta_link)
-    ok = np.asarray(valid, bool) & np.isfinite(tau)
+    motion = link.solve(qa)
+    p = np.zeros(qa.shape)
+    for n, f in forces.items():
+        p += load_torque(link, motion, coef, n, f)
+    tau = _with_losses(p, eta)
+    ok = np.asarray(valid, bool) & motion.valid & np.isfinite(tau)
     return np.where(ok, tau, 0.0), ok
+
+
+def _with_losses(p: Array, eta: float) -> Array:
+    """The motor's torque for an ideal ``p`` with efficiency ``eta``: ``p / eta`` where the motor drives
+    (``p >= 0``), ``p eta`` where the load drives the motor."""
+    return np.where(p >= 0, p / eta, p * eta)
 
 
 # --------------------------------------------------------------------------

@@ -33,6 +33,7 @@ from planar.cams.joint import CamContact
 from planar.cams.profile import CamError, CamProfile, CamReport
 from planar.core.geometry import poses_apply
 from planar.core.model import Driver, Mechanism, Part, Pivot
+from planar.core.rates import PartRates, RatesResult, point_rates
 from planar.errors import InputError
 from planar.linkages import Link, Linkage
 from planar.linkages.nodes import Actuator, Crank, Fixed, NodeKind
@@ -281,6 +282,33 @@ class CamMechanism(Mechanism):
         s, v, a = self.profile.follower_output(qa)
         w = self.driver.rate
         return {"q": s, "dq_dt": v * w, "d2q_dt2": a * w * w}
+
+    def part_rates(self, q: Array, qd: Array, qdd: Array) -> RatesResult:
+        """Rates of every part (see :meth:`Mechanism.part_rates`).
+
+        The follower's coordinate ``s(theta)`` from the motion law (closed form,
+        with ``s'``, ``s''``) is the input of its linkage, by the chain rule
+        ``ds/dt = s' qd``, ``d2s/dt2 = s'' qd^2 + s' qdd``; the cam turns with
+        the driver; a roller rolls without slip, its angle
+        ``theta - L(theta) / r_roller`` (``L`` the pitch curve's arc length), so
+        ``omega = qd (1 - |P'| / r)`` and
+        ``alpha = qdd (1 - |P'| / r) - qd^2 (P' . P'') / (|P'| r)``.
+        """
+        prof = self.profile
+        s, s1, s2 = prof.follower_output(q)
+        parts, valid, _ = self.linkage.part_rates(s, s1 * qd, s2 * qd * qd + s1 * qdd)
+        zero = np.zeros((q.shape[0], 2))
+        parts["cam"] = PartRates(zero, zero.copy(), np.array(qd, float), np.array(qdd, float))
+        if prof.follower.kind == "roller":
+            fol = self.linkage.solve(s).poses["follower"]
+            c = poses_apply(fol, self.tip_local)
+            vc, ac = point_rates(fol, parts["follower"], c)
+            _, P1, P2 = prof.pitch(q)
+            speed = np.hypot(P1[:, 0], P1[:, 1])
+            dspeed = np.einsum("ij,ij->i", P1, P2) / np.maximum(speed, 1e-300)
+            r = prof.rr
+            parts["roller"] = PartRates(vc, ac, qd * (1.0 - speed / r), qdd * (1.0 - speed / r) - qd * qd * dspeed / r)
+        return parts, valid, "cam motion law (closed form) through the linkage's closure equations, differentiated twice"
 
 
 def _hull_polygon(hull: Sequence[tuple[float, float, float]]) -> tuple[tuple[float, float], ...]:

@@ -16,6 +16,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
+from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, ClassVar, Literal, Protocol, TypeVar
 
 import numpy as np
@@ -27,6 +28,8 @@ from planar.errors import InputError
 
 if TYPE_CHECKING:  # shapely is imported only when an outline is asked for
     import shapely
+
+    from planar.core.rates import RatesResult
 
 __all__ = [
     "JOINT_KINDS",
@@ -547,6 +550,16 @@ class Mechanism:
     joints: tuple[JointProtocol, ...]
     driver: Driver
     points: dict[str, tuple[str, Vec]]
+    #: the elemental stages a composed toy is made of, in order (empty for every other mechanism)
+    stages: Sequence[Any] = ()
+    #: true when a part turns out of the driver's plane (elemental #6, #9): no 2D physics rebuild
+    spatial: bool = False
+    #: the plane the poses are given in: ``"xy"``, or ``"xz"`` (elemental #8: ``(x, z)`` coordinates)
+    view: str = "xy"
+    #: rigid bodies -> the parts they are made of (a toy's pieces); empty: every part is a body of its own
+    bodies: Mapping[str, Sequence[str]] = MappingProxyType({})
+    #: what building the mechanism noticed and a maker should read (a toy's merged outlines)
+    notes: Sequence[str] = ()
 
     def __init__(
         self,
@@ -595,6 +608,23 @@ class Mechanism:
     def _solve_poses(self, q: Array) -> tuple[dict[str, Array], list[tuple[NDArray[np.bool_], str, str]]]:
         """Poses for driver values ``q`` and the per-joint validity checks."""
         raise NotImplementedError
+
+    def part_rates(self, q: Array, qd: Array, qdd: Array) -> RatesResult:
+        """Velocity, acceleration, angular velocity and acceleration of every part, in closed form.
+
+        ``q``, ``qd``, ``qdd``: the driver's values, rates and rates of change,
+        one each per sample (1-D arrays of one shape; rad or model units, per s,
+        per s^2).  Returns ``(parts, valid, method)``: a
+        :class:`~planar.core.rates.PartRates` per part (world frame, see
+        :mod:`planar.core.rates`), where they are defined, and how they were
+        found.  A kind with closed-form rates overrides this; the base raises
+        :class:`~planar.core.registry.UnsupportedError` naming the kind (never a difference).
+        """
+        from planar.core.registry import UnsupportedError
+
+        raise UnsupportedError(
+            f"rates (velocities, accelerations, torque): no closed-form derivatives for {type(self).__name__} {self.name!r}"
+        )
 
     # -- shared ------------------------------------------------------------
     def part(self, name: str) -> Part:

@@ -42,7 +42,7 @@ from planar.errors import InputError
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from planar.core.model import Motion
+    from planar.core.model import Mechanism, Motion
     from planar.scene.load import Scene
 
 __all__ = ["CHARTS", "available_charts", "scene_figure", "write_plot"]
@@ -68,7 +68,7 @@ def available_charts(scene: Scene) -> list[str]:
     return out + ["acceleration", "torque"]
 
 
-def _is_cam(mech: Any) -> bool:
+def _is_cam(mech: Mechanism) -> bool:
     from planar.cams.mechanism import CamMechanism
 
     return isinstance(mech, CamMechanism)

@@ -165,7 +165,7 @@ class Renderer:
             self.mech, self.motion, self.marks = assembled(orig, self.motion)
             if self.mech is not orig and self.trail_motion is not None:
                 self.trail_motion = assembled(orig, self.trail_motion)[1]
-        self.view = self.view or getattr(self.mech, "view", "xy")
+        self.view = self.view or self.mech.view
         s = self.style
         self.S = max(1, int(s.supersample))
         self.W, self.H = s.width, s.height

@@ -133,7 +133,7 @@ def assembled(mech: Mechanism, motion: Motion) -> tuple[Mechanism, Motion, Marks
         m = asm.solve(motion.driver, t=motion.t)
         m.valid, m.fail_code, m.fail_table = motion.valid, motion.fail_code, motion.fail_table
         front_plane = "xy"
-    elif isinstance(mech, ElementalMechanism) and mech.number in (6, 8, 9):
+    elif isinstance(mech, ElementalMechanism) and (mech.spatial or mech.view != "xy"):  # #6, #9; #8
         asm, m, front_plane = mech, motion, mech.view
     else:
         return mech, motion, Marks()
@@ -174,7 +174,7 @@ def assembled(mech: Mechanism, motion: Motion) -> tuple[Mechanism, Motion, Marks
     joints = [j for j in asm.joints if j.a in poses and j.b in poses]
     points = {k: v for k, v in asm.points.items() if v[0] in poses}
     view = _ViewMechanism(f"{asm.name}", parts, joints, asm.driver, points)
-    view.view = "xy"  # type: ignore[attr-defined]
+    view.view = "xy"
     pts = {k: poses_apply(poses[part], xy) for k, (part, xy) in points.items()}
     vm = Motion(driver=m.driver, poses=poses, valid=m.valid, fail_code=m.fail_code, fail_table=m.fail_table, points=pts, t=m.t)
     return view, vm, marks
@@ -195,7 +195,7 @@ class _FrontOnly(Mechanism):
         return {p.name: poses[p.name] for p in self.parts}, checks
 
 
-def _stage_params(mech: Any, joint: str) -> Any:
+def _stage_params(mech: Mechanism, joint: str) -> Any:
     """The parameters (world frame) of the elemental mechanism a joint belongs to."""
     from planar.windup.chain import ToyMechanism
 

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from planar.core.model import Mechanism
 from planar.errors import InputError
 from planar.fabrication.joints import joint_pins, pin_features
 from planar.fabrication.layers import Assembly, letter, pin_stacks, plan_assembly
@@ -48,7 +49,7 @@ class Fabrication:
     warnings: list[str] = field(default_factory=list)
 
 
-def _shaft_pin(mech: Any, pins) -> Any:
+def _shaft_pin(mech: Mechanism, pins) -> Any:
     drv = mech.driver
     if drv.kind != "rotation":
         return None
@@ -59,7 +60,7 @@ def _shaft_pin(mech: Any, pins) -> Any:
     return None
 
 
-def _fab_mechanism(mech: Any) -> Any:
+def _fab_mechanism(mech: Mechanism) -> Any:
     """The mechanism whose parts are cut: a wind-up toy is cut as its assembly (merged parts, one frame,
     cams keyed to the shaft; :mod:`planar.toys.assembly`), anything else as it is; pieces standing
     perpendicular to the xy stack get brackets and lose repeated guides (:func:`planar.fabrication.tabs.fab_view`)."""
@@ -103,7 +104,7 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
     pinned = pin_features(mech)
     shaft = _shaft_pin(mech, pins)
     notes: list[str] = list(getattr(mech, "design_notes", ()))  # what a mechanism reports of its own design
-    notes += list(getattr(mech, "notes", []))
+    notes += list(mech.notes)
     if mech.driver.kind != "rotation":
         notes.append(f"driver {mech.driver.part!r} is a {mech.driver.kind} drive: no motor shaft hole")
     elif shaft is None:

@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from planar.core.model import Mechanism
 from planar.fabrication.joints import Contact, PinSpec
 
 __all__ = ["Assembly", "PinPlan", "letter", "plan_assembly"]
@@ -120,7 +121,7 @@ def _swept(poly, poses: np.ndarray, u: float):
 
 
 def plan_assembly(
-    mech: Any,
+    mech: Mechanism,
     material: dict[str, Any],
     pins: list[PinSpec],
     contacts: list[Contact],

@@ -64,7 +64,7 @@ from typing import Any
 
 import numpy as np
 
-from planar.core.model import Hole, Part, Pivot, Slide
+from planar.core.model import Hole, Mechanism, Part, Pivot, Slide
 from planar.fabrication.joints import FabricationError
 from planar.fabrication.parts import Feature
 
@@ -107,13 +107,13 @@ class FabView:
     Everything else (driver, notes, keyed cams, poses) is the wrapped mechanism's; a bracket stands still.
     """
 
-    def __init__(self, mech: Any, parts: list[Part], joints: list[Any], extra: list[str], notes: list[str]) -> None:
+    def __init__(self, mech: Mechanism, parts: list[Part], joints: list[Any], extra: list[str], notes: list[str]) -> None:
         self._mech = mech
         self.parts = tuple(parts)
         self.joints = tuple(joints)
         self.extra = extra
-        self.notes = list(getattr(mech, "notes", [])) + notes
-        self.bodies: dict[str, list[str]] = {k: list(v) for k, v in getattr(mech, "bodies", {}).items()}
+        self.notes = list(mech.notes) + notes
+        self.bodies: dict[str, list[str]] = {k: list(v) for k, v in mech.bodies.items()}
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._mech, name)
@@ -131,9 +131,9 @@ class FabView:
         return m
 
 
-def _bodies(mech: Any) -> dict[str, list[str]]:
+def _bodies(mech: Mechanism) -> dict[str, list[str]]:
     """Rigid bodies -> pieces (a toy assembly's own; else each part alone, every ground one body)."""
-    got = getattr(mech, "bodies", None)
+    got = mech.bodies
     if got:
         return {k: list(v) for k, v in got.items()}
     out: dict[str, list[str]] = {}
@@ -142,7 +142,7 @@ def _bodies(mech: Any) -> dict[str, list[str]]:
     return out
 
 
-def _joined(mech: Any, bodies: dict[str, list[str]]) -> dict[str, str]:
+def _joined(mech: Mechanism, bodies: dict[str, list[str]]) -> dict[str, str]:
     """Perpendicular piece -> the xy piece of its body it is tab-joined to."""
     plane = {p.name: p.plane for p in mech.parts}
     out: dict[str, str] = {}
@@ -362,7 +362,7 @@ class TabPlan:
     shape: dict[str, Any] = field(default_factory=dict)
 
 
-def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any], s: Any, samples: int = 48) -> TabPlan:
+def plan_tabs(mech: Mechanism, layers: dict[str, int | None], material: dict[str, Any], s: Any, samples: int = 48) -> TabPlan:
     """Tab joints of every perpendicular piece that is rigid with an xy piece, and travel slots for every
     perpendicular piece passing through another xy layer (see the module docstring).
 
@@ -659,7 +659,7 @@ def plan_tabs(mech: Any, layers: dict[str, int | None], material: dict[str, Any]
 
 
 def travel_slots(
-    mech: Any, layers: dict[str, int | None], material: dict[str, Any], s: Any, plan: TabPlan
+    mech: Mechanism, layers: dict[str, int | None], material: dict[str, Any], s: Any, plan: TabPlan
 ) -> tuple[dict[str, list[Feature]], list[str]]:
     """Travel slots (xy piece -> cuts, mm) for perpendicular pieces that pass through another xy piece's layer
     where it has material (``material``: as cut so far), and a note for each; pieces joined by a joint

@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -47,6 +48,7 @@ from planar.core.model import (
     check_positive,
     merge_failures,
 )
+from planar.core.rates import PartRates, RatesResult, rotate_vectors
 from planar.errors import AssemblyError, InputError
 from planar.linkages.chunked import Solved, _Plan, compiled_ready, fast_solve, plan_for, solve_compiled
 from planar.linkages.nodes import NODE_KINDS, RRP, Actuator, Crank, Fixed, Mask, NodeKind, Vec, _cross, frame_rates, path_mask
@@ -727,3 +729,31 @@ class Linkage(Mechanism):
             pl = np.asarray(self.placement)
             return {k: poses_apply(pl, v) for k, v in pos.items()}
         return pos
+
+    # -- rates: the kind's own answer to Mechanism.part_rates ---------------------------------------
+    #: the last node solve of any linkage, ``(linkage, digest of q, solve_nodes result)``: a motion table
+    #: asks for rates at two driver speeds and the transmission angles of the same samples
+    _last_node_solve: ClassVar[list[tuple[Linkage, bytes, Any]]] = []
+
+    def cached_solve_nodes(self, q: Array) -> tuple[dict[str, Array], list[tuple[Mask, str, str]]]:
+        """:meth:`solve_nodes` of ``q``, remembered for the last ``q`` asked (one entry for all linkages)."""
+        import hashlib
+
+        key = hashlib.blake2b(np.ascontiguousarray(q).tobytes(), digest_size=16).digest() + str(q.shape).encode()
+        last = Linkage._last_node_solve
+        if last and last[0][0] is self and last[0][1] == key:
+            return last[0][2]
+        solved = self.solve_nodes(q)
+        last[:] = [(self, key, solved)]
+        return solved
+
+    def part_rates(self, q: Array, qd: Array, qdd: Array) -> RatesResult:
+        """Rates of every link (see :meth:`Mechanism.part_rates`): every node kind's closure differentiated
+        twice (:meth:`node_accelerations`), the link frames' rates (:meth:`link_rates`) turned by the placement."""
+        pos, vel, acc, valid = self.node_accelerations(q, qd, qdd, solved=self.cached_solve_nodes(q))
+        ang = self.placement[2]
+        out = {
+            name: PartRates(rotate_vectors(v, ang), rotate_vectors(a, ang), om, al)
+            for name, (v, a, om, al) in self.link_rates(pos, vel, acc).items()
+        }
+        return out, valid, "linkage closure equations differentiated twice (node kinds)"

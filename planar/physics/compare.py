@@ -219,7 +219,7 @@ def compare_scene(
     result = compare(scene.mechanism, scene.motion(), sim.motion, threshold=threshold)
     result.torque_threshold = torque_threshold
     mech = scene.mechanism
-    if mech.driver.kind == "rotation" and mech.driver.amplitude is None and len(getattr(mech, "stages", [])) <= 1:
+    if mech.driver.kind == "rotation" and mech.driver.amplitude is None and len(mech.stages) <= 1:
         try:
             tc = torque_comparison(mech, scene.motion().t, scene.effects, settings)
             keep = (

@@ -203,12 +203,12 @@ class SimResult:
 
 
 def _check_mechanism(mech: Mechanism) -> None:
-    if getattr(mech, "spatial", False):
+    if mech.spatial:
         raise SimulationError(
             f"{mech.name}: a spatial mechanism (its follower turns about an axis in the driver's plane) "
             "cannot be rebuilt in a 2D physics engine"
         )
-    for st in getattr(mech, "stages", []):
+    for st in mech.stages:
         if st.mech.spatial:
             raise SimulationError(
                 f"{mech.name}: stage {st.label} ({st.realisation.pattern}, mechanism #{st.realisation.number}) "
@@ -220,7 +220,7 @@ def _driven_parts(mech: Mechanism) -> list[str]:
     """Parts whose motion is imposed: the driver, and in toys every stage's driver that has no parent."""
     out = [mech.driver.part]
     out += [p for p in getattr(mech, "extra_driven_parts", []) if p not in out]  # a two-input linkage
-    for st in getattr(mech, "stages", []):
+    for st in mech.stages:
         name = f"{st.label}.driver"
         if name not in out:
             out.append(name)

@@ -171,7 +171,7 @@ def _register() -> None:
 StageDrive = tuple[Driver, Callable[[Array], Array]]
 
 
-def _law(mech: Any, drive: StageDrive | None, speed: float) -> Driver:
+def _law(mech: Mechanism, drive: StageDrive | None, speed: float) -> Driver:
     """The driver law at ``speed`` cycles/s: the toy's (``drive``) or the stage's standalone one."""
     from dataclasses import replace
 
@@ -292,7 +292,7 @@ def contact_hold(
 
 
 def liftoff_speed(
-    mech: Any, gravity: tuple[float, float], speeds: Any, refine: int = 5, **kw: Any
+    mech: Mechanism, gravity: tuple[float, float], speeds: Any, refine: int = 5, **kw: Any
 ) -> tuple[float | None, list[ContactRun]]:
     """Run :func:`contact_hold` at each of ``speeds`` (cycles/s, rising) until one lets go, then bisect ``refine``
     times between the last that held and it; returns the lowest speed seen to let go (None: it always held)
@@ -364,7 +364,7 @@ def hold_margin(
 
 
 def skew_stage(
-    mech: Any,
+    mech: Mechanism,
     speed: float,
     cycles: float = 1.0,
     samples_per_cycle: int = 72,
@@ -508,7 +508,7 @@ def _skew_gap_a(j: SkewContact, fpose: Array, dpose: Array, da: float = 0.0) -> 
 
 
 def _skew_terms(
-    mech: Any, j: SkewContact, gravity: tuple[float, float], density: float, samples: int, drive: StageDrive | None
+    mech: Mechanism, j: SkewContact, gravity: tuple[float, float], density: float, samples: int, drive: StageDrive | None
 ) -> tuple[Array, Array, Array, Array]:
     """Over one cycle at 1 cycle/s (``samples`` per cycle): ``(t, I_p phi'', M_g, push)`` of :func:`skew_hold`."""
     from planar.analysis.dynamics import mass_properties
@@ -531,7 +531,7 @@ def _skew_terms(
 
 
 def skew_hold(
-    mech: Any,
+    mech: Mechanism,
     gravity: tuple[float, float],
     speed: float,
     density: float = 1.0,

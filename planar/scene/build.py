@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -11,8 +12,19 @@ import numpy as np
 
 from planar.core.effects import Effects, Load, Spring
 from planar.core.model import Mechanism, Motion
+from planar.core.registry import Registry
 from planar.errors import InputError, PlanarError, SceneError
-from planar.scene.schema import CamSpec, ChainSpec, ElementalSpec, FourBarSpec, LinkageSpec, SceneSpec, SliderCrankSpec, ToySpec
+from planar.scene.schema import (
+    CamSpec,
+    CatalogSpec,
+    ChainSpec,
+    ElementalSpec,
+    FourBarSpec,
+    LinkageSpec,
+    SceneSpec,
+    SliderCrankSpec,
+    ToySpec,
+)
 
 __all__ = ["Scene", "build_scene"]
 
@@ -192,121 +204,163 @@ def _rocking(spec: SceneSpec, m: Any) -> dict[str, Any]:
     return {"amplitude": _angle(spec, d.amplitude), "centre": _angle(spec, d.centre)}
 
 
-def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, Any]) -> Mechanism:
-    from planar.scene.catalog import get
+@dataclass(frozen=True)
+class _Build:
+    """What every mechanism table's builder reads besides its own table: the driver's rate (rad/s) and
+    phase (rad), the rocking driver's amplitude and centre (empty for a turning one), the placement."""
 
+    rate: float
+    phase: float
+    rock: dict[str, Any]
+    placement: tuple[float, float, float]
+
+
+#: the builder of each scene mechanism table, keyed by its spec class (``type = "..."`` in the file)
+BUILDERS: Registry[Callable[[SceneSpec, Any, _Build], Mechanism]] = Registry("scene build", "mechanism table")
+
+
+def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, Any]) -> Mechanism:
     placement: tuple[float, float, float] = (0.0, 0.0, 0.0)
     if hasattr(m, "placement"):
         placement = (m.placement[0], m.placement[1], _angle(spec, m.placement[2]))
-    if isinstance(m, FourBarSpec):
-        from planar.linkages import FourBar
+    return BUILDERS.get(m, f"mechanism type {getattr(m, 'type', '?')!r}")(spec, m, _Build(rate, phase, rock, placement))
 
-        return FourBar(
-            m.ground,
-            m.crank,
-            m.coupler,
-            m.rocker,
-            coupler_point=m.coupler_point,
-            circuit=m.circuit,
-            placement=placement,
-            rate=rate,
-            phase=phase,
-            name=spec.name or "fourbar",
-            **rock,
-        )
-    if isinstance(m, SliderCrankSpec):
-        from planar.linkages import SliderCrank
 
-        return SliderCrank(
-            m.crank,
-            m.rod,
-            offset=m.offset,
-            branch=m.branch,
-            placement=placement,
-            rate=rate,
-            phase=phase,
-            name=spec.name or "slidercrank",
-            **rock,
-        )
-    if isinstance(m, LinkageSpec):
-        from planar.linkages import NODE_KINDS, Link, Linkage
+@BUILDERS.register(FourBarSpec)
+def _build_fourbar(spec: SceneSpec, m: FourBarSpec, b: _Build) -> Mechanism:
+    from planar.linkages import FourBar
 
-        nodes = []
-        for n in m.nodes:
-            cls = NODE_KINDS[n.kind]  # each node kind declares the scene keys it is built from
-            args = [
-                _angle(spec, getattr(n, f)) if f in cls.angle_fields and getattr(n, f) is not None else getattr(n, f)
-                for f in cls.scene_fields
-            ]
-            nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
-        links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
-        return Linkage(spec.name or "linkage", nodes, links, points=m.points, placement=placement, rate=rate, phase=phase, **rock)
-    if isinstance(m, ElementalSpec):
-        from planar.windup import ELEMENTAL, ElementalMechanism, params_for
-        from planar.windup.params import coerce
+    return FourBar(
+        m.ground,
+        m.crank,
+        m.coupler,
+        m.rocker,
+        coupler_point=m.coupler_point,
+        circuit=m.circuit,
+        placement=b.placement,
+        rate=b.rate,
+        phase=b.phase,
+        name=spec.name or "fourbar",
+        **b.rock,
+    )
 
-        base = params_for(m.number)
-        angle_params = ELEMENTAL[m.number].angle_params
-        kw: dict[str, Any] = {}
-        known = sorted(f for f in vars(base))
-        for k, v in m.params.items():
-            if k not in known:
-                raise InputError(f"params.{k}", v, f"a parameter of mechanism #{m.number}, one of {known}")
-            val = coerce(f"params.{k}", getattr(base, k), v)  # a vector of the right length, or a number
-            if k in angle_params:
-                val = tuple(_angle(spec, x) for x in val) if isinstance(val, tuple) else _angle(spec, val)
-            kw[k] = val
-        try:
-            return ElementalMechanism(m.number, base.replace(**kw), rate=rate, phase=phase)
-        except InputError as e:  # check_params names "#5.F_o": the scene's key is params.F_o
-            if e.field.startswith(f"#{m.number}.") and e.field[len(f"#{m.number}.") :] != "params":
-                raise InputError("params." + e.field[len(f"#{m.number}.") :], e.value, e.expected) from None
-            raise
-    if isinstance(m, ChainSpec):
-        from planar.windup.chain import chain_mechanism
 
-        return chain_mechanism(m.chain, rate=rate, name=spec.name or " ".join(m.chain))
-    if isinstance(m, ToySpec):
-        from planar.windup.chain import ToyMechanism
+@BUILDERS.register(SliderCrankSpec)
+def _build_slidercrank(spec: SceneSpec, m: SliderCrankSpec, b: _Build) -> Mechanism:
+    from planar.linkages import SliderCrank
 
-        cams = {}
-        if m.left:
-            cams["left"] = [tuple(c) for c in m.left]
-        if m.right:
-            cams["right"] = [tuple(c) for c in m.right]
-        from planar.windup import ELEMENTAL
-        from planar.windup.table import realise
+    return SliderCrank(
+        m.crank,
+        m.rod,
+        offset=m.offset,
+        branch=m.branch,
+        placement=b.placement,
+        rate=b.rate,
+        phase=b.phase,
+        name=spec.name or "slidercrank",
+        **b.rock,
+    )
 
-        overrides: dict[Any, dict[str, Any]] = {}
-        names: dict[tuple[str, tuple[str, ...]], str] = {}
-        for i, sg in enumerate(m.stages):
-            key = (sg.cam, tuple(sg.chain))
-            if not any(tuple(c[: len(key[1])]) == key[1] for c in cams.get(sg.cam, [])):
-                raise InputError(f"mechanism.stages[{i}].chain", sg.chain, f"a prefix of a chain on the {sg.cam} cam")
-            angle_params = ELEMENTAL[realise(sg.chain[-1]).number].angle_params
-            kw = {}
-            for k, v in sg.params.items():
-                val = tuple(v) if isinstance(v, list) else v
-                if k in angle_params:
-                    val = tuple(_angle(spec, x) for x in val) if isinstance(val, tuple) else _angle(spec, val)
-                kw[k] = val
-            if kw:
-                overrides[key] = kw
-            if sg.name is not None:
-                names[key] = sg.name
-        return ToyMechanism(
-            cams, phase=_angle(spec, m.phase), rate=rate, name=spec.name or "toy", overrides=overrides, names=names
-        )
-    if isinstance(m, CamSpec):
-        return _build_cam(spec, m, rate, phase)
+
+@BUILDERS.register(LinkageSpec)
+def _build_linkage(spec: SceneSpec, m: LinkageSpec, b: _Build) -> Mechanism:
+    from planar.linkages import NODE_KINDS, Link, Linkage
+
+    nodes = []
+    for n in m.nodes:
+        cls = NODE_KINDS[n.kind]  # each node kind declares the scene keys it is built from
+        args = [
+            _angle(spec, getattr(n, f)) if f in cls.angle_fields and getattr(n, f) is not None else getattr(n, f)
+            for f in cls.scene_fields
+        ]
+        nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
+    links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
+    return Linkage(
+        spec.name or "linkage", nodes, links, points=m.points, placement=b.placement, rate=b.rate, phase=b.phase, **b.rock
+    )
+
+
+def _scene_angles(spec: SceneSpec, kw: dict[str, Any], angle_params: tuple[str, ...]) -> dict[str, Any]:
+    """``kw`` with the parameters a scene gives in its angle unit turned to radians (a number or a vector)."""
+    out = dict(kw)
+    for k in angle_params:
+        if k in out:
+            val = out[k]
+            out[k] = tuple(_angle(spec, x) for x in val) if isinstance(val, tuple) else _angle(spec, val)
+    return out
+
+
+@BUILDERS.register(ElementalSpec)
+def _build_elemental(spec: SceneSpec, m: ElementalSpec, b: _Build) -> Mechanism:
+    from planar.windup import ELEMENTAL, ElementalMechanism, params_for
+    from planar.windup.params import coerce
+
+    base = params_for(m.number)
+    kw: dict[str, Any] = {}
+    known = sorted(f for f in vars(base))
+    for k, v in m.params.items():
+        if k not in known:
+            raise InputError(f"params.{k}", v, f"a parameter of mechanism #{m.number}, one of {known}")
+        kw[k] = coerce(f"params.{k}", getattr(base, k), v)  # a vector of the right length, or a number
+    kw = _scene_angles(spec, kw, ELEMENTAL[m.number].angle_params)
+    try:
+        return ElementalMechanism(m.number, base.replace(**kw), rate=b.rate, phase=b.phase)
+    except InputError as e:  # check_params names "#5.F_o": the scene's key is params.F_o
+        if e.field.startswith(f"#{m.number}.") and e.field[len(f"#{m.number}.") :] != "params":
+            raise InputError("params." + e.field[len(f"#{m.number}.") :], e.value, e.expected) from None
+        raise
+
+
+@BUILDERS.register(ChainSpec)
+def _build_chain(spec: SceneSpec, m: ChainSpec, b: _Build) -> Mechanism:
+    from planar.windup.chain import chain_mechanism
+
+    return chain_mechanism(m.chain, rate=b.rate, name=spec.name or " ".join(m.chain))
+
+
+@BUILDERS.register(ToySpec)
+def _build_toy(spec: SceneSpec, m: ToySpec, b: _Build) -> Mechanism:
+    from planar.windup import ELEMENTAL
+    from planar.windup.chain import ToyMechanism
+    from planar.windup.table import realise
+
+    cams = {}
+    if m.left:
+        cams["left"] = [tuple(c) for c in m.left]
+    if m.right:
+        cams["right"] = [tuple(c) for c in m.right]
+    overrides: dict[Any, dict[str, Any]] = {}
+    names: dict[tuple[str, tuple[str, ...]], str] = {}
+    for i, sg in enumerate(m.stages):
+        key = (sg.cam, tuple(sg.chain))
+        if not any(tuple(c[: len(key[1])]) == key[1] for c in cams.get(sg.cam, [])):
+            raise InputError(f"mechanism.stages[{i}].chain", sg.chain, f"a prefix of a chain on the {sg.cam} cam")
+        kw = {k: tuple(v) if isinstance(v, list) else v for k, v in sg.params.items()}
+        kw = _scene_angles(spec, kw, ELEMENTAL[realise(sg.chain[-1]).number].angle_params)
+        if kw:
+            overrides[key] = kw
+        if sg.name is not None:
+            names[key] = sg.name
+    return ToyMechanism(cams, phase=_angle(spec, m.phase), rate=b.rate, name=spec.name or "toy", overrides=overrides, names=names)
+
+
+@BUILDERS.register(CamSpec)
+def _build_cam_table(spec: SceneSpec, m: CamSpec, b: _Build) -> Mechanism:
+    return _build_cam(spec, m, b.rate, b.phase)
+
+
+@BUILDERS.register(CatalogSpec)
+def _build_catalog(spec: SceneSpec, m: CatalogSpec, b: _Build) -> Mechanism:
+    from planar.scene.catalog import get
+
     try:
         mech = get(m.name)
     except InputError as e:
         raise InputError("name", m.name, e.expected) from None
-    if rate != 2 * math.pi or phase:
+    if b.rate != 2 * math.pi or b.phase:
         from dataclasses import replace
 
-        mech.driver = replace(mech.driver, rate=rate, phase=phase)
+        mech.driver = replace(mech.driver, rate=b.rate, phase=b.phase)
     return mech
 
 

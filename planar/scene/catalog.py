@@ -11,6 +11,7 @@ from collections.abc import Callable
 
 from planar.core.model import Mechanism
 from planar.linkages import RRR, Crank, Fixed, FourBar, Link, Linkage, SliderCrank
+from planar.windup.mechanisms import ELEMENTAL
 
 __all__ = ["CATALOG", "get", "jansen_leg", "kangaroo_leg", "paddle_boat"]
 
@@ -82,7 +83,7 @@ def _windup(k: int) -> Callable[[], Mechanism]:
     return make
 
 
-for _k in range(1, 12):
+for _k in sorted(ELEMENTAL):  # the elemental records say which numbers exist
     CATALOG[f"windup-{_k}"] = _windup(_k)
 
 

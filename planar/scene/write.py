@@ -29,6 +29,7 @@ from planar.errors import InputError
 
 if TYPE_CHECKING:
     from planar.core.model import Mechanism
+    from planar.linkages import Linkage
     from planar.scene.schema import SceneSpec
 
 __all__ = ["driver_table", "mechanism_table", "scene_data", "scene_toml", "write_scene"]
@@ -46,7 +47,7 @@ def _f(v: Any) -> Any:
     return v
 
 
-def _placement(mech: Any) -> list[float]:
+def _placement(mech: Linkage) -> list[float]:
     return [float(x) for x in mech.placement]
 
 

@@ -57,7 +57,7 @@ from numpy.typing import NDArray
 
 from planar.errors import InputError, PlanarError
 from planar.windup.chain import Chain, ToyMechanism, _to_base, _to_world, tree_cost
-from planar.windup.mechanisms import ELEMENTAL, check_params, params_for
+from planar.windup.mechanisms import ELEMENTAL, ElementalMechanism, check_params, params_for
 from planar.windup.sizing import DESIGN_PARAMETER
 from planar.windup.table import MOTION_TYPES, enumerate_chains, realise
 
@@ -127,12 +127,12 @@ class Design:
     @property
     def gravity_x(self) -> list[str]:
         """The #8 stages for which the toy is written with gravity along +x (:func:`design_scene`)."""
-        return [st.label for st in self.toy.stages if st.realisation.number == 8]
+        return [st.label for st in self.toy.stages if st.mech.view == "xz"]
 
     @property
     def gravity_y(self) -> list[str]:
         """The #6/#9 stages for which the toy is written with gravity along -y (:func:`design_scene`)."""
-        return [st.label for st in self.toy.stages if st.realisation.number in (6, 9)]
+        return [st.label for st in self.toy.stages if st.mech.spatial]
 
     def report(self) -> dict[str, Any]:
         return {
@@ -852,7 +852,7 @@ def _shifted(kw: dict[str, Any], number: int, var: PlacementVariable, dx: float)
     return out
 
 
-def _geometry(mech: Any) -> Any:
+def _geometry(mech: ElementalMechanism) -> Any:
     """What a stage's placement changes: its parts' hulls, cuts and outlines, and its follower's rest pose."""
     out = np.zeros((1, 3)) if mech.motion_out == "OzT" else np.zeros(1)
     return ([(p.hull, p.features, p.polygon) for p in mech.parts], np.round(mech._follower_pose(out), 12).tolist())

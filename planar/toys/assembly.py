@@ -55,8 +55,11 @@ from planar.core.model import (
     Slot,
     joint_kind,
 )
+from planar.core.rates import PartRates, RatesResult
 from planar.core.registry import Registry
 from planar.errors import InputError
+from planar.toys.redundant import _without_cuts_of, _without_redundant_slides
+from planar.windup.chain import ToyMechanism
 from planar.windup.mechanisms import SkewContact
 
 __all__ = ["PLACERS", "KeyedShaft", "ToyAssembly", "assembly_residual", "toy_assembly"]
@@ -321,15 +324,48 @@ class ToyAssembly(Mechanism):
     the piece's frame; ``keyed`` maps each cam to its phase (rad).
     """
 
-    def __init__(self, toy: Any) -> None:
+    def __init__(self, toy: ToyMechanism) -> None:
         self.toy = toy
         self.placed = _placements(toy)
         self.notes: list[str] = []
-        # which piece each stage part belongs to
-        merged_of: dict[str, str] = {}
-        for group in toy.merged:
-            for n in group:
-                merged_of[n] = group[0]
+        cam_name = self._cam_names()
+        # rest poses (world, per plane) of every stage part, from the toy's own solve at q = 0
+        poses0 = self._stage_poses(np.zeros(1))[0]
+        piece_of, body_of, rename = self._pieces_and_bodies(cam_name)
+        members, frames = self._piece_frames(piece_of, poses0)
+        self.members = members
+        self.piece_of = piece_of
+        self.bodies: dict[str, list[str]] = {}
+        for full, body in body_of.items():
+            lst = self.bodies.setdefault(body, [])
+            if piece_of[full] not in lst:
+                lst.append(piece_of[full])
+        self._frames = frames
+        parts = self._merged_parts()
+        # joints
+        xf = {full: m for mem in members.values() for full, m in mem}
+        main_cam = cam_name[min(cam_name)]
+        self.keyed: dict[str, float] = {main_cam: 0.0}
+        #: each keyed cam's own part of its key angle (rad): its root stage's turn relative to the first cam's
+        #: (``keyed`` = cam phase difference + this; a Ty cam is #1 turned a quarter)
+        self.key_turn: dict[str, float] = {main_cam: 0.0}
+        joints, dropped = _without_redundant_slides(self._placed_joints(cam_name, main_cam, xf))
+        #: slides dropped as repeats of another (same pieces, same line) and the cuts they took with them
+        self.redundant: list[Any] = dropped
+        self.removed_features: list[tuple[str, Any]] = []
+        if dropped:  # the dropped slides' own cuts go too: their slot on the guide, their pin holes on the body
+            parts, self.removed_features = _without_cuts_of(parts, dropped, joints)
+        joints += self._keyed_shafts(cam_name, main_cam)
+        self.main_cam = main_cam
+        d = toy.driver
+        driver = Driver(main_cam, "rotation", origin=(0.0, 0.0), rate=d.rate, phase=d.phase)
+        named = set(rename.values()) & set(piece_of.values())  # effector pieces carry the name themselves
+        points = {k: (piece_of[v[0]], _xf_point(xf[v[0]], v[1])) for k, v in toy.points.items() if k not in named}
+        super().__init__(f"{toy.name} (assembled)", parts, joints, driver, points)
+
+    # -- construction, one seam each -------------------------------------------------------------
+    def _cam_names(self) -> dict[int, str]:
+        """Each root stage's cam piece name (``cam.left``, ``cam.right``, numbered when a side has several)."""
         cams: dict[str, list[int]] = {}
         for p in self.placed:
             if p.stage.parent is None:
@@ -338,9 +374,15 @@ class ToyAssembly(Mechanism):
         for side, idx in cams.items():
             for k, i in enumerate(idx):
                 cam_name[i] = f"cam.{side}" + (f"{k + 1}" if len(idx) > 1 else "")
-        # rest poses (world, per plane) of every stage part, from the toy's own solve at q = 0
-        q0 = np.zeros(1)
-        poses0 = self._stage_poses(q0)[0]
+        return cam_name
+
+    def _pieces_and_bodies(self, cam_name: dict[int, str]) -> tuple[dict[str, str], dict[str, str], dict[str, str]]:
+        """Which piece and which rigid body each stage part belongs to, and the named effectors' renames."""
+        toy = self.toy
+        merged_of: dict[str, str] = {}
+        for group in toy.merged:
+            for n in group:
+                merged_of[n] = group[0]
         piece_of: dict[str, str] = {}
         body_of: dict[str, str] = {}
         for p in self.placed:
@@ -361,13 +403,19 @@ class ToyAssembly(Mechanism):
                 body_of[full] = body
         # a named end effector's follower that is a piece of its own takes the effector's name
         label_of = {(st.cam, st.key): st.label for st in toy.stages}
-        rename = {f"{label_of[k]}.follower": n for k, n in getattr(toy, "names", {}).items()}
+        rename = {f"{label_of[k]}.follower": n for k, n in toy.names.items()}
         for full, n in rename.items():
             if piece_of.get(full) == full:
                 piece_of[full] = n
                 if body_of.get(full) == full:
                     body_of[full] = n
-        # each piece's frame: world for frames, else its first member's frame
+        return piece_of, body_of, rename
+
+    def _piece_frames(
+        self, piece_of: dict[str, str], poses0: dict[str, Array]
+    ) -> tuple[dict[str, list[tuple[str, XForm]]], dict[str, Array]]:
+        """Each piece's members with their transforms into its frame (world for frames, else its first
+        member's frame at rest), and the frames."""
         members: dict[str, list[tuple[str, XForm]]] = {}
         for full, piece in piece_of.items():
             members.setdefault(piece, []).append((full, (0.0, 0.0, 0.0)))
@@ -382,16 +430,12 @@ class ToyAssembly(Mechanism):
                 rel = poses_compose(poses_invert(frames[piece]), poses0[full][0])
                 xs.append((full, (float(rel[0]), float(rel[1]), float(rel[2]))))
             members[piece] = xs
-        self.members = members
-        self.piece_of = piece_of
-        self.bodies: dict[str, list[str]] = {}
-        for full, body in body_of.items():
-            lst = self.bodies.setdefault(body, [])
-            if piece_of[full] not in lst:
-                lst.append(piece_of[full])
-        self._frames = frames
+        return members, frames
+
+    def _merged_parts(self) -> list[Part]:
+        """One part per piece: its members' outlines merged (:func:`_merge`); its notes go to :attr:`notes`."""
         parts: list[Part] = []
-        for piece, mem in members.items():
+        for piece, mem in self.members.items():
             p0 = self._stage_part(mem[0][0])
             part, notes = _merge(piece, [(self._stage_part(f), m) for f, m in mem], p0.plane, p0.ground)
             if p0.plane == "yz":  # its x offset moves with its stage
@@ -399,14 +443,11 @@ class ToyAssembly(Mechanism):
                 part = replace(part, offset=p0.offset + st.place[0])
             self.notes += notes
             parts.append(part)
-        # joints
-        xf = {full: m for mem in members.values() for full, m in mem}
+        return parts
+
+    def _placed_joints(self, cam_name: dict[int, str], main_cam: str, xf: dict[str, XForm]) -> list[Any]:
+        """Every stage joint placed between pieces (:data:`PLACERS`), but the axles of the second cams."""
         joints: list[Any] = []
-        main_cam = cam_name[min(cam_name)]
-        self.keyed: dict[str, float] = {main_cam: 0.0}
-        #: each keyed cam's own part of its key angle (rad): its root stage's turn relative to the first cam's
-        #: (``keyed`` = cam phase difference + this; a Ty cam is #1 turned a quarter)
-        self.key_turn: dict[str, float] = {main_cam: 0.0}
         for p in self.placed:
             for j in p.stage.mech.joints:
                 a, b = f"{p.label}.{j.a}", f"{p.label}.{j.b}"
@@ -418,31 +459,26 @@ class ToyAssembly(Mechanism):
                 ):
                     continue  # the axle of a second cam: it is keyed to the first instead (below)
                 placer = PLACERS.get(j, f"joint {j.name!r} of stage {p.label}")
-                joints.append(placer(j, f"{p.label}.{j.name}", piece_of[a], piece_of[b], xf[a], xf[b], p))
-        joints, dropped = _without_redundant_slides(joints)
-        #: slides dropped as repeats of another (same pieces, same line) and the cuts they took with them
-        self.redundant: list[Any] = dropped
-        self.removed_features: list[tuple[str, Any]] = []
-        if dropped:  # the dropped slides' own cuts go too: their slot on the guide, their pin holes on the body
-            parts, self.removed_features = _without_cuts_of(parts, dropped, joints)
+                joints.append(placer(j, f"{p.label}.{j.name}", self.piece_of[a], self.piece_of[b], xf[a], xf[b], p))
+        return joints
+
+    def _keyed_shafts(self, cam_name: dict[int, str], main_cam: str) -> list[Any]:
+        """Every cam but the first keyed to it at its phase (fills :attr:`keyed` and :attr:`key_turn`)."""
+        toy = self.toy
+        out: list[Any] = []
         size = 1.0
+        first = self.placed[min(cam_name)]
         for i, name in sorted(cam_name.items()):
             if name == main_cam:
                 continue
-            ph = toy.cam_phase[self.placed[i].stage.cam] - toy.cam_phase[self.placed[min(cam_name)].stage.cam]
+            ph = toy.cam_phase[self.placed[i].stage.cam] - toy.cam_phase[first.stage.cam]
             # a root stage turned by its realisation (Rz->Ty is #1 turned a quarter) turns its cam as much
-            turn = self.placed[i].place[2] - self.placed[min(cam_name)].place[2]
+            turn = self.placed[i].place[2] - first.place[2]
             self.key_turn[name] = float(wrap_angle(np.array([turn]))[0])
             ph = float(wrap_angle(np.array([ph + turn]))[0])
             self.keyed[name] = float(ph)
-            joints.append(KeyedShaft(f"{name}.key", main_cam, name, (0.0, 0.0), (0.0, 0.0), float(ph), size))
-        self.main_cam = main_cam
-        d = toy.driver
-        driver = Driver(main_cam, "rotation", origin=(0.0, 0.0), rate=d.rate, phase=d.phase)
-        named = set(rename.values()) & set(piece_of.values())  # effector pieces carry the name themselves
-        points = {k: (piece_of[v[0]], _xf_point(xf[v[0]], v[1])) for k, v in toy.points.items() if k not in named}
-        super().__init__(f"{toy.name} (assembled)", parts, joints, driver, points)
-        self.spatial = False
+            out.append(KeyedShaft(f"{name}.key", main_cam, name, (0.0, 0.0), (0.0, 0.0), float(ph), size))
+        return out
 
     def _stage_part(self, full: str) -> Part:
         label, name = full.split(".", 1)
@@ -481,6 +517,39 @@ class ToyAssembly(Mechanism):
         """Every stage part's own pose track at its place (for drawing a stage's parts one by one)."""
         return self._stage_poses(np.asarray(q, float))[0]
 
+    def part_rates(self, q: Array, qd: Array, qdd: Array) -> RatesResult:
+        """Rates of every piece (see :meth:`Mechanism.part_rates`), from the rates of the toy's stages.
+
+        Each piece is a stage part (its first member) at the stage's place, then offset on its body.  The
+        place is a turn by ``a`` about z and a shift for an xy stage, a shift for xz and yz
+        (:func:`_world_track`): the stage part's velocity and acceleration turn by ``a``, its angular rates
+        do not change; the piece's origin is a point of that body (``v + omega x r``,
+        ``a + alpha x r - omega^2 r``, ``r`` from the stage part's origin to the piece's).
+        """
+        raw, ok, _ = self.toy.part_rates(q, qd, qdd)
+        stage_poses = self.stage_poses(q)
+        pieces = self.piece_poses(stage_poses)
+        out: dict[str, PartRates] = {}
+        for piece, members in self.members.items():
+            full = members[0][0]
+            r0 = raw[full]
+            v, a = np.asarray(r0.v, float), np.asarray(r0.a, float)
+            if self._stage_part(full).plane == "xy":
+                ang = self.placed[int(full.split(".")[0][1:])].place[2]
+                c, s_ = np.cos(ang), np.sin(ang)
+                v = np.column_stack([c * v[:, 0] - s_ * v[:, 1], s_ * v[:, 0] + c * v[:, 1]])
+                a = np.column_stack([c * a[:, 0] - s_ * a[:, 1], s_ * a[:, 0] + c * a[:, 1]])
+            r = pieces[piece][:, :2] - stage_poses[full][:, :2]
+            om = np.broadcast_to(np.asarray(r0.omega, float), q.shape)
+            al = np.broadcast_to(np.asarray(r0.alpha, float), q.shape)
+            pv = np.column_stack([v[:, 0] - om * r[:, 1], v[:, 1] + om * r[:, 0]])
+            pa = np.column_stack([a[:, 0] - al * r[:, 1] - om * om * r[:, 0], a[:, 1] + al * r[:, 0] - om * om * r[:, 1]])
+            out[piece] = PartRates(pv, pa, om, al)
+        method = (
+            "wind-up closed forms differentiated analytically, composed through the toy's stages, turned to each piece's place"
+        )
+        return out, ok, method
+
     def piece_count(self) -> dict[str, int]:
         """Cut pieces per plane."""
         out: dict[str, int] = {}
@@ -518,87 +587,3 @@ def assembly_residual(asm: ToyAssembly, samples: int = 73) -> dict[str, float]:
     m = asm.run(samples_per_cycle=samples)
     ok = m.valid
     return {j.name: float(np.max(np.asarray(j.residual(m.poses))[ok], initial=0.0)) for j in asm.joints}
-
-
-def _without_cuts_of(
-    parts: list[Part], dropped: list[Any], kept: list[Any], tol: float = 1e-9
-) -> tuple[list[Part], list[tuple[str, Any]]]:
-    """``parts`` without the slots and pin holes of the ``dropped`` slides (features at their slot ends or at
-    their pin points), except that where a ``kept`` joint has a pin at the same place (piece frames) one hole
-    stays (the first there, the one the kept pin goes through); and the ``(piece, feature)`` pairs removed."""
-    from planar.core.features import Hole, Slot
-
-    keep_pins: dict[str, list[tuple[float, float]]] = {}
-    for j in kept:
-        for pname, xy in j.pins():
-            keep_pins.setdefault(pname, []).append((float(xy[0]), float(xy[1])))
-    drop_pins: dict[str, list[tuple[float, float]]] = {}
-    drop_slots: dict[str, list[tuple[Any, Any]]] = {}
-    for j in dropped:
-        for xy in j.pin_points():
-            drop_pins.setdefault(j.b, []).append((float(xy[0]), float(xy[1])))
-        drop_slots.setdefault(j.a, []).append((j.start, j.end))
-
-    def near(p: Any, q: Any) -> bool:
-        return float(np.hypot(p[0] - q[0], p[1] - q[1])) <= tol
-
-    out = []
-    removed: list[tuple[str, Any]] = []
-    for part in parts:
-        feats = []
-        kept_at: list[tuple[float, float]] = []  # kept pins' places that already have their one hole
-        for f in part.features:
-            if isinstance(f, Hole) and any(near(f.centre, q) for q in drop_pins.get(part.name, ())):
-                # a kept pin at the same place keeps ONE hole there (the first, the one fabjoints finds); any
-                # other hole there is the dropped slide's own (e.g. the Bunny's s1.driver 6 mm pin hole under
-                # s0's pin B): cut, it would be pinned to nothing and swallow the pin hole at its own size
-                at_kept = next((q for q in keep_pins.get(part.name, ()) if near(f.centre, q)), None)
-                if at_kept is None or any(near(at_kept, q) for q in kept_at):
-                    removed.append((part.name, f))
-                    continue
-                kept_at.append(at_kept)
-            if isinstance(f, Slot) and any(
-                (near(f.start, a) and near(f.end, b)) or (near(f.start, b) and near(f.end, a))
-                for a, b in drop_slots.get(part.name, ())
-            ):
-                removed.append((part.name, f))
-                continue
-            feats.append(f)
-        out.append(replace(part, features=tuple(feats)))
-    return out, removed
-
-
-def _without_redundant_slides(joints: list[Any]) -> tuple[list[Any], list[Any]]:
-    """``joints`` without a slide that repeats another: the same two pieces, the same line (a merged body
-    guided by two stages' slots on one line, e.g. the Bunny's s0 follower and s1 driver).  The longest
-    slot is kept; a second slide would cut a second slot inside the first and two more pin holes beside the
-    first two (they overlapped), and over-constrain the physics rebuild."""
-    from planar.core.model import Slide
-
-    out: list[Any] = []
-    dropped: list[Any] = []
-    for j in joints:
-        if isinstance(j, Slide):
-            s0, s1 = np.asarray(j.start, float), np.asarray(j.end, float)
-            length = float(np.hypot(*(s1 - s0)))
-            e = (s1 - s0) / length
-            same = None
-            for k, o in enumerate(out):
-                if not isinstance(o, Slide) or {o.a, o.b} != {j.a, j.b}:
-                    continue
-                o0, o1 = np.asarray(o.start, float), np.asarray(o.end, float)
-                d = (o1 - o0) / np.hypot(*(o1 - o0))
-                off = abs(float(e[0] * (o0 - s0)[1] - e[1] * (o0 - s0)[0]))
-                if abs(float(e[0] * d[1] - e[1] * d[0])) < 1e-9 and off < 1e-9 * max(1.0, length):
-                    same = k
-                    break
-            if same is not None:
-                o = out[same]
-                if length > float(np.hypot(*(np.asarray(o.end) - np.asarray(o.start)))):
-                    out[same] = j
-                    dropped.append(o)
-                else:
-                    dropped.append(j)
-                continue
-        out.append(j)
-    return out, dropped

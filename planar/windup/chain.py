@@ -26,9 +26,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planar.core.model import CamOnLine, Driver, Mechanism, Part, PinInArcSlot, PinInSlot, Pivot, Slide, check_finite
+from planar.core.rates import PartRates, RatesResult
 from planar.core.registry import Registry
 from planar.errors import InputError
 from planar.windup.mechanisms import ELEMENTAL, ElementalMechanism, SkewContact
+from planar.windup.rates import stage_part_rates
 from planar.windup.table import MOTION_TYPES, Realisation, enumerate_chains, realise
 
 __all__ = ["Chain", "ToyMechanism", "bunny", "chain_mechanism", "horse", "rank_trees", "tree_cost"]
@@ -281,6 +283,27 @@ class ToyMechanism(Mechanism):
                     pose[:, 1] += oy
                 poses[f"{st.label}.{pname}"] = pose
         return poses, checks
+
+    def part_rates(self, q: Array, qd: Array, qdd: Array) -> RatesResult:
+        """Rates of every stage's parts (see :meth:`Mechanism.part_rates`): each stage's input is its parent's
+        output (or the motor's at its cam's phase) through the same linear axis maps as the motions."""
+        outs: dict[int, tuple[Array, Array, Array]] = {}
+        valid = np.ones(q.shape, bool)
+        parts: dict[str, PartRates] = {}
+        for st in self.stages:
+            r = st.realisation
+            if st.parent is None:
+                u = (_to_base(r, q + self.cam_phase[st.cam]), _to_base(r, qd), _to_base(r, qdd))
+            else:
+                pw = outs[st.parent]
+                u = (_to_base(r, pw[0]), _to_base(r, pw[1]), _to_base(r, pw[2]))
+            res = st.mech.forward(u[0])
+            o1, o2, ok = st.mech.record.rates(st.mech.params, u[0], u[1], u[2])
+            valid &= ok & res.valid
+            outs[st.index] = (_to_world(r, res.out), _to_world(r, o1), _to_world(r, o2))
+            for name, rates in stage_part_rates(st.mech.motion_in, st.mech.record.follower_motion, u, o1, o2).items():
+                parts[f"{st.label}.{name}"] = rates
+        return parts, valid, "wind-up closed forms differentiated analytically, composed through the toy's stages"
 
     @property
     def mechanism_count(self) -> int:

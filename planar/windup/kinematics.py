@@ -36,7 +36,22 @@ from numpy.typing import NDArray
 from planar.core.geometry import circle_circle, line_circle, wrap_angle
 from planar.windup import params as P_
 
-__all__ = ["Stage", "rot", "cam_centre"] + [f"forward_{k}" for k in range(1, 12)]
+__all__ = [
+    "Stage",
+    "cam_centre",
+    "forward_1",
+    "forward_2",
+    "forward_3",
+    "forward_4",
+    "forward_5",
+    "forward_6",
+    "forward_7",
+    "forward_8",
+    "forward_9",
+    "forward_10",
+    "forward_11",
+    "rot",
+]
 
 Array = NDArray[np.float64]
 

@@ -43,9 +43,11 @@ from planar.core.model import (
     Slot,
     joint_kind,
 )
+from planar.core.rates import RatesResult
 from planar.errors import InputError
 from planar.windup import kinematics as K
 from planar.windup import params as P_
+from planar.windup import rates as R
 from planar.windup.kinematics import Stage
 
 __all__ = [
@@ -117,7 +119,7 @@ class SkewContact:
 
 
 class ElementalMechanism(Mechanism):
-    """Elemental mechanism ``number`` (1-11) with parameters ``params``."""
+    """Elemental mechanism ``number`` (a key of :data:`ELEMENTAL`, 1-11) with parameters ``params``."""
 
     def __init__(
         self,
@@ -179,6 +181,15 @@ class ElementalMechanism(Mechanism):
     def stage(self, q: Array) -> Stage:
         """Forward kinematics for driver values ``q`` (the standalone law applied)."""
         return self.forward(self.driver_motion(np.asarray(q, float)))
+
+    def part_rates(self, q: Array, qd: Array, qdd: Array) -> RatesResult:
+        """Rates of the three parts (see :meth:`Mechanism.part_rates`): the record's ``rates`` (its forward
+        kinematics differentiated twice) through the driver's and follower's pose rules, in the view plane's
+        coordinates."""
+        u = R.driver_motion_rates(self.motion_in, self.params, self.driver_motion(q), q, qd, qdd)
+        out1, out2, ok = self.record.rates(self.params, u[0], u[1], u[2])
+        parts = R.stage_part_rates(self.motion_in, self.record.follower_motion, u, out1, out2)
+        return parts, ok & self.forward(u[0]).valid, "wind-up closed forms differentiated analytically"
 
     # -- travel helper --------------------------------------------------------
     def _sweep(self, n: int = 721) -> tuple[Array, Stage]:
@@ -727,7 +738,10 @@ class ElementalRecord:
     ``spatial``: its follower turns out of the driver's plane;
     ``follower_pose``: pose track from follower motion (``forward`` and
     ``follower_pose`` take the parameters in the supplement's frames, see
-    :mod:`planar.windup.params`, and resolve them to world themselves); ``lengths``: derived
+    :mod:`planar.windup.params`, and resolve them to world themselves); ``rates``: the forward
+    kinematics differentiated twice in time, ``(params, u, u1, u2) -> (out1, out2, ok)``
+    (:mod:`planar.windup.rates`); ``follower_motion``: how ``follower_pose`` moves with the follower
+    motion (``"x"``, ``"y"``, ``"pivot"``, ``"-pivot"``, ``"free"``), for the parts' rates; ``lengths``: derived
     lengths that must be positive; ``angle_params``: parameters a scene gives
     in its angle unit.
     """
@@ -739,6 +753,8 @@ class ElementalRecord:
     build: Callable[[ElementalMechanism], tuple[list[Part], list[Any]]]
     contact_joint: str
     follower_pose: Callable[[Any, Array], Array]
+    rates: Callable[[Any, Array, Array, Array], tuple[Array, Array, NDArray[np.bool_]]]
+    follower_motion: str
     view: str = "xy"
     spatial: bool = False
     lengths: tuple[tuple[str, str, Callable[[Any], float]], ...] = ()
@@ -759,8 +775,12 @@ def register_elemental(rec: ElementalRecord) -> ElementalRecord:
 
 EM = ElementalMechanism
 for _rec in (
-    ElementalRecord(1, ("Rz", "Tx"), P_.P1, K.forward_1, EM._build_1, "cam-window", _slide_x, lengths=(_CAM_ECC,)),
-    ElementalRecord(2, ("Rz", "Oz"), P_.P2, K.forward_2, EM._build_2, "cam-window", _pivot, lengths=(_CAM_ECC,)),
+    ElementalRecord(
+        1, ("Rz", "Tx"), P_.P1, K.forward_1, EM._build_1, "cam-window", _slide_x, R.rates_1, "x", lengths=(_CAM_ECC,)
+    ),
+    ElementalRecord(
+        2, ("Rz", "Oz"), P_.P2, K.forward_2, EM._build_2, "cam-window", _pivot, R.rates_2, "pivot", lengths=(_CAM_ECC,)
+    ),
     ElementalRecord(
         3,
         ("Rz", "OzT"),
@@ -769,6 +789,8 @@ for _rec in (
         EM._build_3,
         "track",
         _free,
+        R.rates_3,
+        "free",
         lengths=(
             _CAM_ECC,
             ("S_c", "track radius |S_c|", lambda P: _norm2(P.S_c)),
@@ -776,7 +798,16 @@ for _rec in (
         ),
     ),
     ElementalRecord(
-        4, ("Oz", "Ty"), P_.P4, K.forward_4, EM._build_4, "pin-slot", _slide_y, angle_params=("phi", "D_theta", "amplitude")
+        4,
+        ("Oz", "Ty"),
+        P_.P4,
+        K.forward_4,
+        EM._build_4,
+        "pin-slot",
+        _slide_y,
+        R.rates_4,
+        "y",
+        angle_params=("phi", "D_theta", "amplitude"),
     ),
     ElementalRecord(
         5,
@@ -786,6 +817,8 @@ for _rec in (
         EM._build_5,
         "pin-slot",
         _pivot,
+        R.rates_5,
+        "pivot",
         lengths=(("F_jc", "pin radius |F_jc|", lambda P: _norm2(P.F_jc)),),
         angle_params=("phi", "D_theta", "amplitude"),
     ),
@@ -797,6 +830,8 @@ for _rec in (
         EM._build_6,
         "edge-pin",
         _tilt_yz,
+        R.rates_6,
+        "pivot",
         spatial=True,
         angle_params=("phi", "D_theta", "amplitude"),
     ),
@@ -808,11 +843,13 @@ for _rec in (
         EM._build_7,
         "pin-slot",
         _pivot,
+        R.rates_7,
+        "pivot",
         lengths=(("F_o", "pin-to-pivot distance |F_o - D_jc|", lambda P: _norm2(_sub(P.F_o, P.D_jc))),),
     ),
-    ElementalRecord(8, ("Tx", "Oy"), P_.P8, K.forward_8, EM._build_8, "window-tab", _pivot_xz, view="xz"),
-    ElementalRecord(9, ("Tx", "Ox"), P_.P9, K.forward_9, EM._build_9, "slot-pin", _tilt_yz, spatial=True),
-    ElementalRecord(10, ("OzT", "Tx"), P_.P10, K.forward_10, EM._build_10, "pin-arc", _slide_x),
+    ElementalRecord(8, ("Tx", "Oy"), P_.P8, K.forward_8, EM._build_8, "window-tab", _pivot_xz, R.rates_8, "-pivot", view="xz"),
+    ElementalRecord(9, ("Tx", "Ox"), P_.P9, K.forward_9, EM._build_9, "slot-pin", _tilt_yz, R.rates_9, "pivot", spatial=True),
+    ElementalRecord(10, ("OzT", "Tx"), P_.P10, K.forward_10, EM._build_10, "pin-arc", _slide_x, R.rates_10, "x"),
     ElementalRecord(
         11,
         ("OzT", "Oz"),
@@ -821,6 +858,8 @@ for _rec in (
         EM._build_11,
         "pin-arc",
         _pivot,
+        R.rates_11,
+        "pivot",
         lengths=(("F_jc", "pin radius |F_jc|", lambda P: _norm2(P.F_jc)),),
     ),
 ):

@@ -2,7 +2,8 @@
 
 Each elemental mechanism's forward kinematics (:mod:`planar.windup.kinematics`)
 is differentiated twice by hand, sample by sample with arrays, never by
-differencing (:func:`forward_rates`):
+differencing: ``rates_N`` for mechanism ``N``, carried by its record
+(:data:`planar.windup.mechanisms.ELEMENTAL`, field ``rates``):
 
 * the cam and slot contacts that are dyads reuse the linkage node kinds'
   differentiated closures: #3 and #11 (pin on two circles) are an RRR dyad,
@@ -18,26 +19,41 @@ differencing (:func:`forward_rates`):
 
 The OzT driver path ``(a_x sin q, a_y (cos q - 1), theta_max sin q)`` and the
 pose maps (driver and follower poses are affine in their motions) are
-differentiated directly; a toy composes its stages' rates through the same
-linear axis maps as their motions (:mod:`planar.windup.chain`).
+differentiated directly (:func:`driver_motion_rates`, :func:`stage_part_rates`);
+:meth:`ElementalMechanism.part_rates <planar.windup.mechanisms.ElementalMechanism.part_rates>`
+assembles them, and a toy composes its stages' rates through the same linear
+axis maps as their motions (:meth:`planar.windup.chain.ToyMechanism.part_rates`).
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from planar.core.rates import PartRates
 from planar.core.registry import UnsupportedError
 from planar.linkages.nodes import RRP, RRR, frame_rates
+from planar.windup import kinematics as K
 from planar.windup import params as P_
-from planar.windup.mechanisms import ELEMENTAL, ElementalMechanism
+from planar.windup.kinematics import Stage
 
-if TYPE_CHECKING:
-    from planar.core.model import Mechanism
-
-__all__ = ["driver_motion_rates", "elemental_rates", "forward_rates", "windup_rates"]
+__all__ = [
+    "driver_motion_rates",
+    "rates_1",
+    "rates_2",
+    "rates_3",
+    "rates_4",
+    "rates_5",
+    "rates_6",
+    "rates_7",
+    "rates_8",
+    "rates_9",
+    "rates_10",
+    "rates_11",
+    "stage_part_rates",
+]
 
 Array = NDArray[np.float64]
 Mask = NDArray[np.bool_]
@@ -124,207 +140,208 @@ def _oval_rates(e0: Jet, e: Jet, p0: Array, N: float, r: float, alpha: Array) ->
     return t1 / s, t2 / s - 2 * t * t1 * t1 / s**2, ok
 
 
-def forward_rates(number: int, params: Any, u: Array, u1: Array, u2: Array) -> tuple[Array, Array, Mask]:
-    """First and second time derivatives of mechanism ``number``'s follower motion.
+# ---------------------------------------------------------------- one rule per elemental mechanism
+# Each ``rates_N(params, u, u1, u2)`` differentiates ``forward_N`` (same parameters, the supplement's
+# frames): ``u`` the driver's motion, ``u1``, ``u2`` its time derivatives; returns ``(out1, out2, ok)``
+# shaped like the follower motion, ``ok`` false where a differentiated closure is singular.  Each
+# record of :data:`planar.windup.mechanisms.ELEMENTAL` carries its own as ``rates``.
 
-    ``u`` is the driver's motion (``(N,)``, or ``(N, 3)`` for OzT), ``u1`` and
-    ``u2`` its time derivatives.  Returns ``(out1, out2, ok)`` shaped like the
-    follower motion; ``ok`` false where a differentiated closure is singular.
-    """
-    rec = ELEMENTAL[number]
+
+def _cam_centre_rates(params: Any, st: Stage, u1: Array, u2: Array) -> tuple[Any, Array, Array, Array]:
+    """#1-3: the cam centre ``m`` turning about ``D_o``, and its rates."""
     P = P_.in_world(params)
-    st = rec.forward(params, u)
-    n = u.shape[0]
-    ok = np.ones(n, bool)
-    if number in (1, 2, 3):
-        o = _xy(P.D_o)
-        m = st.aux["m"]
-        m1, m2 = _turning(o, m, u1, u2)
-        if number == 1:
-            return m1[:, 0], m2[:, 0], ok
-        if number == 2:
-            s = _xy(P.F_o)
-            w0 = _xy(P.D_jc) - s
-            phi1, phi2 = _angle(m - s, m1, m2)
-            b1, b2 = _offset_angle(w0[1], 1.0 if w0[0] >= 0 else -1.0, m - s, m1, m2)
-            return phi1 - b1, phi2 - b2, ok
-        p0 = _xy(P.F_o)
-        s = p0 + _xy(P.S_c)
-        p = st.aux["p"]
-        node = RRR("p", "m", 1.0, "s", 1.0)
-        pv, pa, ok = _dyad(
-            node, {"p": p, "m": m, "s": np.broadcast_to(s, m.shape)}, {"m": m1, "s": _zeros(n)}, {"m": m2, "s": _zeros(n)}
-        )
-        al1, al2 = _angle(p - m, pv - m1, pa - m2)
-        return np.column_stack([pv, al1]), np.column_stack([pa, al2]), ok
-    if number == 4:
-        q = _xy(P.D_o)
-        p0 = _xy(P.F_o) + _xy(P.F_jc)
-        Dx, Y0 = p0 - q
-        c, sn = np.cos(u), np.sin(u)
-        ok = np.abs(c) > 1e-9
-        sec = 1.0 / np.where(ok, c, 1.0)
-        tan = sn * sec
-        f1 = Dx * sec * sec + Y0 * sec * tan
-        f2 = 2 * Dx * sec * sec * tan + Y0 * (sec * tan * tan + sec**3)
-        return f1 * u1, f2 * u1 * u1 + f1 * u2, ok
-    if number == 5:
-        q = _xy(P.D_o)
-        s = _xy(P.F_o)
-        p = st.aux["p"]
-        d = (s + _xy(P.F_jc))[1] - q[1]
-        c, sn = np.cos(u), np.sin(u)
-        base = q + np.column_stack([-d * sn, d * c])
-        tip = base + np.column_stack([c, sn])
-        bv, ba = _turning(q, base, u1, u2)
-        tv, ta = _turning(q, tip, u1, u2)
-        z = _zeros(n)
-        node5 = RRP("p", "s", 1.0, "b", "t")
-        pv, pa, ok = _dyad(
-            node5,
-            {"p": p, "s": np.broadcast_to(s, p.shape), "b": base, "t": tip},
-            {"s": z, "b": bv, "t": tv},
-            {"s": z, "b": ba, "t": ta},
-        )
-        return (*_angle(p - s, pv, pa), ok)
-    if number in (6, 9):
-        p0 = _xy(P.F_o)
-        r = P.F_jr
-        N = P.F_o[2] - P.D_o[2]
-        if number == 6:
-            q = _xy(P.D_o)
-            e0 = st.aux["e0"]
-            c, sn = np.cos(u), np.sin(u)
-            e = np.column_stack([c, sn])
-            e0v, e0a = _turning(q, e0, u1, u2)
-            ev, ea = _turning(np.zeros(2), e, u1, u2)
-        else:
-            e0 = st.aux["e0"]
-            e = np.broadcast_to(np.array([np.cos(P.phi), -np.sin(P.phi)]), (n, 2))
-            e0v, e0a = np.column_stack([u1, np.zeros(n)]), np.column_stack([u2, np.zeros(n)])
-            ev = ea = _zeros(n)
-        return _oval_rates((e0, e0v, e0a), (e, ev, ea), p0, N, r, st.out)
-    if number == 7:
-        s = _xy(P.F_o)
-        p = st.aux["p"]
-        z = np.zeros(n)
-        return (*_angle(p - s, np.column_stack([u1, z]), np.column_stack([u2, z])), ok)
-    if number == 8:
-        B = np.array([P.F_o[0], P.F_o[2]])
-        w = st.aux["A"] - B
-        z = np.zeros(n)
-        w1, w2 = np.column_stack([u1, z]), np.column_stack([u2, z])
-        phi1, phi2 = _angle(w, w1, w2)
-        b1, b2 = _offset_angle(P.F_jcx, 1.0, w, w1, w2)
-        return -(phi1 + b1), -(phi2 + b2), ok
-    # 10, 11: the arc slot's centre m = D_o + (dx, dy) moves with the OzT driver
     m = st.aux["m"]
+    m1, m2 = _turning(_xy(P.D_o), m, u1, u2)
+    return P, m, m1, m2
+
+
+def rates_1(params: Any, u: Array, u1: Array, u2: Array) -> tuple[Array, Array, Mask]:
+    """#1 (Rz -> Tx): the window follows the cam centre's x."""
+    _, _, m1, m2 = _cam_centre_rates(params, K.forward_1(params, u), u1, u2)
+    return m1[:, 0], m2[:, 0], np.ones(u.shape[0], bool)
+
+
+def rates_2(params: Any, u: Array, u1: Array, u2: Array) -> tuple[Array, Array, Mask]:
+    """#2 (Rz -> Oz): a window at distance ``c`` from its pivot through the cam centre."""
+    P, m, m1, m2 = _cam_centre_rates(params, K.forward_2(params, u), u1, u2)
+    s = _xy(P.F_o)
+    w0 = _xy(P.D_jc) - s
+    phi1, phi2 = _angle(m - s, m1, m2)
+    b1, b2 = _offset_angle(w0[1], 1.0 if w0[0] >= 0 else -1.0, m - s, m1, m2)
+    return phi1 - b1, phi2 - b2, np.ones(u.shape[0], bool)
+
+
+def rates_3(params: Any, u: Array, u1: Array, u2: Array) -> tuple[Array, Array, Mask]:
+    """#3 (Rz -> OzT): the pin on two circles, an RRR dyad."""
+    st = K.forward_3(params, u)
+    P, m, m1, m2 = _cam_centre_rates(params, st, u1, u2)
+    n = u.shape[0]
+    s = _xy(P.F_o) + _xy(P.S_c)
     p = st.aux["p"]
-    m1, m2 = u1[:, :2], u2[:, :2]
+    node = RRR("p", "m", 1.0, "s", 1.0)
+    pv, pa, ok = _dyad(
+        node, {"p": p, "m": m, "s": np.broadcast_to(s, m.shape)}, {"m": m1, "s": _zeros(n)}, {"m": m2, "s": _zeros(n)}
+    )
+    al1, al2 = _angle(p - m, pv - m1, pa - m2)
+    return np.column_stack([pv, al1]), np.column_stack([pa, al2]), ok
+
+
+def rates_4(params: Any, u: Array, u1: Array, u2: Array) -> tuple[Array, Array, Mask]:
+    """#4 (Oz -> Ty): ``dy = D_x tan(theta) + Y0 (sec(theta) - 1)`` differentiated in theta."""
+    P = P_.in_world(params)
+    q = _xy(P.D_o)
+    p0 = _xy(P.F_o) + _xy(P.F_jc)
+    Dx, Y0 = p0 - q
+    c, sn = np.cos(u), np.sin(u)
+    ok = np.abs(c) > 1e-9
+    sec = 1.0 / np.where(ok, c, 1.0)
+    tan = sn * sec
+    f1 = Dx * sec * sec + Y0 * sec * tan
+    f2 = 2 * Dx * sec * sec * tan + Y0 * (sec * tan * tan + sec**3)
+    return f1 * u1, f2 * u1 * u1 + f1 * u2, ok
+
+
+def rates_5(params: Any, u: Array, u1: Array, u2: Array) -> tuple[Array, Array, Mask]:
+    """#5 (Oz -> Oz): the pin on a turning line and a circle, an RRP dyad."""
+    P = P_.in_world(params)
+    n = u.shape[0]
+    q = _xy(P.D_o)
+    s = _xy(P.F_o)
+    p = K.forward_5(params, u).aux["p"]
+    d = (s + _xy(P.F_jc))[1] - q[1]
+    c, sn = np.cos(u), np.sin(u)
+    base = q + np.column_stack([-d * sn, d * c])
+    tip = base + np.column_stack([c, sn])
+    bv, ba = _turning(q, base, u1, u2)
+    tv, ta = _turning(q, tip, u1, u2)
     z = _zeros(n)
-    if number == 10:
-        p0 = _xy(P.F_o) + _xy(P.F_jc)
-        g1 = np.broadcast_to(np.array([0.0, p0[1]]), m.shape)
-        g2 = np.broadcast_to(np.array([1.0, p0[1]]), m.shape)
-        node10 = RRP("p", "m", 1.0, "g1", "g2")
-        pv, pa, ok = _dyad(node10, {"p": p, "m": m, "g1": g1, "g2": g2}, {"m": m1, "g1": z, "g2": z}, {"m": m2, "g1": z, "g2": z})
-        return pv[:, 0], pa[:, 0], ok
+    node5 = RRP("p", "s", 1.0, "b", "t")
+    pv, pa, ok = _dyad(
+        node5,
+        {"p": p, "s": np.broadcast_to(s, p.shape), "b": base, "t": tip},
+        {"s": z, "b": bv, "t": tv},
+        {"s": z, "b": ba, "t": ta},
+    )
+    return (*_angle(p - s, pv, pa), ok)
+
+
+def rates_6(params: Any, u: Array, u1: Array, u2: Array) -> tuple[Array, Array, Mask]:
+    """#6 (Oz -> Ox): the tilted pin's tangency to a turning edge, differentiated implicitly."""
+    P = P_.in_world(params)
+    st = K.forward_6(params, u)
+    q = _xy(P.D_o)
+    e0 = st.aux["e0"]
+    c, sn = np.cos(u), np.sin(u)
+    e = np.column_stack([c, sn])
+    e0v, e0a = _turning(q, e0, u1, u2)
+    ev, ea = _turning(np.zeros(2), e, u1, u2)
+    return _oval_rates((e0, e0v, e0a), (e, ev, ea), _xy(P.F_o), P.F_o[2] - P.D_o[2], P.F_jr, st.out)
+
+
+def rates_9(params: Any, u: Array, u1: Array, u2: Array) -> tuple[Array, Array, Mask]:
+    """#9 (Tx -> Ox): the tilted pin's tangency to a sliding edge, differentiated implicitly."""
+    P = P_.in_world(params)
+    st = K.forward_9(params, u)
+    n = u.shape[0]
+    e0 = st.aux["e0"]
+    e = np.broadcast_to(np.array([np.cos(P.phi), -np.sin(P.phi)]), (n, 2))
+    e0v, e0a = np.column_stack([u1, np.zeros(n)]), np.column_stack([u2, np.zeros(n)])
+    ev = ea = _zeros(n)
+    return _oval_rates((e0, e0v, e0a), (e, ev, ea), _xy(P.F_o), P.F_o[2] - P.D_o[2], P.F_jr, st.out)
+
+
+def rates_7(params: Any, u: Array, u1: Array, u2: Array) -> tuple[Array, Array, Mask]:
+    """#7 (Tx -> Oz): the slot's angle through a sliding pin."""
+    P = P_.in_world(params)
+    n = u.shape[0]
+    s = _xy(P.F_o)
+    p = K.forward_7(params, u).aux["p"]
+    z = np.zeros(n)
+    return (*_angle(p - s, np.column_stack([u1, z]), np.column_stack([u2, z])), np.ones(n, bool))
+
+
+def rates_8(params: Any, u: Array, u1: Array, u2: Array) -> tuple[Array, Array, Mask]:
+    """#8 (Tx -> Oy): a line at distance ``c`` from the pivot through a sliding point (xz plane)."""
+    P = P_.in_world(params)
+    n = u.shape[0]
+    B = np.array([P.F_o[0], P.F_o[2]])
+    w = K.forward_8(params, u).aux["A"] - B
+    z = np.zeros(n)
+    w1, w2 = np.column_stack([u1, z]), np.column_stack([u2, z])
+    phi1, phi2 = _angle(w, w1, w2)
+    b1, b2 = _offset_angle(P.F_jcx, 1.0, w, w1, w2)
+    return -(phi1 + b1), -(phi2 + b2), np.ones(n, bool)
+
+
+def rates_10(params: Any, u: Array, u1: Array, u2: Array) -> tuple[Array, Array, Mask]:
+    """#10 (OzT -> Tx): the arc slot's centre moves with the OzT driver; the pin on a line and a circle."""
+    P = P_.in_world(params)
+    st = K.forward_10(params, u)
+    m, p = st.aux["m"], st.aux["p"]
+    m1, m2 = u1[:, :2], u2[:, :2]
+    z = _zeros(u.shape[0])
+    p0 = _xy(P.F_o) + _xy(P.F_jc)
+    g1 = np.broadcast_to(np.array([0.0, p0[1]]), m.shape)
+    g2 = np.broadcast_to(np.array([1.0, p0[1]]), m.shape)
+    node10 = RRP("p", "m", 1.0, "g1", "g2")
+    pv, pa, ok = _dyad(node10, {"p": p, "m": m, "g1": g1, "g2": g2}, {"m": m1, "g1": z, "g2": z}, {"m": m2, "g1": z, "g2": z})
+    return pv[:, 0], pa[:, 0], ok
+
+
+def rates_11(params: Any, u: Array, u1: Array, u2: Array) -> tuple[Array, Array, Mask]:
+    """#11 (OzT -> Oz): the arc slot's centre moves with the OzT driver; the pin on two circles."""
+    P = P_.in_world(params)
+    st = K.forward_11(params, u)
+    m, p = st.aux["m"], st.aux["p"]
+    m1, m2 = u1[:, :2], u2[:, :2]
+    z = _zeros(u.shape[0])
     s = _xy(P.F_o)
     node11 = RRR("p", "m", 1.0, "s", 1.0)
     pv, pa, ok = _dyad(node11, {"p": p, "m": m, "s": np.broadcast_to(s, m.shape)}, {"m": m1, "s": z}, {"m": m2, "s": z})
     return (*_angle(p - s, pv, pa), ok)
 
 
-def driver_motion_rates(mech: ElementalMechanism, q: Array, qd: Array, qdd: Array) -> Jet:
-    """The driver's motion and its time derivatives (the OzT path differentiated; else ``q`` itself)."""
-    u = mech.driver_motion(q)
-    if mech.motion_in != "OzT":
+def driver_motion_rates(motion_in: str, params: Any, u: Array, q: Array, qd: Array, qdd: Array) -> Jet:
+    """The driver's motion ``u`` (for driver values ``q``) and its time derivatives: the OzT path
+    ``(a_x sin q, a_y (cos q - 1), theta_max sin q)`` differentiated; any other motion is ``q`` itself."""
+    if motion_in != "OzT":
         return u, qd, qdd
-    ax, ay = mech.params.path
-    th = mech.params.D_theta[1]
+    ax, ay = params.path
+    th = params.D_theta[1]
     c, s = np.cos(q), np.sin(q)
     d1 = np.column_stack([ax * c, -ay * s, th * c])
     d2 = np.column_stack([-ax * s, -ay * c, -th * s])
     return u, d1 * qd[:, None], d2 * (qd * qd)[:, None] + d1 * qdd[:, None]
 
 
-def _pose_rates(kind: str, m1: Array, m2: Array) -> tuple[Array, Array, Array, Array]:
+def _pose_rates(kind: str, m1: Array, m2: Array) -> PartRates:
     """``(v, a, omega, alpha)`` of a pose affine in a motion, from the motion's rates (``kind``: how it moves)."""
     n = m1.shape[0]
     z, z2 = np.zeros(n), np.zeros((n, 2))
     if kind in ("Rz", "Oz", "Ox", "Ox-yz", "pivot"):
-        return z2, z2, m1, m2
+        return PartRates(z2, z2, m1, m2)
     if kind == "-pivot":
-        return z2, z2, -m1, -m2
+        return PartRates(z2, z2, -m1, -m2)
     if kind == "x":
-        return np.column_stack([m1, z]), np.column_stack([m2, z]), z, z
+        return PartRates(np.column_stack([m1, z]), np.column_stack([m2, z]), z, z)
     if kind == "y":
-        return np.column_stack([z, m1]), np.column_stack([z, m2]), z, z
-    return m1[:, :2], m2[:, :2], m1[:, 2], m2[:, 2]  # free / OzT: (dx, dy, angle)
+        return PartRates(np.column_stack([z, m1]), np.column_stack([z, m2]), z, z)
+    if kind == "free":  # (dx, dy, angle)
+        return PartRates(m1[:, :2], m2[:, :2], m1[:, 2], m2[:, 2])
+    raise UnsupportedError(f"rates: no rule for a pose that moves by {kind!r}")
 
 
+#: how each driver motion moves the driver's pose (the pose rules of :func:`_pose_rates`)
 _DRIVER_KIND = {"Rz": "Rz", "Oz": "Oz", "Tx": "x", "OzT": "free"}
 
 
-def _follower_kind(mech: ElementalMechanism) -> str:
-    from planar.windup import mechanisms as M
-
-    fp = mech.record.follower_pose
-    table = {M._slide_x: "x", M._slide_y: "y", M._free: "free", M._pivot: "pivot", M._tilt_yz: "pivot", M._pivot_xz: "-pivot"}
-    if fp not in table:
-        raise UnsupportedError(f"rates: no rule for the follower pose {fp.__name__} of mechanism #{mech.number}")
-    return table[fp]
-
-
-def _stage_part_rates(mech: ElementalMechanism, u: Jet, out1: Array, out2: Array) -> dict[str, tuple[Array, ...]]:
+def stage_part_rates(motion_in: str, follower_motion: str, u: Jet, out1: Array, out2: Array) -> dict[str, PartRates]:
+    """Rates of an elemental mechanism's three parts from its driver's motion ``u`` (with its rates) and its
+    follower motion's rates; ``follower_motion``: how the follower's pose moves with its motion
+    (``"x"``, ``"y"``, ``"pivot"``, ``"-pivot"``, ``"free"``: the record's ``follower_motion``)."""
+    n = out1.shape[0]
     return {
-        "ground": _pose_rates("Rz", np.zeros(out1.shape[0]), np.zeros(out1.shape[0])),
-        "driver": _pose_rates(_DRIVER_KIND[mech.motion_in], u[1], u[2]),
-        "follower": _pose_rates(_follower_kind(mech), out1, out2),
+        "ground": _pose_rates("Rz", np.zeros(n), np.zeros(n)),
+        "driver": _pose_rates(_DRIVER_KIND[motion_in], u[1], u[2]),
+        "follower": _pose_rates(follower_motion, out1, out2),
     }
-
-
-def elemental_rates(mech: ElementalMechanism, q: Array, qd: Array, qdd: Array) -> tuple[dict[str, tuple[Array, ...]], Mask]:
-    """Part rates ``(v, a, omega, alpha)`` of an elemental mechanism (its view plane's coordinates)."""
-    u = driver_motion_rates(mech, q, qd, qdd)
-    out1, out2, ok = forward_rates(mech.number, mech.params, u[0], u[1], u[2])
-    return _stage_part_rates(mech, u, out1, out2), ok & mech.forward(u[0]).valid
-
-
-def toy_rates(toy: Any, q: Array, qd: Array, qdd: Array) -> tuple[dict[str, tuple[Array, ...]], Mask]:
-    """Part rates of a :class:`~planar.windup.chain.ToyMechanism`: each stage's input is its parent's output."""
-    from planar.windup.chain import _to_base, _to_world
-
-    outs: dict[int, Jet] = {}
-    valid = np.ones(q.shape, bool)
-    parts: dict[str, tuple[Array, ...]] = {}
-    for st in toy.stages:
-        r = st.realisation
-        if st.parent is None:
-            u = (_to_base(r, q + toy.cam_phase[st.cam]), _to_base(r, qd), _to_base(r, qdd))
-        else:
-            pw = outs[st.parent]
-            u = (_to_base(r, pw[0]), _to_base(r, pw[1]), _to_base(r, pw[2]))
-        res = st.mech.forward(u[0])
-        o1, o2, ok = forward_rates(r.number, st.mech.params, u[0], u[1], u[2])
-        valid &= ok & res.valid
-        outs[st.index] = (_to_world(r, res.out), _to_world(r, o1), _to_world(r, o2))
-        for name, rates in _stage_part_rates(st.mech, u, o1, o2).items():
-            parts[f"{st.label}.{name}"] = rates
-    return parts, valid
-
-
-def windup_rates(mech: Mechanism, q: Array, qd: Array, qdd: Array) -> tuple[dict[str, tuple[Array, ...]], Mask, str]:
-    """Part rates ``(v, a, omega, alpha)`` of an elemental mechanism or a toy (see the module's note), with the
-    validity and the method's name; other mechanisms are refused by name."""
-    from planar.windup.chain import ToyMechanism
-
-    if isinstance(mech, ElementalMechanism):
-        raw, ok = elemental_rates(mech, q, qd, qdd)
-        return raw, ok, "wind-up closed forms differentiated analytically"
-    if isinstance(mech, ToyMechanism):
-        raw, ok = toy_rates(mech, q, qd, qdd)
-        return raw, ok, "wind-up closed forms differentiated analytically, composed through the toy's stages"
-    raise UnsupportedError(
-        f"rates (velocities, accelerations, torque): no closed-form derivatives for {type(mech).__name__} {mech.name!r}"
-    )

@@ -182,7 +182,7 @@ def _setup(
     number: int, parameter: str | None, component: int | None, bracket: tuple[float, float] | None, fixed: dict[str, Any]
 ) -> tuple[_Range, float, float]:
     if not isinstance(number, (int, np.integer)) or isinstance(number, bool) or number not in DESIGN_PARAMETER:
-        raise InputError("mechanism", number, "an elemental mechanism number 1-11")
+        raise InputError("mechanism", number, f"an elemental mechanism number, one of {sorted(DESIGN_PARAMETER)}")
     name, comp, br, _ = DESIGN_PARAMETER[int(number)]
     if parameter is not None:
         name, comp = parameter, component

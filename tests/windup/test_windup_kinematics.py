@@ -14,6 +14,7 @@ from scipy.optimize import brentq, minimize_scalar
 from planar import InputError
 from planar.windup import elemental, params_for
 from planar.windup.kinematics import cam_centre
+from planar.windup.mechanisms import ELEMENTAL
 
 TOL = 1e-9
 
@@ -160,7 +161,7 @@ def _check(mech, n=121):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("k", range(1, 12))
+@pytest.mark.parametrize("k", sorted(ELEMENTAL))
 def test_closed_form_matches_numerical_solution_at_defaults(k):
     _check(elemental(k))
 
@@ -181,7 +182,7 @@ def _perturbed(k, rng):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("k", range(1, 12))
+@pytest.mark.parametrize("k", sorted(ELEMENTAL))
 def test_closed_form_matches_numerical_solution_at_random_parameters(k):
     rng = np.random.default_rng(1000 + k)
     done = 0
