@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ast
 import importlib
 import json
 import pkgutil
@@ -17,6 +18,32 @@ import planar
 ROOT = Path(__file__).resolve().parents[1]
 
 
+def _module_names(module: str) -> set[str]:
+    """The names a module defines or imports at its top level, read from its source (nothing imported)."""
+    path = ROOT / (module.replace(".", "/") + ".py")
+    if not path.exists():
+        path = ROOT / module.replace(".", "/") / "__init__.py"
+    names: set[str] = set()
+    for node in ast.parse(path.read_text(encoding="utf-8")).body:
+        if isinstance(node, ast.FunctionDef | ast.ClassDef):
+            names.add(node.name)
+        elif isinstance(node, ast.Assign | ast.AnnAssign):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            names.update(t.id for t in targets if isinstance(t, ast.Name))
+        elif isinstance(node, ast.ImportFrom):
+            names.update(a.asname or a.name for a in node.names)
+    return names
+
+
+def test_every_name_in_all_has_a_home() -> None:
+    # quick and import-free: each lazy name is defined (or re-exported) by the module it is loaded from
+    lazy = planar._LAZY
+    homeless = [n for n in planar.__all__ if n not in vars(planar) and n not in _module_names(lazy.get(n, "planar"))]
+    assert homeless == []
+    assert set(lazy) <= set(planar.__all__)
+
+
+@pytest.mark.slow  # imports every room the names live in (pymunk, pydantic): about a second of CPU
 def test_every_name_in_all_resolves() -> None:
     assert len(planar.__all__) == len(set(planar.__all__))
     for name in planar.__all__:
@@ -43,13 +70,19 @@ def _subpackages() -> list[str]:
 
 
 @pytest.mark.parametrize("room", _subpackages())
-def test_every_subpackage_declares_all_and_its_names_resolve(room: str) -> None:
-    pkg = importlib.import_module(f"planar.{room}")
+def test_every_subpackage_declares_all_without_shadowing_its_modules(room: str) -> None:
+    pkg = importlib.import_module(f"planar.{room}")  # light: the names load on first use
     names = pkg.__all__
     assert names, room
     modules = {m.name for m in pkgutil.iter_modules(pkg.__path__)}
     assert not set(names) & modules, f"planar.{room} exports names that shadow its modules: {set(names) & modules}"
-    for name in names:
+
+
+@pytest.mark.slow  # imports every module of every room
+@pytest.mark.parametrize("room", _subpackages())
+def test_every_subpackage_name_resolves(room: str) -> None:
+    pkg = importlib.import_module(f"planar.{room}")
+    for name in pkg.__all__:
         assert not isinstance(getattr(pkg, name), types.ModuleType), name
 
 
