@@ -76,6 +76,11 @@ def test_every_subpackage_declares_all_without_shadowing_its_modules(room: str) 
     assert names, room
     modules = {m.name for m in pkgutil.iter_modules(pkg.__path__)}
     assert not set(names) & modules, f"planar.{room} exports names that shadow its modules: {set(names) & modules}"
+    # a room's __init__ loads names from its own modules only (the import scan in test_layout.py does not
+    # see a module named in a string)
+    source = (ROOT / "planar" / room / "__init__.py").read_text(encoding="utf-8")
+    named = {n.value for n in ast.walk(ast.parse(source)) if isinstance(n, ast.Constant) and str(n.value).startswith("planar.")}
+    assert all(m.startswith(f"planar.{room}.") for m in named), named
 
 
 @pytest.mark.slow  # imports every module of every room
