@@ -1,41 +1,208 @@
 """planar: 2D rigid-body mechanisms with exact (closed-form) kinematics.
 
-``import planar`` is light: the errors only.  The model's names
-(``planar.Mechanism`` ...) load numpy on first use; shapely, pymunk, ezdxf and
-imageio are imported by the modules that use them.  So the ``planar`` command
-holds nothing heavy until its interrupt handling is in place (a Ctrl-C while
-numpy loads is one line, not a traceback).
+The working set a user needs is here, under one name each::
+
+    import planar
+
+    leg = planar.FourBar(ground=4, crank=1, coupler=4, rocker=3, coupler_point=(5.5, -2.0))
+    motion = leg.solve([0.0, 0.5, 1.0])      # a planar.Motion
+    planar.render(leg, "leg.gif")            # a mechanism or a planar.Scene
+    scene = planar.load_scene("gallery/kangaroo-leg.toml")
+    planar.export(scene, dxf="leg.dxf")
+
+``import planar`` is light: the errors only.  Every other name is loaded on
+first use (module ``__getattr__``), so numpy comes in when a model name is
+first read, and shapely, pymunk, ezdxf and imageio only with the modules that
+use them.  So the ``planar`` command holds nothing heavy until its interrupt
+handling is in place (a Ctrl-C while numpy loads is one line, not a traceback).
 """
 
 from __future__ import annotations
 
+import importlib
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from planar.errors import AssemblyError, InputError, LimitError, PlanarError, SceneError
 
 if TYPE_CHECKING:  # pragma: no cover
-    from planar.core.model import Driver, Mechanism, Motion, Part, joint_residuals
+    from planar.core.model import Driver, Mechanism, Motion, Part, PinInSlot, Pivot, Slide, joint_residuals
+    from planar.fabrication.build import Fabrication
+    from planar.linkages import RRP, RRR, Actuator, Crank, Fixed, FourBar, Link, Linkage, Rigid, SliderCrank, Triad
+    from planar.physics.compare import Comparison
+    from planar.physics.simulate import SimResult, SimSettings, simulate
+    from planar.scene.load import Scene, load_scene, scene_from_mechanism
 
 __all__ = [
+    "RRP",
+    "RRR",
+    "Actuator",
     "AssemblyError",
+    "Crank",
     "Driver",
+    "Fixed",
+    "FourBar",
     "InputError",
     "LimitError",
+    "Link",
+    "Linkage",
     "Mechanism",
     "Motion",
     "Part",
+    "PinInSlot",
+    "Pivot",
     "PlanarError",
+    "Rigid",
+    "Scene",
     "SceneError",
+    "SimSettings",
+    "Slide",
+    "SliderCrank",
+    "Triad",
+    "compare",
+    "export",
     "joint_residuals",
+    "load_scene",
+    "render",
+    "scene_from_mechanism",
+    "simulate",
 ]
 __version__ = "0.1.0"
 
-_MODEL_NAMES = ("Driver", "Mechanism", "Motion", "Part", "joint_residuals")
+#: name -> the module that defines it, imported on first use
+_LAZY: dict[str, str] = {
+    **dict.fromkeys(
+        ("Driver", "Mechanism", "Motion", "Part", "PinInSlot", "Pivot", "Slide", "joint_residuals"),
+        "planar.core.model",
+    ),
+    **dict.fromkeys(
+        ("FourBar", "SliderCrank", "Linkage", "Link", "Fixed", "Crank", "Actuator", "RRR", "RRP", "Rigid", "Triad"),
+        "planar.linkages",
+    ),
+    **dict.fromkeys(("Scene", "load_scene", "scene_from_mechanism"), "planar.scene.load"),
+    **dict.fromkeys(("SimSettings", "simulate"), "planar.physics.simulate"),
+}
 
 
 def __getattr__(name: str) -> Any:
-    if name in _MODEL_NAMES:
-        from planar.core import model
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'planar' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value  # later reads skip this function
+    return value
 
-        return getattr(model, name)
-    raise AttributeError(f"module 'planar' has no attribute {name!r}")
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
+
+def _scene(obj: Scene | Mechanism, tables: dict[str, Any]) -> Scene:
+    """``obj`` as a scene: a :class:`Scene` as it is, a :class:`Mechanism` through :func:`scene_from_mechanism`."""
+    from planar.scene.load import Scene, scene_from_mechanism
+
+    if isinstance(obj, Scene):
+        if tables:
+            raise InputError(", ".join(sorted(tables)), "given with a Scene", "scene tables only with a Mechanism")
+        return obj
+    return scene_from_mechanism(obj, **tables)
+
+
+def render(obj: Scene | Mechanism, out: str | Path, *, progress: bool = False, fps: float | None = None, **tables: Any) -> int:
+    """Render a scene or a mechanism to an animation file, as ``planar render`` does; returns the frame count.
+
+    Parameters
+    ----------
+    obj : Scene or Mechanism
+        A loaded scene (:func:`load_scene`) or a mechanism built in Python.
+    out : str or Path
+        ``.gif`` (reproducible bytes), or ``.mp4``/``.webm`` with the ``video`` extra.
+    progress : bool
+        Show a progress bar on a terminal.
+    fps : float, optional
+        Frames per second (default: the scene's ``[render] fps``).
+    **tables
+        For a mechanism only: scene tables as dicts (``driver``, ``render``,
+        ``effects``, ``fabrication``, ``name``), e.g. ``render={"width": 320}``.
+
+    Returns
+    -------
+    int
+        The number of frames written.
+    """
+    from planar.app.pipeline import render_scene
+
+    return render_scene(_scene(obj, tables), out, progress=progress, fps=fps)
+
+
+def export(
+    obj: Scene | Mechanism,
+    dxf: str | Path | None = None,
+    svg: str | Path | None = None,
+    *,
+    fabrication: dict[str, Any] | None = None,
+    **files: Any,
+) -> Fabrication:
+    """Lay a scene's or a mechanism's parts out for cutting and write the files, as ``planar export`` does.
+
+    Parameters
+    ----------
+    obj : Scene or Mechanism
+        A loaded scene or a mechanism built in Python.
+    dxf, svg : str or Path, optional
+        The cut sheet as DXF (layers CUT, ENGRAVE, ...) and as SVG, in millimetres.
+    fabrication : dict, optional
+        For a mechanism only: ``[fabrication]`` keys (``unit_mm``, ``kerf_mm``,
+        ``sheet_mm``, ...); a scene carries its own.
+    **files
+        ``preview``, ``bom``, ``assembly``, ``kerf_test`` (paths) and the
+        ``kerf`` (mm) and ``sheet`` ((width, height) mm) overrides.
+
+    Returns
+    -------
+    Fabrication
+        The parts, their placement on the sheet and the files written; every
+        file goes to a temporary and is renamed only when all succeeded.
+    """
+    from planar.app.pipeline import export_scene
+
+    scene = _scene(obj, {} if fabrication is None else {"fabrication": fabrication})
+    return export_scene(scene, dxf, svg, **files)
+
+
+def compare(
+    obj: Scene | Mechanism,
+    *,
+    settings: SimSettings | None = None,
+    threshold: float = 1e-3,
+    torque_threshold: float = 0.01,
+    **tables: Any,
+) -> tuple[Comparison, SimResult]:
+    """Rebuild a scene or a mechanism in pymunk, run it, and compare it with the analytic motion.
+
+    As ``planar compare`` does: per-part pose errors and per-joint drift as a
+    fraction of :attr:`Mechanism.size`, and, for a steadily turning driver,
+    the motor torque against inverse dynamics.
+
+    Parameters
+    ----------
+    obj : Scene or Mechanism
+        A loaded scene or a mechanism built in Python.
+    settings : SimSettings, optional
+        Time step, substeps and solver iterations (default: planar's defaults).
+    threshold : float
+        Largest pose error accepted, as a fraction of the size (the simulation
+        stops at the first part further off).
+    torque_threshold : float
+        Largest motor-torque difference accepted, relative to the peak.
+    **tables
+        For a mechanism only: scene tables as dicts (``driver``, ``effects``...).
+
+    Returns
+    -------
+    (Comparison, SimResult)
+        ``comparison.passed`` is false when a check failed (the CLI exits 3).
+    """
+    from planar.physics.compare import compare_scene
+
+    return compare_scene(_scene(obj, tables), settings, threshold, torque_threshold)

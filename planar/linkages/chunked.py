@@ -290,7 +290,7 @@ def _rigid(node: Any, pos: dict[str, tuple[Coord, Coord]], q: Array, w: Scratch,
 
 
 #: per node kind: (node, bound from its refs, grows from its refs, bounds, grows, index) -> (bound, grows),
-#: a bound on the node's |coordinate| at q = 0 and whether it moves with |q| (downstream of an actuator)
+#: a bound on the node's ``|coordinate|`` at ``q = 0`` and whether it moves with ``|q|`` (downstream of an actuator)
 BOUNDS: dict[str, Callable[..., tuple[float, bool]]] = {
     "fixed": lambda nd, b, g, bound, grows, index: (float(np.hypot(*nd.xy)), g),
     "crank": lambda nd, b, g, bound, grows, index: (b + nd.radius, g),

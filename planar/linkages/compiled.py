@@ -60,7 +60,7 @@ _INVPIO2 = 6.36619772367581382433e-01
 _PIO2_1 = 1.57079632673412561417e00
 _PIO2_2 = 6.07710050630396597660e-11
 _PIO2_2T = 2.02226624879595063154e-21
-#: largest |angle| the polynomial sine and cosine take (beyond: the C library's)
+#: largest ``|angle|`` the polynomial sine and cosine take (beyond: the C library's)
 SINCOS_MAX = 2.0**19 * math.pi / 2
 _S1, _S2, _S3 = -1.66666666666666324348e-01, 8.33333333332248946124e-03, -1.98412698298579493134e-04
 _S4, _S5, _S6 = 2.75573137070700676789e-06, -2.50507602534068634195e-08, 1.58969099521155010221e-10

@@ -6,4 +6,26 @@
   :mod:`.function_search` — a search for a valid four-bar on one circuit when it is none;
 * :mod:`.motion` — motion generation by Burmester theory (3, 4, 5 poses);
 * :mod:`.scene_out` — the result as a scene file.
+
+Every name in ``__all__`` is imported from its module on first use (:func:`planar.core.lazy.attach`).
 """
+
+from planar.core.lazy import attach
+
+__getattr__, __dir__, __all__ = attach(
+    __name__,
+    {
+        "FourBarDesign": "planar.synth.path",
+        "synthesise_path": "planar.synth.path",
+        "SixBarDesign": "planar.synth.sixbar",
+        "synthesise_sixbar": "planar.synth.sixbar",
+        "FunctionDesign": "planar.synth.function",
+        "synthesise_function": "planar.synth.function",
+        "search_function": "planar.synth.function_search",
+        "MotionDesign": "planar.synth.motion",
+        "burmester": "planar.synth.motion",
+        "Design": "planar.synth.design",
+        "design_toy": "planar.synth.design",
+        "load_request": "planar.synth.design",
+    },
+)

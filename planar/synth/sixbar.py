@@ -43,7 +43,7 @@ __all__ = ["TOPOLOGIES", "SixBarDesign", "sixbar_points", "synthesise_sixbar"]
 Array = NDArray[np.float64]
 TOPOLOGIES = ("stephenson", "watt")
 N6 = 15  # continuous parameters; columns 15, 16 are the circuit signs
-#: the second dyad must close with h^2 / (l5^2 |E - O6|^2) at least this over the turn
+#: the second dyad must close with ``h^2 / (l5^2 |E - O6|^2)`` at least this over the turn
 DYAD_MARGIN = 1e-4
 
 

@@ -211,8 +211,8 @@ def test_the_cam_key_angle_names_the_phase_and_the_stages_own_turn() -> None:
 
 def test_exit_status_3_is_documented_for_every_command_that_returns_it() -> None:
     epilog = " ".join(build_parser().epilog.split())
-    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
-    row = next(ln for ln in readme.splitlines() if ln.startswith("| 3 |"))
+    contract = (Path(__file__).resolve().parents[2] / "docs" / "explanation" / "contract.md").read_text()
+    row = next(ln for ln in contract.splitlines() if ln.startswith("| 3 |"))
     for cmd in ("compare", "toy", "design", "synth"):
         assert cmd in epilog and f"`planar {cmd}`" in row, cmd
     assert "own check" in epilog and "own check" in row
