@@ -9,6 +9,7 @@ numpy loads is one line, not a traceback).
 
 from __future__ import annotations
 
+import sys
 from typing import TYPE_CHECKING, Any
 
 from planar.errors import AssemblyError, InputError, LimitError, PlanarError, SceneError
@@ -29,6 +30,9 @@ __all__ = [
     "joint_residuals",
 ]
 __version__ = "0.1.0"
+
+if "IPython" in sys.modules:  # a notebook: mechanisms and motions display as tables and players
+    import planar.draw.notebook  # noqa: F401  (light: registers renderers (planar.core.display); numpy loads on first display)
 
 _MODEL_NAMES = ("Driver", "Mechanism", "Motion", "Part", "joint_residuals")
 
