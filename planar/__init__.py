@@ -20,6 +20,7 @@ handling is in place (a Ctrl-C while numpy loads is one line, not a traceback).
 from __future__ import annotations
 
 import importlib
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -82,6 +83,9 @@ _LAZY: dict[str, str] = {
     **dict.fromkeys(("Scene", "load_scene", "scene_from_mechanism"), "planar.scene.load"),
     **dict.fromkeys(("SimSettings", "simulate"), "planar.physics.simulate"),
 }
+
+if "IPython" in sys.modules:  # a notebook: mechanisms and motions display as tables and players
+    import planar.draw.notebook  # noqa: F401  (light: registers renderers (planar.core.display); numpy loads on first display)
 
 
 def __getattr__(name: str) -> Any:

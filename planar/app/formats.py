@@ -22,6 +22,7 @@ FORMATS: dict[str, tuple[str, str]] = {
     "gif": ("exporters.gif", "animation, streamed frame by frame"),
     "mp4": ("exporters.video", "animation through ffmpeg (the video extra)"),
     "webm": ("exporters.video", "animation through ffmpeg (the video extra)"),
+    "html": ("exporters.html", "animation player: one self-contained page of SVG and JavaScript"),
     "dxf": ("exporters.dxf", "cut sheets for a laser cutter, millimetres"),
     "svg": ("exporters.svg", "cut sheets and the assembly drawing, millimetres"),
     "png": ("exporters.preview", "a photo-like preview of a cut sheet"),

@@ -109,7 +109,7 @@ def overlay_motion(scene: Scene) -> Motion:
 
 
 #: output suffixes ``render_scene`` writes
-ANIMATION_SUFFIXES = (".gif", ".mp4", ".webm")
+ANIMATION_SUFFIXES = (".gif", ".mp4", ".webm", ".html")
 
 
 def animation_plan(scene: Scene, out: str | Path, fps: float | None = None) -> FramePlan:
@@ -164,7 +164,7 @@ def render_scene(
     suffix = Path(out).suffix.lower()
     if suffix not in ANIMATION_SUFFIXES:
         raise InputError("-o", str(out), f"an animation file ending in {', '.join(ANIMATION_SUFFIXES)}")
-    if suffix != ".gif":
+    if suffix not in (".gif", ".html"):
         from planar.app.formats import writer
 
         video_available = writer("mp4").video_available
@@ -211,6 +211,14 @@ def render_scene(
             )
     if overlay is not None:
         overlay = resample(overlay, plan.times())
+    if suffix == ".html":
+        from planar.app.formats import writer
+        from planar.draw.player import player_html
+
+        with numeric_guard(scene, "the animation"):
+            page = player_html(scene.mechanism, motion, fine, scene_style(scene), frame_ms=plan.delay_ms)
+        writer("html").write_html(out, page)
+        return len(motion)
     polys = {n: scene.polygons[n] for n in scene.spec.render.sweep}
     with numeric_guard(scene, "the animation"):
         r = Renderer(scene.mechanism, motion, scene_style(scene), overlay=overlay, polygons=polys, trail_motion=fine)

@@ -53,12 +53,85 @@ def _matplotlib_gif(mech, motion, path: str, width: int, height: int, delay_ms: 
     plt.close(fig)
 
 
-def bench_render(n: int = 120, repeats: int = 5, width: int = 480, height: int = 360) -> dict[str, Any]:
-    """Frames per second and GIF size: planar's renderer vs matplotlib's animation writer.
+#: the scenes whose long render's peak memory ``bench render`` reports: the embedded demo's Horse and the Jansen leg
+MEMORY_SCENES = ("horse", "jansen-leg")
+
+_JANSEN = {
+    "name": "jansen-leg",
+    "mechanism": {
+        "type": "linkage",
+        "points": {"foot": "F"},
+        "nodes": [
+            {"name": "O", "kind": "fixed", "at": [0.0, 0.0]},
+            {"name": "Z", "kind": "fixed", "at": [-38.0, -7.8]},
+            {"name": "A", "kind": "crank", "centre": "O", "radius": 15.0},
+            {"name": "B", "kind": "rrr", "a": "A", "ra": 50.0, "b": "Z", "rb": 41.5, "branch": -1},
+            {"name": "C", "kind": "rrr", "a": "A", "ra": 61.9, "b": "Z", "rb": 39.3, "branch": 1},
+            {"name": "D", "kind": "rrr", "a": "B", "ra": 55.8, "b": "Z", "rb": 40.1, "branch": -1},
+            {"name": "E", "kind": "rrr", "a": "D", "ra": 39.4, "b": "C", "rb": 36.7, "branch": -1},
+            {"name": "F", "kind": "rrr", "a": "E", "ra": 65.7, "b": "C", "rb": 49.0, "branch": -1},
+        ],
+        "links": [
+            {"name": "crank", "nodes": ["O", "A"]},
+            {"name": "j", "nodes": ["A", "B"]},
+            {"name": "k", "nodes": ["A", "C"]},
+            {"name": "upper", "nodes": ["Z", "B", "D"]},
+            {"name": "c", "nodes": ["Z", "C"]},
+            {"name": "f", "nodes": ["D", "E"]},
+            {"name": "lower", "nodes": ["C", "E", "F"]},
+        ],
+    },
+    "driver": {"speed": 1.0, "samples_per_cycle": 36},
+    "render": {"width": 320, "height": 240},
+}
+
+_MEMORY_CHILD = """
+import json, resource, sys, time
+from planar.app.pipeline import render_scene
+from planar.scene.load import build_scene, parse_scene
+data = json.loads(sys.argv[1])
+scene = build_scene(parse_scene(data, "<bench>"), "<bench>")
+t0 = time.process_time()
+n = render_scene(scene, sys.argv[2], progress=False)
+print(json.dumps({"frames": n, "cpu_s": time.process_time() - t0,
+                  "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0}))
+"""
+
+
+def render_peak_memory(name: str, frames: int) -> dict[str, Any]:
+    """Peak resident memory (MB, ``ru_maxrss`` of a fresh process) of rendering ``frames`` frames of ``name``
+    (``"horse"``: the demo's Horse, ``"jansen-leg"``) to a GIF at 25 frames/s, and the CPU seconds it took."""
+    import json
+    import subprocess
+    import sys
+    import tempfile
+
+    from planar.app.pipeline import DEMO_SCENES
+
+    data = json.loads(json.dumps(_JANSEN if name == "jansen-leg" else DEMO_SCENES[name]))
+    speed = data["driver"]["speed"]
+    data["driver"]["cycles"] = frames / (25.0 / speed)  # 25 frames/s: a cycle is 25/speed frames
+    data["render"]["fps"] = 25.0
+    with tempfile.TemporaryDirectory() as tmp:
+        out = subprocess.run(
+            [sys.executable, "-c", _MEMORY_CHILD, json.dumps(data), os.path.join(tmp, "x.gif")],
+            capture_output=True,
+            text=True,
+            check=True,
+        )
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def bench_render(
+    n: int = 120, repeats: int = 5, width: int = 480, height: int = 360, memory_frames: int = 10_000
+) -> dict[str, Any]:
+    """Frames per second and GIF size: planar's renderer vs matplotlib's animation writer; and peak memory.
 
     Both draw the same four-bar (parts as filled outlines, coupler trail) at
     the same size and frame count into a GIF; the best of ``repeats`` runs
-    each, end to end (drawing, palette, encoding, file).
+    each, end to end (drawing, palette, encoding, file).  Then the Horse and
+    the Jansen leg are rendered to ``memory_frames`` frames each in a fresh
+    process, whose peak resident memory (MB) is reported (0 frames: skipped).
     """
     import tempfile
 
@@ -100,6 +173,7 @@ def bench_render(n: int = 120, repeats: int = 5, width: int = 480, height: int =
         "planar_gif_bytes": size_ours,
         "peer_gif_bytes": size_peer,
         "size_ratio": size_ours / size_peer,
+        "memory": {name: render_peak_memory(name, memory_frames) for name in MEMORY_SCENES} if memory_frames else {},
     }
 
 
@@ -110,5 +184,9 @@ def format_render(r: dict[str, Any]) -> str:
             f"  planar        {r['planar_fps']:8.1f} frames/s   {r['planar_gif_bytes']:>9,} bytes",
             f"  matplotlib    {r['peer_fps']:8.1f} frames/s   {r['peer_gif_bytes']:>9,} bytes",
             f"  ratio planar/matplotlib  {r['ratio']:.2f} (frames/s), size {r['size_ratio']:.2f}",
+        ]
+        + [
+            f"peak memory, {m['frames']:,} frames of {name}: {m['peak_mb']:.0f} MB ({m['cpu_s']:.1f} s CPU)"
+            for name, m in r.get("memory", {}).items()
         ]
     )

@@ -44,6 +44,7 @@ COMMANDS: tuple[tuple[str, str], ...] = (
     ("toy", "planar.cli.toy"),
     ("design", "planar.cli.design"),
     ("plot", "planar.cli.plot"),
+    ("info", "planar.cli.info"),
     ("synth", "planar.cli.synth"),
 )
 

@@ -29,13 +29,14 @@ def _cmd_render(args: argparse.Namespace) -> int:
 def add_parser(sub: Any) -> None:
     """Add ``planar render`` to the subcommands ``sub``."""
 
-    r = sub.add_parser("render", help="render a scene's animation to a GIF (or MP4/WebM)")
+    r = sub.add_parser("render", help="render a scene's animation to a GIF, an HTML player (or MP4/WebM)")
     r.add_argument("scene", help="scene file (TOML)")
     r.add_argument(
         "-o",
         "--output",
         required=True,
-        help="animation to write: .gif, or .mp4/.webm with the video extra (pip install 'planar[video]')",
+        help="animation to write: .gif, .html (a self-contained player page), or .mp4/.webm with the video "
+        "extra (pip install 'planar[video]')",
     )
     r.add_argument(
         "--fps",

@@ -476,9 +476,31 @@ class Motion:
     fail_table: list[tuple[str, str]] = field(default_factory=list)
     points: dict[str, Array] = field(default_factory=dict)
     t: Array | None = None
+    #: the mechanism solved (set by :meth:`Mechanism.solve`; what ``animate`` and the notebook display draw)
+    mechanism: Any = field(default=None, repr=False, compare=False)
 
     def __len__(self) -> int:
         return int(self.driver.shape[0])
+
+    def __repr__(self) -> str:
+        n = len(self)
+        bad = n - int(np.count_nonzero(self.valid))
+        src = f" of {self.mechanism.name!r}" if self.mechanism is not None else ""
+        span = f", driver {float(self.driver[0]):.4g} to {float(self.driver[-1]):.4g}" if n else ""
+        return f"<Motion{src}: {n} samples, {len(self.poses)} parts, {bad} invalid{span}>"
+
+    def _repr_html_(self) -> str | None:
+        from planar.core.display import html
+
+        return html("motion", self)
+
+    def animate(self, **options: Any) -> Any:
+        """An animation player of this motion (see :func:`planar.draw.notebook.animate`); needs its mechanism."""
+        from planar.core.display import RENDERERS
+
+        if self.mechanism is None:
+            raise InputError("motion.mechanism", None, "a motion made by Mechanism.solve or run (it knows its mechanism)")
+        return RENDERERS["animate"](self.mechanism, self, **options)
 
     def reason(self, i: int) -> str:
         """Why sample ``i`` is invalid (empty string when it is valid)."""
@@ -504,6 +526,7 @@ class Motion:
             fail_table=list(self.fail_table),
             points={k: v[idx] for k, v in self.points.items()},
             t=None if self.t is None else self.t[idx],
+            mechanism=self.mechanism,
         )
 
     @property
@@ -688,6 +711,7 @@ class Mechanism:
             fail_table=table,
             points=pts,
             t=None if t is None else np.asarray(t, dtype=float),
+            mechanism=self,
         )
 
     def _solve_points(
@@ -725,6 +749,23 @@ class Mechanism:
 
     def __repr__(self) -> str:
         return f"<{type(self).__name__} {self.name!r}: {len(self.parts)} parts, {len(self.joints)} joints>"
+
+    def _repr_html_(self) -> str | None:
+        from planar.core.display import html
+
+        return html("mechanism", self)
+
+    def animate(self, samples_per_cycle: int = 72, **options: Any) -> Any:
+        """An animation player of one cycle (``samples_per_cycle`` frames), shown inline in a notebook.
+
+        See :func:`planar.draw.notebook.animate` for the options; ``.save("x.html")`` writes the page.
+        The drawing side (:mod:`planar.draw.notebook`) must be imported (``import planar`` in a notebook does).
+        """
+        from planar.core.display import RENDERERS
+
+        if "animate" not in RENDERERS:
+            raise InputError("animate", self.name, "planar.draw.notebook imported first (import planar.draw.notebook)")
+        return RENDERERS["animate"](self, self.run(samples_per_cycle=samples_per_cycle), **options)
 
 
 def _with_joint_features(parts: tuple[Part, ...], joints: Sequence[Any]) -> tuple[Part, ...]:

@@ -19,6 +19,7 @@ loop only issues drawing calls.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -28,10 +29,38 @@ from numpy.typing import NDArray
 from planar.core.geometry import poses_apply
 from planar.core.model import Mechanism, Motion, Part
 
-__all__ = ["Renderer", "Style", "palette_colors", "project"]
+__all__ = ["CHUNK_FRAMES", "Renderer", "Style", "palette_colors", "project"]
 
 Array = NDArray[np.float64]
 RGB = tuple[int, int, int]
+
+#: frames whose outlines are computed together: the renderer's memory is bounded by this, not by the animation
+CHUNK_FRAMES = 256
+
+
+@dataclass
+class _Chunk:
+    """Pixel geometry of frames ``start`` to ``stop`` (exclusive): per part its rings ``(K, M, 2)``,
+    the swept polygons, the pins ``(K, 2)`` and the overlay's parts."""
+
+    start: int
+    stop: int
+    parts: list[list[Array]]
+    sweeps: list[list[Array]]
+    pins: dict[str, Array]
+    overlay: list[list[Array]]
+
+
+def _extent(tracks: Sequence[Array]) -> tuple[Array, Array] | None:
+    """Lowest and highest finite point of ``tracks`` (arrays of points, last axis 2), or None if none is finite."""
+    if not tracks:
+        return None
+    allp = np.concatenate([np.asarray(v).reshape(-1, 2) for v in tracks])
+    allp = allp[np.all(np.isfinite(allp), axis=1)]
+    if allp.size == 0:
+        return None
+    return allp.min(0), allp.max(0)
+
 
 PART_COLORS = ("#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b07aa1", "#ff9da7", "#9c755f", "#bab0ac")
 
@@ -169,13 +198,11 @@ class Renderer:
         s = self.style
         self.S = max(1, int(s.supersample))
         self.W, self.H = s.width, s.height
-        world = self._world_geometry(self.motion)
         fine = self.trail_motion if self.trail_motion is not None else self.motion
         self._fine_valid = np.asarray(fine.valid, bool)
-        frame_trails = world["trails"]  # the point on its trail at each frame
-        if self.trail_motion is not None:
-            world["trails"] = self._trails(self.trail_motion)
-        self._fit(world)
+        self._lock = threading.Lock()
+        self._cached: _Chunk | None = None
+        self._fit(fine)
         self.lw = max(1.0, s.line_width)
         # static parts (pose constant over the motion) go into the pre-drawn layer
         self.static: list[int] = []
@@ -186,15 +213,9 @@ class Renderer:
                 self.static.append(i)
             else:
                 self.moving.append(i)
-        self.world_parts = [[self._px(r) for r in rings] for rings in world["parts"]]
-        self.sweep_rings = [[self._px(v)] for v in world["sweeps"].values()]
-        self.trails = {k: self._px(v) for k, v in world["trails"].items()}
-        self.trail_dots = {k: self._px(v) for k, v in frame_trails.items()}
-        self.pins = {k: self._px(v) for k, v in world["pins"].items()}
-        self.overlay_parts = []
-        if self.overlay is not None:
-            ow = self._world_geometry(self.overlay)
-            self.overlay_parts = [[self._px(r) for r in rings] for rings in ow["parts"]]
+        # trails are one point per sample: held whole (the outlines are computed a chunk of frames at a time)
+        self.trails = {k: self._px(v) for k, v in self._trails(fine).items()}
+        self.trail_dots = {k: self._px(v) for k, v in self._trails(self.motion).items()}
         self.base = self._static_layer()
         self.trail_layer = self._trail_layer()
         self.dot = {c: self._dot(_rgb(c), 2.2) for c in (s.pin, s.trail, s.invalid)}
@@ -204,13 +225,13 @@ class Renderer:
             [(self._px(r), c) for r, c in self.marks.dots],
         )
 
-    # -- geometry, all frames at once --------------------------------------------
+    # -- geometry, a chunk of frames at once ----------------------------------------
     def _world_geometry(self, motion: Motion) -> dict:
+        """Every part's rings, the swept polygons and the pins of ``motion``'s samples, in view coordinates."""
         parts = []
         for p in self.mech.parts:
             pose = motion.poses[p.name]
             parts.append([project(p, poses_apply(pose, r), self.view) for r in _rings(p)])
-        trails = self._trails(motion)
         sweeps = {}
         for n, (pname, pts) in self.polygons.items():
             part = self.mech.part(pname)
@@ -222,7 +243,38 @@ class Renderer:
                 part = self.mech.part(pname)
                 key = j.name if k == 0 else f"{j.name}#{k}"
                 pins[key] = project(part, poses_apply(motion.poses[pname], xy), self.view)
-        return {"parts": parts, "trails": trails, "sweeps": sweeps, "pins": pins}
+        return {"parts": parts, "sweeps": sweeps, "pins": pins}
+
+    def chunk(self, i: int) -> _Chunk:
+        """The pixel geometry of the chunk of :data:`CHUNK_FRAMES` frames holding frame ``i`` (the last one is kept)."""
+        with self._lock:
+            c = self._cached
+            if c is not None and c.start <= i < c.stop:
+                return c
+        start = (i // CHUNK_FRAMES) * CHUNK_FRAMES
+        stop = min(len(self), start + CHUNK_FRAMES)
+        idx = np.arange(start, stop)
+        world = self._world_geometry(self.motion.take(idx))
+        overlay: list[list[Array]] = []
+        if self.overlay is not None:
+            ow = self._world_geometry(self.overlay.take(idx))
+            overlay = [[self._px(r) for r in rings] for rings in ow["parts"]]
+        c = _Chunk(
+            start,
+            stop,
+            [[self._px(r) for r in rings] for rings in world["parts"]],
+            [[self._px(v)] for v in world["sweeps"].values()],
+            {k: self._px(v) for k, v in world["pins"].items()},
+            overlay,
+        )
+        with self._lock:
+            self._cached = c
+        return c
+
+    def part_rings(self, k: int, i: int) -> list[Array]:
+        """Part ``k``'s rings (exterior first) at frame ``i``, in output pixels."""
+        c = self.chunk(i)
+        return [r[i - c.start] for r in c.parts[k]]
 
     def _trails(self, motion: Motion) -> dict[str, Array]:
         names = self.style.trails if self.style.trails is not None else list(motion.points)
@@ -233,26 +285,31 @@ class Renderer:
                 trails[n] = project(part, motion.points[n], self.view)
         return trails
 
-    def _fit(self, world: dict) -> None:
+    def _fit(self, fine: Motion) -> None:
         """Scale and origin that frame the geometry of the motion's valid samples.
 
         Invalid samples (a linkage that cannot close there) may hold any
         numbers, so they never move the camera; with no valid sample at all,
-        every finite point is framed.
+        every finite point is framed.  The extent is gathered a chunk of
+        frames at a time (the minimum and maximum of the chunks' extents are
+        those of the whole, exactly).
         """
         valid = np.asarray(self.motion.valid, bool)
         keep = valid if valid.any() else np.ones_like(valid)
         fine_keep = self._fine_valid if self._fine_valid.any() else np.ones_like(self._fine_valid)
-        tracks = [r for rings in world["parts"] for r in rings]  # (N, M, 2) each
-        tracks += list(world["sweeps"].values())  # (N, M, 2)
-        allp = np.concatenate(
-            [np.asarray(v)[keep].reshape(-1, 2) for v in tracks]
-            + [np.asarray(v)[fine_keep].reshape(-1, 2) for v in world["trails"].values()]
-        )
-        allp = allp[np.all(np.isfinite(allp), axis=1)]
-        if allp.size == 0:
-            allp = np.zeros((1, 2))
-        lo, hi = allp.min(0), allp.max(0)
+        boxes = [_extent([np.asarray(v)[fine_keep] for v in self._trails(fine).values()])]
+        for start in range(0, len(self), CHUNK_FRAMES):
+            idx = np.arange(start, min(len(self), start + CHUNK_FRAMES))
+            world = self._world_geometry(self.motion.take(idx))
+            tracks = [r for rings in world["parts"] for r in rings]  # (K, M, 2) each
+            tracks += list(world["sweeps"].values())  # (K, M, 2)
+            boxes.append(_extent([np.asarray(v)[keep[idx]] for v in tracks]))
+        found = [b for b in boxes if b is not None]
+        if found:
+            lo = np.min([b[0] for b in found], axis=0)
+            hi = np.max([b[1] for b in found], axis=0)
+        else:
+            lo = hi = np.zeros(2)
         span = np.maximum(hi - lo, 1e-12)
         m = self.style.margin
         scale = min(self.W * (1 - 2 * m) / span[0], self.H * (1 - 2 * m) / span[1])
@@ -298,7 +355,7 @@ class Renderer:
         lw = max(1, int(round(self.lw * S)))
         for i in self.static:
             p = self.mech.parts[i]
-            rings = [r[0] * S for r in self.world_parts[i]]
+            rings = [r * S for r in self.part_rings(i, 0)]
             mask = Image.new("L", img.size, 0)
             md = ImageDraw.Draw(mask)
             md.polygon([tuple(q) for q in rings[0]], fill=255)
@@ -362,9 +419,14 @@ class Renderer:
 
     def frame(self, i: int):
         """Frame ``i`` as a PIL RGB image of the style's size."""
+        return self._frame(i, self.chunk(i))
+
+    def _frame(self, i: int, c: _Chunk):
+        """Frame ``i`` drawn from the chunk ``c`` that holds it."""
         from PIL import ImageDraw
 
         s = self.style
+        k = i - c.start
         img = self.base.copy()
         valid = bool(self.motion.valid[i])
         draw = ImageDraw.Draw(img)
@@ -373,21 +435,21 @@ class Renderer:
             fill = self._fill(idx, self.mech.parts[idx])
             if not valid:
                 fill = tuple(int(0.5 * a + 0.5 * b) for a, b in zip(fill, tint))  # type: ignore[assignment]
-            self._draw_rings(img, [r[i] for r in self.world_parts[idx]], fill, self.style.opacity)
-        for rings in self.sweep_rings:
-            self._draw_rings(img, [r[i] for r in rings], _rgb(s.sweep), self.style.opacity)
+            self._draw_rings(img, [r[k] for r in c.parts[idx]], fill, self.style.opacity)
+        for rings in c.sweeps:
+            self._draw_rings(img, [r[k] for r in rings], _rgb(s.sweep), self.style.opacity)
         self._draw_marks(img, draw, i)
         if self.trail_layer is not None:
             img.paste(_rgb(s.trail), (0, 0, self.W, self.H), self.trail_layer)
-        for rings in self.overlay_parts:
+        for rings in c.overlay:
             for r in rings:
-                pts = np.vstack([r[i], r[i][:1]]).ravel().tolist()
+                pts = np.vstack([r[k], r[k][:1]]).ravel().tolist()
                 draw.line(pts, fill=_rgb(s.overlay), width=max(1, int(round(self.lw))))
         if s.show_pins:
             dot = self.dot[s.pin]
             h = dot.size[0] // 2
-            for track in self.pins.values():
-                x, y = track[i]
+            for track in c.pins.values():
+                x, y = track[k]
                 img.paste(dot, (int(round(x)) - h, int(round(y)) - h), dot)
         dot = self.dot[s.trail]
         h = dot.size[0] // 2
@@ -395,7 +457,7 @@ class Renderer:
             x, y = tr[i]
             img.paste(dot, (int(round(x)) - h, int(round(y)) - h), dot)
         if not valid:
-            self._mark_invalid(draw, i)
+            self._mark_invalid(draw, k, c)
         return img
 
     def _draw_marks(self, img, draw, i: int) -> None:
@@ -412,15 +474,15 @@ class Renderer:
             x, y = pts[i]
             img.paste(dot, (int(round(x)) - h, int(round(y)) - h), dot)
 
-    def _mark_invalid(self, draw, i: int) -> None:
+    def _mark_invalid(self, draw, k: int, c: _Chunk) -> None:
         s = self.style
-        code = int(self.motion.fail_code[i])
+        code = int(self.motion.fail_code[c.start + k])
         joint = self.motion.fail_table[code][0] if code >= 0 else ""
         red = _rgb(s.invalid)
         draw.rectangle([0, 0, self.W - 1, self.H - 1], outline=red, width=3)
-        for name, pts in self.pins.items():
+        for name, pts in c.pins.items():
             if name == joint or name.split(":")[0] == joint or joint.endswith("." + name) or joint == name.split(".")[-1]:
-                x, y = pts[i]
+                x, y = pts[k]
                 r = 7
                 draw.ellipse([x - r, y - r, x + r, y + r], outline=red, width=2)
         draw.text((6, 4), f"invalid: joint {joint}", fill=red)
@@ -445,21 +507,25 @@ class Renderer:
             from tqdm import tqdm
 
             bar = tqdm(total=n, desc="render", unit="frame", disable=not sys.stderr.isatty(), leave=False)
-        try:
-            work = self.frame if post is None else (lambda i: post(self.frame(i)))
-            if threads <= 1 or n < 8:
-                for i in range(n):
-                    yield work(i)
-                    if bar is not None:
-                        bar.update()
-                return
-            from concurrent.futures import ThreadPoolExecutor
+        from concurrent.futures import ThreadPoolExecutor
 
-            with ThreadPoolExecutor(threads) as ex:
-                for img in ex.map(work, range(n)):
+        # the geometry is computed a chunk at a time and only that chunk's frames are queued: memory stays flat
+        pool = ThreadPoolExecutor(threads) if threads > 1 and n >= 8 else None
+        try:
+            for start in range(0, n, CHUNK_FRAMES):
+                c = self.chunk(start)
+
+                def work(i: int, c: _Chunk = c):
+                    img = self._frame(i, c)
+                    return img if post is None else post(img)
+
+                frames = range(c.start, c.stop)
+                for img in map(work, frames) if pool is None else pool.map(work, frames):
                     yield img
                     if bar is not None:
                         bar.update()
         finally:
+            if pool is not None:
+                pool.shutdown()
             if bar is not None:
                 bar.close()

@@ -69,13 +69,21 @@ def layer_order(mech: Mechanism, unit_mm: float = 100.0, samples: int = 24) -> d
     return {k: (v if v is not None else 0) for k, v in asm.layers.items()}
 
 
-def _extent(parts: list[Part], poses: dict[str, Array], valid: NDArray[np.bool_]) -> tuple[Array, Array]:
-    pts = []
+def _extent(parts: list[Part], poses: dict[str, Array], valid: NDArray[np.bool_], chunk: int = 256) -> tuple[Array, Array]:
+    """Lowest and highest point of ``parts``' outlines over the ``valid`` samples, gathered ``chunk`` samples at a
+    time (the renderer's memory stays bounded by a chunk of frames; the extent is the same, exactly)."""
+    lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
+    found = False
     for p in parts:
         ring = np.asarray(p.outline.exterior.coords)
-        pts.append(poses_apply(poses[p.name][valid], ring).reshape(-1, 2))
-    allp = np.concatenate(pts) if pts else np.zeros((1, 2))
-    return allp.min(0), allp.max(0)
+        track = poses[p.name][valid]
+        for start in range(0, len(track), chunk):
+            pts = poses_apply(track[start : start + chunk], ring).reshape(-1, 2)
+            lo, hi = np.minimum(lo, pts.min(0)), np.maximum(hi, pts.max(0))
+            found = True
+    if not found:
+        return np.zeros(2), np.zeros(2)
+    return lo, hi
 
 
 def _taper(mech_parts: dict[str, Part], j: CamOnLine, P: Any, pose: Array) -> Array:

@@ -38,6 +38,14 @@ class Scene:
     path: str = "<scene>"
     polygons: dict[str, tuple[str, np.ndarray]] = field(default_factory=dict)
 
+    def __repr__(self) -> str:
+        return f"<Scene {self.spec.name!r} from {self.path}: {self.mechanism!r}>"
+
+    def _repr_html_(self) -> str | None:
+        from planar.core.display import html
+
+        return html("scene", self)
+
     def sample_count(self) -> int:
         """Samples of :meth:`motion`, checked against :mod:`planar.core.limits` (samples and memory)
         before anything is allocated; :class:`~planar.errors.LimitError` names the scene's field."""

@@ -162,7 +162,7 @@ def test_trails_are_drawn_above_the_parts(tmp_path):
     for i in range(0, len(frames), 5):
         img = np.asarray(r.frame(i)).astype(int)
         for k in r.moving:
-            ext = Polygon(r.world_parts[k][0][i]).buffer(-3)
+            ext = Polygon(r.part_rings(k, i)[0]).buffer(-3)
             for pts in r.trails.values():
                 for x, y in pts[::3]:
                     if ext.contains(Point(x, y)):

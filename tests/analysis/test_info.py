@@ -1,0 +1,141 @@
+"""planar info: the homework figures checked against hand computations written here (closed forms)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from planar.analysis.info import info
+from planar.cli.main import main
+from planar.linkages.fourbar import FourBar
+from planar.scene.load import load_scene
+
+GALLERY = Path(__file__).resolve().parents[2] / "gallery"
+
+
+def _hand_crank_rocker(a: float, b: float, c: float, d: float):
+    """Crank-rocker by the law of cosines: the rocker's dead centres (crank and coupler in line, O2 C = b + a
+    extended and b - a folded), its swing, the time ratio (180 + alpha) / (180 - alpha) and the transmission
+    angle's extremes (crank along the ground line, theta = 0 and 180 deg)."""
+    # angle at O2 of the triangle O2 C O4 (sides O2C, c, d), C above the ground line (open circuit)
+    ext = math.acos(((b + a) ** 2 + d**2 - c**2) / (2 * (b + a) * d))
+    fold = math.acos(((b - a) ** 2 + d**2 - c**2) / (2 * (b - a) * d))
+    theta_ext = ext  # crank along O2 -> C
+    theta_fold = fold + math.pi  # crank pointing away from C
+    alpha = abs(fold - ext)  # crank angle beyond 180 deg of the slow stroke
+    ratio = (math.pi + alpha) / (math.pi - alpha)
+    psi_ext = math.acos((d**2 + c**2 - (b + a) ** 2) / (2 * d * c))  # rocker angle at O4 from O4->O2
+    psi_fold = math.acos((d**2 + c**2 - (b - a) ** 2) / (2 * d * c))
+    swing = abs(psi_ext - psi_fold)
+    mu0 = math.acos((b**2 + c**2 - (d - a) ** 2) / (2 * b * c))
+    mu180 = math.acos((b**2 + c**2 - (d + a) ** 2) / (2 * b * c))
+    return sorted(map(math.degrees, (theta_ext, theta_fold))), ratio, math.degrees(swing), math.degrees(mu0), math.degrees(mu180)
+
+
+@pytest.mark.parametrize(
+    "dims",
+    [(4.0, 1.0, 3.5, 3.0), (7.0, 2.0, 6.0, 5.5), (1.0, 0.11, 0.98, 0.35)],  # the last: extreme ratios
+)
+def test_crank_rocker_figures_match_the_law_of_cosines(dims):
+    d, a, b, c = dims
+    r = info(FourBar(ground=d, crank=a, coupler=b, rocker=c))
+    assert r.dof == 1
+    assert r.grashof == "crank-rocker" and r.turns_fully == ["crank"]
+    assert r.toggle_angles == [] and r.valid_range == [(0.0, 360.0)]
+    dead, ratio, swing, mu0, mu180 = _hand_crank_rocker(a, b, c, d)
+    (rocker,) = [o for o in r.outputs if o.part == "rocker"]
+    assert rocker.motion == "rocks"
+    assert rocker.dead_centres == pytest.approx(dead, abs=1e-6)
+    assert rocker.time_ratio == pytest.approx(ratio, rel=1e-9)
+    assert r.time_ratio == pytest.approx(ratio, rel=1e-9)
+    assert rocker.swing == pytest.approx(swing, abs=1e-6)
+    (t,) = r.transmission
+    assert min(t.low, t.high) == pytest.approx(min(mu0, mu180), abs=1e-9)
+    assert max(t.low, t.high) == pytest.approx(max(mu0, mu180), abs=1e-9)
+    worst = mu0 if abs(mu0 - 90) > abs(mu180 - 90) else mu180
+    assert t.worst == pytest.approx(worst, abs=1e-9)
+
+
+def test_random_crank_rockers():
+    rng = np.random.default_rng(7)
+    done = 0
+    while done < 4:
+        a, b, c, d = rng.uniform(0.2, 5.0, 4)
+        if not (a < min(b, c, d) and a + max(b, c, d) < sum((a, b, c, d)) - a - max(b, c, d)):
+            continue
+        r = info(FourBar(ground=d, crank=a, coupler=b, rocker=c), samples=720)
+        dead, ratio, swing, _, _ = _hand_crank_rocker(a, b, c, d)
+        (rocker,) = [o for o in r.outputs if o.part == "rocker"]
+        assert rocker.time_ratio == pytest.approx(ratio, rel=1e-8), (a, b, c, d)
+        assert rocker.dead_centres == pytest.approx(dead, abs=1e-6)
+        assert rocker.swing == pytest.approx(swing, abs=1e-6)
+        done += 1
+
+
+def test_triple_rocker_toggles_are_the_law_of_cosines():
+    d, a, b, c = 2.0, 2.2, 1.9, 2.5  # s + l = 4.4 > p + q = 4.2: non-Grashof
+    r = info(FourBar(ground=d, crank=a, coupler=b, rocker=c))
+    assert r.grashof == "non-Grashof" and r.turns_fully == []
+    # toggles where B O4 = b + c or |b - c|: a^2 + d^2 - 2 a d cos(theta) = (b +/- c)^2
+    ends = []
+    for L in (b + c, abs(b - c)):
+        cs = (a * a + d * d - L * L) / (2 * a * d)
+        if -1 <= cs <= 1:
+            th = math.acos(cs)
+            ends += [math.degrees(th), 360 - math.degrees(th)]
+    assert r.toggle_angles == pytest.approx(sorted(ends), abs=1e-9)
+    assert r.outputs == []  # the input cannot turn: no full cycle, no time ratio
+    assert r.time_ratio is None
+
+
+def test_quick_return_time_ratio_is_the_closed_form():
+    scene = load_scene(GALLERY / "quick-return.toml")
+    r = info(scene.mechanism)
+    # crank radius r, pivots d apart: the lever's extremes are tangent to the crank circle,
+    # alpha = 2 asin(r / d) ... the slow stroke spans 180 + alpha: ratio (180 + alpha) / (180 - alpha)
+    rad, dist = 1.0, 2.0
+    alpha = 180.0 - 2 * math.degrees(math.acos(rad / dist))
+    hand = (180.0 + alpha) / (180.0 - alpha)
+    (lever,) = [o for o in r.outputs if o.part == "lever"]
+    assert lever.time_ratio == pytest.approx(hand, rel=1e-9)
+    assert lever.swing == pytest.approx(2 * math.degrees(math.asin(rad / dist)), abs=1e-6)
+    assert r.dof == 1
+
+
+def test_offset_slider_crank_stroke_and_ratio():
+    scene = load_scene(GALLERY / "slider-crank.toml")
+    r = info(scene.mechanism)
+    a, rod, e = 1.0, 3.0, 0.4
+    hand_stroke = math.sqrt((a + rod) ** 2 - e**2) - math.sqrt((rod - a) ** 2 - e**2)
+    beta = math.asin(e / (rod - a)) - math.asin(e / (rod + a))
+    hand_ratio = (math.pi + beta) / (math.pi - beta)
+    (slider,) = [o for o in r.outputs if o.motion == "slides"]
+    assert slider.swing == pytest.approx(hand_stroke, rel=1e-9)
+    assert slider.time_ratio == pytest.approx(hand_ratio, rel=1e-8)
+
+
+@pytest.mark.slow
+def test_gruebler_counts_for_linkage_and_toy():
+    assert info(load_scene(GALLERY / "jansen-leg.toml").mechanism).dof == 1
+    horse = info(load_scene(GALLERY / "horse.toml").mechanism)
+    assert horse.dof == 1  # counted assembled: one frame, the cams on one shaft
+    assert horse.chains == {"left": [["Rz->OzT", "OzT->Oz"]], "right": [["Rz->OzT", "OzT->Ty"], ["Rz->OzT", "OzT->Oz"]]}
+    assert len(horse.stages) == 5
+
+
+def test_cli_text_and_json(capsys):
+    assert main(["info", str(GALLERY / "quick-return.toml")]) == 0
+    text = capsys.readouterr().out
+    assert "time ratio 2" in text and "degrees of freedom (Gruebler/Kutzbach): 1" in text
+    assert main(["info", str(GALLERY / "quick-return.toml"), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["time_ratio"] == pytest.approx(2.0)
+
+
+def test_cli_missing_scene_is_one_line(tmp_path, capsys):
+    assert main(["info", str(tmp_path / "nope.toml")]) == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1
