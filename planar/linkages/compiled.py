@@ -579,9 +579,9 @@ class Program:
         moving = [name for name, o, _, _ in plan.links if o >= 0]
         self.parts = [(name, moving.index(name) if o >= 0 else -1) for name, o, _, _ in plan.links]
         self.pt_names = [name for name, _ in plan.points]
-        #: a node moves with |q| (its tolerance depends on the batch)
+        #: a node moves with ``|q|`` (its tolerance depends on the batch)
         self.grows = any(plan.grows)
-        #: the branch-screen tolerances when no node moves with |q| (as ``chunked._tols``)
+        #: the branch-screen tolerances when no node moves with ``|q|`` (as ``chunked._tols``)
         self.tol = np.array([1e-9 * (1.0 + b) for b in plan.bound])
         row = np.array(plan.placement, dtype=float)
         row.flags.writeable = False
