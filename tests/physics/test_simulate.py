@@ -240,9 +240,16 @@ def test_rocker_driven_to_its_toggles():
     assert all(np.isfinite(p).all() for p in analytic.poses.values())
     sim = simulate(fb, t)
     assert all(np.isfinite(p).all() for p in sim.motion.poses.values())
+    # at a toggle the assembly branch is undecided: pymunk may go on in the other one, and only there; the
+    # joints still hold (a branch switch, not a blow-up) and up to the toggle the motion is the analytic one
+    toggles = np.flatnonzero(np.abs(np.abs(fb.driver.value(t) - mid) - amp) < 1e-9 * amp)
+    assert toggles.size >= 1
+    f = sim.failure
+    if f is not None:
+        assert f.kind == "branch", f.message
+        assert 0 <= f.sample - toggles[0] <= 2, (f.sample, toggles)
     c = compare(fb, analytic, sim.motion)
-    # the toggle makes the solver's job ill-conditioned: the error grows there but stays bounded
-    assert c.max_rel_error < 1e-2 or sim.blowup is not None
+    assert c.first_over is None or c.first_over > toggles[0], (c.first_over, toggles)
 
 
 def test_elemental_near_its_failure_boundary():
