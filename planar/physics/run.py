@@ -508,32 +508,97 @@ def torque_comparison(
     # one sample of lead-in, so that the first compared interval starts with settled joint forces
     sim = simulate(mech, np.concatenate([[t[0] - dt], t]), effects, settings, mode="motor", densities=densities)
     K = int(sim.built["substeps"])
-    # a step's impulse is what holds the motion at the step's end (symplectic Euler): compare with the
-    # analytic torque at the ends of the steps of the interval ending at each sample, averaged
-    t_fine = t[0] - dt + (np.arange(t.size * K) + 1.0) * (dt / K)
-    fine = inverse_dynamics_torque(mech, t_fine, effects, densities, t_rest=float(t[0] - dt))
-    analytic = fine.reshape(t.size, K).mean(axis=1)
+    analytic = _interval_torque(mech, t, K, effects, densities)
     tau = np.asarray(sim.torque, float)[1:]
     upto = t.size if sim.failure is None else sim.failure.sample - 1
-    peak = float(np.abs(analytic[1:]).max()) or 1.0
-    diff = np.abs(tau[1:upto] - analytic[1:upto]) if upto > 1 else np.zeros(1)
+    peak = float(np.abs(analytic[1:]).max()) if t.size > 1 else 0.0
+    scale = max(peak, torque_scale(mech, t[: min(t.size, _SCALE_SAMPLES)], effects, densities))
+    diff = np.abs(tau[1:upto] - analytic[1:upto]) if upto > 1 else np.zeros(0)
+    worst = int(np.argmax(diff)) + 1 if diff.size else None
     limit = effects.motor_force_limit if effects is not None else None
     out = {
         "analytic": analytic.tolist(),
         "simulated": [None] + [None if not np.isfinite(v) else float(v) for v in tau[1:]],
         "peak": peak,
-        "max_abs_diff": float(diff.max()),
-        "max_rel_diff": float(diff.max() / peak),
-        "samples_compared": max(upto - 1, 0),
+        "scale": scale,
+        "max_abs_diff": float(diff.max()) if diff.size else None,
+        "max_rel_diff": float(diff.max() / scale) if diff.size and scale > 0 else 0.0,
+        "worst_sample": worst,
+        "worst_angle_deg": None if worst is None else float(np.degrees(mech.driver.value(t[worst]))),
+        "samples_compared": int(diff.size),
         "motor_force_limit": limit,
         "saturated": (sim.saturated[sim.saturated > 0] - 1).tolist(),
         "failure": None if sim.failure is None else sim.failure.message,
+        "failure_kind": None if sim.failure is None else sim.failure.kind,
         "pose_error": max(sim.pose_error.values(), default=0.0),
         "pins": "each groove's pin is a body of its own whose mass is taken out of its part "
         "(same mass, centre and moment), so both sides model the same inertia",
-        "note": "simulated torque: the motor's signed impulse per step / dt (mean over the interval)",
+        "note": "simulated torque: the motor's signed impulse per step / dt (mean over the interval); "
+        "differences are fractions of the mechanism's torque scale (see torque_scale)",
         "wall_time": sim.wall_time,
         "substeps": K,
         "iterations": sim.built["iterations"],
+        "correction": sim.built["correction"],
     }
     return out
+
+
+#: samples of the run over which :func:`torque_scale` is measured (a cycle's worth is enough)
+_SCALE_SAMPLES = 4096
+
+
+def _interval_torque(mech: Mechanism, t: Array, K: int, effects: Effects | None, densities: dict[str, float] | None) -> Array:
+    """Analytic torque averaged over the ``K`` steps' ends of the interval ending at each sample, in chunks.
+
+    A step's impulse is what holds the motion at the step's end (symplectic
+    Euler), so the steps' ends are where pymunk's torque is compared.
+    """
+    dt = float(t[1] - t[0])
+    out = np.empty(t.size)
+    chunk = max(1, _STEP_CHUNK // K)
+    for i0 in range(0, t.size, chunk):
+        m = min(chunk, t.size - i0)
+        t_fine = t[i0] - dt + (np.arange(m * K) + 1.0) * (dt / K)
+        fine = inverse_dynamics_torque(mech, t_fine, effects, densities, t_rest=float(t[0] - dt))
+        out[i0 : i0 + m] = fine.reshape(m, K).mean(axis=1)
+    return out
+
+
+def torque_scale(mech: Mechanism, t: Array, effects: Effects | None = None, densities: dict[str, float] | None = None) -> float:
+    """The mechanism's own torque scale at times ``t`` (force x length), for judging a torque difference.
+
+    The largest over ``t`` of ``sum (m |a . v| + m |g . v| + I |alpha omega|) / w``
+    over the moving parts plus ``sum |F . v| / w`` over the loads (``w`` the
+    driver's rate): the torque each inertial and load term alone asks of the
+    motor, without the cancellations that can leave the true torque at zero
+    (a crank driving a slider at constant speed); and at least the largest
+    kinetic energy per radian of the driver, ``sum (m |v|^2 + I omega^2) / 2``.
+    A torque difference is reported as a fraction of this, never of a peak
+    that may be round-off.
+    """
+    from planar.analysis.dynamics import _wrapped, gravity_and_damping, part_mass_table, plane_gravity
+
+    t = np.asarray(t, float)
+    drv = mech.driver
+    w = float(drv.rate)
+    h = 1e-4 * drv.period
+    m0, mp, mm = (mech.solve(drv.value(t + d)) for d in (0.0, h, -h))
+    g, _ = gravity_and_damping(effects)
+    work = np.zeros(t.size)
+    energy = np.zeros(t.size)
+    for name, (mass, cog, inertia) in part_mass_table(mech, effects, densities).items():
+        gp = plane_gravity(getattr(mech.part(name), "plane", "xy"), g)
+        X0, Xp, Xm = (poses_apply(m.poses[name], np.asarray(cog, float)) for m in (m0, mp, mm))
+        v = (Xp - Xm) / (2 * h)
+        a = (Xp - 2 * X0 + Xm) / (h * h)
+        fwd = _wrapped(mp.poses[name][:, 2] - m0.poses[name][:, 2])
+        back = _wrapped(m0.poses[name][:, 2] - mm.poses[name][:, 2])
+        om = (fwd + back) / (2 * h)
+        al = (fwd - back) / (h * h)
+        work += (mass * (np.abs((a * v).sum(-1)) + np.abs((gp * v).sum(-1))) + inertia * np.abs(al * om)) / w
+        energy += 0.5 * (mass * (v * v).sum(-1) + inertia * om * om)
+    if effects is not None:
+        for load in effects.loads:
+            vp = (mp.points[load.point] - mm.points[load.point]) / (2 * h)
+            work += np.abs((np.asarray(load.force, float) * vp).sum(-1)) / w
+    return float(max(work.max(initial=0.0), energy.max(initial=0.0)))

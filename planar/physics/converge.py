@@ -1,0 +1,123 @@
+"""Solver settings chosen by measured behaviour: escalate the budget until two budgets agree.
+
+A run at the given settings that holds its analytic motion is taken as it
+is (no extra cost).  One that does not is run again with the budget its
+failure asks for: more solver iterations where a joint's constraint error
+moved the part (a blow-up, a branch switch, or a drift with a joint residual
+comparable to the pose error), more substeps where the part drifted while its
+joints held.  The search ends with one of three verdicts:
+
+* ``"pass"``: a budget at which the run holds (its settings are reported);
+* ``"differs"``: two budgets agree (the same first failing sample, errors
+  within a factor of two): the mechanism itself leaves the analytic motion;
+* ``"unconverged"``: the CPU-time cap was reached while each budget still
+  changed the result ("could not converge within N s").
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+from planar.physics.settings import SimSettings
+
+__all__ = ["DEFAULT_TIME_CAP", "Search", "converge", "failure_cause", "hint"]
+
+#: CPU seconds the search may spend on one mechanism by default
+DEFAULT_TIME_CAP = 60.0
+
+#: most budgets tried (each doubles one knob)
+_MAX_TRIES = 6
+
+
+@dataclass
+class Search:
+    """What the search tried and concluded."""
+
+    verdict: str
+    settings: SimSettings
+    tried: list[str] = field(default_factory=list)
+    cpu_s: float = 0.0
+    cap_s: float = DEFAULT_TIME_CAP
+
+    def line(self) -> str:
+        """One line for the terminal."""
+        if self.verdict == "unconverged":
+            return f"could not converge within {self.cap_s:g} s (tried {'; '.join(self.tried)})"
+        if self.verdict == "differs":
+            return f"two budgets agree ({'; '.join(self.tried[-2:])}): the mechanism differs from its analytic motion"
+        if len(self.tried) > 1:
+            return f"converged at {self.tried[-1]} (tried {'; '.join(self.tried[:-1])})"
+        return f"held at {self.tried[-1]}"
+
+
+def failure_cause(kind: str | None, error: float, residual: float) -> str | None:
+    """``"constraint"`` (the joints' error moved the part), ``"drift"`` (the part drifted with its joints
+    holding) or ``None`` for no failure; ``error`` and ``residual`` are fractions of the size."""
+    if kind is None:
+        return None
+    if kind in ("blow-up", "branch") or residual >= 0.1 * error:
+        return "constraint"
+    return "drift"
+
+
+def hint(cause: str | None) -> str:
+    """The change that helps for a cause of failure (checked by the tests)."""
+    return {
+        "constraint": "raise the solver iterations (--iterations): the joints' constraint error moved the part",
+        "drift": "raise the substeps (--substeps): the part drifted while its joints held",
+        "saturation": "raise [effects] motor_force_limit above the needed peak, or lighten the heavy part "
+        "(a lower [effects] density or a smaller coupler)",
+    }.get(cause or "", "")
+
+
+def label(settings: SimSettings, built: dict[str, Any]) -> str:
+    """``substeps 28, iterations 40, correction 0.2`` as the run used them."""
+    return (
+        f"substeps {built.get('substeps', settings.substeps)}, iterations {built.get('iterations', settings.iterations)}, "
+        f"correction {float(built.get('correction', settings.correction)):.3g}"
+    )
+
+
+def _next(settings: SimSettings, built: dict[str, Any], cause: str) -> SimSettings:
+    if cause == "constraint":
+        return replace(settings, iterations=2 * settings.iterations)
+    return replace(settings, substeps=2 * int(built.get("substeps", settings.substeps)))
+
+
+def converge(
+    run: Callable[[SimSettings], Any],
+    outcome: Callable[[Any], tuple[str | None, int, float, dict[str, Any]]],
+    settings: SimSettings,
+    cap_s: float = DEFAULT_TIME_CAP,
+) -> tuple[Any, Search]:
+    """Run at ``settings``, escalating on failure; returns the last result and the :class:`Search`.
+
+    ``run(settings)`` simulates; ``outcome(result)`` gives ``(cause, first
+    failing sample, error / size, built settings)``, cause ``None`` when it held.
+    """
+    t0 = time.process_time()
+    tried: list[str] = []
+    last: tuple[int, float] | None = None
+    knob_failed: str | None = None
+    res = None
+    for _ in range(_MAX_TRIES):
+        res = run(settings)
+        cause, sample, err, built = outcome(res)
+        tried.append(label(settings, built))
+        spent = time.process_time() - t0
+        if cause is None:
+            return res, Search("pass", settings, tried, spent, cap_s)
+        if last is not None and abs(sample - last[0]) <= 1 and 0.5 <= err / max(last[1], 1e-300) <= 2.0:
+            return res, Search("differs", settings, tried, spent, cap_s)
+        if last is not None and sample < last[0]:
+            knob_failed = cause  # this knob made it fail earlier: turn the other one
+        if knob_failed == cause:
+            cause = "drift" if cause == "constraint" else "constraint"
+        last = (sample, err)
+        if spent * 3.0 > cap_s:  # the next budget costs about twice this one
+            break
+        settings = _next(settings, built, cause)
+    return res, Search("unconverged", settings, tried, time.process_time() - t0, cap_s)
