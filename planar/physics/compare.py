@@ -72,7 +72,10 @@ class Comparison:
         if self.search is not None and self.search.verdict == "unconverged":
             out.append(f"simulation {self.search.line()}; last: {self.failure}")
         elif self.failure:
-            why = " (two budgets agree: the mechanism differs)" if self.search and self.search.verdict == "differs" else ""
+            verdict = self.search.verdict if self.search is not None else None
+            why = {"differs": " (two budgets agree: the mechanism differs)", "change-point": " at a change point"}.get(
+                verdict or "", ""
+            )
             out.append(f"simulation failed{why}: {self.failure}" + (f"; {self.hint}" if self.hint else ""))
         if self.max_rel_error > self.threshold and not self.failure:
             worst = max(self.parts, key=lambda p: p.max_rel_error)
@@ -256,6 +259,10 @@ def _torque_outcome(threshold: float) -> Any:
     return outcome
 
 
+#: a run that holds but is further than this fraction of the threshold from its analytic motion is refined
+_AIM = 0.1
+
+
 def compare_scene(
     scene: Any,
     settings: Any = None,
@@ -284,7 +291,15 @@ def compare_scene(
     settings = replace(settings or DEFAULT_SETTINGS, tolerance=threshold)
     mech = scene.mechanism
     motion = scene.motion()
-    sim, search = converge(lambda st: simulate_scene(scene, st, mode="kinematic"), _kinematic_outcome(mech), settings, cap)
+    aim = threshold * _AIM
+
+    def rough(sim: Any) -> float | None:
+        e = max(sim.pose_error.values(), default=0.0)
+        return e if e > aim else None
+
+    sim, search = converge(
+        lambda st: simulate_scene(scene, st, mode="kinematic"), _kinematic_outcome(mech), settings, cap, refine=rough
+    )
     result = compare(mech, motion, sim.motion, threshold=threshold)
     result.torque_threshold = torque_threshold
     result.search = search

@@ -10,6 +10,8 @@ joints held.  The search ends with one of three verdicts:
 * ``"pass"``: a budget at which the run holds (its settings are reported);
 * ``"differs"``: two budgets agree (the same first failing sample, errors
   within a factor of two): the mechanism itself leaves the analytic motion;
+* ``"change-point"``: the run left its assembly where the analytic motion
+  passes a change point or toggle (either assembly is a solution there);
 * ``"unconverged"``: the CPU-time cap was reached while each budget still
   changed the result ("could not converge within N s").
 """
@@ -46,6 +48,8 @@ class Search:
         """One line for the terminal."""
         if self.verdict == "unconverged":
             return f"could not converge within {self.cap_s:g} s (tried {'; '.join(self.tried)})"
+        if self.verdict == "change-point":
+            return f"at {self.tried[-1]}, the simulation took the other assembly at a change point (no budget decides that)"
         if self.verdict == "differs":
             return f"two budgets agree ({'; '.join(self.tried[-2:])}): the mechanism differs from its analytic motion"
         if len(self.tried) > 1:
@@ -54,10 +58,13 @@ class Search:
 
 
 def failure_cause(kind: str | None, error: float, residual: float) -> str | None:
-    """``"constraint"`` (the joints' error moved the part), ``"drift"`` (the part drifted with its joints
-    holding) or ``None`` for no failure; ``error`` and ``residual`` are fractions of the size."""
+    """Why a run failed: ``"constraint"`` (the joints' error moved the part), ``"drift"`` (the part drifted
+    with its joints holding), ``"change-point"`` (it took the other assembly at a change point) or ``None``
+    for no failure; ``error`` and ``residual`` are fractions of the size."""
     if kind is None:
         return None
+    if kind == "change-point":
+        return "change-point"
     if kind in ("blow-up", "branch") or residual >= 0.1 * error:
         return "constraint"
     return "drift"
@@ -92,16 +99,21 @@ def converge(
     outcome: Callable[[Any], tuple[str | None, int, float, dict[str, Any]]],
     settings: SimSettings,
     cap_s: float = DEFAULT_TIME_CAP,
+    refine: Callable[[Any], float | None] | None = None,
 ) -> tuple[Any, Search]:
     """Run at ``settings``, escalating on failure; returns the last result and the :class:`Search`.
 
     ``run(settings)`` simulates; ``outcome(result)`` gives ``(cause, first
     failing sample, error / size, built settings)``, cause ``None`` when it held.
+    ``refine(result)``: for a run that held, its error when that is above the
+    accuracy aimed at (else ``None``); such a run is raised once more (iterations)
+    and the better of the two kept: two budgets that agree within the aim settle it.
     """
     t0 = time.process_time()
     tried: list[str] = []
     last: tuple[int, float] | None = None
     knob_failed: str | None = None
+    held: tuple[Any, float, SimSettings] | None = None
     res = None
     for _ in range(_MAX_TRIES):
         res = run(settings)
@@ -109,7 +121,18 @@ def converge(
         tried.append(label(settings, built))
         spent = time.process_time() - t0
         if cause is None:
-            return res, Search("pass", settings, tried, spent, cap_s)
+            rough = refine(res) if refine is not None and held is None else None
+            if rough is None or spent * 3.0 > cap_s:
+                if held is not None and _error(refine, res) > held[1]:
+                    return held[0], Search("pass", held[2], tried, spent, cap_s)
+                return res, Search("pass", settings, tried, spent, cap_s)
+            held = (res, rough, settings)
+            settings = replace(settings, iterations=2 * settings.iterations)
+            continue
+        if held is not None:  # the refinement failed where the coarser budget held: keep that one
+            return held[0], Search("pass", held[2], tried, spent, cap_s)
+        if cause == "change-point":  # either assembly is right there: no budget decides it
+            return res, Search("change-point", settings, tried, spent, cap_s)
         if last is not None and abs(sample - last[0]) <= 1 and 0.5 <= err / max(last[1], 1e-300) <= 2.0:
             return res, Search("differs", settings, tried, spent, cap_s)
         if last is not None and sample < last[0]:
@@ -121,3 +144,8 @@ def converge(
             break
         settings = _next(settings, built, cause)
     return res, Search("unconverged", settings, tried, time.process_time() - t0, cap_s)
+
+
+def _error(refine: Callable[[Any], float | None] | None, res: Any) -> float:
+    e = refine(res) if refine is not None else None
+    return 0.0 if e is None else e

@@ -5,7 +5,7 @@ from __future__ import annotations
 import ctypes
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -39,6 +39,8 @@ class SimFailure:
     """Where and how a simulation left its analytic motion.
 
     ``kind``: ``"blow-up"`` (non-finite state or a joint came apart),
+    ``"change-point"`` (a branch switch or drift within three samples after the
+    analytic motion passes a change point or toggle, see :func:`change_point`),
     ``"branch"`` (every joint holds but a part is more than ten tolerances
     elsewhere: another assembly branch) or ``"drift"`` (the part is off by
     more than ``tolerance``, the joints by less than ``blowup_tol``).  ``error``: the part's distance from its
@@ -350,7 +352,14 @@ def _rebuilt(
 
 
 def _failure_at(
-    mech: Mechanism, rb: _Rebuild, check: _PoseCheck, raw: Array, hit: tuple[int, str, float], t: Array, settings: SimSettings
+    mech: Mechanism,
+    rb: _Rebuild,
+    check: _PoseCheck,
+    raw: Array,
+    hit: tuple[int, str, float],
+    t: Array,
+    settings: SimSettings,
+    analytic: dict[str, Array],
 ) -> SimFailure:
     done = hit[0]
     poses_all = check.part_poses(raw[: done + 1])
@@ -358,7 +367,65 @@ def _failure_at(
     for p in mech.parts:
         if p.name not in pp:
             pp[p.name] = np.repeat(rb.static_pose[p.name][None, :], done + 1, axis=0)
-    return _classify(mech, pp, done, hit[1], hit[2], float(t[done]), settings)
+    f = _classify(mech, pp, done, hit[1], hit[2], float(t[done]), settings)
+    if f.kind in ("branch", "drift"):
+        cp = change_point(mech, analytic, max(0, done - 3), done + 1)
+        if cp is not None:
+            k, joint, a, b = cp
+            f = replace(
+                f,
+                kind="change-point",
+                message=f"{f.message}; the analytic motion passes a change point or toggle at sample {k} (joint "
+                f"{joint!r} in line with its neighbours on {a!r} and {b!r}), where the mechanism may go on "
+                "in either assembly",
+            )
+    return f
+
+
+def _joint_points(mech: Mechanism, poses: dict[str, Array], i0: int, i1: int) -> dict[str, list[tuple[str, Array]]]:
+    """Per part: its joints' names and world points over samples ``i0:i1``."""
+    per: dict[str, list[tuple[str, Array]]] = {}
+    for j in mech.joints:
+        pins = j.pins()
+        if not pins:
+            continue
+        part0, xy0 = pins[0]
+        w = poses_apply(poses[part0][i0:i1], np.asarray(xy0, float))
+        for side in (j.a, j.b):
+            per.setdefault(side, []).append((j.name, w))
+    return per
+
+
+def change_point(mech: Mechanism, poses: dict[str, Array], i0: int, i1: int) -> tuple[int, str, str, str] | None:
+    """A sample of ``i0:i1`` where a joint lies in line with a neighbouring joint on each of its two parts.
+
+    There two of the mechanism's links are stretched or folded in line: a
+    change point (a parallelogram folding) or a toggle, where the
+    constraints lose a rank and the motion may go on in either assembly.
+    Found where the triangle's signed area crosses zero between samples or
+    is within 1e-6 of the product of its sides.  Returns ``(sample, joint,
+    part a, part b)`` or ``None``.
+    """
+    per = _joint_points(mech, poses, i0, i1)
+    for j in mech.joints:
+        if not j.pins():
+            continue
+        here = next(w for name, w in per[j.a] if name == j.name)
+        for na, pa in per.get(j.a, []):
+            for nb, pb in per.get(j.b, []):
+                if j.name in (na, nb):
+                    continue
+                u, v = pa - here, pb - here
+                cross = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+                scale = np.hypot(u[:, 0], u[:, 1]) * np.hypot(v[:, 0], v[:, 1])
+                if not (scale > 0).all():
+                    continue
+                near = np.abs(cross) <= 1e-6 * scale
+                cross_zero = np.flatnonzero(np.signbit(cross[1:]) != np.signbit(cross[:-1])) + 1
+                hits = sorted(set(np.flatnonzero(near).tolist()) | set(cross_zero.tolist()))
+                if hits and not near.all():
+                    return i0 + hits[0], j.name, j.a, j.b
+    return None
 
 
 def _simulated_motion(
@@ -453,7 +520,7 @@ def simulate(
             hit = check.block(check.part_poses(raw[checked : i + 1]), checked)
             checked = i + 1
             if hit is not None:
-                failure = _failure_at(mech, rb, check, raw, hit, t, settings)
+                failure = _failure_at(mech, rb, check, raw, hit, t, settings, poses_a)
                 break
     wall = time.perf_counter() - t0
     motion = _simulated_motion(mech, rb, check, raw, analytic, t, failure)
