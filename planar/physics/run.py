@@ -371,61 +371,80 @@ def _failure_at(
     if f.kind in ("branch", "drift"):
         cp = change_point(mech, analytic, max(0, done - 3), done + 1)
         if cp is not None:
-            k, joint, a, b = cp
+            k, parts = cp
             f = replace(
                 f,
                 kind="change-point",
-                message=f"{f.message}; the analytic motion passes a change point or toggle at sample {k} (joint "
-                f"{joint!r} in line with its neighbours on {a!r} and {b!r}), where the mechanism may go on "
+                message=f"{f.message}; the analytic motion passes a change point or toggle at sample {k} (with the "
+                f"input held, {' and '.join(repr(p) for p in parts)} can still move), where the mechanism may go on "
                 "in either assembly",
             )
     return f
 
 
-def _joint_points(mech: Mechanism, poses: dict[str, Array], i0: int, i1: int) -> dict[str, list[tuple[str, Array]]]:
-    """Per part: its joints' names and world points over samples ``i0:i1``."""
-    per: dict[str, list[tuple[str, Array]]] = {}
-    for j in mech.joints:
-        pins = j.pins()
-        if not pins:
-            continue
-        part0, xy0 = pins[0]
-        w = poses_apply(poses[part0][i0:i1], np.asarray(xy0, float))
-        for side in (j.a, j.b):
-            per.setdefault(side, []).append((j.name, w))
-    return per
+def _closure_error(mech: Mechanism, poses: dict[str, Array]) -> Array:
+    """Sum of the squared joint residuals per sample (zero on the analytic motion)."""
+    return sum((np.asarray(j.residual(poses), float) ** 2 for j in mech.joints), np.zeros(len(next(iter(poses.values())))))
 
 
-def change_point(mech: Mechanism, poses: dict[str, Array], i0: int, i1: int) -> tuple[int, str, str, str] | None:
-    """A sample of ``i0:i1`` where a joint lies in line with a neighbouring joint on each of its two parts.
+def _mobility(mech: Mechanism, poses: dict[str, Array], free: list[str]) -> tuple[Array, Array]:
+    """Per sample: the smallest over the largest eigenvalue of ``J^T J`` with the imposed parts held, and
+    the eigenvector of the smallest (the free parts' way to move).
 
-    There two of the mechanism's links are stretched or folded in line: a
-    change point (a parallelogram folding) or a toggle, where the
-    constraints lose a rank and the motion may go on in either assembly.
-    Found where the triangle's signed area crosses zero between samples or
-    is within 1e-6 of the product of its sides.  Returns ``(sample, joint,
-    part a, part b)`` or ``None``.
+    ``J`` is the joints' constraint Jacobian in the free parts' poses (x, y
+    and angle x size), found as the Hessian of the summed squared residuals
+    by finite differences.  It is singular, the ratio near zero, where the
+    mechanism can move with its input held: a change point or a toggle.
     """
-    per = _joint_points(mech, poses, i0, i1)
-    for j in mech.joints:
-        if not j.pins():
-            continue
-        here = next(w for name, w in per[j.a] if name == j.name)
-        for na, pa in per.get(j.a, []):
-            for nb, pb in per.get(j.b, []):
-                if j.name in (na, nb):
-                    continue
-                u, v = pa - here, pb - here
-                cross = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
-                scale = np.hypot(u[:, 0], u[:, 1]) * np.hypot(v[:, 0], v[:, 1])
-                if not (scale > 0).all():
-                    continue
-                near = np.abs(cross) <= 1e-6 * scale
-                cross_zero = np.flatnonzero(np.signbit(cross[1:]) != np.signbit(cross[:-1])) + 1
-                hits = sorted(set(np.flatnonzero(near).tolist()) | set(cross_zero.tolist()))
-                if hits and not near.all():
-                    return i0 + hits[0], j.name, j.a, j.b
-    return None
+    size = mech.size
+    m = 3 * len(free)
+    h = 1e-4 * size
+    n = len(next(iter(poses.values())))
+
+    def shifted(steps: list[int]) -> dict[str, Array]:
+        out = dict(poses)
+        for k in steps:
+            part, c = free[k // 3], k % 3
+            arr = out[part].copy() if out[part] is poses[part] else out[part]
+            arr[:, c] += h if c < 2 else h / size
+            out[part] = arr
+        return out
+
+    f0 = _closure_error(mech, poses)
+    f1 = [_closure_error(mech, shifted([i])) for i in range(m)]
+    H = np.empty((n, m, m))
+    for i in range(m):
+        for j in range(i, m):
+            fij = _closure_error(mech, shifted([i, j]))
+            H[:, i, j] = H[:, j, i] = (fij - f1[i] - f1[j] + f0) / (h * h)
+    w, v = np.linalg.eigh(H)
+    top = np.maximum(w[:, -1], 1e-300)
+    return np.maximum(w[:, 0], 0.0) / top, v[:, :, 0]
+
+
+def change_point(mech: Mechanism, poses: dict[str, Array], i0: int, i1: int) -> tuple[int, list[str]] | None:
+    """A sample of ``i0:i1`` where the mechanism could move with its input held: a change point or toggle.
+
+    There the constraints lose a rank (:func:`_mobility`) and the motion may
+    go on in either assembly.  A sample counts when its ratio is below a
+    hundredth of the median over 16 samples spread along the run.  Returns
+    ``(sample, the parts that move most in the free motion)`` or ``None``.
+    """
+    imposed = set(_driven_parts(mech)) | {p.name for p in mech.parts if p.ground}
+    free = [p.name for p in mech.parts if p.name not in imposed]
+    if not free:
+        return None
+    n = len(next(iter(poses.values())))
+    ref = np.unique(np.linspace(0, n - 1, 16).astype(int))
+    idx = np.concatenate([np.arange(i0, i1), ref])
+    ratio, vec = _mobility(mech, {k: v[idx] for k, v in poses.items()}, free)
+    w = ratio[: i1 - i0]
+    k = int(np.argmin(w))
+    if not w[k] < 1e-2 * float(np.median(ratio[i1 - i0 :])):
+        return None
+    amount = np.abs(vec[k]).reshape(-1, 3).max(axis=1)
+    parts = [free[q] for q in np.argsort(-amount)[:2]]
+    return i0 + k, parts
 
 
 def _simulated_motion(
