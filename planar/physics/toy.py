@@ -318,6 +318,22 @@ def liftoff_speed(
     return None, runs
 
 
+def liftoff_resolution(speeds: Any, lift: float, refine: int = 5) -> float:
+    """How finely :func:`liftoff_speed` measured ``lift`` (cycles/s): the bracket it bisected, halved ``refine``
+    times (the whole first scanned speed when the first one already let go: no bisection then)."""
+    sc = [float(x) for x in speeds]
+    k = next(i for i, x in enumerate(sc) if x >= lift - 1e-12 * abs(lift))
+    if k == 0:
+        return sc[0]
+    return (sc[k] - sc[k - 1]) / 2**refine
+
+
+def format_speed(value: float, resolution: float) -> str:
+    """``value`` with as many decimals as ``resolution`` supports, e.g. ``3.41`` for a resolution of 0.06."""
+    decimals = max(0, -math.floor(math.log10(resolution))) if resolution > 0 else 6
+    return f"{value:.{decimals}f}"
+
+
 def hold_margin(
     mech: Any, gravity: tuple[float, float], density: float = 1.0, samples: int = 720, drive: StageDrive | None = None
 ) -> float:
@@ -669,6 +685,7 @@ def simulate_toy(
                 "predicted_speed": crit,
                 "scanned": sc,
                 "liftoff_speed": lift,
+                "resolution": None if lift is None else liftoff_resolution(sc, lift),
                 "sample": runs[-1].liftoff,
                 "pose_error": r0.pose_error,
             }
@@ -688,7 +705,11 @@ def simulate_toy(
                         )
                         + f"#8 one-sided contact: {'holds' if held else 'lets go'} at {speed:g} cycles/s "
                         f"(pose error {r0.pose_error:.2g} of the size); lift-off "
-                        + (f"at {lift:g} cycles/s, sample {runs[-1].liftoff}" if lift is not None else "not seen in the scan")
+                        + (
+                            f"at {format_speed(lift, res)} cycles/s (measured to {res:.2g}), sample {runs[-1].liftoff}"
+                            if lift is not None and (res := liftoff_resolution(sc, lift)) > 0
+                            else "not seen in the scan"
+                        )
                         + f"; inverse dynamics predicts {crit:.3g} cycles/s"
                     ),
                 )

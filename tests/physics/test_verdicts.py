@@ -122,3 +122,28 @@ def test_the_constraint_hint_helps():
     good = simulate(mech, t, None, replace(st, iterations=2 * st.iterations))
     assert good.failure is None or good.failure.sample > i
     assert np.isfinite(good.motion.poses[mech.driver.part]).all()
+
+
+def test_kite_names_its_coincident_pivots():
+    fb = FourBar(1.0, 1.0, 2.0, 2.0)  # ground = crank: at 0 the crank pin sits on the rocker's pivot
+    th = np.linspace(0.0, 2 * np.pi, 361)
+    m = fb.solve(th)
+    bad = np.flatnonzero(~m.valid)
+    assert bad.tolist() == [0]
+    why = m.reason(0)
+    assert "coincide" in why and "cannot span" not in why
+    # a four-bar that truly cannot span keeps saying so
+    fb2 = FourBar(4.0, 1.5, 2.0, 1.0)
+    m2 = fb2.solve(th)
+    i = int(np.flatnonzero(~m2.valid)[0])
+    assert "cannot span" in m2.reason(i)
+
+
+def test_liftoff_speed_is_printed_to_its_resolution():
+    from planar.physics.toy import format_speed, liftoff_resolution
+
+    res = liftoff_resolution([2.0, 4.0, 8.0], 3.4375)  # bisected five times between 2 and 4
+    assert res == pytest.approx(2.0 / 32)
+    assert format_speed(3.4375, res) == "3.44"
+    assert liftoff_resolution([2.0, 4.0], 2.0) == 2.0  # the first scanned speed let go: no bisection
+    assert format_speed(2.0, 2.0) == "2"
