@@ -242,7 +242,7 @@ def _kinematic_outcome(mech: Mechanism) -> Any:
             return None, len(sim.motion), 0.0, sim.built
         i = f.sample
         res = max((float(v[i]) for v in sim.residuals.values()), default=0.0) / mech.size
-        return failure_cause(f.kind, f.error, res), i, f.error, sim.built
+        return failure_cause(f.kind, f.error, res, float(sim.built.get("standing_drift", 0.0))), i, f.error, sim.built
 
     return outcome
 

@@ -57,17 +57,25 @@ class Search:
         return f"held at {self.tried[-1]}"
 
 
-def failure_cause(kind: str | None, error: float, residual: float) -> str | None:
-    """Why a run failed: ``"constraint"`` (the joints' error moved the part), ``"drift"`` (the part drifted
-    with its joints holding), ``"change-point"`` (it took the other assembly at a change point) or ``None``
-    for no failure; ``error`` and ``residual`` are fractions of the size."""
+def failure_cause(kind: str | None, error: float, residual: float, standing: float = 0.0) -> str | None:
+    """Why a run failed, from its first failing sample.
+
+    ``"change-point"`` (it took the other assembly at a change point);
+    ``"drift"`` when the joints' residual is what stepping alone leaves
+    standing (``standing``: the predicted drift per step over the correction
+    per step, see :func:`planar.physics.settings.joint_drift`), so smaller steps
+    help; else ``"constraint"``: the solver left more error than stepping
+    explains (a blow-up, a branch switch, a residual beyond three times the
+    standing drift), so more iterations help.  ``None`` for no failure.
+    ``error``, ``residual`` and ``standing`` are fractions of the size.
+    """
     if kind is None:
         return None
     if kind == "change-point":
         return "change-point"
-    if kind in ("blow-up", "branch") or residual >= 0.1 * error:
-        return "constraint"
-    return "drift"
+    if kind == "drift" and residual <= 3.0 * standing:
+        return "drift"
+    return "constraint"
 
 
 def hint(cause: str | None) -> str:

@@ -23,6 +23,7 @@ from planar.physics.settings import (
     SimulationError,
     _check_mechanism,
     _driven_parts,
+    joint_drift,
     mass_ratio_correction,
     moving_masses,
     substeps_for,
@@ -543,7 +544,10 @@ def simulate(
                 break
     wall = time.perf_counter() - t0
     motion = _simulated_motion(mech, rb, check, raw, analytic, t, failure)
-    built = dict(rb.built, mode=mode, pins_compensated=sorted(comp), substeps=sub)
+    c = float(rb.built["correction"])
+    # the joints' standing error from stepping alone: drift per step d, corrected by c per step, stands at d (1 - c) / c
+    standing = joint_drift(mech, poses_a, vel_a) * dt * dt * (1.0 - c) / c if c > 0 else math.inf
+    built = dict(rb.built, mode=mode, pins_compensated=sorted(comp), substeps=sub, standing_drift=standing)
     return SimResult(
         motion,
         settings,

@@ -5,6 +5,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from planar.core.effects import Effects
 from planar.linkages import FourBar
 from planar.physics.compare import compare_scene, torque_line
 from planar.physics.converge import converge, failure_cause, hint
@@ -98,9 +99,10 @@ def test_search_verdicts():
 
 
 def test_causes_and_their_hints():
-    assert failure_cause("blow-up", 0.1, 0.2) == "constraint"
-    assert failure_cause("drift", 2e-3, 1e-3) == "constraint"
-    assert failure_cause("drift", 2e-3, 1e-5) == "drift"
+    assert failure_cause("blow-up", 0.1, 0.2, 1.0) == "constraint"
+    assert failure_cause("drift", 2e-3, 1e-3, 1e-5) == "constraint"  # more residual than stepping leaves
+    assert failure_cause("drift", 2e-3, 1e-5, 1e-5) == "drift"
+    assert failure_cause("change-point", 0.1, 0.0) == "change-point"
     assert "--iterations" in hint("constraint") and "--substeps" in hint("drift")
     assert "motor_force_limit" in hint("saturation")
 
@@ -117,7 +119,7 @@ def test_the_constraint_hint_helps():
     assert bad.failure is not None
     i = bad.failure.sample
     res = max(float(v[i]) for v in bad.residuals.values()) / mech.size
-    cause = failure_cause(bad.failure.kind, bad.failure.error, res)
+    cause = failure_cause(bad.failure.kind, bad.failure.error, res, bad.built["standing_drift"])
     assert cause == "constraint" and "--iterations" in hint(cause)
     good = simulate(mech, t, None, replace(st, iterations=2 * st.iterations))
     assert good.failure is None or good.failure.sample > i
@@ -147,3 +149,39 @@ def test_liftoff_speed_is_printed_to_its_resolution():
     assert format_speed(3.4375, res) == "3.44"
     assert liftoff_resolution([2.0, 4.0], 2.0) == 2.0  # the first scanned speed let go: no bisection
     assert format_speed(2.0, 2.0) == "2"
+
+
+def _cause(sim, mech):
+    f = sim.failure
+    res = max(float(v[f.sample]) for v in sim.residuals.values()) / mech.size
+    return failure_cause(f.kind, f.error, res, sim.built["standing_drift"])
+
+
+@pytest.mark.slow
+def test_the_drift_hint_helps_and_the_other_knob_does_not():
+    # a four-bar at 12 samples a turn and 8 fixed substeps: the joints drift by what stepping leaves standing
+    fb = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0))
+    t = fb.driver.times(12)
+    st = SimSettings(substeps=8, iterations=40, step_drift=None)
+    bad = simulate(fb, t, None, st)
+    assert bad.failure is not None
+    cause = _cause(bad, fb)
+    assert cause == "drift" and "--substeps" in hint(cause)
+    more_steps = simulate(fb, t, None, replace(st, substeps=32))
+    assert more_steps.failure is None
+    more_iterations = simulate(fb, t, None, replace(st, iterations=80))  # the hint not given: no help
+    assert more_iterations.failure is not None
+
+
+@pytest.mark.slow
+def test_the_saturation_hint_helps():
+    fb = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0))
+    t = fb.driver.times(36)
+    peak = torque_comparison(fb, t, None)["peak"]
+    weak = torque_comparison(fb, t, Effects(motor_force_limit=0.3 * peak))
+    assert weak["saturated"]
+    assert "motor_force_limit" in hint("saturation")
+    strong = torque_comparison(fb, t, Effects(motor_force_limit=1.5 * peak))  # the limit above the needed peak
+    assert not strong["saturated"] and strong["max_rel_diff"] < 0.01
+    lighter = torque_comparison(fb, t, Effects(motor_force_limit=0.3 * peak, density=0.2))  # or lighter parts
+    assert not lighter["saturated"]
