@@ -306,10 +306,19 @@ class _MotorReader:
             raise SimulationError("the motor's signed impulse does not match pymunk's magnitude: unknown pymunk motor layout")
 
 
-def _run_steps(rb: _Rebuild, imposed: _Imposed | None, motor: _MotorReader, i: int, sub: int, dt: float) -> tuple[float, bool]:
+Load = tuple[Any, tuple[float, float], tuple[float, float]]
+
+
+def _loads(rb: _Rebuild, dt: float) -> list[Load]:
+    """Each load as (body, point in its frame, the force it pushes back with, per step)."""
+    return [(rb.bodies[part], rb._local(part, xy), (float(-F[0]) * dt * dt, float(-F[1]) * dt * dt)) for part, xy, F in rb.loads]
+
+
+def _run_steps(
+    rb: _Rebuild, imposed: _Imposed | None, motor: _MotorReader, loads: list[Load], i: int, sub: int, dt: float
+) -> tuple[float, bool]:
     """The physics steps of sample ``i``; returns the motor's mean torque over them (or nan) and whether it saturated."""
     step = rb.space.step
-    loads = [(rb.bodies[part], rb._local(part, xy), (float(-F[0]) * dt * dt, float(-F[1]) * dt * dt)) for part, xy, F in rb.loads]
     if imposed is not None:
         imposed.sample(i)
     if (imposed is None or not imposed.per_step) and not loads and motor.jacc is None:
@@ -523,6 +532,7 @@ def simulate(
     raw[0] = [(b.position.x, b.position.y, b.angle) for b in bodies]
     imposed = _Imposed(mech, rb, t, poses_a, sub, dt) if mode == "kinematic" else None
     motor = _MotorReader(rb, dt)
+    loads = _loads(rb, dt)
     torque = np.full(n, np.nan) if mode == "motor" else None
     sat = np.zeros(n, dtype=bool)
     block = max(4, min(64, 1024 // sub))
@@ -531,7 +541,7 @@ def simulate(
     steps = 0
     t0 = time.perf_counter()
     for i in range(1, n):
-        tau, sat[i] = _run_steps(rb, imposed, motor, i, sub, dt)
+        tau, sat[i] = _run_steps(rb, imposed, motor, loads, i, sub, dt)
         if torque is not None:
             torque[i] = tau
         steps += sub

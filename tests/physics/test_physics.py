@@ -92,9 +92,13 @@ def test_compare_exit_status_3_when_the_error_passes_the_threshold():
     d = json.loads(ok.stdout)
     assert d["passed"] and d["problems"] == [] and d["max_rel_error"] < 1e-3
     # the same run against a threshold below its own error fails, with status 3 and the reason
-    tight = run_cli("compare", path, "--threshold", f"{d['max_rel_error'] / 4:.3e}")
+    tight = run_cli("compare", path, "--threshold", f"{d['max_rel_error'] / 4:.3e}", "--time-cap", "1e-9")
     assert tight.returncode == EXIT_MISMATCH == 3, tight.stdout + tight.stderr
     assert "FAILED" in tight.stdout and "Traceback" not in tight.stderr
+    # given time, the settings search finds a budget that meets the tighter threshold, and says which
+    found = run_cli("compare", path, "--threshold", f"{d['max_rel_error'] / 4:.3e}")
+    assert found.returncode == 0, found.stdout + found.stderr
+    assert "converged at" in found.stdout
     # a user error is still 2
     assert run_cli("compare", str(GALLERY / "nope.toml")).returncode == 2
 
