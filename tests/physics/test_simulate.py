@@ -408,3 +408,22 @@ def test_overlay_render(tmp_path):
     out = tmp_path / "o.gif"
     assert main(["render", str(GALLERY / "slider-crank.toml"), "--overlay", "-o", str(out)]) == 0
     assert out.stat().st_size > 1000
+
+
+@pytest.mark.slow
+def test_overlay_draws_up_to_where_the_simulation_stops_holding(tmp_path, capsys):
+    from PIL import Image
+
+    from planar.cli.main import main
+
+    out = tmp_path / "o.gif"
+    # no error correction: the Jansen leg's simulation leaves its assembly at sample 20; the render still happens
+    args = ["render", str(GALLERY / "jansen-leg.toml"), "--overlay", "-o", str(out)]
+    assert main([*args, "--error-bias", "0", "--substeps", "64", "--iterations", "40"]) == 0
+    text = capsys.readouterr().out
+    assert "holds up to sample 20" in text and "drawn frozen from there" in text
+    frames = Image.open(out).n_frames
+    assert frames == 25
+    # the solver options are checked as compare checks them
+    assert main([*args, "--substeps", "0"]) == 2
+    assert "--substeps" in capsys.readouterr().err
