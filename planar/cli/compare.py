@@ -105,7 +105,10 @@ def add_parser(sub: Any) -> None:
         "--threshold", type=float, default=1e-3, help="error threshold, fraction of size (1e-3); exit status 3 when a check fails"
     )
     cp.add_argument(
-        "--torque-threshold", type=float, default=0.01, help="motor torque vs inverse dynamics, fraction of its peak (0.01)"
+        "--torque-threshold",
+        type=float,
+        default=0.01,
+        help="motor torque vs inverse dynamics, fraction of the torque scale (at least its peak; 0.01)",
     )
     add_solver_options(cp)
     cp.add_argument(

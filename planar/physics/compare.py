@@ -9,7 +9,8 @@ A comparison *fails* (:attr:`Comparison.passed` is false, ``planar compare``
 exits with :data:`EXIT_MISMATCH`) when a part's error passes the threshold,
 when the simulation reported a failure (left its analytic pose, switched
 assembly branch, blew up), when the motor torque differs from inverse
-dynamics by more than ``torque_threshold`` of its peak, or when the motor
+dynamics by more than ``torque_threshold`` of the mechanism's torque scale
+(:func:`planar.physics.run.torque_scale`, at least the peak), or when the motor
 saturated.
 """
 
