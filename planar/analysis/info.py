@@ -330,7 +330,7 @@ def info(mech: Mechanism, samples: int = SAMPLES) -> Info:
         outputs=outputs,
         transmission=_transmission(mech, q, ok),
         time_ratio=ratios[0].time_ratio if ratios else None,
-        stages=[f"{s.cam}: {' -> '.join(s.key)} ({s.mech.name})" for s in getattr(mech, "stages", [])] if cams else [],
+        stages=[f"{s.cam}: {' -> '.join(s.key)} ({s.mech.name})" for s in mech.stages] if cams else [],
         chains={cam: [list(c) for c in chains] for cam, chains in cams.items()} if isinstance(cams, dict) else {},
     )
 

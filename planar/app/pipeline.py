@@ -92,18 +92,21 @@ def scene_style(scene: Scene) -> Style:
     )
 
 
-def overlay_motion(scene: Scene) -> Motion:
+def overlay_motion(scene: Scene, settings: SimSettings | None = None, notes: list[str] | None = None) -> Motion:
     """The pymunk rebuild's motion of ``scene``, for drawing over the analytic one.
 
-    Raises :class:`~planar.physics.simulate.SimulationError` if the simulation blew up.
+    Where the simulation stops holding its analytic motion, the overlay stays
+    at the last pose it reached (drawn frozen from there on) and a note naming
+    that sample, its time and why is added to ``notes``.  ``settings``: the
+    solver settings, as ``planar compare`` takes them.
     """
-    from planar.physics.simulate import SimulationError, simulate_scene
+    from planar.physics.simulate import DEFAULT_SETTINGS, simulate_scene
 
-    sim = simulate_scene(scene)
-    if sim.blowup is not None:
-        raise SimulationError(
-            f"{scene.path}: the simulation {sim.motion.reason(sim.blowup[0])}; "
-            "no animation written (try more substeps: planar compare --substeps)"
+    sim = simulate_scene(scene, settings or DEFAULT_SETTINGS, mode="kinematic")
+    if sim.failure is not None and notes is not None:
+        f = sim.failure
+        notes.append(
+            f"the simulation holds up to sample {f.sample} (t = {f.time:.6g} s) and is drawn frozen from there: {f.message}"
         )
     return sim.motion
 
@@ -419,6 +422,8 @@ def compare_scene(
     threshold: float = 1e-3,
     torque_threshold: float = 0.01,
     with_series: bool = False,
+    motor: bool | None = None,
+    time_cap: float | None = None,
 ) -> tuple[Comparison, SimResult]:
     """Simulate ``scene`` in pymunk and compare it with its analytic motion (and the motor torque).
 
@@ -427,7 +432,7 @@ def compare_scene(
     """
     from planar.physics.compare import compare_scene as _compare_scene
 
-    return _compare_scene(scene, settings, threshold, torque_threshold, with_series=with_series)
+    return _compare_scene(scene, settings, threshold, torque_threshold, with_series, motor, time_cap)
 
 
 # --------------------------------------------------------------------------- mechanisms built in Python

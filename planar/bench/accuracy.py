@@ -382,7 +382,7 @@ def _accuracy_chart(path, agg: list[dict[str, Any]]) -> None:
     dflt = [i for i, a in enumerate(agg) if a["default"]]
     for axis, y, label, line in (
         (ax, e, "worst position error / size (kinematic and motor mode)", 1e-4),
-        (ax2, tq, "worst motor torque error / peak", 1e-2),
+        (ax2, tq, "worst motor torque error / torque scale", 1e-2),
     ):
         bad = ~np.isfinite(y)
         y = np.where(bad, 1.0, y)

@@ -13,16 +13,13 @@ from planar.errors import InputError
 __all__ = ["add_parser"]
 
 
-def _cmd_compare(args: argparse.Namespace) -> int:
+def settings_from_args(args: argparse.Namespace) -> Any:
+    """:class:`~planar.physics.simulate.SimSettings` from ``--substeps``, ``--iterations``, ``--step-drift``,
+    ``--error-bias`` (checked: exit 2 naming the option)."""
     from dataclasses import replace
 
-    from planar.app.pipeline import compare_scene
-    from planar.physics.compare import EXIT_MISMATCH, format_comparison
     from planar.physics.simulate import SimSettings
-    from planar.scene.load import load_scene
 
-    for option, v in (("--threshold", args.threshold), ("--torque-threshold", args.torque_threshold)):
-        positive(option, v)
     positive("--substeps", args.substeps, integer=True)
     positive("--iterations", args.iterations, integer=True)
     for option, v, cap in (("--substeps", args.substeps, 100_000), ("--iterations", args.iterations, 100_000)):
@@ -32,19 +29,50 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         raise InputError("--step-drift", args.step_drift, "a drift fraction >= 0 (0 keeps --substeps fixed)")
     if args.error_bias is not None and not (0 <= args.error_bias <= 1):
         raise InputError("--error-bias", args.error_bias, "a number between 0 and 1")
-    scene = load_scene(args.scene)
-    settings = SimSettings(
-        **{
-            k: v
-            for k, v in (("substeps", args.substeps), ("iterations", args.iterations), ("error_bias", args.error_bias))
-            if v is not None
-        }
-    )
+    given = (("substeps", args.substeps), ("iterations", args.iterations), ("error_bias", args.error_bias))
+    settings = SimSettings(**{k: v for k, v in given if v is not None})
     if args.step_drift is not None:  # 0: fixed substeps
         settings = replace(settings, step_drift=args.step_drift or None)
-    result, sim = compare_scene(scene, settings, args.threshold, args.torque_threshold, with_series=args.json)
-    t = sim.motion.t
-    assert t is not None  # a simulation records its output times
+    return settings
+
+
+def add_solver_options(p: Any) -> None:
+    """The solver settings ``compare`` and ``render --overlay`` take."""
+    p.add_argument(
+        "--substeps",
+        type=int,
+        default=None,
+        help="physics steps per sample, at least (28); raised where joints turn fast, see --step-drift",
+    )
+    p.add_argument(
+        "--step-drift",
+        type=float,
+        default=None,
+        help="largest predicted joint drift per step, fraction of size (3.5e-6); 0 keeps --substeps fixed",
+    )
+    p.add_argument("--iterations", type=int, default=None, help="solver iterations per step, at least (40)")
+    p.add_argument(
+        "--error-bias",
+        type=float,
+        default=None,
+        help="joint error left after one second (replaces the correction of 0.2 per step)",
+    )
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from planar.app.pipeline import compare_scene
+    from planar.physics.compare import EXIT_MISMATCH, format_comparison
+    from planar.scene.load import load_scene
+
+    for option, v in (("--threshold", args.threshold), ("--torque-threshold", args.torque_threshold)):
+        positive(option, v)
+    positive("--time-cap", args.time_cap)
+    settings = settings_from_args(args)
+    scene = load_scene(args.scene)
+    motor = True if args.motor else None
+    result, sim = compare_scene(
+        scene, settings, args.threshold, args.torque_threshold, with_series=args.json, motor=motor, time_cap=args.time_cap
+    )
     if args.json:
         d = result.to_dict()
         d["settings"] = {
@@ -54,6 +82,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
             "correction": sim.built.get("correction"),
             "error_bias": settings.error_bias,
         }
+        d["search"] = None if result.search is None else {"verdict": result.search.verdict, "tried": result.search.tried}
         d["wall_time_s"] = sim.wall_time
         d["built"] = dict(sim.built.items())
         print(json.dumps(d, indent=2, default=str))
@@ -76,25 +105,21 @@ def add_parser(sub: Any) -> None:
         "--threshold", type=float, default=1e-3, help="error threshold, fraction of size (1e-3); exit status 3 when a check fails"
     )
     cp.add_argument(
-        "--torque-threshold", type=float, default=0.01, help="motor torque vs inverse dynamics, fraction of its peak (0.01)"
+        "--torque-threshold",
+        type=float,
+        default=0.01,
+        help="motor torque vs inverse dynamics, fraction of the torque scale (at least its peak; 0.01)",
+    )
+    add_solver_options(cp)
+    cp.add_argument(
+        "--motor",
+        action="store_true",
+        help="also drive with a motor and check its torque (on by default when the scene's [effects] names a motor)",
     )
     cp.add_argument(
-        "--substeps",
-        type=int,
-        default=None,
-        help="physics steps per sample, at least (28); raised where joints turn fast, see --step-drift",
-    )
-    cp.add_argument(
-        "--step-drift",
+        "--time-cap",
         type=float,
         default=None,
-        help="largest predicted joint drift per step, fraction of size (3.5e-6); 0 keeps --substeps fixed",
-    )
-    cp.add_argument("--iterations", type=int, default=None, help="solver iterations per step, at least (40)")
-    cp.add_argument(
-        "--error-bias",
-        type=float,
-        default=None,
-        help="joint error left after one second (replaces the correction of 0.2 per step)",
+        help="CPU seconds the settings search may spend per run (60); past it the verdict is 'could not converge'",
     )
     cp.set_defaults(func=_cmd_compare)

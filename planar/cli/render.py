@@ -6,18 +6,21 @@ import argparse
 from typing import Any
 
 from planar.cli.common import outputs
+from planar.cli.compare import add_solver_options
 
 __all__ = ["add_parser"]
 
 
 def _cmd_render(args: argparse.Namespace) -> int:
     from planar.app.pipeline import ANIMATION_SUFFIXES, animation_plan, overlay_motion, render_scene
+    from planar.cli.compare import settings_from_args
     from planar.scene.load import load_scene
 
     outputs(args, (args.scene,), ("-o", "output", ANIMATION_SUFFIXES))
+    settings = settings_from_args(args)
     scene = load_scene(args.scene)
-    overlay = overlay_motion(scene) if args.overlay else None
     notes: list[str] = []
+    overlay = overlay_motion(scene, settings, notes) if args.overlay else None
     n = render_scene(scene, args.output, overlay=overlay, fps=args.fps, notes=notes)
     for note in notes:
         print(f"note: {note}")
@@ -46,4 +49,5 @@ def add_parser(sub: Any) -> None:
         "a GIF plays at most 50); a cycle plays for 1/speed seconds within one frame",
     )
     r.add_argument("--overlay", action="store_true", help="draw the pymunk simulation over the analytic motion")
+    add_solver_options(r)
     r.set_defaults(func=_cmd_render)

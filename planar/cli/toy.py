@@ -4,7 +4,7 @@ Prints the pieces (merged parts, one frame, keyed cams) and the worst joint
 residual on them, the motor torque of the coupled run against inverse
 dynamics, and every stage's fate (simulated, or why not; #8's lift-off).
 Exit status 3 when a check fails (joint residual, torque beyond
-``--torque-threshold`` of its peak, a simulation failure, #8 letting go at
+``--torque-threshold`` of its torque scale, a simulation failure, #8 letting go at
 the scene's speed, a #6/#9 edge that would have to pull its pin at the
 scene's speed); 2 for bad input.
 """
@@ -106,7 +106,7 @@ def _cmd_toy(args: argparse.Namespace) -> int:
             f"motor on the cam shaft, the only driver, turning {len(tq['pieces'])} pieces"
             + (f" (not {', '.join(out_of_run)})" if out_of_run else "")
             + f": torque peak {tq['peak']:.4g} (model units: density x unit^4/s^2; see README, Conventions)"
-            + f", pymunk vs inverse dynamics {tq['max_rel_diff']:.2g} of the peak "
+            + f", pymunk vs inverse dynamics {tq['max_rel_diff']:.2g} of the torque scale "
             f"over {tq['samples_compared']} samples, pose error {tq['pose_error']:.2g} of the size{fail} "
             + ("[ok]" if ok_torque else "[FAIL]")
         )
@@ -140,7 +140,7 @@ def add_parser(sub: Any) -> None:
         "--torque-threshold",
         type=float,
         default=0.01,
-        help="motor torque vs inverse dynamics, fraction of its peak (0.01); exit status 3 beyond it",
+        help="motor torque vs inverse dynamics, fraction of the torque scale (at least its peak; 0.01); exit status 3 beyond it",
     )
     t.add_argument(
         "--speeds",

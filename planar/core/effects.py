@@ -45,7 +45,8 @@ class Effects:
 
     ``damping``: pymunk's space damping (fraction of velocity kept per
     second, in (0, 1]); ``density``: mass per unit area of every part;
-    ``motor_force_limit``: the largest torque the motor may apply.
+    ``motor``: the scene asks for the motor-driven torque check (implied by
+    ``motor_force_limit``); ``motor_force_limit``: the largest torque the motor may apply.
     """
 
     gravity: Vec | None = None
@@ -54,6 +55,12 @@ class Effects:
     springs: tuple[Spring, ...] = ()
     loads: tuple[Load, ...] = ()
     motor_force_limit: float | None = None
+    motor: bool = False
+
+    @property
+    def wants_motor(self) -> bool:
+        """Whether the scene names a motor (``motor = true`` or a ``motor_force_limit``)."""
+        return self.motor or self.motor_force_limit is not None
 
 
 NO_EFFECTS = Effects()

@@ -419,10 +419,21 @@ class RRR(NodeKind):
         other, _ = circle_circle(pos[self.a], self.ra, pos[self.b], self.rb, -self.branch)
         flip = carry_branch(keep, other, ok, path)
         p = np.where(flip[:, None], other, keep) if flip.any() else keep
-        return p, (
-            ok,
+        return p, (ok, self._why(pos, ok))
+
+    def _why(self, pos: Mapping[str, Array], ok: Mask) -> str:
+        """Why the dyad cannot close where ``ok`` is false: its two pivots coincide (the joint could be anywhere
+        on a circle), or its links cannot span their distance."""
+        d = np.hypot(*(pos[self.b] - pos[self.a]).T)
+        coincide = d <= 1e-9 * (self.ra + self.rb)
+        if (~ok).any() and coincide[~ok].all():
+            return (
+                f"its pivots {self.a!r} and {self.b!r} coincide, so links of length {self.ra:g} and {self.rb:g} "
+                "leave the joint anywhere on a circle (the position is undetermined)"
+            )
+        return (
             f"links of length {self.ra:g} (from {self.a!r}) and {self.rb:g} (from {self.b!r}) "
-            "cannot span the distance between them",
+            "cannot span the distance between them"
         )
 
     def held_by(self) -> tuple[tuple[str, ...], ...]:

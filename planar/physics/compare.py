@@ -9,7 +9,8 @@ A comparison *fails* (:attr:`Comparison.passed` is false, ``planar compare``
 exits with :data:`EXIT_MISMATCH`) when a part's error passes the threshold,
 when the simulation reported a failure (left its analytic pose, switched
 assembly branch, blew up), when the motor torque differs from inverse
-dynamics by more than ``torque_threshold`` of its peak, or when the motor
+dynamics by more than ``torque_threshold`` of the mechanism's torque scale
+(:func:`planar.physics.run.torque_scale`, at least the peak), or when the motor
 saturated.
 """
 
@@ -53,8 +54,14 @@ class Comparison:
     notes: list[str] = field(default_factory=list)
     #: the simulation's own failure report (sample, part, how), if any
     failure: str | None = None
-    #: largest torque difference allowed, fraction of the analytic peak
+    #: largest torque difference allowed, fraction of the mechanism's torque scale
     torque_threshold: float = 0.01
+    #: how the kinematic run's settings were found (:class:`planar.physics.converge.Search`)
+    search: Any = None
+    #: how the motor run's settings were found, when the scene names a motor
+    torque_search: Any = None
+    #: what helps, for the kinematic run's failure
+    hint: str = ""
 
     @property
     def max_rel_error(self) -> float:
@@ -63,46 +70,27 @@ class Comparison:
     def problems(self) -> list[str]:
         """Every failed check, one line each (empty when all passed)."""
         out = []
-        if self.failure:
-            out.append(f"simulation failed: {self.failure}")
-        if self.max_rel_error > self.threshold:
+        if self.search is not None and self.search.verdict == "unconverged":
+            out.append(f"simulation {self.search.line()}; last: {self.failure}")
+        elif self.failure:
+            verdict = self.search.verdict if self.search is not None else None
+            why = {"differs": " (two budgets agree: the mechanism differs)", "change-point": " at a change point"}.get(
+                verdict or "", ""
+            )
+            out.append(f"simulation failed{why}: {self.failure}" + (f"; {self.hint}" if self.hint else ""))
+        if self.max_rel_error > self.threshold and not self.failure:
             worst = max(self.parts, key=lambda p: p.max_rel_error)
             out.append(
                 f"part {worst.part!r} is {worst.max_rel_error:.3g} of the size off (threshold "
                 f"{self.threshold:g}) from sample {worst.first_over}"
             )
-        t = self.torque
-        if t:
-            if t.get("saturated"):
-                s = t["saturated"]
-                shown = ", ".join(str(i) for i in s[:12]) + (", ..." if len(s) > 12 else "")
-                out.append(
-                    f"motor saturated at {len(s)} sample(s) [{shown}] "
-                    f"(force limit {t.get('motor_force_limit'):g}, needed peak {t['peak']:.4g})"
-                )
-            if t.get("failure") and not self.failure:
-                out.append(f"motor-driven simulation failed: {t['failure']}")
-            if t["max_rel_diff"] > self.torque_threshold:
-                out.append(
-                    f"motor torque differs from inverse dynamics by {t['max_rel_diff']:.2%} of its peak "
-                    f"(threshold {self.torque_threshold:.0%})"
-                )
+        if self.torque:
+            out += _torque_problems(self.torque, self.torque_threshold, self.torque_search)
         return out
 
     @property
     def passed(self) -> bool:
         return not self.problems()
-
-    def __repr__(self) -> str:
-        return (
-            f"<Comparison {self.mechanism!r}: {self.samples} samples, worst error {self.max_rel_error:.3g} of size "
-            f"(threshold {self.threshold:g}), {'passed' if self.passed else 'FAILED'}>"
-        )
-
-    def _repr_html_(self) -> str | None:
-        from planar.core.display import html
-
-        return html("comparison", self)
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -129,6 +117,30 @@ class Comparison:
             "passed": self.passed,
             "problems": self.problems(),
         }
+
+
+def _torque_problems(t: dict[str, Any], threshold: float, search: Any) -> list[str]:
+    from planar.physics.converge import hint
+
+    out = []
+    if t.get("saturated"):
+        s = t["saturated"]
+        shown = ", ".join(str(i) for i in s[:12]) + (", ..." if len(s) > 12 else "")
+        out.append(
+            f"motor saturated at {len(s)} sample(s) [{shown}] "
+            f"(force limit {t.get('motor_force_limit'):g}, needed peak {t['peak']:.4g}); {hint('saturation')}"
+        )
+    if search is not None and search.verdict == "unconverged":
+        out.append(f"motor-driven simulation {search.line()}")
+    elif t.get("failure"):
+        out.append(f"motor-driven simulation failed: {t['failure']}; {hint('constraint')}")
+    if t["samples_compared"] and t["max_rel_diff"] > threshold:
+        out.append(
+            f"motor torque differs from inverse dynamics by {t['max_rel_diff']:.3g} of the torque scale "
+            f"{t['scale']:.4g} at sample {t['worst_sample']} (driver at {t['worst_angle_deg']:.4g} deg; "
+            f"threshold {threshold:g}); {hint('constraint')}"
+        )
+    return out
 
 
 def _part_points(mech: Mechanism, part: str) -> NDArray[np.float64]:
@@ -183,6 +195,18 @@ def compare(mech: Mechanism, reference: Motion, other: Motion, threshold: float 
     return Comparison(mech.name, size, len(reference), threshold, parts, joints, first_all, failure=failure)
 
 
+def torque_line(t: dict[str, Any]) -> str:
+    """The motor check on one line: ``0 samples compared`` when none were."""
+    if not t["samples_compared"]:
+        return "motor torque: 0 samples compared (the motor-driven run failed before its second sample)"
+    return (
+        f"motor torque: pymunk vs inverse dynamics over {t['samples_compared']} samples: max |diff| "
+        f"{t['max_abs_diff']:.3e} = {t['max_rel_diff']:.2g} of the torque scale {t['scale']:.4g} (peak {t['peak']:.4g}) "
+        f"at sample {t['worst_sample']} (driver at {t['worst_angle_deg']:.4g} deg); motor-driven poses within "
+        f"{t['pose_error']:.2e} of the size"
+    )
+
+
 def format_comparison(c: Comparison) -> str:
     """A table for the terminal."""
     lines = [
@@ -197,13 +221,12 @@ def format_comparison(c: Comparison) -> str:
     lines.append(f"  {'joint':<16}{'residual':>11}{'/size':>11}")
     for k, v in c.joints.items():
         lines.append(f"  {k:<16}{v:11.3e}{v / c.size:11.3e}")
+    if c.search is not None:
+        lines.append(f"  settings: {c.search.line()}")
     if c.torque:
-        t = c.torque
-        lines.append(
-            f"  motor torque: pymunk vs inverse dynamics: max |diff| {t['max_abs_diff']:.3e} "
-            f"({100 * t['max_rel_diff']:.2g}% of peak {t['peak']:.4g}); motor-driven poses within "
-            f"{t['pose_error']:.2e} of the size"
-        )
+        lines.append("  " + torque_line(c.torque))
+        if c.torque_search is not None:
+            lines.append(f"  motor settings: {c.torque_search.line()}")
     for n in c.notes:
         lines.append(f"  note: {n}")
     for n in c.problems():
@@ -211,43 +234,101 @@ def format_comparison(c: Comparison) -> str:
     return "\n".join(lines)
 
 
-def compare_scene(
-    scene: Any, settings: Any = None, threshold: float = 1e-3, torque_threshold: float = 0.01, with_series: bool = False
-) -> tuple[Comparison, Any]:
-    """Simulate a scene, compare it with its analytic motion, and (for a steadily turning driver) the
-    motor torque with inverse dynamics; returns the comparison and the simulation result.
+def _kinematic_outcome(mech: Mechanism) -> Any:
+    from planar.physics.converge import failure_cause
 
-    The simulation stops at the first part further than ``threshold`` of the
-    size from its analytic pose.
+    def outcome(sim: Any) -> tuple[str | None, int, float, dict[str, Any]]:
+        f = sim.failure
+        if f is None:
+            return None, len(sim.motion), 0.0, sim.built
+        i = f.sample
+        res = max((float(v[i]) for v in sim.residuals.values()), default=0.0) / mech.size
+        return failure_cause(f.kind, f.error, res, float(sim.built.get("standing_drift", 0.0))), i, f.error, sim.built
+
+    return outcome
+
+
+def _torque_outcome(threshold: float) -> Any:
+    def outcome(tc: dict[str, Any]) -> tuple[str | None, int, float, dict[str, Any]]:
+        built = {"substeps": tc["substeps"], "iterations": tc["iterations"], "correction": tc["correction"]}
+        if tc["failure"] is None and tc["max_rel_diff"] <= threshold:
+            return None, tc["samples_compared"], 0.0, built
+        if tc["failure_kind"] == "drift" and tc["max_rel_diff"] <= threshold:
+            return "drift", tc["samples_compared"], tc["pose_error"], built
+        return "constraint", tc["samples_compared"], max(tc["max_rel_diff"], tc["pose_error"]), built
+
+    return outcome
+
+
+#: a run that holds but is further than this fraction of the threshold from its analytic motion is refined
+_AIM = 0.1
+
+
+def compare_scene(
+    scene: Any,
+    settings: Any = None,
+    threshold: float = 1e-3,
+    torque_threshold: float = 0.01,
+    with_series: bool = False,
+    motor: bool | None = None,
+    time_cap: float | None = None,
+) -> tuple[Comparison, Any]:
+    """Simulate a scene and compare it with its analytic motion; with a motor, its torque with inverse dynamics.
+
+    The kinematic comparison always runs.  The motor-driven torque check runs
+    when the scene names a motor (``[effects] motor = true`` or
+    ``motor_force_limit``) or ``motor`` is true.  Each run's settings come
+    from :func:`planar.physics.converge.converge` (raised from ``settings``
+    until the run holds or two budgets agree, within ``time_cap`` CPU seconds
+    each).  Returns the comparison and the last kinematic simulation.
     """
     from dataclasses import replace
 
     from planar.errors import PlanarError
+    from planar.physics.converge import DEFAULT_TIME_CAP, converge, hint
     from planar.physics.simulate import DEFAULT_SETTINGS, simulate_scene, torque_comparison
 
+    cap = DEFAULT_TIME_CAP if time_cap is None else time_cap
     settings = replace(settings or DEFAULT_SETTINGS, tolerance=threshold)
-    sim = simulate_scene(scene, settings)
-    result = compare(scene.mechanism, scene.motion(), sim.motion, threshold=threshold)
-    result.torque_threshold = torque_threshold
     mech = scene.mechanism
-    if mech.driver.kind == "rotation" and mech.driver.amplitude is None and len(mech.stages) <= 1:
-        try:
-            tc = torque_comparison(mech, scene.motion().t, scene.effects, settings)
-            keep = (
-                "peak",
-                "max_abs_diff",
-                "max_rel_diff",
-                "samples_compared",
-                "motor_force_limit",
-                "saturated",
-                "failure",
-                "pose_error",
-                "pins",
-                "note",
-            )
-            result.torque = {k: tc[k] for k in keep}
-            if with_series:
-                result.torque.update(analytic=tc["analytic"], simulated=tc["simulated"])
-        except PlanarError as err:
-            result.notes.append(f"torque not compared: {err}")
+    motion = scene.motion()
+    aim = threshold * _AIM
+
+    def rough(sim: Any) -> float | None:
+        e = max(sim.pose_error.values(), default=0.0)
+        return e if e > aim else None
+
+    sim, search = converge(
+        lambda st: simulate_scene(scene, st, mode="kinematic"), _kinematic_outcome(mech), settings, cap, refine=rough
+    )
+    result = compare(mech, motion, sim.motion, threshold=threshold)
+    result.torque_threshold = torque_threshold
+    result.search = search
+    if sim.failure is not None and search.verdict != "differs":
+        cause, *_ = _kinematic_outcome(mech)(sim)
+        result.hint = hint(cause)
+    wants = scene.effects.wants_motor if motor is None else motor
+    if not wants:
+        return result, sim
+    try:
+        tc, tsearch = converge(
+            lambda st: torque_comparison(mech, motion.t, scene.effects, st), _torque_outcome(torque_threshold), settings, cap
+        )
+    except PlanarError as err:
+        result.notes.append(f"torque not compared: {err}")
+        return result, sim
+    keep: tuple[str, ...] = (
+        "peak",
+        "scale",
+        "max_abs_diff",
+        "max_rel_diff",
+        "worst_sample",
+        "worst_angle_deg",
+        "samples_compared",
+    )
+    keep += ("motor_force_limit", "saturated", "failure", "pose_error", "pins", "note", "substeps", "iterations")
+    result.torque = {k: tc[k] for k in keep}
+    result.torque_search = tsearch
+    if with_series:
+        result.torque.update(analytic=tc["analytic"], simulated=tc["simulated"])
     return result, sim

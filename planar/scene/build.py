@@ -120,6 +120,7 @@ class Scene:
             ),
             loads=tuple(Load(ld.point, (float(ld.force[0]), float(ld.force[1]))) for ld in e.loads),
             motor_force_limit=e.motor_force_limit,
+            motor=e.motor,
         )
 
 

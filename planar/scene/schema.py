@@ -458,6 +458,9 @@ class EffectsSpec(_Strict):
     """Damped springs between parts: ``[{ a = "crank", b = "rocker", stiffness = 10.0 }]``."""
     loads: list[LoadSpec] = []
     """Forces at named points: ``[{ point = "coupler_point", force = [0.0, 10.0] }]``."""
+    motor: bool = False
+    """``compare`` also drives the mechanism with a motor and checks its torque against inverse dynamics,
+    e.g. ``true``; implied by ``motor_force_limit``.  Without it only the motion is compared."""
     motor_force_limit: Pos | None = None
     """``compare`` drives with a motor of this largest torque instead of an exact input, e.g. ``50.0``."""
 

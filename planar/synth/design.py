@@ -583,7 +583,7 @@ SCENE_TABLES: dict[str, Any] = {
 #: Earth's gravity in the written scene's model units per s^2 (9810 mm/s^2 at its ``unit_mm``): physics runs in
 #: model units, so a toy cut at 100 mm per unit falls at 98.1 units/s^2
 EARTH_GRAVITY = 9810.0 / SCENE_TABLES["fabrication"]["unit_mm"]
-#: the motor torque's largest allowed difference from inverse dynamics, fraction of its peak (as ``planar toy``)
+#: the motor torque's largest allowed difference from inverse dynamics, fraction of the torque scale (as ``planar toy``)
 TORQUE_TOLERANCE = 0.01
 
 

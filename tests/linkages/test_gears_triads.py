@@ -127,7 +127,7 @@ def test_geared_five_bar_scene_export_and_compare(tmp_path: Path) -> None:
     assert m.valid.all()
     names, _table = motion_columns(scene.mechanism, m)
     assert names[:4] == ["t", "driver", "driver.A", "driver.B"]
-    result, sim = compare_scene(scene)
+    result, sim = compare_scene(scene, motor=True)  # the scene names no motor: asked for here
     assert sim.failure is None
     assert result.torque is not None and result.torque["max_rel_diff"] < 0.01  # the GearJoint carries the load
     # cut: both gears as their pitch circles (2 units each, 12 mm a unit, kerf 0.15 mm), read back with ezdxf;
