@@ -123,24 +123,33 @@ def _search(
 ) -> Any:
     """The search on normalised targets ``t``: the atlas first when untimed, the global search when timed or
     when the atlas's best is not within ``tolerance`` (largest distance, targets' size 1)."""
-    from planar.synth.search import in_order, max_distance, search_atlas
+    from planar.synth.search import in_order, max_distance, search_atlas, timed_from_atlas
 
     kw = BUDGETS[budget]
-    if theta is None:
-        if atlas is None:
-            from planar.synth.atlas import DEFAULT_SIZE, QUICK_SIZE, load_atlas
+    if atlas is None:
+        from planar.synth.atlas import DEFAULT_SIZE, QUICK_SIZE, load_atlas
 
-            atlas = load_atlas(QUICK_SIZE if budget == "quick" else DEFAULT_SIZE, progress=True)
-        r = search_atlas(t, atlas, cons, ordered=ordered)
-        row = np.append(r.params, r.circuit)
-        good = r.feasible and (in_order(r.theta) or not ordered)
-        if good and max_distance(PathObjective(t, None, cons), row, r.theta) <= tolerance:
-            return r
-        g = search_fourbar(t, None, cons, seed=seed, **kw)
-        g_good = g.feasible and (in_order(g.theta) or not ordered)
-        # the better of the two: usable first, then the smaller error
-        return g if (g_good, -g.sse) > (good, -r.sse) else r
-    return search_fourbar(t, theta, cons, seed=seed, **kw)
+        atlas = load_atlas(QUICK_SIZE if budget == "quick" else DEFAULT_SIZE, progress=True)
+    if theta is not None:
+        # the curve from the atlas, then the timing: exact when the atlas finds the four-bar itself (a cognate
+        # traces the same curve at other crank angles: then the global search runs)
+        timed = timed_from_atlas(t, theta, atlas, cons)
+        if (
+            timed is not None
+            and timed.feasible
+            and max_distance(PathObjective(t, theta, cons), np.append(timed.params, timed.circuit), theta) <= tolerance
+        ):
+            return timed
+        return search_fourbar(t, theta, cons, seed=seed, **kw)
+    r = search_atlas(t, atlas, cons, ordered=ordered)
+    row = np.append(r.params, r.circuit)
+    good = r.feasible and (in_order(r.theta) or not ordered)
+    if good and max_distance(PathObjective(t, None, cons), row, r.theta) <= tolerance:
+        return r
+    g = search_fourbar(t, None, cons, seed=seed, **kw)
+    g_good = g.feasible and (in_order(g.theta) or not ordered)
+    # the better of the two: usable first, then the smaller error
+    return g if (g_good, -g.sse) > (good, -r.sse) else r
 
 
 #: effort of the global search (random sample, differential evolution, least-squares starts) per budget

@@ -238,7 +238,12 @@ def _nearest_theta(obj: PathObjective, row: Array, n: int = 720) -> Array:
 
 
 def _refine(
-    obj: PathObjective, row: Array, bounds: list[tuple[float, float]], max_nfev: int, method: str = "trf"
+    obj: PathObjective,
+    row: Array,
+    bounds: list[tuple[float, float]],
+    max_nfev: int,
+    method: str = "trf",
+    theta0: Array | None = None,
 ) -> tuple[Array, Array, float]:
     """least_squares from ``row``: returns (row, theta at the targets, sse with penalties).
 
@@ -252,7 +257,7 @@ def _refine(
     hi = np.array([b[1] for b in bounds[:N_PARAMS]])
     timed = obj.theta is not None
     n = len(obj.targets)
-    th0: Array = obj.theta if obj.theta is not None else _nearest_theta(obj, row)
+    th0: Array = obj.theta if obj.theta is not None else (_nearest_theta(obj, row) if theta0 is None else theta0)
     w = np.sqrt(obj.penalty)
 
     def split(z: Array) -> tuple[Array, Array]:
@@ -453,19 +458,57 @@ def search_atlas(
         if all(np.linalg.norm((row - s) / (hi - lo)) > 1e-3 for s in starts):
             starts.append(row)
     t1 = time.perf_counter()
-    best: tuple[float, Array, Array] | None = None
+    done: list[tuple[float, Array, Array]] = []
     for row in starts:
-        r, tt, e = _refine(obj, row, b, max_nfev=REFINE_NFEV, method="lm")
-        if ordered and not in_order(tt):
-            e += obj.penalty  # out of order: worse than any in-order result
-        if best is None or e < best[0]:
-            best = (e, r, tt)
-        if ordered and not in_order(tt):
-            continue
-        if max_distance(obj, r, tt) <= stop and not violation(r[None, :N_PARAMS], cons, obj.scale, 0.0)[0] > 0:
+        if _refined(obj, cons, b, row, None, REFINE_NFEV, ordered, stop, done):
             break
+    else:
+        # none reached ``stop``: the two best go on (Levenberg-Marquardt can crawl along a valley; on 8 targets,
+        # underdetermined, it sometimes needs a thousand evaluations)
+        for _, r, tt in sorted(done, key=lambda d: d[0])[:2]:
+            if _refined(obj, cons, b, r, tt, 10 * REFINE_NFEV, ordered, stop, done):
+                break
     stages["refine_s"] = time.perf_counter() - t1
-    assert best is not None
+    best = min(done, key=lambda d: d[0])
     e, r, tt = best
     feasible = not constraint_failures(r[:N_PARAMS], cons)
     return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), feasible, len(C), stages)
+
+
+def _refined(
+    obj: PathObjective,
+    cons: Constraints,
+    b: list[tuple[float, float]],
+    row: Array,
+    theta0: Array | None,
+    nfev: int,
+    ordered: bool,
+    stop: float,
+    done: list[tuple[float, Array, Array]],
+) -> bool:
+    """Refine one start (appended to ``done``); whether it reached ``stop`` keeping the constraints (and order)."""
+    r, tt, e = _refine(obj, row, b, max_nfev=nfev, method="lm", theta0=theta0)
+    ok_order = in_order(tt) or not ordered
+    done.append((e if ok_order else e + obj.penalty, r, tt))  # out of order: worse than any in-order result
+    return ok_order and max_distance(obj, r, tt) <= stop and not violation(r[None, :N_PARAMS], cons, obj.scale, 0.0)[0] > 0
+
+
+def timed_from_atlas(
+    targets: Array, theta: Array, atlas: Any, cons: Constraints | None = None, starts: int = 3
+) -> SearchResult | None:
+    """Timed targets (normalised) from the atlas: the untimed curve (:func:`search_atlas`), then least squares
+    with the crank angles fixed at ``theta`` from it (None when no start closes at every crank angle)."""
+    import time
+
+    cons = cons if cons is not None else Constraints()
+    t0 = time.perf_counter()
+    u = search_atlas(targets, atlas, cons)
+    obj = PathObjective(np.asarray(targets, float), np.asarray(theta, float), cons)
+    b = default_bounds(obj.targets, cons, True)
+    b[8] = (-3 * np.pi, 3 * np.pi)
+    r, tt, e = _refine(obj, np.append(u.params, u.circuit), b, max_nfev=REFINE_NFEV, method="lm")
+    if not np.isfinite(e):
+        return None
+    stages = {**u.stages, "timed_s": time.perf_counter() - t0}
+    feasible = not constraint_failures(r[:N_PARAMS], cons)
+    return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), feasible, u.evaluations, stages)
