@@ -245,13 +245,19 @@ def kernel_rate(n: int = 200_000, samples: int = 64, repeats: int = 5) -> dict[s
 
 
 def bench_synthesis(
-    repeats: int = 3, quick: bool = False, n: int | None = None, problems: tuple[str, ...] | None = None
+    repeats: int = 3,
+    quick: bool = False,
+    n: int | None = None,
+    problems: tuple[str, ...] | None = None,
+    reachable: int | None = None,
 ) -> dict[str, Any]:
     """Both problems, planar and pylinkage alternating ``repeats`` times (see the module).
 
     ``quick``: one repeat, planar's ``quick`` budget, pylinkage's coarser
     orientation grid; ``n`` (``-n``): candidates in the kernel-rate measurement;
-    ``problems``: a subset of :data:`PROBLEMS` by name (all by default).
+    ``problems``: a subset of :data:`PROBLEMS` by name (all by default);
+    ``reachable``: random reachable curves per number of targets in :func:`bench_reachable` (25, or 2 with
+    ``quick``; 0 leaves that benchmark and the targets scaling out).
     """
     if repeats < 1:
         raise PlanarError("planar bench synthesis needs repeats >= 1")
@@ -318,7 +324,13 @@ def bench_synthesis(
             }
         )
     rate = kernel_rate(n or (50_000 if quick else 250_000), repeats=1 if quick else 5)
+    count = (2 if quick else 25) if reachable is None else reachable
+    extra: dict[str, Any] = {}
+    if count > 0:
+        extra["reachable"] = bench_reachable(count=count, quick=quick)
+        extra["targets_scaling"] = bench_targets_scaling(quick=quick)
     return {
+        **extra,
         "benchmark": "synthesis",
         "repeats": repeats,
         "quick": quick,
@@ -386,4 +398,190 @@ def format_synthesis(r: dict[str, Any]) -> str:
             )
     if any(c["published_best_error"] == "not found" for c in r["cases"]):
         lines.append("  published errors not found: --json's published_searched (and the README) say where this looked")
+    if "reachable" in r:
+        lines.append(format_reachable(r["reachable"], r["targets_scaling"]))
+    return "\n".join(lines)
+
+
+# --- reachable curves: random four-bars the search was not tuned on (issue: synthesis that finds the mechanism) ---
+
+
+def random_crank_rocker(rng: np.random.Generator) -> tuple[Array, float]:
+    """A random Grashof crank-rocker (crank shortest, link ratio <= 10) with a random coupler point and placement:
+    the kernel's 9 parameters and the circuit.  Lengths uniform (not the atlas's log-uniform), coupler point
+    uniform in a box twice the coupler's length, placement anywhere in the unit square, any rotation."""
+    while True:
+        g, c, r = rng.uniform(0.3, 3.0, 3)
+        k = rng.uniform(0.1, 1.0) * min(g, c, r)
+        L = sorted((g, k, c, r))
+        if L[0] == k and L[0] + L[3] < 0.98 * (L[1] + L[2]) and L[3] <= 9.5 * L[0]:
+            break
+    u, v = c * rng.uniform(-1.0, 2.0), c * rng.uniform(-1.0, 1.0)
+    row = np.array([g, k, c, r, u, v, rng.uniform(), rng.uniform(), rng.uniform(-np.pi, np.pi)])
+    return row, float(rng.choice([-1.0, 1.0]))
+
+
+def reachable_problem(rng: np.random.Generator, n: int) -> tuple[Array, Array]:
+    """``n`` targets on the coupler curve of :func:`random_crank_rocker` at sorted random crank angles, and the angles."""
+    from planar.synth.kernel import coupler_points
+
+    row, circ = random_crank_rocker(rng)
+    th = np.sort(rng.uniform(0.0, 2 * np.pi, n))
+    x, y, _ = coupler_points(row[None, :], th, np.array([circ]))
+    return np.column_stack([x[0], y[0]]), th
+
+
+def _max_error(targets: Array, row: Array, theta: Array) -> float:
+    """Largest distance from a target to the coupler point of ``row`` (9 + circuit) at ``theta``, over the
+    targets' size (RMS distance from their centroid)."""
+    from planar.synth.search import Constraints, PathObjective, max_distance
+    from planar.synth.targets import normalisation
+
+    _, s = normalisation(targets)
+    return max_distance(PathObjective(targets, None, Constraints()), row, np.asarray(theta, float)) / s
+
+
+def scipy_baseline(targets: Array, theta: Array | None, cpu_s: float, seed: int = 0) -> tuple[float, int]:
+    """A plain many-start :func:`scipy.optimize.least_squares` (trf, its own finite differences) from random
+    starts in planar's bounds, the crank angles at the targets free when untimed (started at the nearest
+    point of the start's curve), until ``cpu_s`` of CPU time is spent: (best largest error over the targets'
+    size, starts).  Same normalisation as planar (targets moved to centroid 0, size 1)."""
+    from scipy.optimize import least_squares
+
+    from planar.synth.kernel import coupler_points
+    from planar.synth.search import Constraints, PathObjective, _nearest_theta, default_bounds, violation
+    from planar.synth.targets import normalisation
+
+    c, s = normalisation(targets)
+    t = (targets - c) / s
+    b = default_bounds(t, Constraints(), theta is not None)
+    lo, hi = np.array([v[0] for v in b]), np.array([v[1] for v in b])
+    rng = np.random.default_rng(seed)
+    obj = PathObjective(t, theta, Constraints())
+    best, starts, t0 = math.inf, 0, time.process_time()
+    while starts == 0 or time.process_time() - t0 < cpu_s:
+        row = lo + (hi - lo) * rng.random(len(b))
+        circ = 1.0 if row[9] >= 0 else -1.0
+        th0 = theta if theta is not None else _nearest_theta(obj, row)
+
+        def resid(z: Array, circ: float = circ) -> Array:
+            th = theta if theta is not None else z[9:]
+            x, y, ok = coupler_points(z[None, :9], np.asarray(th)[None, :], np.array([circ]))
+            r = np.concatenate([x[0] - t[:, 0], y[0] - t[:, 1]])
+            return np.append(np.where(np.concatenate([ok[0], ok[0]]), r, 10.0), 10.0 * violation(z[None, :9], obj.cons, 1.0)[0])
+
+        z0 = row[:9] if theta is not None else np.concatenate([row[:9], th0])
+        res = least_squares(resid, z0, method="trf", max_nfev=200 * len(z0))
+        starts += 1
+        th = theta if theta is not None else res.x[9:]
+        if violation(res.x[None, :9], Constraints(), 1.0, 0.0)[0] == 0:
+            best = min(best, _max_error(t, np.append(res.x[:9], circ), th))
+    return best, starts
+
+
+def bench_reachable(
+    sizes: tuple[int, ...] = (8, 12, 25, 50), count: int = 25, seed: int = 2026, quick: bool = False, noise: float = 0.01
+) -> dict[str, Any]:
+    """Reachable curves of random crank-rockers (:func:`reachable_problem`, seeded ``seed``, never used to tune
+    anything), ``count`` per number of targets in ``sizes``: planar untimed (atlas, after it is loaded) and
+    timed, each by CPU time (``time.process_time``) and largest error over the targets' size; then the same
+    curves with Gaussian noise (``noise`` of their size; unreachable), planar against :func:`scipy_baseline`
+    given the CPU time planar took.  ``quick``: the 20,000-curve atlas."""
+    from threadpoolctl import threadpool_limits
+
+    from planar.synth.atlas import DEFAULT_SIZE, QUICK_SIZE, load_atlas
+    from planar.synth.path import synthesise_path
+
+    t0 = time.process_time()
+    atlas = load_atlas(QUICK_SIZE if quick else DEFAULT_SIZE)
+    atlas.tree  # noqa: B018 (built here, not inside the first timed problem)
+    load_s = time.process_time() - t0
+    rng = np.random.default_rng(seed)
+    rows: list[dict[str, Any]] = []
+    with threadpool_limits(1):
+        for n in sizes:
+            for _ in range(count):
+                T, th = reachable_problem(rng, n)
+                rec: dict[str, Any] = {"targets": n}
+                for mode, theta in (("untimed", None), ("timed", th)):
+                    c0 = time.process_time()
+                    d = synthesise_path(T, theta, budget="quick" if quick else "normal", atlas=atlas)
+                    rec[mode] = {"cpu_s": time.process_time() - c0, "max_error": d.checks["max_error"], "ok": d.ok}
+                noisy = T + noise * float(np.sqrt(np.mean(np.sum((T - T.mean(0)) ** 2, 1)))) * rng.standard_normal(T.shape)
+                c0 = time.process_time()
+                d = synthesise_path(noisy, None, budget="quick" if quick else "normal", atlas=atlas)
+                cpu = time.process_time() - c0
+                base, starts = scipy_baseline(noisy, None, cpu)
+                rec["noisy"] = {
+                    "cpu_s": cpu,
+                    "planar_max_error": d.checks["max_error"],
+                    "scipy_max_error": base,
+                    "scipy_starts": starts,
+                }
+                rows.append(rec)
+    return {
+        "atlas_size": len(atlas),
+        "atlas_load_cpu_s": load_s,
+        "atlas_build_cpu_s": atlas.build_seconds,
+        "rows": rows,
+        "summary": _reachable_summary(rows),
+    }
+
+
+def _reachable_summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for n in sorted({r["targets"] for r in rows}):
+        rs = [r for r in rows if r["targets"] == n]
+        u = np.array([r["untimed"]["max_error"] for r in rs])
+        ti = np.array([r["timed"]["max_error"] for r in rs])
+        out[str(n)] = {
+            "problems": len(rs),
+            "untimed_recovered_1e-6": float(np.mean(u <= 1e-6)),
+            "untimed_median_error": float(np.median(u)),
+            "untimed_median_cpu_s": float(np.median([r["untimed"]["cpu_s"] for r in rs])),
+            "timed_exact_1e-6": float(np.mean(ti <= 1e-6)),
+            "timed_median_cpu_s": float(np.median([r["timed"]["cpu_s"] for r in rs])),
+            "noisy_planar_as_good_as_scipy": float(
+                np.mean([r["noisy"]["planar_max_error"] <= r["noisy"]["scipy_max_error"] * (1 + 1e-9) for r in rs])
+            ),
+            "noisy_planar_median_error": float(np.median([r["noisy"]["planar_max_error"] for r in rs])),
+            "noisy_scipy_median_error": float(np.median([r["noisy"]["scipy_max_error"] for r in rs])),
+        }
+    return out
+
+
+def bench_targets_scaling(
+    sizes: tuple[int, ...] = (8, 16, 32, 64, 128), seed: int = 7, quick: bool = False
+) -> list[dict[str, Any]]:
+    """CPU time of untimed path synthesis against the number of targets (one reachable curve each, atlas loaded)."""
+    from planar.synth.atlas import DEFAULT_SIZE, QUICK_SIZE, load_atlas
+    from planar.synth.path import synthesise_path
+
+    atlas = load_atlas(QUICK_SIZE if quick else DEFAULT_SIZE)
+    atlas.tree  # noqa: B018
+    rng = np.random.default_rng(seed)
+    out = []
+    for n in sizes:
+        T, _ = reachable_problem(rng, n)
+        c0 = time.process_time()
+        d = synthesise_path(T, None, budget="quick" if quick else "normal", atlas=atlas)
+        out.append({"targets": n, "cpu_s": time.process_time() - c0, "max_error": d.checks["max_error"]})
+    return out
+
+
+def format_reachable(r: dict[str, Any], scaling: list[dict[str, Any]]) -> str:
+    lines = [
+        f"reachable curves of random crank-rockers (atlas of {r['atlas_size']:,}: built in {r['atlas_build_cpu_s']:.1f} s CPU, "
+        f"loaded in {r['atlas_load_cpu_s']:.1f} s CPU)",
+        "  targets  untimed ok(<=1e-6)  median err  median CPU | timed ok  median CPU | noisy: planar >= scipy  "
+        "median err planar / scipy",
+    ]
+    for n, s in r["summary"].items():
+        lines.append(
+            f"  {n:>7}  {s['untimed_recovered_1e-6']:>17.0%}  {s['untimed_median_error']:>10.2g}  "
+            f"{s['untimed_median_cpu_s']:>8.2f} s | {s['timed_exact_1e-6']:>8.0%}  {s['timed_median_cpu_s']:>8.2f} s | "
+            f"{s['noisy_planar_as_good_as_scipy']:>21.0%}  "
+            f"{s['noisy_planar_median_error']:.3g} / {s['noisy_scipy_median_error']:.3g}"
+        )
+    lines.append("  untimed CPU against targets: " + ", ".join(f"{x['targets']}: {x['cpu_s']:.2f} s" for x in scaling))
     return "\n".join(lines)

@@ -86,10 +86,12 @@ def _path_failing(d: Any) -> list[str]:
             out += d.checks["constraint_failures"]
         elif k == "ok_accuracy":
             out.append(
-                f"RMS distance to the targets {d.checks['rms_error']:.3g} of their size (RMS distance from "
+                f"largest distance to a target {d.checks['max_error']:.3g} of their size (RMS distance from "
                 f"their centroid, {d.checks['size']:.6g}), over --tolerance {d.checks['tolerance']:g} "
-                f"(sse {d.sse:.6g})"
+                f"(RMS distance {d.checks['rms_error']:.3g} of the size, sse {d.sse:.6g})"
             )
+        elif k == "ok_order":
+            out.append("the branch does not pass the targets in their order (--ordered)")
         elif k == "ok_valid_over_turn" and d.checks.get("failures"):
             out += d.checks["failures"]
         else:
@@ -141,7 +143,14 @@ def _cmd_path(args: argparse.Namespace) -> int:
     cons = Constraints(full_turn=True, max_ratio=args.max_ratio, region=_region(args.pivots))
     if args.type == "sixbar":
         return _sixbar(args, targets, theta, cons)
-    d = synthesise_path(targets, theta, cons, budget=args.budget, seed=args.seed, tolerance=args.tolerance)
+    atlas = None
+    if args.atlas is not None and theta is None:
+        from planar.synth.atlas import read_atlas
+
+        atlas = read_atlas(args.atlas)
+    d = synthesise_path(
+        targets, theta, cons, budget=args.budget, seed=args.seed, tolerance=args.tolerance, atlas=atlas, ordered=args.ordered
+    )
     why = _unusable(d, "four-bar", cons.region is not None)
     if why is not None:
         return _no_design(args, "synth path", {"targets": len(targets)}, why)
@@ -167,8 +176,8 @@ def _cmd_path(args: argparse.Namespace) -> int:
     report = {"command": "synth path", "targets": len(targets), **d.to_dict()}
     return _finish_path(
         args,
-        f"four-bar ({fb.grashof}, {d.circuit}), sse {d.sse:.3g} (RMS distance "
-        f"{d.checks['rms_error']:.3g} of the targets' size) over {len(targets)} targets "
+        f"four-bar ({fb.grashof}, {d.circuit}), largest distance {d.checks['max_error']:.3g} of the targets' size "
+        f"(RMS {d.checks['rms_error']:.3g}) over {len(targets)} targets "
         f"in {d.seconds:.2f} s",
         text,
         report,
@@ -218,13 +227,38 @@ def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | N
     report = {"command": "synth path", "targets": len(targets), **d.to_dict()}
     return _finish_path(
         args,
-        f"{d.topology} six-bar, sse {d.sse:.3g} (RMS distance {d.checks['rms_error']:.3g} of "
-        f"the targets' size) over {len(targets)} targets in {d.seconds:.2f} s",
+        f"{d.topology} six-bar, largest distance {d.checks['max_error']:.3g} of the targets' size "
+        f"(RMS {d.checks['rms_error']:.3g}) over {len(targets)} targets in {d.seconds:.2f} s",
         text,
         report,
         d.ok,
         failing,
     )
+
+
+def _cmd_atlas(args: argparse.Namespace) -> int:
+    import os
+    import time
+
+    from planar.synth.atlas import atlas_path, build_atlas, read_atlas
+
+    if args.size < 100:
+        raise InputError("--size", args.size, "at least 100 four-bars")
+    if args.seed < 0:
+        raise InputError("--seed", args.seed, "a seed of 0 or more")
+    path = args.output if args.output is not None else str(atlas_path(args.size, args.seed))
+    if not path.endswith(".npz"):
+        raise InputError("-o", path, "an .npz file")
+    if os.path.exists(path) and not args.force:
+        a = read_atlas(path)
+        print(f"{path}: atlas of {len(a)} four-bars exists (built in {a.build_seconds:.1f} s CPU); --force rebuilds it")
+        return 0
+    t0 = time.process_time()
+    a = build_atlas(args.size, args.seed, progress=True)
+    a.save(path)
+    size = os.path.getsize(path)
+    print(f"wrote {path}: {len(a)} four-bars, {size / 1e6:.1f} MB, built in {time.process_time() - t0:.1f} s CPU")
+    return 0
 
 
 def _plus(v: float) -> str:
@@ -469,12 +503,29 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--tolerance",
         type=float,
-        default=0.01,
-        help="largest RMS distance to the targets accepted, as a fraction of the targets' size (their "
-        "RMS distance from their centroid); beyond it the design is written and exits 3 (0.01)",
+        default=1e-3,
+        help="largest distance from a target to the coupler point accepted, as a fraction of the targets' size "
+        "(their RMS distance from their centroid; the RMS is reported beside it); beyond it the design is "
+        "written and exits 3 (0.001)",
+    )
+    p.add_argument(
+        "--ordered", action="store_true", help="the coupler point must pass the targets in their order (one way round)"
+    )
+    p.add_argument(
+        "--atlas",
+        default=None,
+        help="coupler-curve atlas file (from planar synth atlas -o) for untimed targets (default: the cached one, "
+        "built on first use)",
     )
     p.add_argument("--seed", type=int, default=0, help="random seed of the search (same seed, same result)")
     p.set_defaults(func=_cmd_path)
+
+    a = ss.add_parser("atlas", help="build the coupler-curve atlas untimed path synthesis searches (cached)")
+    a.add_argument("--size", type=int, default=1_000_000, help="four-bars in the atlas (1000000: about 40 s, 100 MB)")
+    a.add_argument("--seed", type=int, default=0, help="random seed (same size and seed, same atlas)")
+    a.add_argument("-o", "--output", default=None, help="atlas file (.npz) to write (default: the user cache folder)")
+    a.add_argument("--force", action="store_true", help="rebuild even if the file exists")
+    a.set_defaults(func=_cmd_atlas)
 
     f = ss.add_parser("function", help="input/output angle pairs (Freudenstein): CSV input,output")
     f.add_argument(

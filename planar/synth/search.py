@@ -27,6 +27,7 @@ screened in float32, refined and checked in float64.  Same inputs and
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -48,6 +49,10 @@ Array = NDArray[np.float64]
 
 #: relative tolerance of the final constraint check (rounding-level overshoots pass)
 REL_TOL = 1e-9
+
+#: evaluations of one least-squares refinement (bounded, so its cost grows with the targets only through
+#: each evaluation's size)
+REFINE_NFEV = 200
 
 #: relative margin kept from a change-point (s + l = p + q) and from equal shortest links
 GRASHOF_MARGIN = 1e-3
@@ -232,8 +237,19 @@ def _nearest_theta(obj: PathObjective, row: Array, n: int = 720) -> Array:
     return th[np.argmin(d2, axis=1)]
 
 
-def _refine(obj: PathObjective, row: Array, bounds: list[tuple[float, float]], max_nfev: int) -> tuple[Array, Array, float]:
-    """least_squares from ``row``: returns (row, theta at the targets, sse with penalties)."""
+def _refine(
+    obj: PathObjective,
+    row: Array,
+    bounds: list[tuple[float, float]],
+    max_nfev: int,
+    method: str = "trf",
+    theta0: Array | None = None,
+) -> tuple[Array, Array, float]:
+    """least_squares from ``row``: returns (row, theta at the targets, sse with penalties).
+
+    ``method="lm"`` (Levenberg-Marquardt, no bounds: the constraints stay penalties) converges in far fewer
+    evaluations on reachable targets; it needs at least as many residuals as variables (else trf is used).
+    """
     from scipy.optimize import least_squares
 
     circ = np.array([1.0 if row[9] >= 0 else -1.0])
@@ -241,7 +257,7 @@ def _refine(obj: PathObjective, row: Array, bounds: list[tuple[float, float]], m
     hi = np.array([b[1] for b in bounds[:N_PARAMS]])
     timed = obj.theta is not None
     n = len(obj.targets)
-    th0: Array = obj.theta if obj.theta is not None else _nearest_theta(obj, row)
+    th0: Array = obj.theta if obj.theta is not None else (_nearest_theta(obj, row) if theta0 is None else theta0)
     w = np.sqrt(obj.penalty)
 
     def split(z: Array) -> tuple[Array, Array]:
@@ -261,12 +277,25 @@ def _refine(obj: PathObjective, row: Array, bounds: list[tuple[float, float]], m
         return rows(z[None, :])[0]
 
     def jac(z: Array) -> Array:
-        # forward differences, every perturbed vector in one call (the kernel is vectorised over candidates)
+        # forward differences exploiting the structure: the residuals at target i depend on the 9 parameters and
+        # on theta_i only, so one extra row perturbing every theta at once gives all of d(x_i, y_i)/d(theta_i):
+        # 10 or 11 kernel rows per Jacobian whatever the number of targets (all in one call)
         h = 1.49e-8 * np.maximum(1.0, np.abs(z))
         h = np.where(z + h > hi, -h, h)  # stay inside the bounds
-        Z = np.vstack([z[None, :], z[None, :] + np.diag(h)])
+        m = len(z)
+        Z = np.repeat(z[None, :], N_PARAMS + 2 if not timed else N_PARAMS + 1, axis=0)
+        Z[1 : N_PARAMS + 1, :N_PARAMS] += np.diag(h[:N_PARAMS])
+        if not timed:
+            Z[-1, N_PARAMS:] += h[N_PARAMS:]
         R = rows(Z)
-        return ((R[1:] - R[0]) / h[:, None]).T
+        J = np.zeros((R.shape[1], m))
+        J[:, :N_PARAMS] = ((R[1 : N_PARAMS + 1] - R[0]) / h[:N_PARAMS, None]).T
+        if not timed:
+            d = (R[-1] - R[0])[: 2 * n]
+            i = np.arange(n)
+            J[i, N_PARAMS + i] = d[:n] / h[N_PARAMS:]
+            J[n + i, N_PARAMS + i] = d[n:] / h[N_PARAMS:]
+        return J
 
     z0 = np.clip(row[:N_PARAMS], lo, hi)
     if not timed:
@@ -277,7 +306,11 @@ def _refine(obj: PathObjective, row: Array, bounds: list[tuple[float, float]], m
     fin = np.isfinite(lo) & np.isfinite(hi)
     span = np.where(fin, hi - lo, 0.0)
     z0 = np.where(fin, np.clip(z0, np.where(fin, lo, 0.0) + 1e-9 * span, np.where(fin, hi, 0.0) - 1e-9 * span), z0)
-    res = least_squares(resid, z0, jac=jac, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=max_nfev)
+    tight = {"xtol": 1e-14, "ftol": 1e-14, "gtol": 1e-14}
+    if method == "lm" and 2 * n + 1 >= len(z0):
+        res = least_squares(resid, z0, jac=jac, method="lm", x_scale="jac", max_nfev=max_nfev, **tight)
+    else:
+        res = least_squares(resid, z0, jac=jac, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=max_nfev, **tight)
     p, th = split(res.x)
     out = np.append(p, row[9])
     return (
@@ -355,7 +388,7 @@ def search_fourbar(
     t2 = time.perf_counter()
     best: tuple[float, Array, Array] | None = None
     for row in starts:
-        r, tt, e = _refine(obj, row, b, max_nfev=60 * (len(b) + (0 if th is not None else len(targets))))
+        r, tt, e = _refine(obj, row, b, max_nfev=REFINE_NFEV)
         if best is None or e < best[0]:
             best = (e, r, tt)
     stages["refine_s"] = time.perf_counter() - t2
@@ -363,3 +396,119 @@ def search_fourbar(
     e, r, tt = best
     feasible = not constraint_failures(r[:N_PARAMS], cons)
     return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), feasible, evals, stages)
+
+
+def max_distance(obj: PathObjective, row: Array, theta: Array) -> float:
+    """Largest distance from a target to the coupler point of ``row`` at ``theta`` (inf if it cannot close)."""
+    x, y, ok = coupler_points(row[None, :N_PARAMS], theta[None, :], np.array([1.0 if row[9] >= 0 else -1.0]))
+    if not ok.all():
+        return float("inf")
+    return float(np.max(np.hypot(x[0] - obj.targets[:, 0], y[0] - obj.targets[:, 1])))
+
+
+def in_order(theta: Array) -> bool:
+    """Whether crank angles ``theta`` (radians, one per target in the targets' order) run one way round
+    within one turn: the branch passes the targets in their order."""
+    d = np.diff(np.asarray(theta, float)) % (2 * np.pi)
+    span = 2 * np.pi * (1 - 1e-9)
+    return bool(d.sum() < span or (-np.diff(np.asarray(theta, float)) % (2 * np.pi)).sum() < span)
+
+
+def search_atlas(
+    targets: Array,
+    atlas: Any,
+    cons: Constraints | None = None,
+    neighbours: int = 64,
+    refine: int = 16,
+    stop: float = 1e-9,
+    samples: int = 128,
+    ordered: bool = False,
+) -> SearchResult:
+    """Untimed targets (normalised: centroid 0, size 1) from an atlas (:mod:`planar.synth.atlas`), refined.
+
+    The atlas gives ``8 neighbours`` candidates (:func:`planar.synth.atlas.candidates`); they are scored
+    by the untimed objective at ``samples`` crank angles, and the ``refine`` best distinct ones are refined
+    by least squares (crank angles at the targets free), best first, stopping early once the largest
+    distance to a target is at most ``stop`` (model units of the normalised targets).  ``ordered``: a
+    result whose branch passes the targets out of order (:func:`in_order`) is kept only if no other is found.
+    """
+    import time
+
+    from planar.synth.atlas import candidates
+
+    cons = cons if cons is not None else Constraints()
+    t = np.asarray(targets, float)
+    obj = PathObjective(t, None, cons, samples)
+    b = default_bounds(t, cons, False)
+    b[8] = (-3 * np.pi, 3 * np.pi)  # the ground line's angle: no wall at +-pi for a candidate placed near it
+    stages: dict[str, float] = {}
+    t0 = time.perf_counter()
+    lo = np.array([v[0] for v in b])
+    hi = np.array([v[1] for v in b])
+    every = candidates(atlas, t, neighbours)
+    inside = np.all((every - lo >= 0) & (hi - every >= 0), axis=1)
+    C = every[inside] if inside.any() else np.clip(every, lo, hi)
+    f = obj.population(C, np.float64)
+    order = np.argsort(f, kind="stable")
+    stages["atlas_s"] = time.perf_counter() - t0
+    starts: list[Array] = []
+    for row in C[order]:
+        if len(starts) >= refine:
+            break
+        if all(np.linalg.norm((row - s) / (hi - lo)) > 1e-3 for s in starts):
+            starts.append(row)
+    t1 = time.perf_counter()
+    done: list[tuple[float, Array, Array]] = []
+    for row in starts:
+        if _refined(obj, cons, b, row, None, REFINE_NFEV, ordered, stop, done):
+            break
+    else:
+        # none reached ``stop``: the two best go on (Levenberg-Marquardt can crawl along a valley; on 8 targets,
+        # underdetermined, it sometimes needs a thousand evaluations)
+        for _, r, tt in sorted(done, key=lambda d: d[0])[:2]:
+            if _refined(obj, cons, b, r, tt, 10 * REFINE_NFEV, ordered, stop, done):
+                break
+    stages["refine_s"] = time.perf_counter() - t1
+    best = min(done, key=lambda d: d[0])
+    e, r, tt = best
+    feasible = not constraint_failures(r[:N_PARAMS], cons)
+    return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), feasible, len(C), stages)
+
+
+def _refined(
+    obj: PathObjective,
+    cons: Constraints,
+    b: list[tuple[float, float]],
+    row: Array,
+    theta0: Array | None,
+    nfev: int,
+    ordered: bool,
+    stop: float,
+    done: list[tuple[float, Array, Array]],
+) -> bool:
+    """Refine one start (appended to ``done``); whether it reached ``stop`` keeping the constraints (and order)."""
+    r, tt, e = _refine(obj, row, b, max_nfev=nfev, method="lm", theta0=theta0)
+    ok_order = in_order(tt) or not ordered
+    done.append((e if ok_order else e + obj.penalty, r, tt))  # out of order: worse than any in-order result
+    return ok_order and max_distance(obj, r, tt) <= stop and not violation(r[None, :N_PARAMS], cons, obj.scale, 0.0)[0] > 0
+
+
+def timed_from_atlas(
+    targets: Array, theta: Array, atlas: Any, cons: Constraints | None = None, starts: int = 3
+) -> SearchResult | None:
+    """Timed targets (normalised) from the atlas: the untimed curve (:func:`search_atlas`), then least squares
+    with the crank angles fixed at ``theta`` from it (None when no start closes at every crank angle)."""
+    import time
+
+    cons = cons if cons is not None else Constraints()
+    t0 = time.perf_counter()
+    u = search_atlas(targets, atlas, cons)
+    obj = PathObjective(np.asarray(targets, float), np.asarray(theta, float), cons)
+    b = default_bounds(obj.targets, cons, True)
+    b[8] = (-3 * np.pi, 3 * np.pi)
+    r, tt, e = _refine(obj, np.append(u.params, u.circuit), b, max_nfev=REFINE_NFEV, method="lm")
+    if not np.isfinite(e):
+        return None
+    stages = {**u.stages, "timed_s": time.perf_counter() - t0}
+    feasible = not constraint_failures(r[:N_PARAMS], cons)
+    return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), feasible, u.evaluations, stages)

@@ -484,6 +484,7 @@ def check_sixbar(d: SixBarDesign, cons: Constraints, scale: float, tolerance: fl
         "size": size,
         "rms_error": rms,
         "tolerance": tolerance,
-        "ok_accuracy": bool(rms <= tolerance),
         "max_target_distance": float(np.max(np.hypot(*(pts - d.targets).T))) if at.valid.all() else float("inf"),
     }
+    d.checks["max_error"] = d.checks["max_target_distance"] / size
+    d.checks["ok_accuracy"] = bool(d.checks["max_error"] <= tolerance)

@@ -10,6 +10,7 @@ with ezdxf, and it renders and runs ``planar toy``.
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -152,9 +153,25 @@ def test_bunny_request_renders_exports_and_runs(tmp_path: Path, capsys) -> None:
     _check(out, rows)
     toy = load_scene(out).mechanism
     assert toy.cost == gallery.cost  # the paper's Bunny tree is the cheapest: one slider, two ears
+    capsys.readouterr()
     assert main(["export", str(out), "-o", str(tmp_path / "b.dxf")]) == 0
-    doc = ezdxf.readfile(tmp_path / "b.dxf")
-    assert len(doc.modelspace()) > 20
+    said = "".join(capsys.readouterr())
+    parts = int(re.search(r"(\d+) parts on 1 sheet", said).group(1))
+    # read back by ezdxf: one closed cut outline per part the export reports, each on the sheet
+    msp = ezdxf.readfile(tmp_path / "b.dxf").modelspace()
+    outer = [e for e in msp if e.dxf.layer == "CUT_OUTER"]
+    assert len(outer) == parts >= 2
+    assert all(e.closed for e in outer if e.dxftype() == "LWPOLYLINE")
+    from ezdxf import bbox
+
+    sheet = bbox.extents([e for e in msp if e.dxf.layer == "SHEET"])
+    for e in outer:
+        b = bbox.extents([e])
+        assert sheet.extmin.x <= b.extmin.x and b.extmax.x <= sheet.extmax.x
+        assert sheet.extmin.y <= b.extmin.y and b.extmax.y <= sheet.extmax.y
+    # every pin the export reports has a round hole to go through
+    pins = int(re.search(r"(\d+) pin\(s\)", said).group(1))
+    assert sum(1 for e in msp if e.dxf.layer == "CUT_INNER" and e.dxftype() == "CIRCLE") >= pins >= 1
     from planar.app.pipeline import render_scene
 
     scene = load_scene(out)

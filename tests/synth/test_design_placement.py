@@ -118,9 +118,14 @@ def test_a_stage_left_unsimulated_fails_by_name(tmp_path, capsys, monkeypatch) -
     """A #8 stage with nothing holding its tab is not simulated: the design names the stage, its effector and
     why, in the text and the JSON, and exits 3 (here the scene is written without the gravity the design adds)."""
     import planar.synth.design as design
+    import planar.synth.design.pipeline as pipeline
     from planar.scene.load import scene_from_mechanism
 
-    monkeypatch.setattr(design, "design_scene", lambda toy, name: scene_from_mechanism(toy, name=name, **design.SCENE_TABLES))
+    def bare(toy, name):
+        return scene_from_mechanism(toy, name=name, **design.SCENE_TABLES)
+
+    monkeypatch.setattr(pipeline, "design_scene", bare)  # what design_toy's physics check runs
+    monkeypatch.setattr(design, "design_scene", bare)  # what planar design writes
     req = tmp_path / "r.toml"
     req.write_text('[[effector]]\nname = "ear"\nmotion = "Oy"\nrange = 20.0\n')
     out = tmp_path / "toy.toml"

@@ -1,0 +1,362 @@
+"""An atlas of normalised four-bar coupler curves, searched by nearest neighbour.
+
+Each entry is one four-bar on one circuit, in a normalised frame: ground
+``1`` along +x from the crank pivot at the origin, crank, coupler and rocker
+lengths and the coupler point ``(u, v)`` in the coupler's frame (as
+:mod:`planar.synth.kernel`).  The atlas covers linkages whose crank turns
+fully (Grashof with the crank or the ground shortest: crank-rockers and
+drag-links), link ratio at most :data:`MAX_RATIO`, both circuits.
+
+Its coupler curve, solved at :data:`CURVE_SAMPLES` crank angles over the
+turn, is resampled to :data:`RESAMPLE` points evenly spaced by arc length
+and described by its Fourier coefficients ``c_n`` (``n = +-1 ... +-K``,
+:data:`HARMONICS`), normalised for
+
+* position: ``c_0`` (the centroid) is left out;
+* scale: divided by the RMS distance from the centroid;
+* rotation ``phi`` and starting point ``s``: ``c_n`` is multiplied by
+  ``exp(-i (phi + n s))`` with ``phi`` and ``s`` chosen so ``c_1`` and
+  ``c_-1`` are real and positive.  That leaves one ambiguity (``phi + pi``,
+  ``s + pi`` flips the sign of every even harmonic): the atlas stores one
+  choice and a query tries both.
+
+A query (:func:`candidates`) describes the targets the same way (their
+polygon, closed, resampled by arc length), also reversed (the crank may turn
+either way along them) and mirrored, finds the nearest entries with
+:class:`scipy.spatial.cKDTree`, and maps each back onto the targets (scale,
+rotation and position from the two descriptions).  The candidates are then
+refined by :mod:`planar.synth.search` on the targets themselves.
+
+The build (:func:`build_atlas`) is vectorised over chunks of linkages (no
+Python loop per linkage; memory bounded by the chunk), deterministic for a
+given size and seed (every chunk has its own seeded generator), and cached
+on disk (:func:`load_atlas`).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planar.errors import InputError
+from planar.synth.kernel import coupler_points
+
+__all__ = [
+    "DEFAULT_SIZE",
+    "Atlas",
+    "atlas_path",
+    "build_atlas",
+    "candidates",
+    "describe",
+    "load_atlas",
+]
+
+Array = NDArray[np.float64]
+
+#: format version of the files on disk (a change rebuilds them)
+VERSION = 1
+#: harmonics kept on each side (n = +-1 ... +-K): 2 + 4 (K - 1) numbers per curve
+HARMONICS = 5
+#: crank angles each atlas curve is solved at
+CURVE_SAMPLES = 128
+#: points per curve after arc-length resampling (the FFT length)
+RESAMPLE = 64
+#: longest / shortest link of an atlas linkage at most this
+MAX_RATIO = 10.0
+#: entries of the default atlas (four-bars, each on one circuit)
+DEFAULT_SIZE = 1_000_000
+#: entries of the atlas the quick budget uses (builds in about a second)
+QUICK_SIZE = 20_000
+#: linkages per chunk of the build (memory: about 40 MB of temporaries)
+CHUNK = 20_000
+
+
+@dataclass
+class Atlas:
+    """Normalised four-bars and their curve descriptors (see the module).
+
+    ``params`` ``(M, 6)``: crank, coupler, rocker, u, v, circuit (ground 1);
+    ``frame`` ``(M, 4)``: the curve's centroid x, y, its size (RMS distance
+    from the centroid) and the rotation ``phi`` (radians) of the stored
+    description; ``desc`` ``(M, D)``.
+    """
+
+    params: NDArray[np.float32]
+    frame: NDArray[np.float32]
+    desc: NDArray[np.float32]
+    seed: int
+    build_seconds: float = 0.0
+    _tree: Any = field(default=None, repr=False)
+
+    def __len__(self) -> int:
+        return len(self.params)
+
+    @property
+    def tree(self) -> Any:
+        """The :class:`scipy.spatial.cKDTree` over the descriptors (built on first use)."""
+        if self._tree is None:
+            from scipy.spatial import cKDTree
+
+            self._tree = cKDTree(np.asarray(self.desc, float), balanced_tree=False, compact_nodes=False)
+        return self._tree
+
+    def save(self, path: str | Path) -> None:
+        """Write the atlas as one ``.npz`` file (written to a temporary name, then moved into place)."""
+        p = Path(path)
+        p.parent.mkdir(parents=True, exist_ok=True)
+        tmp = p.with_name(p.name + f".{os.getpid()}.tmp.npz")
+        meta = np.array([VERSION, HARMONICS, CURVE_SAMPLES, RESAMPLE, self.seed], dtype=np.int64)
+        np.savez(tmp, params=self.params, frame=self.frame, desc=self.desc, meta=meta, seconds=np.float64(self.build_seconds))
+        os.replace(tmp, p)
+
+
+def _descriptor(c: NDArray[np.complex128], pos: NDArray[np.complex128], neg: NDArray[np.complex128]) -> Array:
+    """Real descriptor rows from normalised coefficients ``c_1, c_-1`` (real) and ``c_n, c_-n`` (n >= 2)."""
+    return np.concatenate([c.real, pos.real, pos.imag, neg.real, neg.imag], axis=1)
+
+
+def describe(z: NDArray[np.complex128]) -> tuple[Array, Array]:
+    """Descriptors of closed curves ``z`` ``(P, S)`` (complex points in order, the last joined to the first).
+
+    Returns ``desc`` ``(P, D)`` and ``frame`` ``(P, 4)`` (centroid x, y, size, rotation; see :class:`Atlas`),
+    both after arc-length resampling to :data:`RESAMPLE` points.  A curve of zero length gives NaN.
+    """
+    P, S = z.shape
+    seg = np.abs(np.diff(z, axis=1, append=z[:, :1]))
+    cum = np.concatenate([np.zeros((P, 1)), np.cumsum(seg, axis=1)], axis=1)
+    total = cum[:, -1:]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u = cum / total  # 0 ... 1 per row
+    rows = np.arange(P)[:, None]
+    flat = (u + 2.0 * rows).ravel()  # increasing over the whole array
+    q = (np.arange(RESAMPLE) / RESAMPLE)[None, :] + 2.0 * rows
+    k = np.clip(np.searchsorted(flat, q.ravel(), side="right") - 1, 0, None).reshape(P, RESAMPLE)
+    k = np.minimum(k - rows * (S + 1), S - 1)
+    zz = np.concatenate([z, z[:, :1]], axis=1)
+    u0 = np.take_along_axis(u, k, axis=1)
+    u1 = np.take_along_axis(u, k + 1, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        f = np.clip((q - 2.0 * rows - u0) / (u1 - u0), 0.0, 1.0)
+    f = np.nan_to_num(f)
+    w = np.take_along_axis(zz, k, axis=1) * (1 - f) + np.take_along_axis(zz, k + 1, axis=1) * f
+    C = np.fft.fft(w, axis=1) / RESAMPLE
+    c0 = C[:, 0]
+    size = np.sqrt(np.sum(np.abs(C[:, 1:]) ** 2, axis=1))
+    a1, am1 = np.angle(C[:, 1]), np.angle(C[:, -1])
+    phi, s = 0.5 * (a1 + am1), 0.5 * (a1 - am1)
+    n = np.arange(2, HARMONICS + 1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        inv = 1.0 / size
+    rot = np.exp(-1j * phi)[:, None]
+    pos = C[:, n] * rot * np.exp(-1j * n[None, :] * s[:, None]) * inv[:, None]
+    neg = C[:, -n] * rot * np.exp(1j * n[None, :] * s[:, None]) * inv[:, None]
+    c1 = np.column_stack([np.abs(C[:, 1]), np.abs(C[:, -1])]) * inv[:, None]
+    desc = _descriptor(c1.astype(complex), pos, neg)
+    frame = np.column_stack([c0.real, c0.imag, size, phi])
+    return desc, frame
+
+
+def _flip(desc: Array) -> Array:
+    """The other normalisation (``phi + pi``, ``s + pi``): every even harmonic changes sign."""
+    out = desc.copy()
+    K = HARMONICS - 1
+    n = np.arange(2, HARMONICS + 1)
+    sign = np.where(n % 2 == 0, -1.0, 1.0)
+    for j in range(4):  # pos.real, pos.imag, neg.real, neg.imag blocks
+        out[:, 2 + j * K : 2 + (j + 1) * K] *= sign
+    return out
+
+
+def _sample_linkages(rng: np.random.Generator, n: int) -> Array:
+    """``n`` rows of crank, coupler, rocker, u, v, circuit (ground 1) whose crank turns fully, ratio <= MAX_RATIO."""
+    out: list[Array] = []
+    have = 0
+    while have < n:
+        m = 3 * (n - have) + 64
+        L = np.exp(rng.uniform(np.log(1 / MAX_RATIO), np.log(MAX_RATIO), (m, 3)))
+        allL = np.column_stack([np.ones(m), L])
+        lo, hi = allL.min(1), allL.max(1)
+        total = allL.sum(1)
+        margin = 1e-3 * total
+        grashof = lo + hi + margin <= total - lo - hi
+        crank_or_ground = np.minimum(allL[:, 0], allL[:, 1]) + margin <= np.minimum(allL[:, 2], allL[:, 3])
+        keep = grashof & crank_or_ground & (hi <= MAX_RATIO * lo)
+        L = L[keep]
+        k = len(L)
+        u = L[:, 1] * rng.uniform(-1.5, 2.5, k)
+        v = L[:, 1] * rng.uniform(-2.0, 2.0, k)
+        circ = np.where(rng.random(k) < 0.5, 1.0, -1.0)
+        out.append(np.column_stack([L, u, v, circ]))
+        have += k
+    return np.concatenate(out)[:n]
+
+
+def _chunk(seed: int, index: int, n: int) -> tuple[Array, Array, Array]:
+    rng = np.random.default_rng([seed, index])
+    p = _sample_linkages(rng, n)
+    X = np.column_stack([np.ones(n), p[:, :5], np.zeros((n, 3))])
+    th = np.linspace(0.0, 2 * np.pi, CURVE_SAMPLES, endpoint=False)
+    x, y, ok = coupler_points(X, th, p[:, 5], threads=1)
+    desc, frame = describe(x + 1j * y)
+    good = ok.all(1) & np.isfinite(desc).all(1) & (frame[:, 2] > 1e-9)
+    return p[good], frame[good], desc[good]
+
+
+def build_atlas(size: int = DEFAULT_SIZE, seed: int = 0, progress: bool = False) -> Atlas:
+    """Build an atlas of ``size`` four-bars (deterministic for ``size`` and ``seed``; see the module).
+
+    ``progress``: show a progress bar (tqdm, on standard error).  About 40 s of CPU per million entries.
+    """
+    if size < 100:
+        raise InputError("atlas size", size, "at least 100 four-bars")
+    t0 = time.process_time()
+    parts: list[tuple[Array, Array, Array]] = []
+    have, index = 0, 0
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=size, unit="curve", desc="atlas", unit_scale=True)
+    while have < size:
+        n = min(CHUNK, size - have)
+        p, f, d = _chunk(seed, index, n)
+        parts.append((p, f, d))
+        have += len(p)
+        index += 1
+        if bar is not None:
+            bar.update(len(p))
+    if bar is not None:
+        bar.close()
+    params = np.concatenate([a[0] for a in parts])[:size].astype(np.float32)
+    frame = np.concatenate([a[1] for a in parts])[:size].astype(np.float32)
+    desc = np.concatenate([a[2] for a in parts])[:size].astype(np.float32)
+    return Atlas(params, frame, desc, seed, time.process_time() - t0)
+
+
+def cache_dir() -> Path:
+    """Where atlases are cached: ``PLANAR_CACHE_DIR`` if set, else the user's cache folder (platformdirs)."""
+    env = os.environ.get("PLANAR_CACHE_DIR", "").strip()
+    if env:
+        return Path(env)
+    import platformdirs
+
+    return Path(platformdirs.user_cache_dir("planar", appauthor=False))
+
+
+def atlas_path(size: int = DEFAULT_SIZE, seed: int = 0) -> Path:
+    """The cache file of the atlas of ``size`` entries and ``seed``."""
+    return cache_dir() / f"atlas-v{VERSION}-{size}-{seed}.npz"
+
+
+_LOADED: dict[str, Atlas] = {}
+
+
+def read_atlas(path: str | Path) -> Atlas:
+    """An atlas written by :meth:`Atlas.save`; raises :class:`InputError` naming the file if it is not one."""
+    p = str(path)
+    if p in _LOADED:
+        return _LOADED[p]
+    try:
+        with np.load(p) as z:
+            meta = z["meta"]
+            if meta[:4].tolist() != [VERSION, HARMONICS, CURVE_SAMPLES, RESAMPLE]:
+                raise InputError(p, f"atlas format {meta[:4].tolist()}", "an atlas of this planar (rebuild it)")
+            a = Atlas(z["params"], z["frame"], z["desc"], int(meta[4]), float(z["seconds"]))
+    except FileNotFoundError:
+        raise InputError(p, "missing", "an atlas file written by planar synth atlas") from None
+    except (KeyError, ValueError, OSError) as e:
+        raise InputError(p, type(e).__name__, "an atlas file written by planar synth atlas") from None
+    _LOADED[p] = a
+    return a
+
+
+def load_atlas(size: int = DEFAULT_SIZE, seed: int = 0, progress: bool = False) -> Atlas:
+    """The cached atlas of ``size`` entries, built and cached first if missing (see :func:`atlas_path`).
+
+    When the cache folder cannot be written the atlas is kept in memory only.
+    """
+    path = atlas_path(size, seed)
+    if path.exists():
+        return read_atlas(path)
+    a = build_atlas(size, seed, progress)
+    try:
+        a.save(path)
+        _LOADED[str(path)] = a
+    except OSError:
+        pass
+    return a
+
+
+def _mirror(rows: Array) -> Array:
+    """Candidate rows (kernel's 9 parameters and the circuit) mirrored across the x axis."""
+    out = rows.copy()
+    out[:, 5] *= -1.0  # v
+    out[:, 7] *= -1.0  # y0
+    out[:, 8] *= -1.0  # phi
+    out[:, 9] *= -1.0  # circuit
+    return out
+
+
+def _place(atlas: Atlas, idx: NDArray[np.intp], wframe: Array) -> Array:
+    """Atlas entries ``idx`` mapped onto a query described by ``wframe`` (centroid x, y, size, rotation)."""
+    p = atlas.params[idx].astype(float)
+    fr = atlas.frame[idx].astype(float)
+    k = wframe[2] / fr[:, 2]
+    psi = wframe[3] - fr[:, 3]
+    e = np.exp(1j * psi)
+    o2 = (wframe[0] + 1j * wframe[1]) - k * e * (fr[:, 0] + 1j * fr[:, 1])
+    rows = np.column_stack(
+        [k, k * p[:, 0], k * p[:, 1], k * p[:, 2], k * p[:, 3], k * p[:, 4], o2.real, o2.imag, np.angle(e), p[:, 5]]
+    )
+    return rows
+
+
+def smooth_closed(z: NDArray[np.complex128], n: int = CURVE_SAMPLES) -> NDArray[np.complex128]:
+    """``n`` points on the periodic cubic spline through the closed polygon ``z`` (parametrised by chord length).
+
+    Sparse targets (8 of them) describe their curve better through the spline than through the polygon.
+    """
+    from scipy.interpolate import CubicSpline
+
+    seg = np.abs(np.diff(z, append=z[:1]))
+    if len(z) < 4 or np.any(seg <= 1e-12 * max(float(seg.max()), 1e-300)):
+        return z
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    zz = np.append(z, z[0])
+    cs = CubicSpline(s, np.column_stack([zz.real, zz.imag]), bc_type="periodic")
+    q = cs(np.linspace(0.0, s[-1], n, endpoint=False))
+    return np.asarray(q[:, 0] + 1j * q[:, 1])
+
+
+def candidates(atlas: Atlas, targets: Array, k: int = 32) -> Array:
+    """Four-bars near ``targets`` ``(N, 2)`` (ordered), as rows of the kernel's 9 parameters and the circuit.
+
+    The targets are described as a closed curve (:func:`smooth_closed`), in both directions and mirrored, each description
+    in both normalisations (see the module): ``8 k`` rows, nearest first within each query.
+    """
+    t = np.asarray(targets, float)
+    z = t[:, 0] + 1j * t[:, 1]
+    out: list[Array] = []
+    for mirrored in (False, True):
+        zm = np.conj(z) if mirrored else z
+        for seq in (zm, zm[::-1]):
+            d, fr = describe(smooth_closed(seq)[None, :])
+            if not np.isfinite(d).all():
+                continue
+            for flipped in (False, True):
+                q = _flip(d) if flipped else d
+                wf = fr[0].copy()
+                if flipped:
+                    wf[3] += np.pi
+                _, idx = atlas.tree.query(q[0], k=min(k, len(atlas)))
+                rows = _place(atlas, np.atleast_1d(idx), wf)
+                out.append(_mirror(rows) if mirrored else rows)
+    if not out:
+        return np.empty((0, 10))
+    return np.concatenate(out)
