@@ -46,6 +46,10 @@ class Fabrication:
     #: motions the cut parts will not make (a toy's cam throw or effector stroke under a few times the fit's
     #: play: :func:`planar.toys.fitcheck.small_motions`), one line each
     warnings: list[str] = field(default_factory=list)
+    #: the mechanism as cut (a toy's assembly, perpendicular pieces bracketed): its motion is what the build check moves
+    mechanism: Any = None
+    #: what the build check found (:func:`planar.fabrication.check.build_check`); empty: it goes together and moves
+    violations: list[Any] = field(default_factory=list)
 
 
 def _shaft_pin(mech: Any, pins) -> Any:
@@ -245,6 +249,11 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
         _engrave_joins(cuts, joins, s)
     notes.extend(part_notes)
     notes.extend(asm.notes)
+    from types import SimpleNamespace
+
+    from planar.fabrication.plan import settle
+
+    violations = settle(SimpleNamespace(mechanism=mech, assembly=asm, own=material, settings=s))
     for pc in cuts:
         pc.layer = asm.layers.get(pc.name)
     # spacer rings, cut from the same sheet
@@ -282,6 +291,8 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
         stack_z=tab_plan.z_stack,
         planes=dict(tab_plan.planes),
         warnings=warnings,
+        mechanism=mech,
+        violations=violations,
     )
 
 

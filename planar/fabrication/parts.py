@@ -83,6 +83,13 @@ class FabSettings:
     svg_stroke_mm: float = 0.025
     cut_colour: str = "#ff0000"
     engrave_colour: str = "#0000ff"
+    #: the fastener every pin is (:data:`planar.fabrication.hardware.HARDWARE`)
+    hardware: str = "rod-eclip"
+    #: colours of the cuts: "planar" (``cut_colour`` for both cuts) or "boxes" (Boxes.py's: black outer, blue inner,
+    #: green engrave)
+    colours: str = "planar"
+    #: side of a reference square cut in a corner of each sheet (mm; 0: none), to measure the scale after cutting
+    reference_square_mm: float = 0.0
 
     @classmethod
     def from_spec(cls, fab: Any, kerf: float | None = None, sheet: tuple[float, float] | None = None) -> FabSettings:
@@ -109,6 +116,9 @@ class FabSettings:
             svg_stroke_mm=fab.svg_stroke_mm,
             cut_colour=fab.cut_colour,
             engrave_colour=fab.engrave_colour,
+            hardware=getattr(fab, "hardware", "rod-eclip"),
+            colours=getattr(fab, "colours", "planar"),
+            reference_square_mm=getattr(fab, "reference_square_mm", 0.0),
         )
 
 
