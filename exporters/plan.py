@@ -28,8 +28,8 @@ def _parts(fab: Any) -> list[dict[str, Any]]:
     asm = fab.assembly
     out = []
     for p in fab.layout.parts:
-        if p.name.startswith("spacer "):
-            continue
+        if p.name.startswith("spacer ") or p.name not in asm.layers:
+            continue  # spacers are listed on their own; the reference square is no part of the assembly
         layer = asm.layers.get(p.name)
         a, dx, dy = p.placed
         out.append(
@@ -54,6 +54,7 @@ def _pin(fab: Any, pp: Any) -> dict[str, Any]:
         "name": pp.letter,
         "joints": list(pp.joints),
         "parts": list(pp.parts),
+        "plane": fab.assembly.plane.get(pp.parts[0], "xy"),
         "layers": [lo + 1, hi + 1],
         "length_mm": _r(shaft_length(s, pp) if pp.shaft else pp.length_mm),
         "diameter_mm": _r(s.shaft_mm if pp.shaft else pp.diameter_mm),

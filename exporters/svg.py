@@ -83,7 +83,9 @@ def svg_text(layout: Layout, sheet: int = 0, settings: Any = None) -> str:
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{_f(W)}mm" height="{_f(H)}mm" viewBox="0 0 {_f(W)} {_f(H)}">',
     ]
-    colour = {"CUT_INNER": cut, "CUT_OUTER": cut, "ENGRAVE": eng}
+    colour = (
+        settings.layer_colours() if hasattr(settings, "layer_colours") else {"CUT_INNER": cut, "CUT_OUTER": cut, "ENGRAVE": eng}
+    )
     for name in ("CUT_INNER", "CUT_OUTER", "ENGRAVE"):
         out.append(
             f'<g id="{name}" fill="none" stroke="{colour[name]}" stroke-width="{_f(stroke)}" '

@@ -270,6 +270,8 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
                     nominal_holes=[((0.0, 0.0), ri)],
                 )
             )
+    if s.reference_square_mm > 0:
+        cuts.append(_reference_square(s))
     layout = nest(cuts, s.sheet, s.spacing, s.margin, s.kerf, s.unit_mm)
     warnings: list[str] = []
     from planar.windup.chain import ToyMechanism
@@ -319,6 +321,19 @@ def _engrave_joins(cuts: list[PartCut], joins: list[Any], s: FabSettings) -> Non
         piece.engrave.extend(
             letter_marks(mat, [((float(mid.x), float(mid.y)), s.thickness_mm, jn.letter)], max(s.min_label, 1.5))
         )
+
+
+def _reference_square(s: FabSettings) -> PartCut:
+    """A square of ``reference_square_mm`` (kerf-compensated like every outline) with its size engraved: measure
+    it after cutting to check the scale (a part is never scaled by the laser software's import)."""
+    from planar.fabrication.sheet import Contour
+    from planar.fabrication.strokefont import text_strokes
+
+    a = s.reference_square_mm / 2 + s.kerf / 2
+    outer = Contour([(-a, -a, 0.0), (a, -a, 0.0), (a, a, 0.0), (-a, a, 0.0)])
+    h = min(2.0, s.reference_square_mm / 6)
+    text = f"{s.reference_square_mm:g}"
+    return PartCut("reference square", outer, [], text_strokes(text, h, (0.0, 0.0), 0.0), text, h)
 
 
 def sheet_paths(path: str | os.PathLike, sheets: int) -> list[Path]:

@@ -217,6 +217,8 @@ def build_check(fab: Any, samples: int = 240) -> list[Violation]:
     bodies = list(parts)
     out: list[Violation] = []
     for pp in asm.pins:
+        if asm.plane.get(pp.parts[0], "xy") != "xy":
+            continue  # a pin between pieces standing perpendicular: not in the xy stack
         own = {asm.layers[p] for p in pp.parts if asm.layers.get(p) is not None}
         bodies += pin_bodies(pp, poses, s, own)
         out += _in_own_holes(pp, poses, s, by_name)

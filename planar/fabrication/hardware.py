@@ -23,7 +23,7 @@ from typing import Any
 
 from planar.errors import InputError
 
-__all__ = ["HARDWARE", "Item", "PinHardware", "hardware_of", "pin_ends", "pin_items"]
+__all__ = ["HARDWARE", "Item", "PinHardware", "hardware_of", "pin_ends", "pin_items", "shaft_items", "shaft_length"]
 
 #: DIN 125 washer per nominal diameter: (outer diameter, thickness) mm
 WASHER = {2.0: (5.0, 0.3), 2.5: (6.0, 0.5), 3.0: (7.0, 0.5), 4.0: (9.0, 0.8), 5.0: (10.0, 1.0), 6.0: (12.0, 1.6)}
@@ -168,3 +168,15 @@ def shaft_length(settings: Any, pin: Any) -> float:
     _, hi = pin.layers or (0, 0)
     (_, _), (ht, _) = pin_ends(settings, pin)
     return math.ceil(((hi + 1) * settings.thickness_mm + ht + 0.5) * 2 - 1e-9) / 2
+
+
+def shaft_items(settings: Any, pin: Any) -> list[Item]:
+    """What holds the motor shaft's top end: a washer and an e-clip of its diameter (where they are sold)."""
+    d = round(settings.shaft_mm * 2) / 2
+    if d not in WASHER:
+        return []
+    wd, wt = WASHER[d]
+    return [
+        Item("washer DIN 125", f"M{d:g} ({wd:g} x {wt:g} mm)", 1),
+        Item("e-clip DIN 6799", f"{ECLIP[d][0]:g} (for {d:g} mm shaft)", 1),
+    ]
