@@ -13,7 +13,7 @@ import math
 import re
 from typing import Any
 
-__all__ = ["refit_pins", "settle"]
+__all__ = ["blocking", "refit_pins", "settle"]
 
 #: rounds of opening gaps before the plan is left to the check's verdict
 MAX_ROUNDS = 6
@@ -84,3 +84,49 @@ def settle(fab: Any, samples: int = 120, final: int = 240) -> list[Any]:
         refit_pins(asm, s)
         violations = build_check(fab, samples)
     return build_check(fab, final)
+
+
+def _pin_letter(body: str) -> str | None:
+    m = re.match(r"^(?:pin|motor shaft) (\S+)", body)
+    return m.group(1) if m else None
+
+
+def blocking(asm: Any, violations: list[Any]) -> list[str]:
+    """Why no plan clears what is left, one line per blocked pair: the constraint that holds it.
+
+    * two pins colliding that both ride a part they share (one slot, one frame): every layer order passes both
+      through that part's layer, so no plan separates them; the tracks must be apart in the design;
+    * a pin crossing a part between its ends: every order of the fewest layers (and up to two more) that keeps
+      parts whose swept areas overlap apart puts that part between the pin's ends;
+    * anything else: the pair and the layer, as the check found it.
+    """
+    pins = {pp.letter: pp for pp in asm.pins}
+    out: list[str] = []
+    seen: set[tuple[str, ...]] = set()
+    for v in violations:
+        pa, pb = _pin_letter(v.a), _pin_letter(v.b)
+        if v.what == "pins collide" and pa is not None and pb is not None and pa in pins and pb in pins:
+            shared = sorted(set(pins[pa].parts) & set(pins[pb].parts))
+            key = ("pins", *sorted((pa, pb)))
+            if key in seen:
+                continue
+            seen.add(key)
+            if shared:
+                out.append(
+                    f"no plan: pins {pa} and {pb} both ride {', '.join(shared)} and come closer than a pin plus the "
+                    "clearance; every layer order passes both through its layer (keep their tracks apart in the design)"
+                )
+            else:
+                out.append(f"no plan found: pins {pa} and {pb} collide on layer {v.layer} (their layers overlap)")
+        elif v.what in ("pin through part", "spacer strikes part") and (pa in pins or pb in pins):
+            letter_ = str(pa if pa in pins else pb)
+            part = v.b if pa in pins else v.a
+            key = ("through", letter_, part)
+            if key in seen:
+                continue
+            seen.add(key)
+            out.append(
+                f"no plan: pin {letter_} crosses {part} between its ends; no order of the fewest layers (or up to two "
+                f"more) that keeps overlapping parts apart puts {part} outside the pin's layers"
+            )
+    return out
