@@ -115,6 +115,37 @@ def _shaft_holes(
     return drive_at, motor_at, flat
 
 
+def _cut_polygons(scene: Any, mech: Any, s: FabSettings) -> dict[str, list[Any]]:
+    """The scene's polygons marked ``cut = true``, by part: shapely polygons in mm, the part's own frame."""
+    from shapely.geometry import Polygon
+
+    names = {p.name for p in mech.parts}
+    out: dict[str, list[Any]] = {}
+    for i, poly in enumerate(getattr(getattr(scene.spec, "mechanism", None), "polygons", []) or []):
+        if not getattr(poly, "cut", False):
+            continue
+        if poly.part not in names:
+            raise InputError(f"mechanism.polygons[{i}].part", poly.part, "a part that is cut (" + ", ".join(sorted(names)) + ")")
+        out.setdefault(poly.part, []).append(Polygon([(x * s.unit_mm, y * s.unit_mm) for x, y in poly.points]).buffer(0))
+    return out
+
+
+def _merged_outline(outer: Any, polys: list[Any], s: FabSettings) -> Any:
+    """The part's outline with its cut polygons merged in (grown by the kerf like the outline; a polygon apart
+    from the part is joined to it by their convex hull), as a contour of straight segments (mm)."""
+    import shapely
+
+    from planar.fabrication.sheet import Contour, cut_polygon
+
+    shape = cut_polygon(outer, math.radians(2.0))
+    for p in polys:
+        grown = p.buffer(s.kerf / 2, join_style="mitre")
+        joined = shape.union(grown)
+        shape = joined if joined.geom_type == "Polygon" else shapely.convex_hull(shape.union(grown))
+    ring = shapely.geometry.polygon.orient(shape, 1.0).exterior.coords[:-1]
+    return Contour([(float(x), float(y), 0.0) for x, y in ring])
+
+
 def _drive_notes(mech: Any, shaft: Any) -> list[str]:
     """Why there is no motor shaft hole, when there is none."""
     if mech.driver.kind != "rotation":
@@ -210,6 +241,7 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
     notes += list(getattr(mech, "notes", []))
     notes += _drive_notes(mech, shaft)
     letters = _hole_letters(mech, pins, shaft)
+    merged = _cut_polygons(scene, mech, s)
 
     cut_cache: dict[Any, PartCut] = {}
 
@@ -240,6 +272,8 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
                     tabs=tab,
                 )
             pc = copy.deepcopy(cut_cache[key])
+            if part.name in merged:
+                pc.outer = _merged_outline(pc.outer, merged[part.name], s)
             if drive_at is not None and part.name in keyed:
                 _phase_mark(
                     pc,
