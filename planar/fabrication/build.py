@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from planar.errors import InputError
+from planar.fabrication.check import spacer_radius
 from planar.fabrication.joints import joint_pins, pin_features
 from planar.fabrication.layers import Assembly, letter, pin_stacks, plan_assembly
 from planar.fabrication.nesting import nest
@@ -298,6 +299,7 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
             s.pin_mm,
             s.pin_head,
             shaft.joint if shaft is not None else None,
+            ring_mm=2 * spacer_radius(s),
         )
 
     cuts, part_notes = cut_all([], {})

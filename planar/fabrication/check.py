@@ -294,7 +294,7 @@ def pin_bodies(pp: Any, poses: dict[str, np.ndarray], s: Any, own_layers: set[in
         if layer not in own_layers:
             out.append(
                 BodyZ(
-                    f"{name} spacer on layer {layer + 1}",
+                    f"{name} spacer",
                     _swept_discs(xy, ro),
                     layer * t,
                     (layer + 1) * t,

@@ -130,8 +130,13 @@ def plan_assembly(
     pin_head: float,
     shaft_pin: str | None = None,
     samples: int = 48,
+    ring_mm: float | None = None,
 ) -> Assembly:
-    """Layers, pins and spacers for ``mech`` whose parts' material polygons (mm, own frame) are given."""
+    """Layers, pins and spacers for ``mech`` whose parts' material polygons (mm, own frame) are given.
+
+    ``ring_mm``: the outer diameter of a spacer ring (default ``pin_mm``): a part between a pin's ends must clear
+    the ring on the pin, not only the pin.
+    """
     from shapely.geometry import LineString, Point
 
     u = unit_mm
@@ -152,9 +157,9 @@ def plan_assembly(
         c, s = np.cos(pa[:, 2]), np.sin(pa[:, 2])
         xy = np.c_[pa[:, 0] + c * loc[0] - s * loc[1], pa[:, 1] + s * loc[0] + c * loc[1]] * u
         geom = (
-            LineString(xy).buffer(pin_mm / 2)
+            LineString(xy).buffer((ring_mm or pin_mm) / 2)
             if len(xy) > 1 and np.ptp(xy, axis=0).max() > 1e-9
-            else Point(xy[0]).buffer(pin_mm / 2)
+            else Point(xy[0]).buffer((ring_mm or pin_mm) / 2)
         )
         paths.append(geom)
     stacks = pin_stacks(pins)
