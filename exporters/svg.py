@@ -158,7 +158,7 @@ def assembly_steps_svg(fab: Any) -> list[str]:
             lo, hi = pp.layers or (0, 0)
             if lo == k and not pp.shaft:
                 what = ", ".join(f"{i.qty} x {i.item} {i.size}" for i in pin_items(s, pp))
-                lines.append(f"pin {pp.letter} in from below (one end fitted first): {what}")
+                lines.append(f"pin {pp.letter} up through this layer, its lower end fitted first: {what}")
             if lo < k <= hi and not any(asm.layers.get(p) == k for p in pp.parts):
                 lines.append(f"slide a spacer ring onto pin {pp.letter}")
         lines.append("lay " + (", ".join(here) if here else "nothing (an empty layer: the spacers fill it)"))
