@@ -1,6 +1,9 @@
 """Bill of materials (CSV): parts with layer and sheet, pins with diameter and length, spacers, motor, screws.
 
-Columns: ``item, id, qty, layer, sheet, size_mm, joins, notes``.  A ``tabs`` row
+Columns: ``item, id, qty, layer, sheet, size_mm, joins, notes``.  Each pin's row names what it is made of (the
+``[fabrication] hardware``: a steel rod with washers and e-clips, or a button-head screw with washers and a nylon
+lock nut; :mod:`planar.fabrication.hardware`), the motor shaft's row its length above the motor, and the
+``buy`` rows at the end total every item to buy by size.  A ``tabs`` row
 per tab-and-slot joint (``planar.fabrication.tabs``): its letter, the number of tabs,
 a tab's ``width x length``, ``piece -> xy piece`` and which slots they go into.  Layers and
 sheets count from 1; ``size_mm`` is the part's bounding box as laid out, a pin's
@@ -15,6 +18,7 @@ import io
 import math
 from typing import Any
 
+from planar.fabrication.hardware import pin_items, shaft_items, shaft_length
 from planar.fabrication.sheet import cut_polygon
 
 __all__ = ["bom_text"]
@@ -29,8 +33,8 @@ def bom_text(fab: Any) -> str:
     for n in fab.notes:
         notes_of.setdefault(n.split(":", 1)[0], []).append(n.split(":", 1)[-1].strip())
     for p in lay.parts:
-        if p.name.startswith("spacer "):
-            continue
+        if p.name.startswith("spacer ") or p.name not in asm.layers:
+            continue  # spacers have their own rows; the reference square is no part
         x0, y0, x1, y1 = cut_polygon(p.outer, math.radians(0.5)).bounds
         layer = asm.layers.get(p.name)
         plane = asm.plane.get(p.name, "xy")
@@ -60,7 +64,7 @@ def bom_text(fab: Any) -> str:
                     1,
                     f"{lo + 1}-{hi + 1}",
                     "",
-                    f"D {s.shaft_mm:g} ({s.shaft_flat_mm:g} across flat)",
+                    f"D {s.shaft_mm:g} ({s.shaft_flat_mm:g} across flat) x {shaft_length(s, pp):g} above the motor",
                     joins,
                     f"joint {', '.join(pp.joints)}; motor under the ground plate, 2 screws M{s.motor_screw_mm:g} "
                     f"{s.motor_screw_spacing_mm:g} mm apart",
@@ -76,7 +80,9 @@ def bom_text(fab: Any) -> str:
                     "",
                     f"{pp.diameter_mm:g} x {pp.length_mm:g}",
                     joins,
-                    f"joint {', '.join(pp.joints)}" + (f"; passes through {', '.join(pp.clashes)}" if pp.clashes else ""),
+                    f"joint {', '.join(pp.joints)}; "
+                    + " + ".join(f"{i.qty} {i.item} {i.size}" for i in pin_items(s, pp))
+                    + (f"; passes through {', '.join(pp.clashes)}" if pp.clashes else ""),
                 ]
             )
         if pp.spacers:
@@ -127,4 +133,17 @@ def bom_text(fab: Any) -> str:
                 f"{s.mounting_hole_mm:g} mm holes, two per ground plate",
             ]
         )
+    _buy_rows(w, fab)
     return buf.getvalue()
+
+
+def _buy_rows(w: Any, fab: Any) -> None:
+    """One ``buy`` row per item to buy (fasteners by size, the motor shaft's washer and clip): totals."""
+    s, asm = fab.settings, fab.assembly
+    total: dict[tuple[str, str], int] = {}
+    for pp in asm.pins:
+        items = shaft_items(s, pp) if pp.shaft else pin_items(s, pp)
+        for i in items:
+            total[(i.item, i.size)] = total.get((i.item, i.size), 0) + i.qty
+    for (item, size), qty in sorted(total.items()):
+        w.writerow(["buy", item, qty, "", "", size, "", "total for every pin"])

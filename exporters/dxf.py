@@ -7,7 +7,10 @@ letters as single-line polylines, not live text) in the engrave colour (blue),
 and kerf are noted in a custom drawing property (``planar``).  Contours are closed LWPOLYLINEs with bulges (arcs as arcs),
 round holes are CIRCLEs.  Each part's entities form a DXF group named after the
 part.  ``$INSUNITS`` = 4 (mm), ``$MEASUREMENT`` = 1, ``$EXTMIN``/``$EXTMAX``
-the sheet.  One file per sheet.
+the sheet, ``$PSVPSCALE`` = 1 (LibreCAD shows a blank page at its default options when it is 0).
+One file per sheet.  Colours follow the ``[fabrication] colours`` preset
+(:meth:`planar.fabrication.parts.FabSettings.layer_colours`): ``"boxes"`` gives Boxes.py's black outer cut,
+blue inner cut and green engraving.
 
 Reproducible byte for byte in any process: ezdxf's fixed metadata (no
 timestamps, constant GUIDs), a deterministic entity order and CLASSES
@@ -66,8 +69,13 @@ def build_document(layout: Layout, sheet: int = 0, settings: Any = None, note: s
 
     cut = getattr(settings, "cut_colour", "#ff0000")
     eng = getattr(settings, "engrave_colour", "#0000ff")
+    colours = {"CUT_INNER": cut, "CUT_OUTER": cut, "ENGRAVE": eng}
+    if hasattr(settings, "layer_colours"):
+        colours = settings.layer_colours()
+    colours["SHEET"] = "#808080"
     doc = ezdxf.new("R2010", setup=False)
     doc.header["$INSUNITS"] = 4
+    doc.header["$PSVPSCALE"] = 1.0  # LibreCAD draws nothing at its default options when the view scale is 0
     doc.header["$MEASUREMENT"] = 1
     doc.header["$LUNITS"] = 2
     W, H = layout.sheet_size
@@ -79,7 +87,6 @@ def build_document(layout: Layout, sheet: int = 0, settings: Any = None, note: s
     msp.dxf.limmax = (W, H)
     doc.header["$EXTMIN"] = (0.0, 0.0, 0.0)  # (ezdxf keeps these when the layout's minimum is the origin)
     doc.header["$EXTMAX"] = (W, H, 0.0)
-    colours = {"CUT_INNER": cut, "CUT_OUTER": cut, "ENGRAVE": eng, "SHEET": "#808080"}
     for name, hexcol in colours.items():
         layer = doc.layers.add(name, color=aci(hexcol))
         layer.rgb = (int(hexcol[1:3], 16), int(hexcol[3:5], 16), int(hexcol[5:7], 16))

@@ -26,7 +26,7 @@ from xml.sax.saxutils import escape
 from planar.fabrication.sheet import Circle, Contour, Layout
 from planar.fileio import atomic_write, check_name
 
-__all__ = ["assembly_svg_text", "svg_text", "write_svg"]
+__all__ = ["assembly_steps_svg", "assembly_svg_text", "svg_text", "write_svg"]
 
 
 def _f(v: float) -> str:
@@ -83,7 +83,9 @@ def svg_text(layout: Layout, sheet: int = 0, settings: Any = None) -> str:
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{_f(W)}mm" height="{_f(H)}mm" viewBox="0 0 {_f(W)} {_f(H)}">',
     ]
-    colour = {"CUT_INNER": cut, "CUT_OUTER": cut, "ENGRAVE": eng}
+    colour = (
+        settings.layer_colours() if hasattr(settings, "layer_colours") else {"CUT_INNER": cut, "CUT_OUTER": cut, "ENGRAVE": eng}
+    )
     for name in ("CUT_INNER", "CUT_OUTER", "ENGRAVE"):
         out.append(
             f'<g id="{name}" fill="none" stroke="{colour[name]}" stroke-width="{_f(stroke)}" '
@@ -106,8 +108,8 @@ def write_svg(path: str | os.PathLike, layout: Layout, sheet: int = 0, settings:
 LAYER_FILLS = ("#c8a064", "#6aa0d8", "#e07a5f", "#81b29a", "#f2cc8f", "#9c89b8", "#5fa8d3", "#d4a5a5")
 
 
-def assembly_svg_text(fab: Any) -> str:
-    """The assembly drawing of a :class:`planar.app.export.Fabrication` (see the module docstring)."""
+def _placed_shapes(fab: Any) -> list[tuple[int, str, Any]]:
+    """Every flat part's material in place at the drawn pose, bottom layer first: ``(layer, name, polygon)``."""
     from shapely import affinity
 
     asm = fab.assembly
@@ -116,23 +118,82 @@ def assembly_svg_text(fab: Any) -> str:
         if layer is None or name not in fab.own:
             continue
         x, y, a = asm.pose[name]
-        poly = fab.own[name]
         c, s = math.cos(a), math.sin(a)
-        shapes.append((layer, name, affinity.affine_transform(poly, [c, -s, s, c, x, y]).simplify(0.01)))
+        shapes.append((layer, name, affinity.affine_transform(fab.own[name], [c, -s, s, c, x, y]).simplify(0.01)))
     shapes.sort(key=lambda t: (t[0], list(asm.layers).index(t[1])))
+    return shapes
+
+
+def assembly_svg_text(fab: Any) -> str:
+    """The assembly drawing of a :class:`planar.app.export.Fabrication` (see the module docstring); the build
+    check's collisions (:mod:`planar.fabrication.check`) are red rings where they first happen, numbered as in
+    the legend."""
+    legend = _legend(fab)
+    for k, v in enumerate(getattr(fab, "violations", []), start=1):
+        legend.append(f"collision {k}: {v.text()}")
+    marks = [v.at for v in getattr(fab, "violations", [])]
+    return _page(fab, _placed_shapes(fab), fab.assembly.pins, legend, marks)
+
+
+def assembly_steps_svg(fab: Any) -> list[str]:
+    """The assembly steps: one SVG page per layer from the bottom, the parts laid so far grey, this step's parts
+    coloured, and what to do: which pins go in from below, which spacers go on, which ends close the pins."""
+    from planar.fabrication.hardware import pin_items
+
+    asm, s = fab.assembly, fab.settings
+    shapes = _placed_shapes(fab)
+    flat = [pp for pp in asm.pins if pp.layers is not None]
+    top = max((layer for layer, _, _ in shapes), default=0)
+    pages = []
+    for k in range(top + 1):
+        here = [n for layer, n, _ in shapes if layer == k]
+        lines = [f"{fab.name}: step {k + 1} of {top + 1}, layer {k + 1} ({s.thickness_mm:g} mm)"]
+        if k == 0:
+            shaft = [pp for pp in flat if pp.shaft]
+            if shaft:
+                lines.append(
+                    f"fit the motor under {', '.join(here) or 'the bottom layer'}: its shaft up through {shaft[0].letter}"
+                )
+        for pp in flat:
+            lo, hi = pp.layers or (0, 0)
+            if lo == k and not pp.shaft:
+                what = ", ".join(f"{i.qty} x {i.item} {i.size}" for i in pin_items(s, pp))
+                lines.append(f"pin {pp.letter} up through this layer, its lower end fitted first: {what}")
+            if lo < k <= hi and not any(asm.layers.get(p) == k for p in pp.parts):
+                lines.append(f"slide a spacer ring onto pin {pp.letter}")
+        lines.append("lay " + (", ".join(here) if here else "nothing (an empty layer: the spacers fill it)"))
+        for pp in flat:
+            if (pp.layers or (0, 0))[1] == k:
+                lines.append(f"close {'the motor shaft' if pp.shaft else 'pin ' + pp.letter} on top (washer, e-clip)")
+        drawn = [(layer if layer == k else -1, n, g) for layer, n, g in shapes if layer <= k]
+        pins = [pp for pp in flat if (pp.layers or (0, 0))[0] <= k]
+        pages.append(_page(fab, drawn, pins, lines, [], extent=shapes))
+    return pages
+
+
+def _page(
+    fab: Any,
+    shapes: list[tuple[int, str, Any]],
+    pins: list[Any],
+    legend: list[str],
+    marks: list[tuple[float, float]],
+    extent: list[tuple[int, str, Any]] | None = None,
+) -> str:
+    """One drawing: parts filled by layer (-1: grey, laid before), pins lettered, red rings at ``marks``, a legend."""
+    asm = fab.assembly
     pts = []
-    for *_, g in shapes:
+    for *_, g in extent if extent is not None else shapes:
         b = g.bounds
         pts += [(b[0], b[1]), (b[2], b[3])]
     for pp in asm.pins:
         pts.append(_pin_xy(asm, pp))
+    pts += list(marks)
     if not pts:
         pts = [(0.0, 0.0), (10.0, 10.0)]
     x0 = min(p[0] for p in pts) - 10
     y0 = min(p[1] for p in pts) - 10
     x1 = max(p[0] for p in pts) + 10
     y1 = max(p[1] for p in pts) + 10
-    legend = _legend(fab)
     fs = max(2.5, 0.025 * max(x1 - x0, y1 - y0))
     lw = fs * 0.6 * max(len(t) for t in legend) + 10
     W = (x1 - x0) + lw
@@ -158,12 +219,14 @@ def assembly_svg_text(fab: Any) -> str:
             for ring in [poly.exterior, *poly.interiors]:
                 xy = list(ring.coords)
                 d.append("M " + " L ".join(f"{X(a):.3f} {Y(b):.3f}" for a, b in xy) + " Z")
+        fill = "#d0d0d0" if layer < 0 else LAYER_FILLS[layer % len(LAYER_FILLS)]
+        title = "laid before" if layer < 0 else f"layer {layer + 1}"
         out.append(
-            f'<path d="{" ".join(d)}" fill="{LAYER_FILLS[layer % len(LAYER_FILLS)]}" fill-opacity="0.75" '
+            f'<path d="{" ".join(d)}" fill="{fill}" fill-opacity="0.75" '
             f'fill-rule="evenodd" stroke="#333333" stroke-width="{_f(fs * 0.08)}"><title>{escape(name)} '
-            f"(layer {layer + 1})</title></path>"
+            f"({title})</title></path>"
         )
-    for pp in asm.pins:
+    for pp in pins:
         px, py = _pin_xy(asm, pp)
         out.append(
             f'<circle cx="{_f(X(px))}" cy="{_f(Y(py))}" r="{_f(fs * 0.7)}" fill="#ffffff" stroke="#000000" '
@@ -172,6 +235,11 @@ def assembly_svg_text(fab: Any) -> str:
         out.append(
             f'<text x="{_f(X(px))}" y="{_f(Y(py) + fs * 0.35)}" font-size="{_f(fs)}" text-anchor="middle">'
             f"{escape(pp.letter)}</text>"
+        )
+    for k, (mx, my) in enumerate(marks, start=1):
+        out.append(
+            f'<circle cx="{_f(X(mx))}" cy="{_f(Y(my))}" r="{_f(fs * 1.2)}" fill="none" stroke="#ff0000" '
+            f'stroke-width="{_f(fs * 0.15)}"><title>collision {k}</title></circle>'
         )
     lx = x1 - x0 + 5
     for i, t in enumerate(legend):
@@ -205,7 +273,7 @@ def _legend(fab: Any) -> list[str]:
             lines.append(f"  layer {k + 1}: " + ", ".join(n for n in names if asm.layers[n] == k))
     for pp in asm.pins:
         lo, hi = pp.layers or (0, 0)
-        what = "motor shaft" if pp.shaft else f"pin d{pp.diameter_mm:g} x {pp.length_mm:g} mm"
+        what = "motor shaft" if pp.shaft else f"pin d{pp.diameter_mm:g} x {pp.length_mm:g} mm ({fab.settings.hardware})"
         sp = f", {pp.spacers} spacer(s)" if pp.spacers else ""
         joins = " + ".join(pp.parts)
         lines.append(f"{pp.letter}: {what}, {joins}, layers {lo + 1}-{hi + 1}{sp}")

@@ -36,6 +36,24 @@ def _commit(files: dict[Path, bytes]) -> None:
                 fh.write(data)
 
 
+def _motion_csv(fab: Fabrication, samples: int = 240) -> bytes:
+    """The motion table (CSV) of the mechanism as cut: the parts of ``plan.json`` (a toy's merged pieces), one
+    cycle of ``samples`` samples, 17 significant digits."""
+    import csv
+    import io
+
+    import numpy as np
+
+    from planar.fileio import motion_columns
+
+    mech = fab.mechanism
+    names, table = motion_columns(mech, mech.run(samples_per_cycle=samples))
+    buf = io.StringIO()
+    csv.writer(buf, lineterminator="\n").writerow(names)
+    np.savetxt(buf, table, fmt=",".join(["%.17g"] * (len(names) - 1) + ["%d"]))
+    return buf.getvalue().encode()
+
+
 def write_outputs(
     fab: Fabrication | None,
     dxf=None,
@@ -45,6 +63,9 @@ def write_outputs(
     assembly=None,
     kerf_test=None,
     settings: FabSettings | None = None,
+    plan=None,
+    motion=None,
+    steps=None,
 ) -> list[Path]:
     """Render every requested output in memory, then write them all (see the module docstring)."""
     from planar.app.formats import writer
@@ -75,6 +96,14 @@ def write_outputs(
             assembly_svg_text = writer("svg").assembly_svg_text
 
             files[Path(assembly)] = assembly_svg_text(fab).encode()
+        if plan is not None:
+            files[Path(plan)] = writer("json").plan_json(fab).encode()
+        if motion is not None:
+            files[Path(motion)] = _motion_csv(fab)
+        if steps is not None:
+            pages = writer("svg").assembly_steps_svg(fab)
+            for k, p in enumerate(sheet_paths(steps, len(pages))):
+                files[p] = pages[k].encode()
     if kerf_test is not None:
         s = settings or (fab.settings if fab is not None else FabSettings())
         lay = kerf_test_layout(s)

@@ -27,6 +27,7 @@ FORMATS: dict[str, tuple[str, str]] = {
     "svg": ("exporters.svg", "cut sheets and the assembly drawing, millimetres"),
     "png": ("exporters.preview", "a photo-like preview of a cut sheet"),
     "bom": ("exporters.bom", "the bill of materials (CSV)"),
+    "json": ("exporters.plan", "the assembly plan (plan.json: parts, layers, placements, pins, spacers, motor shaft)"),
 }
 
 

@@ -384,6 +384,9 @@ def export_scene(
     bom: str | Path | None = None,
     assembly: str | Path | None = None,
     kerf_test: str | Path | None = None,
+    plan: str | Path | None = None,
+    motion: str | Path | None = None,
+    steps: str | Path | None = None,
 ) -> Fabrication:
     """Check, layer and nest a scene's parts and write the requested files (see :mod:`planar.app.export`).
 
@@ -409,7 +412,7 @@ def export_scene(
             "a smaller unit_mm or a larger sheet)",
         )
     fab = build(scene, FabSettings.from_spec(spec, kerf, sheet))
-    fab.written = write_outputs(fab, dxf, svg, preview, bom, assembly, kerf_test)
+    fab.written = write_outputs(fab, dxf, svg, preview, bom, assembly, kerf_test, plan=plan, motion=motion, steps=steps)
     return fab
 
 

@@ -19,6 +19,9 @@ _EXPORT_OUTPUTS = (
     ("--bom", "bom", (".csv",)),
     ("--assembly", "assembly", (".svg",)),
     ("--kerf-test", "kerf_test", (".dxf", ".svg")),
+    ("--plan", "plan", (".json",)),
+    ("--motion", "motion", (".csv",)),
+    ("--steps", "steps", (".svg",)),
 )
 
 
@@ -31,19 +34,39 @@ def _cmd_export(args: argparse.Namespace) -> int:
         raise InputError(
             "export",
             args.scene,
-            "an output: -o parts.dxf, --svg, --preview, --bom, --assembly or --kerf-test (nothing would be written)",
+            "an output: -o parts.dxf, --svg, --preview, --bom, --assembly, --plan, --motion, --steps or --kerf-test "
+            "(nothing would be written)",
         )
     outputs(args, (args.scene,), *_EXPORT_OUTPUTS)
     if args.kerf is not None and not (0 <= args.kerf <= 2):
         raise InputError("--kerf", args.kerf, "a kerf between 0 and 2 mm")
     scene = load_scene(args.scene)
     size = sheet(args.sheet) if args.sheet else None
-    fab = export_scene(scene, args.output, args.svg, args.kerf, size, args.preview, args.bom, args.assembly, args.kerf_test)
+    fab = export_scene(
+        scene,
+        args.output,
+        args.svg,
+        args.kerf,
+        size,
+        args.preview,
+        args.bom,
+        args.assembly,
+        args.kerf_test,
+        plan=args.plan,
+        motion=args.motion,
+        steps=args.steps,
+    )
     for note in fab.notes:
         print(f"note: {note}")
     for w in fab.warnings:  # a toy's motion the cut parts will not make (the design exits 3 for it; cut anyway)
         print(f"warning: {w}")
     print(f"{summary(fab)} -> {', '.join(map(str, fab.written)) or 'nothing written'}")
+    for v in fab.violations:  # the build check: the files are written (to look at), the exit status says it fails
+        print(f"build check: {v.text()}")
+    if fab.violations:
+        print(f"build check failed: {len(fab.violations)} collision(s); see the assembly drawing's red marks")
+        return 3
+    print("build check: every part, pin, spacer and the motor shaft clear through the cycle")
     return 0
 
 
@@ -60,4 +83,11 @@ def add_parser(sub: Any) -> None:
     ex.add_argument("--bom", default=None, help="bill of materials (CSV): parts, layers, pins, spacers, tab joints")
     ex.add_argument("--assembly", default=None, help="assembly drawing (SVG): parts in place, layers, letters")
     ex.add_argument("--kerf-test", default=None, help="a kerf calibration piece (.dxf or .svg)")
+    ex.add_argument(
+        "--plan", default=None, help="the assembly as data (JSON): parts' layers and placements, pins, spacers, motor shaft"
+    )
+    ex.add_argument("--motion", default=None, help="the motion table (CSV) of the parts as cut, one cycle of 240 samples")
+    ex.add_argument(
+        "--steps", default=None, help="assembly steps (SVG pages steps-1.svg, ...): layer by layer, which pin goes where"
+    )
     ex.set_defaults(func=_cmd_export)

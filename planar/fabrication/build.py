@@ -14,6 +14,7 @@ from typing import Any
 
 from planar.core.model import Mechanism
 from planar.errors import InputError
+from planar.fabrication.check import spacer_radius
 from planar.fabrication.joints import joint_pins, pin_features
 from planar.fabrication.layers import Assembly, letter, pin_stacks, plan_assembly
 from planar.fabrication.nesting import nest
@@ -47,6 +48,10 @@ class Fabrication:
     #: motions the cut parts will not make (a toy's cam throw or effector stroke under a few times the fit's
     #: play: :func:`planar.toys.fitcheck.small_motions`), one line each
     warnings: list[str] = field(default_factory=list)
+    #: the mechanism as cut (a toy's assembly, perpendicular pieces bracketed): its motion is what the build check moves
+    mechanism: Any = None
+    #: what the build check found (:func:`planar.fabrication.check.build_check`); empty: it goes together and moves
+    violations: list[Any] = field(default_factory=list)
 
 
 def _shaft_pin(mech: Mechanism, pins) -> Any:
@@ -91,6 +96,137 @@ def _phase_mark(pc: PartCut, at: tuple[float, float], flat: float, phase: float,
     pc.notes.append(f"{pc.name}: keyed to the motor shaft at {deg} degrees{why} (engraved tick along the D's flat)")
 
 
+def _shaft_holes(
+    name: str, shaft: Any, driven: str, keyed: dict[str, float]
+) -> tuple[tuple[float, float] | None, tuple[float, float] | None, float]:
+    """Where part ``name`` takes the motor shaft: ``(D hole, motor hole, the D's flat direction rad)``, own frame.
+
+    The driven part has the D hole, the ground the motor's hole; a toy's cam keyed to the shaft has a D at its
+    origin turned by its phase.
+    """
+    drive_at = motor_at = None
+    if shaft is not None and name in shaft.parts:
+        k = shaft.parts.index(name)
+        if name == driven:
+            drive_at = shaft.at[k]
+        else:
+            motor_at = shaft.at[k]
+    flat = math.pi / 2
+    if shaft is not None and name in keyed:  # a toy's cam: a D on the shaft, turned by its phase
+        drive_at, flat = (0.0, 0.0), math.pi / 2 - keyed[name]
+    return drive_at, motor_at, flat
+
+
+def _cut_polygons(scene: Any, mech: Any, s: FabSettings) -> dict[str, list[Any]]:
+    """The scene's polygons marked ``cut = true``, by part: shapely polygons in mm, the part's own frame."""
+    from shapely.geometry import Polygon
+
+    names = {p.name for p in mech.parts}
+    out: dict[str, list[Any]] = {}
+    for i, poly in enumerate(getattr(getattr(scene.spec, "mechanism", None), "polygons", []) or []):
+        if not getattr(poly, "cut", False):
+            continue
+        if poly.part not in names:
+            raise InputError(f"mechanism.polygons[{i}].part", poly.part, "a part that is cut (" + ", ".join(sorted(names)) + ")")
+        out.setdefault(poly.part, []).append(Polygon([(x * s.unit_mm, y * s.unit_mm) for x, y in poly.points]).buffer(0))
+    return out
+
+
+def _merged_outline(outer: Any, polys: list[Any], s: FabSettings) -> Any:
+    """The part's outline with its cut polygons merged in (grown by the kerf like the outline; a polygon apart
+    from the part is joined to it by their convex hull), as a contour of straight segments (mm)."""
+    import shapely
+
+    from planar.fabrication.sheet import Contour, cut_polygon
+
+    shape = cut_polygon(outer, math.radians(2.0))
+    for p in polys:
+        grown = p.buffer(s.kerf / 2, join_style="mitre")
+        joined = shape.union(grown)
+        shape = joined if joined.geom_type == "Polygon" else shapely.convex_hull(shape.union(grown))
+    ring = shapely.geometry.polygon.orient(shape, 1.0).exterior.coords[:-1]
+    return Contour([(float(x), float(y), 0.0) for x, y in ring])
+
+
+def _drive_notes(mech: Any, shaft: Any) -> list[str]:
+    """Why there is no motor shaft hole, when there is none."""
+    if mech.driver.kind != "rotation":
+        return [f"driver {mech.driver.part!r} is a {mech.driver.kind} drive: no motor shaft hole"]
+    if shaft is None:
+        return [f"driver {mech.driver.part!r}: no pin to the ground on its axis, no motor shaft hole"]
+    return []
+
+
+def _unplannable_tabs(layers: dict[str, int | None], used: dict[str, int | None]) -> None:
+    """Raise the error of tab joints whose rounds did not settle: a part whose layer keeps changing, or
+    perpendicular pieces still in other layers' way."""
+    from planar.fabrication.joints import FabricationError
+
+    moved = [n for n in layers if layers[n] != used.get(n)]
+    raise FabricationError(
+        f"part {moved[0]!r}: its layer keeps changing as the tab joints are cut; they cannot be planned"
+        if moved
+        else "the pieces standing perpendicular are still in the way of other layers after 4 "
+        "rounds of travel slots; they cannot be tab-joined"
+    )
+
+
+def _hole_letters(mech: Any, pins: list[Any], shaft: Any) -> dict[str, list[tuple[tuple[float, float], str]]]:
+    """Each part's hole letters: ``(hole centre, letter)``, a pin's letter once beside each hole it goes through."""
+    letters: dict[str, list[tuple[tuple[float, float], str]]] = {p.name: [] for p in mech.parts}
+    for k, stack in enumerate(pin_stacks(pins)):
+        marked: set[tuple[str, tuple[float, float]]] = set()
+        for i in stack:
+            pin = pins[i]
+            for side in (0, 1):
+                key = (pin.parts[side], pin.at[side])
+                if pin.kinds[side] == "hole" and pin is not shaft and key not in marked:
+                    marked.add(key)
+                    letters[pin.parts[side]].append((pin.at[side], letter(k)))
+    return letters
+
+
+def _spacer_cuts(asm: Assembly, s: FabSettings) -> list[PartCut]:
+    """The spacer rings of every pin, cut from the same sheet (``spacer B1``, ``spacer B2``, ...)."""
+    from planar.fabrication.check import spacer_radius
+
+    k2 = s.kerf / 2
+    ri = (s.pin_mm + s.clearance) / 2
+    ro = spacer_radius(s)
+    return [
+        PartCut(
+            f"spacer {pp.letter}{j + 1}",
+            Circle((0.0, 0.0), ro + k2),
+            [Circle((0.0, 0.0), ri - k2)],
+            nominal_holes=[((0.0, 0.0), ri)],
+        )
+        for pp in asm.pins
+        for j in range(pp.spacers)
+    ]
+
+
+def _tab_notes(cuts: list[PartCut], joins: list[Any], s: FabSettings) -> list[str]:
+    """Each tabbed piece's and each slotted base's note (added to its part's notes too)."""
+    out: list[str] = []
+    tabs = {jn.piece: jn for jn in joins}
+    for pc in cuts:
+        if pc.name in tabs:
+            jn = tabs[pc.name]
+            pc.notes.append(
+                f"{pc.name}: {len(jn.spans)} tab(s) {jn.letter}, {jn.tab_width:g} x "
+                f"{s.thickness_mm:g} mm, into the slots {jn.letter} of {jn.base}"
+            )
+            out.append(pc.notes[-1])
+        for jn in joins:
+            if jn.base == pc.name:
+                pc.notes.append(
+                    f"{pc.name}: {len(jn.slots)} slot(s) {jn.letter} "
+                    f"{jn.slot_size[0]:g} x {jn.slot_size[1]:g} mm for the tabs of {jn.piece}"
+                )
+                out.append(pc.notes[-1])
+    return out
+
+
 def build(scene: Any, settings: FabSettings) -> Fabrication:
     """Cut-ready, checked, layered and nested parts of ``scene`` (raises FabricationError/InputError)."""
     s = settings
@@ -105,20 +241,9 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
     shaft = _shaft_pin(mech, pins)
     notes: list[str] = list(getattr(mech, "design_notes", ()))  # what a mechanism reports of its own design
     notes += list(mech.notes)
-    if mech.driver.kind != "rotation":
-        notes.append(f"driver {mech.driver.part!r} is a {mech.driver.kind} drive: no motor shaft hole")
-    elif shaft is None:
-        notes.append(f"driver {mech.driver.part!r}: no pin to the ground on its axis, no motor shaft hole")
-    letters: dict[str, list[tuple[tuple[float, float], str]]] = {p.name: [] for p in mech.parts}
-    for k, stack in enumerate(pin_stacks(pins)):
-        marked: set[tuple[str, tuple[float, float]]] = set()
-        for i in stack:
-            pin = pins[i]
-            for side in (0, 1):
-                key = (pin.parts[side], pin.at[side])
-                if pin.kinds[side] == "hole" and pin is not shaft and key not in marked:
-                    marked.add(key)
-                    letters[pin.parts[side]].append((pin.at[side], letter(k)))
+    notes += _drive_notes(mech, shaft)
+    letters = _hole_letters(mech, pins, shaft)
+    merged = _cut_polygons(scene, mech, s)
 
     cut_cache: dict[Any, PartCut] = {}
 
@@ -130,16 +255,7 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
         cuts: list[PartCut] = []
         part_notes: list[str] = []
         for n, part in enumerate(mech.parts, start=1):
-            drive_at = motor_at = None
-            if shaft is not None and part.name in shaft.parts:
-                k = shaft.parts.index(part.name)
-                if part.name == mech.driver.part:
-                    drive_at = shaft.at[k]
-                else:
-                    motor_at = shaft.at[k]
-            flat = math.pi / 2
-            if shaft is not None and part.name in keyed:  # a toy's cam: a D on the shaft, turned by its phase
-                drive_at, flat = (0.0, 0.0), math.pi / 2 - keyed[part.name]
+            drive_at, motor_at, flat = _shaft_holes(part.name, shaft, mech.driver.part, keyed)
             extra = tuple(slots.get(part.name, ()))
             tab = tab_of.get(part.name)
             key = (part.name, extra, None if tab is None else (tab.letter, tab.edge, tuple(tab.spans)))
@@ -158,6 +274,8 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
                     tabs=tab,
                 )
             pc = copy.deepcopy(cut_cache[key])
+            if part.name in merged:
+                pc.outer = _merged_outline(pc.outer, merged[part.name], s)
             if drive_at is not None and part.name in keyed:
                 _phase_mark(
                     pc,
@@ -182,6 +300,7 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
             s.pin_mm,
             s.pin_head,
             shaft.joint if shaft is not None else None,
+            ring_mm=2 * spacer_radius(s),
         )
 
     cuts, part_notes = cut_all([], {})
@@ -216,52 +335,24 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
             tab_plan = plan_tabs(mech, layers_used, material0, s)
             joins = tab_plan.joins
         if not done:
-            from planar.fabrication.joints import FabricationError
-
-            moved = [n for n in asm2.layers if asm2.layers[n] != layers_used.get(n)]
-            raise FabricationError(
-                f"part {moved[0]!r}: its layer keeps changing as the tab joints are cut; they cannot be planned"
-                if moved
-                else "the pieces standing perpendicular are still in the way of other layers after 4 "
-                "rounds of travel slots; they cannot be tab-joined"
-            )
+            _unplannable_tabs(asm2.layers, layers_used)
         notes.extend(travel_notes)
         asm = asm2
-        tabs = {jn.piece: jn for jn in joins}
-        for pc in cuts:
-            if pc.name in tabs:
-                jn = tabs[pc.name]
-                pc.notes.append(
-                    f"{pc.name}: {len(jn.spans)} tab(s) {jn.letter}, {jn.tab_width:g} x "
-                    f"{s.thickness_mm:g} mm, into the slots {jn.letter} of {jn.base}"
-                )
-                part_notes.append(pc.notes[-1])
-            for jn in joins:
-                if jn.base == pc.name:
-                    pc.notes.append(
-                        f"{pc.name}: {len(jn.slots)} slot(s) {jn.letter} "
-                        f"{jn.slot_size[0]:g} x {jn.slot_size[1]:g} mm for the tabs of {jn.piece}"
-                    )
-                    part_notes.append(pc.notes[-1])
+        part_notes += _tab_notes(cuts, joins, s)
         _engrave_joins(cuts, joins, s)
     notes.extend(part_notes)
     notes.extend(asm.notes)
+    from types import SimpleNamespace
+
+    from planar.fabrication.plan import blocking, settle
+
+    violations = settle(SimpleNamespace(mechanism=mech, assembly=asm, own=material, settings=s))
+    notes.extend(blocking(asm, violations))
     for pc in cuts:
         pc.layer = asm.layers.get(pc.name)
-    # spacer rings, cut from the same sheet
-    k2 = s.kerf / 2
-    ri = (s.pin_mm + s.clearance) / 2
-    ro = max(ri + s.min_wall, s.min_part / 2)
-    for pp in asm.pins:
-        for j in range(pp.spacers):
-            cuts.append(
-                PartCut(
-                    f"spacer {pp.letter}{j + 1}",
-                    Circle((0.0, 0.0), ro + k2),
-                    [Circle((0.0, 0.0), ri - k2)],
-                    nominal_holes=[((0.0, 0.0), ri)],
-                )
-            )
+    cuts += _spacer_cuts(asm, s)
+    if s.reference_square_mm > 0:
+        cuts.append(_reference_square(s))
     layout = nest(cuts, s.sheet, s.spacing, s.margin, s.kerf, s.unit_mm)
     warnings: list[str] = []
     from planar.windup.chain import ToyMechanism
@@ -283,6 +374,8 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
         stack_z=tab_plan.z_stack,
         planes=dict(tab_plan.planes),
         warnings=warnings,
+        mechanism=mech,
+        violations=violations,
     )
 
 
@@ -309,6 +402,19 @@ def _engrave_joins(cuts: list[PartCut], joins: list[Any], s: FabSettings) -> Non
         piece.engrave.extend(
             letter_marks(mat, [((float(mid.x), float(mid.y)), s.thickness_mm, jn.letter)], max(s.min_label, 1.5))
         )
+
+
+def _reference_square(s: FabSettings) -> PartCut:
+    """A square of ``reference_square_mm`` (kerf-compensated like every outline) with its size engraved: measure
+    it after cutting to check the scale (a part is never scaled by the laser software's import)."""
+    from planar.fabrication.sheet import Contour
+    from planar.fabrication.strokefont import text_strokes
+
+    a = s.reference_square_mm / 2 + s.kerf / 2
+    outer = Contour([(-a, -a, 0.0), (a, -a, 0.0), (a, a, 0.0), (-a, a, 0.0)])
+    h = min(2.0, s.reference_square_mm / 6)
+    text = f"{s.reference_square_mm:g}"
+    return PartCut("reference square", outer, [], text_strokes(text, h, (0.0, 0.0), 0.0), text, h)
 
 
 def sheet_paths(path: str | os.PathLike, sheets: int) -> list[Path]:

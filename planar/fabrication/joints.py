@@ -42,6 +42,8 @@ class PinSpec:
     at: tuple[tuple[float, float], tuple[float, float]]
     #: "hole" or "slot" on each side
     kinds: tuple[str, str]
+    #: ``(part, feature index)`` of each hole or slot this pin goes through (cut at the scene's pin size)
+    features: tuple[tuple[str, int], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -62,6 +64,20 @@ def _hole_at(part: Part, p: tuple[float, float]) -> Hole | None:
     return None
 
 
+def _index(mech: Mechanism, part: str, feature: Any) -> tuple[tuple[str, int], ...]:
+    """``((part, index),)`` of ``feature`` on ``part``, or ``()`` when there is none."""
+    if feature is None:
+        return ()
+    return ((part, mech.part(part).features.index(feature)),)
+
+
+def _slot_on(part: Part, j: PinInSlot | Slide) -> Slot | None:
+    for f in part.features:
+        if isinstance(f, Slot) and _close(f.start, j.start) and _close(f.end, j.end):
+            return f
+    return None
+
+
 def _v(p: Any) -> tuple[float, float]:
     return (float(p[0]), float(p[1]))
 
@@ -76,30 +92,52 @@ PIN_RULES: Registry[Callable[[Mechanism, Any], tuple[list[PinSpec], list[Contact
 
 @PIN_RULES.register(Pivot)
 def _pivot(mech: Mechanism, j: Pivot) -> tuple[list[PinSpec], list[Contact]]:
-    if _hole_at(mech.part(j.a), j.anchor_a) and _hole_at(mech.part(j.b), j.anchor_b):
-        return [PinSpec(j.name, (j.a, j.b), (_v(j.anchor_a), _v(j.anchor_b)), ("hole", "hole"))], []
+    ha, hb = _hole_at(mech.part(j.a), j.anchor_a), _hole_at(mech.part(j.b), j.anchor_b)
+    if ha and hb:
+        feats = _index(mech, j.a, ha) + _index(mech, j.b, hb)
+        return [PinSpec(j.name, (j.a, j.b), (_v(j.anchor_a), _v(j.anchor_b)), ("hole", "hole"), feats)], []
     return [], [Contact(j.name, (j.a, j.b), True)]  # a round cam running in a hole: the disc is the pin
 
 
 @PIN_RULES.register(PinInSlot)
 def _pin_in_slot(mech: Mechanism, j: PinInSlot) -> tuple[list[PinSpec], list[Contact]]:
-    if _hole_at(mech.part(j.b), j.pin) is None:
+    hole = _hole_at(mech.part(j.b), j.pin)
+    if hole is None:
         # no hole at the "pin": the part's own round body runs in the slot (a wind-up eccentric cam in its
         # follower's window), so nothing is pinned and the window keeps its own width
         return [], [Contact(j.name, (j.a, j.b), True)]
-    return [PinSpec(j.name, (j.b, j.a), (_v(j.pin), _v(j.start)), ("hole", "slot"))], []
+    feats = _index(mech, j.b, hole) + _index(mech, j.a, _slot_on(mech.part(j.a), j))
+    return [PinSpec(j.name, (j.b, j.a), (_v(j.pin), _v(j.start)), ("hole", "slot"), feats)], []
 
 
 @PIN_RULES.register(PinInArcSlot)
 def _pin_in_arc_slot(mech: Mechanism, j: PinInArcSlot) -> tuple[list[PinSpec], list[Contact]]:
     on_arc = (float(j.centre[0] + j.radius), float(j.centre[1]))
-    return [PinSpec(j.name, (j.b, j.a), (_v(j.pin), on_arc), ("hole", "slot"))], []
+    arc = next(
+        (
+            f
+            for f in mech.part(j.a).features
+            if isinstance(f, ArcSlot) and _close(f.centre, j.centre) and abs(f.radius - j.radius) < TOL * max(1.0, j.radius)
+        ),
+        None,
+    )
+    feats = _index(mech, j.b, _hole_at(mech.part(j.b), j.pin)) + _index(mech, j.a, arc)
+    return [PinSpec(j.name, (j.b, j.a), (_v(j.pin), on_arc), ("hole", "slot"), feats)], []
 
 
 @PIN_RULES.register(Slide)
 def _slide(mech: Mechanism, j: Slide) -> tuple[list[PinSpec], list[Contact]]:
-    pts = j.pin_points()
-    return [PinSpec(f"{j.name}#{k + 1}", (j.b, j.a), (_v(p), _v(j.start)), ("hole", "slot")) for k, p in enumerate(pts)], []
+    slot = _index(mech, j.a, _slot_on(mech.part(j.a), j))
+    return [
+        PinSpec(
+            f"{j.name}#{k + 1}",
+            (j.b, j.a),
+            (_v(p), _v(j.start)),
+            ("hole", "slot"),
+            _index(mech, j.b, _hole_at(mech.part(j.b), p)) + slot,
+        )
+        for k, p in enumerate(j.pin_points())
+    ], []
 
 
 @PIN_RULES.register(KeyedShaft)
@@ -139,33 +177,7 @@ def joint_pins(mech: Mechanism) -> tuple[list[PinSpec], list[Contact]]:
 
 
 def pin_features(mech: Mechanism) -> set[tuple[str, int]]:
-    """``(part, feature index)`` of every hole or slot a pin goes through (cut at the scene's pin size)."""
-    out: set[tuple[str, int]] = set()
-    by_name = {p.name: p for p in mech.parts}
-    for j in mech.joints:
-        if isinstance(j, Pivot):
-            pa, pb = by_name[j.a], by_name[j.b]
-            ha, hb = _hole_at(pa, j.anchor_a), _hole_at(pb, j.anchor_b)
-            if ha and hb:
-                out.add((j.a, pa.features.index(ha)))
-                out.add((j.b, pb.features.index(hb)))
-        elif isinstance(j, (PinInSlot, PinInArcSlot, Slide)):
-            pin_part, slot_part = by_name[j.b], by_name[j.a]
-            anchors = list(j.pin_points()) if isinstance(j, Slide) else [j.pin]
-            if isinstance(j, PinInSlot) and _hole_at(pin_part, j.pin) is None:
-                continue  # a round body in a window, not a pin (see _pin_in_slot)
-            for p in anchors:
-                h = _hole_at(pin_part, p)
-                if h is not None:
-                    out.add((j.b, pin_part.features.index(h)))
-            for i, f in enumerate(slot_part.features):
-                if isinstance(j, PinInArcSlot):
-                    if (
-                        isinstance(f, ArcSlot)
-                        and _close(f.centre, j.centre)
-                        and abs(f.radius - j.radius) < TOL * max(1.0, j.radius)
-                    ):
-                        out.add((j.a, i))
-                elif isinstance(f, Slot) and _close(f.start, j.start) and _close(f.end, j.end):
-                    out.add((j.a, i))
-    return out
+    """``(part, feature index)`` of every hole or slot a pin goes through (cut at the scene's pin size): what
+    each joint kind's rule in ``PIN_RULES`` says its pins go through."""
+    pins, _ = joint_pins(mech)
+    return {f for pin in pins for f in pin.features}

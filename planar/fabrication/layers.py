@@ -131,8 +131,13 @@ def plan_assembly(
     pin_head: float,
     shaft_pin: str | None = None,
     samples: int = 48,
+    ring_mm: float | None = None,
 ) -> Assembly:
-    """Layers, pins and spacers for ``mech`` whose parts' material polygons (mm, own frame) are given."""
+    """Layers, pins and spacers for ``mech`` whose parts' material polygons (mm, own frame) are given.
+
+    ``ring_mm``: the outer diameter of a spacer ring (default ``pin_mm``): a part between a pin's ends must clear
+    the ring on the pin, not only the pin.
+    """
     from shapely.geometry import LineString, Point
 
     u = unit_mm
@@ -153,9 +158,9 @@ def plan_assembly(
         c, s = np.cos(pa[:, 2]), np.sin(pa[:, 2])
         xy = np.c_[pa[:, 0] + c * loc[0] - s * loc[1], pa[:, 1] + s * loc[0] + c * loc[1]] * u
         geom = (
-            LineString(xy).buffer(pin_mm / 2)
+            LineString(xy).buffer((ring_mm or pin_mm) / 2)
             if len(xy) > 1 and np.ptp(xy, axis=0).max() > 1e-9
-            else Point(xy[0]).buffer(pin_mm / 2)
+            else Point(xy[0]).buffer((ring_mm or pin_mm) / 2)
         )
         paths.append(geom)
     stacks = pin_stacks(pins)
@@ -233,36 +238,42 @@ def plan_assembly(
         for r in nodes:
             for n in group[r]:
                 layers[n] = assign[r]
-    plans = []
-    for i, (st, sp) in enumerate(zip(stacks, stack_parts)):
-        pin = pins[st[0]]
-        ls = sorted({lp for p in sp if (lp := layers[p]) is not None})
-        lo, hi = (ls[0], ls[-1]) if ls else (0, 0)
-        clashes = [q for q in crossing[i] if (lq := layers[q]) is not None and lo < lq < hi]
-        shaft = any(pins[j].joint == shaft_pin for j in st)
-        joints = tuple(pins[j].joint for j in st)
-        plans.append(
-            PinPlan(
-                letter(i),
-                pin,
-                (lo, hi),
-                (hi - lo + 1) - len(ls),
-                thickness * (hi - lo + 1) + 2 * pin_head,
-                pin_mm,
-                shaft,
-                sp,
-                joints,
-                clashes,
-            )
-        )
-        if clashes:
-            notes.append(f"pin {letter(i)} ({', '.join(joints)}) passes through {', '.join(clashes)} between its layers")
+    plans = _pin_plans(pins, stacks, stack_parts, crossing, layers, (thickness, pin_mm, pin_head), shaft_pin, notes)
     first = int(ok[0])
     pose = {
         n: (float(motion.poses[n][first, 0] * u), float(motion.poses[n][first, 1] * u), float(motion.poses[n][first, 2]))
         for n in names
     }
     return Assembly(layers, n_layers, plans, contacts, pose, notes, plane, u)
+
+
+def _pin_plans(
+    pins: list[PinSpec],
+    stacks: list[list[int]],
+    stack_parts: list[tuple[str, ...]],
+    crossing: list[list[str]],
+    layers: dict[str, int | None],
+    sizes: tuple[float, float, float],
+    shaft_pin: str | None,
+    notes: list[str],
+) -> list[PinPlan]:
+    """One :class:`PinPlan` per pin stack: its layers, spacers, length (``sizes``: thickness, pin diameter, head
+    allowance, mm) and the parts it crosses between its ends (each noted in ``notes``)."""
+    thickness, pin_mm, pin_head = sizes
+    plans = []
+    for i, (st, sp) in enumerate(zip(stacks, stack_parts)):
+        ls = sorted({lp for p in sp if (lp := layers[p]) is not None})
+        lo, hi = (ls[0], ls[-1]) if ls else (0, 0)
+        clashes = [q for q in crossing[i] if (lq := layers[q]) is not None and lo < lq < hi]
+        joints = tuple(pins[j].joint for j in st)
+        shaft = any(pins[j].joint == shaft_pin for j in st)
+        length = thickness * (hi - lo + 1) + 2 * pin_head
+        plans.append(
+            PinPlan(letter(i), pins[st[0]], (lo, hi), (hi - lo + 1) - len(ls), length, pin_mm, shaft, sp, joints, clashes)
+        )
+        if clashes:
+            notes.append(f"pin {letter(i)} ({', '.join(joints)}) passes through {', '.join(clashes)} between its layers")
+    return plans
 
 
 def _score(pins_q: list, a: dict[str, int]) -> tuple[int, int, int]:

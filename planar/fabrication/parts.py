@@ -83,6 +83,27 @@ class FabSettings:
     svg_stroke_mm: float = 0.025
     cut_colour: str = "#ff0000"
     engrave_colour: str = "#0000ff"
+    #: the fastener every pin is (:data:`planar.fabrication.hardware.HARDWARE`)
+    hardware: str = "rod-eclip"
+    #: colours of the cuts: "planar" (``cut_colour`` for both cuts) or "boxes" (Boxes.py's: black outer, blue inner,
+    #: green engrave)
+    colours: str = "planar"
+    #: side of a reference square cut in a corner of each sheet (mm; 0: none), to measure the scale after cutting
+    reference_square_mm: float = 0.0
+
+    def layer_colours(self) -> dict[str, str]:
+        """``#rrggbb`` of each cut-file layer under the colour preset: ``"planar"`` (both cuts ``cut_colour``,
+        engraving ``engrave_colour``) or ``"boxes"`` (Boxes.py's: outer cut black, inner cut blue, engrave green)."""
+        if self.colours not in COLOUR_PRESETS:
+            from planar.errors import InputError
+
+            raise InputError("fabrication.colours", self.colours, "one of " + ", ".join(sorted(COLOUR_PRESETS)))
+        preset = COLOUR_PRESETS[self.colours]
+        return {
+            "CUT_INNER": preset.get("CUT_INNER", self.cut_colour),
+            "CUT_OUTER": preset.get("CUT_OUTER", self.cut_colour),
+            "ENGRAVE": preset.get("ENGRAVE", self.engrave_colour),
+        }
 
     @classmethod
     def from_spec(cls, fab: Any, kerf: float | None = None, sheet: tuple[float, float] | None = None) -> FabSettings:
@@ -109,7 +130,17 @@ class FabSettings:
             svg_stroke_mm=fab.svg_stroke_mm,
             cut_colour=fab.cut_colour,
             engrave_colour=fab.engrave_colour,
+            hardware=getattr(fab, "hardware", "rod-eclip"),
+            colours=getattr(fab, "colours", "planar"),
+            reference_square_mm=getattr(fab, "reference_square_mm", 0.0),
         )
+
+
+#: colour presets of the cut files (a layer missing from a preset takes ``cut_colour`` / ``engrave_colour``)
+COLOUR_PRESETS: dict[str, dict[str, str]] = {
+    "planar": {},
+    "boxes": {"CUT_OUTER": "#000000", "CUT_INNER": "#0000ff", "ENGRAVE": "#00ff00"},
+}
 
 
 @dataclass(frozen=True)

@@ -48,6 +48,9 @@ class PolygonSpec(_Strict):
     """The part it is fixed to, e.g. ``"coupler"`` (a four-bar's parts: crank, coupler, rocker)."""
     points: Annotated[list[tuple[Real, Real]], Field(min_length=3)]
     """At least three ``[x, y]`` vertices in the part's frame (model units), e.g. ``[[0, 0], [1, 0], [1, 0.2]]``."""
+    cut: StrictBool = False
+    """``true``: ``planar export`` cuts the polygon as part of its part, merged into the part's outline (joined to
+    it by their convex hull where they do not touch); ``false`` (default): drawn only."""
 
 
 class FourBarSpec(_Strict):
@@ -555,6 +558,14 @@ class FabricationSpec(_Strict):
     """Colour of cut lines ``#rrggbb``."""
     engrave_colour: Annotated[Name, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#0000ff"
     """Colour of engraved lines (labels, letters) ``#rrggbb``."""
+    colours: Literal["planar", "boxes"] = "planar"
+    """Colour preset of the cut files: ``"planar"`` (``cut_colour`` for every cut, ``engrave_colour``) or
+    ``"boxes"`` (Boxes.py's: outer cut black, inner cut blue, engraving green)."""
+    reference_square_mm: Annotated[float, Strict(), Field(ge=0, le=100)] = 0.0
+    """Side of a reference square cut beside the parts (measure it to check the scale), 0 for none, e.g. ``10``."""
+    hardware: Literal["rod-eclip", "screw"] = "rod-eclip"
+    """What every pin is: ``"rod-eclip"`` (steel rod, DIN 125 washers and DIN 6799 e-clips) or ``"screw"``
+    (ISO 7380 button-head screw, DIN 125 washers, DIN 985 nylon lock nut), sized by ``pin_diameter_mm``."""
 
 
 #: millimetres per model unit of a wind-up scene that does not say (the paper's toys are about 0.9 units across)

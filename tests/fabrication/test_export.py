@@ -184,7 +184,8 @@ def test_every_gallery_scene_exports_checked_files(tmp_path, path):
         if asm.layers.get(g) is not None:
             same_plane = [n for n, v in asm.layers.items() if v is not None and asm.plane[n] == asm.plane[g]]
             assert asm.layers[g] == min(asm.layers[n] for n in same_plane), (g, asm.layers)
-    # BOM: pins as long as the layers they span plus heads
+    # BOM: pins as long as the layers they span plus each end's washer (DIN 125 M3: 0.5 mm) and e-clip (DIN 6799
+    # 2.3: 0.6 mm) and 0.5 mm past the clip's groove, a rod cut to the next 0.5 mm
     import csv
 
     rows = list(csv.DictReader((tmp_path / "b.csv").open()))
@@ -194,7 +195,8 @@ def test_every_gallery_scene_exports_checked_files(tmp_path, path):
         if r["item"] == "pin":
             lo, hi = map(int, r["layer"].split("-"))
             d, length = map(float, r["size_mm"].split(" x "))
-            assert d == s.pin_mm and abs(length - (s.thickness_mm * (hi - lo + 1) + 2 * s.pin_head)) < 1e-9
+            rod = math.ceil((s.thickness_mm * (hi - lo + 1) + 2 * (0.5 + 0.6 + 0.5)) * 2 - 1e-9) / 2
+            assert d == s.pin_mm and abs(length - rod) < 1e-9
     # the assembly drawing reads back with svgelements: one filled shape per layered part
     from svgelements import SVG
     from svgelements import Path as SPath

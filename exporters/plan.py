@@ -1,0 +1,129 @@
+"""``plan.json``: the assembly as data, for a tool that checks or assembles it without planar.
+
+Everything in millimetres and degrees, layers and sheets counting from 1.  Each part's ``placement``
+``[x_mm, y_mm, angle_deg]`` maps the part's own frame (the frame of the motion table's ``<part>.x``,
+``<part>.y``, ``<part>.angle``, lengths times ``unit_mm``) onto its sheet: a point ``p`` of the part lies on
+the sheet at ``R(angle) p + (x, y)``.  Each pin names its parts, the layers it spans, its bought length, its
+diameter, its ends (height and diameter beyond its outer layers) and where it is: ``anchor`` (a part and the
+point in that part's own frame, mm).  The schema is ``docs/reference/plan.schema.json``.  Fixed key order and
+number formatting: the same input gives the same bytes.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+__all__ = ["SCHEMA_VERSION", "plan_dict", "plan_json"]
+
+SCHEMA_VERSION = 1
+
+
+def _r(v: float) -> float:
+    return round(float(v), 6) + 0.0
+
+
+def _parts(fab: Any) -> list[dict[str, Any]]:
+    asm = fab.assembly
+    out = []
+    for p in fab.layout.parts:
+        if p.name.startswith("spacer ") or p.name not in asm.layers:
+            continue  # spacers are listed on their own; the reference square is no part of the assembly
+        layer = asm.layers.get(p.name)
+        a, dx, dy = p.placed
+        out.append(
+            {
+                "name": p.name,
+                "layer": None if layer is None else layer + 1,
+                "plane": asm.plane.get(p.name, "xy"),
+                "sheet": p.sheet + 1,
+                "placement": [_r(dx), _r(dy), _r(math.degrees(a))],
+            }
+        )
+    return out
+
+
+def _pin(fab: Any, pp: Any) -> dict[str, Any]:
+    from planar.fabrication.hardware import pin_ends, pin_items, shaft_length
+
+    s = fab.settings
+    lo, hi = pp.layers or (0, 0)
+    (hb, db), (ht, dt) = pin_ends(s, pp)
+    d = {
+        "name": pp.letter,
+        "joints": list(pp.joints),
+        "parts": list(pp.parts),
+        "plane": fab.assembly.plane.get(pp.parts[0], "xy"),
+        "layers": [lo + 1, hi + 1],
+        "length_mm": _r(shaft_length(s, pp) if pp.shaft else pp.length_mm),
+        "diameter_mm": _r(s.shaft_mm if pp.shaft else pp.diameter_mm),
+        "head_mm": _r(max(hb, ht)),
+        "ends": {"lower": {"height_mm": _r(hb), "diameter_mm": _r(db)}, "upper": {"height_mm": _r(ht), "diameter_mm": _r(dt)}},
+        "anchor": {"part": pp.spec.parts[0], "at_mm": [_r(pp.spec.at[0][0] * s.unit_mm), _r(pp.spec.at[0][1] * s.unit_mm)]},
+    }
+    if pp.shaft:
+        d["flat_mm"] = _r(s.shaft_flat_mm)
+    else:
+        d["hardware"] = [{"item": i.item, "size": i.size, "qty": i.qty} for i in pin_items(s, pp)]
+    return d
+
+
+def _spacers(fab: Any) -> list[dict[str, Any]]:
+    from planar.fabrication.check import spacer_radius
+
+    s, asm = fab.settings, fab.assembly
+    cut = {p.name: p for p in fab.layout.parts}
+    out = []
+    for pp in asm.pins:
+        lo, hi = pp.layers or (0, 0)
+        own = {asm.layers.get(p) for p in pp.parts}
+        free = [k for k in range(lo, hi + 1) if k not in own]
+        for j, layer in enumerate(free):
+            pc = cut.get(f"spacer {pp.letter}{j + 1}")
+            a, dx, dy = pc.placed if pc is not None else (0.0, 0.0, 0.0)
+            out.append(
+                {
+                    "name": f"spacer {pp.letter}{j + 1}",
+                    "pin": pp.letter,
+                    "layer": layer + 1,
+                    "sheet": None if pc is None else pc.sheet + 1,
+                    "placement": [_r(dx), _r(dy), _r(math.degrees(a))],
+                    "inner_mm": _r(s.pin_mm + s.clearance),
+                    "outer_mm": _r(2 * spacer_radius(s)),
+                }
+            )
+    return out
+
+
+def plan_dict(fab: Any) -> dict[str, Any]:
+    """The plan of a :class:`~planar.fabrication.build.Fabrication` as plain data (see the module docstring)."""
+    s = fab.settings
+    pins = [p for p in fab.assembly.pins if not p.shaft]
+    shafts = [p for p in fab.assembly.pins if p.shaft]
+    return {
+        "schema": SCHEMA_VERSION,
+        "name": fab.name,
+        "unit_mm": _r(s.unit_mm),
+        "thickness_mm": _r(s.thickness_mm),
+        "kerf_mm": _r(s.kerf),
+        "pin_diameter_mm": _r(s.pin_mm),
+        "clearance_mm": _r(s.clearance),
+        "hardware": s.hardware,
+        "sheets": fab.layout.sheets,
+        "sheet_mm": [_r(fab.layout.sheet_size[0]), _r(fab.layout.sheet_size[1])],
+        "layers": max(fab.assembly.n_layers.values(), default=0),
+        "parts": _parts(fab),
+        "pins": [_pin(fab, p) for p in pins],
+        "spacers": _spacers(fab),
+        "motor_shaft": _pin(fab, shafts[0]) if shafts else None,
+        "contacts": [{"joint": c.joint, "parts": list(c.parts)} for c in fab.assembly.contacts],
+        "violations": [
+            {"what": v.what, "a": v.a, "b": v.b, "layer": v.layer, "sample": v.sample, "samples": v.count} for v in fab.violations
+        ],
+    }
+
+
+def plan_json(fab: Any) -> str:
+    """``plan.json``'s text (two-space indent, a newline at the end)."""
+    return json.dumps(plan_dict(fab), indent=2) + "\n"

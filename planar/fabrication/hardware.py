@@ -1,0 +1,182 @@
+"""Fasteners you can buy: what holds each pin in place, its ends' size, its length, and the BOM's items.
+
+A pin is one of these kinds (``[fabrication] hardware``), sized from ``pin_diameter_mm``:
+
+* ``"rod-eclip"`` (the default): a steel rod (silver steel, drill rod) of the pin's diameter, cut to
+  length, a DIN 125 washer and a DIN 6799 e-clip at each end (a groove for the clip near each end).
+  Each end stands a washer plus a clip above its layer (1.1 mm for 3 mm).
+* ``"screw"``: an ISO 7380 button-head screw, a DIN 125 washer under the head and under the nut,
+  and a DIN 985 nylon lock nut (the lock nut keeps the joint free without tightening it).  The nut's end
+  stands a washer, the nut and a thread past it above its layer (5.5 mm for M3).
+
+The motor shaft ends in one washer and e-clip above its top layer (the motor holds it below).
+Sizes are the standard tables' for the diameters makers use (2, 2.5, 3, 4, 5 and 6 mm); another
+diameter is an error naming ``pin_diameter_mm``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from planar.errors import InputError
+
+__all__ = ["HARDWARE", "Item", "PinHardware", "hardware_of", "pin_ends", "pin_items", "shaft_items", "shaft_length"]
+
+#: DIN 125 washer per nominal diameter: (outer diameter, thickness) mm
+WASHER = {2.0: (5.0, 0.3), 2.5: (6.0, 0.5), 3.0: (7.0, 0.5), 4.0: (9.0, 0.8), 5.0: (10.0, 1.0), 6.0: (12.0, 1.6)}
+#: DIN 6799 e-clip per shaft diameter: (clip size = groove diameter, outer diameter, thickness) mm
+ECLIP = {
+    2.0: (1.5, 4.25, 0.4),
+    2.5: (1.9, 4.8, 0.5),
+    3.0: (2.3, 6.0, 0.6),
+    4.0: (3.2, 7.3, 0.6),
+    5.0: (4.0, 9.3, 0.7),
+    6.0: (5.0, 11.3, 0.7),
+}
+#: ISO 7380 button head: (head diameter, head height) mm
+BUTTON = {2.0: (3.5, 1.1), 2.5: (4.7, 1.3), 3.0: (5.7, 1.65), 4.0: (7.6, 2.2), 5.0: (9.5, 2.75), 6.0: (10.5, 3.3)}
+#: DIN 985 nylon lock nut: (width across corners, height) mm
+NYLOC = {2.0: (4.4, 2.8), 2.5: (5.5, 3.5), 3.0: (6.0, 4.0), 4.0: (7.7, 5.0), 5.0: (8.8, 5.0), 6.0: (11.1, 6.0)}
+#: screw lengths sold (mm)
+SCREW_LENGTHS = (4, 5, 6, 8, 10, 12, 14, 16, 18, 20, 22, 25, 28, 30, 35, 40, 45, 50, 55, 60, 70, 80)
+
+
+@dataclass(frozen=True)
+class Item:
+    """One line of the shopping list: what, its size, how many."""
+
+    item: str
+    size: str
+    qty: int
+
+
+@dataclass(frozen=True)
+class PinHardware:
+    """One kind of fastener: its two ends ``(height, diameter)`` mm beyond the stack, its length and items."""
+
+    name: str
+    ends: Callable[[float], tuple[tuple[float, float], tuple[float, float]]]
+    length: Callable[[float, float], float]
+    items: Callable[[float, float], list[Item]]
+
+
+def _size(d: float, table: dict[float, Any]) -> Any:
+    for k, v in table.items():
+        if math.isclose(k, d, abs_tol=1e-6):
+            return v
+    raise InputError("fabrication.pin_diameter_mm", d, "a diameter hardware is sold in: " + ", ".join(f"{k:g}" for k in table))
+
+
+def _rod_ends(d: float) -> tuple[tuple[float, float], tuple[float, float]]:
+    wd, wt = _size(d, WASHER)
+    _, cd, ct = _size(d, ECLIP)
+    end = (wt + ct, max(wd, cd))
+    return end, end
+
+
+def _rod_length(d: float, stack: float) -> float:
+    """Rod length (mm): the stack, a washer and a clip each end and 0.5 mm past each groove, up to 0.5 mm."""
+    (h, _), _ = _rod_ends(d)
+    return math.ceil((stack + 2 * (h + 0.5)) * 2 - 1e-9) / 2
+
+
+def _rod_items(d: float, stack: float) -> list[Item]:
+    wd, wt = _size(d, WASHER)
+    size, _, _ = _size(d, ECLIP)
+    return [
+        Item("steel rod", f"{d:g} mm x {_rod_length(d, stack):g} mm", 1),
+        Item("washer DIN 125", f"M{d:g} ({wd:g} x {wt:g} mm)", 2),
+        Item("e-clip DIN 6799", f"{size:g} (for {d:g} mm shaft)", 2),
+    ]
+
+
+def _screw_ends(d: float) -> tuple[tuple[float, float], tuple[float, float]]:
+    wd, wt = _size(d, WASHER)
+    hd, hh = _size(d, BUTTON)
+    _, nh = _size(d, NYLOC)
+    return (hh + wt, max(wd, hd)), (wt + nh + 1.0, wd)
+
+
+def _screw_length(d: float, stack: float) -> float:
+    """Screw length sold (mm): under the head through the stack, both washers, the nut and a thread past it."""
+    _, wt = _size(d, WASHER)
+    _, nh = _size(d, NYLOC)
+    need = stack + 2 * wt + nh + 1.0
+    for n in SCREW_LENGTHS:
+        if n >= need - 1e-9:
+            return float(n)
+    raise InputError("fabrication.hardware", "screw", f"a stack under {SCREW_LENGTHS[-1] - 2 * wt - nh - 1:g} mm")
+
+
+def _screw_items(d: float, stack: float) -> list[Item]:
+    wd, wt = _size(d, WASHER)
+    return [
+        Item("button head screw ISO 7380", f"M{d:g} x {_screw_length(d, stack):g}", 1),
+        Item("washer DIN 125", f"M{d:g} ({wd:g} x {wt:g} mm)", 2),
+        Item("nylon lock nut DIN 985", f"M{d:g}", 1),
+    ]
+
+
+#: fastener kinds by ``[fabrication] hardware``
+HARDWARE: dict[str, PinHardware] = {
+    "rod-eclip": PinHardware("rod-eclip", _rod_ends, _rod_length, _rod_items),
+    "screw": PinHardware("screw", _screw_ends, _screw_length, _screw_items),
+}
+
+
+def hardware_of(settings: Any) -> PinHardware:
+    """The fastener kind the settings name (an unknown one is an error naming ``fabrication.hardware``)."""
+    name = getattr(settings, "hardware", "rod-eclip")
+    if name not in HARDWARE:
+        raise InputError("fabrication.hardware", name, "one of " + ", ".join(sorted(HARDWARE)))
+    return HARDWARE[name]
+
+
+def pin_ends(settings: Any, pin: Any) -> tuple[tuple[float, float], tuple[float, float]]:
+    """``((height, diameter) below, (height, diameter) above)`` mm of a pin's ends beyond its layers.
+
+    The motor shaft has none below (the motor) and a washer and e-clip of the shaft's diameter above.
+    """
+    if pin.shaft:
+        wd, wt = WASHER.get(round(settings.shaft_mm * 2) / 2, (2 * settings.shaft_mm + 1, 0.5))
+        return (0.0, 0.0), (wt + 0.6, wd)
+    return hardware_of(settings).ends(pin.diameter_mm)
+
+
+def stack_mm(settings: Any, pin: Any) -> float:
+    """The thickness of the layers a pin spans (mm)."""
+    lo, hi = pin.layers or (0, 0)
+    return (hi - lo + 1) * settings.thickness_mm
+
+
+def pin_length(settings: Any, pin: Any) -> float:
+    """A pin's length (mm) as bought: a rod cut to length or a screw's sold length."""
+    return hardware_of(settings).length(pin.diameter_mm, stack_mm(settings, pin))
+
+
+def pin_items(settings: Any, pin: Any) -> list[Item]:
+    """What to buy for one pin."""
+    return hardware_of(settings).items(pin.diameter_mm, stack_mm(settings, pin))
+
+
+def shaft_length(settings: Any, pin: Any) -> float:
+    """The motor shaft's length above the motor's face (mm): through every layer up to its top one, a washer and
+    e-clip and 0.5 mm past the groove, rounded up to 0.5 mm (the motor sits under the bottom layer)."""
+    _, hi = pin.layers or (0, 0)
+    (_, _), (ht, _) = pin_ends(settings, pin)
+    return math.ceil(((hi + 1) * settings.thickness_mm + ht + 0.5) * 2 - 1e-9) / 2
+
+
+def shaft_items(settings: Any, pin: Any) -> list[Item]:
+    """What holds the motor shaft's top end: a washer and an e-clip of its diameter (where they are sold)."""
+    d = round(settings.shaft_mm * 2) / 2
+    if d not in WASHER:
+        return []
+    wd, wt = WASHER[d]
+    return [
+        Item("washer DIN 125", f"M{d:g} ({wd:g} x {wt:g} mm)", 1),
+        Item("e-clip DIN 6799", f"{ECLIP[d][0]:g} (for {d:g} mm shaft)", 1),
+    ]

@@ -1,0 +1,111 @@
+"""The build check's pieces on hand-made cases (closed forms), the hardware tables, and export's exit status."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import shapely
+from shapely.geometry import box
+
+from planar.fabrication.check import BodyZ, check_bodies, placed_array
+from planar.fabrication.hardware import HARDWARE
+
+GALLERY = Path(__file__).resolve().parents[2] / "gallery"
+
+
+def _still(poly, n=5):
+    return np.array([poly] * n, dtype=object)
+
+
+def test_placed_array_moves_every_sample_like_shapely_affinity():
+    rng = np.random.default_rng(3)
+    poly = box(0, 0, 4, 1).difference(box(1, 0.25, 2, 0.75))
+    poses = np.c_[rng.uniform(-5, 5, (20, 2)), rng.uniform(-3, 3, 20)]
+    got = placed_array(poly, poses, 2.0)
+    for g, (x, y, a) in zip(got, poses):
+        ref = shapely.affinity.translate(shapely.affinity.rotate(poly, a, origin=(0, 0), use_radians=True), 2 * x, 2 * y)
+        assert g.symmetric_difference(ref).area < 1e-9
+
+
+def test_two_parts_on_one_layer_collide_only_where_they_overlap():
+    moving = placed_array(box(0, 0, 2, 2), np.c_[np.linspace(0, 6, 7), np.zeros(7), np.zeros(7)], 1.0)
+    fixed = _still(box(4.5, 0, 6, 2), 7)
+    a = BodyZ("a", moving, 0.0, 3.0, "part")
+    b = BodyZ("b", fixed, 0.0, 3.0, "part")
+    (v,) = check_bodies([a, b], 3.0)
+    # the square [x, x + 2] overlaps [4.5, 6] for x = 3, 4, 5 (at x = 6 they only touch)
+    assert (v.what, v.layer, v.sample, v.count) == ("parts overlap", 1, 3, 3)
+    assert v.depth == pytest.approx(3.0)  # x = 4.5 .. 6: the full 1.5 x 2
+    c = BodyZ("c", fixed, 3.0, 6.0, "part")  # the next layer up: never meets
+    assert check_bodies([a, c], 3.0) == []
+    assert check_bodies([a, b], 3.0, skip={frozenset(("a", "b"))}) == []
+
+
+def test_round_bodies_keep_their_radii_plus_clearance_apart():
+    t = np.linspace(0, 1, 11)
+    p = np.c_[t * 10, np.zeros_like(t)]
+    q = np.c_[np.full_like(t, 7.0), np.zeros_like(t)]
+    disc = shapely.buffer(shapely.points(p), 1.5)
+    a = BodyZ("pin A", disc, 0, 6, "pin", track=p, radius=1.5)
+    b = BodyZ("pin B", disc, 3, 9, "pin", track=q, radius=1.5)
+    (v,) = check_bodies([a, b], 3.0, clearance=0.1)
+    # |10 t - 7| < 3.1 for t in (0.39, 1.0]: samples 4..10
+    assert (v.what, v.sample, v.count, v.layer) == ("pins collide", 4, 7, 2)
+    far = BodyZ("pin B", disc, 6.5, 9, "pin", track=q, radius=1.5)  # z-ranges apart
+    assert check_bodies([a, far], 3.0, clearance=0.1) == []
+
+
+@pytest.mark.parametrize(
+    ("kind", "stack", "length", "ends"),
+    [
+        # rod: stack + 2 x (washer 0.5 + clip 0.6 + 0.5 past the groove), up to 0.5 mm
+        ("rod-eclip", 9.0, 12.5, ((1.1, 7.0), (1.1, 7.0))),
+        # screw: stack + 2 washers + nut 4 + 1 thread = 15 -> sold 16
+        ("screw", 9.0, 16.0, ((2.15, 7.0), (5.5, 7.0))),
+    ],
+)
+def test_hardware_lengths_and_ends_from_the_standard_tables(kind, stack, length, ends):
+    hw = HARDWARE[kind]
+    assert hw.length(3.0, stack) == pytest.approx(length)
+    got = hw.ends(3.0)
+    assert np.allclose(np.array(got, float), np.array(ends, float))
+    assert all(i.qty >= 1 and i.size for i in hw.items(3.0, stack))
+
+
+@pytest.mark.slow
+def test_export_exits_3_naming_the_pair_and_still_writes(tmp_path):
+    out = tmp_path / "h.dxf"
+    res = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "planar",
+            "export",
+            str(GALLERY / "horse.toml"),
+            "-o",
+            str(out),
+            "--assembly",
+            str(tmp_path / "a.svg"),
+        ],
+        capture_output=True,
+        text=True,
+    )
+    assert res.returncode == 3
+    assert "pins collide: pin B and pin E" in res.stdout
+    assert "no plan: pins B and E both ride frame" in res.stdout
+    assert out.exists() and 'stroke="#ff0000"' in (tmp_path / "a.svg").read_text()
+
+
+@pytest.mark.slow
+def test_export_of_a_clean_scene_exits_0(tmp_path):
+    res = subprocess.run(
+        [sys.executable, "-m", "planar", "export", str(GALLERY / "slider-crank.toml"), "-o", str(tmp_path / "s.dxf")],
+        capture_output=True,
+        text=True,
+    )
+    assert res.returncode == 0, res.stdout
+    assert "build check: every part" in res.stdout
