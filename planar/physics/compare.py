@@ -92,6 +92,17 @@ class Comparison:
     def passed(self) -> bool:
         return not self.problems()
 
+    def __repr__(self) -> str:
+        return (
+            f"<Comparison {self.mechanism!r}: {self.samples} samples, worst error {self.max_rel_error:.3g} of size "
+            f"(threshold {self.threshold:g}), {'passed' if self.passed else 'FAILED'}>"
+        )
+
+    def _repr_html_(self) -> str | None:
+        from planar.core.display import html
+
+        return html("comparison", self)
+
     def to_dict(self) -> dict[str, Any]:
         return {
             "mechanism": self.mechanism,

@@ -108,6 +108,16 @@ class ToyPhysics:
     def not_simulated(self) -> list[StageReport]:
         return [s for s in self.stages if not s.simulated]
 
+    def __repr__(self) -> str:
+        diff = self.torque.get("max_rel_diff") if self.torque else None
+        shown = f", motor torque within {diff:.3g} of its scale" if isinstance(diff, float) else ""
+        return f"<ToyPhysics: {len(self.stages)} stages, {len(self.not_simulated)} not simulated{shown}>"
+
+    def _repr_html_(self) -> str | None:
+        from planar.core.display import html
+
+        return html("toy-report", self)
+
 
 def simulate_toy(
     toy: Any, t: Array, effects: Any = None, settings: Any = None, speeds: Any = None, densities: dict[str, float] | None = None
