@@ -60,18 +60,30 @@ def hold_signals_after_commit(on: bool = True) -> None:
 
 @contextlib.contextmanager
 def _renaming() -> Iterator[None]:
-    """Block the interrupt signals while outputs are renamed (and after, with :func:`hold_signals_after_commit`)."""
+    """Hold the interrupt signals while outputs are renamed (and after, with :func:`hold_signals_after_commit`).
+
+    Dispositions, not a thread's mask: numpy's BLAS threads keep the old mask, and a signal sent to the
+    process would reach one of them.  A signal that arrives meanwhile is delivered after the renames
+    (from Python) or ignored until the process exits (the ``planar`` command).
+    """
     import threading
 
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+    got: list[int] = []
+    old = {s: signal.signal(s, lambda n, _f: got.append(n)) for s in _HELD}
     try:
         yield
     finally:
-        if not _HOLD["until_exit"]:
-            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        if _HOLD["until_exit"]:
+            for s in _HELD:
+                signal.signal(s, signal.SIG_IGN)
+        else:
+            for s, h in old.items():
+                signal.signal(s, h)
+            for n in dict.fromkeys(got):
+                signal.raise_signal(n)
 
 
 def _alive(pid: int) -> bool:

@@ -26,7 +26,17 @@ from typing import Any
 
 from planar.errors import InputError, LimitError
 
-__all__ = ["DEFAULTS", "check_count", "check_memory", "limit", "sample_count"]
+__all__ = [
+    "DEFAULTS",
+    "RESOLUTION",
+    "SIZE_RANGE",
+    "check_count",
+    "check_memory",
+    "check_scale",
+    "limit",
+    "motion_bytes",
+    "sample_count",
+]
 
 #: name -> (environment variable, default)
 DEFAULTS: dict[str, tuple[str, int]] = {
@@ -76,6 +86,13 @@ def check_memory(field: str, value: object, n_bytes: float, what: str) -> None:
         raise LimitError(
             field, value, f"{what} within {cap:,} MiB (it needs about {mib:,.0f} MiB; raise the limit with {var}=MIB)"
         )
+
+
+def motion_bytes(parts: int, points: int, n: float) -> float:
+    """Bytes a solve of ``n`` samples holds at its peak: poses (x, y, angle) of every part, points (x, y),
+    driver, time and validity, and the solver's working copies (4 of each; measured 880 bytes a sample for
+    the 8-part Jansen leg, estimated 960)."""
+    return 8.0 * (3 * parts + 2 * points + 4) * 4 * max(n, 2)
 
 
 def sample_count(

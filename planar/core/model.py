@@ -660,10 +660,16 @@ class Mechanism:
                 f"a {'masked' if isinstance(q, np.ma.MaskedArray) else 'bool'} array",
                 "plain driver values (a masked array: pass q[~q.mask] or q.filled(v))",
             )
-        from planar.core.limits import check_count
+        from planar.core.limits import check_count, check_memory, motion_bytes
 
         check_count(
             "samples", f"{self.name}.solve(q)", float(np.size(q)), "samples of one motion", shown=f"{np.size(q):,} driver values"
+        )
+        check_memory(
+            f"{self.name}.solve(q)",
+            f"{np.size(q):,} driver values",
+            motion_bytes(len(self.parts), len(self.points), float(np.size(q))),
+            "a motion",
         )
         qin = np.atleast_1d(check_finite(f"{self.name}.driver value", q))
         qa = new_block(qin.shape)  # the motion's own copy (recycled memory for a large batch)
