@@ -398,10 +398,12 @@ def motor_torque(
         if name not in vel:
             raise InputError(f"{link.name}.loads", name, f"a named point, one of {sorted(vel)}")
     names = list(loads)
-    qa = np.atleast_1d(np.asarray(q, float))
+    from planar.core.model import check_finite
+
+    qa = np.atleast_1d(check_finite(f"{link.name}: q", q))
     forces = []
     for n in names:
-        f = np.asarray(loads[n], float)
+        f = check_finite(f"{link.name}.loads[{n!r}]", loads[n])
         if not np.isfinite(f).all():
             raise InputError(f"{link.name}.loads[{n!r}]", loads[n], "a finite force (x, y)")
         try:

@@ -57,12 +57,16 @@ Array = NDArray[np.float64]
 
 def check_finite(field_name: str, value: ArrayLike) -> NDArray[np.float64]:
     """Return ``value`` as a float array or raise :class:`InputError` on NaN/inf (or what is not numbers)."""
-    if np.iscomplexobj(value):  # numpy would drop the imaginary part with only a warning
+    try:
+        raw = np.asarray(value)
+    except (TypeError, ValueError, OverflowError):  # ragged nesting
+        raise InputError(field_name, value, "numbers (a number or an array of them)") from None
+    if raw.dtype.kind == "c":  # numpy would drop the imaginary part with only a warning
         raise InputError(field_name, "complex numbers", "real numbers")
-    if isinstance(value, (str, bytes)) or np.asarray(value).dtype.kind in "USVb":  # "1.0" is text, True no number
+    if isinstance(value, (str, bytes)) or raw.dtype.kind in "USVb":  # "1.0" is text, True no number
         raise InputError(field_name, value, "numbers (not text or truth values)")
     try:
-        arr = np.asarray(value, dtype=float)
+        arr = np.asarray(raw, dtype=float)
     except (TypeError, ValueError, OverflowError):
         raise InputError(field_name, value, "numbers (a number or an array of them)") from None
     # a sum is finite only if every term is (NaN and inf propagate); a finite array whose sum

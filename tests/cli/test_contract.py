@@ -299,6 +299,7 @@ def test_api_renames_restore_the_signal_handlers(tmp_path: Path, monkeypatch) ->
     """From Python (no hold): a Ctrl-C during the renames arrives after them, and the handlers are given back."""
     import planar.fileio as fileio
 
+    outer = signal.signal(signal.SIGINT, signal.default_int_handler)  # a test worker may ignore SIGINT
     before = signal.getsignal(signal.SIGINT)
     real = os.replace
 
@@ -313,6 +314,7 @@ def test_api_renames_restore_the_signal_handlers(tmp_path: Path, monkeypatch) ->
                 fh.write(name)
     assert (tmp_path / "a.txt").read_text() == "a.txt" and (tmp_path / "b.txt").read_text() == "b.txt"
     assert signal.getsignal(signal.SIGINT) is before
+    signal.signal(signal.SIGINT, outer)
 
 
 def test_an_interrupt_a_library_turned_into_its_error_exits_130(tmp_path: Path, capsys, monkeypatch) -> None:
