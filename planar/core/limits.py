@@ -35,6 +35,8 @@ __all__ = [
     "check_scale",
     "limit",
     "motion_bytes",
+    "pilot_bytes",
+    "resident_bytes",
     "sample_count",
 ]
 
@@ -93,6 +95,43 @@ def motion_bytes(parts: int, points: int, n: float) -> float:
     driver, time and validity, and the solver's working copies (4 of each; measured 880 bytes a sample for
     the 8-part Jansen leg, estimated 960)."""
     return 8.0 * (3 * parts + 2 * points + 4) * 4 * max(n, 2)
+
+
+#: a solve of more samples than this measures its memory on a pilot of :data:`PILOT` samples first
+PILOT_ABOVE = 200_000
+PILOT = 32_768
+
+
+def resident_bytes() -> float:
+    """This process's resident memory now (bytes; 0 where ``/proc`` is not there to tell)."""
+    try:
+        with open("/proc/self/statm") as fh:
+            return float(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return 0.0
+
+
+def pilot_bytes(solve: Any, n: int) -> float | None:
+    """Bytes a solve of ``n`` samples will hold at its peak, from the peak of a :data:`PILOT`-sample solve
+    (``solve(k)``: run once untraced to warm the kernels, then traced by :mod:`tracemalloc`) scaled to
+    ``n``; ``None`` when tracemalloc is already in use (the caller then keeps its static estimate).
+    Measures what each kind really allocates (a cam's profile, a toy's stages), where
+    :func:`motion_bytes` only counts the motion's numbers."""
+    import tracemalloc
+
+    if tracemalloc.is_tracing():
+        return None
+    from planar.core.buffers import release
+
+    solve(PILOT)  # untraced first: loading or compiling the kernels is no cost of the samples
+    release()  # and no recycled block from it: the traced pilot allocates what a first solve does
+    tracemalloc.start()
+    try:
+        solve(PILOT)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    return peak / PILOT * n
 
 
 def sample_count(

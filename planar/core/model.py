@@ -664,17 +664,19 @@ class Mechanism:
                 f"a {'masked' if isinstance(q, np.ma.MaskedArray) else 'bool'} array",
                 "plain driver values (a masked array: pass q[~q.mask] or q.filled(v))",
             )
-        from planar.core.limits import check_count, check_memory, motion_bytes
+        from planar.core import limits
 
-        check_count(
-            "samples", f"{self.name}.solve(q)", float(np.size(q)), "samples of one motion", shown=f"{np.size(q):,} driver values"
+        n_q = int(np.size(q))
+        limits.check_count(
+            "samples", f"{self.name}.solve(q)", float(n_q), "samples of one motion", shown=f"{n_q:,} driver values"
         )
-        check_memory(
-            f"{self.name}.solve(q)",
-            f"{np.size(q):,} driver values",
-            motion_bytes(len(self.parts), len(self.points), float(np.size(q))),
-            "a motion",
-        )
+        need, held = None, 0.0
+        if n_q > limits.PILOT_ABOVE:  # a large solve: what this kind really allocates (a pilot), and what is held
+            qf = np.ravel(check_finite(f"{self.name}.driver value", q))
+            need, held = limits.pilot_bytes(lambda k: self.solve(qf[:k]), n_q), limits.resident_bytes()
+        if need is None:
+            need = limits.motion_bytes(len(self.parts), len(self.points), float(n_q))
+        limits.check_memory(f"{self.name}.solve(q)", f"{n_q:,} driver values", need + held, "a motion")
         qin = np.atleast_1d(check_finite(f"{self.name}.driver value", q))
         qa = new_block(qin.shape)  # the motion's own copy (recycled memory for a large batch)
         np.copyto(qa, qin)
