@@ -674,7 +674,10 @@ def torque_scale(mech: Mechanism, t: Array, effects: Effects | None = None, dens
     (a crank driving a slider at constant speed); and at least the largest
     kinetic energy per radian of the driver, ``sum (m |v|^2 + I omega^2) / 2``.
     A torque difference is reported as a fraction of this, never of a peak
-    that may be round-off.
+    that may be round-off.  Only samples whose rates are defined count, not
+    those within :data:`_SCALE_GUARD` samples of a change point or toggle
+    (where differenced rates are singular), and the scale is at most
+    :data:`_SCALE_SPREAD` times the median of the samples kept.
     """
     from planar.analysis.dynamics import _wrapped, gravity_and_damping, part_mass_table, plane_gravity
 
@@ -701,4 +704,42 @@ def torque_scale(mech: Mechanism, t: Array, effects: Effects | None = None, dens
         for load in effects.loads:
             vp = (mp.points[load.point] - mm.points[load.point]) / (2 * h)
             work += np.abs((np.asarray(load.force, float) * vp).sum(-1)) / w
-    return float(max(work.max(initial=0.0), energy.max(initial=0.0)))
+    keep = _scale_samples(mech, t) & np.isfinite(work) & np.isfinite(energy)
+    return float(max(_robust_max(work[keep]), _robust_max(energy[keep])))
+
+
+#: samples either side of one whose rates are undefined (a change point or toggle) left out of the torque scale
+_SCALE_GUARD = 3
+
+#: the torque scale is at most this many times the median of its samples (a singular spike is not a scale)
+_SCALE_SPREAD = 10.0
+
+
+def _scale_samples(mech: Mechanism, t: Array) -> NDArray[np.bool_]:
+    """Samples where the rates are defined and at least :data:`_SCALE_GUARD` samples from where they are not.
+
+    At a change point or toggle the differenced rates are singular (NaN or
+    huge); they measure the singularity, not the mechanism.  A kind without
+    closed-form rates keeps every sample (the finiteness check still applies).
+    """
+    from planar.analysis.rates import mechanism_rates
+    from planar.core.registry import UnsupportedError
+
+    try:
+        _, valid, _ = mechanism_rates(mech, mech.driver.value(t), 1.0, 0.0)
+    except UnsupportedError:
+        return np.ones(t.size, bool)
+    valid = np.asarray(valid, bool)
+    bad = np.flatnonzero(~valid)
+    keep = valid.copy()
+    for d in range(1, _SCALE_GUARD + 1):
+        keep[np.clip(bad - d, 0, t.size - 1)] = False
+        keep[np.clip(bad + d, 0, t.size - 1)] = False
+    return keep if keep.any() else valid
+
+
+def _robust_max(x: Array) -> float:
+    """The largest of ``x``, capped at :data:`_SCALE_SPREAD` times its median (0 for none)."""
+    if not x.size:
+        return 0.0
+    return float(min(x.max(), _SCALE_SPREAD * np.median(x))) if np.median(x) > 0 else float(x.max())
