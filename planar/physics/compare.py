@@ -74,7 +74,7 @@ class Comparison:
             out.append(f"simulation {self.search.line()}; last: {self.failure}")
         elif self.failure:
             verdict = self.search.verdict if self.search is not None else None
-            why = {"differs": " (two budgets agree: the mechanism differs)", "change-point": " at a change point"}.get(
+            why = {"differs": " (the budgets agree: the mechanism differs)", "change-point": " at a change point"}.get(
                 verdict or "", ""
             )
             out.append(f"simulation failed{why}: {self.failure}" + (f"; {self.hint}" if self.hint else ""))
@@ -262,6 +262,7 @@ def _kinematic_outcome(mech: Mechanism) -> Any:
 def _torque_outcome(threshold: float) -> Any:
     def outcome(tc: dict[str, Any]) -> tuple[str | None, int, float, dict[str, Any]]:
         built = {"substeps": tc["substeps"], "iterations": tc["iterations"], "correction": tc["correction"]}
+        built["progress"] = tc["pose_error"]  # shrinks with the budget while the solver is what limits the torque
         if tc["failure"] is None and tc["max_rel_diff"] <= threshold:
             return None, tc["samples_compared"], 0.0, built
         if tc["failure_kind"] == "drift" and tc["max_rel_diff"] <= threshold:

@@ -1,11 +1,15 @@
 """Verdicts on scenes a new user wrote: the torque scale, the search's verdicts and messages, the hints."""
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from planar.physics.compare import compare_scene
+from planar.physics.converge import converge
 from planar.physics.run import torque_scale
+from planar.physics.settings import DEFAULT_SETTINGS
 from planar.physics.simulate import torque_comparison
 from planar.scene.load import load_scene
 
@@ -25,3 +29,58 @@ def test_torque_scale_ignores_the_change_points():
     assert tc["max_rel_diff"] == pytest.approx(tc["max_abs_diff"] / tc["scale"])
     # it is the scale measured between the change points
     assert torque_scale(mech, t[5:26], scene.effects) == pytest.approx(tc["scale"], rel=1e-6)
+
+
+def _budgets(results):
+    """A run whose outcome per budget is given as (cause, sample, error, progress); the last repeats."""
+    seen = []
+
+    def run(st):
+        seen.append(st)
+        return results[min(len(seen) - 1, len(results) - 1)]
+
+    def outcome(r):
+        return r[0], r[1], r[2], {"progress": r[3]}
+
+    return run, outcome, seen
+
+
+def test_differs_needs_the_error_to_stop_shrinking():
+    # the parallelogram's motor run near its change point: the torque error wanders while the pose error
+    # halves with each budget: the solver limits it, not the mechanism, and a larger budget passes
+    errors = [(3.09, 2.6e-4), (1.54, 1.6e-4), (0.389, 9.9e-5), (0.485, 3.7e-5), (0.374, 1.8e-5)]
+    run, outcome, seen = _budgets([("constraint", 71, e, p) for e, p in errors] + [(None, 71, 0.0, 0.0)])
+    _, s = converge(run, outcome, DEFAULT_SETTINGS)
+    assert s.verdict == "pass", s.line()
+    # the same errors with nothing shrinking: the mechanism differs, said after three budgets
+    run, outcome, seen = _budgets([("constraint", 71, 0.4, 1e-4)])
+    _, s = converge(run, outcome, DEFAULT_SETTINGS)
+    assert s.verdict == "differs" and len(seen) == 3 and "3 budgets agree" in s.line()
+
+
+def test_the_search_names_the_limit_that_stopped_it():
+    # every budget still improves: the tries run out long before the time cap
+    run, outcome, seen = _budgets([("constraint", 71, 2.0**-k, 2.0**-k) for k in range(10)])
+    _, s = converge(run, outcome, DEFAULT_SETTINGS, cap_s=1e9)
+    line = s.line()
+    assert s.verdict == "unconverged" and s.stopped == "tries"
+    assert "within" not in line and f"gave up after {len(seen)} tries" in line
+    assert f"up to {max(st.iterations for st in seen)} iterations" in line and "s CPU" in line
+    assert f"--iterations {2 * seen[-1].iterations}" in line  # the budget it would have tried next
+    # the time cap, when it is what stops it, is named as such
+    run, outcome, seen = _budgets([("constraint", 71, 2.0**-k, 2.0**-k) for k in range(10)])
+    _, s = converge(run, outcome, DEFAULT_SETTINGS, cap_s=0.0)
+    assert s.stopped == "time" and "could not converge within 0 s CPU" in s.line()
+
+
+@pytest.mark.slow
+def test_the_parallelogram_motor_run_is_not_called_different():
+    scene = load_scene(SCENES / "parallelogram-phase.toml")
+    r, _ = compare_scene(scene)
+    s = r.torque_search
+    assert s.verdict != "differs", s.line()
+    if s.verdict == "unconverged":
+        # its hint, applied, converges
+        assert s.next_settings is not None and f"--iterations {s.next_settings.iterations}" in s.line()
+        r2, _ = compare_scene(scene, replace(DEFAULT_SETTINGS, iterations=s.next_settings.iterations))
+        assert r2.torque_search.verdict == "pass" and r2.torque["max_rel_diff"] < 0.01, r2.problems()
