@@ -16,6 +16,7 @@ from planar.scene.load import load_scene
 SCENES = Path(__file__).resolve().parent / "scenes"
 
 
+@pytest.mark.slow
 def test_torque_scale_ignores_the_change_points():
     # at a parallelogram's change points the differenced rates are singular: they must not set the scale,
     # so that a torque off by more than its peak is reported as such
@@ -84,3 +85,36 @@ def test_the_parallelogram_motor_run_is_not_called_different():
         assert s.next_settings is not None and f"--iterations {s.next_settings.iterations}" in s.line()
         r2, _ = compare_scene(scene, replace(DEFAULT_SETTINGS, iterations=s.next_settings.iterations))
         assert r2.torque_search.verdict == "pass" and r2.torque["max_rel_diff"] < 0.01, r2.problems()
+
+
+@pytest.mark.slow
+def test_a_saturated_motor_gets_its_own_hint_only():
+    from planar.analysis.dynamics import part_mass_table
+
+    scene = load_scene(SCENES / "shaper-saturated.toml")
+    r, _ = compare_scene(scene)
+    text = "\n".join(r.problems())
+    assert r.torque["saturated"] and "motor saturated" in text
+    assert "--iterations" not in text and "--substeps" not in text  # no budget helps a motor at its limit
+    assert r.torque_search.verdict == "saturated"
+    # the part to lighten is the heaviest moving one of this mechanism (it has no coupler)
+    ground = {p.name for p in scene.mechanism.parts if p.ground}
+    masses = {k: v[0] for k, v in part_mass_table(scene.mechanism, scene.effects).items() if k not in ground}
+    assert f"a lighter {max(masses, key=lambda k: masses[k])!r}" in text
+    assert "coupler" not in text and "coupler" not in {p.name for p in scene.mechanism.parts}
+
+
+def test_the_imposed_crank_has_no_error_after_a_branch_switch():
+    # the kinematic parallelogram takes the other assembly at its change point; the crank is imposed
+    from planar.physics.compare import compare
+    from planar.physics.simulate import simulate
+
+    scene = load_scene(SCENES / "parallelogram.toml")
+    motion = scene.motion()
+    sim = simulate(scene.mechanism, motion.t, scene.effects)
+    assert sim.failure is not None
+    r = compare(scene.mechanism, motion, sim.motion)
+    crank = next(p for p in r.parts if p.part == "crank")
+    assert crank.max_angle_error < 1e-9 and crank.max_rel_error < 1e-9 and crank.first_over is None
+    assert any(f"compared up to sample {sim.failure.sample}" in n for n in r.notes)
+    assert not r.passed  # the parts that did switch still fail
