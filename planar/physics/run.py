@@ -634,7 +634,7 @@ def torque_comparison(
         "pins": "each groove's pin is a body of its own whose mass is taken out of its part "
         "(same mass, centre and moment), so both sides model the same inertia",
         "note": "simulated torque: the motor's signed impulse per step / dt (mean over the interval); "
-        "differences are fractions of the mechanism's torque scale (see torque_scale)",
+        "differences are fractions of 'scale', the mechanism's torque scale (planar.physics.run.torque_scale)",
         "wall_time": sim.wall_time,
         "substeps": K,
         "iterations": sim.built["iterations"],

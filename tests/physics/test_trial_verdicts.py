@@ -118,3 +118,28 @@ def test_the_imposed_crank_has_no_error_after_a_branch_switch():
     assert crank.max_angle_error < 1e-9 and crank.max_rel_error < 1e-9 and crank.first_over is None
     assert any(f"compared up to sample {sim.failure.sample}" in n for n in r.notes)
     assert not r.passed  # the parts that did switch still fail
+
+
+@pytest.mark.slow
+def test_json_describes_both_runs():
+    import json
+    import re
+    import subprocess
+    import sys
+
+    out = subprocess.run(
+        [sys.executable, "-m", "planar", "compare", str(SCENES / "parallelogram-motor.toml"), "--json"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert out.returncode in (0, 3), out.stderr
+    d = json.loads(out.stdout)
+    assert set(d["search"]) == {"kinematic", "motor"}
+    for run in ("kinematic", "motor"):
+        assert d["search"][run]["verdict"] and d["search"][run]["tried"] and d["search"][run]["line"]
+    # the note names the keys it refers to as they are spelled in the same table
+    named = re.findall(r"'(\w+)'", d["torque"]["note"])
+    assert named and all(k in d["torque"] for k in named), named
+    assert "motor" in d["built"]["mode"] and "kinematic" in d["built"]["mode"]
+    assert d["built"]["motor"]["iterations"] == d["torque"]["iterations"]
