@@ -16,6 +16,7 @@ from planar.core.effects import Effects
 from planar.core.geometry import poses_apply, wrap_angle
 from planar.core.model import Mechanism, Motion, joint_residuals
 from planar.errors import PlanarError
+from planar.physics.cycle import check_cycle
 from planar.physics.rebuild import _JACC, _motor_impulse_offset, _Rebuild
 from planar.physics.settings import (
     DEFAULT_SETTINGS,
@@ -581,6 +582,7 @@ def simulate_scene(scene: Scene, settings: SimSettings = DEFAULT_SETTINGS, mode:
         mode = "motor" if e.motor_force_limit is not None else "kinematic"
     motion = scene.motion()
     assert motion.t is not None  # a scene's motion is sampled in time
+    check_cycle(scene, motion)  # a cycle that breaks is refused saying what to change, in the scene's unit
     return simulate(scene.mechanism, motion.t, e, settings, mode)
 
 

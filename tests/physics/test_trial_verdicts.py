@@ -143,3 +143,30 @@ def test_json_describes_both_runs():
     assert named and all(k in d["torque"] for k in named), named
     assert "motor" in d["built"]["mode"] and "kinematic" in d["built"]["mode"]
     assert d["built"]["motor"]["iterations"] == d["torque"]["iterations"]
+
+
+@pytest.mark.slow
+def test_a_crank_that_cannot_turn_is_refused_with_what_to_change():
+    import re
+    import tomllib
+
+    from planar.physics.settings import SimulationError
+    from planar.physics.simulate import simulate_scene
+    from planar.scene.load import build_scene, parse_scene
+
+    path = SCENES / "nongrashof-deg.toml"
+    with pytest.raises(SimulationError) as err:
+        simulate_scene(load_scene(path))
+    msg = str(err.value)
+    assert "deg" in msg and "rad" not in msg  # the scene's unit
+    q = load_scene(path).mechanism.driver.value(load_scene(path).motion().t)
+    i = int(re.search(r"invalid at sample (\d+)", msg).group(1))
+    assert f"driver value {np.degrees(q[i]):.4g} deg" in msg
+    assert "other link lengths" in msg
+    amp, centre = (float(v) for v in re.search(r"amplitude = ([-\d.]+), centre = ([-\d.]+)", msg).groups())
+    # the rocking input it suggests assembles, and simulates
+    spec = tomllib.loads(path.read_text())
+    spec["driver"].update(amplitude=amp, centre=centre)
+    rocking = build_scene(parse_scene(spec))
+    assert rocking.motion().valid.all()
+    assert simulate_scene(rocking).failure is None
