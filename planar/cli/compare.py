@@ -36,6 +36,19 @@ def settings_from_args(args: argparse.Namespace) -> Any:
     return settings
 
 
+def _search_dict(search: Any) -> dict[str, Any] | None:
+    """A settings search for the JSON report (``None`` when that run did not happen)."""
+    if search is None:
+        return None
+    return {
+        "verdict": search.verdict,
+        "line": search.line(),
+        "tried": search.tried,
+        "stopped": search.stopped or None,
+        "cpu_s": search.cpu_s,
+    }
+
+
 def add_solver_options(p: Any) -> None:
     """The solver settings ``compare`` and ``render --overlay`` take."""
     p.add_argument(
@@ -82,9 +95,12 @@ def _cmd_compare(args: argparse.Namespace) -> int:
             "correction": sim.built.get("correction"),
             "error_bias": settings.error_bias,
         }
-        d["search"] = None if result.search is None else {"verdict": result.search.verdict, "tried": result.search.tried}
+        d["search"] = {"kinematic": _search_dict(result.search), "motor": _search_dict(result.torque_search)}
         d["wall_time_s"] = sim.wall_time
         d["built"] = dict(sim.built.items())
+        if result.torque is not None:  # a motor run happened too: say so, with its own settings
+            d["built"]["mode"] = "kinematic and motor"
+            d["built"]["motor"] = {k: result.torque.get(k) for k in ("substeps", "iterations")}
         print(json.dumps(d, indent=2, default=str))
     else:
         print(format_comparison(result))

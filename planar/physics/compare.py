@@ -74,7 +74,7 @@ class Comparison:
             out.append(f"simulation {self.search.line()}; last: {self.failure}")
         elif self.failure:
             verdict = self.search.verdict if self.search is not None else None
-            why = {"differs": " (two budgets agree: the mechanism differs)", "change-point": " at a change point"}.get(
+            why = {"differs": " (the budgets agree: the mechanism differs)", "change-point": " at a change point"}.get(
                 verdict or "", ""
             )
             out.append(f"simulation failed{why}: {self.failure}" + (f"; {self.hint}" if self.hint else ""))
@@ -134,22 +134,25 @@ def _torque_problems(t: dict[str, Any], threshold: float, search: Any) -> list[s
     from planar.physics.converge import hint
 
     out = []
+    # a saturated motor explains the lines after it: no solver budget helps those
     if t.get("saturated"):
         s = t["saturated"]
         shown = ", ".join(str(i) for i in s[:12]) + (", ..." if len(s) > 12 else "")
         out.append(
             f"motor saturated at {len(s)} sample(s) [{shown}] "
-            f"(force limit {t.get('motor_force_limit'):g}, needed peak {t['peak']:.4g}); {hint('saturation')}"
+            f"(force limit {t.get('motor_force_limit'):g}, needed peak {t['peak']:.4g}); "
+            f"{hint('saturation', t.get('heaviest_part'))}"
         )
+    why = "a consequence of the saturation" if t.get("saturated") else hint("constraint")
     if search is not None and search.verdict == "unconverged":
         out.append(f"motor-driven simulation {search.line()}")
     elif t.get("failure"):
-        out.append(f"motor-driven simulation failed: {t['failure']}; {hint('constraint')}")
+        out.append(f"motor-driven simulation failed: {t['failure']}; {why}")
     if t["samples_compared"] and t["max_rel_diff"] > threshold:
         out.append(
             f"motor torque differs from inverse dynamics by {t['max_rel_diff']:.3g} of the torque scale "
             f"{t['scale']:.4g} at sample {t['worst_sample']} (driver at {t['worst_angle_deg']:.4g} deg; "
-            f"threshold {threshold:g}); {hint('constraint')}"
+            f"threshold {threshold:g}); {why}"
         )
     return out
 
@@ -164,12 +167,16 @@ def _part_points(mech: Mechanism, part: str) -> NDArray[np.float64]:
 def compare(mech: Mechanism, reference: Motion, other: Motion, threshold: float = 1e-3) -> Comparison:
     """Errors of ``other`` against ``reference`` (same samples) for every part and joint."""
     size = mech.size
-    # samples the simulation marked as failed still count (their poses are what it did), so the table agrees
-    # with the failure it reports; a non-finite pose counts as infinitely far
+    # the sample the simulation failed at still counts (its pose is what it did), so the table agrees with the
+    # failure it reports; the samples after it are not compared (nothing was simulated there, the imposed
+    # driver included); a non-finite pose counts as infinitely far
     finite = np.ones(len(reference), bool)
     for p in mech.parts:
         finite &= np.isfinite(other.poses[p.name]).all(axis=1)
     ok = reference.valid.copy()
+    stop = int(np.flatnonzero(~other.valid)[0]) if not other.valid.all() else None
+    if stop is not None:  # the simulation stopped at its failure: the later samples hold no simulated pose
+        ok[stop + 1 :] = False
     parts = []
     first_all: int | None = None
     for p in mech.parts:
@@ -203,7 +210,13 @@ def compare(mech: Mechanism, reference: Motion, other: Motion, threshold: float 
     if not other.valid.all():
         i = int(np.flatnonzero(~other.valid)[0])
         failure = other.fail_table[int(other.fail_code[i])][1] if other.fail_code[i] >= 0 else f"sample {i} invalid"
-    return Comparison(mech.name, size, len(reference), threshold, parts, joints, first_all, failure=failure)
+    notes = []
+    if stop is not None and stop + 1 < len(reference):
+        notes.append(
+            f"compared up to sample {stop}, where the simulation stopped; the {len(reference) - stop - 1} later "
+            "samples were not simulated"
+        )
+    return Comparison(mech.name, size, len(reference), threshold, parts, joints, first_all, notes=notes, failure=failure)
 
 
 def torque_line(t: dict[str, Any]) -> str:
@@ -262,6 +275,9 @@ def _kinematic_outcome(mech: Mechanism) -> Any:
 def _torque_outcome(threshold: float) -> Any:
     def outcome(tc: dict[str, Any]) -> tuple[str | None, int, float, dict[str, Any]]:
         built = {"substeps": tc["substeps"], "iterations": tc["iterations"], "correction": tc["correction"]}
+        built["progress"] = tc["pose_error"]  # shrinks with the budget while the solver is what limits the torque
+        if tc["saturated"]:  # the motor cannot give the torque: no solver budget changes that
+            return "saturation", tc["samples_compared"], max(tc["max_rel_diff"], tc["pose_error"]), built
         if tc["failure"] is None and tc["max_rel_diff"] <= threshold:
             return None, tc["samples_compared"], 0.0, built
         if tc["failure_kind"] == "drift" and tc["max_rel_diff"] <= threshold:
@@ -269,6 +285,34 @@ def _torque_outcome(threshold: float) -> Any:
         return "constraint", tc["samples_compared"], max(tc["max_rel_diff"], tc["pose_error"]), built
 
     return outcome
+
+
+def _heaviest_part(mech: Mechanism, effects: Any) -> str | None:
+    """The heaviest part that moves (for the saturation hint), or ``None``."""
+    from planar.analysis.dynamics import part_mass_table
+
+    ground = {p.name for p in mech.parts if p.ground}
+    masses = {k: v[0] for k, v in part_mass_table(mech, effects).items() if k not in ground}
+    return max(masses, key=lambda k: masses[k]) if masses else None
+
+
+#: samples either side of a failing sample searched for a change point or toggle
+_NEAR = 3
+
+
+def _near_change_point(mech: Mechanism, motion: Motion, i: int) -> str:
+    """``"sample k (within 2 samples) is a change point or toggle ..."`` when one is within :data:`_NEAR` samples of ``i``."""
+    from planar.physics.run import change_point
+
+    n = len(motion)
+    cp = change_point(mech, motion.poses, max(0, i - _NEAR), min(n, i + _NEAR + 1))
+    if cp is None:
+        return ""
+    k, parts = cp
+    return (
+        f"the analytic motion passes a change point or toggle at sample {k}, {abs(k - i)} sample(s) from the "
+        f"worst one (with the input held, {' and '.join(repr(p) for p in parts)} can still move)"
+    )
 
 
 #: a run that holds but is further than this fraction of the threshold from its analytic motion is refined
@@ -315,6 +359,8 @@ def compare_scene(
     result = compare(mech, motion, sim.motion, threshold=threshold)
     result.torque_threshold = torque_threshold
     result.search = search
+    if sim.failure is not None and search.verdict in ("differs", "unconverged"):
+        search.near = _near_change_point(mech, motion, sim.failure.sample)
     if sim.failure is not None and search.verdict != "differs":
         cause, *_ = _kinematic_outcome(mech)(sim)
         result.hint = hint(cause)
@@ -339,6 +385,9 @@ def compare_scene(
     )
     keep += ("motor_force_limit", "saturated", "failure", "pose_error", "pins", "note", "substeps", "iterations")
     result.torque = {k: tc[k] for k in keep}
+    result.torque["heaviest_part"] = _heaviest_part(mech, scene.effects)
+    if tsearch.verdict in ("differs", "unconverged") and tc["worst_sample"] is not None:
+        tsearch.near = _near_change_point(mech, motion, int(tc["worst_sample"]))
     result.torque_search = tsearch
     if with_series:
         result.torque.update(analytic=tc["analytic"], simulated=tc["simulated"])

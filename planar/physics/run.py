@@ -16,6 +16,7 @@ from planar.core.effects import Effects
 from planar.core.geometry import poses_apply, wrap_angle
 from planar.core.model import Mechanism, Motion, joint_residuals
 from planar.errors import PlanarError
+from planar.physics.cycle import check_cycle
 from planar.physics.rebuild import _JACC, _motor_impulse_offset, _Rebuild
 from planar.physics.settings import (
     DEFAULT_SETTINGS,
@@ -581,6 +582,7 @@ def simulate_scene(scene: Scene, settings: SimSettings = DEFAULT_SETTINGS, mode:
         mode = "motor" if e.motor_force_limit is not None else "kinematic"
     motion = scene.motion()
     assert motion.t is not None  # a scene's motion is sampled in time
+    check_cycle(scene, motion)  # a cycle that breaks is refused saying what to change, in the scene's unit
     return simulate(scene.mechanism, motion.t, e, settings, mode)
 
 
@@ -634,7 +636,7 @@ def torque_comparison(
         "pins": "each groove's pin is a body of its own whose mass is taken out of its part "
         "(same mass, centre and moment), so both sides model the same inertia",
         "note": "simulated torque: the motor's signed impulse per step / dt (mean over the interval); "
-        "differences are fractions of the mechanism's torque scale (see torque_scale)",
+        "differences are fractions of 'scale', the mechanism's torque scale (planar.physics.run.torque_scale)",
         "wall_time": sim.wall_time,
         "substeps": K,
         "iterations": sim.built["iterations"],
@@ -674,7 +676,10 @@ def torque_scale(mech: Mechanism, t: Array, effects: Effects | None = None, dens
     (a crank driving a slider at constant speed); and at least the largest
     kinetic energy per radian of the driver, ``sum (m |v|^2 + I omega^2) / 2``.
     A torque difference is reported as a fraction of this, never of a peak
-    that may be round-off.
+    that may be round-off.  Only samples whose rates are defined count, not
+    those within :data:`_SCALE_GUARD` samples of a change point or toggle
+    (where differenced rates are singular), and the scale is at most
+    :data:`_SCALE_SPREAD` times the 90th percentile of the samples kept.
     """
     from planar.analysis.dynamics import _wrapped, gravity_and_damping, part_mass_table, plane_gravity
 
@@ -701,4 +706,44 @@ def torque_scale(mech: Mechanism, t: Array, effects: Effects | None = None, dens
         for load in effects.loads:
             vp = (mp.points[load.point] - mm.points[load.point]) / (2 * h)
             work += np.abs((np.asarray(load.force, float) * vp).sum(-1)) / w
-    return float(max(work.max(initial=0.0), energy.max(initial=0.0)))
+    keep = _scale_samples(mech, t) & np.isfinite(work) & np.isfinite(energy)
+    return float(max(_robust_max(work[keep]), _robust_max(energy[keep])))
+
+
+#: samples either side of one whose rates are undefined (a change point or toggle) left out of the torque scale
+_SCALE_GUARD = 3
+
+#: the torque scale is at most this many times the 90th percentile of its samples (a singular spike at a
+#: few samples is not a scale; a quick return's genuine peak, ~2x its 90th percentile, is kept)
+_SCALE_SPREAD = 10.0
+
+
+def _scale_samples(mech: Mechanism, t: Array) -> NDArray[np.bool_]:
+    """Samples where the rates are defined and at least :data:`_SCALE_GUARD` samples from where they are not.
+
+    At a change point or toggle the differenced rates are singular (NaN or
+    huge); they measure the singularity, not the mechanism.  A kind without
+    closed-form rates keeps every sample (the finiteness check still applies).
+    """
+    from planar.analysis.rates import mechanism_rates
+    from planar.core.registry import UnsupportedError
+
+    try:
+        _, valid, _ = mechanism_rates(mech, mech.driver.value(t), 1.0, 0.0)
+    except UnsupportedError:
+        return np.ones(t.size, bool)
+    valid = np.asarray(valid, bool)
+    bad = np.flatnonzero(~valid)
+    keep = valid.copy()
+    for d in range(1, _SCALE_GUARD + 1):
+        keep[np.clip(bad - d, 0, t.size - 1)] = False
+        keep[np.clip(bad + d, 0, t.size - 1)] = False
+    return keep if keep.any() else valid
+
+
+def _robust_max(x: Array) -> float:
+    """The largest of ``x``, capped at :data:`_SCALE_SPREAD` times its 90th percentile (0 for none)."""
+    if not x.size:
+        return 0.0
+    p90 = float(np.percentile(x, 90))
+    return float(min(x.max(), _SCALE_SPREAD * p90)) if p90 > 0 else float(x.max())
