@@ -206,6 +206,7 @@ def _finish_path(args: argparse.Namespace, what: str, text: str, report: dict[st
 
 
 def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | None, cons: Any) -> int:
+    from planar.synth.path import wrapped
     from planar.synth.scene_out import linkage_scene_text
     from planar.synth.sixbar import synthesise_sixbar
 
@@ -223,7 +224,7 @@ def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | N
         comments=[
             f"planar synth path {args.target} --type sixbar --topology {d.topology}: {len(targets)} targets, "
             f"{'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
-            "crank angle at each target (rad, from the ground line O2-O4): " + ", ".join(f"{t:.6g}" for t in d.theta),
+            "crank angle at each target (rad, from the ground line O2-O4): " + ", ".join(f"{t:.6g}" for t in wrapped(d.theta)),
         ],
     )
     report = {"command": "synth path", "targets": len(targets), **d.to_dict()}

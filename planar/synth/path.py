@@ -41,6 +41,13 @@ Array = NDArray[np.float64]
 DEFAULT_TOLERANCE = 1e-3
 
 
+def wrapped(theta: Array) -> Array:
+    """Crank angles ``theta`` (radians) wrapped to ``[0, 2 pi)``, as the scene's comment and the JSON give them."""
+    t = np.mod(np.asarray(theta, float), 2 * np.pi)
+    t[t >= 2 * np.pi] = 0.0  # a tiny negative angle rounds to 2 pi
+    return t
+
+
 def normalised(cons: Constraints, c: Array, s: float) -> Constraints:
     """``cons`` for targets moved by ``-c`` and divided by ``s`` (the pivots box moves with them)."""
     if cons.region is None:
@@ -60,7 +67,7 @@ class FourBarDesign(Checked, PlacedFourBar):
     coupler_point: tuple[float, float]
     circuit: str
     placement: tuple[float, float, float]
-    theta: Array  # crank angle at each target (radians from the ground line)
+    theta: Array  # crank angle at each target (radians from the ground line, in [0, 2 pi))
     sse: float  # from planar's solver at ``theta``
     targets: Array
     timed: bool
@@ -217,7 +224,7 @@ def synthesise_path(
         (float(p[4]), float(p[5])),
         "open" if r.circuit > 0 else "crossed",
         (float(p[6]), float(p[7]), float(p[8])),
-        np.asarray(r.theta, float),
+        wrapped(r.theta),
         float("nan"),
         t,
         theta is not None,
