@@ -189,8 +189,8 @@ def _search(
     g_good = g.feasible and (in_order(g.theta) or not ordered)
     e_global = max_distance(PathObjective(t, None, cons), np.append(g.params, g.circuit), g.theta)
     stages = {**load, **r.stages, **_prefixed(g.stages)}
-    # the better of the two: usable first, then the smaller error
-    if (g_good, -g.sse) > (good, -r.sse):
+    # the better of the two: usable first, then the smaller largest distance (what the check judges)
+    if (g_good, -e_global) > (good, -e_atlas):
         g.stages = stages
         return g, (
             f"the global search (--budget {budget}; largest distance {e_global:.3g} of the size, "

@@ -172,3 +172,22 @@ def test_min_transmission_fails_the_check_naming_the_angle(tmp_path, capsys):
     rc = main(["synth", "path", str(src), "-o", str(tmp_path / "r.toml"), "--budget", "quick", "--json"])
     rep = json.loads(capsys.readouterr().out)
     assert rep["checks"]["ok_transmission"] == (rep["checks"]["min_transmission_deg"] >= 1.0)
+
+
+def test_atlas_and_global_results_compared_by_largest_distance(monkeypatch):
+    """The global search's result with the smaller sum of squares but the larger largest distance loses."""
+    import planar.synth.path as P
+    import planar.synth.search as S
+
+    row = np.array([1.0, 0.3, 1.1, 0.9, 0.5, 0.4, 0.0, 0.0, 0.0])
+    th = np.linspace(0, 2 * np.pi, 12, endpoint=False)
+    T = _curve(row, 1.0, th)
+    near, far = row.copy(), row.copy()
+    near[4] += 1e-3
+    far[5] += 1e-1
+    good = S.SearchResult(near, 1, th, 1.0, True, 1, {"atlas_s": 0.0})  # sse values swapped on purpose
+    bad = S.SearchResult(far, 1, th, 1e-9, True, 1, {"sample_s": 0.0})
+    monkeypatch.setattr(S, "search_atlas", lambda *a, **k: good)
+    monkeypatch.setattr(P, "search_fourbar", lambda *a, **k: bad)
+    r, found = P._search(T, None, S.Constraints(), "quick", 0, 1e-9, object(), False)
+    assert r is good and found.startswith("the atlas") and "global_sample_s" in r.stages
