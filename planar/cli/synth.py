@@ -90,6 +90,15 @@ def _path_failing(d: Any) -> list[str]:
                 f"their centroid, {d.checks['size']:.6g}), over --tolerance {d.checks['tolerance']:g} "
                 f"(RMS distance {d.checks['rms_error']:.3g} of the size, sse {d.sse:.6g})"
             )
+            if d.checks["max_error"] > FAR_OFF * d.checks["tolerance"]:
+                out.append(_unreachable(d))
+        elif k == "ok_transmission":
+            out.append(
+                f"the transmission angle falls to {d.checks['min_transmission_deg']:.3g} deg from a toggle at crank "
+                f"angle {d.checks['min_transmission_at_rad']:.4g} rad from the ground line (limit "
+                f"{d.checks['transmission_limit_deg']:g} deg, --min-transmission): coupler and rocker fold nearly "
+                "flat there, the coupler point jumps between samples and the linkage may lock or flip"
+            )
         elif k == "ok_order":
             out.append("the branch does not pass the targets in their order (--ordered)")
         elif k == "ok_valid_over_turn" and d.checks.get("failures"):
@@ -97,6 +106,47 @@ def _path_failing(d: Any) -> list[str]:
         else:
             out.append(k[3:].replace("_", " "))
     return out
+
+
+#: a best design more than this many times the tolerance off is reported as no four-bar tracing the curve
+FAR_OFF = 10.0
+
+
+def _sharpest_turn(t: np.ndarray) -> tuple[float, int]:
+    """``(degrees, target)``: the largest turn of the targets' polyline at one target (1-based), closing it
+    when its last target is about as near its first as its neighbours are; 0 when no turn stands out (at
+    least twice its neighbours' turns: a smooth curve sampled coarsely turns alike at neighbouring targets)."""
+    import numpy as np
+
+    seg = np.diff(t, axis=0)
+    gap = np.hypot(*(t[0] - t[-1]))
+    closed = len(t) > 3 and gap <= 2 * float(np.median(np.hypot(*seg.T)))
+    if closed:
+        seg = np.vstack([seg, t[:1] - t[-1:]])
+    a = np.arctan2(seg[:, 1], seg[:, 0])
+    turn = np.abs((np.diff(np.append(a, a[0]) if closed else a) + np.pi) % (2 * np.pi) - np.pi)
+    k = int(np.argmax(turn))
+    near = [turn[i % len(turn)] for i in (k - 1, k + 1) if closed or 0 <= i < len(turn)]
+    if turn[k] < 2 * max(near, default=0.0):
+        return 0.0, 0
+    return float(np.degrees(turn[k])), (k + 1) % len(t) + 1
+
+
+def _unreachable(d: Any) -> str:
+    """The plain word for a best design far beyond the tolerance: no four-bar traces the curve, and likely why."""
+    deg, at = _sharpest_turn(d.targets)
+    why = (
+        f"the targets turn by {deg:.0f} deg at target {at}, a sharp corner, and a coupler curve is smooth: "
+        "it rounds corners (round them in the drawing, or accept a larger --tolerance)"
+        if deg >= 60
+        else "the curve's shape is not one a four-bar's coupler point traces (the atlas and the global search "
+        "found nothing nearer); try --type sixbar or a larger --tolerance"
+    )
+    return (
+        f"no four-bar traces this curve within --tolerance {d.checks['tolerance']:g}: the best found is "
+        f"{d.checks['max_error']:.3g} of the targets' size off at target {d.checks['worst_target']} "
+        f"({d.checks['max_error'] / d.checks['tolerance']:.0f} times the tolerance). Likely why: {why}"
+    )
 
 
 def _unusable(d: Any, kind: str, region: bool) -> str | None:
@@ -126,6 +176,8 @@ def _cmd_path(args: argparse.Namespace) -> int:
         raise InputError("--seed", args.seed, "a seed of 0 or more")
     if not (args.tolerance > 0 and math.isfinite(args.tolerance)):
         raise InputError("--tolerance", args.tolerance, "a positive fraction of the targets' size")
+    if not 0 <= args.min_transmission < 90:
+        raise InputError("--min-transmission", args.min_transmission, "degrees from 0 up to (not including) 90")
     if args.topology is not None and args.type != "sixbar":
         raise InputError("--topology", args.topology, "--topology only with --type sixbar")
     if args.points is not None and not 3 <= args.points <= MAX_TARGETS:
@@ -151,7 +203,15 @@ def _cmd_path(args: argparse.Namespace) -> int:
 
         atlas = read_atlas(args.atlas)
     d = synthesise_path(
-        targets, theta, cons, budget=args.budget, seed=args.seed, tolerance=args.tolerance, atlas=atlas, ordered=args.ordered
+        targets,
+        theta,
+        cons,
+        budget=args.budget,
+        seed=args.seed,
+        tolerance=args.tolerance,
+        atlas=atlas,
+        ordered=args.ordered,
+        min_transmission=math.radians(args.min_transmission),
     )
     why = _unusable(d, "four-bar", cons.region is not None)
     if why is not None:
@@ -180,7 +240,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
         args,
         f"four-bar ({fb.grashof}, {d.circuit}), largest distance {d.checks['max_error']:.3g} of the targets' size "
         f"(RMS {d.checks['rms_error']:.3g}) over {len(targets)} targets "
-        f"in {d.seconds:.2f} s",
+        f"in {d.seconds:.2f} s; found by {d.checks['found_by']}",
         text,
         report,
         d.ok,
@@ -206,6 +266,7 @@ def _finish_path(args: argparse.Namespace, what: str, text: str, report: dict[st
 
 
 def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | None, cons: Any) -> int:
+    from planar.synth.path import wrapped
     from planar.synth.scene_out import linkage_scene_text
     from planar.synth.sixbar import synthesise_sixbar
 
@@ -223,7 +284,7 @@ def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | N
         comments=[
             f"planar synth path {args.target} --type sixbar --topology {d.topology}: {len(targets)} targets, "
             f"{'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
-            "crank angle at each target (rad, from the ground line O2-O4): " + ", ".join(f"{t:.6g}" for t in d.theta),
+            "crank angle at each target (rad, from the ground line O2-O4): " + ", ".join(f"{t:.6g}" for t in wrapped(d.theta)),
         ],
     )
     report = {"command": "synth path", "targets": len(targets), **d.to_dict()}
@@ -525,6 +586,13 @@ def add_parser(sub: Any) -> None:
         default=None,
         help="coupler-curve atlas file (from planar synth atlas -o) for untimed targets (default: the cached one, "
         "built on first use)",
+    )
+    p.add_argument(
+        "--min-transmission",
+        type=float,
+        default=0.0,
+        help="four-bar: keep the transmission angle at least this far from 0 and 180 (a toggle) over the turn, "
+        "degrees (0; never nearer than 1 deg: beyond it the design is written and exits 3)",
     )
     p.add_argument("--seed", type=int, default=0, help="random seed of the search (same seed, same result)")
     p.set_defaults(func=_cmd_path)

@@ -254,6 +254,23 @@ def atlas_path(size: int = DEFAULT_SIZE, seed: int = 0) -> Path:
     return cache_dir() / f"atlas-v{VERSION}-{size}-{seed}.npz"
 
 
+#: bytes of one atlas entry on disk (float32: 6 parameters, 4 of frame, 2 + 4 (K - 1) descriptor numbers)
+ENTRY_BYTES = 4 * (6 + 4 + 2 + 4 * (HARMONICS - 1))
+#: CPU seconds of the build per million entries (measured: about 22 to 25 s)
+BUILD_S_PER_MILLION = 25.0
+
+
+def build_notice(size: int, path: str | Path) -> str:
+    """The line printed before a first-use build: what is built, how big, where, and how to choose the place."""
+    return (
+        f"planar: building the coupler-curve atlas once ({size:,} four-bar curves, about "
+        f"{max(1, round(size * BUILD_S_PER_MILLION / 1e6))} s of CPU, {size * ENTRY_BYTES / 1e6:.3g} MB on disk), "
+        f"cached at {path}; "
+        "later runs read it. Set PLANAR_CACHE_DIR to choose the folder, or build one with "
+        "'planar synth atlas -o FILE' and pass --atlas FILE"
+    )
+
+
 _LOADED: dict[str, Atlas] = {}
 
 
@@ -284,6 +301,10 @@ def load_atlas(size: int = DEFAULT_SIZE, seed: int = 0, progress: bool = False) 
     path = atlas_path(size, seed)
     if path.exists():
         return read_atlas(path)
+    if progress:
+        import sys
+
+        print(build_notice(size, path), file=sys.stderr, flush=True)
     a = build_atlas(size, seed, progress)
     try:
         a.save(path)

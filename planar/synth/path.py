@@ -37,8 +37,19 @@ __all__ = ["FourBarDesign", "synthesise_path"]
 
 Array = NDArray[np.float64]
 
+#: transmission angle (degrees) nearer than this to a toggle (0 or 180) fails the check whatever
+#: ``min_transmission`` asks: coupler and rocker fold almost flat there and the coupler point jumps (a
+#: design at 0.4 deg moved its coupler point by 20 units between two of a scene's 72 samples)
+TOGGLE_FLOOR_DEG = 1.0
 #: default largest distance to a target, as a fraction of the targets' size (RMS distance from the centroid)
 DEFAULT_TOLERANCE = 1e-3
+
+
+def wrapped(theta: Array) -> Array:
+    """Crank angles ``theta`` (radians) wrapped to ``[0, 2 pi)``, as the scene's comment and the JSON give them."""
+    t = np.mod(np.asarray(theta, float), 2 * np.pi)
+    t[t >= 2 * np.pi] = 0.0  # a tiny negative angle rounds to 2 pi
+    return t
 
 
 def normalised(cons: Constraints, c: Array, s: float) -> Constraints:
@@ -60,7 +71,7 @@ class FourBarDesign(Checked, PlacedFourBar):
     coupler_point: tuple[float, float]
     circuit: str
     placement: tuple[float, float, float]
-    theta: Array  # crank angle at each target (radians from the ground line)
+    theta: Array  # crank angle at each target (radians from the ground line, in [0, 2 pi))
     sse: float  # from planar's solver at ``theta``
     targets: Array
     timed: bool
@@ -109,6 +120,7 @@ def check_design(d: FourBarDesign, kernel_points: Array | None = None) -> None:
         "ok_same_circuit_over_turn": bool(batch.valid.all() and path.valid.all())
         and bool(np.max(np.abs(batch.points["coupler_point"] - path.points["coupler_point"][perm])) <= 1e-9 * scale),
         "max_target_distance": float(np.max(np.hypot(*(pts - d.targets).T))) if at.valid.all() else float("inf"),
+        "worst_target": int(np.argmax(np.hypot(*(pts - d.targets).T))) + 1 if at.valid.all() else 0,
     }
     if kernel_points is not None:
         # the search's own kernel and planar's solver must place the coupler point alike at the targets (a
@@ -118,38 +130,83 @@ def check_design(d: FourBarDesign, kernel_points: Array | None = None) -> None:
         d.checks["ok_kernel_matches_solve"] = bool(gap <= 1e-6 * scale)
 
 
+def transmission_margin(fb: Any) -> tuple[float, float]:
+    """``(margin, theta)``: the smallest distance (radians) of the transmission angle from a toggle (0 or pi)
+    over the crank's whole turn, and the crank angle (radians from the ground line) where it is.
+
+    The angle depends on the crank only through the diagonal ``B-O4``, longest at ``theta = pi`` and
+    shortest at ``0``, so its extremes over a turn are there; a grid of 721 angles is checked as well."""
+    th = np.concatenate([[0.0, np.pi], np.linspace(0.0, 2 * np.pi, 721, endpoint=False)])
+    mu = np.asarray(fb.transmission_angle(th), float)
+    m = np.minimum(mu, np.pi - mu)
+    k = int(np.argmin(m))
+    return float(m[k]), float(th[k])
+
+
 def _search(
     t: Array, theta: Array | None, cons: Constraints, budget: str, seed: int, tolerance: float, atlas: Any, ordered: bool
-) -> Any:
+) -> tuple[Any, str]:
     """The search on normalised targets ``t``: the atlas first when untimed, the global search when timed or
-    when the atlas's best is not within ``tolerance`` (largest distance, targets' size 1)."""
+    when the atlas's best is not within ``tolerance`` (largest distance, targets' size 1).
+
+    Returns the result (its ``stages``: every stage that ran, seconds: ``atlas_load_s``, ``atlas_s``,
+    ``refine_s``, ``timed_s`` and, when the global search ran, ``global_sample_s``, ``global_de_s``,
+    ``global_refine_s``) and a sentence saying which stage produced it."""
+    import time
+
     from planar.synth.search import in_order, max_distance, search_atlas, timed_from_atlas
 
     kw = BUDGETS[budget]
+    t0 = time.perf_counter()
     if atlas is None:
         from planar.synth.atlas import DEFAULT_SIZE, QUICK_SIZE, load_atlas
 
         atlas = load_atlas(QUICK_SIZE if budget == "quick" else DEFAULT_SIZE, progress=True)
+    load = {"atlas_load_s": time.perf_counter() - t0}
     if theta is not None:
         # the curve from the atlas, then the timing: exact when the atlas finds the four-bar itself (a cognate
         # traces the same curve at other crank angles: then the global search runs)
         timed = timed_from_atlas(t, theta, atlas, cons)
-        if (
-            timed is not None
-            and timed.feasible
-            and max_distance(PathObjective(t, theta, cons), np.append(timed.params, timed.circuit), theta) <= tolerance
-        ):
-            return timed
-        return search_fourbar(t, theta, cons, seed=seed, **kw)
+        e_atlas = (
+            max_distance(PathObjective(t, theta, cons), np.append(timed.params, timed.circuit), theta)
+            if timed is not None
+            else float("inf")
+        )
+        if timed is not None and timed.feasible and e_atlas <= tolerance:
+            timed.stages = {**load, **timed.stages}
+            return timed, "the atlas lookup and refinement (the global search did not run: within the tolerance)"
+        g = search_fourbar(t, theta, cons, seed=seed, **kw)
+        g.stages = {**load, **(timed.stages if timed is not None else {}), **_prefixed(g.stages)}
+        return g, f"the global search (--budget {budget}; the atlas's best was {e_atlas:.3g} of the size off)"
     r = search_atlas(t, atlas, cons, ordered=ordered)
     row = np.append(r.params, r.circuit)
     good = r.feasible and (in_order(r.theta) or not ordered)
-    if good and max_distance(PathObjective(t, None, cons), row, r.theta) <= tolerance:
-        return r
+    e_atlas = max_distance(PathObjective(t, None, cons), row, r.theta)
+    if good and e_atlas <= tolerance:
+        r.stages = {**load, **r.stages}
+        return r, "the atlas lookup and refinement (the global search did not run: within the tolerance)"
     g = search_fourbar(t, None, cons, seed=seed, **kw)
     g_good = g.feasible and (in_order(g.theta) or not ordered)
-    # the better of the two: usable first, then the smaller error
-    return g if (g_good, -g.sse) > (good, -r.sse) else r
+    e_global = max_distance(PathObjective(t, None, cons), np.append(g.params, g.circuit), g.theta)
+    stages = {**load, **r.stages, **_prefixed(g.stages)}
+    # the better of the two: usable first, then the smaller largest distance (what the check judges)
+    if (g_good, -e_global) > (good, -e_atlas):
+        g.stages = stages
+        return g, (
+            f"the global search (--budget {budget}; largest distance {e_global:.3g} of the size, "
+            f"better than the atlas's {e_atlas:.3g})"
+        )
+    r.stages = stages
+    other = f"found no better: {e_global:.3g}" if g_good else "found none usable (out of order or breaking a constraint)"
+    return r, (
+        f"the atlas lookup and refinement (largest distance {e_atlas:.3g} of the size; the global search, "
+        f"--budget {budget}, ran too and {other})"
+    )
+
+
+def _prefixed(stages: dict[str, float]) -> dict[str, float]:
+    """The global search's stages named as such (``global_sample_s``, ``global_de_s``, ``global_refine_s``)."""
+    return {f"global_{k}": v for k, v in stages.items()}
 
 
 #: effort of the global search (random sample, differential evolution, least-squares starts) per budget
@@ -169,6 +226,7 @@ def synthesise_path(
     tolerance: float = DEFAULT_TOLERANCE,
     atlas: Any = None,
     ordered: bool = False,
+    min_transmission: float = 0.0,
 ) -> FourBarDesign:
     """A four-bar whose coupler point passes through (or nearest to) ``targets`` ``(N, 2)``.
 
@@ -181,7 +239,12 @@ def synthesise_path(
     ``tolerance``: the largest accepted distance from a target to the
     coupler point, as a fraction of the targets' size (RMS distance from
     their centroid; check ``ok_accuracy``).  ``ordered``: the branch must
-    pass the targets in their order (check ``ok_order``).  Raises
+    pass the targets in their order (check ``ok_order``).  ``min_transmission``
+    (radians): the transmission angle must stay at least this far from a
+    toggle (0 or pi) over the turn, and never nearer than
+    :data:`TOGGLE_FLOOR_DEG` (check ``ok_transmission``; the angle and the
+    crank angle where it is smallest are ``min_transmission_deg`` and
+    ``min_transmission_at_rad``).  Raises
     :class:`InputError` for fewer than 3 targets or mismatched lengths.
 
     Small dense algebra (the least-squares steps) runs on one BLAS thread
@@ -204,7 +267,7 @@ def synthesise_path(
     # searched on the targets moved to their centroid and divided by their size, then mapped back
     c, s = normalisation(t)
     with threadpool_limits(1):
-        r = _search((t - c) / s, theta, normalised(cons, c, s), budget, seed, tolerance, atlas, ordered)
+        r, source = _search((t - c) / s, theta, normalised(cons, c, s), budget, seed, tolerance, atlas, ordered)
     secs = time.perf_counter() - t0
     p = r.params.copy()
     p[:6] *= s
@@ -217,7 +280,7 @@ def synthesise_path(
         (float(p[4]), float(p[5])),
         "open" if r.circuit > 0 else "crossed",
         (float(p[6]), float(p[7]), float(p[8])),
-        np.asarray(r.theta, float),
+        wrapped(r.theta),
         float("nan"),
         t,
         theta is not None,
@@ -237,6 +300,13 @@ def synthesise_path(
     d.checks["tolerance"] = tolerance
     if ordered:
         d.checks["ok_order"] = in_order(d.theta)
+    margin, where = transmission_margin(d.fourbar())
+    limit = max(float(min_transmission), math.radians(TOGGLE_FLOOR_DEG))
+    d.checks["min_transmission_deg"] = math.degrees(margin)
+    d.checks["min_transmission_at_rad"] = where
+    d.checks["transmission_limit_deg"] = math.degrees(limit)
+    d.checks["ok_transmission"] = bool(margin >= limit)
     d.checks["stages_s"] = r.stages
+    d.checks["found_by"] = source
     d.checks["evaluations"] = r.evaluations
     return d
