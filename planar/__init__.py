@@ -84,8 +84,18 @@ _LAZY: dict[str, str] = {
     **dict.fromkeys(("SimSettings", "simulate"), "planar.physics.simulate"),
 }
 
+
+def _load_display() -> None:
+    """Import the drawing side, which registers the renderers of :mod:`planar.core.display`."""
+    importlib.import_module("planar.draw.notebook")
+
+
 if "IPython" in sys.modules:  # a notebook: mechanisms and motions display as tables and players
-    import planar.draw.notebook  # noqa: F401  (light: registers renderers (planar.core.display); numpy loads on first display)
+    import planar.draw.notebook  # (light: registers renderers (planar.core.display); numpy loads on first display)
+else:  # plain Python: core loads the drawing side the first time it needs a renderer (animate, _repr_html_)
+    import planar.core.display
+
+    planar.core.display.set_loader(_load_display)
 
 
 def __getattr__(name: str) -> Any:

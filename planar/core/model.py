@@ -496,11 +496,14 @@ class Motion:
 
     def animate(self, **options: Any) -> Any:
         """An animation player of this motion (see :func:`planar.draw.notebook.animate`); needs its mechanism."""
-        from planar.core.display import RENDERERS
+        from planar.core.display import renderer
 
         if self.mechanism is None:
             raise InputError("motion.mechanism", None, "a motion made by Mechanism.solve or run (it knows its mechanism)")
-        return RENDERERS["animate"](self.mechanism, self, **options)
+        player = renderer("animate")
+        if player is None:
+            raise InputError("animate", self.mechanism.name, "the drawing side (planar.draw.notebook) importable")
+        return player(self.mechanism, self, **options)
 
     def reason(self, i: int) -> str:
         """Why sample ``i`` is invalid (empty string when it is valid)."""
@@ -759,13 +762,14 @@ class Mechanism:
         """An animation player of one cycle (``samples_per_cycle`` frames), shown inline in a notebook.
 
         See :func:`planar.draw.notebook.animate` for the options; ``.save("x.html")`` writes the page.
-        The drawing side (:mod:`planar.draw.notebook`) must be imported (``import planar`` in a notebook does).
+        The drawing side (:mod:`planar.draw.notebook`) is loaded on first use (``import planar`` is enough).
         """
-        from planar.core.display import RENDERERS
+        from planar.core.display import renderer
 
-        if "animate" not in RENDERERS:
-            raise InputError("animate", self.name, "planar.draw.notebook imported first (import planar.draw.notebook)")
-        return RENDERERS["animate"](self, self.run(samples_per_cycle=samples_per_cycle), **options)
+        player = renderer("animate")
+        if player is None:
+            raise InputError("animate", self.name, "the drawing side (planar.draw.notebook) importable")
+        return player(self, self.run(samples_per_cycle=samples_per_cycle), **options)
 
 
 def _with_joint_features(parts: tuple[Part, ...], joints: Sequence[Any]) -> tuple[Part, ...]:
