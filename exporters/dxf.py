@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import logging
 import os
 from collections.abc import Iterator
 from typing import Any
@@ -29,6 +30,16 @@ from planar.fabrication.sheet import Circle, Layout
 from planar.fileio import atomic_write, check_name
 
 __all__ = ["LAYERS", "aci", "dxf_bytes", "preview_png", "write_dxf"]
+
+
+def _no_cache_notes(record: logging.LogRecord) -> bool:
+    """Drop ezdxf's notes that its font cache cannot be saved (an unwritable ``$HOME/.cache``): the cache
+    only speeds up ezdxf's next start, it changes nothing in our files, and the notes would follow every export."""
+    text = str(record.msg)
+    return not (text.startswith("Cannot create cache home directory") or text.startswith("Error writing cache file"))
+
+
+logging.getLogger("ezdxf").addFilter(_no_cache_notes)  # before any import of ezdxf (it builds the cache on import)
 
 #: layer -> default ACI colour
 LAYERS = {"CUT_INNER": 1, "CUT_OUTER": 1, "ENGRAVE": 5, "SHEET": 8}

@@ -13,10 +13,12 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import csv
-import io
 import os
+import re
+import signal
 import tempfile
-from collections.abc import Iterable, Iterator, Sequence
+import time
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import IO, Any
 
@@ -25,7 +27,101 @@ import numpy as np
 from planar.core.model import Mechanism, Motion
 from planar.errors import InputError
 
-__all__ = ["atomic_write", "check_name", "check_output", "motion_columns", "output_transaction", "write_motion_csv"]
+__all__ = [
+    "atomic_write",
+    "check_name",
+    "check_output",
+    "clean_stale",
+    "hold_signals_after_commit",
+    "motion_columns",
+    "output_transaction",
+    "read_text",
+    "write_motion_csv",
+]
+
+#: the wall-clock time this process started writing (near enough to its start): a temporary older than this,
+#: whose writer process is gone, was left by a killed run (``kill -9``) and is removed (:func:`clean_stale`)
+_STARTED = time.time()
+#: folders already swept for stale temporaries by this process
+_SWEPT: set[str] = set()
+#: a temporary's name: ``.<target>.<writer pid>.<random>.part``
+_PART = re.compile(r"^\..+\.(\d+)\.[A-Za-z0-9_]{8}\.part$")
+#: signals held from the first rename of a command's outputs until the process exits (see :func:`hold_signals`)
+_HELD = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGQUIT)
+_HOLD = {"until_exit": False}
+
+
+def hold_signals_after_commit(on: bool = True) -> None:
+    """Once outputs start being renamed into place, keep Ctrl-C and ``kill`` (SIGINT, SIGTERM, SIGHUP,
+    SIGQUIT) blocked until the process exits, so an interrupt never lands between a finished rename and
+    the command's exit (the ``planar`` command turns this on; the Python API blocks them only during renames)."""
+    _HOLD["until_exit"] = on
+
+
+@contextlib.contextmanager
+def _renaming() -> Iterator[None]:
+    """Hold the interrupt signals while outputs are renamed (and after, with :func:`hold_signals_after_commit`).
+
+    Dispositions, not a thread's mask: numpy's BLAS threads keep the old mask, and a signal sent to the
+    process would reach one of them.  A signal that arrives meanwhile is delivered after the renames
+    (from Python) or ignored until the process exits (the ``planar`` command).
+    """
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    got: list[int] = []
+    old = {s: signal.signal(s, lambda n, _f: got.append(n)) for s in _HELD}
+    try:
+        yield
+    finally:
+        if _HOLD["until_exit"]:
+            for s in _HELD:
+                signal.signal(s, signal.SIG_IGN)
+        else:
+            for s, h in old.items():
+                signal.signal(s, h)
+            for n in dict.fromkeys(got):
+                signal.raise_signal(n)
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # another user's live process
+        return True
+    return True
+
+
+def clean_stale(folder: str | os.PathLike) -> list[str]:
+    """Remove the temporaries a killed run left in ``folder`` (``.NAME.PID.xxxxxxxx.part`` older than this
+    process, whose writer ``PID`` is no longer running); the names removed.  Done once per folder per process
+    by :func:`atomic_write`; a live writer's temporaries (another run writing now) are left alone."""
+    removed: list[str] = []
+    try:
+        entries = list(os.scandir(os.fspath(str(folder))))
+    except OSError:
+        return removed
+    for entry in entries:
+        m = _PART.match(entry.name)
+        if m is None:
+            continue
+        try:
+            if entry.stat(follow_symlinks=False).st_mtime >= _STARTED or _alive(int(m.group(1))):
+                continue
+            if not entry.is_file(follow_symlinks=False):
+                continue
+            os.unlink(entry.path)
+            removed.append(entry.name)
+        except OSError:
+            continue
+    return removed
+
 
 #: the temporaries ``(tmp, target)`` of the innermost :func:`output_transaction`, renamed at its end
 _PENDING: contextvars.ContextVar[list[tuple[str, Path]] | None] = contextvars.ContextVar("_PENDING", default=None)
@@ -56,9 +152,10 @@ def output_transaction() -> Iterator[None]:
         return
     done = 0
     try:
-        for tmp, target in pending:
-            os.replace(tmp, target)
-            done += 1
+        with _renaming():
+            for tmp, target in pending:
+                os.replace(tmp, target)
+                done += 1
     except BaseException:
         for tmp, _ in pending[done:]:
             with contextlib.suppress(FileNotFoundError):
@@ -80,13 +177,24 @@ def atomic_write(path: str | os.PathLike, mode: str = "wb") -> Iterator[IO[Any]]
         raise InputError("output", str(path), f"a path in an existing directory ({parent} does not exist)")
     if target.is_dir():
         raise InputError("output", str(path), "a file name (it is a directory)")
+    key = os.path.realpath(parent)
+    if key not in _SWEPT:
+        _SWEPT.add(key)
+        clean_stale(parent)
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=parent)
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.{os.getpid()}.", suffix=".part", dir=parent)
     except OSError as e:
         raise InputError("output", str(path), f"a writable place ({e.strerror})") from None
     try:
-        with os.fdopen(fd, mode) as fh:
-            yield fh
+        try:
+            with os.fdopen(fd, mode) as fh:
+                yield fh
+        except OSError as e:  # a full disc, a file size limit: name the file the user asked for
+            if e.filename is not None or e.errno is None:
+                raise
+            raise OSError(
+                e.errno, f"{e.strerror} (while writing it; the old file, if any, is left as it was)", str(target)
+            ) from None
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the file the usual permissions
@@ -94,11 +202,46 @@ def atomic_write(path: str | os.PathLike, mode: str = "wb") -> Iterator[IO[Any]]
         if pending is not None:
             pending.append((tmp, target))
         else:
-            os.replace(tmp, target)
+            with _renaming():
+                os.replace(tmp, target)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
+
+
+def read_text(path: str | os.PathLike, what: str = "text file", max_bytes: int = 64 * 2**20) -> str:
+    """The file ``path`` as text: UTF-8 (a byte-order mark skipped) or UTF-16 with its byte-order mark.
+
+    Anything else (a binary file, another encoding, a folder, a missing or
+    unreadable file, more than ``max_bytes``) is an :class:`InputError` naming
+    the file and what was expected (``what``: "request file", "CSV file", ...).
+    """
+    p = str(path)
+    try:
+        with open(p, "rb") as fh:
+            raw = fh.read(max_bytes + 1)
+    except FileNotFoundError:
+        raise InputError(p, "no such file", f"an existing {what}") from None
+    except IsADirectoryError:
+        raise InputError(p, "a folder", f"a {what}") from None
+    except OSError as e:  # a loop of symbolic links, no permission, a device
+        raise InputError(p, f"cannot be read ({e.strerror or e})", f"a readable {what}") from None
+    if len(raw) > max_bytes:
+        raise InputError(p, f"more than {max_bytes // 2**20} MiB", f"a {what} of at most {max_bytes // 2**20} MiB")
+    codec = "utf-16" if raw[:2] in (b"\xff\xfe", b"\xfe\xff") else "utf-8-sig"
+    try:
+        text = raw.decode(codec)
+    except UnicodeDecodeError as e:
+        raise InputError(
+            p,
+            f"byte {e.start} is {raw[e.start : e.start + 1]!r}",
+            f"a {what} in UTF-8 (or UTF-16 with a byte-order mark)",
+        ) from None
+    text = text.removeprefix("\ufeff")
+    if "\x00" in text:
+        raise InputError(p, "NUL bytes", f"a {what} (text, not binary)")
+    return text
 
 
 def _same_file(a: Path, b: Path) -> bool:
@@ -193,14 +336,45 @@ def motion_columns(mech: Mechanism, motion: Motion) -> tuple[list[str], np.ndarr
     return names, np.column_stack(cols)
 
 
-def write_motion_csv(path: str | os.PathLike, mech: Mechanism, motion: Motion) -> None:
-    """Write the motion table as CSV (17 significant digits: round-trips exactly)."""
-    names, table = motion_columns(mech, motion)
-    for name in names:
-        check_name(f"{mech.name}: column", name)
-    buf = io.StringIO()
-    csv.writer(buf, lineterminator="\n").writerow(names)  # a comma or quote in a name is quoted
-    fmt = ",".join(["%.17g"] * (len(names) - 1) + ["%d"])
-    np.savetxt(buf, table, fmt=fmt)
+#: rows formatted at a time by :func:`write_motion_csv`: memory for formatting (and for ``extra`` columns)
+#: is bounded by this many rows, not by the motion's length
+CSV_CHUNK = 16384
+
+
+def write_motion_csv(
+    path: str | os.PathLike,
+    mech: Mechanism,
+    motion: Motion,
+    extra: Callable[[Motion], tuple[list[str], list[np.ndarray]]] | None = None,
+) -> None:
+    """Write the motion table as CSV (17 significant digits: round-trips exactly), streamed.
+
+    ``extra(sub_motion) -> (names, columns)`` adds columns (before ``valid``), computed on
+    :data:`CSV_CHUNK` samples at a time (so they must depend on each sample alone, as the
+    analytic rates do).  A row holding NaN or inf in the motion's own columns is refused
+    (:class:`InputError`) and nothing is written.
+    """
+    n = len(motion)
+    names = None
     with atomic_write(path, "w") as fh:
-        fh.write(buf.getvalue())
+        for lo in range(0, max(n, 1), CSV_CHUNK):
+            sub = motion if n <= CSV_CHUNK else motion.take(np.arange(lo, min(n, lo + CSV_CHUNK)))
+            cols, table = motion_columns(mech, sub)
+            bad = ~np.isfinite(table.sum(axis=1))  # one float per row: NaN or inf anywhere in it
+            if bad.any():
+                i = int(np.flatnonzero(bad)[0])
+                raise InputError(
+                    f"{mech.name}: motion row {lo + i}",
+                    table[i].tolist(),
+                    "finite numbers (a time or pose of NaN or inf is no sample)",
+                )
+            if extra is not None:
+                more, extra_cols = extra(sub)
+                cols = cols[:-1] + more + cols[-1:]
+                table = np.column_stack([table[:, :-1], *extra_cols, table[:, -1]])
+            if names is None:
+                names = cols
+                for name in names:
+                    check_name(f"{mech.name}: column", name)
+                csv.writer(fh, lineterminator="\n").writerow(names)  # a comma or quote in a name is quoted
+            np.savetxt(fh, table, fmt=",".join(["%.17g"] * (len(names) - 1) + ["%d"]))

@@ -178,3 +178,100 @@ def test_slider_position_honours_branch() -> None:
         m = sc.solve(TH)
         np.testing.assert_allclose(sc.slider_position(TH), m.points["slider_pin"][:, 0], atol=1e-12)
     assert SliderCrank(1.0, 3.0, branch=-1).slider_position(np.pi / 2) == pytest.approx(-math.sqrt(8.0))
+
+
+# ----------------------------------------------------------------------------- issue 26: the entrances
+
+
+def _motion():
+    leg = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(5.5, -2.0))
+    return leg.solve(np.linspace(0.0, 1.0, 5))
+
+
+@pytest.mark.parametrize(
+    "call,needle",
+    [
+        (lambda: __import__("planar").Driver("a", phase=math.nan), "driver.phase"),
+        (lambda: __import__("planar").Driver("a", kind="translation", axis=(0, 0), amplitude=1.0), "driver.axis"),
+        (lambda: __import__("planar").Driver("a", axis=(1.0, 2.0, 3.0)), "driver.axis"),
+        (lambda: __import__("planar").Driver("a", origin=(math.inf, 0.0)), "driver.origin"),
+        (lambda: __import__("planar").Driver("a", amplitude=math.nan), "driver.amplitude"),
+        (lambda: __import__("planar").Driver("a", centre="0"), "driver.centre"),
+        (lambda: __import__("planar").Driver(5), "driver.part"),
+        (lambda: __import__("planar").Driver("a", rate="1"), "driver.rate"),
+        (lambda: __import__("planar").Part("p", hull=((math.nan, 0, 1),)), "hull"),
+        (lambda: __import__("planar").Part("p", hull=((0, 0, -1),)), "hull"),
+        (lambda: __import__("planar").Part("p", hull=((0, 0),)), "hull"),
+        (lambda: __import__("planar").Part("p", hull="abc"), "hull"),
+        (lambda: __import__("planar").Part("", hull=()), "Part.name"),
+        (lambda: __import__("planar").Part("p", hull=(), plane="xw"), "plane"),
+        (lambda: __import__("planar").Part("p", hull=(), offset=math.nan), "offset"),
+        (lambda: __import__("planar").Part("p", hull=(), polygon=((0, 0), (1, math.nan), (0, 1))), "polygon"),
+        (lambda: __import__("planar").Mechanism("m", "abc", [], __import__("planar").Driver("a")), "m.parts"),
+        (lambda: __import__("planar").Mechanism("m", [], [], "a"), "m.driver"),
+        (lambda: __import__("planar").Mechanism("m", [], [1], __import__("planar").Driver("a")), "m.joints"),
+        (lambda: __import__("planar").Mechanism(None, [], [], __import__("planar").Driver("a")), "Mechanism.name"),
+        (lambda: _motion().take([99]), "take"),
+        (lambda: _motion().take([-6]), "take"),
+        (lambda: _motion().take("a"), "take"),
+        (lambda: _motion().take([0.5]), "take"),
+        (lambda: _motion().take(np.ones(3, bool)), "take"),
+        (lambda: FourBar(4, 1, 4, 3).solve("1.0"), "driver value"),
+        (lambda: FourBar(4, 1, 4, 3).solve([True, False]), "solve(q)"),
+        (lambda: FourBar(4, 1, 4, 3).solve([0.0, 1.0], t=[math.nan, 0.0]), "solve(t)"),
+        (lambda: FourBar(4, 1, 4, 3).solve([0.0, 1.0], t=["a", "b"]), "solve(t)"),
+        (lambda: FourBar(4, 1, 4, 3).run(samples_per_cycle="36"), "samples_per_cycle"),
+        (lambda: FourBar(4, 1, 4, 3).run(cycles="1"), "cycles"),
+        (lambda: FourBar(4, 1, 4, 3).run(samples_per_cycle=True), "samples_per_cycle"),
+    ],
+)
+def test_entrances_raise_a_named_planar_error(call, needle: str) -> None:
+    with pytest.raises(PlanarError) as info:
+        call()
+    assert isinstance(info.value, ValueError) and needle in str(info.value) and "\n" not in str(info.value)
+
+
+def test_geared_ratio_and_mesh_are_checked() -> None:
+    from planar.linkages.gears import Geared
+
+    for kw, needle in (({"ratio": "-1"}, "ratio"), ({"ratio": 1.0}, "negative"), ({"mesh": "B"}, "itself")):
+        args = {"name": "B", "centre": "O", "radius": 1.0, "mesh": "A", "ratio": -1.0, **kw}
+        with pytest.raises(PlanarError, match=needle):
+            Geared(**args).validate("B")
+
+
+@pytest.mark.parametrize(
+    "phi,psi,ground,needle",
+    [
+        ([0.0, math.nan, 1.0], [0.0, 1.0, 2.0], 1.0, "input"),
+        ([0.0, 0.5, 1.0], [0.0, math.inf, 2.0], 1.0, "output"),
+        ([0.0, 0.5, 1.0], [0.0, 1.0, 2.0], 1e300, "ground"),
+        ([0.0, 0.5, 1.0], [0.0, 1.0, 2.0], "1", "ground"),
+        (["a", 0.5, 1.0], [0.0, 1.0, 2.0], 1.0, "input"),
+    ],
+)
+def test_synthesise_function_entrance(phi, psi, ground, needle: str) -> None:
+    from planar.synth.function import synthesise_function
+
+    with pytest.raises(PlanarError, match=needle):
+        synthesise_function(phi, psi, ground)
+
+
+def test_export_checks_that_the_suffix_names_the_format(tmp_path) -> None:
+    """``export_mechanism(leg, "x.svg")`` wrote DXF bytes into x.svg; now refused, nothing written."""
+    from planar.app.pipeline import export_mechanism
+
+    leg = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(5.5, -2.0))
+    for kw in ({"dxf": tmp_path / "x.svg"}, {"svg": tmp_path / "x.dxf"}, {"bom": tmp_path / "b.txt"}):
+        with pytest.raises(InputError, match="ending in"):
+            export_mechanism(leg, fabrication={"unit_mm": 15.0}, **kw)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_check_scale_refuses_coarse_placements() -> None:
+    from planar.core.limits import check_scale
+
+    check_scale("leg", FourBar(4.0, 1.0, 4.0, 3.0, placement=(0.0, 1e5, 0.0)))
+    for place in ((0.0, 1e16, 0.0), (1e308, 0.0, 0.0)):
+        with pytest.raises(InputError, match="float64"):
+            check_scale("leg", FourBar(4.0, 1.0, 4.0, 3.0, placement=place))

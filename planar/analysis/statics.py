@@ -391,13 +391,15 @@ def motor_torque(
     from planar.analysis.rates import mechanism_rates
 
     eta = _check_eff("eta_trans", eta_trans) * _check_eff("eta_link", eta_link)
-    qa = np.atleast_1d(np.asarray(q, float))
+    from planar.core.model import check_finite
+
+    qa = np.atleast_1d(check_finite(f"{link.name}: q", q))
     for name in loads:
         if name not in link.points:
             raise InputError(f"{link.name}.loads", name, f"a named point, one of {sorted(link.points)}")
     forces = {}
     for n, f0 in loads.items():
-        f = np.asarray(f0, float)
+        f = check_finite(f"{link.name}.loads[{n!r}]", f0)
         if not np.isfinite(f).all():
             raise InputError(f"{link.name}.loads[{n!r}]", f0, "a finite force (x, y)")
         try:

@@ -304,11 +304,7 @@ def write_scene_motion(scene: Scene, out: str | Path, derivatives: bool = False,
     angles, motor torque under the scene's ``[effects]``) before ``valid``.
     Nothing is written if they cannot be computed.
     """
-    import io
-
-    import numpy as np
-
-    from planar.fileio import atomic_write, motion_columns, write_motion_csv
+    from planar.fileio import write_motion_csv
 
     if Path(out).suffix.lower() != ".csv":
         raise InputError("output", str(out), "a .csv file (the motion table is CSV)")
@@ -318,16 +314,8 @@ def write_scene_motion(scene: Scene, out: str | Path, derivatives: bool = False,
         return motion
     from planar.analysis.rates import derivative_columns
 
-    names, table = motion_columns(mech, motion)
-    with numeric_guard(scene, "the rates and motor torque"):
-        extra_names, extra = derivative_columns(mech, motion, scene.effects)
-    names = names[:-1] + extra_names + names[-1:]
-    table = np.column_stack([table[:, :-1], *extra, table[:, -1]])
-    buf = io.StringIO()
-    buf.write(",".join(names) + "\n")
-    np.savetxt(buf, table, fmt=",".join(["%.17g"] * (len(names) - 1) + ["%d"]))
-    with atomic_write(out, "w") as fh:
-        fh.write(buf.getvalue())
+    with numeric_guard(scene, "the rates and motor torque"):  # rates per sample: streamed a chunk at a time
+        write_motion_csv(out, mech, motion, extra=lambda sub: derivative_columns(mech, sub, scene.effects))
     return motion
 
 
@@ -397,7 +385,17 @@ def export_scene(
     from planar.app.export import write_outputs
     from planar.fabrication.build import build
     from planar.fabrication.parts import FabSettings
+    from planar.fileio import check_output
 
+    for arg, path, ends in (
+        ("dxf", dxf, (".dxf",)),
+        ("svg", svg, (".svg",)),
+        ("preview", preview, (".png",)),
+        ("bom", bom, (".csv",)),
+        ("assembly", assembly, (".svg",)),
+        ("kerf_test", kerf_test, (".dxf", ".svg")),
+    ):  # the suffix names the format: DXF bytes never go into x.svg
+        check_output(arg, path, ends, (scene.path,) if Path(str(scene.path)).is_file() else ())
     spec = scene.spec.fabrication
     w, h = sheet if sheet is not None else spec.sheet_mm
     where = "--sheet" if sheet is not None else f"{scene.path}: fabrication.sheet_mm"

@@ -99,9 +99,11 @@ class Program:
     ``where`` names the scene field in error messages (``"mechanism.segments"``).
     """
 
-    def __init__(self, segments: list[Segment] | tuple[Segment, ...], where: str = "segments") -> None:
+    def __init__(self, segments: list[Segment] | tuple[Segment, ...], where: str = "segments", lift_unit: str = "") -> None:
         self.segments = tuple(segments)
         self.where = where
+        #: how a lift is shown in a message: ``"deg"`` for an oscillating follower's lift given in degrees
+        self.lift_unit = lift_unit
         if not self.segments:
             raise InputError(where, [], "at least one segment")
         for i, sg in enumerate(self.segments):
@@ -126,7 +128,9 @@ class Program:
         scale = max(abs(sg.lift) for sg in self.segments) if any(sg.lift for sg in self.segments) else 1.0
         if abs(levels[-1]) > 1e-9 * scale:
             raise InputError(
-                f"{where}", f"lifts summing to {levels[-1]:.6g}", "lifts summing to 0 (the follower returns to where it started)"
+                f"{where}",
+                f"lifts summing to {self._shown(levels[-1])}",
+                "lifts summing to 0 (the follower returns to where it started)",
             )
         if not any(sg.lift for sg in self.segments):
             raise InputError(f"{where}", "only dwells", "at least one rise and one return")
@@ -134,12 +138,18 @@ class Program:
             if levels[i + 1] < -1e-9 * scale:
                 raise InputError(
                     f"{where}[{i}].lift",
-                    self.segments[i].lift,
+                    float(f"{self._shown(self.segments[i].lift, unit=False)}"),
                     f"a lift that keeps the follower at or above its start (it would go to "
-                    f"{levels[i + 1]:.6g}, inside the base circle)",
+                    f"{self._shown(levels[i + 1])}, inside the base circle)",
                 )
         self.levels = levels[:-1]
         self.max_lift = float(levels.max())
+
+    def _shown(self, lift: float, unit: bool = True) -> str:
+        """A lift as the user wrote it (degrees for a lift in degrees)."""
+        if self.lift_unit == "deg":
+            return f"{math.degrees(lift):.6g}" + (" deg" if unit else "")
+        return f"{lift:.6g}"
 
     @staticmethod
     def _wrap(theta: ArrayLike) -> Array:

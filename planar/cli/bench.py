@@ -4,12 +4,16 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 from typing import Any
 
 from planar.cli.common import positive
 from planar.errors import InputError
 
 __all__ = ["add_parser"]
+
+#: exit status of a benchmark whose own check failed (its figures disagree with the peer's), as ``planar compare``
+EXIT_CHECK = 3
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
@@ -32,12 +36,20 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     if args.name == "synthesis":
         kwargs["quick"] = args.quick
     if args.name == "accuracy":
+        from planar.fileio import check_output
+
+        check_output("-o", args.output, (), directory=True)  # before the minutes of work, not after
+        parent = os.path.dirname(os.path.abspath(args.output))
+        if not os.path.isdir(parent):
+            raise InputError("-o", args.output, f"a folder in an existing folder ({parent} does not exist)")
+        if not os.path.isdir(args.scenes):
+            raise InputError("--scenes", args.scenes, "an existing folder of scene files")
         kwargs["scenes"] = args.scenes
         kwargs["out_dir"] = args.output
         kwargs["quick"] = args.quick
     result = fn(**kwargs)
     print(json.dumps(result, indent=2) if args.json else fmt(result))
-    return 0 if result.get("ok", True) else 1
+    return 0 if result.get("ok", True) else EXIT_CHECK
 
 
 def add_parser(sub: Any) -> None:

@@ -42,8 +42,9 @@ def _cmd_design(args: argparse.Namespace) -> int:
         raise InputError("--max-length", args.max_length, "a chain length of at least 1")
     check_count("chain", "--max-length", args.max_length, "stages in a chain")
     effectors = load_request(args.request)
-    with open(args.request, "rb") as fh:
-        name = tomllib.load(fh).get("name") or Path(args.request).stem
+    from planar.fileio import read_text
+
+    name = tomllib.loads(read_text(args.request, "request file (TOML)")).get("name") or Path(args.request).stem
     import re
 
     from planar.scene.load import _NAME

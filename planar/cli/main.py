@@ -107,8 +107,14 @@ def _main(argv: Sequence[str] | None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as e:  # --help, or a usage error already printed on one line
         return e.code if isinstance(e.code, int) else (0 if e.code is None else 2)
+    _quiet_cache_notes()
     try:
         import numpy as np
+
+        if argv is None:  # the command itself: no interrupt between its outputs' renames and its exit
+            from planar.fileio import hold_signals_after_commit
+
+            hold_signals_after_commit()
 
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             if not args.debug:
@@ -142,12 +148,54 @@ def _main(argv: Sequence[str] | None) -> int:
     except Exception as e:  # the guard: a bug in planar, still one line
         if args.debug:
             raise
+        if _interrupted(e):  # a Ctrl-C that a library turned into its own error (an import, a worker)
+            raise KeyboardInterrupt from None
         print(
             f"planar: internal error: {type(e).__name__}: {_one_line(e)[:300]} "
             f"(a bug in planar; run again with --debug for the traceback)",
             file=sys.stderr,
         )
         return 1
+
+
+def _interrupted(e: BaseException) -> bool:
+    """Whether ``e`` was caused by a Ctrl-C (a ``KeyboardInterrupt`` in its chain of causes)."""
+    seen: set[int] = set()
+    cur: BaseException | None = e
+    while cur is not None and id(cur) not in seen:
+        if isinstance(cur, KeyboardInterrupt):
+            return True
+        seen.add(id(cur))
+        cur = cur.__cause__ or cur.__context__
+    return False
+
+
+#: what a library logs when it cannot keep its cache in ``$HOME/.cache`` (it works on without; the notes
+#: would follow every command): dropped by :func:`_quiet_cache_notes`
+_CACHE_NOTES = {
+    "matplotlib": ("mkdir -p failed for path", "Matplotlib created a temporary cache directory"),
+    "ezdxf": ("Cannot create cache home directory", "Error writing cache file"),
+}
+
+
+def _quiet_cache_notes() -> None:
+    """Drop the libraries' notes that their caches cannot be saved (an unwritable ``$HOME/.cache``)."""
+    import logging
+
+    for name, starts in _CACHE_NOTES.items():
+        log = logging.getLogger(name)
+        if not any(isinstance(f, _NotStarting) for f in log.filters):
+            log.addFilter(_NotStarting(starts))
+
+
+class _NotStarting:
+    """A logging filter dropping the records whose message starts with one of ``starts``."""
+
+    def __init__(self, starts: tuple[str, ...]) -> None:
+        self.starts = starts
+
+    def filter(self, record: object) -> bool:
+        return not str(getattr(record, "msg", "")).startswith(self.starts)
 
 
 def _quiet(unraisable: object) -> None:

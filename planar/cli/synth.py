@@ -128,6 +128,8 @@ def _cmd_path(args: argparse.Namespace) -> int:
         raise InputError("--tolerance", args.tolerance, "a positive fraction of the targets' size")
     if args.topology is not None and args.type != "sixbar":
         raise InputError("--topology", args.topology, "--topology only with --type sixbar")
+    if args.points is not None and not 3 <= args.points <= MAX_TARGETS:
+        raise InputError("--points", args.points, f"3 to {MAX_TARGETS} points sampled along the SVG (a path is matched at each)")
     targets, theta = read_path_targets(args.target, args.points)
     if len(targets) > MAX_TARGETS:
         raise InputError(
@@ -292,6 +294,10 @@ def _cmd_function(args: argparse.Namespace) -> int:
 
     if not (args.max_ratio > 1 and math.isfinite(args.max_ratio)):
         raise InputError("--max-ratio", args.max_ratio, "a finite ratio greater than 1")
+    from planar.core.limits import SIZE_RANGE
+
+    if not (math.isfinite(args.ground) and SIZE_RANGE[0] <= args.ground <= SIZE_RANGE[1]):
+        raise InputError("--ground", args.ground, f"a ground length from {SIZE_RANGE[0]:g} to {SIZE_RANGE[1]:g} (model units)")
     if not 0 <= args.min_transmission < 90:
         raise InputError("--min-transmission", args.min_transmission, "degrees from 0 up to (not including) 90")
     if not (args.tolerance > 0 and math.isfinite(args.tolerance)):
@@ -422,6 +428,9 @@ def _cmd_motion(args: argparse.Namespace) -> int:
     poses = np.column_stack([t["x"], t["y"], ang])
     if len(poses) > 5:
         raise InputError(str(args.poses), f"{len(poses)} poses", "3, 4 or 5 poses (Burmester theory)")
+    from planar.synth.targets import normalisation
+
+    normalisation(poses[:, :2], str(args.poses))  # coordinates float64 holds faithfully at the poses' size
     _check_poses(str(args.poses), poses)
     try:
         d = burmester(poses, max_ratio=args.max_ratio)

@@ -22,10 +22,23 @@ from __future__ import annotations
 
 import math
 import os
+from typing import Any
 
 from planar.errors import InputError, LimitError
 
-__all__ = ["DEFAULTS", "check_count", "check_memory", "limit", "sample_count"]
+__all__ = [
+    "DEFAULTS",
+    "RESOLUTION",
+    "SIZE_RANGE",
+    "check_count",
+    "check_memory",
+    "check_scale",
+    "limit",
+    "motion_bytes",
+    "pilot_bytes",
+    "resident_bytes",
+    "sample_count",
+]
 
 #: name -> (environment variable, default)
 DEFAULTS: dict[str, tuple[str, int]] = {
@@ -77,10 +90,57 @@ def check_memory(field: str, value: object, n_bytes: float, what: str) -> None:
         )
 
 
+def motion_bytes(parts: int, points: int, n: float) -> float:
+    """Bytes a solve of ``n`` samples holds at its peak: poses (x, y, angle) of every part, points (x, y),
+    driver, time and validity, and the solver's working copies (4 of each; measured 880 bytes a sample for
+    the 8-part Jansen leg, estimated 960)."""
+    return 8.0 * (3 * parts + 2 * points + 4) * 4 * max(n, 2)
+
+
+#: a solve of more samples than this measures its memory on a pilot of :data:`PILOT` samples first
+PILOT_ABOVE = 200_000
+PILOT = 32_768
+
+
+def resident_bytes() -> float:
+    """This process's resident memory now (bytes; 0 where ``/proc`` is not there to tell)."""
+    try:
+        with open("/proc/self/statm") as fh:
+            return float(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return 0.0
+
+
+def pilot_bytes(solve: Any, n: int) -> float | None:
+    """Bytes a solve of ``n`` samples will hold at its peak, from the peak of a :data:`PILOT`-sample solve
+    (``solve(k)``: run once untraced to warm the kernels, then traced by :mod:`tracemalloc`) scaled to
+    ``n``; ``None`` when tracemalloc is already in use (the caller then keeps its static estimate).
+    Measures what each kind really allocates (a cam's profile, a toy's stages), where
+    :func:`motion_bytes` only counts the motion's numbers."""
+    import tracemalloc
+
+    if tracemalloc.is_tracing():
+        return None
+    from planar.core.buffers import release
+
+    solve(PILOT)  # untraced first: loading or compiling the kernels is no cost of the samples
+    release()  # and no recycled block from it: the traced pilot allocates what a first solve does
+    tracemalloc.start()
+    try:
+        solve(PILOT)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    return peak / PILOT * n
+
+
 def sample_count(
     samples_per_cycle: float, cycles: float, spc_field: str = "samples_per_cycle", cycles_field: str = "cycles"
 ) -> int:
     """Samples of ``cycles`` cycles at ``samples_per_cycle``, checked against the ``samples`` limit."""
+    for name, v in ((spc_field, samples_per_cycle), (cycles_field, cycles)):
+        if isinstance(v, (str, bytes, bool)) or not hasattr(v, "__float__"):
+            raise InputError(name, v, "a number (not text or a truth value)")
     try:
         spc, cyc = float(samples_per_cycle), float(cycles)
     except (TypeError, ValueError):
@@ -91,3 +151,58 @@ def sample_count(
         raise InputError(cycles_field, cycles, "a positive, finite number of cycles")
     n = spc * cyc
     return check_count("samples", f"{spc_field} x {cycles_field}", round(n) if math.isfinite(n) else n, "samples")
+
+
+#: the smallest and largest characteristic length (model units) whose squares, products and sums of
+#: squares float64 holds without overflow or underflow (a solve multiplies up to four lengths; synthesis
+#: measured the same relative error from 1e-90 to 1e75, and at 1e90 its check in the file's units overflows)
+SIZE_RANGE = (1e-60, 1e60)
+#: how fine float64 must resolve a coordinate, as a fraction of the mechanism's smallest length (the
+#: solver's validity tolerance is 1e-9 of the size: a coarser grid makes every check meaningless)
+RESOLUTION = 1e-9
+
+
+def check_scale(where: str, mech: object) -> None:
+    """:class:`InputError` if ``mech``'s numbers are beyond what float64 holds faithfully.
+
+    Refused: a size (:attr:`Mechanism.size`) outside :data:`SIZE_RANGE`, and a
+    placement or part coordinate so far from the origin that float64's spacing
+    there exceeds :data:`RESOLUTION` times the mechanism's smallest length (its
+    smallest pin or hull radius, at most its size): at y = 1e16 the nearest
+    floats are 2 apart, so a four-bar of 4-unit links is computed into nonsense.
+    ``where`` names the file or mechanism in the message.
+    """
+    parts = getattr(mech, "parts", ())
+    with _quiet_numpy():
+        import numpy as np
+
+        size = float(getattr(mech, "size", 1.0))
+        hulls = [np.asarray(p.hull, dtype=float).reshape(-1, 3) for p in parts if getattr(p, "hull", None)]
+        h = np.concatenate(hulls) if hulls else np.zeros((0, 3))
+        place = np.asarray(getattr(mech, "placement", (0.0, 0.0, 0.0)), dtype=float).ravel()[:2]
+        extent = float(np.abs(place).max(initial=0.0)) + float(np.abs(h[:, :2]).max(initial=0.0))
+        radii = h[:, 2][h[:, 2] > 0]
+        smallest = min(size, float(radii.min())) if radii.size else size
+    if not (math.isfinite(size) and SIZE_RANGE[0] <= size <= SIZE_RANGE[1]):
+        raise InputError(
+            f"{where}: mechanism size",
+            size,
+            f"a size (largest part diameter, model units) from {SIZE_RANGE[0]:g} to {SIZE_RANGE[1]:g}: "
+            "beyond, its squares leave what float64 holds (choose another model unit, e.g. [fabrication] unit_mm)",
+        )
+    if not math.isfinite(extent) or float(np.spacing(extent)) > RESOLUTION * smallest:
+        far = smallest * RESOLUTION / float(np.finfo(float).eps)
+        raise InputError(
+            f"{where}: placement and coordinates",
+            f"{extent:.6g} from the origin",
+            f"coordinates within about {far:.3g} model units of the origin: float64 resolves "
+            f"{float(np.spacing(extent)) if math.isfinite(extent) else math.inf:.3g} there, coarser than "
+            f"{RESOLUTION:g} of the mechanism's smallest length {smallest:.6g} (move it nearer the origin)",
+        )
+
+
+def _quiet_numpy() -> Any:
+    """numpy's error state with every floating-point warning off (numpy is imported only when used)."""
+    import numpy as np
+
+    return np.errstate(all="ignore")

@@ -60,10 +60,16 @@ Array = NDArray[np.float64]
 
 def check_finite(field_name: str, value: ArrayLike) -> NDArray[np.float64]:
     """Return ``value`` as a float array or raise :class:`InputError` on NaN/inf (or what is not numbers)."""
-    if np.iscomplexobj(value):  # numpy would drop the imaginary part with only a warning
-        raise InputError(field_name, "complex numbers", "real numbers")
     try:
-        arr = np.asarray(value, dtype=float)
+        raw = np.asarray(value)
+    except (TypeError, ValueError, OverflowError):  # ragged nesting
+        raise InputError(field_name, value, "numbers (a number or an array of them)") from None
+    if raw.dtype.kind == "c":  # numpy would drop the imaginary part with only a warning
+        raise InputError(field_name, "complex numbers", "real numbers")
+    if isinstance(value, (str, bytes)) or raw.dtype.kind in "USVb":  # "1.0" is text, True no number
+        raise InputError(field_name, value, "numbers (not text or truth values)")
+    try:
+        arr = np.asarray(raw, dtype=float)
     except (TypeError, ValueError, OverflowError):
         raise InputError(field_name, value, "numbers (a number or an array of them)") from None
     # a sum is finite only if every term is (NaN and inf propagate); a finite array whose sum
@@ -126,6 +132,23 @@ class Part:
     offset: float = 0.0
     #: an explicit outer polygon (own frame) replacing the rounded hull, if given
     polygon: tuple[Vec, ...] | None = None
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise InputError("Part.name", self.name, "a non-empty string")
+        where = f"Part {self.name!r}"
+        h = check_finite(f"{where}.hull", self.hull) if len(self.hull) else np.zeros((0, 3))
+        if h.ndim != 2 or h.shape[1] != 3:
+            raise InputError(f"{where}.hull", self.hull, "circles (x, y, r): a sequence of three numbers each")
+        if (h[:, 2] < 0).any():
+            raise InputError(f"{where}.hull", self.hull, "circles with radius r >= 0")
+        if self.polygon is not None:
+            poly = check_finite(f"{where}.polygon", self.polygon)
+            if poly.ndim != 2 or poly.shape[1] != 2 or len(poly) < 3:
+                raise InputError(f"{where}.polygon", self.polygon, "three or more points (x, y)")
+        if self.plane not in ("xy", "xz", "yz"):
+            raise InputError(f"{where}.plane", self.plane, "'xy', 'xz' or 'yz'")
+        check_finite(f"{where}.offset", self.offset)
 
     @cached_property
     def outline(self) -> shapely.Polygon:
@@ -418,8 +441,20 @@ class Driver:
     centre: float = 0.0
 
     def __post_init__(self) -> None:
+        if not isinstance(self.part, str) or not self.part:
+            raise InputError("driver.part", self.part, "the name of the part it drives (a non-empty string)")
         if self.kind not in ("rotation", "translation", "path"):
             raise InputError("driver.kind", self.kind, "'rotation', 'translation' or 'path'")
+        for f in ("origin", "axis"):
+            v = check_finite(f"driver.{f}", getattr(self, f))
+            if v.shape != (2,):
+                raise InputError(f"driver.{f}", getattr(self, f), "a point (x, y)" if f == "origin" else "a direction (x, y)")
+        if not float(np.hypot(*np.asarray(self.axis, float))) > 0:
+            raise InputError("driver.axis", self.axis, "a direction of non-zero length")
+        check_finite("driver.phase", self.phase)
+        check_finite("driver.centre", self.centre)
+        if self.amplitude is not None:
+            check_finite("driver.amplitude", self.amplitude)
         check_positive("driver.rate", self.rate)
         if self.kind == "translation" and self.amplitude is None:
             raise InputError("driver.amplitude", None, "a stroke amplitude for a translation driver")
@@ -521,6 +556,15 @@ class Motion:
     def take(self, index: ArrayLike) -> Motion:
         """The samples ``index`` (an index array or boolean mask) as a new motion."""
         idx = np.asarray(index)
+        n = len(self)
+        if idx.dtype == bool:
+            if idx.shape != (n,):
+                raise InputError("Motion.take(index)", f"a mask of shape {idx.shape}", f"a mask of shape ({n},)")
+        elif idx.dtype.kind not in "iu" and not (idx.size == 0 and idx.dtype.kind == "f"):
+            raise InputError("Motion.take(index)", index, "sample indices (whole numbers) or a boolean mask")
+        elif idx.size and not (-n <= int(idx.min()) and int(idx.max()) < n):
+            raise InputError("Motion.take(index)", index, f"indices from {-n} to {n - 1} (the motion has {n} samples)")
+        idx = idx.astype(np.intp) if idx.dtype.kind == "f" else idx
         return Motion(
             driver=self.driver[idx],
             poses={k: v[idx] for k, v in self.poses.items()},
@@ -595,6 +639,14 @@ class Mechanism:
         driver: Driver,
         points: Mapping[str, tuple[str, Vec]] | None = None,
     ) -> None:
+        if not isinstance(name, str) or not name:
+            raise InputError("Mechanism.name", name, "a non-empty string")
+        if isinstance(parts, (str, bytes)) or not all(isinstance(p, Part) for p in parts):
+            raise InputError(f"{name}.parts", parts, "a sequence of Part")
+        if isinstance(joints, (str, bytes)) or not all(hasattr(j, "residual") for j in joints):
+            raise InputError(f"{name}.joints", joints, "a sequence of joints (planar.core.model's joint kinds)")
+        if not isinstance(driver, Driver):
+            raise InputError(f"{name}.driver", driver, "a Driver")
         self.name = name
         self.parts = tuple(parts)
         self.joints = tuple(joints)
@@ -668,16 +720,26 @@ class Mechanism:
                 f"a {'masked' if isinstance(q, np.ma.MaskedArray) else 'bool'} array",
                 "plain driver values (a masked array: pass q[~q.mask] or q.filled(v))",
             )
-        from planar.core.limits import check_count
+        from planar.core import limits
 
-        check_count(
-            "samples", f"{self.name}.solve(q)", float(np.size(q)), "samples of one motion", shown=f"{np.size(q):,} driver values"
+        n_q = int(np.size(q))
+        limits.check_count(
+            "samples", f"{self.name}.solve(q)", float(n_q), "samples of one motion", shown=f"{n_q:,} driver values"
         )
+        need, held = None, 0.0
+        if n_q > limits.PILOT_ABOVE:  # a large solve: what this kind really allocates (a pilot), and what is held
+            qf = np.ravel(check_finite(f"{self.name}.driver value", q))
+            need, held = limits.pilot_bytes(lambda k: self.solve(qf[:k]), n_q), limits.resident_bytes()
+        if need is None:
+            need = limits.motion_bytes(len(self.parts), len(self.points), float(n_q))
+        limits.check_memory(f"{self.name}.solve(q)", f"{n_q:,} driver values", need + held, "a motion")
         qin = np.atleast_1d(check_finite(f"{self.name}.driver value", q))
         qa = new_block(qin.shape)  # the motion's own copy (recycled memory for a large batch)
         np.copyto(qa, qin)
         if qa.ndim != 1:  # an OzT driver's path is a function of its 1-D driver value too
             raise InputError(f"{self.name}.solve(q)", f"an array of shape {qa.shape}", "a scalar or a 1-D array of driver values")
+        if t is not None:
+            t = check_finite(f"{self.name}.solve(t)", t)
         if t is not None and np.shape(t) != qa.shape[:1]:
             raise InputError(
                 f"{self.name}.solve(t)", f"an array of shape {np.shape(t)}", f"one time per driver value (shape {qa.shape[:1]})"

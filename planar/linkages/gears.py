@@ -85,8 +85,14 @@ class Geared(NodeKind):
         return ((self.name, self.centre),)
 
     def validate(self, where: str) -> None:
+        if self.mesh == self.name:
+            raise InputError(f"{where}.mesh", self.mesh, "another gear's node (a gear cannot mesh with itself)")
+        if self.mesh == self.centre:
+            raise InputError(f"{where}.mesh", self.mesh, "the gear it meshes with, not its own centre")
         check_positive(f"{where}.radius", self.radius)
         check_finite(f"{where}.phase", self.phase)
+        if isinstance(self.ratio, (str, bytes, bool)):
+            raise InputError(f"{where}.ratio", self.ratio, "a negative number")
         r = float(check_finite(f"{where}.ratio", self.ratio))
         if not r < 0:
             raise InputError(

@@ -212,6 +212,9 @@ class Linkage(Mechanism):
             if n.name in seen:
                 raise InputError(where, n.name, "a node name used once")
             for r in n.refs():
+                if r == n.name:
+                    n.validate(where)  # its own words first (a gear meshing with itself says so)
+                    raise InputError(where, r, "another node (a node cannot refer to itself)")
                 if r not in seen:
                     raise InputError(where, r, "a node declared before it")
             n.validate(where)

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from planar.core.effects import Effects, Load, Spring
+from planar.core.limits import check_scale
 from planar.core.model import Mechanism, Motion
 from planar.core.registry import Registry
 from planar.errors import InputError, PlanarError, SceneError
@@ -152,6 +153,10 @@ def build_scene(spec: SceneSpec, path: str = "<scene>") -> Scene:
             f"{path}: mechanism: cannot be built from these numbers "
             f"({type(e).__name__}: {' '.join(str(e).split())}); check for extreme values"
         ) from None
+    try:
+        check_scale(path, mech)  # numbers float64 holds faithfully (not a placement at 1e16 or a size of 1e-200)
+    except InputError as e:
+        raise SceneError(str(e)) from None
     polygons: dict[str, tuple[str, np.ndarray]] = {}
     names = {p.name for p in mech.parts}
     for i, poly in enumerate(getattr(m, "polygons", [])):
@@ -383,6 +388,7 @@ def _build_cam(spec: SceneSpec, m: CamSpec, rate: float, phase: float) -> Mechan
     program = Program(
         [Segment(sg.law, _angle(spec, sg.angle), _angle(spec, sg.lift) if osc else float(sg.lift)) for sg in m.segments],
         "mechanism.segments",
+        lift_unit="deg" if osc and spec.angle_unit == "deg" else "",
     )
     geom = FollowerGeometry(
         f.kind,

@@ -105,12 +105,15 @@ class FunctionDesign(Checked):
 
 def _pairs(phi: Array, psi: Array, ground: float) -> tuple[Array, Array]:
     """The (input, output) angles as float arrays, refused unless 3 or more pairs with a positive ground."""
-    phi = np.asarray(phi, float)
-    psi = np.asarray(psi, float)
+    from planar.core.limits import SIZE_RANGE
+    from planar.core.model import check_finite, check_positive
+
+    phi = check_finite("pairs: input", phi).ravel()
+    psi = check_finite("pairs: output", psi).ravel()
     if len(phi) < 3 or len(phi) != len(psi):
         raise InputError("pairs", len(phi), "3 or more (input, output) angle pairs")
-    if not ground > 0:
-        raise InputError("--ground", ground, "a positive ground length")
+    if not SIZE_RANGE[0] <= check_positive("ground", ground) <= SIZE_RANGE[1]:
+        raise InputError("ground", ground, f"a ground length from {SIZE_RANGE[0]:g} to {SIZE_RANGE[1]:g} (model units)")
     return phi, psi
 
 

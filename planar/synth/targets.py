@@ -13,15 +13,12 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from planar.core.limits import RESOLUTION, SIZE_RANGE
 from planar.errors import InputError
 
 __all__ = ["SIZE_RANGE", "check_theta", "normalisation", "read_path_targets", "read_svg_points", "read_table"]
 
-#: the targets' size (RMS distance from their centroid) and coordinates planar synthesises at: the search's
-#: kernel multiplies four lengths together, so 1e60 keeps every such product finite and normal (the search
-#: works in normalised units; the result is checked in the file's units). Measured: the same relative
-#: error from 1e-90 to 1e75; at 1e90 the kernel's check in the file's units overflows.
-SIZE_RANGE = (1e-60, 1e60)
+# SIZE_RANGE (re-exported): the sizes and coordinates planar synthesises at, from planar.core.limits
 
 Array = NDArray[np.float64]
 
@@ -35,13 +32,11 @@ def read_table(
     (a misspelt one) is an error naming it and the accepted ones.
     """
     p = str(path)
-    try:
-        with open(path, newline="", encoding="utf-8-sig") as fh:
-            rows = list(csv.reader(fh))
-    except FileNotFoundError:
-        raise InputError(p, "missing", "an existing CSV file") from None
-    except (IsADirectoryError, UnicodeDecodeError) as e:
-        raise InputError(p, type(e).__name__, "a readable CSV text file") from None
+    import io
+
+    from planar.fileio import read_text
+
+    rows = list(csv.reader(io.StringIO(read_text(p, "CSV file"), newline="")))
     rows = [r for r in rows if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
     if not rows:
         raise InputError(p, "empty", f"a header row with columns {', '.join(required)}")
@@ -99,6 +94,15 @@ def read_svg_points(path: str | Path, n: int) -> Array:
     for el in svg.elements():
         if isinstance(el, se.Shape) and not isinstance(el, se.Group):
             path_ = se.Path(el)
+            box = path_.bbox()
+            if box is not None:  # coordinates first: a length integrated at 1e160 differs from run to run
+                big = max(abs(float(v)) for v in box)
+                if not (math.isfinite(big) and big <= SIZE_RANGE[1]):
+                    raise InputError(
+                        p,
+                        f"a coordinate of {big:.3g}",
+                        f"coordinates within {SIZE_RANGE[1]:g} (the solvers multiply four lengths; scale the drawing)",
+                    )
             if len(path_) == 0 or path_.length() <= 0:
                 continue
             d = path_.d()
@@ -146,6 +150,13 @@ def normalisation(targets: Array, name: str = "targets") -> tuple[Array, float]:
             name,
             f"size {s:.3g} (RMS distance from the centroid)",
             f"a size between {lo:g} and {hi:g} model units (the solvers multiply four lengths; scale the targets)",
+        )
+    if float(np.spacing(big)) > RESOLUTION * s:
+        raise InputError(
+            name,
+            f"a coordinate of {big:.6g} with the targets {s:.3g} across",
+            f"targets nearer the origin: float64 resolves {float(np.spacing(big)):.3g} there, coarser than "
+            f"{RESOLUTION:g} of their size (move them toward the origin)",
         )
     return c, s
 

@@ -112,5 +112,5 @@ def test_bench_kinematics_disagreement_changes_the_exit_status(monkeypatch, caps
     import planar.bench.kinematics
 
     monkeypatch.setattr(planar.bench.kinematics, "AGREEMENT", -1.0)  # no difference can pass
-    assert main(["bench", "kinematics", "-n", "2000", "--repeats", "1"]) == 1
+    assert main(["bench", "kinematics", "-n", "2000", "--repeats", "1"]) == 3  # a failed check, as compare's
     assert "DISAGREES" in capsys.readouterr().out

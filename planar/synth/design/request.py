@@ -147,11 +147,10 @@ class Design:
 def load_request(path: str | Path) -> list[Effector]:
     """Read a request file (TOML ``[[effector]]`` tables); bad input is an :class:`InputError` naming the field."""
     p = str(path)
+    from planar.fileio import read_text
+
     try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except OSError as e:
-        raise InputError(p, p, f"a readable request file ({e.strerror})") from None
+        data = tomllib.loads(read_text(p, "request file (TOML)"))
     except tomllib.TOMLDecodeError as e:
         raise InputError(p, p, f"TOML ({e})") from None
     extra = sorted(set(data) - {"effector", "name"})
