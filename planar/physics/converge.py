@@ -13,7 +13,9 @@ joints held.  The search ends with one of three verdicts:
 * ``"change-point"``: the run left its assembly where the analytic motion
   passes a change point or toggle (either assembly is a solution there);
 * ``"unconverged"``: the CPU-time cap was reached while each budget still
-  changed the result ("could not converge within N s").
+  changed the result ("could not converge within N s"), or the run drifted
+  with the substeps fixed (``step_drift`` None, ``--step-drift 0``: the search
+  then turns only the iterations, never the substeps).
 """
 
 from __future__ import annotations
@@ -47,6 +49,11 @@ class Search:
     def line(self) -> str:
         """One line for the terminal."""
         if self.verdict == "unconverged":
+            if self.settings.step_drift is None and self.cpu_s * 3.0 <= self.cap_s:  # stopped by the fixed substeps
+                return (
+                    f"could not converge with the substeps fixed (--step-drift 0): the run drifted "
+                    f"(tried {'; '.join(self.tried)}; raise --substeps)"
+                )
             return f"could not converge within {self.cap_s:g} s (tried {'; '.join(self.tried)})"
         if self.verdict == "change-point":
             return f"at {self.tried[-1]}, the simulation took the other assembly at a change point (no budget decides that)"
@@ -149,6 +156,8 @@ def converge(
             cause = "drift" if cause == "constraint" else "constraint"
         last = (sample, err)
         if spent * 3.0 > cap_s:  # the next budget costs about twice this one
+            break
+        if cause != "constraint" and settings.step_drift is None:  # substeps fixed (--step-drift 0): no knob left
             break
         settings = _next(settings, built, cause)
     return res, Search("unconverged", settings, tried, time.process_time() - t0, cap_s)
