@@ -540,13 +540,21 @@ class Motion:
             raise InputError("animate", self.mechanism.name, "the drawing side (planar.draw.notebook) importable")
         return player(self.mechanism, self, **options)
 
-    def reason(self, i: int) -> str:
-        """Why sample ``i`` is invalid (empty string when it is valid)."""
+    def reason(self, i: int, angle_unit: str = "rad") -> str:
+        """Why sample ``i`` is invalid (empty string when it is valid).
+
+        ``angle_unit``: ``"deg"`` says a rotation driver's value in degrees (a scene's
+        ``angle_unit``); otherwise the driver value is as stored (radians, or a length).
+        """
         code = int(self.fail_code[i])
         if code < 0:
             return ""
         joint, why = self.fail_table[code]
-        return f"joint {joint!r} cannot close at driver value {self.driver[i]:.6g}: {why}"
+        value, unit = float(self.driver[i]), ""
+        driver = getattr(self.mechanism, "driver", None)
+        if angle_unit == "deg" and getattr(driver, "kind", None) == "rotation":
+            value, unit = float(np.degrees(value)), " deg"
+        return f"joint {joint!r} cannot close at driver value {value:.6g}{unit}: {why}"
 
     def failures(self) -> list[tuple[int, float, str, str]]:
         """``(index, driver value, joint, why)`` for every invalid sample."""
