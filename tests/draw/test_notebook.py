@@ -89,6 +89,7 @@ def test_import_planar_under_ipython_registers_without_numpy():
     assert out == ["False"]
 
 
+@pytest.mark.slow  # a fresh interpreter: about 1 s of CPU
 def test_animate_and_html_in_plain_python_without_importing_draw():
     # no IPython: a bare `import planar` registers nothing, yet animate and _repr_html_ work (the loader)
     code = (
