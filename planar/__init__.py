@@ -84,8 +84,18 @@ _LAZY: dict[str, str] = {
     **dict.fromkeys(("SimSettings", "simulate"), "planar.physics.simulate"),
 }
 
+
+def _load_display() -> None:
+    """Import the drawing side, which registers the renderers of :mod:`planar.core.display`."""
+    importlib.import_module("planar.draw.notebook")
+
+
 if "IPython" in sys.modules:  # a notebook: mechanisms and motions display as tables and players
-    import planar.draw.notebook  # noqa: F401  (light: registers renderers (planar.core.display); numpy loads on first display)
+    import planar.draw.notebook  # (light: registers renderers (planar.core.display); numpy loads on first display)
+else:  # plain Python: core loads the drawing side the first time it needs a renderer (animate, _repr_html_)
+    import planar.core.display
+
+    planar.core.display.set_loader(_load_display)
 
 
 def __getattr__(name: str) -> Any:
@@ -180,12 +190,14 @@ def compare(
     settings: SimSettings | None = None,
     threshold: float = 1e-3,
     torque_threshold: float = 0.01,
+    motor: bool | None = None,
     **tables: Any,
 ) -> tuple[Comparison, SimResult]:
     """Rebuild a scene or a mechanism in pymunk, run it, and compare it with the analytic motion.
 
     As ``planar compare`` does: per-part pose errors and per-joint drift as a
-    fraction of :attr:`Mechanism.size`, and, for a steadily turning driver,
+    fraction of :attr:`Mechanism.size`, and, when the scene names a motor
+    (``[effects] motor = true`` or ``motor_force_limit``) or ``motor`` is true,
     the motor torque against inverse dynamics.
 
     Parameters
@@ -199,6 +211,9 @@ def compare(
         stops at the first part further off).
     torque_threshold : float
         Largest motor-torque difference accepted, relative to the peak.
+    motor : bool, optional
+        True: also drive with a motor and check its torque (as ``--motor``); False: never;
+        None (default): when the scene's ``[effects]`` names a motor.
     **tables
         For a mechanism only: scene tables as dicts (``driver``, ``effects``...).
 
@@ -209,4 +224,4 @@ def compare(
     """
     from planar.physics.compare import compare_scene
 
-    return compare_scene(_scene(obj, tables), settings, threshold, torque_threshold)
+    return compare_scene(_scene(obj, tables), settings, threshold, torque_threshold, motor=motor)

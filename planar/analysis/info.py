@@ -70,6 +70,19 @@ FULL_TURN = {
     "non-Grashof": [],
 }
 
+#: what each class's full turns are relative to (``planar info``'s text)
+FULL_TURN_NOTE = {
+    "crank-rocker": "the crank turns fully relative to the ground and the coupler; the rocker rocks",
+    "double-crank": "the ground is the shortest link: crank and rocker both turn fully relative to it",
+    "rocker-crank": "the rocker turns fully relative to the ground and the coupler; the crank (the input) rocks",
+    "double-rocker": (
+        "the coupler (the shortest link) turns fully relative to the crank, the rocker and the ground; "
+        "crank and rocker only rock, so a crank driven through a full turn assembles only over the valid range"
+    ),
+    "change-point": "every link can turn fully, through change points where the linkage may switch circuit",
+    "non-Grashof": "a triple rocker: every link only rocks relative to its neighbours",
+}
+
 #: samples of one driver cycle the figures are found on (then refined)
 SAMPLES = 3600
 
@@ -82,6 +95,9 @@ class Output:
     or ``"slides"`` (no rotation, ``swing`` is the stroke in model units).  ``dead_centres`` are the driver
     angles (degrees, in ``[0, 360)``) where it stops and turns back; ``time_ratio`` the driver angle of
     the slower stroke over the faster's (``>= 1``; None when it turns or the input does not turn fully).
+    ``ranges``: when a full-turn driver assembles only over parts of its turn, ``(from, to, swing)`` per
+    assemblable driver range (degrees; the swing in degrees or model units as ``swing``), and ``swing``
+    is the largest of them.
     """
 
     part: str
@@ -91,6 +107,7 @@ class Output:
     time_ratio: float | None = None
     working_deg: float | None = None
     return_deg: float | None = None
+    ranges: list[tuple[float, float, float]] = field(default_factory=list)
 
 
 @dataclass
@@ -206,6 +223,55 @@ def _output(mech: Mechanism, part: str, q: Array, poses: Array, full_input: bool
     )
 
 
+def _edge(mech: Mechanism, good: float, bad: float) -> float:
+    """The driver angle between ``good`` (assembles) and ``bad`` (does not) where assembly ends, to 1e-12 rad."""
+    import numpy as np
+
+    for _ in range(60):
+        if abs(bad - good) < 1e-12:
+            break
+        mid = 0.5 * (good + bad)
+        if bool(mech.solve(np.array([mid])).valid[0]):
+            good = mid
+        else:
+            bad = mid
+    return good
+
+
+def _runs(mech: Mechanism, q: Array, ok: Any) -> list[Array]:
+    """The driver angles of each run of assemblable samples of a full turn ``q``, with the run's ends refined."""
+    import numpy as np
+
+    start = int(np.argmin(ok))  # an invalid sample: no run is cut by the roll
+    n = len(q)
+    idx = np.roll(np.arange(n), -start)
+    qq = q[idx] + 2 * math.pi * (idx < start)  # increasing through the roll
+    okr = ok[idx]
+    d = np.diff(np.concatenate([[0], okr.astype(int), [0]]))
+    runs = []
+    for s, e in zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1)):
+        lo = _edge(mech, float(qq[s]), float(qq[s - 1]))  # s >= 1: sample 0 is invalid
+        hi = _edge(mech, float(qq[e - 1]), float(qq[e]) if e < n else float(qq[0]) + 2 * math.pi)
+        runs.append(np.concatenate([[lo], qq[s:e], [hi]]))
+    return runs
+
+
+def _partial_output(mech: Mechanism, part: str, runs: list[Array]) -> Output:
+    """Swing or stroke of ``part`` over each run of driver angles ``runs`` (radians) that assembles."""
+    import numpy as np
+
+    ranges, hows = [], []
+    for r in runs:
+        how, coord, _ = _output_coordinate(mech.solve(r).poses[part])
+        if how == "turns" and float(np.ptp(coord)) < 2 * math.pi:  # over part of a turn: a swing, however wide
+            how = "rocks"
+        swing = 360.0 if how == "turns" else float(np.ptp(coord))
+        hows.append(how)
+        ranges.append((math.degrees(r[0]) % 360.0, math.degrees(r[-1]) % 360.0, math.degrees(swing) if how == "rocks" else swing))
+    how = "turns" if "turns" in hows else ("rocks" if "rocks" in hows else "slides")
+    return Output(part, how, max((v[2] for v in ranges), default=0.0), ranges=ranges)
+
+
 def _dof(mech: Mechanism) -> int:
     """Gruebler/Kutzbach mobility: 3 (n - 1) - sum of the freedoms each joint removes (ground parts are one body).
 
@@ -307,9 +373,14 @@ def info(mech: Mechanism, samples: int = SAMPLES) -> Info:
     ground = {p.name for p in mech.parts if p.ground}
     joined = {j.b if j.a in ground else j.a for j in mech.joints if (j.a in ground) != (j.b in ground)}
     outputs = []
+    runs = _runs(mech, q, ok) if full_input and ok.any() and not ok.all() else []
     for p in mech.parts:
-        if p.name in joined and p.name != d.part and ok.all():
+        if p.name not in joined or p.name == d.part:
+            continue
+        if ok.all():
             outputs.append(_output(mech, p.name, q, motion.poses[p.name], full_input))
+        elif runs:  # over the ranges the linkage assembles (a double rocker's input)
+            outputs.append(_partial_output(mech, p.name, runs))
     if isinstance(grashof, str):
         turns = list(FULL_TURN.get(grashof, []))
     else:
@@ -342,7 +413,10 @@ def format_info(r: Info) -> str:
         f"degrees of freedom (Gruebler/Kutzbach): {r.dof}",
     ]
     if r.grashof is not None:
-        lines.append(f"Grashof class: {r.grashof}; turns fully: {', '.join(r.turns_fully) or 'no link'}")
+        note = FULL_TURN_NOTE.get(r.grashof)
+        lines.append(
+            f"Grashof class: {r.grashof}; turns fully: {', '.join(r.turns_fully) or 'no link'}" + (f" ({note})" if note else "")
+        )
     elif r.turns_fully:
         lines.append(f"turns fully: {', '.join(r.turns_fully)}")
     if r.toggle_angles:
@@ -351,6 +425,14 @@ def format_info(r: Info) -> str:
     for o in r.outputs:
         what = {"turns": "turns fully", "rocks": f"rocks {o.swing:.6g} deg", "slides": f"slides, stroke {o.swing:.6g}"}
         line = f"output {o.part}: {what[o.motion]}"
+        if o.ranges:
+            unit = "deg" if o.motion == "rocks" else ""
+            line = line.replace("rocks", "rocks up to").replace("stroke", "stroke up to")
+            line += (
+                " (over the driver ranges that assemble: "
+                + ", ".join(f"{sw:.6g}{' ' + unit if unit else ''} over {a:.4g} to {b:.4g} deg" for a, b, sw in o.ranges)
+                + ")"
+            )
         if o.dead_centres:
             line += "; dead centres at driver " + ", ".join(f"{a:.4f}" for a in o.dead_centres) + " deg"
         if o.time_ratio is not None:

@@ -210,7 +210,7 @@ def render_scene(
         if bad.any():
             notes.append(
                 f"{int(bad.sum())} of the {len(fine)} samples drawn from cannot be assembled and are drawn "
-                f"tinted red; first: {fine.reason(int(bad.argmax()))}"
+                f"tinted red; first: {fine.reason(int(bad.argmax()), scene.spec.angle_unit)}"
             )
     if overlay is not None:
         overlay = resample(overlay, plan.times())

@@ -484,6 +484,8 @@ def _cmd_motion(args: argparse.Namespace) -> int:
 
     if not (args.max_ratio > 1 and math.isfinite(args.max_ratio)):
         raise InputError("--max-ratio", args.max_ratio, "a finite ratio greater than 1")
+    if not 0 <= args.min_transmission < 90:
+        raise InputError("--min-transmission", args.min_transmission, "degrees from 0 up to (not including) 90")
     t = read_table(args.poses, ("x", "y", "angle"), min_rows=3)
     ang = np.radians(t["angle"]) if args.deg else t["angle"]
     poses = np.column_stack([t["x"], t["y"], ang])
@@ -494,7 +496,7 @@ def _cmd_motion(args: argparse.Namespace) -> int:
     normalisation(poses[:, :2], str(args.poses))  # coordinates float64 holds faithfully at the poses' size
     _check_poses(str(args.poses), poses)
     try:
-        d = burmester(poses, max_ratio=args.max_ratio)
+        d = burmester(poses, max_ratio=args.max_ratio, min_transmission=math.radians(args.min_transmission))
     except NoMotionDesign as e:
         return _no_design(args, "synth motion", {"poses": len(poses)}, str(e))
     amp, centre = (
@@ -503,6 +505,11 @@ def _cmd_motion(args: argparse.Namespace) -> int:
         else (max(0.5 * (d.crank_range[1] - d.crank_range[0]), 1e-6), 0.5 * (d.crank_range[0] + d.crank_range[1]))
     )
     failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]
+    if not d.checks["ok_transmission"]:
+        failing[failing.index("transmission")] = (
+            f"transmission angle {d.checks['min_transmission_deg']:.3g} deg from a toggle (limit "
+            f"{args.min_transmission:g}, --min-transmission) at {d.checks['min_transmission_at']}"
+        )
     text = fourbar_scene_text(
         "synth-motion",
         d.ground,
@@ -522,7 +529,8 @@ def _cmd_motion(args: argparse.Namespace) -> int:
     report = {"command": "synth motion", "poses": len(poses), "angle_offset": d.angle_offset, **d.to_dict()}
     return _finish(
         args,
-        f"four-bar ({d.grashof}, {d.circuit}) through {len(poses)} poses, position error {d.checks['max_position_error']:.3g}",
+        f"four-bar ({d.grashof}, {d.circuit}) through {len(poses)} poses, position error {d.checks['max_position_error']:.3g}"
+        f", transmission angle >= {d.checks['min_transmission_deg']:.3g} deg ({d.checks['min_transmission_at']})",
         text,
         report,
         d.ok,
@@ -643,5 +651,12 @@ def add_parser(sub: Any) -> None:
     m.add_argument("-o", "--output", required=True, help="scene file (TOML) to write")
     m.add_argument("--max-ratio", type=float, default=10.0, help="longest / shortest link at most this, a finite number > 1 (10)")
     m.add_argument("--deg", action="store_true", help="angles in degrees")
+    m.add_argument(
+        "--min-transmission",
+        type=float,
+        default=0.0,
+        help="keep the transmission angle at least this far from 0 and 180 (a toggle) over the motion, degrees "
+        "(0); exit 3 naming the angle and where when the design does not",
+    )
     m.add_argument("--json", action="store_true", help="print the design and its checks as JSON")
     m.set_defaults(func=_cmd_motion)

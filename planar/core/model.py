@@ -531,19 +531,30 @@ class Motion:
 
     def animate(self, **options: Any) -> Any:
         """An animation player of this motion (see :func:`planar.draw.notebook.animate`); needs its mechanism."""
-        from planar.core.display import RENDERERS
+        from planar.core.display import renderer
 
         if self.mechanism is None:
             raise InputError("motion.mechanism", None, "a motion made by Mechanism.solve or run (it knows its mechanism)")
-        return RENDERERS["animate"](self.mechanism, self, **options)
+        player = renderer("animate")
+        if player is None:
+            raise InputError("animate", self.mechanism.name, "the drawing side (planar.draw.notebook) importable")
+        return player(self.mechanism, self, **options)
 
-    def reason(self, i: int) -> str:
-        """Why sample ``i`` is invalid (empty string when it is valid)."""
+    def reason(self, i: int, angle_unit: str = "rad") -> str:
+        """Why sample ``i`` is invalid (empty string when it is valid).
+
+        ``angle_unit``: ``"deg"`` says a rotation driver's value in degrees (a scene's
+        ``angle_unit``); otherwise the driver value is as stored (radians, or a length).
+        """
         code = int(self.fail_code[i])
         if code < 0:
             return ""
         joint, why = self.fail_table[code]
-        return f"joint {joint!r} cannot close at driver value {self.driver[i]:.6g}: {why}"
+        value, unit = float(self.driver[i]), ""
+        driver = getattr(self.mechanism, "driver", None)
+        if angle_unit == "deg" and getattr(driver, "kind", None) == "rotation":
+            value, unit = float(np.degrees(value)), " deg"
+        return f"joint {joint!r} cannot close at driver value {value:.6g}{unit}: {why}"
 
     def failures(self) -> list[tuple[int, float, str, str]]:
         """``(index, driver value, joint, why)`` for every invalid sample."""
@@ -821,13 +832,14 @@ class Mechanism:
         """An animation player of one cycle (``samples_per_cycle`` frames), shown inline in a notebook.
 
         See :func:`planar.draw.notebook.animate` for the options; ``.save("x.html")`` writes the page.
-        The drawing side (:mod:`planar.draw.notebook`) must be imported (``import planar`` in a notebook does).
+        The drawing side (:mod:`planar.draw.notebook`) is loaded on first use (``import planar`` is enough).
         """
-        from planar.core.display import RENDERERS
+        from planar.core.display import renderer
 
-        if "animate" not in RENDERERS:
-            raise InputError("animate", self.name, "planar.draw.notebook imported first (import planar.draw.notebook)")
-        return RENDERERS["animate"](self, self.run(samples_per_cycle=samples_per_cycle), **options)
+        player = renderer("animate")
+        if player is None:
+            raise InputError("animate", self.name, "the drawing side (planar.draw.notebook) importable")
+        return player(self, self.run(samples_per_cycle=samples_per_cycle), **options)
 
 
 def _with_joint_features(parts: tuple[Part, ...], joints: Sequence[Any]) -> tuple[Part, ...]:

@@ -483,6 +483,8 @@ class RRP(NodeKind):
     q: str
     branch: int = 1
     offset: float = 0.0
+    #: what the line is, for messages (e.g. "the slider's guide"); empty: named by its nodes p-q
+    line: str = ""
 
     def refs(self) -> tuple[str, ...]:
         return (self.a, self.p, self.q)
@@ -501,7 +503,8 @@ class RRP(NodeKind):
         other, _, _ = line_circle(base, u, pos[self.a], self.ra, -self.branch)
         flip = carry_branch(keep, other, ok, path)
         p = np.where(flip[:, None], other, keep) if flip.any() else keep
-        return p, (ok, f"a link of length {self.ra:g} from {self.a!r} cannot reach the line {self.p!r}-{self.q!r}")
+        line = self.line or f"the line {self.p!r}-{self.q!r}"
+        return p, (ok, f"a link of length {self.ra:g} from {self.a!r} cannot reach {line}")
 
     def toggle_margin(self, pos: Mapping[str, Array]) -> Array:
         """``|cos|`` of the angle between the rod ``a -> node`` and the slide line ``p -> q``: 0 where the

@@ -56,7 +56,7 @@ class SliderCrank(Linkage):
             Fixed("G1", (-span, e)),
             Fixed("G2", (2 * span, e)),
             Crank("A", "O", r),
-            RRP("S", "A", l, "G1", "G2", branch),
+            RRP("S", "A", l, "G1", "G2", branch, line="the slider's guide line"),
         ]
         links = [
             Link("crank", ("O", "A")),

@@ -62,6 +62,8 @@ class Comparison:
     torque_search: Any = None
     #: what helps, for the kinematic run's failure
     hint: str = ""
+    #: the kinematic run's solver settings as used (substeps, iterations, step_drift, correction, error_bias)
+    settings: dict[str, Any] | None = None
 
     @property
     def max_rel_error(self) -> float:
@@ -127,6 +129,8 @@ class Comparison:
             "failure": self.failure,
             "passed": self.passed,
             "problems": self.problems(),
+            "settings": self.settings,
+            "search": None if self.search is None else {"verdict": self.search.verdict, "tried": self.search.tried},
         }
 
 
@@ -361,6 +365,13 @@ def compare_scene(
     result.search = search
     if sim.failure is not None and search.verdict in ("differs", "unconverged"):
         search.near = _near_change_point(mech, motion, sim.failure.sample)
+    result.settings = {
+        "substeps": sim.built.get("substeps"),
+        "iterations": sim.built.get("iterations"),
+        "step_drift": settings.step_drift,
+        "correction": sim.built.get("correction"),
+        "error_bias": settings.error_bias,
+    }
     if sim.failure is not None and search.verdict != "differs":
         cause, *_ = _kinematic_outcome(mech)(sim)
         result.hint = hint(cause)

@@ -18,7 +18,9 @@ joints held.  The search ends with one of these verdicts:
 * ``"unconverged"``: a limit of the search stopped it while each budget
   still changed the result: the CPU-time cap ("could not converge within
   N s") or the number of budgets it tries ("gave up after 6 tries, up to 1280
-  iterations, in 2.5 s CPU"); :attr:`Search.stopped` says which.
+  iterations, in 2.5 s CPU"), or the run drifted with the substeps fixed
+  (``step_drift`` None, ``--step-drift 0``: the search then turns only the
+  iterations); :attr:`Search.stopped` says which.
 """
 
 from __future__ import annotations
@@ -80,6 +82,11 @@ class Search:
         tried = f"tried {'; '.join(self.tried)}"
         nxt = self.next_settings
         more = f"; try --iterations {nxt.iterations} --substeps {nxt.substeps}" if nxt is not None else ""
+        if self.stopped == "substeps":
+            return (
+                f"could not converge with the substeps fixed (--step-drift 0): the run drifted "
+                f"({tried}; raise --substeps)"
+            )
         if self.stopped == "tries":
             its = max((_knob(x, "iterations") for x in self.tried), default=0)
             subs = max((_knob(x, "substeps") for x in self.tried), default=0)
@@ -207,6 +214,9 @@ def converge(
             knob_failed = cause  # this knob made it fail earlier: turn the other one
         if knob_failed == cause:
             cause = "drift" if cause == "constraint" else "constraint"
+        if cause != "constraint" and settings.step_drift is None:  # substeps fixed (--step-drift 0): no knob left
+            stopped = "substeps"
+            break
         settings = _next(settings, built, cause)
         if spent * 3.0 > cap_s:  # the next budget costs about twice this one
             stopped = "time"

@@ -288,8 +288,13 @@ def _choose(poses: Array, z: Array, c: Array, max_ratio: float) -> tuple[int, in
     return int(I[k]), int(J[k]), bool(full[k])
 
 
-def burmester(poses: Array, max_ratio: float = 10.0, grid: int = 24) -> MotionDesign:
-    """A four-bar guiding a body through 3, 4 or 5 ``poses`` ``(n, 3)`` (see the module)."""
+def burmester(poses: Array, max_ratio: float = 10.0, grid: int = 24, min_transmission: float = 0.0) -> MotionDesign:
+    """A four-bar guiding a body through 3, 4 or 5 ``poses`` ``(n, 3)`` (see the module).
+
+    ``min_transmission`` (radians, default 0) is the least distance of the transmission
+    angle from 0 and pi (a toggle) over the crank's sweep that the design's check
+    ``ok_transmission`` accepts (:func:`check_motion`).
+    """
     poses = np.asarray(poses, float)
     if poses.ndim != 2 or poses.shape[1] != 3 or not 3 <= len(poses) <= 5:
         raise InputError("poses", poses.shape, "3, 4 or 5 poses (x, y, angle)")
@@ -321,10 +326,12 @@ def burmester(poses: Array, max_ratio: float = 10.0, grid: int = 24) -> MotionDe
     ok = np.isfinite(c).all(1)
     z, c = z[ok], c[ok]
     i, j, _ = _choose(poses, z, c, max_ratio)
-    return _design(poses, z[i], c[i], z[j], c[j], len(z))
+    return _design(poses, z[i], c[i], z[j], c[j], len(z), min_transmission)
 
 
-def _design(poses: Array, zi: Array, ci: Array, zj: Array, cj: Array, candidates: int) -> MotionDesign:
+def _design(
+    poses: Array, zi: Array, ci: Array, zj: Array, cj: Array, candidates: int, min_transmission: float = 0.0
+) -> MotionDesign:
     from planar.linkages import grashof_class
 
     R = _rot(poses[:, 2])
@@ -364,16 +371,34 @@ def _design(poses: Array, zi: Array, ci: Array, zj: Array, cj: Array, candidates
         None if full[0] else (float(lo[0]), float(hi[0])),
         bool(ordered[0]),
     )
-    check_motion(md)
+    check_motion(md, min_transmission=min_transmission)
     return md
 
 
-def check_motion(md: MotionDesign, samples: int = 4096) -> None:
+def _between(theta: Array, x: float, full: bool) -> str:
+    """Where crank angle ``x`` lies among the poses' crank angles ``theta`` (1-based pose numbers)."""
+    two_pi = 2 * np.pi
+    t = theta % two_pi if full else theta
+    x = x % two_pi if full else x
+    order = np.argsort(t)
+    k = int(np.searchsorted(t[order], x))
+    if k == 0 or k == len(t):
+        if full:  # past the last pose the crank comes round to the first
+            return f"between poses {int(order[-1]) + 1} and {int(order[0]) + 1}"
+        return f"beyond pose {int(order[0 if k == 0 else -1]) + 1}"
+    i, j = sorted((int(order[k - 1]) + 1, int(order[k]) + 1))
+    return f"between poses {i} and {j}"
+
+
+def check_motion(md: MotionDesign, samples: int = 4096, min_transmission: float = 0.0) -> None:
     """Solve the four-bar at each pose's crank angle with planar's solver; compare the coupler poses.
 
     Between poses the four-bar is solved again at ``samples`` crank angles
     over the swept range (the whole turn, or the rocking arc): every one must
-    assemble on the design's circuit (no dead zone or toggle between poses).
+    assemble on the design's circuit (no dead zone or toggle between poses),
+    and the transmission angle stays at least ``min_transmission`` (radians)
+    from 0 and pi there (``ok_transmission``; ``min_transmission_deg`` and
+    ``min_transmission_at`` say how close it comes and where).
     """
     fb = md.fourbar()
     m = fb.solve(md.theta)
@@ -383,13 +408,22 @@ def check_motion(md: MotionDesign, samples: int = 4096) -> None:
     dp = np.hypot(*(pos - md.poses[:, :2]).T)
     da = np.abs((ang - md.poses[:, 2] + np.pi) % (2 * np.pi) - np.pi)
     lo, hi = md.crank_range if md.crank_range is not None else (0.0, 2 * np.pi)
-    sweep = fb.solve(np.linspace(lo, hi, samples))
+    crank = np.linspace(lo, hi, samples)
+    sweep = fb.solve(crank)
+    mu = fb.transmission_angle(crank)
+    margin = np.minimum(mu, np.pi - mu)
+    worst = int(np.argmin(margin))
     md.checks = {
         "max_position_error": float(dp.max()) if m.valid.all() else float("inf"),
         "max_angle_error_rad": float(da.max()) if m.valid.all() else float("inf"),
         "ok_reaches_every_pose": bool(m.valid.all() and dp.max() <= 1e-6 * L and da.max() <= 1e-6),
         "ok_poses_in_order": md.in_order,
         "ok_assembles_between_poses": bool(sweep.valid.all()),
+        "ok_transmission": bool(margin[worst] >= min_transmission - 1e-9),
+        "min_transmission_deg": float(np.degrees(margin[worst])),
+        "min_transmission_at": (
+            f"crank angle {np.degrees(crank[worst]):.4g} deg, {_between(md.theta, float(crank[worst]), md.crank_range is None)}"
+        ),
         "sweep_samples": samples,
         "crank_turns_fully": md.crank_range is None,
     }

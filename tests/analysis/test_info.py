@@ -88,7 +88,10 @@ def test_triple_rocker_toggles_are_the_law_of_cosines():
             th = math.acos(cs)
             ends += [math.degrees(th), 360 - math.degrees(th)]
     assert r.toggle_angles == pytest.approx(sorted(ends), abs=1e-9)
-    assert r.outputs == []  # the input cannot turn: no full cycle, no time ratio
+    # the input cannot turn: the rocker's swing over the one range that assembles, no dead centres or time ratio
+    (out,) = r.outputs
+    assert out.part == "rocker" and out.motion == "rocks" and len(out.ranges) == 1 and out.dead_centres == []
+    assert out.ranges[0][:2] == pytest.approx(sorted(ends), abs=1e-6)  # the refined ends are the toggles
     assert r.time_ratio is None
 
 
@@ -139,3 +142,52 @@ def test_cli_text_and_json(capsys):
 def test_cli_missing_scene_is_one_line(tmp_path, capsys):
     assert main(["info", str(tmp_path / "nope.toml")]) == 2
     assert len(capsys.readouterr().err.strip().splitlines()) == 1
+
+
+def _own_rocker_swings(a: float, b: float, c: float, d: float):
+    """Per assemblable crank interval, the rocker's swing (deg) on each circuit, by circle intersection (B on
+    the crank circle, C at distance b from B and c from O4 = (d, 0)), from toggle to toggle."""
+    # |B - O4|^2 = a^2 + d^2 - 2 a d cos(theta) must lie in [(b - c)^2, (b + c)^2]
+    lo = math.acos(np.clip((a * a + d * d - (b + c) ** 2) / (2 * a * d), -1, 1))
+    hi = math.acos(np.clip((a * a + d * d - (b - c) ** 2) / (2 * a * d), -1, 1))
+    out = []
+    for t0, t1 in ((min(lo, hi), max(lo, hi)), (-max(lo, hi), -min(lo, hi))):
+        th = np.linspace(t0, t1, 200001)
+        B = np.stack([a * np.cos(th), a * np.sin(th)], -1)
+        v = np.array([d, 0.0]) - B
+        s = np.hypot(*v.T)
+        u = v / s[:, None]
+        along = (b * b - c * c + s * s) / (2 * s)
+        h = np.sqrt(np.clip(b * b - along**2, 0, None))
+        swings = []
+        for sign in (1, -1):
+            C = B + along[:, None] * u + sign * h[:, None] * np.stack([-u[:, 1], u[:, 0]], -1)
+            psi = np.unwrap(np.arctan2(C[:, 1], C[:, 0] - d))
+            swings.append(math.degrees(float(np.ptp(psi))))
+        out.append(swings)
+    return out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(4))
+def test_double_rocker_under_a_full_turn_reports_the_rocker_swing(seed):
+    rng = np.random.default_rng(seed)
+    while True:  # a Grashof double rocker: the coupler shortest, s + l < p + q
+        c_, a, r, d = rng.uniform(0.2, 1.0), *rng.uniform(1.0, 5.0, 3)
+        L = sorted([a, c_, r, d])
+        if L[0] == c_ and L[0] + L[3] < L[1] + L[2] - 0.05:
+            break
+    m = FourBar(ground=d, crank=a, coupler=c_, rocker=r)
+    assert m.grashof == "double-rocker"
+    rep = info(m)
+    (out,) = [o for o in rep.outputs if o.part == "rocker"]
+    own = _own_rocker_swings(a, c_, r, d)
+    assert out.motion == "rocks" and len(out.ranges) == 2
+    for lo, hi, swing in out.ranges:
+        mid = math.radians(0.5 * (lo + hi))
+        k = 0 if math.sin(mid) > 0 else 1  # the interval above or below the ground line
+        assert min(abs(swing - w) for w in own[k]) < 1e-3, (swing, own[k])
+    assert out.swing == max(r_[2] for r_ in out.ranges)
+    text = str(rep)
+    assert "turns fully: coupler (the coupler" in text and "relative to the crank, the rocker and the ground" in text
+    assert "output rocker: rocks up to" in text

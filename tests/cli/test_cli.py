@@ -114,3 +114,27 @@ def test_bench_kinematics_disagreement_changes_the_exit_status(monkeypatch, caps
     monkeypatch.setattr(planar.bench.kinematics, "AGREEMENT", -1.0)  # no difference can pass
     assert main(["bench", "kinematics", "-n", "2000", "--repeats", "1"]) == 3  # a failed check, as compare's
     assert "DISAGREES" in capsys.readouterr().out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("unit", ["deg", "rad"])
+def test_render_note_says_the_driver_value_in_the_scene_unit(tmp_path, capsys, unit):
+    import math
+    import re
+
+    # crank 2, rod 1.5, offset 0.5: the rod reaches the guide only while 2 sin(theta) - 0.5 >= -1.5
+    scene = tmp_path / "sc.toml"
+    head = 'angle_unit = "deg"\n' if unit == "deg" else ""
+    scene.write_text(
+        f'name = "sc"\n{head}[mechanism]\ntype = "slidercrank"\ncrank = 2.0\nrod = 1.5\noffset = 0.5\n'
+        "[driver]\nsamples_per_cycle = 36\n"
+    )
+    assert main(["render", str(scene), "-o", str(tmp_path / "sc.gif")]) == 0
+    err = capsys.readouterr().out  # the notes go with the summary line
+    m = re.search(r"cannot close at driver value ([0-9.]+)( deg)?: (.*)", err)
+    assert m is not None, err
+    value = float(m.group(1))
+    assert (m.group(2) is not None) == (unit == "deg")
+    theta = math.radians(value) if unit == "deg" else value
+    assert 2 * math.sin(theta) - 0.5 < -1.5 and 0 <= theta < 2 * math.pi
+    assert "G1" not in m.group(3) and "slider's guide" in m.group(3)

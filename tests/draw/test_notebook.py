@@ -89,6 +89,20 @@ def test_import_planar_under_ipython_registers_without_numpy():
     assert out == ["False"]
 
 
+@pytest.mark.slow  # a fresh interpreter: about 1 s of CPU
+def test_animate_and_html_in_plain_python_without_importing_draw():
+    # no IPython: a bare `import planar` registers nothing, yet animate and _repr_html_ work (the loader)
+    code = (
+        "import sys, planar; assert 'IPython' not in sys.modules; "
+        "m = planar.FourBar(ground=4, crank=1, coupler=3.5, rocker=3); "
+        "before = 'planar.draw.notebook' in sys.modules; "
+        "p = m.solve([0.0, 0.5, 1.0]).animate(); q = m.animate(samples_per_cycle=6); h = m._repr_html_(); "
+        "print(before, p.frames, q.frames, h.startswith('<table>'), 'planar.draw.notebook' in sys.modules)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert out == ["False", "3", "6", "True", "True"]
+
+
 @pytest.mark.parametrize("name", ["jansen-leg", "windup-06", "cam-automaton"])
 def test_scenes_display(name):
     s = load_scene(GALLERY / f"{name}.toml")

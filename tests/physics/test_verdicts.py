@@ -185,3 +185,38 @@ def test_the_saturation_hint_helps():
     assert not strong["saturated"] and strong["max_rel_diff"] < 0.01
     lighter = torque_comparison(fb, t, Effects(motor_force_limit=0.3 * peak, density=0.2))  # or lighter parts
     assert not lighter["saturated"]
+
+
+def test_fixed_substeps_are_never_raised_by_the_search():
+    # --step-drift 0 (step_drift None) keeps --substeps fixed: a run that keeps drifting stops the search
+    from planar.physics.converge import converge
+    from planar.physics.settings import SimSettings
+
+    seen = []
+
+    def run(st):
+        seen.append((st.substeps, st.iterations))
+        return st
+
+    def outcome(st):  # drifts while its joints hold, failing later with each budget (never "differs")
+        return "drift", len(seen) * 10, 1e-2, {"substeps": st.substeps, "iterations": st.iterations, "correction": 0.2}
+
+    _, search = converge(run, outcome, SimSettings(substeps=7, step_drift=None), cap_s=1e9)
+    assert {s for s, _ in seen} == {7} and search.verdict == "unconverged" and "fixed" in search.line()
+    seen.clear()
+    _, search = converge(run, outcome, SimSettings(substeps=7), cap_s=1e9)  # step_drift given: substeps raised
+    assert max(s for s, _ in seen) > 7 and "fixed" not in search.line()
+
+
+@pytest.mark.slow
+def test_comparison_to_dict_has_the_settings_like_the_cli():
+    import planar
+    from planar.linkages.fourbar import FourBar
+    from planar.physics.simulate import SimSettings
+
+    comp, sim = planar.compare(
+        FourBar(ground=4, crank=1, coupler=3.5, rocker=3), settings=SimSettings(step_drift=None), driver={"samples_per_cycle": 24}
+    )
+    d = comp.to_dict()
+    assert d["settings"]["substeps"] == sim.built["substeps"] == 28 and d["settings"]["step_drift"] is None
+    assert d["search"]["verdict"] == comp.search.verdict

@@ -122,3 +122,30 @@ def test_duplicate_pose_and_translation_exit_2(tmp_path, capsys):
     trans = "x,y,angle\n0,0,0.3\n1,0,0.3\n2,0.5,0.3\n"
     assert main(["synth", "motion", str(_write(tmp_path, trans)), "-o", str(out)]) == 2
     assert "pure translation" in capsys.readouterr().err and not out.exists()
+
+
+@pytest.mark.slow
+def test_min_transmission_checked_like_function(tmp_path, capsys):
+    # own loop closure over the crank's sweep: the angle at C between coupler (C->B) and rocker (C->O4)
+    path = _write(tmp_path, P4)
+    d = burmester(np.loadtxt(path, delimiter=",", skiprows=1))
+    L = (d.ground, d.crank, d.coupler, d.rocker)
+    lo, hi = d.crank_range if d.crank_range is not None else (0.0, 2 * np.pi)
+    theta = np.linspace(lo, hi, 20001)
+    margins = []
+    for sign in (1, -1):
+        B, ang, ok = _coupler_pose(L, theta, sign)
+        C = B + d.coupler * np.stack([np.cos(ang), np.sin(ang)], -1)
+        u, v = B - C, np.array([d.ground, 0.0]) - C
+        mu = np.abs(np.arctan2(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0], (u * v).sum(1)))
+        margins.append(float(np.degrees(np.minimum(mu, np.pi - mu)).min()) if ok.all() else np.inf)
+    own = min(margins)  # the design's circuit is one of the two; both circuits have the same |mu| here
+    assert abs(d.checks["min_transmission_deg"] - own) < 0.05
+    out = tmp_path / "m.toml"
+    rc = main(["synth", "motion", str(path), "-o", str(out), "--min-transmission", f"{own + 0.5:.4f}"])
+    err = capsys.readouterr()
+    assert rc == 3 and "check failed: transmission angle" in err.err + err.out and "crank angle" in err.err + err.out
+    rc = main(["synth", "motion", str(path), "-o", str(out), "--min-transmission", f"{own - 0.5:.4f}", "--json"])
+    rep = json.loads(capsys.readouterr().out)
+    assert rc == 0 and rep["checks"]["ok_transmission"] and "between poses" in rep["checks"]["min_transmission_at"]
+    assert main(["synth", "motion", str(path), "-o", str(out), "--min-transmission", "90"]) == 2
