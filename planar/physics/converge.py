@@ -83,10 +83,7 @@ class Search:
         nxt = self.next_settings
         more = f"; try --iterations {nxt.iterations} --substeps {nxt.substeps}" if nxt is not None else ""
         if self.stopped == "substeps":
-            return (
-                f"could not converge with the substeps fixed (--step-drift 0): the run drifted "
-                f"({tried}; raise --substeps)"
-            )
+            return f"could not converge with the substeps fixed (--step-drift 0): the run drifted ({tried}; raise --substeps)"
         if self.stopped == "tries":
             its = max((_knob(x, "iterations") for x in self.tried), default=0)
             subs = max((_knob(x, "substeps") for x in self.tried), default=0)
