@@ -89,7 +89,7 @@ def test_export_cuts_the_assembly_once(tmp_path, toys):
     names = [pc.name for pc in fab.layout.parts if not pc.name.startswith("spacer")]
     assert sorted(names) == sorted(p.name for p in toys["horse"].parts)
     assert names.count("frame") == 1
-    assert any("keyed to the motor shaft at 180 degrees" in n for n in fab.notes)
+    assert any("keyed to the motor shaft at 0 degrees = cam phase 180 + the stage's own turn 180" in n for n in fab.notes)
     out = tmp_path / "h.dxf"
     write_outputs(fab, dxf=out)
     doc = ezdxf.readfile(out)
@@ -197,7 +197,7 @@ def test_cli_toy(capsys):
 
     assert main(["toy", "gallery/horse.toml", "--json"]) == 0
     rep = json.loads(capsys.readouterr().out)
-    assert len(rep["pieces"]) == 8 and rep["keyed"] == {"cam.left": 0.0, "cam.right": 180.0}
+    assert len(rep["pieces"]) == 8 and rep["keyed"] == {"cam.left": 0.0, "cam.right": 0.0}
     assert rep["torque"]["max_rel_diff"] < 0.01 and all(s["simulated"] for s in rep["stages"])
     assert main(["toy", "gallery/windup-01.toml"]) == 2
     assert "a toy scene" in capsys.readouterr().err
