@@ -200,9 +200,32 @@ def _rest_pose(st: Any, which: str) -> Array:
     return np.asarray(m._follower_pose(out)[0], float)
 
 
+def _track_turns(toy: Any) -> list[float]:
+    """Each stage's turn about the motor axis (rad) that keeps merged grounds' tracks apart.
+
+    Two root stages of one pattern on different cams have one ground: merged into one frame, their slots
+    would be one track with both pins riding it.  The later such root, and every stage above it, is turned
+    half a turn about the motor axis (its cam keyed half a turn further, so it moves as before, turned):
+    its track lies across the shaft from the first.  A tree with a stage moving out of the xy plane is not
+    turned (no part records a turned xz or yz plane).
+    """
+    turns = [0.0] * len(toy.stages)
+    first: dict[str, str] = {}  # each root pattern's first cam
+    for i, st in enumerate(toy.stages):
+        if st.parent is not None:
+            turns[i] = turns[st.parent]
+            continue
+        cam = first.setdefault(st.key[0], st.cam)
+        tree = [s for s in toy.stages if s.cam == st.cam and s.key[:1] == st.key[:1]]
+        if cam != st.cam and all(p.plane == "xy" for s in tree for p in s.mech.parts):
+            turns[i] = math.pi
+    return turns
+
+
 def _placements(toy: Any) -> list[_Placed]:
     out: list[_Placed] = []
-    for st in toy.stages:
+    turns = _track_turns(toy)
+    for st, turn in zip(toy.stages, turns, strict=True):
         R = st.realisation.matrix
         ang = math.atan2(R[1, 0], R[0, 0])
         proper = abs(R[2, 2] - 1.0) < 1e-12 and abs(np.linalg.det(R[:2, :2]) - 1.0) < 1e-12
@@ -235,6 +258,7 @@ def _placements(toy: Any) -> list[_Placed]:
                 )
             anchor = _xf_point(par.place, f0[:2])
         if plane == "xy":
+            ang += turn
             c, s = math.cos(ang), math.sin(ang)
             t = (anchor[0] - (c * d0[0] - s * d0[1]), anchor[1] - (s * d0[0] + c * d0[1]))
             out.append(_Placed(st, (t[0], t[1], ang)))

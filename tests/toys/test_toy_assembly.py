@@ -89,7 +89,7 @@ def test_export_cuts_the_assembly_once(tmp_path, toys):
     names = [pc.name for pc in fab.layout.parts if not pc.name.startswith("spacer")]
     assert sorted(names) == sorted(p.name for p in toys["horse"].parts)
     assert names.count("frame") == 1
-    assert any("keyed to the motor shaft at 180 degrees" in n for n in fab.notes)
+    assert any("keyed to the motor shaft at 0 degrees = cam phase 180 + the stage's own turn 180" in n for n in fab.notes)
     out = tmp_path / "h.dxf"
     write_outputs(fab, dxf=out)
     doc = ezdxf.readfile(out)
@@ -197,7 +197,7 @@ def test_cli_toy(capsys):
 
     assert main(["toy", "gallery/horse.toml", "--json"]) == 0
     rep = json.loads(capsys.readouterr().out)
-    assert len(rep["pieces"]) == 8 and rep["keyed"] == {"cam.left": 0.0, "cam.right": 180.0}
+    assert len(rep["pieces"]) == 8 and rep["keyed"] == {"cam.left": 0.0, "cam.right": 0.0}
     assert rep["torque"]["max_rel_diff"] < 0.01 and all(s["simulated"] for s in rep["stages"])
     assert main(["toy", "gallery/windup-01.toml"]) == 2
     assert "a toy scene" in capsys.readouterr().err
@@ -235,3 +235,21 @@ def test_a_slide_repeated_on_one_line_is_cut_once(toys):
     slides = [j for j in asm.joints if isinstance(j, Slide)]
     pairs = [(j.a, j.b) for j in slides]
     assert len(pairs) == len(set(pairs))
+
+
+def test_merged_grounds_keep_separate_tracks():
+    """The Horse's two cam trees start with one pattern: the second is turned half a turn about the motor axis,
+    so the frame's two track slots do not coincide and the pins riding them stay apart over the cycle."""
+    asm = toy_assembly(horse(rate=math.pi))
+    tracks = [j for j in asm.joints if "frame" in (j.a, j.b) and j.name.endswith(".track")]
+    assert len(tracks) == 2
+    (c0, c1) = (np.array(j.centre) for j in tracks)
+    assert np.linalg.norm(c0 + c1) < 1e-12 and np.linalg.norm(c0 - c1) > 2 * tracks[0].radius
+    motion = asm.run(samples_per_cycle=97)
+    ends = []
+    for j in tracks:
+        part = j.b if j.a == "frame" else j.a
+        x, y, a = np.asarray(motion.poses[part], float).T
+        ends.append(np.c_[x + np.cos(a) * j.pin[0] - np.sin(a) * j.pin[1], y + np.sin(a) * j.pin[0] + np.cos(a) * j.pin[1]])
+    assert np.linalg.norm(ends[0] - ends[1], axis=1).min() > 2 * tracks[0].radius
+    assert max(assembly_residual(asm).values()) < 1e-9
