@@ -14,6 +14,5 @@ __getattr__, __dir__, __all__ = attach(
         "PLACERS": "planar.toys.assembly",
         "fit_play": "planar.toys.fitcheck",
         "small_motions": "planar.toys.fitcheck",
-        "assembly_rates": "planar.toys.rates",
     },
 )

@@ -391,7 +391,7 @@ def test_accuracy_benchmark_needs_a_scenes_folder(tmp_path, args):
     )
     assert r.returncode == 2, r.stderr
     assert "Traceback" not in r.stderr and len(r.stderr.strip().splitlines()) == 1
-    assert "scenes folder" in r.stderr and (args[-1] if args else "gallery") in r.stderr
+    assert "folder of scene files" in r.stderr and (args[-1] if args else "gallery") in r.stderr
     assert list(tmp_path.iterdir()) == []
 
 
