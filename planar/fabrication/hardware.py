@@ -23,7 +23,17 @@ from typing import Any
 
 from planar.errors import InputError
 
-__all__ = ["HARDWARE", "Item", "PinHardware", "hardware_of", "pin_ends", "pin_items", "shaft_items", "shaft_length"]
+__all__ = [
+    "HARDWARE",
+    "Item",
+    "PinHardware",
+    "hardware_of",
+    "pin_closing",
+    "pin_ends",
+    "pin_items",
+    "shaft_items",
+    "shaft_length",
+]
 
 #: DIN 125 washer per nominal diameter: (outer diameter, thickness) mm
 WASHER = {2.0: (5.0, 0.3), 2.5: (6.0, 0.5), 3.0: (7.0, 0.5), 4.0: (9.0, 0.8), 5.0: (10.0, 1.0), 6.0: (12.0, 1.6)}
@@ -61,6 +71,10 @@ class PinHardware:
     ends: Callable[[float], tuple[tuple[float, float], tuple[float, float]]]
     length: Callable[[float, float], float]
     items: Callable[[float, float], list[Item]]
+    #: what closes the lower end, fitted first (e.g. ``"washer, e-clip"``)
+    lower: str = ""
+    #: what closes the upper end, fitted last (e.g. ``"washer, nylon lock nut"``)
+    upper: str = ""
 
 
 def _size(d: float, table: dict[float, Any]) -> Any:
@@ -122,8 +136,10 @@ def _screw_items(d: float, stack: float) -> list[Item]:
 
 #: fastener kinds by ``[fabrication] hardware``
 HARDWARE: dict[str, PinHardware] = {
-    "rod-eclip": PinHardware("rod-eclip", _rod_ends, _rod_length, _rod_items),
-    "screw": PinHardware("screw", _screw_ends, _screw_length, _screw_items),
+    "rod-eclip": PinHardware("rod-eclip", _rod_ends, _rod_length, _rod_items, "e-clip, washer", "washer, e-clip"),
+    "screw": PinHardware(
+        "screw", _screw_ends, _screw_length, _screw_items, "button head screw, washer", "washer, nylon lock nut"
+    ),
 }
 
 
@@ -155,6 +171,12 @@ def stack_mm(settings: Any, pin: Any) -> float:
 def pin_length(settings: Any, pin: Any) -> float:
     """A pin's length (mm) as bought: a rod cut to length or a screw's sold length."""
     return hardware_of(settings).length(pin.diameter_mm, stack_mm(settings, pin))
+
+
+def pin_closing(settings: Any, pin: Any) -> tuple[str, str]:
+    """``(lower, upper)``: what closes a pin's lower end (fitted first) and its upper end (fitted last), in words."""
+    hw = hardware_of(settings)
+    return hw.lower, hw.upper
 
 
 def pin_items(settings: Any, pin: Any) -> list[Item]:
