@@ -18,7 +18,7 @@ import io
 import math
 from typing import Any
 
-from planar.fabrication.hardware import pin_items, shaft_items, shaft_length
+from planar.fabrication.hardware import driven_part, pin_items, shaft_items, shaft_length, shaft_retention
 from planar.fabrication.sheet import cut_polygon
 
 __all__ = ["bom_text"]
@@ -66,8 +66,9 @@ def bom_text(fab: Any) -> str:
                     "",
                     f"D {s.shaft_mm:g} ({s.shaft_flat_mm:g} across flat) x {shaft_length(s, pp):g} above the motor",
                     joins,
-                    f"joint {', '.join(pp.joints)}; motor under the ground plate, 2 screws M{s.motor_screw_mm:g} "
-                    f"{s.motor_screw_spacing_mm:g} mm apart",
+                    f"joint {', '.join(pp.joints)}; motor under the ground plate, 2 screws "
+                    f"{s.motor_screw_spacing_mm:g} mm apart; {shaft_retention(driven_part(pp, fab.grounds))}: "
+                    + " + ".join(f"{i.qty} {i.item} {i.size}" for i in shaft_items(s, pp)),
                 ]
             )
         else:

@@ -165,19 +165,20 @@ def assembly_steps_svg(fab: Any) -> list[str]:
         lines.append("lay " + (", ".join(here) if here else "nothing (an empty layer: the spacers fill it)"))
         for pp in flat:
             if (pp.layers or (0, 0))[1] == k:
-                lines.append(_close_line(s, pp))
+                lines.append(_close_line(fab, pp))
         drawn = [(layer if layer == k else -1, n, g) for layer, n, g in shapes if layer <= k]
         pins = [pp for pp in flat if (pp.layers or (0, 0))[0] <= k]
         pages.append(_page(fab, drawn, pins, lines, [], extent=shapes))
     return pages
 
 
-def _close_line(s: Any, pp: Any) -> str:
-    """The step line that closes a pin's (or the motor shaft's) upper end with its own hardware."""
-    from planar.fabrication.hardware import pin_closing
+def _close_line(fab: Any, pp: Any) -> str:
+    """The step line that closes a pin's upper end with its own hardware (the motor shaft: how it is held)."""
+    from planar.fabrication.hardware import driven_part, pin_closing, shaft_retention
 
+    s = fab.settings
     if pp.shaft:
-        return "close the motor shaft on top (washer, e-clip)"
+        return f"fix the motor shaft: {shaft_retention(driven_part(pp, fab.grounds))}"
     return f"close pin {pp.letter} on top ({pin_closing(s, pp)[1]})"
 
 

@@ -9,7 +9,10 @@ A pin is one of these kinds (``[fabrication] hardware``), sized from ``pin_diame
   and a DIN 985 nylon lock nut (the lock nut keeps the joint free without tightening it).  The nut's end
   stands a washer, the nut and a thread past it above its layer (5.5 mm for M3).
 
-The motor shaft ends in one washer and e-clip above its top layer (the motor holds it below).
+The motor shaft (an N20 gearmotor's D shaft: no groove for a clip) is held by its driven part: that part's D
+hole fits the shaft's flat (snug: the flat carries the torque) and a drop of glue (cyanoacrylate or epoxy) on the
+flat keeps it from sliding off.
+The shaft ends flush with its top layer (shorten a longer one): nothing stands above it.
 Sizes are the standard tables' for the diameters makers use (2, 2.5, 3, 4, 5 and 6 mm); another
 diameter is an error naming ``pin_diameter_mm``.
 """
@@ -101,7 +104,11 @@ def _rod_items(d: float, stack: float) -> list[Item]:
     wd, wt = _size(d, WASHER)
     size, _, _ = _size(d, ECLIP)
     return [
-        Item("steel rod", f"{d:g} mm x {_rod_length(d, stack):g} mm", 1),
+        Item(
+            f"steel rod (an e-clip groove {size:g} mm near each end: bought grooved or cut)",
+            f"{d:g} mm x {_rod_length(d, stack):g} mm",
+            1,
+        ),
         Item("washer DIN 125", f"M{d:g} ({wd:g} x {wt:g} mm)", 2),
         Item("e-clip DIN 6799", f"{size:g} (for {d:g} mm shaft)", 2),
     ]
@@ -154,11 +161,10 @@ def hardware_of(settings: Any) -> PinHardware:
 def pin_ends(settings: Any, pin: Any) -> tuple[tuple[float, float], tuple[float, float]]:
     """``((height, diameter) below, (height, diameter) above)`` mm of a pin's ends beyond its layers.
 
-    The motor shaft has none below (the motor) and a washer and e-clip of the shaft's diameter above.
+    The motor shaft has none: the motor is below it, and it ends flush with its top layer (held by glue).
     """
     if pin.shaft:
-        wd, wt = WASHER.get(round(settings.shaft_mm * 2) / 2, (2 * settings.shaft_mm + 1, 0.5))
-        return (0.0, 0.0), (wt + 0.6, wd)
+        return (0.0, 0.0), (0.0, 0.0)
     return hardware_of(settings).ends(pin.diameter_mm)
 
 
@@ -185,20 +191,29 @@ def pin_items(settings: Any, pin: Any) -> list[Item]:
 
 
 def shaft_length(settings: Any, pin: Any) -> float:
-    """The motor shaft's length above the motor's face (mm): through every layer up to its top one, a washer and
-    e-clip and 0.5 mm past the groove, rounded up to 0.5 mm (the motor sits under the bottom layer)."""
+    """The motor shaft's length above the motor's face (mm): through every layer up to its top one, ending flush,
+    rounded up to 0.5 mm (the motor sits under the bottom layer; a longer shaft is shortened to it)."""
     _, hi = pin.layers or (0, 0)
-    (_, _), (ht, _) = pin_ends(settings, pin)
-    return math.ceil(((hi + 1) * settings.thickness_mm + ht + 0.5) * 2 - 1e-9) / 2
+    return math.ceil((hi + 1) * settings.thickness_mm * 2 - 1e-9) / 2
+
+
+#: what holds the driven part on the motor shaft (an N20's D shaft has no groove for an e-clip)
+SHAFT_GLUE = Item("glue (cyanoacrylate or epoxy)", "a drop on the shaft's flat", 1)
 
 
 def shaft_items(settings: Any, pin: Any) -> list[Item]:
-    """What holds the motor shaft's top end: a washer and an e-clip of its diameter (where they are sold)."""
-    d = round(settings.shaft_mm * 2) / 2
-    if d not in WASHER:
-        return []
-    wd, wt = WASHER[d]
-    return [
-        Item("washer DIN 125", f"M{d:g} ({wd:g} x {wt:g} mm)", 1),
-        Item("e-clip DIN 6799", f"{ECLIP[d][0]:g} (for {d:g} mm shaft)", 1),
-    ]
+    """What holds the motor shaft in its driven part: a drop of glue on the flat (the D hole is a snug fit)."""
+    return [SHAFT_GLUE]
+
+
+def driven_part(pin: Any, grounds: Any) -> str:
+    """The part the motor shaft turns (the one with the D hole): the first of the shaft's parts that is no ground."""
+    return next((p for p in pin.parts if p not in grounds), pin.parts[-1])
+
+
+def shaft_retention(driven: str) -> str:
+    """How the driven part (named) is held on the motor shaft, in words (the BOM, plan.json and the steps say it)."""
+    return (
+        f"{driven}'s D hole fits the shaft's flat (a snug fit, the flat carries the torque); a drop of glue "
+        "(cyanoacrylate or epoxy) on the flat keeps it on the shaft (no e-clip: a D shaft has no groove)"
+    )

@@ -86,3 +86,29 @@ def test_step_lines_name_each_pins_own_closing_hardware(tmp_path, hardware, clos
         assert len(close) == 1, (p["name"], lines)
         assert closer in close[0] and not_closer not in close[0], close[0]
         assert closer in bought  # the step names an item the plan says to buy for that pin
+
+
+@pytest.mark.parametrize("hardware", ["screw", "rod-eclip"])
+def test_motor_shaft_hardware_agrees_in_bom_plan_and_steps(tmp_path, hardware):
+    out = export_bird(tmp_path, f'hardware = "{hardware}"\n')
+    shaft = out["plan"]["motor_shaft"]
+    assert shaft["hardware"], shaft  # what holds it is listed, and it is no clip (a D shaft has no groove)
+    assert not any("clip" in h["item"] for h in shaft["hardware"])
+    row = next(r for r in out["bom"] if r["item"] == "motor shaft")
+    for h in shaft["hardware"]:
+        assert f"{h['qty']} {h['item']} {h['size']}" in row["notes"]
+    assert shaft["retention"] in row["notes"]
+    assert any(shaft["retention"] in ln for ln in _step_lines(out))
+    # ends flush with its top layer: the length above the motor is the layers it passes, nothing stands above
+    _lo, hi = shaft["layers"]
+    assert shaft["length_mm"] == pytest.approx(hi * out["plan"]["thickness_mm"])
+    assert shaft["ends"]["upper"]["height_mm"] == 0
+    # the buy totals are the sum of every pin's and the shaft's hardware, item by item
+    want: dict = {}
+    for p in [*out["plan"]["pins"], shaft]:
+        for h in p["hardware"]:
+            want[(h["item"], h["size"])] = want.get((h["item"], h["size"]), 0) + h["qty"]
+    got = {(r["id"], r["size_mm"]): int(r["qty"]) for r in out["bom"] if r["item"] == "buy"}
+    assert {k: v for k, v in got.items() if k in want} == want
+    if hardware == "rod-eclip":  # a rod holds its clips only in grooves: the row says so
+        assert all("groove" in r["notes"] for r in out["bom"] if r["item"] == "pin")
