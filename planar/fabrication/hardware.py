@@ -206,6 +206,57 @@ def shaft_items(settings: Any, pin: Any) -> list[Item]:
     return [SHAFT_GLUE]
 
 
+#: metric screw sizes (mm) and the short lengths sold for the small ones
+METRIC = (1.6, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0)
+SMALL_LENGTHS = (2, 2.5, 3, 4, 5, 6, 8, 10)
+#: thread a motor screw engages in an N20 gearmotor's face (its holes are 2-3 mm deep) (mm)
+MOTOR_THREAD_MM = 1.5
+
+
+def _metric_for(hole: float) -> float:
+    """The largest metric screw a clearance hole of ``hole`` mm takes (at least 0.1 mm of play)."""
+    fits = [m for m in METRIC if m <= hole - 0.1 + 1e-9]
+    return fits[-1] if fits else METRIC[0]
+
+
+def _sold(need: float) -> float:
+    """The shortest screw length sold (mm) of at least ``need`` mm."""
+    for n in sorted(set(SMALL_LENGTHS) | set(SCREW_LENGTHS)):
+        if n >= need - 1e-9:
+            return float(n)
+    raise InputError("fabrication.thickness_mm", need, f"a plate a screw under {SCREW_LENGTHS[-1]} mm passes")
+
+
+def motor_items(settings: Any) -> list[Item]:
+    """The motor (an N20 gearmotor with the settings' D shaft) and its two face screws: through the plate holding
+    it and ``MOTOR_THREAD_MM`` into the motor's face (M1.6 for the default 1.7 mm holes: check your motor)."""
+    m = _metric_for(settings.motor_screw_mm)
+    n = _sold(settings.thickness_mm + MOTOR_THREAD_MM)
+    return [
+        Item(
+            "N20 gearmotor",
+            f"D {settings.shaft_mm:g} shaft ({settings.shaft_flat_mm:g} across flat), "
+            f"face screws {settings.motor_screw_spacing_mm:g} mm apart",
+            1,
+        ),
+        Item("pan head screw ISO 7045", f"M{m:g} x {n:g} (check your motor)", 2),
+    ]
+
+
+def mounting_items(settings: Any) -> list[Item]:
+    """One ground plate's two mounting screws, washers and nylon lock nuts, long enough for the plate on a base
+    board of the same thickness (a thicker base needs a longer screw: the BOM row says so)."""
+    m = _metric_for(settings.mounting_hole_mm)
+    wd, wt = WASHER.get(m, (2 * m + 1, 0.5))
+    _, nh = NYLOC.get(m, (2 * m, 0.8 * m))
+    n = _sold(2 * settings.thickness_mm + wt + nh + 1.0)
+    return [
+        Item("button head screw ISO 7380", f"M{m:g} x {n:g}", 2),
+        Item("washer DIN 125", f"M{m:g} ({wd:g} x {wt:g} mm)", 2),
+        Item("nylon lock nut DIN 985", f"M{m:g}", 2),
+    ]
+
+
 def driven_part(pin: Any, grounds: Any) -> str:
     """The part the motor shaft turns (the one with the D hole): the first of the shaft's parts that is no ground."""
     return next((p for p in pin.parts if p not in grounds), pin.parts[-1])

@@ -48,10 +48,10 @@ sheet_mm = [300.0, 200.0]
 """
 
 
-def export_bird(tmp_path: Path, extra: str = "") -> dict:
+def export_bird(tmp_path: Path, extra: str = "", thickness_mm: float = 3.0) -> dict:
     """Export the bird with ``extra`` lines in its ``[fabrication]`` table; the files' texts by kind."""
     toml = tmp_path / "bird.toml"
-    toml.write_text(BIRD + extra)
+    toml.write_text(BIRD.replace("thickness_mm = 3.0", f"thickness_mm = {thickness_mm}") + extra)
     fab = export_scene(
         load_scene(toml),
         dxf=tmp_path / "parts.dxf",
@@ -108,7 +108,31 @@ def test_motor_shaft_hardware_agrees_in_bom_plan_and_steps(tmp_path, hardware):
     for p in [*out["plan"]["pins"], shaft]:
         for h in p["hardware"]:
             want[(h["item"], h["size"])] = want.get((h["item"], h["size"]), 0) + h["qty"]
-    got = {(r["id"], r["size_mm"]): int(r["qty"]) for r in out["bom"] if r["item"] == "buy"}
-    assert {k: v for k, v in got.items() if k in want} == want
+    buy = {(r["id"], r["size_mm"]): r for r in out["bom"] if r["item"] == "buy"}
+    for k, qty in want.items():  # items the mounting screws use too are counted with theirs
+        assert int(buy[k]["qty"]) == qty if "mounting" not in buy[k]["notes"] else int(buy[k]["qty"]) > qty
     if hardware == "rod-eclip":  # a rod holds its clips only in grooves: the row says so
         assert all("groove" in r["notes"] for r in out["bom"] if r["item"] == "pin")
+
+
+@pytest.mark.parametrize("thickness", [3.0, 6.0])
+def test_bom_buys_the_motor_its_screws_and_the_mounting_screws_with_lengths(tmp_path, thickness):
+    out = export_bird(tmp_path, 'hardware = "screw"\n', thickness_mm=thickness)
+    bom = out["bom"]
+    buy = [r for r in bom if r["item"] == "buy"]
+    assert [int(r["qty"]) for r in buy if r["id"] == "N20 gearmotor"] == [1]
+    motor_screw = next(r for r in bom if r["item"] == "motor screw")
+    assert motor_screw["size_mm"].startswith("M1.6 x ") and "check your motor" in motor_screw["size_mm"]
+    length = float(motor_screw["size_mm"].split(" x ")[1].split()[0])
+    t = out["plan"]["thickness_mm"]
+    assert t == thickness
+    assert t + 1 <= length <= t + 3  # through the plate and 1-3 mm into the motor's face (holes 2-3 mm deep)
+    assert any(r["size_mm"] == motor_screw["size_mm"] and int(r["qty"]) == 2 for r in buy)
+    mounting = next(r for r in bom if r["item"] == "mounting screw")
+    plates = [p for p in out["plan"]["parts"] if p["name"] == "ground"]
+    assert int(mounting["qty"]) == 2 * len(plates)
+    m, length_text = mounting["size_mm"].split(" x ")
+    assert m == "M3"  # 3.2 mm holes
+    # plate + base board + washer (0.5) + DIN 985 M3 nut (4 mm) + a thread past it
+    assert float(length_text) >= 2 * t + 0.5 + 4.0 + 1.0
+    assert any(r["size_mm"] == mounting["size_mm"] for r in buy)
