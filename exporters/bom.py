@@ -129,6 +129,21 @@ def bom_text(fab: Any) -> str:
                 f"{jn.letter} ({lo:g} x {hi:g} mm) of {jn.base}; glue them",
             ]
         )
+    for p in lay.parts:
+        if p.name == "reference square":  # cut beside the parts, no part of the assembly
+            x0, y0, x1, y1 = cut_polygon(p.outer, math.radians(0.5)).bounds
+            w.writerow(
+                [
+                    "reference square",
+                    "",
+                    1,
+                    "",
+                    p.sheet + 1,
+                    f"{s.reference_square_mm:g} x {s.reference_square_mm:g}",
+                    "",
+                    "not a part: measure it after cutting to check the scale",
+                ]
+            )
     _fixing_rows(w, fab)
     _buy_rows(w, fab)
     return buf.getvalue()

@@ -117,6 +117,11 @@ def plan_dict(fab: Any) -> dict[str, Any]:
         "parts": _parts(fab),
         "pins": [_pin(fab, p) for p in pins],
         "spacers": _spacers(fab),
+        "extras": [
+            {"name": p.name, "sheet": p.sheet + 1, "placement": [_r(p.placed[1]), _r(p.placed[2]), _r(math.degrees(p.placed[0]))]}
+            for p in fab.layout.parts
+            if p.name == "reference square"
+        ],
         "motor_shaft": _pin(fab, shafts[0]) if shafts else None,
         "contacts": [{"joint": c.joint, "parts": list(c.parts)} for c in fab.assembly.contacts],
         "violations": [

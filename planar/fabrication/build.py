@@ -451,8 +451,10 @@ def summary(fab: Fabrication) -> str:
     layers = max(asm.n_layers.values()) if asm.n_layers else 0
     spacers = sum(p.spacers for p in asm.pins)
     rings = f" + {spacers} spacer ring(s)" if spacers else ""
+    extras = [p.name for p in lay.parts if p.name == "reference square"]  # cut, but no part of the assembly
+    rings += "".join(f" + a {n}" for n in extras)
     return (
-        f"{len(lay.parts) - spacers} parts{rings} on {lay.sheets} sheet(s) of {lay.sheet_size[0]:g} x "
+        f"{len(lay.parts) - spacers - len(extras)} parts{rings} on {lay.sheets} sheet(s) of {lay.sheet_size[0]:g} x "
         f"{lay.sheet_size[1]:g} mm (utilisation {util}), kerf {lay.kerf:g} mm, {layers} layer(s) of "
         f"{fab.settings.thickness_mm:g} mm, {len(asm.pins)} pin(s)"
     )

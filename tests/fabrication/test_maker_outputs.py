@@ -136,3 +136,18 @@ def test_bom_buys_the_motor_its_screws_and_the_mounting_screws_with_lengths(tmp_
     # plate + base board + washer (0.5) + DIN 985 M3 nut (4 mm) + a thread past it
     assert float(length_text) >= 2 * t + 0.5 + 4.0 + 1.0
     assert any(r["size_mm"] == mounting["size_mm"] for r in buy)
+
+
+def test_reference_square_is_listed_everywhere_and_counted_nowhere_as_a_part(tmp_path):
+    import ezdxf
+
+    from planar.fabrication.build import summary
+
+    out = export_bird(tmp_path, "reference_square_mm = 20\n")
+    groups = set(dict(ezdxf.readfile(tmp_path / "parts.dxf").groups))
+    parts = [p["name"] for p in out["plan"]["parts"]]
+    assert [e["name"] for e in out["plan"]["extras"]] == ["reference square"]
+    assert any("reference" in g and "square" in g for g in groups)
+    assert [r["item"] for r in out["bom"] if "reference" in r["item"]] == ["reference square"]
+    assert len([r for r in out["bom"] if r["item"] == "part"]) == len(parts)
+    assert summary(out["fab"]).startswith(f"{len(parts)} parts")
