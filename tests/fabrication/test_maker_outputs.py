@@ -151,3 +151,14 @@ def test_reference_square_is_listed_everywhere_and_counted_nowhere_as_a_part(tmp
     assert [r["item"] for r in out["bom"] if "reference" in r["item"]] == ["reference square"]
     assert len([r for r in out["bom"] if r["item"] == "part"]) == len(parts)
     assert summary(out["fab"]).startswith(f"{len(parts)} parts")
+
+
+def test_fabrication_value_error_starts_with_the_scene_file(tmp_path, capsys):
+    from planar.cli.main import main
+
+    toml = tmp_path / "bird.toml"
+    toml.write_text(BIRD.replace("pin_diameter_mm = 3.0", "pin_diameter_mm = 3.5"))
+    assert main(["export", str(toml), "-o", str(tmp_path / "p.dxf")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "bird.toml: fabrication.pin_diameter_mm = 3.5: " in err[0], err
+    assert not (tmp_path / "p.dxf").exists()
