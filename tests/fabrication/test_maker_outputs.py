@@ -14,6 +14,8 @@ import pytest
 from planar.app.pipeline import export_scene
 from planar.scene.load import load_scene
 
+pytestmark = pytest.mark.slow  # each test exports the bird with its build check (over 0.5 s CPU)
+
 BIRD = """name = "nodding-bird"
 angle_unit = "deg"
 
