@@ -281,7 +281,8 @@ def _legend(fab: Any) -> list[str]:
         if pl != "xy":
             lines.append(f"standing in the {pl} plane:")
         for k in range(max(asm.layers[n] or 0 for n in names) + 1):
-            lines.append(f"  layer {k + 1}: " + ", ".join(n for n in names if asm.layers[n] == k))
+            here = ", ".join(n for n in names if asm.layers[n] == k)
+            lines.append(f"  layer {k + 1}: " + (here or "spacers only (room for a pin's end or a part passing)"))
     for pp in asm.pins:
         lo, hi = pp.layers or (0, 0)
         what = "motor shaft" if pp.shaft else f"pin d{pp.diameter_mm:g} x {pp.length_mm:g} mm ({fab.settings.hardware})"

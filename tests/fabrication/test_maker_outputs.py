@@ -60,12 +60,14 @@ def export_bird(tmp_path: Path, extra: str = "", thickness_mm: float = 3.0) -> d
         bom=tmp_path / "bom.csv",
         plan=tmp_path / "plan.json",
         steps=tmp_path / "steps.svg",
+        assembly=tmp_path / "assembly.svg",
     )
     steps = [p.read_text() for p in sorted(tmp_path.glob("steps-*.svg"), key=lambda p: int(p.stem.split("-")[1]))]
     return {
         "fab": fab,
         "bom": list(csv.DictReader((tmp_path / "bom.csv").read_text().splitlines())),
         "plan": json.loads((tmp_path / "plan.json").read_text()),
+        "assembly": re.sub(r"<[^>]+>", "\n", (tmp_path / "assembly.svg").read_text()),
         "steps": [re.sub(r"<[^>]+>", "\n", s) for s in steps],
     }
 
@@ -164,3 +166,13 @@ def test_fabrication_value_error_starts_with_the_scene_file(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "bird.toml: fabrication.pin_diameter_mm = 3.5: " in err[0], err
     assert not (tmp_path / "p.dxf").exists()
+
+
+def test_legend_names_what_fills_an_empty_layer(tmp_path):
+    out = export_bird(tmp_path)
+    layers = [ln.strip() for ln in out["assembly"].splitlines() if ln.strip().startswith("layer ")]
+    assert layers and all(not ln.endswith(":") for ln in layers), layers
+    used = {p["layer"] for p in out["plan"]["parts"]}
+    for s in out["plan"]["spacers"]:
+        if s["layer"] not in used:
+            assert any(ln.startswith(f"layer {s['layer']}: spacers") for ln in layers), layers
