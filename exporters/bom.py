@@ -2,7 +2,8 @@
 
 Columns: ``item, id, qty, layer, sheet, size_mm, joins, notes``.  Each pin's row names what it is made of (the
 ``[fabrication] hardware``: a steel rod with washers and e-clips, or a button-head screw with washers and a nylon
-lock nut; :mod:`planar.fabrication.hardware`), the motor shaft's row its length above the motor, and the
+lock nut; :mod:`planar.fabrication.hardware`), the motor shaft's row its length above the motor and what holds
+its driven part, the ``motor``, ``motor screw`` and ``mounting screw`` rows their sizes with lengths, and the
 ``buy`` rows at the end total every item to buy by size.  A ``tabs`` row
 per tab-and-slot joint (``planar.fabrication.tabs``): its letter, the number of tabs,
 a tab's ``width x length``, ``piece -> xy piece`` and which slots they go into.  Layers and
@@ -18,7 +19,15 @@ import io
 import math
 from typing import Any
 
-from planar.fabrication.hardware import pin_items, shaft_items, shaft_length
+from planar.fabrication.hardware import (
+    driven_part,
+    motor_items,
+    mounting_items,
+    pin_items,
+    shaft_items,
+    shaft_length,
+    shaft_retention,
+)
 from planar.fabrication.sheet import cut_polygon
 
 __all__ = ["bom_text"]
@@ -66,8 +75,9 @@ def bom_text(fab: Any) -> str:
                     "",
                     f"D {s.shaft_mm:g} ({s.shaft_flat_mm:g} across flat) x {shaft_length(s, pp):g} above the motor",
                     joins,
-                    f"joint {', '.join(pp.joints)}; motor under the ground plate, 2 screws M{s.motor_screw_mm:g} "
-                    f"{s.motor_screw_spacing_mm:g} mm apart",
+                    f"joint {', '.join(pp.joints)}; motor under the ground plate, 2 screws "
+                    f"{s.motor_screw_spacing_mm:g} mm apart; {shaft_retention(driven_part(pp, fab.grounds))}: "
+                    + " + ".join(f"{i.qty} {i.item} {i.size}" for i in shaft_items(s, pp)),
                 ]
             )
         else:
@@ -119,31 +129,85 @@ def bom_text(fab: Any) -> str:
                 f"{jn.letter} ({lo:g} x {hi:g} mm) of {jn.base}; glue them",
             ]
         )
-    grounds = [p for p in lay.parts if asm.layers.get(p.name) is not None and p.name in fab.grounds]
-    if grounds:
-        w.writerow(
-            [
-                "mounting screw",
-                "",
-                2 * len(grounds),
-                "",
-                "",
-                f"M{s.mounting_hole_mm - 0.2:g}",
-                "",
-                f"{s.mounting_hole_mm:g} mm holes, two per ground plate",
-            ]
-        )
+    for p in lay.parts:
+        if p.name == "reference square":  # cut beside the parts, no part of the assembly
+            x0, y0, x1, y1 = cut_polygon(p.outer, math.radians(0.5)).bounds
+            w.writerow(
+                [
+                    "reference square",
+                    "",
+                    1,
+                    "",
+                    p.sheet + 1,
+                    f"{s.reference_square_mm:g} x {s.reference_square_mm:g}",
+                    "",
+                    "not a part: measure it after cutting to check the scale",
+                ]
+            )
+    _fixing_rows(w, fab)
     _buy_rows(w, fab)
     return buf.getvalue()
 
 
+def _plates(fab: Any) -> list[str]:
+    """The ground plates cut flat (each has two mounting holes)."""
+    asm = fab.assembly
+    return [p.name for p in fab.layout.parts if asm.layers.get(p.name) is not None and p.name in fab.grounds]
+
+
+def _fixing_rows(w: Any, fab: Any) -> None:
+    """The motor with its face screws, and the ground plates' mounting screws, washers and nuts."""
+    s = fab.settings
+    for pp in fab.assembly.pins:
+        if pp.shaft:
+            motor, screw = motor_items(s)
+            w.writerow(["motor", pp.letter, motor.qty, "", "", motor.size, "", f"{motor.item}; its shaft is pin {pp.letter}"])
+            w.writerow(
+                [
+                    "motor screw",
+                    pp.letter,
+                    screw.qty,
+                    "",
+                    "",
+                    screw.size,
+                    "",
+                    f"{screw.item}, up through the plate into the motor's face "
+                    f"({s.motor_screw_mm:g} mm holes, {s.motor_screw_spacing_mm:g} mm apart)",
+                ]
+            )
+    plates = _plates(fab)
+    if plates:
+        screw, washer, nut = mounting_items(s)
+        w.writerow(
+            [
+                "mounting screw",
+                "",
+                screw.qty * len(plates),
+                "",
+                "",
+                screw.size,
+                "",
+                f"{screw.item} + {washer.item} + {nut.item}, two per ground plate ({s.mounting_hole_mm:g} mm holes); "
+                f"long enough for a {s.thickness_mm:g} mm base board under the plate (a thicker base: a longer screw)",
+            ]
+        )
+
+
 def _buy_rows(w: Any, fab: Any) -> None:
-    """One ``buy`` row per item to buy (fasteners by size, the motor shaft's washer and clip): totals."""
+    """One ``buy`` row per item to buy by size (pins' fasteners, the motor, its screws and glue, mounting screws): totals."""
     s, asm = fab.settings, fab.assembly
     total: dict[tuple[str, str], int] = {}
-    for pp in asm.pins:
-        items = shaft_items(s, pp) if pp.shaft else pin_items(s, pp)
+    uses: dict[tuple[str, str], list[str]] = {}
+
+    def add(items: list[Any], use: str) -> None:
         for i in items:
             total[(i.item, i.size)] = total.get((i.item, i.size), 0) + i.qty
+            if use not in uses.setdefault((i.item, i.size), []):
+                uses[(i.item, i.size)].append(use)
+
+    for pp in asm.pins:
+        add(shaft_items(s, pp) + motor_items(s) if pp.shaft else pin_items(s, pp), "motor" if pp.shaft else "pins")
+    for _ in _plates(fab):
+        add(mounting_items(s), "mounting")
     for (item, size), qty in sorted(total.items()):
-        w.writerow(["buy", item, qty, "", "", size, "", "total for every pin"])
+        w.writerow(["buy", item, qty, "", "", size, "", "total for " + ", ".join(uses[(item, size)])])

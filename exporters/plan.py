@@ -45,7 +45,7 @@ def _parts(fab: Any) -> list[dict[str, Any]]:
 
 
 def _pin(fab: Any, pp: Any) -> dict[str, Any]:
-    from planar.fabrication.hardware import pin_ends, pin_items, shaft_length
+    from planar.fabrication.hardware import driven_part, pin_ends, pin_items, shaft_items, shaft_length, shaft_retention
 
     s = fab.settings
     lo, hi = pp.layers or (0, 0)
@@ -64,8 +64,9 @@ def _pin(fab: Any, pp: Any) -> dict[str, Any]:
     }
     if pp.shaft:
         d["flat_mm"] = _r(s.shaft_flat_mm)
-    else:
-        d["hardware"] = [{"item": i.item, "size": i.size, "qty": i.qty} for i in pin_items(s, pp)]
+        d["retention"] = shaft_retention(driven_part(pp, fab.grounds))
+    items = shaft_items(s, pp) if pp.shaft else pin_items(s, pp)
+    d["hardware"] = [{"item": i.item, "size": i.size, "qty": i.qty} for i in items]
     return d
 
 
@@ -116,6 +117,11 @@ def plan_dict(fab: Any) -> dict[str, Any]:
         "parts": _parts(fab),
         "pins": [_pin(fab, p) for p in pins],
         "spacers": _spacers(fab),
+        "extras": [
+            {"name": p.name, "sheet": p.sheet + 1, "placement": [_r(p.placed[1]), _r(p.placed[2]), _r(math.degrees(p.placed[0]))]}
+            for p in fab.layout.parts
+            if p.name == "reference square"
+        ],
         "motor_shaft": _pin(fab, shafts[0]) if shafts else None,
         "contacts": [{"joint": c.joint, "parts": list(c.parts)} for c in fab.assembly.contacts],
         "violations": [

@@ -138,7 +138,7 @@ def assembly_svg_text(fab: Any) -> str:
 def assembly_steps_svg(fab: Any) -> list[str]:
     """The assembly steps: one SVG page per layer from the bottom, the parts laid so far grey, this step's parts
     coloured, and what to do: which pins go in from below, which spacers go on, which ends close the pins."""
-    from planar.fabrication.hardware import pin_items
+    from planar.fabrication.hardware import pin_closing, pin_items
 
     asm, s = fab.assembly, fab.settings
     shapes = _placed_shapes(fab)
@@ -158,17 +158,28 @@ def assembly_steps_svg(fab: Any) -> list[str]:
             lo, hi = pp.layers or (0, 0)
             if lo == k and not pp.shaft:
                 what = ", ".join(f"{i.qty} x {i.item} {i.size}" for i in pin_items(s, pp))
-                lines.append(f"pin {pp.letter} up through this layer, its lower end fitted first: {what}")
+                low = pin_closing(s, pp)[0]
+                lines.append(f"pin {pp.letter} up through this layer, its lower end ({low}) fitted first: {what}")
             if lo < k <= hi and not any(asm.layers.get(p) == k for p in pp.parts):
                 lines.append(f"slide a spacer ring onto pin {pp.letter}")
         lines.append("lay " + (", ".join(here) if here else "nothing (an empty layer: the spacers fill it)"))
         for pp in flat:
             if (pp.layers or (0, 0))[1] == k:
-                lines.append(f"close {'the motor shaft' if pp.shaft else 'pin ' + pp.letter} on top (washer, e-clip)")
+                lines.append(_close_line(fab, pp))
         drawn = [(layer if layer == k else -1, n, g) for layer, n, g in shapes if layer <= k]
         pins = [pp for pp in flat if (pp.layers or (0, 0))[0] <= k]
         pages.append(_page(fab, drawn, pins, lines, [], extent=shapes))
     return pages
+
+
+def _close_line(fab: Any, pp: Any) -> str:
+    """The step line that closes a pin's upper end with its own hardware (the motor shaft: how it is held)."""
+    from planar.fabrication.hardware import driven_part, pin_closing, shaft_retention
+
+    s = fab.settings
+    if pp.shaft:
+        return f"fix the motor shaft: {shaft_retention(driven_part(pp, fab.grounds))}"
+    return f"close pin {pp.letter} on top ({pin_closing(s, pp)[1]})"
 
 
 def _page(
@@ -270,7 +281,8 @@ def _legend(fab: Any) -> list[str]:
         if pl != "xy":
             lines.append(f"standing in the {pl} plane:")
         for k in range(max(asm.layers[n] or 0 for n in names) + 1):
-            lines.append(f"  layer {k + 1}: " + ", ".join(n for n in names if asm.layers[n] == k))
+            here = ", ".join(n for n in names if asm.layers[n] == k)
+            lines.append(f"  layer {k + 1}: " + (here or "spacers only (room for a pin's end or a part passing)"))
     for pp in asm.pins:
         lo, hi = pp.layers or (0, 0)
         what = "motor shaft" if pp.shaft else f"pin d{pp.diameter_mm:g} x {pp.length_mm:g} mm ({fab.settings.hardware})"

@@ -228,7 +228,22 @@ def _tab_notes(cuts: list[PartCut], joins: list[Any], s: FabSettings) -> list[st
 
 
 def build(scene: Any, settings: FabSettings) -> Fabrication:
-    """Cut-ready, checked, layered and nested parts of ``scene`` (raises FabricationError/InputError)."""
+    """Cut-ready, checked, layered and nested parts of ``scene`` (raises FabricationError/InputError).
+
+    An error in a ``[fabrication]`` value read from a scene file starts with the file's name
+    (``bird.toml: fabrication.pin_diameter_mm = 3.5: ...``), as every scene error does.
+    """
+    try:
+        return _build(scene, settings)
+    except InputError as e:
+        where = getattr(scene, "path", None)
+        if not (e.field.startswith("fabrication.") and where and Path(str(where)).is_file()):
+            raise
+        raise InputError(f"{Path(str(where)).name}: {e.field}", e.value, e.expected) from e
+
+
+def _build(scene: Any, settings: FabSettings) -> Fabrication:
+    """:func:`build` without the file name on its errors."""
     s = settings
     if not (0 <= s.kerf <= 2):
         raise InputError("kerf", s.kerf, "a kerf between 0 and 2 mm")
@@ -451,8 +466,10 @@ def summary(fab: Fabrication) -> str:
     layers = max(asm.n_layers.values()) if asm.n_layers else 0
     spacers = sum(p.spacers for p in asm.pins)
     rings = f" + {spacers} spacer ring(s)" if spacers else ""
+    extras = [p.name for p in lay.parts if p.name == "reference square"]  # cut, but no part of the assembly
+    rings += "".join(f" + a {n}" for n in extras)
     return (
-        f"{len(lay.parts) - spacers} parts{rings} on {lay.sheets} sheet(s) of {lay.sheet_size[0]:g} x "
+        f"{len(lay.parts) - spacers - len(extras)} parts{rings} on {lay.sheets} sheet(s) of {lay.sheet_size[0]:g} x "
         f"{lay.sheet_size[1]:g} mm (utilisation {util}), kerf {lay.kerf:g} mm, {layers} layer(s) of "
         f"{fab.settings.thickness_mm:g} mm, {len(asm.pins)} pin(s)"
     )

@@ -9,7 +9,10 @@ A pin is one of these kinds (``[fabrication] hardware``), sized from ``pin_diame
   and a DIN 985 nylon lock nut (the lock nut keeps the joint free without tightening it).  The nut's end
   stands a washer, the nut and a thread past it above its layer (5.5 mm for M3).
 
-The motor shaft ends in one washer and e-clip above its top layer (the motor holds it below).
+The motor shaft (an N20 gearmotor's D shaft: no groove for a clip) is held by its driven part: that part's D
+hole fits the shaft's flat (snug: the flat carries the torque) and a drop of glue (cyanoacrylate or epoxy) on the
+flat keeps it from sliding off.
+The shaft ends flush with its top layer (shorten a longer one): nothing stands above it.
 Sizes are the standard tables' for the diameters makers use (2, 2.5, 3, 4, 5 and 6 mm); another
 diameter is an error naming ``pin_diameter_mm``.
 """
@@ -23,7 +26,17 @@ from typing import Any
 
 from planar.errors import InputError
 
-__all__ = ["HARDWARE", "Item", "PinHardware", "hardware_of", "pin_ends", "pin_items", "shaft_items", "shaft_length"]
+__all__ = [
+    "HARDWARE",
+    "Item",
+    "PinHardware",
+    "hardware_of",
+    "pin_closing",
+    "pin_ends",
+    "pin_items",
+    "shaft_items",
+    "shaft_length",
+]
 
 #: DIN 125 washer per nominal diameter: (outer diameter, thickness) mm
 WASHER = {2.0: (5.0, 0.3), 2.5: (6.0, 0.5), 3.0: (7.0, 0.5), 4.0: (9.0, 0.8), 5.0: (10.0, 1.0), 6.0: (12.0, 1.6)}
@@ -61,6 +74,10 @@ class PinHardware:
     ends: Callable[[float], tuple[tuple[float, float], tuple[float, float]]]
     length: Callable[[float, float], float]
     items: Callable[[float, float], list[Item]]
+    #: what closes the lower end, fitted first (e.g. ``"washer, e-clip"``)
+    lower: str = ""
+    #: what closes the upper end, fitted last (e.g. ``"washer, nylon lock nut"``)
+    upper: str = ""
 
 
 def _size(d: float, table: dict[float, Any]) -> Any:
@@ -87,7 +104,11 @@ def _rod_items(d: float, stack: float) -> list[Item]:
     wd, wt = _size(d, WASHER)
     size, _, _ = _size(d, ECLIP)
     return [
-        Item("steel rod", f"{d:g} mm x {_rod_length(d, stack):g} mm", 1),
+        Item(
+            f"steel rod (an e-clip groove {size:g} mm near each end: bought grooved or cut)",
+            f"{d:g} mm x {_rod_length(d, stack):g} mm",
+            1,
+        ),
         Item("washer DIN 125", f"M{d:g} ({wd:g} x {wt:g} mm)", 2),
         Item("e-clip DIN 6799", f"{size:g} (for {d:g} mm shaft)", 2),
     ]
@@ -122,8 +143,10 @@ def _screw_items(d: float, stack: float) -> list[Item]:
 
 #: fastener kinds by ``[fabrication] hardware``
 HARDWARE: dict[str, PinHardware] = {
-    "rod-eclip": PinHardware("rod-eclip", _rod_ends, _rod_length, _rod_items),
-    "screw": PinHardware("screw", _screw_ends, _screw_length, _screw_items),
+    "rod-eclip": PinHardware("rod-eclip", _rod_ends, _rod_length, _rod_items, "e-clip, washer", "washer, e-clip"),
+    "screw": PinHardware(
+        "screw", _screw_ends, _screw_length, _screw_items, "button head screw, washer", "washer, nylon lock nut"
+    ),
 }
 
 
@@ -138,11 +161,10 @@ def hardware_of(settings: Any) -> PinHardware:
 def pin_ends(settings: Any, pin: Any) -> tuple[tuple[float, float], tuple[float, float]]:
     """``((height, diameter) below, (height, diameter) above)`` mm of a pin's ends beyond its layers.
 
-    The motor shaft has none below (the motor) and a washer and e-clip of the shaft's diameter above.
+    The motor shaft has none: the motor is below it, and it ends flush with its top layer (held by glue).
     """
     if pin.shaft:
-        wd, wt = WASHER.get(round(settings.shaft_mm * 2) / 2, (2 * settings.shaft_mm + 1, 0.5))
-        return (0.0, 0.0), (wt + 0.6, wd)
+        return (0.0, 0.0), (0.0, 0.0)
     return hardware_of(settings).ends(pin.diameter_mm)
 
 
@@ -157,26 +179,92 @@ def pin_length(settings: Any, pin: Any) -> float:
     return hardware_of(settings).length(pin.diameter_mm, stack_mm(settings, pin))
 
 
+def pin_closing(settings: Any, pin: Any) -> tuple[str, str]:
+    """``(lower, upper)``: what closes a pin's lower end (fitted first) and its upper end (fitted last), in words."""
+    hw = hardware_of(settings)
+    return hw.lower, hw.upper
+
+
 def pin_items(settings: Any, pin: Any) -> list[Item]:
     """What to buy for one pin."""
     return hardware_of(settings).items(pin.diameter_mm, stack_mm(settings, pin))
 
 
 def shaft_length(settings: Any, pin: Any) -> float:
-    """The motor shaft's length above the motor's face (mm): through every layer up to its top one, a washer and
-    e-clip and 0.5 mm past the groove, rounded up to 0.5 mm (the motor sits under the bottom layer)."""
+    """The motor shaft's length above the motor's face (mm): through every layer up to its top one, ending flush,
+    rounded up to 0.5 mm (the motor sits under the bottom layer; a longer shaft is shortened to it)."""
     _, hi = pin.layers or (0, 0)
-    (_, _), (ht, _) = pin_ends(settings, pin)
-    return math.ceil(((hi + 1) * settings.thickness_mm + ht + 0.5) * 2 - 1e-9) / 2
+    return math.ceil((hi + 1) * settings.thickness_mm * 2 - 1e-9) / 2
+
+
+#: what holds the driven part on the motor shaft (an N20's D shaft has no groove for an e-clip)
+SHAFT_GLUE = Item("glue (cyanoacrylate or epoxy)", "a drop on the shaft's flat", 1)
 
 
 def shaft_items(settings: Any, pin: Any) -> list[Item]:
-    """What holds the motor shaft's top end: a washer and an e-clip of its diameter (where they are sold)."""
-    d = round(settings.shaft_mm * 2) / 2
-    if d not in WASHER:
-        return []
-    wd, wt = WASHER[d]
+    """What holds the motor shaft in its driven part: a drop of glue on the flat (the D hole is a snug fit)."""
+    return [SHAFT_GLUE]
+
+
+#: metric screw sizes (mm) and the short lengths sold for the small ones
+METRIC = (1.6, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0)
+SMALL_LENGTHS = (2, 2.5, 3, 4, 5, 6, 8, 10)
+#: thread a motor screw engages in an N20 gearmotor's face (its holes are 2-3 mm deep) (mm)
+MOTOR_THREAD_MM = 1.5
+
+
+def _metric_for(hole: float) -> float:
+    """The largest metric screw a clearance hole of ``hole`` mm takes (at least 0.1 mm of play)."""
+    fits = [m for m in METRIC if m <= hole - 0.1 + 1e-9]
+    return fits[-1] if fits else METRIC[0]
+
+
+def _sold(need: float) -> float:
+    """The shortest screw length sold (mm) of at least ``need`` mm."""
+    for n in sorted(set(SMALL_LENGTHS) | set(SCREW_LENGTHS)):
+        if n >= need - 1e-9:
+            return float(n)
+    raise InputError("fabrication.thickness_mm", need, f"a plate a screw under {SCREW_LENGTHS[-1]} mm passes")
+
+
+def motor_items(settings: Any) -> list[Item]:
+    """The motor (an N20 gearmotor with the settings' D shaft) and its two face screws: through the plate holding
+    it and ``MOTOR_THREAD_MM`` into the motor's face (M1.6 for the default 1.7 mm holes: check your motor)."""
+    m = _metric_for(settings.motor_screw_mm)
+    n = _sold(settings.thickness_mm + MOTOR_THREAD_MM)
     return [
-        Item("washer DIN 125", f"M{d:g} ({wd:g} x {wt:g} mm)", 1),
-        Item("e-clip DIN 6799", f"{ECLIP[d][0]:g} (for {d:g} mm shaft)", 1),
+        Item(
+            "N20 gearmotor",
+            f"D {settings.shaft_mm:g} shaft ({settings.shaft_flat_mm:g} across flat), "
+            f"face screws {settings.motor_screw_spacing_mm:g} mm apart",
+            1,
+        ),
+        Item("pan head screw ISO 7045", f"M{m:g} x {n:g} (check your motor)", 2),
     ]
+
+
+def mounting_items(settings: Any) -> list[Item]:
+    """One ground plate's two mounting screws, washers and nylon lock nuts, long enough for the plate on a base
+    board of the same thickness (a thicker base needs a longer screw: the BOM row says so)."""
+    m = _metric_for(settings.mounting_hole_mm)
+    wd, wt = WASHER.get(m, (2 * m + 1, 0.5))
+    _, nh = NYLOC.get(m, (2 * m, 0.8 * m))
+    n = _sold(2 * settings.thickness_mm + wt + nh + 1.0)
+    return [
+        Item("button head screw ISO 7380", f"M{m:g} x {n:g}", 2),
+        Item("washer DIN 125", f"M{m:g} ({wd:g} x {wt:g} mm)", 2),
+        Item("nylon lock nut DIN 985", f"M{m:g}", 2),
+    ]
+
+
+def driven_part(pin: Any, grounds: Any) -> str:
+    """The part the motor shaft turns (the one with the D hole): the first of the shaft's parts that is no ground."""
+    return next((p for p in pin.parts if p not in grounds), pin.parts[-1])
+
+
+def shaft_retention(driven: str) -> str:
+    """How the driven part (named) is held on the motor shaft, in words (the BOM, plan.json and the steps say it)."""
+    return (
+        f"{driven}'s D hole fits the shaft's flat (a snug fit, the flat carries the torque); a drop of glue "
+        "(cyanoacrylate or epoxy) on the flat keeps it on the shaft (no e-clip: a D shaft has no groove)"
+    )
