@@ -332,3 +332,15 @@ def test_an_interrupt_a_library_turned_into_its_error_exits_130(tmp_path: Path, 
     assert main(["motion", str(GALLERY / "kangaroo-leg.toml"), "-o", str(out)]) == 130
     err = capsys.readouterr().err.strip()
     assert err == "planar: interrupted (no output written)" and not out.exists()
+
+
+# ----------------------------------------------------------------------------- the second abuse trial
+
+
+def test_debug_shows_the_traceback_and_keeps_the_exit_status(tmp_path: Path, capsys) -> None:
+    """``--debug`` prints the traceback of a user error and still exits 2 (it used to exit 1)."""
+    rc = main(["--debug", "info", str(tmp_path / "nofile.toml")])
+    err = capsys.readouterr().err
+    assert rc == 2, err
+    assert "Traceback (most recent call last)" in err
+    assert err.strip().splitlines()[-1].startswith("planar: error: ")
