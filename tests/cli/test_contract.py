@@ -344,3 +344,14 @@ def test_debug_shows_the_traceback_and_keeps_the_exit_status(tmp_path: Path, cap
     assert rc == 2, err
     assert "Traceback (most recent call last)" in err
     assert err.strip().splitlines()[-1].startswith("planar: error: ")
+
+
+def test_synth_atlas_into_a_missing_folder_is_refused(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "nodir" / "a.npz"
+    _fails_cleanly(capsys, ["synth", "atlas", "--size", "100", "-o", str(out)], "-o", "does not exist", out=out)
+    assert not out.parent.exists()
+
+
+def test_an_output_with_a_trailing_slash_is_refused(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "o.html"
+    _fails_cleanly(capsys, ["render", str(GALLERY / "kangaroo-leg.toml"), "-o", f"{out}/"], "-o", out=out)
