@@ -143,7 +143,13 @@ def render(obj: Scene | Mechanism, out: str | Path, *, progress: bool = False, f
         raise InputError("out", out, "a file name (str or Path) ending in .gif, .mp4 or .webm")
     if fps is not None and (isinstance(fps, bool) or not isinstance(fps, (int, float))):
         raise InputError("fps", fps, "a number of frames per second")
-    return render_scene(_scene(obj, tables), out, progress=progress, fps=fps)
+    try:
+        return render_scene(_scene(obj, tables), out, progress=progress, fps=fps)
+    except InputError as e:  # the Python argument's name, not the command-line option's
+        python_name = {"-o": "out", "--fps": "fps"}.get(e.field)
+        if python_name is None or type(e) is not InputError:
+            raise
+        raise InputError(python_name, e.value, e.expected) from None
 
 
 def export(

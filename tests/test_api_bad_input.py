@@ -392,3 +392,14 @@ def test_size_for_range_far_out_warns_nothing() -> None:
         warnings.simplefilter("error")  # the overflow of a product of two differences was a RuntimeWarning
         with pytest.raises(InputError, match="target"):
             size_for_range(1, 1e300)
+
+
+@pytest.mark.parametrize("kw,needle", [({"out": "r.txt"}, "out = "), ({"fps": 1e9}, "fps = ")])
+def test_render_names_the_python_argument(tmp_path, kw, needle: str) -> None:
+    import planar
+
+    args = {"out": "r.gif", **kw}
+    with pytest.raises(InputError) as info:
+        planar.render(_leg(), tmp_path / args.pop("out"), **args)
+    assert str(info.value).startswith(needle) and "--fps" not in str(info.value)
+    assert not list(tmp_path.iterdir())
