@@ -113,8 +113,11 @@ def __dir__() -> list[str]:
 
 def _scene(obj: Scene | Mechanism, tables: dict[str, Any]) -> Scene:
     """``obj`` as a scene: a :class:`Scene` as it is, a :class:`Mechanism` through :func:`scene_from_mechanism`."""
+    from planar.core.model import Mechanism
     from planar.scene.load import Scene, scene_from_mechanism
 
+    if not isinstance(obj, (Scene, Mechanism)):
+        raise InputError("obj", obj, "a Scene (planar.load_scene) or a Mechanism")
     if isinstance(obj, Scene):
         if tables:
             raise InputError(", ".join(sorted(tables)), "given with a Scene", "scene tables only with a Mechanism")
@@ -146,7 +149,17 @@ def render(obj: Scene | Mechanism, out: str | Path, *, progress: bool = False, f
     """
     from planar.app.pipeline import render_scene
 
-    return render_scene(_scene(obj, tables), out, progress=progress, fps=fps)
+    if not isinstance(out, (str, Path)):
+        raise InputError("out", out, "a file name (str or Path) ending in .gif, .mp4 or .webm")
+    if fps is not None and (isinstance(fps, bool) or not isinstance(fps, (int, float))):
+        raise InputError("fps", fps, "a number of frames per second")
+    try:
+        return render_scene(_scene(obj, tables), out, progress=progress, fps=fps)
+    except InputError as e:  # the Python argument's name, not the command-line option's
+        python_name = {"-o": "out", "--fps": "fps"}.get(e.field)
+        if python_name is None or type(e) is not InputError:
+            raise
+        raise InputError(python_name, e.value, e.expected) from None
 
 
 def export(
@@ -169,8 +182,12 @@ def export(
         For a mechanism only: ``[fabrication]`` keys (``unit_mm``, ``kerf_mm``,
         ``sheet_mm``, ...); a scene carries its own.
     **files
-        ``preview``, ``bom``, ``assembly``, ``kerf_test`` (paths) and the
-        ``kerf`` (mm) and ``sheet`` ((width, height) mm) overrides.
+        ``preview`` (.png), ``bom`` (.csv), ``assembly`` (.svg), ``kerf_test``
+        (.dxf or .svg), ``plan`` (.json), ``motion`` (.csv), ``steps`` (.svg)
+        (paths) and the ``kerf`` (mm) and ``sheet`` ((width, height) mm)
+        overrides.  Each path must end in its format's suffix, and at least
+        one output must be given (as ``planar export`` refuses none): for the
+        layout alone, use :func:`planar.fabrication.build.build`.
 
     Returns
     -------
@@ -180,8 +197,17 @@ def export(
     """
     from planar.app.pipeline import export_scene
 
+    if dxf is None and svg is None and not any(files.get(k) is not None for k in _EXPORT_FILES):
+        raise InputError("dxf, svg, ...", None, f"an output: dxf, svg or one of {', '.join(_EXPORT_FILES)}")
+    unknown = sorted(set(files) - set(_EXPORT_FILES) - {"kerf", "sheet"})
+    if unknown:
+        raise InputError(", ".join(unknown), files[unknown[0]], f"one of the outputs {', '.join(_EXPORT_FILES)}, kerf or sheet")
     scene = _scene(obj, {} if fabrication is None else {"fabrication": fabrication})
     return export_scene(scene, dxf, svg, **files)
+
+
+#: the files :func:`export` writes besides ``dxf`` and ``svg`` (keyword arguments)
+_EXPORT_FILES = ("preview", "bom", "assembly", "kerf_test", "plan", "motion", "steps")
 
 
 def compare(
@@ -222,6 +248,14 @@ def compare(
     (Comparison, SimResult)
         ``comparison.passed`` is false when a check failed (the CLI exits 3).
     """
-    from planar.physics.compare import compare_scene
+    import math
 
+    from planar.physics.compare import compare_scene
+    from planar.physics.settings import SimSettings
+
+    if settings is not None and not isinstance(settings, SimSettings):
+        raise InputError("settings", settings, "a planar.SimSettings (or None for the defaults)")
+    for arg, v in (("threshold", threshold), ("torque_threshold", torque_threshold)):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not (math.isfinite(v) and v > 0):
+            raise InputError(arg, v, "a positive, finite fraction")
     return compare_scene(_scene(obj, tables), settings, threshold, torque_threshold, motor=motor)

@@ -273,7 +273,7 @@ def check_output(
         if p.exists() and not p.is_dir():
             raise InputError(option, text, "a folder (it is an existing file)")
         return
-    if p.is_dir():
+    if p.is_dir() or text.endswith(("/", os.sep)):
         raise InputError(option, text, "a file name (it is a folder)")
     parent = p.parent if str(p.parent) else Path(".")
     if not parent.is_dir():

@@ -110,12 +110,11 @@ def test_fourbar_at_any_scale_is_the_scaled_unit_fourbar(leg: FourBar, scale: fl
 def test_nothing_non_finite_is_valid() -> None:
     """Elemental parameters near the float64 limit: samples are finite, or marked invalid with a reason."""
     for number, kw in ((1, {"F_o": (1e308, 0.0)}), (2, {"D_jr": 1e300}), (7, {"D_jc": (1e308, 1e308)})):
-        try:
-            mech = elemental(number, **kw)
+        try:  # refused (at construction, or at the solve: a placement float64 cannot resolve) is fine too
+            with np.errstate(all="ignore"):
+                m = elemental(number, **kw).run(36)
         except PlanarError:
             continue
-        with np.errstate(all="ignore"):
-            m = mech.run(36)
         for arr in (*m.poses.values(), *m.points.values()):
             assert np.isfinite(arr).all()
 
@@ -204,8 +203,8 @@ def _motion():
         (lambda: __import__("planar").Part("p", hull=((0, 0),)), "hull"),
         (lambda: __import__("planar").Part("p", hull="abc"), "hull"),
         (lambda: __import__("planar").Part("", hull=()), "Part.name"),
-        (lambda: __import__("planar").Part("p", hull=(), plane="xw"), "plane"),
-        (lambda: __import__("planar").Part("p", hull=(), offset=math.nan), "offset"),
+        (lambda: __import__("planar").Part("p", hull=((0, 0, 1),), plane="xw"), "plane"),
+        (lambda: __import__("planar").Part("p", hull=((0, 0, 1),), offset=math.nan), "offset"),
         (lambda: __import__("planar").Part("p", hull=(), polygon=((0, 0), (1, math.nan), (0, 1))), "polygon"),
         (lambda: __import__("planar").Mechanism("m", "abc", [], __import__("planar").Driver("a")), "m.parts"),
         (lambda: __import__("planar").Mechanism("m", [], [], "a"), "m.driver"),
@@ -275,3 +274,132 @@ def test_check_scale_refuses_coarse_placements() -> None:
     for place in ((0.0, 1e16, 0.0), (1e308, 0.0, 0.0)):
         with pytest.raises(InputError, match="float64"):
             check_scale("leg", FourBar(4.0, 1.0, 4.0, 3.0, placement=place))
+
+
+def _leg() -> FourBar:
+    return FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(5.5, -2.0))
+
+
+@pytest.mark.parametrize(
+    "call,needle",
+    [
+        (lambda p: __import__("planar").render(5, p / "r.gif"), "obj"),
+        (lambda p: __import__("planar").render(None, p / "r.gif"), "obj"),
+        (lambda p: __import__("planar").export("x", p / "e.dxf"), "obj"),
+        (lambda p: __import__("planar").compare(5), "obj"),
+        (lambda p: __import__("planar").scene_from_mechanism(None), "mech"),
+        (lambda p: __import__("planar").render(_leg(), p / "r.gif", bogus={}), "bogus"),
+        (lambda p: __import__("planar").compare(_leg(), bogus={}), "bogus"),
+        (lambda p: __import__("planar").scene_from_mechanism(_leg(), foo={}), "foo"),
+        (lambda p: __import__("planar").render(_leg(), p / "r.gif", render="x"), "render"),
+        (lambda p: __import__("planar").export(_leg(), p / "e.dxf", fabrication="x"), "fabrication"),
+        (lambda p: __import__("planar").export(_leg(), p / "e.dxf", bogus=p / "x.csv"), "bogus"),
+        (lambda p: __import__("planar").render(_leg(), None), "out"),
+        (lambda p: __import__("planar").render(_leg(), p / "r.gif", fps="25"), "fps"),
+        (lambda p: __import__("planar").compare(_leg(), settings="x"), "settings"),
+        (lambda p: __import__("planar").compare(_leg(), threshold="0.1"), "threshold"),
+        (lambda p: __import__("planar").compare(_leg(), threshold=math.nan), "threshold = nan"),
+        (lambda p: __import__("planar").compare(_leg(), torque_threshold=math.nan), "torque_threshold"),
+        (lambda p: __import__("planar").compare(_leg(), torque_threshold=-1), "torque_threshold"),
+        (lambda p: __import__("planar").compare(_leg(), torque_threshold=math.inf), "torque_threshold"),
+        (lambda p: __import__("planar").SimSettings(substeps=math.nan), "substeps"),
+        (lambda p: __import__("planar").SimSettings(iterations=2.5), "iterations"),
+        (lambda p: __import__("planar").SimSettings(blowup_tol=math.inf), "blowup_tol"),
+        (lambda p: _motion().take([[0]]), "take"),
+        (lambda p: _motion().reason(99), "reason"),
+        (lambda p: _motion().reason("x"), "reason"),
+        (lambda p: __import__("planar").Mechanism("m", 5, [], __import__("planar").Driver("a")), "m.parts"),
+        (lambda p: __import__("planar").Mechanism("m", [], [], __import__("planar").Driver("crank")), "driver.part"),
+        (
+            lambda p: __import__("planar").Mechanism("m", _leg().parts, _leg().joints, __import__("planar").Driver("nope")),
+            "driver.part",
+        ),
+    ],
+)
+def test_api_entrances_of_the_second_trial(tmp_path, call, needle: str) -> None:
+    """Each raised a raw TypeError/AttributeError/IndexError or was accepted; nothing is written."""
+    with pytest.raises(PlanarError) as info:
+        call(tmp_path)
+    assert isinstance(info.value, ValueError) and needle in str(info.value) and "\n" not in str(info.value)
+    assert not list(tmp_path.iterdir())
+
+
+def test_a_bare_mechanism_says_why_it_cannot_solve() -> None:
+    import planar
+
+    leg = _leg()
+    with pytest.raises(PlanarError, match="no solver"):
+        planar.Mechanism("m", leg.parts, leg.joints, leg.driver).solve([0.0])
+
+
+@pytest.mark.parametrize(
+    "call,needle",
+    [
+        (lambda: FourBar(4, 1, 4, 3, name="a\x00b"), "name"),
+        (lambda: __import__("planar").Part("a\nb", hull=((0, 0, 1),)), "Part.name"),
+        (lambda: __import__("planar").Part("p", hull=()), "hull"),
+        (lambda: __import__("planar").Part("p", hull=((0, 0, 1),), ground="yes"), "ground"),
+        (lambda: __import__("planar").Driver("crank", amplitude=-1), "amplitude"),
+        (lambda: __import__("planar").Link("l", "OA"), "nodes"),
+        (lambda: __import__("planar").Fixed("O", (math.nan, 0)), "xy"),
+        (lambda: __import__("planar.linkages.gears").linkages.gears.Geared("B", "O", 1.0, mesh="A", ratio=math.nan), "ratio"),
+        (lambda: __import__("planar.linkages.gears").linkages.gears.Geared("B", "O", 1.0, mesh="A", ratio=1.0), "ratio"),
+    ],
+)
+def test_constructors_refuse_at_once(call, needle: str) -> None:
+    with pytest.raises(PlanarError) as info:
+        call()
+    assert needle in str(info.value) and "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize(
+    "call,needle",
+    [
+        (lambda p: __import__("planar").export(_leg(), p / "e.dxf", steps=p / "s.png"), "steps"),
+        (lambda p: __import__("planar").export(_leg(), p / "e.dxf", plan=p / "p.txt"), "plan"),
+        (lambda p: __import__("planar").export(_leg(), p / "e.dxf", motion=p / "m.txt"), "motion"),
+        (lambda p: __import__("planar").export(_leg()), "an output"),
+        (lambda p: __import__("planar").scene_from_mechanism(_leg()).save(p / "s.csv"), ".toml"),
+    ],
+)
+def test_python_writers_check_the_suffix(tmp_path, call, needle: str) -> None:
+    """SVG went into s.png, TOML into s.csv; an export with no output returned silently."""
+    with pytest.raises(PlanarError, match=needle):
+        call(tmp_path)
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("spc", [3, 2.5, np.float64(36.0)])
+def test_run_takes_a_whole_number_of_at_least_four_samples(spc) -> None:
+    with pytest.raises(InputError, match="samples_per_cycle"):
+        _leg().run(samples_per_cycle=spc)
+
+
+@pytest.mark.parametrize("q", [[0.0], np.zeros(3)])
+def test_a_placement_float64_cannot_resolve_is_refused_from_python(q) -> None:
+    """As a scene's: at 1e17 float64 spaces numbers 16 apart, coarser than the links themselves."""
+    with pytest.raises(InputError, match="placement"):
+        FourBar(4.0, 1.0, 4.0, 3.0, placement=(1e17, 0.0, 0.0)).solve(q)
+    assert FourBar(4e200, 1e200, 4e200, 3e200).solve(q).valid.all()  # any size still solves, scaled
+
+
+def test_size_for_range_far_out_warns_nothing() -> None:
+    import warnings
+
+    from planar.windup.sizing import size_for_range
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the overflow of a product of two differences was a RuntimeWarning
+        with pytest.raises(InputError, match="target"):
+            size_for_range(1, 1e300)
+
+
+@pytest.mark.parametrize("kw,needle", [({"out": "r.txt"}, "out = "), ({"fps": 1e9}, "fps = ")])
+def test_render_names_the_python_argument(tmp_path, kw, needle: str) -> None:
+    import planar
+
+    args = {"out": "r.gif", **kw}
+    with pytest.raises(InputError) as info:
+        planar.render(_leg(), tmp_path / args.pop("out"), **args)
+    assert str(info.value).startswith(needle) and "--fps" not in str(info.value)
+    assert not list(tmp_path.iterdir())

@@ -394,6 +394,9 @@ def export_scene(
         ("bom", bom, (".csv",)),
         ("assembly", assembly, (".svg",)),
         ("kerf_test", kerf_test, (".dxf", ".svg")),
+        ("plan", plan, (".json",)),
+        ("motion", motion, (".csv",)),
+        ("steps", steps, (".svg",)),
     ):  # the suffix names the format: DXF bytes never go into x.svg
         check_output(arg, path, ends, (scene.path,) if Path(str(scene.path)).is_file() else ())
     spec = scene.spec.fabrication

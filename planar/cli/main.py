@@ -77,7 +77,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point: parse, run, turn user errors into exit status 2 (one line, no traceback).
 
     Warnings (numpy's RuntimeWarnings on invalid samples) are silenced: the
-    validity masks carry that information.  ``--debug`` re-raises errors.
+    validity masks carry that information.  ``--debug`` prints an error's traceback
+    before its one line, and keeps its exit status (2 for a user error, 1 for a bug).
     """
     hook = sys.unraisablehook
     debug = "--debug" in (sys.argv[1:] if argv is None else argv)
@@ -121,8 +122,7 @@ def _main(argv: Sequence[str] | None) -> int:
                 warnings.simplefilter("ignore")
             return int(args.func(args) or 0)
     except PlanarError as e:
-        if args.debug:
-            raise
+        _traceback(args.debug)
         print(f"planar: error: {_one_line(e)}", file=sys.stderr)
         return 2
     except BrokenPipeError:
@@ -131,14 +131,12 @@ def _main(argv: Sequence[str] | None) -> int:
         os.dup2(devnull, sys.stdout.fileno())
         return 141
     except OSError as e:  # a file the user named: unreadable, a loop of links, a full disc
-        if args.debug:
-            raise
+        _traceback(args.debug)
         where = f"{e.filename}: " if e.filename else ""
         print(f"planar: error: {where}{_one_line(e.strerror or e)}", file=sys.stderr)
         return 2
     except MemoryError:
-        if args.debug:
-            raise
+        _traceback(args.debug)
         print(
             "planar: error: out of memory; ask for fewer samples or frames (or lower PLANAR_MAX_MEMORY "
             "so this is refused before it starts)",
@@ -146,16 +144,23 @@ def _main(argv: Sequence[str] | None) -> int:
         )
         return 2
     except Exception as e:  # the guard: a bug in planar, still one line
-        if args.debug:
-            raise
         if _interrupted(e):  # a Ctrl-C that a library turned into its own error (an import, a worker)
             raise KeyboardInterrupt from None
+        _traceback(args.debug)
         print(
             f"planar: internal error: {type(e).__name__}: {_one_line(e)[:300]} "
             f"(a bug in planar; run again with --debug for the traceback)",
             file=sys.stderr,
         )
         return 1
+
+
+def _traceback(debug: bool) -> None:
+    """With ``--debug``, print the traceback of the error being handled (the exit status stays its class's)."""
+    if debug:
+        import traceback
+
+        traceback.print_exc()
 
 
 def _interrupted(e: BaseException) -> bool:

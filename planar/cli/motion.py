@@ -31,10 +31,13 @@ def _cmd_motion(args: argparse.Namespace) -> int:
 
 def _cmd_motion_catalog(args: argparse.Namespace) -> int:
     from planar.app.pipeline import write_catalog_motion
-    from planar.core.limits import check_count
+    from planar.core.limits import MIN_SAMPLES_PER_CYCLE, check_count
+    from planar.errors import InputError
 
     outputs(args, (), ("-o", "output", (".csv",)))
     positive("--samples", args.samples, integer=True)
+    if args.samples < MIN_SAMPLES_PER_CYCLE:
+        raise InputError("--samples", args.samples, f"at least {MIN_SAMPLES_PER_CYCLE} samples (a whole number)")
     check_count("samples", "--samples", args.samples, "samples")
     motion = write_catalog_motion(args.mechanism, args.output, args.samples)
     print(f"wrote {args.output}: {len(motion)} samples, {int(motion.valid.sum())} valid")

@@ -10,9 +10,12 @@ __all__ = ["add_parser"]
 
 def _cmd_plot(args: argparse.Namespace) -> int:
     from planar.draw.charts import write_plot
+    from planar.errors import InputError
     from planar.scene.load import load_scene
 
-    what = [w.strip() for w in args.what.split(",") if w.strip()] if args.what else None
+    what = [w.strip() for w in args.what.split(",")] if args.what is not None else None
+    if what is not None and not all(what):
+        raise InputError("--what", args.what, "comma-separated chart names, e.g. curve,torque (no empty item)")
     from planar.app.pipeline import numeric_guard
 
     scene = load_scene(args.scene)

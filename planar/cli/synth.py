@@ -309,6 +309,10 @@ def _cmd_atlas(args: argparse.Namespace) -> int:
         raise InputError("--size", args.size, "at least 100 four-bars")
     if args.seed < 0:
         raise InputError("--seed", args.seed, "a seed of 0 or more")
+    if args.output is not None:  # like every output: an existing folder, no folder made for it
+        from planar.fileio import check_output
+
+        check_output("-o", args.output, (".npz",))
     path = args.output if args.output is not None else str(atlas_path(args.size, args.seed))
     if not path.endswith(".npz"):
         raise InputError("-o", path, "an .npz file")

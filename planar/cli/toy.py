@@ -30,15 +30,19 @@ def _key_text(cam: str, angle: float, turn: float) -> str:
     )
 
 
+#: the fastest speed ``--speeds`` takes, cycles/s (a wind-up toy turns about once a second)
+MAX_SPEED = 1000.0
+
+
 def _speeds(text: str) -> list[float]:
     from planar.errors import InputError
 
-    try:
-        out = [float(v) for v in text.split(",") if v.strip()]
+    try:  # every item a number: an empty list or item ("", "1,,2") is a typo, not a default
+        out = [float(v) for v in text.split(",")]
     except ValueError:
         raise InputError("--speeds", text, "comma-separated speeds in cycles per second, e.g. 0.5,1,2") from None
-    if not out or any(not (math.isfinite(v) and v > 0) for v in out):
-        raise InputError("--speeds", text, "positive speeds in cycles per second, e.g. 0.5,1,2")
+    if any(not (math.isfinite(v) and 0 < v <= MAX_SPEED) for v in out):
+        raise InputError("--speeds", text, f"speeds from 0 to {MAX_SPEED:g} cycles per second, e.g. 0.5,1,2")
     return sorted(out)
 
 
@@ -51,7 +55,7 @@ def _cmd_toy(args: argparse.Namespace) -> int:
 
     if not (0 < args.torque_threshold < 1):
         raise InputError("--torque-threshold", args.torque_threshold, "a fraction between 0 and 1")
-    speeds = _speeds(args.speeds) if args.speeds else None
+    speeds = _speeds(args.speeds) if args.speeds is not None else None
     scene = load_scene(args.scene)
     toy = scene.mechanism
     if not isinstance(toy, ToyMechanism):

@@ -30,6 +30,7 @@ __all__ = [
     "DEFAULTS",
     "RESOLUTION",
     "SIZE_RANGE",
+    "check_angle",
     "check_count",
     "check_memory",
     "check_scale",
@@ -134,6 +135,10 @@ def pilot_bytes(solve: Any, n: int) -> float | None:
     return peak / PILOT * n
 
 
+#: the fewest samples of one cycle (a scene's ``samples_per_cycle``, ``catalog --samples``, ``run``)
+MIN_SAMPLES_PER_CYCLE = 4
+
+
 def sample_count(
     samples_per_cycle: float, cycles: float, spc_field: str = "samples_per_cycle", cycles_field: str = "cycles"
 ) -> int:
@@ -162,7 +167,23 @@ SIZE_RANGE = (1e-60, 1e60)
 RESOLUTION = 1e-9
 
 
-def check_scale(where: str, mech: object) -> None:
+#: the largest angle (rad, about 159 000 turns) a phase, amplitude or a clock's turns may reach: float64
+#: spaces its numbers 1.2e-10 apart there, finer than :data:`RESOLUTION`; at 1e300 a phase is noise
+MAX_ANGLE = 1e6
+
+
+def check_angle(field: str, value: float, scale: float = 1.0) -> None:
+    """:class:`InputError` if the angle ``value * scale`` (rad) is beyond :data:`MAX_ANGLE` (``value`` is shown)."""
+    if not abs(float(value) * scale) <= MAX_ANGLE:
+        raise InputError(
+            field,
+            value,
+            f"a value reaching at most {MAX_ANGLE:g} rad (about {MAX_ANGLE / (2 * math.pi):.0f} turns): beyond, float64 "
+            f"resolves an angle coarser than {RESOLUTION:g} rad",
+        )
+
+
+def check_scale(where: str, mech: object, size_range: bool = True) -> None:
     """:class:`InputError` if ``mech``'s numbers are beyond what float64 holds faithfully.
 
     Refused: a size (:attr:`Mechanism.size`) outside :data:`SIZE_RANGE`, and a
@@ -170,7 +191,8 @@ def check_scale(where: str, mech: object) -> None:
     there exceeds :data:`RESOLUTION` times the mechanism's smallest length (its
     smallest pin or hull radius, at most its size): at y = 1e16 the nearest
     floats are 2 apart, so a four-bar of 4-unit links is computed into nonsense.
-    ``where`` names the file or mechanism in the message.
+    ``where`` names the file or mechanism in the message; ``size_range=False`` checks the placement
+    only (from Python a mechanism of any size solves, scaled).
     """
     parts = getattr(mech, "parts", ())
     with _quiet_numpy():
@@ -183,7 +205,7 @@ def check_scale(where: str, mech: object) -> None:
         extent = float(np.abs(place).max(initial=0.0)) + float(np.abs(h[:, :2]).max(initial=0.0))
         radii = h[:, 2][h[:, 2] > 0]
         smallest = min(size, float(radii.min())) if radii.size else size
-    if not (math.isfinite(size) and SIZE_RANGE[0] <= size <= SIZE_RANGE[1]):
+    if size_range and not (math.isfinite(size) and SIZE_RANGE[0] <= size <= SIZE_RANGE[1]):
         raise InputError(
             f"{where}: mechanism size",
             size,

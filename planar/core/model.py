@@ -13,7 +13,7 @@ are radians, counter-clockwise positive.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from types import MappingProxyType
@@ -97,6 +97,14 @@ def check_positive(field_name: str, value: float) -> float:
     return v
 
 
+def _check_name(field: str, name: object) -> None:
+    """Refuse a name that is not a non-empty string or holds a control character (it names CSV columns, DXF groups)."""
+    if not isinstance(name, str) or not name:
+        raise InputError(field, name, "a non-empty string")
+    if any(ord(c) < 32 or ord(c) == 127 for c in name):
+        raise InputError(field, name, "a name without control characters (newline, tab, NUL)")
+
+
 def _vec(v: ArrayLike) -> Vec:
     a = np.asarray(v, dtype=float).reshape(2)
     return (float(a[0]), float(a[1]))
@@ -134,9 +142,12 @@ class Part:
     polygon: tuple[Vec, ...] | None = None
 
     def __post_init__(self) -> None:
-        if not isinstance(self.name, str) or not self.name:
-            raise InputError("Part.name", self.name, "a non-empty string")
+        _check_name("Part.name", self.name)
         where = f"Part {self.name!r}"
+        if isinstance(self.hull, (str, bytes)) or not (len(self.hull) or self.polygon is not None):
+            raise InputError(f"{where}.hull", self.hull, "one or more circles (x, y, r) (or a polygon)")
+        if not isinstance(self.ground, (bool, np.bool_)):
+            raise InputError(f"{where}.ground", self.ground, "True or False")
         h = check_finite(f"{where}.hull", self.hull) if len(self.hull) else np.zeros((0, 3))
         if h.ndim != 2 or h.shape[1] != 3:
             raise InputError(f"{where}.hull", self.hull, "circles (x, y, r): a sequence of three numbers each")
@@ -455,6 +466,8 @@ class Driver:
         check_finite("driver.centre", self.centre)
         if self.amplitude is not None:
             check_finite("driver.amplitude", self.amplitude)
+            if not self.amplitude > 0:
+                raise InputError("driver.amplitude", self.amplitude, "a positive amplitude (the phase sets the direction)")
         check_positive("driver.rate", self.rate)
         if self.kind == "translation" and self.amplitude is None:
             raise InputError("driver.amplitude", None, "a stroke amplitude for a translation driver")
@@ -546,6 +559,11 @@ class Motion:
         ``angle_unit``: ``"deg"`` says a rotation driver's value in degrees (a scene's
         ``angle_unit``); otherwise the driver value is as stored (radians, or a length).
         """
+        n = len(self)
+        if isinstance(i, (bool, np.bool_)) or not isinstance(i, (int, np.integer)):
+            raise InputError("Motion.reason(i)", i, "a sample index (a whole number)")
+        if not -n <= i < n:
+            raise InputError("Motion.reason(i)", i, f"an index from {-n} to {n - 1} (the motion has {n} samples)")
         code = int(self.fail_code[i])
         if code < 0:
             return ""
@@ -565,6 +583,8 @@ class Motion:
         """The samples ``index`` (an index array or boolean mask) as a new motion."""
         idx = np.asarray(index)
         n = len(self)
+        if idx.ndim > 1:
+            raise InputError("Motion.take(index)", f"an array of shape {idx.shape}", "a 1-D index array or mask")
         if idx.dtype == bool:
             if idx.shape != (n,):
                 raise InputError("Motion.take(index)", f"a mask of shape {idx.shape}", f"a mask of shape ({n},)")
@@ -647,11 +667,14 @@ class Mechanism:
         driver: Driver,
         points: Mapping[str, tuple[str, Vec]] | None = None,
     ) -> None:
-        if not isinstance(name, str) or not name:
-            raise InputError("Mechanism.name", name, "a non-empty string")
-        if isinstance(parts, (str, bytes)) or not all(isinstance(p, Part) for p in parts):
+        _check_name("Mechanism.name", name)
+        if isinstance(parts, (str, bytes)) or not isinstance(parts, Iterable) or not all(isinstance(p, Part) for p in parts):
             raise InputError(f"{name}.parts", parts, "a sequence of Part")
-        if isinstance(joints, (str, bytes)) or not all(hasattr(j, "residual") for j in joints):
+        if (
+            isinstance(joints, (str, bytes))
+            or not isinstance(joints, Iterable)
+            or not all(hasattr(j, "residual") for j in joints)
+        ):
             raise InputError(f"{name}.joints", joints, "a sequence of joints (planar.core.model's joint kinds)")
         if not isinstance(driver, Driver):
             raise InputError(f"{name}.driver", driver, "a Driver")
@@ -669,6 +692,8 @@ class Mechanism:
             if pname in names:
                 raise InputError(f"{name}.points", pname, "a point name that no part has (tables name columns by both)")
         self._check_joints(names)
+        if driver.part not in names:
+            raise InputError(f"{name}.driver.part", driver.part, f"one of the parts {names}")
         self.parts = _with_joint_features(self.parts, self.joints)
 
     def _check_joints(self, names: list[str]) -> None:
@@ -693,7 +718,12 @@ class Mechanism:
     # -- to implement ------------------------------------------------------
     def _solve_poses(self, q: Array) -> tuple[dict[str, Array], list[tuple[NDArray[np.bool_], str, str]]]:
         """Poses for driver values ``q`` and the per-joint validity checks."""
-        raise NotImplementedError
+        from planar.core.registry import UnsupportedError
+
+        raise UnsupportedError(
+            f"{self.name}: a bare Mechanism has no solver; build a kind that solves itself "
+            "(Linkage, FourBar, SliderCrank, ...) from its parts and joints"
+        )
 
     def part_rates(self, q: Array, qd: Array, qdd: Array) -> RatesResult:
         """Velocity, acceleration, angular velocity and acceleration of every part, in closed form.
@@ -720,8 +750,17 @@ class Mechanism:
                 return p
         raise InputError(f"{self.name}.part", name, f"one of {[p.name for p in self.parts]}")
 
+    def _check_placement(self) -> None:
+        """Once per mechanism: refuse a placement float64 cannot resolve (as a scene's, :func:`check_scale`)."""
+        if "_placement_checked" not in self.__dict__:
+            from planar.core.limits import check_scale
+
+            check_scale(self.name, self, size_range=False)
+            self.__dict__["_placement_checked"] = True
+
     def solve(self, q: ArrayLike, t: ArrayLike | None = None) -> Motion:
         """Solve all samples at once for driver values ``q`` (scalar or array)."""
+        self._check_placement()
         if isinstance(q, np.ma.MaskedArray) or np.asarray(q).dtype == bool:
             raise InputError(
                 f"{self.name}.solve(q)",
@@ -798,7 +837,17 @@ class Mechanism:
         return poses, checks, None
 
     def run(self, samples_per_cycle: int = 360, cycles: float = 1.0) -> Motion:
-        """Solve over time with the driver's law (``cycles`` periods)."""
+        """Solve over time with the driver's law (``cycles`` periods of ``samples_per_cycle`` samples each,
+        a whole number of at least 4, as a scene's ``samples_per_cycle``)."""
+        import numbers
+
+        from planar.core.limits import MIN_SAMPLES_PER_CYCLE, sample_count
+
+        sample_count(samples_per_cycle, cycles)  # types, finite, the samples limit: its own words first
+        if not (isinstance(samples_per_cycle, numbers.Integral) and samples_per_cycle >= MIN_SAMPLES_PER_CYCLE):
+            raise InputError(
+                "samples_per_cycle", samples_per_cycle, f"a whole number of at least {MIN_SAMPLES_PER_CYCLE} samples"
+            )
         t = self.driver.times(samples_per_cycle, cycles)
         return self.solve(self.driver.value(t), t=t)
 

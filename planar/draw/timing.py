@@ -126,6 +126,13 @@ def plan_frames(period_s: float, duration_s: float, fps: float | None = None, ti
     frames = max(1, int(round(per_cycle * duration_s / period_s)))
     from planar.core.limits import limit
 
+    if fps is not None and per_cycle > limit("frames"):  # one cycle alone too many: the rate is at fault
+        raise InputError(
+            "--fps",
+            fps,
+            f"at most {limit('frames') / period_s:.3g} frames per second: one cycle of {period_s:.3g} s would take "
+            f"{per_cycle} frames, over the limit of {limit('frames')} (PLANAR_MAX_FRAMES)",
+        )
     if frames > limit("frames"):  # MAX_FRAMES unless PLANAR_MAX_FRAMES raises it
         raise InputError(
             "duration",

@@ -78,6 +78,9 @@ class Geared(NodeKind):
     #: the node it meshes with (set when the linkage is built, :meth:`bind`)
     base: NodeKind | None = field(default=None, compare=False, repr=False)
 
+    def __post_init__(self) -> None:  # refused where it is built, not first at the linkage
+        self.validate(f"nodes.{self.name}")
+
     def refs(self) -> tuple[str, ...]:
         return (self.centre, self.mesh)
 
@@ -217,6 +220,11 @@ class Driven(NodeKind):
         check_finite(f"{where}.mean", self.mean)
         if self.amplitude is not None:
             check_positive(f"{where}.amplitude", self.amplitude)
+        from planar.core.limits import check_angle  # numbers float64 resolves: not cycles = 1e300
+
+        check_angle(f"{where}.cycles", self.cycles, 2 * np.pi)
+        for f in ("phase", "mean", "amplitude"):
+            check_angle(f"{where}.{f}", getattr(self, f) or 0.0)
 
     def input_angle(self, q: Array) -> Array:
         """The crank angle (rad) at clock values ``q``."""

@@ -66,6 +66,10 @@ class Link:
     nodes: tuple[str, ...]
     guide: tuple[str, str] | None = None
 
+    def __post_init__(self) -> None:
+        if isinstance(self.nodes, (str, bytes)) or not all(isinstance(n, str) for n in self.nodes):
+            raise InputError(f"Link {self.name!r}.nodes", self.nodes, "a sequence of node names (('O', 'A'), not 'OA')")
+
 
 #: most steps of a lead-in (:meth:`Linkage._lead_in`)
 LEAD_MAX = 4096
@@ -439,6 +443,7 @@ class Linkage(Mechanism):
         and any batch the warm path cannot finish (a branch that may switch,
         a non-finite number), goes through :meth:`Mechanism.solve`.
         """
+        self._check_placement()
         if t is None and type(q) is np.ndarray and q.dtype == np.float64 and q.ndim == 1:
             warm = self._solve_warm(q)
             if warm is not None:

@@ -293,6 +293,9 @@ class Fixed(NodeKind):
     name: str
     xy: Vec
 
+    def __post_init__(self) -> None:  # refused where it is built, not first at the linkage
+        self.validate(f"nodes.{self.name}")
+
     def validate(self, where: str) -> None:
         check_finite(f"{where}.xy", self.xy)
 

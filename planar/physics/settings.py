@@ -68,8 +68,23 @@ class SimSettings:
     step_drift: float | None = STEP_DRIFT
 
     def __post_init__(self) -> None:
+        import math
+        import numbers
+
         from planar.errors import InputError
 
+        for f in ("substeps", "iterations"):  # whole numbers (numpy's too), never a truth value
+            v = getattr(self, f)
+            if isinstance(v, bool) or not isinstance(v, numbers.Integral):
+                raise InputError(f, v, "a whole number")
+        for f in ("correction", "error_bias", "tolerance", "blowup_tol", "step_drift"):
+            v = getattr(self, f)
+            if v is None and f in ("error_bias", "step_drift"):
+                continue
+            if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
+                raise InputError(f, v, "a finite number")
+        if not isinstance(self.adaptive, bool):
+            raise InputError("adaptive", self.adaptive, "True or False")
         if self.substeps < 1:
             raise InputError("substeps", self.substeps, "at least 1")
         if self.iterations < 1:

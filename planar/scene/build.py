@@ -92,11 +92,14 @@ class Scene:
         """Write this scene as a TOML scene file that :func:`load_scene` reads back to the same motion.
 
         The keys the scene was given are written (defaults left out), angles
-        as given with the scene's ``angle_unit``; atomic.  A mechanism built in
+        as given with the scene's ``angle_unit``; atomic.  ``path`` must end in
+        ``.toml`` and be in an existing folder.  A mechanism built in
         Python becomes a scene with :func:`planar.scene.load.scene_from_mechanism`.
         """
+        from planar.fileio import check_output
         from planar.scene.write import write_scene
 
+        check_output("path", path, (".toml",))  # TOML never goes into s.csv
         write_scene(self.spec, path)
 
     @property

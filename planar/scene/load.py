@@ -16,13 +16,14 @@ from __future__ import annotations
 
 import re
 import tomllib
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 from pydantic import ValidationError
 
 from planar.core.model import Mechanism
-from planar.errors import SceneError
+from planar.errors import InputError, SceneError
 from planar.scene.build import Scene, build_scene
 from planar.scene.schema import _NAME, SceneSpec, scene_schema
 
@@ -113,6 +114,10 @@ def load_scene(path: str | Path) -> Scene:
     return build_scene(parse_scene(data, p), p)
 
 
+#: the keyword tables of :func:`scene_from_mechanism` (the arguments of :func:`planar.scene.write.scene_data`)
+_TABLES = ("name", "driver", "effects", "render", "fabrication", "polygons")
+
+
 def scene_from_mechanism(mech: Mechanism, **tables: Any) -> Scene:
     """A :class:`~planar.scene.load.Scene` of a mechanism built in Python, validated like a scene file.
 
@@ -123,5 +128,12 @@ def scene_from_mechanism(mech: Mechanism, **tables: Any) -> Scene:
     """
     from planar.scene.write import scene_data
 
+    if not isinstance(mech, Mechanism):
+        raise InputError("mech", mech, "a Mechanism (FourBar, Linkage, ...)")
+    for key, table in tables.items():
+        if key not in _TABLES:
+            raise InputError(key, table, f"one of the scene tables {', '.join(_TABLES)}")
+        if key != "name" and table is not None and not isinstance(table, Mapping):
+            raise InputError(key, table, "a dict of the scene table's keys")
     where = f"<{type(mech).__name__} {mech.name!r}>"
     return build_scene(parse_scene(scene_data(mech, **tables), where), where)

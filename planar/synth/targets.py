@@ -57,6 +57,8 @@ def read_table(
     cols = [c for c in required + optional if c in header]
     out: dict[str, list[float]] = {c: [] for c in cols}
     for i, r in enumerate(rows[1:], start=2):
+        if any(c.strip() for c in r[len(header) :]):  # a ragged row: which cell belongs to which column?
+            raise InputError(f"{p}: row {i}", ",".join(r), f"{len(header)} cells, one per header column ({','.join(rows[0])})")
         for c in cols:
             j = header.index(c)
             cell = r[j].strip() if j < len(r) else ""

@@ -123,6 +123,9 @@ class ToyMechanism(Mechanism):
                 raise InputError(f"{name}.cams", cam, "'left' or 'right'")
         self.cams = {cam: [_check_chain(c, f"{cam}[{i}]") for i, c in enumerate(chains)] for cam, chains in cams.items()}
         self.phase = float(check_finite(f"{name}.phase", phase))
+        from planar.core.limits import check_angle
+
+        check_angle(f"{name}.phase", self.phase)
         self.cam_phase = {"left": 0.0, "right": self.phase}
         overrides = dict(overrides or {})
         #: the parameter overrides given, by ``(cam, prefix)`` (what a scene file's ``stages`` record)

@@ -220,7 +220,7 @@ def size_for_range(
         d = ys - target
         for k in np.flatnonzero(d == 0):
             roots.append(float(xs[k]))
-        for k in np.flatnonzero(d[:-1] * d[1:] < 0):
+        for k in np.flatnonzero(np.sign(d[:-1]) * np.sign(d[1:]) < 0):  # signs: a product may overflow
             try:
                 roots.append(float(brentq(lambda v: f(v) - target, xs[k], xs[k + 1], xtol=1e-16, rtol=1e-15)))
             except ValueError:  # NaN inside: a sliver of invalid values the scan did not see

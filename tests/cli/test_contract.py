@@ -334,3 +334,72 @@ def test_an_interrupt_a_library_turned_into_its_error_exits_130(tmp_path: Path, 
     assert main(["motion", str(GALLERY / "kangaroo-leg.toml"), "-o", str(out)]) == 130
     err = capsys.readouterr().err.strip()
     assert err == "planar: interrupted (no output written)" and not out.exists()
+
+
+# ----------------------------------------------------------------------------- the second abuse trial
+
+
+def test_debug_shows_the_traceback_and_keeps_the_exit_status(tmp_path: Path, capsys) -> None:
+    """``--debug`` prints the traceback of a user error and still exits 2 (it used to exit 1)."""
+    rc = main(["--debug", "info", str(tmp_path / "nofile.toml")])
+    err = capsys.readouterr().err
+    assert rc == 2, err
+    assert "Traceback (most recent call last)" in err
+    assert err.strip().splitlines()[-1].startswith("planar: error: ")
+
+
+def test_synth_atlas_into_a_missing_folder_is_refused(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "nodir" / "a.npz"
+    _fails_cleanly(capsys, ["synth", "atlas", "--size", "100", "-o", str(out)], "-o", "does not exist", out=out)
+    assert not out.parent.exists()
+
+
+def test_an_output_with_a_trailing_slash_is_refused(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "o.html"
+    _fails_cleanly(capsys, ["render", str(GALLERY / "kangaroo-leg.toml"), "-o", f"{out}/"], "-o", out=out)
+
+
+@pytest.mark.parametrize("speeds", ["", "1,,2", "1e300", "nan", "0"])
+def test_toy_speeds_list_is_strict(capsys, speeds: str) -> None:
+    _fails_cleanly(capsys, ["toy", str(GALLERY / "windup-01.toml"), "--speeds", speeds], "--speeds")
+
+
+@pytest.mark.parametrize("what", ["", "curve,,torque"])
+def test_plot_what_list_is_strict(tmp_path: Path, capsys, what: str) -> None:
+    out = tmp_path / "p.png"
+    _fails_cleanly(capsys, ["plot", str(GALLERY / "kangaroo-leg.toml"), "-o", str(out), "--what", what], "--what", out=out)
+
+
+def test_synth_path_ragged_target_row_is_named(tmp_path: Path, capsys) -> None:
+    target = tmp_path / "t.csv"
+    target.write_text("x,y\n0,0\n1,0,5\n1,1\n0,1\n")
+    out = tmp_path / "s.toml"
+    _fails_cleanly(capsys, ["synth", "path", str(target), "-o", str(out)], "row 3", out=out)
+
+
+@pytest.mark.parametrize("samples", ["3", "1"])
+def test_catalog_samples_at_least_four(tmp_path: Path, capsys, samples: str) -> None:
+    out = tmp_path / "c.csv"
+    _fails_cleanly(capsys, ["catalog", "jansen", "-o", str(out), "--samples", samples], "--samples", out=out)
+
+
+@pytest.mark.parametrize(
+    "scene,old,new,needle",
+    [
+        ("two-input-five-bar.toml", "cycles = 2.0", "cycles = 1e300", "cycles"),
+        ("two-input-five-bar.toml", "amplitude = 35.0", "amplitude = 1e308", "amplitude"),
+        ("horse.toml", "phase = 180", "phase = 1e300", "phase"),
+    ],
+)
+def test_angles_float64_cannot_resolve_are_refused(tmp_path: Path, capsys, scene: str, old: str, new: str, needle: str) -> None:
+    text = (GALLERY / scene).read_text()
+    assert old in text
+    s = _scene(tmp_path, text.replace(old, new, 1))
+    out = tmp_path / "m.csv"
+    _fails_cleanly(capsys, ["motion", str(s), "-o", str(out)], needle, out=out)
+
+
+def test_render_fps_beyond_the_frame_limit_names_fps(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "o.html"
+    err = _fails_cleanly(capsys, ["render", str(GALLERY / "kangaroo-leg.toml"), "-o", str(out), "--fps", "1e9"], "--fps", out=out)
+    assert "driver.cycles" not in err
