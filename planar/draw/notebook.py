@@ -11,9 +11,12 @@ light (numpy loads at the first display).
 from __future__ import annotations
 
 import html
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from planar.core.display import register
+
+if TYPE_CHECKING:  # numpy loads with the model: only on first display
+    from planar.core.model import Mechanism
 
 __all__ = ["animate", "summary_table"]
 
@@ -32,7 +35,7 @@ def summary_table(title: str, rows: list[tuple[str, Any]]) -> str:
 
 
 def animate(
-    mech: Any,
+    mech: Mechanism,
     motion: Any,
     width: int = INLINE_SIZE[0],
     height: int = INLINE_SIZE[1],
@@ -60,13 +63,13 @@ def animate(
     return Player(page, width, height, len(motion), mech.name)
 
 
-def _driver(mech: Any) -> str:
+def _driver(mech: Mechanism) -> str:
     d = mech.driver
     law = "turns" if d.amplitude is None else f"oscillates +/- {d.amplitude:.4g}"
     return f"{d.kind} of {d.part}, {law}, {d.rate / 6.283185307179586:.4g} cycles/s"
 
 
-def _mechanism_rows(mech: Any) -> list[tuple[str, Any]]:
+def _mechanism_rows(mech: Mechanism) -> list[tuple[str, Any]]:
     rows: list[tuple[str, Any]] = [
         ("kind", type(mech).__name__),
         ("parts", ", ".join(p.name for p in mech.parts)),
@@ -82,7 +85,7 @@ def _mechanism_rows(mech: Any) -> list[tuple[str, Any]]:
     return rows
 
 
-def _mechanism_html(mech: Any) -> str:
+def _mechanism_html(mech: Mechanism) -> str:
     motion = mech.run(samples_per_cycle=48)
     rows = [*_mechanism_rows(mech), ("valid over a cycle", f"{int(motion.valid.sum())} of {len(motion)} samples")]
     return summary_table(mech.name, rows) + animate(mech, motion)._repr_html_()

@@ -117,7 +117,7 @@ def _shaft_holes(
     return drive_at, motor_at, flat
 
 
-def _cut_polygons(scene: Any, mech: Any, s: FabSettings) -> dict[str, list[Any]]:
+def _cut_polygons(scene: Any, mech: Mechanism, s: FabSettings) -> dict[str, list[Any]]:
     """The scene's polygons marked ``cut = true``, by part: shapely polygons in mm, the part's own frame."""
     from shapely.geometry import Polygon
 
@@ -148,7 +148,7 @@ def _merged_outline(outer: Any, polys: list[Any], s: FabSettings) -> Any:
     return Contour([(float(x), float(y), 0.0) for x, y in ring])
 
 
-def _drive_notes(mech: Any, shaft: Any) -> list[str]:
+def _drive_notes(mech: Mechanism, shaft: Any) -> list[str]:
     """Why there is no motor shaft hole, when there is none."""
     if mech.driver.kind != "rotation":
         return [f"driver {mech.driver.part!r} is a {mech.driver.kind} drive: no motor shaft hole"]
@@ -171,7 +171,7 @@ def _unplannable_tabs(layers: dict[str, int | None], used: dict[str, int | None]
     )
 
 
-def _hole_letters(mech: Any, pins: list[Any], shaft: Any) -> dict[str, list[tuple[tuple[float, float], str]]]:
+def _hole_letters(mech: Mechanism, pins: list[Any], shaft: Any) -> dict[str, list[tuple[tuple[float, float], str]]]:
     """Each part's hole letters: ``(hole centre, letter)``, a pin's letter once beside each hole it goes through."""
     letters: dict[str, list[tuple[tuple[float, float], str]]] = {p.name: [] for p in mech.parts}
     for k, stack in enumerate(pin_stacks(pins)):

@@ -14,7 +14,7 @@ from planar.core.geometry import poses_apply
 from planar.physics.toyviews import StageDrive, _law, _poses
 
 __all__ = ["SkewHold", "skew_hold", "skew_stage"]
-from planar.windup.mechanisms import SkewContact
+from planar.windup.mechanisms import ElementalMechanism, SkewContact
 
 Array = NDArray[np.float64]
 
@@ -23,7 +23,7 @@ Array = NDArray[np.float64]
 
 
 def skew_stage(
-    mech: Any,
+    mech: ElementalMechanism,
     speed: float,
     cycles: float = 1.0,
     samples_per_cycle: int = 72,
@@ -167,7 +167,7 @@ def _skew_gap_a(j: SkewContact, fpose: Array, dpose: Array, da: float = 0.0) -> 
 
 
 def _skew_terms(
-    mech: Any, j: SkewContact, gravity: tuple[float, float], density: float, samples: int, drive: StageDrive | None
+    mech: ElementalMechanism, j: SkewContact, gravity: tuple[float, float], density: float, samples: int, drive: StageDrive | None
 ) -> tuple[Array, Array, Array, Array]:
     """Over one cycle at 1 cycle/s (``samples`` per cycle): ``(t, I_p phi'', M_g, push)`` of :func:`skew_hold`."""
     from planar.analysis.dynamics import mass_properties
@@ -190,7 +190,7 @@ def _skew_terms(
 
 
 def skew_hold(
-    mech: Any,
+    mech: ElementalMechanism,
     gravity: tuple[float, float],
     speed: float,
     density: float = 1.0,
