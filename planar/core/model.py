@@ -465,8 +465,8 @@ class Driver:
         check_finite("driver.phase", self.phase)
         check_finite("driver.centre", self.centre)
         if self.amplitude is not None:
-            check_finite("driver.amplitude", self.amplitude)
-            if not self.amplitude > 0:
+            amp = check_finite("driver.amplitude", self.amplitude)
+            if amp.shape != () or not float(amp) > 0:
                 raise InputError("driver.amplitude", self.amplitude, "a positive amplitude (the phase sets the direction)")
         check_positive("driver.rate", self.rate)
         if self.kind == "translation" and self.amplitude is None:
