@@ -93,8 +93,13 @@ data = json.loads(sys.argv[1])
 scene = build_scene(parse_scene(data, "<bench>"), "<bench>")
 t0 = time.process_time()
 n = render_scene(scene, sys.argv[2], progress=False)
-print(json.dumps({"frames": n, "cpu_s": time.process_time() - t0,
-                  "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0}))
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+try:  # Linux keeps ru_maxrss across exec (a parent's size at fork counts): VmHWM is this image's own peak
+    with open("/proc/self/status") as fh:
+        peak = next(int(line.split()[1]) for line in fh if line.startswith("VmHWM:")) / 1024.0
+except (OSError, StopIteration):
+    pass
+print(json.dumps({"frames": n, "cpu_s": time.process_time() - t0, "peak_mb": peak}))
 """
 
 
