@@ -1,9 +1,5 @@
-import sys
+"""``python -m planar``: the same entrance as the ``planar`` console script."""
 
-try:
-    from planar.cli.main import main
-except KeyboardInterrupt:  # Ctrl-C while importing
-    print("planar: interrupted (no output written)", file=sys.stderr)
-    sys.exit(130)
+from planar.cli.entry import run
 
-sys.exit(main())
+run()

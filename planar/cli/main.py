@@ -63,10 +63,23 @@ def build_parser() -> argparse.ArgumentParser:
         "PLANAR_MAX_MEMORY): see the README.",
     )
     p.add_argument("--debug", action="store_true", help="show the Python traceback of an error")
+    p.add_argument("--version", action="version", version=f"planar {_version()}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for _name, module in COMMANDS:
         importlib.import_module(module).add_parser(sub)
     return p
+
+
+def _version() -> str:
+    """The installed distribution's version (the package's own when run from a checkout)."""
+    from importlib import metadata
+
+    try:
+        return metadata.version("planar")
+    except metadata.PackageNotFoundError:
+        import planar
+
+        return str(planar.__version__)
 
 
 def _one_line(text: object) -> str:
