@@ -18,7 +18,9 @@ Built, each leg lies in its own slab of layers between two frame plates (``frame
 * the leg's fixed pivots are rods in the plate it hangs on: the plate below its slab, or for the first leg of a
   mirrored pair the plate above (the pair's slabs are mirror images about their shared plate);
 * ``standoffs`` (model units, the ground frame) are rods through every plate, with spacer rings between them:
-  they hold the plates at their distance.  They must lie clear of every leg's swept area.
+  they hold the plates at their distance.  They must lie clear of every leg's swept area; without any given,
+  two are chosen (:func:`auto_standoffs`: the points nearest the crank axis clear of every sweep by a link's
+  width, on opposite sides of it).
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ from planar.errors import InputError
 from planar.linkages.linkage import Link, Linkage
 from planar.linkages.nodes import RRP, RRR, Crank, Fixed, NodeKind, Rigid
 
-__all__ = ["MIRRORS", "Legs", "LegsAssembly", "Slab"]
+__all__ = ["MIRRORS", "Legs", "LegsAssembly", "Slab", "auto_standoffs"]
 
 Array = NDArray[np.float64]
 
@@ -144,6 +146,7 @@ class Legs(Linkage):
         if not np.isfinite(so).all():
             raise InputError(f"{name}.standoffs", standoffs, "points [x, y] of finite numbers")
         self.standoffs = tuple((float(x), float(y)) for x, y in so)
+        self.standoffs_given = bool(len(self.standoffs))
         all_nodes, all_links, all_points, self.legs_links, self.hangs = self._expand(
             list(nodes), list(links), crank, centre, crank_link, dict(points or {})
         )
@@ -272,7 +275,8 @@ class LegsAssembly(Mechanism):
             joints.append(Pivot(f"{o}:{plates[k]}", plates[k], top[k - 1], ground[o], cs[o], pin))
             if k < n:
                 joints.append(Pivot(f"{o}:{top[k - 1]}-{bottom[k]}", top[k - 1], bottom[k], cs[o], cs[o], pin))
-        for j, xy in enumerate(legs.standoffs):
+        standoffs = legs.standoffs if legs.standoffs_given else auto_standoffs(legs)
+        for j, xy in enumerate(standoffs):
             for k in range(n):
                 joints.append(Pivot(f"standoff{j + 1}:{k}", plates[k], plates[k + 1], xy, xy, pin))
         for i, s in enumerate(slabs):
@@ -284,7 +288,7 @@ class LegsAssembly(Mechanism):
         parts: list[Part] = []
         for pl in plates:
             hung = [nd for i, s in enumerate(slabs) if s.plate == pl for nd in legs.hangs[i].values()]
-            hull = [(*ground[o], r)] + [(*ground[nd], r) for nd in dict.fromkeys(hung)] + [(x, y, r) for x, y in legs.standoffs]
+            hull = [(*ground[o], r)] + [(*ground[nd], r) for nd in dict.fromkeys(hung)] + [(x, y, r) for x, y in standoffs]
             parts.append(Part(pl, tuple(hull), (), ground=True))
         for i, s in enumerate(slabs):
             a = legs.crank_nodes[i]
@@ -297,6 +301,7 @@ class LegsAssembly(Mechanism):
         points = dict(legs.points)
         super().__init__(legs.name, parts, joints, driver, points)
         self.webs = {w: "crankshaft" for s in slabs for w in (s.near, s.far)}
+        self.standoffs = standoffs
         self.design_notes = [
             f"{legs.name}: {n} leg(s) in slabs between {n + 1} frame plates; the crank webs on either side of a "
             "plate are glued on the short shaft through it at their angle (the crank pins set each web's angle)"
@@ -327,3 +332,41 @@ class LegsAssembly(Mechanism):
         for pl in self.layer_stack[0]:
             out[pl] = g
         return out, checks, pts
+
+
+def auto_standoffs(legs: Legs, samples: int = 72) -> tuple[tuple[float, float], ...]:
+    """Two standoff points for a walker's frame plates (model units, ground frame), or none where none fits.
+
+    Every moving part (the crankshaft's hull standing for its webs) swept over the cycle and grown by one link
+    width is kept out of; of the points left on a grid of half a link width, the one nearest the crank axis is
+    the first standoff and the nearest one at least 120 degrees round the axis from it the second.
+    """
+    import shapely
+    from shapely import affinity
+
+    motion = legs.run(samples_per_cycle=samples)
+    ok = np.flatnonzero(motion.valid)
+    moving = [p for p in legs.parts if not p.ground]
+    swept = []
+    for p in moving:
+        shape = p.outline.simplify(0.01 * legs.width)
+        for x, y, a in np.asarray(motion.poses[p.name])[ok]:
+            c, s = math.cos(a), math.sin(a)
+            swept.append(affinity.affine_transform(shape, [c, -s, s, c, x, y]))
+    keep_out = shapely.union_all(swept).buffer(legs.width)
+    o = np.asarray(legs._anchors[legs.ground_name][legs.crank_centre])
+    x0, y0, x1, y1 = keep_out.bounds
+    h = legs.width / 2
+    gx, gy = np.meshgrid(np.arange(x0 - h, x1 + 2 * h, h), np.arange(y0 - h, y1 + 2 * h, h))
+    pts = np.c_[gx.ravel(), gy.ravel()]
+    free = pts[~shapely.contains_xy(keep_out, pts[:, 0], pts[:, 1])]
+    if len(free) == 0:
+        return ()
+    d = np.hypot(*(free - o).T)
+    first = free[np.argmin(d)]
+    ang = np.arctan2(*(free - o).T[::-1]) - math.atan2(first[1] - o[1], first[0] - o[0])
+    apart = np.abs((ang + math.pi) % (2 * math.pi) - math.pi) >= 2 * math.pi / 3
+    if not apart.any():
+        return ((float(first[0]), float(first[1])),)
+    second = free[apart][np.argmin(d[apart])]
+    return ((float(first[0]), float(first[1])), (float(second[0]), float(second[1])))

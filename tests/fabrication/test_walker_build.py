@@ -23,7 +23,15 @@ from planar.scene.write import write_scene
 
 GALLERY = Path(__file__).resolve().parents[2] / "gallery"
 
-CASES = [("jansen", 2, False, True), ("fourbar", 3, False, True), ("jansen", 6, True, True), ("fourbar", 8, True, False)]
+#: (leg, N, mirror, random phases); the five-legged Jansen-like walker is one the planner cannot clear: its fixed
+#: pivot's rod grazes the leg's lower link in every layer order tried, and the export says so
+CASES = [
+    ("jansen", 2, False, True),
+    ("fourbar", 3, False, True),
+    ("jansen", 5, False, False),
+    ("jansen", 6, True, True),
+    ("fourbar", 8, True, False),
+]
 
 
 def _random_scene(kind: str, count: int, mirror: bool, phases: bool, path: Path) -> None:
@@ -77,12 +85,16 @@ def test_random_walkers_build_or_say_what_blocks_them(kind, count, mirror, phase
     _random_scene(kind, count, mirror, phases, scene)
     res, plan = _export(scene, tmp_path)
     _slabs_apart(plan, count)
+    frames = {f"frame_{k}" for k in range(count + 1)}
+    assert sum(set(p["parts"]) == frames for p in plan["pins"]) == 2  # the standoffs chosen: rods through every plate
     if res.returncode == 0:
         assert plan["violations"] == [] and "build check: every part" in res.stdout + res.stderr
-    else:
-        lines = [ln for ln in (res.stdout + res.stderr).splitlines() if ln.startswith("build check: ")]
+    else:  # every collision named (its kind, the pair, the layer, the first sample) and the blocking constraint
+        out = res.stdout + res.stderr
+        lines = [ln for ln in out.splitlines() if ln.startswith("build check: ")]
         assert plan["violations"] and lines
-        assert all(re.search(r": .+ and .+ on layer \d+, first at sample \d+", ln) for ln in lines[1:] or lines), lines
+        assert all(re.match(r"build check: [a-z ]+: .+ and .+ on layer \d+, first at sample \d+", ln) for ln in lines), lines
+        assert "note: no plan: " in out
 
 
 @pytest.mark.slow
