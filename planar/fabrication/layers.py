@@ -219,7 +219,7 @@ def plan_assembly(
     for pl in sorted(set(plane.values()), key=lambda v: (v != "xy", v)):
         members = [n for n in names if plane[n] == pl]
         if pl == "xy" and stack is not None:
-            layers.update(_stacked_layers(stack, swept, stack_parts, crossing))
+            layers.update(_stacked_layers(stack, swept, stack_parts, crossing, notes))
             n_layers[pl] = 1 + max(v for n, v in layers.items() if n in members and v is not None)
             continue
         nodes = sorted({find(n) for n in members}, key=names.index)
@@ -257,11 +257,12 @@ def _stacked_layers(
     swept: dict[str, Any],
     stack_parts: list[tuple[str, ...]],
     crossing: list[list[str]],
+    notes: list[str],
 ) -> dict[str, int]:
     """Layers of a walker's slabs (:class:`planar.linkages.legs.Slab`): the first slab planned (its plate at 0,
     the near web on 1, the leg's links above, the far web on top; fewest layers with no pin clash, as
     :func:`_best_layers`), every other slab the same stack, turned over when it hangs below its plate; the
-    plates between slabs."""
+    plates between slabs.  Where no order clears every pin, ``notes`` says so."""
     plates, slabs = stack
     first = slabs[0]
     roles = {first.plate: "plate", first.near: "near", first.far: "far", **{v: k for k, v in first.links.items()}}
@@ -272,11 +273,17 @@ def _stacked_layers(
         if x not in links or y not in links or swept[x].intersection(swept[y]).area > OVERLAP_MM2:
             adj[x].add(y)
             adj[y].add(x)
-    pins_q = [
-        (i, [p for p in sp if p in roles], [q for q in crossing[i] if q in roles])
-        for i, sp in enumerate(stack_parts)
-        if sum(p in roles for p in sp) >= 2
-    ]
+    # every slab's pins, carried onto the first slab's parts by role: the legs are one leg at other phases, so a
+    # graze one leg's samples catch holds for them all
+    by_role = {v: k for k, v in roles.items()}
+    pins_q = []
+    for sl in slabs:
+        mine = {sl.plate: "plate", sl.near: "near", sl.far: "far", **{v: k for k, v in sl.links.items()}}
+        for i, sp in enumerate(stack_parts):
+            ends = sorted({by_role[mine[p]] for p in sp if p in mine}, key=nodes.index)
+            if len(ends) >= 2:
+                crossed = sorted({by_role[mine[q]] for q in crossing[i] if q in mine} - set(ends), key=nodes.index)
+                pins_q.append((i, ends, crossed))
     order = sorted(nodes, key=lambda r: (-len(adj[r]), nodes.index(r)))
     chosen: tuple[tuple[int, int, int], dict[str, int]] | None = None
     for k in range(3, len(nodes) + 3):
@@ -287,6 +294,11 @@ def _stacked_layers(
         if chosen is not None and chosen[0][0] == 0:
             break
     assert chosen is not None  # k = len(nodes) + 2 layers hold every part on a layer of its own
+    if chosen[0][0]:
+        notes.append(
+            f"walker slab: no order of one leg's {len(links)} links on up to {len(nodes) + 2} layers (the search "
+            f"stops at {MAX_ASSIGNMENTS:,} assignments a layer count) keeps every pin clear of the parts between its ends"
+        )
     rel = {roles[n]: v for n, v in chosen[1].items()}
     size = max(rel.values()) + 1
     out = {pl: k * size for k, pl in enumerate(plates)}
