@@ -102,7 +102,12 @@ def test_the_gallery_walker_stacks_its_legs_in_slabs(tmp_path):
     res, plan = _export(GALLERY / "jansen-walker-4.toml", tmp_path)
     assert res.returncode == 0 and plan["violations"] == []
     _slabs_apart(plan, 4)
-    names = {p["name"] for p in plan["pins"] for p in [p]}
     assert plan["motor_shaft"]["parts"] == ["frame_0", "crank_1b"], plan["motor_shaft"]
     standoffs = [p for p in plan["pins"] if set(p["parts"]) == {f"frame_{k}" for k in range(5)}]
-    assert len(standoffs) == 2 and names
+    assert len(standoffs) == 2
+    # the short shafts between slabs: a web, the plate's bearing, the next slab's web, and nothing else
+    layer = {p["name"]: p["layer"] for p in plan["parts"]}
+    for k in range(1, 4):
+        (shaft,) = [p for p in plan["pins"] if f"frame_{k}" in p["parts"] and sum(q[:6] == "crank_" for q in p["parts"]) == 2]
+        webs = sorted(layer[w] for w in shaft["parts"] if w.startswith("crank_"))
+        assert webs[0] < layer[f"frame_{k}"] < webs[1], shaft
