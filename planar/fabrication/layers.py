@@ -244,12 +244,27 @@ def plan_assembly(
             for n in group[r]:
                 layers[n] = assign[r]
     plans = _pin_plans(pins, stacks, stack_parts, crossing, layers, (thickness, pin_mm, pin_head), shaft_pin, notes)
+    notes += _glue_notes(set(getattr(mech, "glued", ())), pins, plans)
     first = int(ok[0])
     pose = {
         n: (float(motion.poses[n][first, 0] * u), float(motion.poses[n][first, 1] * u), float(motion.poses[n][first, 2]))
         for n in names
     }
     return Assembly(layers, n_layers, plans, contacts, pose, notes, plane, u)
+
+
+def _glue_notes(glued: set[str], pins: list[PinSpec], plans: list[PinPlan]) -> list[str]:
+    """One note per pin carrying a glued joint (``glued``: joint names; a walker's crank webs on the short shaft
+    through a plate): which parts to glue on it."""
+    out = []
+    for pp in plans:
+        for j in sorted(glued & set(pp.joints)):
+            webs = " and ".join(str(p.parts[side]) for p in pins if p.joint == j for side in (0, 1))
+            out.append(
+                f"pin {pp.letter}: glue {webs} on it at their angles (a drop of cyanoacrylate or epoxy in each hole): "
+                "they turn together with the rod, which runs in the plate between them"
+            )
+    return out
 
 
 def _stacked_layers(

@@ -271,10 +271,12 @@ class LegsAssembly(Mechanism):
         cs = anchors["crankshaft"]
         ground = anchors[legs.ground_name]
         joints: list[Any] = [Pivot(f"{o}:motor", plates[0], bottom[0], ground[o], cs[o], pin)]
+        glued: list[str] = []
         for k in range(1, n + 1):
             joints.append(Pivot(f"{o}:{plates[k]}", plates[k], top[k - 1], ground[o], cs[o], pin))
             if k < n:
                 joints.append(Pivot(f"{o}:{top[k - 1]}-{bottom[k]}", top[k - 1], bottom[k], cs[o], cs[o], pin))
+                glued.append(joints[-1].name)
         standoffs = legs.standoffs if legs.standoffs_given else auto_standoffs(legs)
         for j, xy in enumerate(standoffs):
             for k in range(n):
@@ -301,6 +303,8 @@ class LegsAssembly(Mechanism):
         points = dict(legs.points)
         super().__init__(legs.name, parts, joints, driver, points)
         self.webs = {w: "crankshaft" for s in slabs for w in (s.near, s.far)}
+        #: joints whose two parts are glued on the rod through them (the webs on either side of a plate turn as one)
+        self.glued = tuple(glued)
         self.standoffs = standoffs
         self.design_notes = [
             f"{legs.name}: {n} leg(s) in slabs between {n + 1} frame plates; the crank webs on either side of a "
