@@ -76,7 +76,8 @@ def _fab_mechanism(mech: Mechanism) -> Any:
         from planar.toys.assembly import toy_assembly
 
         return fab_view(toy_assembly(mech))
-    return fab_view(mech)
+    built = getattr(mech, "as_built", None)  # a kind built from other parts than it moves as (a walker's webs)
+    return fab_view(built() if built is not None else mech)
 
 
 def _phase_mark(pc: PartCut, at: tuple[float, float], flat: float, phase: float, turn: float = 0.0) -> None:

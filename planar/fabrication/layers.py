@@ -215,8 +215,13 @@ def plan_assembly(
                 root[max(ra, rb, key=names.index)] = min(ra, rb, key=names.index)
     layers: dict[str, int | None] = {}
     n_layers: dict[str, int] = {}
+    stack = getattr(mech, "layer_stack", None)  # a walker's slabs: one leg's layers planned once, repeated
     for pl in sorted(set(plane.values()), key=lambda v: (v != "xy", v)):
         members = [n for n in names if plane[n] == pl]
+        if pl == "xy" and stack is not None:
+            layers.update(_stacked_layers(stack, swept, stack_parts, crossing, notes))
+            n_layers[pl] = 1 + max(v for n, v in layers.items() if n in members and v is not None)
+            continue
         nodes = sorted({find(n) for n in members}, key=names.index)
         group = {r: [n for n in members if find(n) == r] for r in nodes}
         for g in group.values():  # parts in contact share a layer: they must not overlap at any instant
@@ -239,12 +244,85 @@ def plan_assembly(
             for n in group[r]:
                 layers[n] = assign[r]
     plans = _pin_plans(pins, stacks, stack_parts, crossing, layers, (thickness, pin_mm, pin_head), shaft_pin, notes)
+    notes += _glue_notes(set(getattr(mech, "glued", ())), pins, plans)
     first = int(ok[0])
     pose = {
         n: (float(motion.poses[n][first, 0] * u), float(motion.poses[n][first, 1] * u), float(motion.poses[n][first, 2]))
         for n in names
     }
     return Assembly(layers, n_layers, plans, contacts, pose, notes, plane, u)
+
+
+def _glue_notes(glued: set[str], pins: list[PinSpec], plans: list[PinPlan]) -> list[str]:
+    """One note per pin carrying a glued joint (``glued``: joint names; a walker's crank webs on the short shaft
+    through a plate): which parts to glue on it."""
+    out = []
+    for pp in plans:
+        for j in sorted(glued & set(pp.joints)):
+            webs = " and ".join(str(p.parts[side]) for p in pins if p.joint == j for side in (0, 1))
+            out.append(
+                f"pin {pp.letter}: glue {webs} on it at their angles (a drop of cyanoacrylate or epoxy in each hole): "
+                "they turn together with the rod, which runs in the plate between them"
+            )
+    return out
+
+
+def _stacked_layers(
+    stack: tuple[tuple[str, ...], tuple[Any, ...]],
+    swept: dict[str, Any],
+    stack_parts: list[tuple[str, ...]],
+    crossing: list[list[str]],
+    notes: list[str],
+) -> dict[str, int]:
+    """Layers of a walker's slabs (:class:`planar.linkages.legs.Slab`): the first slab planned (its plate at 0,
+    the near web on 1, the leg's links above, the far web on top; fewest layers with no pin clash, as
+    :func:`_best_layers`), every other slab the same stack, turned over when it hangs below its plate; the
+    plates between slabs.  Where no order clears every pin, ``notes`` says so."""
+    plates, slabs = stack
+    first = slabs[0]
+    roles = {first.plate: "plate", first.near: "near", first.far: "far", **{v: k for k, v in first.links.items()}}
+    nodes = list(roles)
+    links = list(first.links.values())
+    adj: dict[str, set[str]] = {r: set() for r in nodes}
+    for x, y in itertools.combinations(nodes, 2):
+        if x not in links or y not in links or swept[x].intersection(swept[y]).area > OVERLAP_MM2:
+            adj[x].add(y)
+            adj[y].add(x)
+    # every slab's pins, carried onto the first slab's parts by role: the legs are one leg at other phases, so a
+    # graze one leg's samples catch holds for them all
+    by_role = {v: k for k, v in roles.items()}
+    pins_q = []
+    for sl in slabs:
+        mine = {sl.plate: "plate", sl.near: "near", sl.far: "far", **{v: k for k, v in sl.links.items()}}
+        for i, sp in enumerate(stack_parts):
+            ends = sorted({by_role[mine[p]] for p in sp if p in mine}, key=nodes.index)
+            if len(ends) >= 2:
+                crossed = sorted({by_role[mine[q]] for q in crossing[i] if q in mine} - set(ends), key=nodes.index)
+                pins_q.append((i, ends, crossed))
+    order = sorted(nodes, key=lambda r: (-len(adj[r]), nodes.index(r)))
+    chosen: tuple[tuple[int, int, int], dict[str, int]] | None = None
+    for k in range(3, len(nodes) + 3):
+        fixed = {first.plate: 0, first.near: 1, first.far: k - 1}
+        best = _search(order, adj, k, functools.partial(_score, pins_q), fixed)
+        if best is not None and (chosen is None or best[0][0] < chosen[0][0]):
+            chosen = best
+        if chosen is not None and chosen[0][0] == 0:
+            break
+    assert chosen is not None  # k = len(nodes) + 2 layers hold every part on a layer of its own
+    if chosen[0][0]:
+        notes.append(
+            f"walker slab: no order of one leg's {len(links)} links on up to {len(nodes) + 2} layers (the search "
+            f"stops at {MAX_ASSIGNMENTS:,} assignments a layer count) keeps every pin clear of the parts between its ends"
+        )
+    rel = {roles[n]: v for n, v in chosen[1].items()}
+    size = max(rel.values()) + 1
+    out = {pl: k * size for k, pl in enumerate(plates)}
+    for i, sl in enumerate(slabs):
+        mine = {sl.plate: "plate", sl.near: "near", sl.far: "far", **{v: k for k, v in sl.links.items()}}
+        for part, role in mine.items():
+            if role != "plate":
+                out[part] = (i + 1) * size - rel[role] if sl.reversed else i * size + rel[role]
+    return out
 
 
 def _pin_plans(

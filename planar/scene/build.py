@@ -21,6 +21,7 @@ from planar.scene.schema import (
     ChainSpec,
     ElementalSpec,
     FourBarSpec,
+    LegsSpec,
     LinkageSpec,
     SceneSpec,
     SliderCrankSpec,
@@ -294,6 +295,35 @@ def _build_linkage(spec: SceneSpec, m: LinkageSpec, b: _Build) -> Mechanism:
     links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
     return Linkage(
         spec.name or "linkage", nodes, links, points=m.points, placement=b.placement, rate=b.rate, phase=b.phase, **b.rock
+    )
+
+
+@BUILDERS.register(LegsSpec)
+def _build_legs(spec: SceneSpec, m: LegsSpec, b: _Build) -> Mechanism:
+    from planar.linkages import NODE_KINDS, Link
+    from planar.linkages.legs import Legs
+
+    nodes = []
+    for n in m.nodes:
+        cls = NODE_KINDS[n.kind]
+        args = [
+            _angle(spec, getattr(n, f)) if f in cls.angle_fields and getattr(n, f) is not None else getattr(n, f)
+            for f in cls.scene_fields
+        ]
+        nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
+    links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
+    phases = None if m.phases is None else [_angle(spec, v) for v in m.phases]
+    return Legs(
+        spec.name or "legs",
+        nodes,
+        links,
+        m.count,
+        phases,
+        mirror=m.mirror,
+        points=m.points,
+        standoffs=[tuple(p) for p in m.standoffs],
+        rate=b.rate,
+        phase=b.phase,
     )
 
 

@@ -41,7 +41,7 @@ def _loc(loc: tuple) -> str:
         elif (
             i == 1
             and loc[0] == "mechanism"
-            and part in ("fourbar", "slidercrank", "linkage", "elemental", "chain", "toy", "catalog", "cam")
+            and part in ("fourbar", "slidercrank", "linkage", "legs", "elemental", "chain", "toy", "catalog", "cam")
         ):
             continue  # the discriminated union's tag
         elif i > 0 and (str(part) in ("float", "int", "str", "bool") or str(part).startswith(("list[", "tuple["))):

@@ -235,6 +235,34 @@ class LinkageSpec(_Strict):
     """Polygons fixed to parts, swept in drawings."""
 
 
+class LegsSpec(_Strict):
+    """A walker: ``count`` identical legs phased on one crankshaft (see ``gallery/jansen-walker-4.toml`` and the
+    how-to "Describe a walker").  The leg is written as a ``linkage`` scene's nodes and links: a ``fixed`` crank
+    centre, exactly one ``crank`` node turning about it on a link of those two nodes, the leg's fixed pivots and
+    its dyads.  Leg ``i``'s nodes, links and points are named with the suffix ``_i`` (``F_1``, ``upper_2``,
+    ``foot_3``); the crankshaft is the link ``crankshaft``."""
+
+    type: Literal["legs"]
+    """``"legs"``."""
+    nodes: Annotated[list[NodeSpec], Field(min_length=3)]
+    """One leg's ``[[mechanism.nodes]]`` tables, as in a ``linkage`` scene."""
+    links: Annotated[list[LinkSpec], Field(min_length=2)]
+    """One leg's ``[[mechanism.links]]`` tables, the crank link among them."""
+    points: dict[Name, Name] = {}
+    """The leg's named points, e.g. ``{ foot = "F" }``: ``foot_1`` ... ``foot_N`` on the walker."""
+    count: Annotated[int, Strict(), Field(ge=1, le=16)]
+    """How many legs, e.g. ``4`` (even with ``mirror``)."""
+    phases: list[Real] | None = None
+    """Each leg's crank angle ahead of the shaft (scene's angle unit), e.g. ``[0, 180, 90, 270]``; default
+    evenly spread over a turn (with ``mirror``: over the pairs, both legs of a pair on one angle)."""
+    mirror: bool = False
+    """Every second leg is the one before it mirrored about the vertical through the crank centre (a
+    Strandbeest's pairs)."""
+    standoffs: list[tuple[Real, Real]] = []
+    """Where rods hold the built frame plates apart: points ``[x, y]`` (model units) clear of every leg's
+    swept area, e.g. ``[[0.0, -30.0]]``."""
+
+
 class ElementalSpec(_Strict):
     """One of the 11 elemental wind-up mechanisms: ``type = "elemental"``, ``number = 2``,
     ``params = { D_jc = [0.0, 0.08] }``."""
@@ -375,7 +403,7 @@ class CamSpec(_Strict):
 
 
 MechanismSpec = Annotated[
-    FourBarSpec | SliderCrankSpec | LinkageSpec | ElementalSpec | ChainSpec | ToySpec | CatalogSpec | CamSpec,
+    FourBarSpec | SliderCrankSpec | LinkageSpec | LegsSpec | ElementalSpec | ChainSpec | ToySpec | CatalogSpec | CamSpec,
     Field(discriminator="type"),
 ]
 
@@ -580,7 +608,7 @@ class SceneSpec(_Strict):
     angle_unit: Literal["rad", "deg"] = "rad"
     """Unit of every angle in the file: ``"rad"`` or ``"deg"``."""
     mechanism: MechanismSpec
-    """The mechanism, by ``type``: fourbar, slidercrank, linkage, elemental, chain, toy, catalog."""
+    """The mechanism, by ``type``: fourbar, slidercrank, linkage, legs, elemental, chain, toy, catalog."""
     driver: DriverSpec = DriverSpec()
     """The input's law over time."""
     effects: EffectsSpec = EffectsSpec()
