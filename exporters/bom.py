@@ -29,6 +29,7 @@ from planar.fabrication.hardware import (
     shaft_items,
     shaft_length,
     shaft_retention,
+    standoffs,
 )
 from planar.fabrication.sheet import cut_polygon
 
@@ -201,20 +202,24 @@ def _fixing_rows(w: Any, fab: Any) -> None:
             )
     plates = _plates(fab)
     if plates:
-        standoff, screw, washer = mounting_items(s, fab.below_mm)
-        w.writerow(
-            [
-                "standoff",
-                "",
-                standoff.qty * len(plates),
-                "",
-                "",
-                standoff.size,
-                "",
-                f"{standoff.item}, two under each ground plate: {fab.below_mm:g} mm hangs below the bottom layer "
-                "(the motor's body, the pins' lower ends), the standoffs stand clear of it",
-            ]
-        )
+        *stack, screw, washer = mounting_items(s, fab.below_mm)
+        k, height = standoffs(fab.below_mm)
+        for standoff in stack:
+            w.writerow(
+                [
+                    "standoff",
+                    "",
+                    standoff.qty * len(plates),
+                    "",
+                    "",
+                    standoff.size,
+                    "",
+                    f"{standoff.item}, under the two mounting holes of each ground plate"
+                    + (f" ({k} stacked under each hole: {height:g} mm, the male-female ones on top)" if k > 1 else "")
+                    + f": {round(fab.below_mm, 1):g} mm hangs below the bottom layer (the motor's body, the pins' lower"
+                    " ends, pieces standing below), the standoffs stand the plate clear of it",
+                ]
+            )
         w.writerow(
             [
                 "mounting screw",

@@ -240,13 +240,19 @@ def _standoff_actions(fab: Any, name: str) -> list[str]:
 
     if name not in fab.mounts:
         return []
-    standoff, screw, washer = mounting_items(fab.settings, fab.below_mm)
+    *stack, screw, washer = mounting_items(fab.settings, fab.below_mm)
+    acts = []
+    if len(stack) > 1:
+        acts.append(
+            f"screw the {stack[1].qty} standoffs ({stack[1].item} {stack[1].size}) onto the tops of the "
+            f"{stack[0].qty} ({stack[0].item} {stack[0].size}), one column under each mounting hole"
+        )
     return [
-        f"screw {standoff.qty} standoffs ({standoff.item} {standoff.size}) under {name}: a mounting screw "
-        f"({screw.item} {screw.size}) with a washer ({washer.item} {washer.size}) down through each mounting hole "
-        "(marked S) into a standoff's top",
-        f"stand {name} on its standoffs (the motor and the pins' lower ends hang {fab.below_mm:g} mm below it, clear "
-        "of the table)",
+        *acts,
+        f"screw {stack[0].qty} standoff columns ({', '.join(f'{i.item} {i.size}' for i in stack)}) under {name}: "
+        f"a mounting screw ({screw.item} {screw.size}) with a washer ({washer.item} {washer.size}) down through each "
+        "mounting hole (marked S) into a column's top",
+        f"stand {name} on its standoffs (what hangs under it, {round(fab.below_mm, 1):g} mm, stays clear of the table)",
     ]
 
 
@@ -256,7 +262,7 @@ def _base_actions(fab: Any) -> list[str]:
 
     if not fab.mounts:
         return []
-    _, screw, _ = mounting_items(fab.settings, fab.below_mm)
+    *_, screw, _ = mounting_items(fab.settings, fab.below_mm)
     n = 2 * len(fab.mounts)
     return [
         f"fix it to a base board ({fab.settings.thickness_mm:g} mm; optional): {n} mounting screws ({screw.item} "
@@ -397,11 +403,11 @@ def _fixing_legend(fab: Any) -> list[str]:
                 f"({screw.item} {screw.size}) down through the plate into its face"
             )
     if fab.mounts:
-        standoff, screw, _ = mounting_items(s, fab.below_mm)
+        *stack, screw, _ = mounting_items(s, fab.below_mm)
         out.append(
-            f"S: {standoff.qty} standoffs ({standoff.item} {standoff.size}) under each ground plate, "
+            f"S: standoffs ({', '.join(f'{i.qty} {i.item} {i.size}' for i in stack)}) under each ground plate, "
             f"mounting screws ({screw.item} {screw.size}) down through its mounting holes into them "
-            f"({fab.below_mm:g} mm hangs below layer 1)"
+            f"({round(fab.below_mm, 1):g} mm hangs below layer 1)"
         )
     return out
 

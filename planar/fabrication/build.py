@@ -398,8 +398,23 @@ def _build(scene: Any, settings: FabSettings) -> Fabrication:
         mechanism=mech,
         violations=violations,
         mounts={pc.name: list(pc.mounting_at) for pc in cuts if pc.mounting_at},
-        below_mm=below_mm(s, asm.pins),
+        below_mm=below_mm(s, asm.pins, _hang(tab_plan)),
     )
+
+
+def _hang(tab_plan: Any) -> float:
+    """How far the pieces standing perpendicular reach below the xy stack's lower face over the cycle (mm, >= 0)."""
+    import numpy as np
+    import shapely
+
+    from planar.fabrication.check import placed_array
+
+    lows = [
+        float(shapely.bounds(placed_array(tab_plan.shape[n], np.asarray(tab_plan.track[n]), 1.0))[:, 1].min())
+        for n in tab_plan.planes
+        if n in tab_plan.track and n in tab_plan.shape
+    ]
+    return max(0.0, tab_plan.z_stack - min(lows)) if lows else 0.0
 
 
 def _shaft_xy(asm: Assembly) -> tuple[float, float]:

@@ -49,6 +49,7 @@ __all__ = [
     "shaft_items",
     "shaft_length",
     "standoff_length",
+    "standoffs",
 ]
 
 #: DIN 125 washer per nominal diameter: (outer diameter, thickness) mm
@@ -287,11 +288,11 @@ STANDOFF_THREAD_MM = 4.0
 STANDOFF_CLEAR_MM = 1.0
 
 
-def below_mm(settings: Any, pins: Any) -> float:
+def below_mm(settings: Any, pins: Any, hang: float = 0.0) -> float:
     """How far below the bottom layer's lower face things hang (mm, >= 0): the motor's body (``motor_body_mm``)
-    when a pin is the motor shaft, and the lower ends (clip and washer, a screw's head) of every pin starting on
-    the bottom layer."""
-    low = 0.0
+    when a pin is the motor shaft, the lower ends (clip and washer, a screw's head) of every pin starting on
+    the bottom layer, and ``hang`` (mm: the lowest reach of pieces standing perpendicular below the stack)."""
+    low = max(0.0, hang)
     for pp in pins:
         lo, _ = pp.layers or (0, 0)
         if pp.shaft:
@@ -301,25 +302,37 @@ def below_mm(settings: Any, pins: Any) -> float:
     return low
 
 
+def standoffs(below: float) -> tuple[int, float]:
+    """``(count, length mm)`` of the standoffs stacked under each mounting hole: one of the shortest length sold
+    that holds the plate ``below`` mm plus ``STANDOFF_CLEAR_MM`` above the surface it stands on, or, past the
+    longest, the fewest of one length sold that reach it stacked (male-female ones screwed into each other)."""
+    need = below + STANDOFF_CLEAR_MM
+    k = max(1, math.ceil(need / STANDOFF_LENGTHS[-1] - 1e-9))
+    return k, float(next(n for n in STANDOFF_LENGTHS if k * n >= need - 1e-9))
+
+
 def standoff_length(settings: Any, below: float) -> float:
-    """The shortest standoff sold (mm) that holds the plate ``below`` mm plus ``STANDOFF_CLEAR_MM`` above the
-    surface it stands on (an error naming ``motor_body_mm`` past the longest)."""
-    for n in STANDOFF_LENGTHS:
-        if n >= below + STANDOFF_CLEAR_MM - 1e-9:
-            return float(n)
-    raise InputError("fabrication.motor_body_mm", settings.motor_body_mm, f"a body under {STANDOFF_LENGTHS[-1] - 1:g} mm")
+    """The standoffs' height under a mounting hole (mm, stacked ones together): at least ``below`` plus
+    ``STANDOFF_CLEAR_MM`` (:func:`standoffs`)."""
+    k, n = standoffs(below)
+    return k * n
 
 
 def mounting_items(settings: Any, below: float = 0.0) -> list[Item]:
-    """One ground plate's mounting: two hex standoffs (female-female) tall enough to clear ``below`` mm (what
-    hangs under the plate: :func:`below_mm`), four screws with washers (two down through the plate's mounting holes
-    into the standoffs' tops, two up through a base board as thick as the sheet into their bottoms:
-    ``STANDOFF_THREAD_MM`` into the standoff)."""
+    """One ground plate's mounting: a hex standoff (female-female; stacked male-female ones where one is too short)
+    under each of its two mounting holes, tall enough to clear ``below`` mm (what hangs under the plate:
+    :func:`below_mm`), four screws with washers (two down through the plate's mounting holes into the standoffs'
+    tops, two up through a base board as thick as the sheet into their bottoms: ``STANDOFF_THREAD_MM`` into the
+    standoff)."""
     m = _metric_for(settings.mounting_hole_mm)
     wd, wt = WASHER.get(m, (2 * m + 1, 0.5))
     n = _sold(settings.thickness_mm + wt + STANDOFF_THREAD_MM)
+    k, length = standoffs(below)
+    stack = [Item(f"hex standoff M{m:g} female-female (nylon or brass)", f"M{m:g} x {length:g}", 2)]
+    if k > 1:  # stacked: male-female ones screwed into each other on the female-female one at the bottom
+        stack.append(Item(f"hex standoff M{m:g} male-female (nylon or brass)", f"M{m:g} x {length:g}", 2 * (k - 1)))
     return [
-        Item(f"hex standoff M{m:g} female-female (nylon or brass)", f"M{m:g} x {standoff_length(settings, below):g}", 2),
+        *stack,
         Item("button head screw ISO 7380", f"M{m:g} x {n:g}", 4),
         Item("washer DIN 125", f"M{m:g} ({wd:g} x {wt:g} mm)", 4),
     ]

@@ -189,6 +189,21 @@ def test_below_and_standoff_clear_the_motor_and_the_lower_ends(hardware):
         assert no_motor == pytest.approx(lower_end)  # without a motor only the pins' lower ends hang
 
 
+def test_standoffs_stack_past_the_longest_sold_and_clear_pieces_hanging_below():
+    from planar.fabrication.hardware import STANDOFF_LENGTHS, below_mm, mounting_items, standoffs
+
+    longest = STANDOFF_LENGTHS[-1]
+    for below in np.random.default_rng(6).uniform(0.0, 4 * longest, 40):
+        k, n = standoffs(float(below))
+        assert k * n >= below + 1.0 and n in STANDOFF_LENGTHS
+        assert (k - 1) * longest < below + 1.0  # no more stacked than needed
+        items = mounting_items(_settings(), float(below))
+        stands = [i for i in items if "standoff" in i.item]
+        assert sum(i.qty for i in stands) == 2 * k and all(i.size == f"M3 x {n:g}" for i in stands)
+    s = _settings(motor_body_mm=26.0)
+    assert below_mm(s, [_pin("A", (0, 1), shaft=True)], hang=84.5) == pytest.approx(84.5)  # a bracket hanging lower
+
+
 def test_short_shaft_is_a_violation_naming_both_lengths_and_the_option():
     from planar.fabrication.hardware import shaft_check
 
@@ -288,8 +303,8 @@ def test_standoffs_clear_the_lowest_extent_below_the_plate(tmp_path, hardware, b
     assert mount["below_mm"] == pytest.approx(lowest)
     assert mount["standoff_mm"] >= lowest
     row = next(r for r in out["bom"] if r["item"] == "standoff")
-    assert float(row["size_mm"].split(" x ")[1]) == mount["standoff_mm"]
-    assert int(row["qty"]) == 2 * len(mount["plates"])
+    assert float(row["size_mm"].split(" x ")[1]) * mount["stacked"] == mount["standoff_mm"]
+    assert sum(int(r["qty"]) for r in out["bom"] if r["item"] == "standoff") == 2 * mount["stacked"] * len(mount["plates"])
     assert len(mount["plates"][0]["at_mm"]) == 2
 
 
