@@ -203,7 +203,7 @@ def _fixing_rows(w: Any, fab: Any) -> None:
     plates = _plates(fab)
     if plates:
         *stack, screw, washer = mounting_items(s, fab.below_mm)
-        k, height = standoffs(fab.below_mm)
+        k, height = standoffs(s, fab.below_mm)
         for standoff in stack:
             w.writerow(
                 [

@@ -133,7 +133,7 @@ def _mounting(fab: Any) -> dict[str, Any] | None:
     return {
         "below_mm": _r(fab.below_mm),
         "standoff_mm": _r(standoff_length(s, fab.below_mm)),
-        "stacked": standoffs(fab.below_mm)[0],
+        "stacked": standoffs(s, fab.below_mm)[0],
         "hole_mm": _r(s.mounting_hole_mm),
         "plates": [{"part": n, "at_mm": [[_r(x), _r(y)] for x, y in fab.mounts[n]]} for n in plates],
         "hardware": [{"item": i.item, "size": i.size, "qty": i.qty * len(plates)} for i in mounting_items(s, fab.below_mm)],

@@ -302,11 +302,21 @@ def below_mm(settings: Any, pins: Any, hang: float = 0.0) -> float:
     return low
 
 
-def standoffs(below: float) -> tuple[int, float]:
+def _mount_screw(settings: Any) -> tuple[float, float, float, float]:
+    """The mounting screws: ``(metric size, washer diameter, washer thickness, length sold)`` mm, long enough for
+    the plate (or a base board as thick), a washer and ``STANDOFF_THREAD_MM`` into the standoff."""
+    m = _metric_for(settings.mounting_hole_mm)
+    wd, wt = WASHER.get(m, (2 * m + 1, 0.5))
+    return m, wd, wt, _sold(settings.thickness_mm + wt + STANDOFF_THREAD_MM)
+
+
+def standoffs(settings: Any, below: float) -> tuple[int, float]:
     """``(count, length mm)`` of the standoffs stacked under each mounting hole: one of the shortest length sold
-    that holds the plate ``below`` mm plus ``STANDOFF_CLEAR_MM`` above the surface it stands on, or, past the
-    longest, the fewest of one length sold that reach it stacked (male-female ones screwed into each other)."""
-    need = below + STANDOFF_CLEAR_MM
+    that holds the plate ``below`` mm plus ``STANDOFF_CLEAR_MM`` above the surface it stands on and leaves 1 mm
+    between the ends of the screws turned into it from above and below, or, past the longest, the fewest of one
+    length sold that reach it stacked (male-female ones screwed into each other)."""
+    _, _, wt, n = _mount_screw(settings)
+    need = max(below + STANDOFF_CLEAR_MM, 2 * (n - settings.thickness_mm - wt) + 1.0)
     k = max(1, math.ceil(need / STANDOFF_LENGTHS[-1] - 1e-9))
     return k, float(next(n for n in STANDOFF_LENGTHS if k * n >= need - 1e-9))
 
@@ -314,7 +324,7 @@ def standoffs(below: float) -> tuple[int, float]:
 def standoff_length(settings: Any, below: float) -> float:
     """The standoffs' height under a mounting hole (mm, stacked ones together): at least ``below`` plus
     ``STANDOFF_CLEAR_MM`` (:func:`standoffs`)."""
-    k, n = standoffs(below)
+    k, n = standoffs(settings, below)
     return k * n
 
 
@@ -324,10 +334,8 @@ def mounting_items(settings: Any, below: float = 0.0) -> list[Item]:
     :func:`below_mm`), four screws with washers (two down through the plate's mounting holes into the standoffs'
     tops, two up through a base board as thick as the sheet into their bottoms: ``STANDOFF_THREAD_MM`` into the
     standoff)."""
-    m = _metric_for(settings.mounting_hole_mm)
-    wd, wt = WASHER.get(m, (2 * m + 1, 0.5))
-    n = _sold(settings.thickness_mm + wt + STANDOFF_THREAD_MM)
-    k, length = standoffs(below)
+    m, wd, wt, n = _mount_screw(settings)
+    k, length = standoffs(settings, below)
     stack = [Item(f"hex standoff M{m:g} female-female (nylon or brass)", f"M{m:g} x {length:g}", 2)]
     if k > 1:  # stacked: male-female ones screwed into each other on the female-female one at the bottom
         stack.append(Item(f"hex standoff M{m:g} male-female (nylon or brass)", f"M{m:g} x {length:g}", 2 * (k - 1)))

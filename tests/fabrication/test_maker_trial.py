@@ -173,7 +173,7 @@ def _pin(letter, layers, shaft=False, d=3.0):
 
 @pytest.mark.parametrize("hardware", ["rod-eclip", "screw"])
 def test_below_and_standoff_clear_the_motor_and_the_lower_ends(hardware):
-    from planar.fabrication.hardware import STANDOFF_LENGTHS, below_mm, pin_ends, standoff_length
+    from planar.fabrication.hardware import STANDOFF_LENGTHS, below_mm, mounting_items, pin_ends, standoff_length
 
     rng = np.random.default_rng(21)
     for body in rng.uniform(0.5, 45.0, 12):
@@ -184,7 +184,9 @@ def test_below_and_standoff_clear_the_motor_and_the_lower_ends(hardware):
         assert low == pytest.approx(max(body, lower_end))
         n = standoff_length(s, low)
         assert n >= low + 1.0 and n in STANDOFF_LENGTHS
-        assert all(m < low + 1.0 for m in STANDOFF_LENGTHS if m < n)  # the shortest that clears it
+        into = float(next(i for i in mounting_items(s, low) if "screw" in i.item).size.split(" x ")[1]) - 3.5
+        least = max(low + 1.0, 2 * into + 1.0)  # clear of what hangs, and room for a screw from each end
+        assert all(m < least for m in STANDOFF_LENGTHS if m < n)  # the shortest that does
         no_motor = below_mm(s, pins[1:])
         assert no_motor == pytest.approx(lower_end)  # without a motor only the pins' lower ends hang
 
@@ -193,13 +195,19 @@ def test_standoffs_stack_past_the_longest_sold_and_clear_pieces_hanging_below():
     from planar.fabrication.hardware import STANDOFF_LENGTHS, below_mm, mounting_items, standoffs
 
     longest = STANDOFF_LENGTHS[-1]
-    for below in np.random.default_rng(6).uniform(0.0, 4 * longest, 40):
-        k, n = standoffs(float(below))
+    rng = np.random.default_rng(6)
+    for below in np.concatenate([rng.uniform(0.0, 4 * longest, 40), [0.0, 1.1, 5.5]]):
+        t = float(rng.choice([2.0, 3.0, 4.0, 6.0]))
+        s = _settings(thickness_mm=t)
+        k, n = standoffs(s, float(below))
         assert k * n >= below + 1.0 and n in STANDOFF_LENGTHS
-        assert (k - 1) * longest < below + 1.0  # no more stacked than needed
-        items = mounting_items(_settings(), float(below))
+        assert (k - 1) * longest < max(below + 1.0, 2 * longest)  # no more stacked than needed
+        items = mounting_items(s, float(below))
         stands = [i for i in items if "standoff" in i.item]
         assert sum(i.qty for i in stands) == 2 * k and all(i.size == f"M3 x {n:g}" for i in stands)
+        screw = next(i for i in items if "screw" in i.item)
+        into = float(screw.size.split(" x ")[1]) - t - 0.5  # through the plate and a washer into the standoff
+        assert into >= 3.0 and (k > 1 or 2 * into < n), (below, t, screw.size, n)  # the two screws never meet
     s = _settings(motor_body_mm=26.0)
     assert below_mm(s, [_pin("A", (0, 1), shaft=True)], hang=84.5) == pytest.approx(84.5)  # a bracket hanging lower
 
