@@ -3,7 +3,9 @@
 Columns: ``item, id, qty, layer, sheet, size_mm, joins, notes``.  Each pin's row names what it is made of (the
 ``[fabrication] hardware``: a steel rod with washers and e-clips, or a button-head screw with washers and a nylon
 lock nut; :mod:`planar.fabrication.hardware`), the motor shaft's row its length above the motor and what holds
-its driven part, the ``motor``, ``motor screw`` and ``mounting screw`` rows their sizes with lengths, and the
+its driven part, the ``motor``, ``motor screw``, ``standoff`` and ``mounting screw`` rows their sizes with
+lengths (the standoffs tall enough for what hangs under the bottom layer: the motor's body, the pins' lower ends),
+a ``sheet`` row first (how many sheets, their size and thickness), and the
 ``buy`` rows at the end total every item to buy by size.  A ``tabs`` row
 per tab-and-slot joint (``planar.fabrication.tabs``): its letter, the number of tabs,
 a tab's ``width x length``, ``piece -> xy piece`` and which slots they go into.  Layers and
@@ -27,6 +29,7 @@ from planar.fabrication.hardware import (
     shaft_items,
     shaft_length,
     shaft_retention,
+    standoffs,
 )
 from planar.fabrication.sheet import cut_polygon
 
@@ -41,6 +44,7 @@ def bom_text(fab: Any) -> str:
     notes_of: dict[str, list[str]] = {}
     for n in fab.notes:
         notes_of.setdefault(n.split(":", 1)[0], []).append(n.split(":", 1)[-1].strip())
+    _sheet_row(w, fab)
     for p in lay.parts:
         if p.name.startswith("spacer ") or p.name not in asm.layers:
             continue  # spacers have their own rows; the reference square is no part
@@ -75,7 +79,9 @@ def bom_text(fab: Any) -> str:
                     "",
                     f"D {s.shaft_mm:g} ({s.shaft_flat_mm:g} across flat) x {shaft_length(s, pp):g} above the motor",
                     joins,
-                    f"joint {', '.join(pp.joints)}; motor under the ground plate, 2 screws "
+                    f"joint {', '.join(pp.joints)}; the motor's shaft is {s.motor_shaft_mm:g} mm (motor_shaft_mm)"
+                    f"{': too short' if shaft_length(s, pp) > s.motor_shaft_mm + 1e-9 else ''}; "
+                    "motor under the ground plate, 2 screws "
                     f"{s.motor_screw_spacing_mm:g} mm apart; {shaft_retention(driven_part(pp, fab.grounds))}: "
                     + " + ".join(f"{i.qty} {i.item} {i.size}" for i in shaft_items(s, pp)),
                 ]
@@ -149,6 +155,25 @@ def bom_text(fab: Any) -> str:
     return buf.getvalue()
 
 
+def _sheet_row(w: Any, fab: Any) -> None:
+    """The sheet itself: how many, their size and thickness (the material is the maker's choice: plywood or
+    acrylic of that thickness)."""
+    s, lay = fab.settings, fab.layout
+    w.writerow(
+        [
+            "sheet",
+            "",
+            lay.sheets,
+            "",
+            "1" if lay.sheets == 1 else f"1-{lay.sheets}",
+            f"{lay.sheet_size[0]:g} x {lay.sheet_size[1]:g} x {s.thickness_mm:g}",
+            "",
+            f"plywood (birch, laser grade) or cast acrylic, {s.thickness_mm:g} mm; every part and spacer ring is cut "
+            f"from it (kerf {lay.kerf:g} mm)",
+        ]
+    )
+
+
 def _plates(fab: Any) -> list[str]:
     """The ground plates cut flat (each has two mounting holes)."""
     asm = fab.assembly
@@ -171,13 +196,30 @@ def _fixing_rows(w: Any, fab: Any) -> None:
                     "",
                     screw.size,
                     "",
-                    f"{screw.item}, up through the plate into the motor's face "
-                    f"({s.motor_screw_mm:g} mm holes, {s.motor_screw_spacing_mm:g} mm apart)",
+                    f"{screw.item}, down through the ground plate into the motor's face under it, heads on the plate "
+                    f"({s.motor_screw_mm:g} mm clearance holes, {s.motor_screw_spacing_mm:g} mm apart)",
                 ]
             )
     plates = _plates(fab)
     if plates:
-        screw, washer, nut = mounting_items(s)
+        *stack, screw, washer = mounting_items(s, fab.below_mm)
+        k, height = standoffs(s, fab.below_mm)
+        for standoff in stack:
+            w.writerow(
+                [
+                    "standoff",
+                    "",
+                    standoff.qty * len(plates),
+                    "",
+                    "",
+                    standoff.size,
+                    "",
+                    f"{standoff.item}, under the two mounting holes of each ground plate"
+                    + (f" ({k} stacked under each hole: {height:g} mm, the male-female ones on top)" if k > 1 else "")
+                    + f": {round(fab.below_mm, 1):g} mm hangs below the bottom layer (the motor's body, the pins' lower"
+                    " ends, pieces standing below), the standoffs stand the plate clear of it",
+                ]
+            )
         w.writerow(
             [
                 "mounting screw",
@@ -187,8 +229,9 @@ def _fixing_rows(w: Any, fab: Any) -> None:
                 "",
                 screw.size,
                 "",
-                f"{screw.item} + {washer.item} + {nut.item}, two per ground plate ({s.mounting_hole_mm:g} mm holes); "
-                f"long enough for a {s.thickness_mm:g} mm base board under the plate (a thicker base: a longer screw)",
+                f"{screw.item} + {washer.item}, four per ground plate: two down through its mounting holes "
+                f"({s.mounting_hole_mm:g} mm) into the standoffs' tops, two up through a {s.thickness_mm:g} mm base "
+                "board into their bottoms (a thicker base: longer screws)",
             ]
         )
 
@@ -208,6 +251,6 @@ def _buy_rows(w: Any, fab: Any) -> None:
     for pp in asm.pins:
         add(shaft_items(s, pp) + motor_items(s) if pp.shaft else pin_items(s, pp), "motor" if pp.shaft else "pins")
     for _ in _plates(fab):
-        add(mounting_items(s), "mounting")
+        add(mounting_items(s, fab.below_mm), "mounting")
     for (item, size), qty in sorted(total.items()):
         w.writerow(["buy", item, qty, "", "", size, "", "total for " + ", ".join(uses[(item, size)])])

@@ -5,8 +5,10 @@ Everything in millimetres and degrees, layers and sheets counting from 1.  Each 
 ``<part>.y``, ``<part>.angle``, lengths times ``unit_mm``) onto its sheet: a point ``p`` of the part lies on
 the sheet at ``R(angle) p + (x, y)``.  Each pin names its parts, the layers it spans, its bought length, its
 diameter, its ends (height and diameter beyond its outer layers) and where it is: ``anchor`` (a part and the
-point in that part's own frame, mm).  The schema is ``docs/reference/plan.schema.json``.  Fixed key order and
-number formatting: the same input gives the same bytes.
+point in that part's own frame, mm). ``motor``: its body's length below its face (the face against the bottom
+layer), its shaft's length above it and its screws; ``mounting``: how far things hang below the bottom layer
+(``below_mm``), the standoffs' length and where they go on each ground plate (own frame, mm). The schema is
+``docs/reference/plan.schema.json``. Fixed key order and number formatting: the same input gives the same bytes.
 """
 
 from __future__ import annotations
@@ -97,6 +99,47 @@ def _spacers(fab: Any) -> list[dict[str, Any]]:
     return out
 
 
+def _motor(fab: Any) -> dict[str, Any] | None:
+    """The motor (under the bottom layer, its face against it): its body's length below the face, its shaft's
+    length above it, and its two face screws."""
+    from planar.fabrication.hardware import motor_items
+
+    s = fab.settings
+    if not any(p.shaft for p in fab.assembly.pins):
+        return None
+    motor, screw = motor_items(s)
+    return {
+        "item": motor.item,
+        "body_mm": _r(s.motor_body_mm),
+        "shaft_mm": _r(s.motor_shaft_mm),
+        "screws": {
+            "item": screw.item,
+            "size": screw.size,
+            "qty": screw.qty,
+            "hole_mm": _r(s.motor_screw_mm),
+            "spacing_mm": _r(s.motor_screw_spacing_mm),
+        },
+    }
+
+
+def _mounting(fab: Any) -> dict[str, Any] | None:
+    """The ground plates' standoffs: what hangs below the bottom layer, the standoff length, where they go."""
+    from planar.fabrication.hardware import mounting_items, standoff_length, standoffs
+
+    s = fab.settings
+    plates = [n for n in fab.grounds if n in fab.mounts and fab.assembly.layers.get(n) is not None]
+    if not plates:
+        return None
+    return {
+        "below_mm": _r(fab.below_mm),
+        "standoff_mm": _r(standoff_length(s, fab.below_mm)),
+        "stacked": standoffs(s, fab.below_mm)[0],
+        "hole_mm": _r(s.mounting_hole_mm),
+        "plates": [{"part": n, "at_mm": [[_r(x), _r(y)] for x, y in fab.mounts[n]]} for n in plates],
+        "hardware": [{"item": i.item, "size": i.size, "qty": i.qty * len(plates)} for i in mounting_items(s, fab.below_mm)],
+    }
+
+
 def plan_dict(fab: Any) -> dict[str, Any]:
     """The plan of a :class:`~planar.fabrication.build.Fabrication` as plain data (see the module docstring)."""
     s = fab.settings
@@ -123,6 +166,8 @@ def plan_dict(fab: Any) -> dict[str, Any]:
             if p.name == "reference square"
         ],
         "motor_shaft": _pin(fab, shafts[0]) if shafts else None,
+        "motor": _motor(fab),
+        "mounting": _mounting(fab),
         "contacts": [{"joint": c.joint, "parts": list(c.parts)} for c in fab.assembly.contacts],
         "violations": [
             {"what": v.what, "a": v.a, "b": v.b, "layer": v.layer, "sample": v.sample, "samples": v.count} for v in fab.violations

@@ -132,54 +132,164 @@ def assembly_svg_text(fab: Any) -> str:
     for k, v in enumerate(getattr(fab, "violations", []), start=1):
         legend.append(f"collision {k}: {v.text()}")
     marks = [v.at for v in getattr(fab, "violations", [])]
-    return _page(fab, _placed_shapes(fab), fab.assembly.pins, legend, marks)
+    return _page(fab, _placed_shapes(fab), fab.assembly.pins, legend, marks, fixings=_fixings(fab, list(fab.grounds)))
 
 
 def assembly_steps_svg(fab: Any) -> list[str]:
     """The assembly steps: one SVG page per layer from the bottom, the parts laid so far grey, this step's parts
-    coloured, and what to do: which pins go in from below, which spacers go on, which ends close the pins."""
-    from planar.fabrication.hardware import pin_closing, pin_items
-
-    asm, s = fab.assembly, fab.settings
+    coloured, and what to do as numbered physical actions in their order: the motor screwed under the ground plate
+    and the standoffs under it (step 1), then per part of the layer each pin that starts there (its lower end
+    fitted, pushed up through the part's hole from below), the part laid over the pins below it, spacer rings slid
+    on, the pins that end there closed; the last step stands it on a base board."""
+    asm = fab.assembly
     shapes = _placed_shapes(fab)
     flat = [pp for pp in asm.pins if pp.layers is not None]
     top = max((layer for layer, _, _ in shapes), default=0)
     pages = []
     for k in range(top + 1):
         here = [n for layer, n, _ in shapes if layer == k]
-        lines = [f"{fab.name}: step {k + 1} of {top + 1}, layer {k + 1} ({s.thickness_mm:g} mm)"]
-        if k == 0:
-            shaft = [pp for pp in flat if pp.shaft]
-            if shaft:
-                lines.append(
-                    f"fit the motor under {', '.join(here) or 'the bottom layer'}: its shaft up through {shaft[0].letter}"
-                )
-        for pp in flat:
-            lo, hi = pp.layers or (0, 0)
-            if lo == k and not pp.shaft:
-                what = ", ".join(f"{i.qty} x {i.item} {i.size}" for i in pin_items(s, pp))
-                low = pin_closing(s, pp)[0]
-                lines.append(f"pin {pp.letter} up through this layer, its lower end ({low}) fitted first: {what}")
-            if lo < k <= hi and not any(asm.layers.get(p) == k for p in pp.parts):
-                lines.append(f"slide a spacer ring onto pin {pp.letter}")
-        lines.append("lay " + (", ".join(here) if here else "nothing (an empty layer: the spacers fill it)"))
-        for pp in flat:
-            if (pp.layers or (0, 0))[1] == k:
-                lines.append(_close_line(fab, pp))
+        acts = _layer_actions(fab, flat, here, k)
+        if k == top:
+            acts += _base_actions(fab)
+        lines = [f"{fab.name}: step {k + 1} of {top + 1}, layer {k + 1} ({fab.settings.thickness_mm:g} mm)"]
+        lines += [f"{i}. {a}" for i, a in enumerate(acts, start=1)]
         drawn = [(layer if layer == k else -1, n, g) for layer, n, g in shapes if layer <= k]
         pins = [pp for pp in flat if (pp.layers or (0, 0))[0] <= k]
-        pages.append(_page(fab, drawn, pins, lines, [], extent=shapes))
+        marks = _fixings(fab, here) if k == 0 or any(n in fab.mounts for n in here) else []
+        pages.append(_page(fab, drawn, pins, lines, [], extent=shapes, fixings=marks))
     return pages
 
 
-def _close_line(fab: Any, pp: Any) -> str:
-    """The step line that closes a pin's upper end with its own hardware (the motor shaft: how it is held)."""
-    from planar.fabrication.hardware import driven_part, pin_closing, shaft_retention
+def _pin_name(fab: Any, pp: Any) -> str:
+    """A pin as the steps call it: its body and letter with its size (``rod B (3 mm x 12.5 mm)``)."""
+    from planar.fabrication.hardware import hardware_of, pin_items
+
+    body = pin_items(fab.settings, pp)[0]
+    return f"{hardware_of(fab.settings).body} {pp.letter} ({body.size})"
+
+
+def _layer_actions(fab: Any, flat: list[Any], here: list[str], k: int) -> list[str]:
+    """One layer's actions in order: (step 1: motor and standoffs), then per part the pins starting in it, the part
+    laid over the pins from below, spacer rings, the pins closed on top."""
+    from planar.fabrication.hardware import hardware_of
+
+    asm = fab.assembly
+    hw = hardware_of(fab.settings)
+    acts: list[str] = []
+    for name in here:
+        fixed = _motor_actions(fab, flat, name) + _standoff_actions(fab, name)  # the plate stands on its standoffs
+        acts += fixed
+        started = [pp for pp in flat if not pp.shaft and (pp.layers or (0, 0))[0] == k and name in pp.parts]
+        for pp in started:
+            acts.append(
+                f"{hw.fit_lower.format(pin=_pin_name(fab, pp))}; push it up through {name}'s hole {pp.letter} from "
+                f"{name}'s underside"
+            )
+        if not fixed:
+            acts.append(_lay_action(fab, flat, name, k, started))
+    if not here:
+        acts.append(f"nothing to lay on layer {k + 1} (an empty layer: room for the pins' ends; spacers fill it)")
+    for pp in flat:
+        lo, hi = pp.layers or (0, 0)
+        if lo < k <= hi and not any(asm.layers.get(p) == k for p in pp.parts):
+            acts.append(f"slide a spacer ring (spacer {pp.letter}) down pin {pp.letter}")
+    for pp in flat:
+        if (pp.layers or (0, 0))[1] == k and not pp.shaft:
+            acts.append(f"close pin {pp.letter} on top: " + hw.fit_upper.format(pin=f"{hw.body} {pp.letter}"))
+    return acts
+
+
+def _lay_action(fab: Any, flat: list[Any], name: str, k: int, started: list[Any]) -> str:
+    """Lay part ``name`` on layer ``k`` (the rods started in it standing in it) over the pins from below (each up
+    through its hole), onto the motor shaft's flat if it is the driven part."""
+    from planar.fabrication.hardware import driven_part, shaft_retention
+
+    below = [pp for pp in flat if (pp.layers or (0, 0))[0] < k and name in pp.parts]
+    through = [pp.letter for pp in below if not pp.shaft]
+    shaft = [pp for pp in below if pp.shaft]
+    what = f"lay {name} on layer {k + 1}" if k else f"lay {name} flat"
+    if started:
+        what += f" (pin(s) {', '.join(pp.letter for pp in started)} standing in it)"
+    if through:
+        what += f" over pin(s) {', '.join(through)}, each up through its hole of that letter"
+    if shaft:
+        what += f", its D hole down onto the motor shaft {shaft[0].letter}: {shaft_retention(driven_part(shaft[0], fab.grounds))}"
+    return what
+
+
+def _motor_actions(fab: Any, flat: list[Any], name: str) -> list[str]:
+    """The motor screwed under the ground plate ``name`` (if the shaft stands in it), its BOM names and sizes."""
+    from planar.fabrication.hardware import motor_items
 
     s = fab.settings
-    if pp.shaft:
-        return f"fix the motor shaft: {shaft_retention(driven_part(pp, fab.grounds))}"
-    return f"close pin {pp.letter} on top ({pin_closing(s, pp)[1]})"
+    shaft = [pp for pp in flat if pp.shaft and name in pp.parts and name in fab.grounds]
+    if not shaft:
+        return []
+    motor, screw = motor_items(s)
+    a = shaft[0].letter
+    return [
+        f"hold the motor ({motor.item}) under {name}, its shaft up through {name}'s hole {a} (the shaft is pin {a})",
+        f"screw it on: {screw.qty} motor screws ({screw.item} {screw.size}) down through the "
+        f"{s.motor_screw_mm:g} mm holes either side of {a} into the motor's face (heads on {name})",
+    ]
+
+
+def _standoff_actions(fab: Any, name: str) -> list[str]:
+    """The standoffs screwed under the ground plate ``name`` (if it has mounting holes)."""
+    from planar.fabrication.hardware import mounting_items
+
+    if name not in fab.mounts:
+        return []
+    *stack, screw, washer = mounting_items(fab.settings, fab.below_mm)
+    acts = []
+    if len(stack) > 1:
+        acts.append(
+            f"screw the {stack[1].qty} standoffs ({stack[1].item} {stack[1].size}) onto the tops of the "
+            f"{stack[0].qty} ({stack[0].item} {stack[0].size}), one column under each mounting hole"
+        )
+    return [
+        *acts,
+        f"screw {stack[0].qty} standoff columns ({', '.join(f'{i.item} {i.size}' for i in stack)}) under {name}: "
+        f"a mounting screw ({screw.item} {screw.size}) with a washer ({washer.item} {washer.size}) down through each "
+        "mounting hole (marked S) into a column's top",
+        f"stand {name} on its standoffs (what hangs under it, {round(fab.below_mm, 1):g} mm, stays clear of the table)",
+    ]
+
+
+def _base_actions(fab: Any) -> list[str]:
+    """The last action: the standoffs fixed to a base board (optional)."""
+    from planar.fabrication.hardware import mounting_items
+
+    if not fab.mounts:
+        return []
+    *_, screw, _ = mounting_items(fab.settings, fab.below_mm)
+    n = 2 * len(fab.mounts)
+    return [
+        f"fix it to a base board ({fab.settings.thickness_mm:g} mm; optional): {n} mounting screws ({screw.item} "
+        f"{screw.size}) with washers up through the board into the standoffs' bottoms"
+    ]
+
+
+def _fixings(fab: Any, here: list[str]) -> list[tuple[float, float, float, str]]:
+    """Where step 1's fixings go (world mm at the drawn pose): standoffs ``S`` at the mounting holes and the motor
+    screws ``m`` either side of the shaft: ``(x, y, radius, label)``."""
+    asm, s = fab.assembly, fab.settings
+    out = []
+
+    def world(part: str, p: tuple[float, float]) -> tuple[float, float]:
+        x, y, a = asm.pose[part]
+        return (x + math.cos(a) * p[0] - math.sin(a) * p[1], y + math.sin(a) * p[0] + math.cos(a) * p[1])
+
+    for name in here:
+        for c in fab.mounts.get(name, []):
+            out.append((*world(name, c), 3.0, "S"))
+        for pp in asm.pins:
+            if pp.shaft and name in pp.spec.parts and name in fab.grounds:
+                cx, cy = pp.spec.at[pp.spec.parts.index(name)]
+                for sx in (-1, 1):
+                    at = (cx * s.unit_mm + sx * s.motor_screw_spacing_mm / 2, cy * s.unit_mm)
+                    out.append((*world(name, at), s.motor_screw_mm / 2, "m"))
+    return out
 
 
 def _page(
@@ -189,8 +299,10 @@ def _page(
     legend: list[str],
     marks: list[tuple[float, float]],
     extent: list[tuple[int, str, Any]] | None = None,
+    fixings: list[tuple[float, float, float, str]] | None = None,
 ) -> str:
-    """One drawing: parts filled by layer (-1: grey, laid before), pins lettered, red rings at ``marks``, a legend."""
+    """One drawing: parts filled by layer (-1: grey, laid before), pins lettered, red rings at ``marks``, a legend;
+    ``fixings`` ``(x, y, r, label)``: standoffs and motor screws drawn as dark rings with a small label."""
     asm = fab.assembly
     pts = []
     for *_, g in extent if extent is not None else shapes:
@@ -247,6 +359,15 @@ def _page(
             f'<text x="{_f(X(px))}" y="{_f(Y(py) + fs * 0.35)}" font-size="{_f(fs)}" text-anchor="middle">'
             f"{escape(pp.letter)}</text>"
         )
+    for fx, fy, fr, label in fixings or []:
+        out.append(
+            f'<circle cx="{_f(X(fx))}" cy="{_f(Y(fy))}" r="{_f(max(fr, fs * 0.3))}" fill="none" stroke="#202020" '
+            f'stroke-width="{_f(fs * 0.12)}"><title>{escape(label)}</title></circle>'
+        )
+        out.append(
+            f'<text x="{_f(X(fx) + max(fr, fs * 0.3) + fs * 0.2)}" y="{_f(Y(fy) - fs * 0.2)}" font-size="{_f(fs * 0.7)}">'
+            f"{escape(label)}</text>"
+        )
     for k, (mx, my) in enumerate(marks, start=1):
         out.append(
             f'<circle cx="{_f(X(mx))}" cy="{_f(Y(my))}" r="{_f(fs * 1.2)}" fill="none" stroke="#ff0000" '
@@ -266,6 +387,29 @@ def _pin_xy(asm, pp) -> tuple[float, float]:
     lx, ly = pp.spec.at[0][0] * u, pp.spec.at[0][1] * u
     c, s = math.cos(ang), math.sin(ang)
     return (x + c * lx - s * ly, y + s * lx + c * ly)
+
+
+def _fixing_legend(fab: Any) -> list[str]:
+    """The legend's lines for the motor with its screws and the ground plates' standoffs and mounting screws."""
+    from planar.fabrication.hardware import motor_items, mounting_items
+
+    s = fab.settings
+    out = []
+    for pp in fab.assembly.pins:
+        if pp.shaft:
+            motor, screw = motor_items(s)
+            out.append(
+                f"motor: {motor.item} under layer 1, its shaft is {pp.letter}; {screw.qty} motor screws "
+                f"({screw.item} {screw.size}) down through the plate into its face"
+            )
+    if fab.mounts:
+        *stack, screw, _ = mounting_items(s, fab.below_mm)
+        out.append(
+            f"S: standoffs ({', '.join(f'{i.qty} {i.item} {i.size}' for i in stack)}) under each ground plate, "
+            f"mounting screws ({screw.item} {screw.size}) down through its mounting holes into them "
+            f"({round(fab.below_mm, 1):g} mm hangs below layer 1)"
+        )
+    return out
 
 
 def _legend(fab: Any) -> list[str]:
@@ -289,6 +433,7 @@ def _legend(fab: Any) -> list[str]:
         sp = f", {pp.spacers} spacer(s)" if pp.spacers else ""
         joins = " + ".join(pp.parts)
         lines.append(f"{pp.letter}: {what}, {joins}, layers {lo + 1}-{hi + 1}{sp}")
+    lines += _fixing_legend(fab)
     for jn in getattr(fab, "joins", []):  # tab-and-slot joints (planar.fabrication.tabs)
         lines.append(
             f"{jn.letter}: the {len(jn.spans)} tabs of {jn.piece} ({jn.plane}) into the slots {jn.letter} of "

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 from typing import Any
 
 from planar.cli.common import outputs, sheet
@@ -60,11 +61,15 @@ def _cmd_export(args: argparse.Namespace) -> int:
         print(f"note: {note}")
     for w in fab.warnings:  # a toy's motion the cut parts will not make (the design exits 3 for it; cut anyway)
         print(f"warning: {w}")
-    print(f"{summary(fab)} -> {', '.join(map(str, fab.written)) or 'nothing written'}")
+    kerf_file = [p for p in fab.written if args.kerf_test is not None and p == Path(args.kerf_test)]
+    rest = [p for p in fab.written if p not in kerf_file]
+    print(f"{summary(fab)} -> {', '.join(map(str, rest)) or 'no part file written'}")
+    for p in kerf_file:  # the calibration piece alone, none of the parts
+        print(f"kerf test piece (a 20 mm square with a 10 mm hole, kerf {fab.settings.kerf:g} mm) -> {p}")
     for v in fab.violations:  # the build check: the files are written (to look at), the exit status says it fails
         print(f"build check: {v.text()}")
     if fab.violations:
-        print(f"build check failed: {len(fab.violations)} collision(s); see the assembly drawing's red marks")
+        print(f"build check failed: {len(fab.violations)} problem(s); see the assembly drawing's red marks")
         return 3
     print("build check: every part, pin, spacer and the motor shaft clear through the cycle")
     return 0

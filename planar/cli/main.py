@@ -57,8 +57,8 @@ def build_parser() -> argparse.ArgumentParser:
         prog="planar",
         description="2D rigid-body mechanisms: exact kinematics and more.",
         epilog="Exit status: 0 success, 2 a user error (one line naming the file, field or option), "
-        "3 a result that failed its own check (compare, toy, design, synth; each failure named, "
-        "design and synth still write their result), 1 an internal error (run with --debug for the traceback). "
+        "3 a result that failed its own check (compare, toy, design, synth, export's build check; each failure "
+        "named; design, synth and export still write their outputs), 1 an internal error (run with --debug for the traceback). "
         "Limits on work (PLANAR_MAX_SAMPLES, PLANAR_MAX_FRAMES, PLANAR_MAX_CHAIN, "
         "PLANAR_MAX_MEMORY): see the README.",
     )

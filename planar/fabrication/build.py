@@ -15,6 +15,7 @@ from typing import Any
 from planar.core.model import Mechanism
 from planar.errors import InputError
 from planar.fabrication.check import spacer_radius
+from planar.fabrication.hardware import below_mm, shaft_check
 from planar.fabrication.joints import joint_pins, pin_features
 from planar.fabrication.layers import Assembly, letter, pin_stacks, plan_assembly
 from planar.fabrication.nesting import nest
@@ -52,6 +53,10 @@ class Fabrication:
     mechanism: Any = None
     #: what the build check found (:func:`planar.fabrication.check.build_check`); empty: it goes together and moves
     violations: list[Any] = field(default_factory=list)
+    #: each ground plate's mounting hole centres (mm, the part's own frame)
+    mounts: dict[str, list[tuple[float, float]]] = field(default_factory=dict)
+    #: how far the motor and the pins' lower ends hang below the bottom layer (mm): the standoffs clear it
+    below_mm: float = 0.0
 
 
 def _shaft_pin(mech: Mechanism, pins) -> Any:
@@ -364,6 +369,7 @@ def _build(scene: Any, settings: FabSettings) -> Fabrication:
 
     violations = settle(SimpleNamespace(mechanism=mech, assembly=asm, own=material, settings=s))
     notes.extend(blocking(asm, violations))
+    violations = violations + shaft_check(s, asm.pins, _shaft_xy(asm))
     for pc in cuts:
         pc.layer = asm.layers.get(pc.name)
     cuts += _spacer_cuts(asm, s)
@@ -392,7 +398,34 @@ def _build(scene: Any, settings: FabSettings) -> Fabrication:
         warnings=warnings,
         mechanism=mech,
         violations=violations,
+        mounts={pc.name: list(pc.mounting_at) for pc in cuts if pc.mounting_at},
+        below_mm=below_mm(s, asm.pins, _hang(tab_plan)),
     )
+
+
+def _hang(tab_plan: Any) -> float:
+    """How far the pieces standing perpendicular reach below the xy stack's lower face over the cycle (mm, >= 0)."""
+    import numpy as np
+    import shapely
+
+    from planar.fabrication.check import placed_array
+
+    lows = [
+        float(shapely.bounds(placed_array(tab_plan.shape[n], np.asarray(tab_plan.track[n]), 1.0))[:, 1].min())
+        for n in tab_plan.planes
+        if n in tab_plan.track and n in tab_plan.shape
+    ]
+    return max(0.0, tab_plan.z_stack - min(lows)) if lows else 0.0
+
+
+def _shaft_xy(asm: Assembly) -> tuple[float, float]:
+    """Where the motor shaft stands in the drawn pose (mm, world), or the origin without one."""
+    for pp in asm.pins:
+        if pp.shaft:
+            x, y, a = asm.pose[pp.spec.parts[0]]
+            lx, ly = pp.spec.at[0][0] * asm.unit_mm, pp.spec.at[0][1] * asm.unit_mm
+            return (x + math.cos(a) * lx - math.sin(a) * ly, y + math.sin(a) * lx + math.cos(a) * ly)
+    return (0.0, 0.0)
 
 
 def _engrave_joins(cuts: list[PartCut], joins: list[Any], s: FabSettings) -> None:

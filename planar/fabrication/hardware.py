@@ -12,7 +12,16 @@ A pin is one of these kinds (``[fabrication] hardware``), sized from ``pin_diame
 The motor shaft (an N20 gearmotor's D shaft: no groove for a clip) is held by its driven part: that part's D
 hole fits the shaft's flat (snug: the flat carries the torque) and a drop of glue (cyanoacrylate or epoxy) on the
 flat keeps it from sliding off.
-The shaft ends flush with its top layer (shorten a longer one): nothing stands above it.
+The shaft ends flush with its top layer (shorten a longer one): nothing stands above it.  The motor's shaft is
+``motor_shaft_mm`` long above its face (default 9: the 3 mm D shaft of Pololu's micro metal gearmotors, the N20
+size, is 9 mm long); a plan that needs it longer is the build check's :class:`ShortShaft` (exit 3).
+
+Under the bottom layer hang the motor's body (``motor_body_mm``, default 26: Pololu's gearbox is 9 mm long, the
+motor behind it about 15 mm, then its end cap and terminals) and the pins' lower ends.  Each ground plate stands on
+two hex standoffs (female-female, M3, nylon or brass) of the shortest length sold that clears them by
+``STANDOFF_CLEAR_MM``, held by screws through its mounting holes (and, from below, through a base board).
+The motor's two M1.6 face screws pass through ``motor_screw_mm`` clearance holes (1.8 mm: ISO 273's medium series
+for M1.6) down into the threaded holes of the gearbox's face.
 Sizes are the standard tables' for the diameters makers use (2, 2.5, 3, 4, 5 and 6 mm); another
 diameter is an error naming ``pin_diameter_mm``.
 """
@@ -30,12 +39,17 @@ __all__ = [
     "HARDWARE",
     "Item",
     "PinHardware",
+    "below_mm",
     "hardware_of",
+    "mounting_items",
     "pin_closing",
     "pin_ends",
     "pin_items",
+    "shaft_check",
     "shaft_items",
     "shaft_length",
+    "standoff_length",
+    "standoffs",
 ]
 
 #: DIN 125 washer per nominal diameter: (outer diameter, thickness) mm
@@ -78,6 +92,11 @@ class PinHardware:
     lower: str = ""
     #: what closes the upper end, fitted last (e.g. ``"washer, nylon lock nut"``)
     upper: str = ""
+    #: the pin's body in the steps (``"rod"``, ``"screw"``)
+    body: str = "pin"
+    #: the step actions closing the lower end (before the pin goes in) and the upper end (last), ``{pin}`` its name
+    fit_lower: str = ""
+    fit_upper: str = ""
 
 
 def _size(d: float, table: dict[float, Any]) -> Any:
@@ -143,9 +162,27 @@ def _screw_items(d: float, stack: float) -> list[Item]:
 
 #: fastener kinds by ``[fabrication] hardware``
 HARDWARE: dict[str, PinHardware] = {
-    "rod-eclip": PinHardware("rod-eclip", _rod_ends, _rod_length, _rod_items, "e-clip, washer", "washer, e-clip"),
+    "rod-eclip": PinHardware(
+        "rod-eclip",
+        _rod_ends,
+        _rod_length,
+        _rod_items,
+        "e-clip, washer",
+        "washer, e-clip",
+        "rod",
+        "snap an e-clip into the lower groove of {pin} and slide a washer down the rod onto it",
+        "slide a washer down {pin} and snap an e-clip into its upper groove",
+    ),
     "screw": PinHardware(
-        "screw", _screw_ends, _screw_length, _screw_items, "button head screw, washer", "washer, nylon lock nut"
+        "screw",
+        _screw_ends,
+        _screw_length,
+        _screw_items,
+        "button head screw, washer",
+        "washer, nylon lock nut",
+        "screw",
+        "slide a washer onto {pin} up to its head",
+        "slide a washer onto {pin} and turn a nylon lock nut on until it touches (the joint must still turn)",
     ),
 }
 
@@ -235,7 +272,7 @@ def motor_items(settings: Any) -> list[Item]:
     return [
         Item(
             "N20 gearmotor",
-            f"D {settings.shaft_mm:g} shaft ({settings.shaft_flat_mm:g} across flat), "
+            f"D {settings.shaft_mm:g} shaft ({settings.shaft_flat_mm:g} across flat) x {settings.motor_shaft_mm:g}, "
             f"face screws {settings.motor_screw_spacing_mm:g} mm apart",
             1,
         ),
@@ -243,18 +280,103 @@ def motor_items(settings: Any) -> list[Item]:
     ]
 
 
-def mounting_items(settings: Any) -> list[Item]:
-    """One ground plate's two mounting screws, washers and nylon lock nuts, long enough for the plate on a base
-    board of the same thickness (a thicker base needs a longer screw: the BOM row says so)."""
+#: hex standoffs (female-female) sold in nylon and brass, M3 (mm)
+STANDOFF_LENGTHS = (5, 6, 8, 10, 12, 15, 20, 25, 30, 35, 40, 45, 50, 60)
+#: thread a mounting screw engages in its standoff (mm)
+STANDOFF_THREAD_MM = 4.0
+#: air left between the lowest thing under the plate and the surface the standoffs stand on (mm)
+STANDOFF_CLEAR_MM = 1.0
+
+
+def below_mm(settings: Any, pins: Any, hang: float = 0.0) -> float:
+    """How far below the bottom layer's lower face things hang (mm, >= 0): the motor's body (``motor_body_mm``)
+    when a pin is the motor shaft, the lower ends (clip and washer, a screw's head) of every pin starting on
+    the bottom layer, and ``hang`` (mm: the lowest reach of pieces standing perpendicular below the stack)."""
+    low = max(0.0, hang)
+    for pp in pins:
+        lo, _ = pp.layers or (0, 0)
+        if pp.shaft:
+            low = max(low, settings.motor_body_mm)
+        elif lo == 0:
+            low = max(low, pin_ends(settings, pp)[0][0])
+    return low
+
+
+def _mount_screw(settings: Any) -> tuple[float, float, float, float]:
+    """The mounting screws: ``(metric size, washer diameter, washer thickness, length sold)`` mm, long enough for
+    the plate (or a base board as thick), a washer and ``STANDOFF_THREAD_MM`` into the standoff."""
     m = _metric_for(settings.mounting_hole_mm)
     wd, wt = WASHER.get(m, (2 * m + 1, 0.5))
-    _, nh = NYLOC.get(m, (2 * m, 0.8 * m))
-    n = _sold(2 * settings.thickness_mm + wt + nh + 1.0)
+    return m, wd, wt, _sold(settings.thickness_mm + wt + STANDOFF_THREAD_MM)
+
+
+def standoffs(settings: Any, below: float) -> tuple[int, float]:
+    """``(count, length mm)`` of the standoffs stacked under each mounting hole: one of the shortest length sold
+    that holds the plate ``below`` mm plus ``STANDOFF_CLEAR_MM`` above the surface it stands on and leaves 1 mm
+    between the ends of the screws turned into it from above and below, or, past the longest, the fewest of one
+    length sold that reach it stacked (male-female ones screwed into each other)."""
+    _, _, wt, n = _mount_screw(settings)
+    need = max(below + STANDOFF_CLEAR_MM, 2 * (n - settings.thickness_mm - wt) + 1.0)
+    k = max(1, math.ceil(need / STANDOFF_LENGTHS[-1] - 1e-9))
+    return k, float(next(n for n in STANDOFF_LENGTHS if k * n >= need - 1e-9))
+
+
+def standoff_length(settings: Any, below: float) -> float:
+    """The standoffs' height under a mounting hole (mm, stacked ones together): at least ``below`` plus
+    ``STANDOFF_CLEAR_MM`` (:func:`standoffs`)."""
+    k, n = standoffs(settings, below)
+    return k * n
+
+
+def mounting_items(settings: Any, below: float = 0.0) -> list[Item]:
+    """One ground plate's mounting: a hex standoff (female-female; stacked male-female ones where one is too short)
+    under each of its two mounting holes, tall enough to clear ``below`` mm (what hangs under the plate:
+    :func:`below_mm`), four screws with washers (two down through the plate's mounting holes into the standoffs'
+    tops, two up through a base board as thick as the sheet into their bottoms: ``STANDOFF_THREAD_MM`` into the
+    standoff)."""
+    m, wd, wt, n = _mount_screw(settings)
+    k, length = standoffs(settings, below)
+    stack = [Item(f"hex standoff M{m:g} female-female (nylon or brass)", f"M{m:g} x {length:g}", 2)]
+    if k > 1:  # stacked: male-female ones screwed into each other on the female-female one at the bottom
+        stack.append(Item(f"hex standoff M{m:g} male-female (nylon or brass)", f"M{m:g} x {length:g}", 2 * (k - 1)))
     return [
-        Item("button head screw ISO 7380", f"M{m:g} x {n:g}", 2),
-        Item("washer DIN 125", f"M{m:g} ({wd:g} x {wt:g} mm)", 2),
-        Item("nylon lock nut DIN 985", f"M{m:g}", 2),
+        *stack,
+        Item("button head screw ISO 7380", f"M{m:g} x {n:g}", 4),
+        Item("washer DIN 125", f"M{m:g} ({wd:g} x {wt:g} mm)", 4),
     ]
+
+
+class ShortShaft:
+    """The build check's verdict on a motor shaft the plan needs longer than the motor's (``motor_shaft_mm``): a
+    violation like the collisions of :mod:`planar.fabrication.check` (exit 3, named, outputs still written)."""
+
+    what = "motor shaft too short"
+
+    def __init__(self, pin: str, need: float, have: float, layers: tuple[int, int], at: tuple[float, float]) -> None:
+        self.a, self.b = f"motor shaft {pin}", "motor"
+        self.need, self.have = need, have
+        self.layer, self.sample, self.count, self.depth = layers[1] + 1, 0, 0, need - have
+        self.layers = layers
+        self.at = at
+
+    def text(self) -> str:
+        lo, hi = self.layers
+        return (
+            f"{self.what}: {self.a} must reach {self.need:g} mm above the motor's face (through layers {lo + 1}-{hi + 1})"
+            f" and the motor's shaft is {self.have:g} mm (fabrication.motor_shaft_mm): a motor with a longer shaft "
+            "(set motor_shaft_mm to it), a thinner sheet or the driven part on a lower layer"
+        )
+
+
+def shaft_check(settings: Any, pins: Any, at: tuple[float, float] = (0.0, 0.0)) -> list[ShortShaft]:
+    """A :class:`ShortShaft` for the motor shaft when the plan needs more than ``motor_shaft_mm`` (else none)."""
+    out = []
+    for pp in pins:
+        if pp.shaft and pp.layers is not None:
+            need = shaft_length(settings, pp)
+            if need > settings.motor_shaft_mm + 1e-9:
+                out.append(ShortShaft(pp.letter, need, settings.motor_shaft_mm, pp.layers, at))
+    return out
 
 
 def driven_part(pin: Any, grounds: Any) -> str:

@@ -12,8 +12,10 @@ Sizes (millimetres):
   ``shaft_flat_mm`` across the flat, each plus ``clearance_mm``: a snug fit
   that still goes on a real shaft; the flat carries the torque); the ground
   plate holding the motor gets a shaft clearance hole, two motor screw holes
-  ``motor_screw_spacing_mm`` apart and two mounting holes of
-  ``mounting_hole_mm`` as cut (the BOM lists the same size).
+  of ``motor_screw_mm`` ``motor_screw_spacing_mm`` apart and two mounting
+  holes of ``mounting_hole_mm``, each cut at the size given (clearance holes:
+  the screw threads into the motor or the standoff, not the plate; the BOM
+  lists the same sizes).
 
 Checks: every inner cut keeps ``min_wall_mm`` of material to the outline.  A
 rounded part (a hull of circles) that is too narrow is widened — a circle of
@@ -75,8 +77,11 @@ class FabSettings:
     pin_head: float = 1.5
     shaft_mm: float = 3.0
     shaft_flat_mm: float = 2.5
-    motor_screw_mm: float = 1.7
+    motor_screw_mm: float = 1.8
     motor_screw_spacing_mm: float = 9.0
+    #: the motor's shaft above its face (mm; an N20's D shaft: 9) and its body below the face (mm; an N20: 26)
+    motor_shaft_mm: float = 9.0
+    motor_body_mm: float = 26.0
     mounting_hole_mm: float = 3.2
     spacing: float = 3.0
     margin: float = 5.0
@@ -124,6 +129,8 @@ class FabSettings:
             shaft_flat_mm=fab.shaft_flat_mm,
             motor_screw_mm=fab.motor_screw_mm,
             motor_screw_spacing_mm=fab.motor_screw_spacing_mm,
+            motor_shaft_mm=getattr(fab, "motor_shaft_mm", 9.0),
+            motor_body_mm=getattr(fab, "motor_body_mm", 26.0),
             mounting_hole_mm=fab.mounting_hole_mm,
             spacing=fab.spacing_mm,
             margin=fab.margin_mm,
@@ -239,7 +246,7 @@ def _features(
                             "hole",
                             "motor screw",
                             (c[0] + sx * s.motor_screw_spacing_mm / 2, c[1]),
-                            (s.motor_screw_mm + s.clearance) / 2,
+                            s.motor_screw_mm / 2,  # the cut diameter itself, as the BOM says (a clearance hole)
                         )
                     )
                 continue
@@ -600,7 +607,9 @@ def part_cuts(
             holes.append(((x * u, y * u), near.r if near.kind != "arc" else 0.0, letter))
         engrave = engrave + letter_marks(material, [h for h in holes if h[1] > 0], max(s.min_label, 1.5))
     nominal = [(f.a, f.r) for f in feats if f.kind == "hole"]
-    return PartCut(part.name, outer, [f.cut(k2) for f in feats], engrave, text, height, nominal_holes=nominal, notes=notes)
+    pc = PartCut(part.name, outer, [f.cut(k2) for f in feats], engrave, text, height, nominal_holes=nominal, notes=notes)
+    pc.mounting_at = [f.a for f in feats if f.what == "mounting hole"]
+    return pc
 
 
 def _with_tabs(name: str, poly: Any, jn: Any, k2: float) -> tuple[Contour, Contour]:

@@ -94,6 +94,8 @@ class PartCut:
     layer: int | None = None
     #: where the part lies from its own frame: ``(angle, dx, dy)``, a point p goes to R(angle) p + (dx, dy)
     placed: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    #: a ground plate's mounting hole centres (mm) in the part's own frame (they stay there when it is laid out)
+    mounting_at: list[tuple[float, float]] = field(default_factory=list)
 
     def transformed(self, angle: float, dx: float, dy: float) -> PartCut:
         c, s = math.cos(angle), math.sin(angle)

@@ -145,6 +145,7 @@ def build_scene(spec: SceneSpec, path: str = "<scene>") -> Scene:
     phase = _angle(spec, spec.driver.phase)
     try:
         rock = _rocking(spec, m)
+        _link_width(spec.fabrication, m.type)
     except InputError as e:
         raise SceneError(f"{path}: {e}") from None
     try:
@@ -294,7 +295,15 @@ def _build_linkage(spec: SceneSpec, m: LinkageSpec, b: _Build) -> Mechanism:
         nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
     links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
     return Linkage(
-        spec.name or "linkage", nodes, links, points=m.points, placement=b.placement, rate=b.rate, phase=b.phase, **b.rock
+        spec.name or "linkage",
+        nodes,
+        links,
+        points=m.points,
+        placement=b.placement,
+        rate=b.rate,
+        phase=b.phase,
+        width=_link_width(spec.fabrication, m.type),
+        **b.rock,
     )
 
 
@@ -325,6 +334,30 @@ def _build_legs(spec: SceneSpec, m: LegsSpec, b: _Build) -> Mechanism:
         rate=b.rate,
         phase=b.phase,
     )
+
+
+def _link_width(fab: Any, kind: str) -> float | None:
+    """``[fabrication] link_width_mm`` in model units (``None``: the linkage's default, 8 % of its span); a width
+    under a pin hole with ``min_wall_mm`` each side, or one given in a scene other than ``linkage``, is an error
+    naming the field."""
+    w = fab.link_width_mm
+    if w is None:
+        return None
+    if kind != "linkage":
+        raise InputError(
+            "fabrication.link_width_mm",
+            w,
+            f"no link_width_mm in a {kind} scene (it sets a linkage scene's links; a cam scene's is [mechanism] link_width)",
+        )
+    least = fab.pin_diameter_mm + fab.clearance_mm + 2 * fab.min_wall_mm
+    if w < least - 1e-9:
+        raise InputError(
+            "fabrication.link_width_mm",
+            w,
+            f"at least {least:g} mm: a pin hole of pin_diameter_mm + clearance_mm = "
+            f"{fab.pin_diameter_mm + fab.clearance_mm:g} mm with min_wall_mm {fab.min_wall_mm:g} each side",
+        )
+    return float(w) / fab.unit_mm
 
 
 def _scene_angles(spec: SceneSpec, kw: dict[str, Any], angle_params: tuple[str, ...]) -> dict[str, Any]:

@@ -569,12 +569,23 @@ class FabricationSpec(_Strict):
     """Motor shaft diameter (the driven part's D hole)."""
     shaft_flat_mm: Pos = 2.5
     """Distance across the shaft's flat (the D)."""
-    motor_screw_mm: Pos = 1.7
-    """Motor screw hole diameter."""
+    motor_screw_mm: Pos = 1.8
+    """Motor screw hole diameter as cut (a clearance hole: the screws thread into the motor's face); 1.8 is
+    ISO 273's medium clearance hole for the N20's M1.6 screws."""
     motor_screw_spacing_mm: Pos = 9.0
     """Distance between the two motor screws, across the shaft (N20: 9)."""
+    motor_shaft_mm: Pos = 9.0
+    """Length of the motor's shaft above its face (an N20 micro gearmotor's D shaft: 9); a plan whose shaft must
+    reach higher fails the build check (exit 3)."""
+    motor_body_mm: Pos = 26.0
+    """Length of the motor's body below its face (an N20: 9 gearbox + 15 motor + its end cap and terminals, about
+    26; more with an encoder): the mounting standoffs clear it."""
     mounting_hole_mm: Pos = 3.2
-    """Diameter of the ground plates' mounting holes (on ears)."""
+    """Diameter of the ground plates' mounting holes (on ears), as cut: M3 screws into the standoffs."""
+    link_width_mm: Pos | None = None
+    """Width of every link of a ``linkage`` scene (mm, the cut and the drawings), at least ``pin_diameter_mm +
+    clearance_mm + 2 min_wall_mm``; default 8 % of the linkage's span (the larger side of the box its joints stay
+    in over a cycle) times ``unit_mm``."""
     # nesting and file conventions
     spacing_mm: Annotated[float, Strict(), Field(ge=0, le=100)] = 3.0
     """Gap between nested parts."""

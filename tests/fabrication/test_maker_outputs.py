@@ -73,7 +73,8 @@ def export_bird(tmp_path: Path, extra: str = "", thickness_mm: float = 3.0) -> d
 
 
 def _step_lines(out: dict) -> list[str]:
-    return [ln.strip() for page in out["steps"] for ln in page.splitlines() if ln.strip()]
+    """Every line of the step pages, an action's number taken off (``3. close pin B ...`` -> ``close pin B ...``)."""
+    return [re.sub(r"^\d+\. ", "", ln.strip()) for page in out["steps"] for ln in page.splitlines() if ln.strip()]
 
 
 @pytest.mark.parametrize(
@@ -134,11 +135,12 @@ def test_bom_buys_the_motor_its_screws_and_the_mounting_screws_with_lengths(tmp_
     assert any(r["size_mm"] == motor_screw["size_mm"] and int(r["qty"]) == 2 for r in buy)
     mounting = next(r for r in bom if r["item"] == "mounting screw")
     plates = [p for p in out["plan"]["parts"] if p["name"] == "ground"]
-    assert int(mounting["qty"]) == 2 * len(plates)
+    assert int(mounting["qty"]) == 4 * len(plates)  # two into the standoffs' tops, two from a base board below
     m, length_text = mounting["size_mm"].split(" x ")
     assert m == "M3"  # 3.2 mm holes
-    # plate + base board + washer (0.5) + DIN 985 M3 nut (4 mm) + a thread past it
-    assert float(length_text) >= 2 * t + 0.5 + 4.0 + 1.0
+    # plate + washer (0.5) + at least 3 mm of thread into the standoff, and no longer than a standoff's half
+    standoff = next(r for r in bom if r["item"] == "standoff")
+    assert t + 0.5 + 3.0 <= float(length_text) <= t + 0.5 + float(standoff["size_mm"].split(" x ")[1]) / 2
     assert any(r["size_mm"] == mounting["size_mm"] for r in buy)
 
 
