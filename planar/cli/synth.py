@@ -66,6 +66,8 @@ def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, An
         ok = False
         failing.append(f"the written scene's motion has {int((~mo.valid).sum())} invalid samples")
     report["ok"] = ok
+    if not ok:  # what failed, as the text output's "check failed" lines
+        report["reason"] = "; ".join(failing) or "a check failed (see checks)"
     report["output"] = str(args.output)
     if args.json:
         print(json.dumps(report, indent=2, default=float))
@@ -76,8 +78,9 @@ def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, An
     return 0 if ok else EXIT_CHECK
 
 
-def _path_failing(d: Any) -> list[str]:
-    """One line per failed check of a path design, naming what failed and by how much."""
+def _path_failing(d: Any, kind: str = "four-bar", box: str = "") -> list[str]:
+    """One line per failed check of a path design, naming what failed and by how much (``kind`` and ``box``:
+    as :func:`_unreachable`'s)."""
     out: list[str] = []
     for k, v in d.checks.items():
         if not k.startswith("ok_") or v:
@@ -91,7 +94,7 @@ def _path_failing(d: Any) -> list[str]:
                 f"(RMS distance {d.checks['rms_error']:.3g} of the size, sse {d.sse:.6g})"
             )
             if d.checks["max_error"] > FAR_OFF * d.checks["tolerance"]:
-                out.append(_unreachable(d))
+                out.append(_unreachable(d, kind, box))
         elif k == "ok_transmission":
             out.append(
                 f"the transmission angle falls to {d.checks['min_transmission_deg']:.3g} deg from a toggle at crank "
@@ -132,18 +135,25 @@ def _sharpest_turn(t: np.ndarray) -> tuple[float, int]:
     return float(np.degrees(turn[k])), (k + 1) % len(t) + 1
 
 
-def _unreachable(d: Any) -> str:
-    """The plain word for a best design far beyond the tolerance: no four-bar traces the curve, and likely why."""
+def _unreachable(d: Any, kind: str = "four-bar", box: str = "") -> str:
+    """The plain word for a best design far beyond the tolerance: nothing of ``kind`` found traces the curve,
+    and the likely reasons (a sharp corner; the ``--pivots`` box, ``box`` saying how the unboxed atlas does)."""
     deg, at = _sharpest_turn(d.targets)
-    why = (
-        f"the targets turn by {deg:.0f} deg at target {at}, a sharp corner, and a coupler curve is smooth: "
-        "it rounds corners (round them in the drawing, or accept a larger --tolerance)"
-        if deg >= 60
-        else "the curve's shape is not one a four-bar's coupler point traces (the atlas and the global search "
-        "found nothing nearer); try --type sixbar or a larger --tolerance"
-    )
+    if deg >= 60:
+        why = (
+            f"the targets turn by {deg:.0f} deg at target {at}, a sharp corner, and a coupler curve is smooth: "
+            "it rounds corners (round them in the drawing, or accept a larger --tolerance)"
+        )
+    elif box:
+        why = box
+    else:
+        more = "; try --type sixbar" if kind == "four-bar" else ""
+        why = (
+            f"no {kind} the search found traces this shape closer (it may be a shape no {kind} traces, or one the "
+            f"search missed: try --budget thorough or another --seed{more}, or a larger --tolerance)"
+        )
     return (
-        f"no four-bar traces this curve within --tolerance {d.checks['tolerance']:g}: the best found is "
+        f"no {kind} found traces this curve within --tolerance {d.checks['tolerance']:g}: the best found is "
         f"{d.checks['max_error']:.3g} of the targets' size off at target {d.checks['worst_target']} "
         f"({d.checks['max_error'] / d.checks['tolerance']:.0f} times the tolerance). Likely why: {why}"
     )
@@ -216,7 +226,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
     why = _unusable(d, "four-bar", cons.region is not None)
     if why is not None:
         return _no_design(args, "synth path", {"targets": len(targets)}, why)
-    failing = _path_failing(d)
+    failing = _path_failing(d, "four-bar", _box_word(d, targets, cons, atlas, args))
     fb = d.fourbar()
     amp, centre = _rocking(fb, d.theta)
     text = fourbar_scene_text(
@@ -248,6 +258,22 @@ def _cmd_path(args: argparse.Namespace) -> int:
     )
 
 
+def _box_word(d: Any, targets: np.ndarray, cons: Any, atlas: Any, args: argparse.Namespace) -> str:
+    """With a ``--pivots`` box and a design far off: how the atlas does without the box (one lookup), in words."""
+    if cons.region is None or not d.checks["max_error"] > FAR_OFF * d.checks["tolerance"]:
+        return ""
+    from planar.synth.path import unboxed_error
+
+    e = unboxed_error(targets, cons, atlas, args.budget)
+    head = f"every ground pivot was kept in the --pivots box; without the box the atlas's best four-bar is {e:.3g} of the size"
+    head += " off"
+    if e <= d.checks["tolerance"]:
+        return f"{head}, within the tolerance: the box is why (widen or move it)"
+    if e < 0.5 * d.checks["max_error"]:
+        return f"{head}: the box is part of why (widen or move it), and the shape is not traced exactly even without it"
+    return f"{head} too: the box is not why; no four-bar the search found traces this shape closer (try --type sixbar)"
+
+
 def _finish_path(args: argparse.Namespace, what: str, text: str, report: dict[str, Any], ok: bool, failing: list[str]) -> int:
     """:func:`_finish`, except that a scene planar cannot build is no design (nothing written, exit 3)."""
     from planar.errors import PlanarError
@@ -271,11 +297,27 @@ def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | N
     from planar.synth.sixbar import synthesise_sixbar
 
     topology = args.topology or "stephenson"
-    d = synthesise_sixbar(targets, theta, topology, cons, budget=args.budget, seed=args.seed, tolerance=args.tolerance)
+    atlas = None
+    if args.atlas is not None and theta is None:
+        from planar.synth.atlas import read_atlas
+
+        atlas = read_atlas(args.atlas)
+    d = synthesise_sixbar(
+        targets,
+        theta,
+        topology,
+        cons,
+        budget=args.budget,
+        seed=args.seed,
+        tolerance=args.tolerance,
+        atlas=atlas,
+        ordered=args.ordered,
+    )
     why = _unusable(d, f"{topology} six-bar", cons.region is not None)
     if why is not None:
         return _no_design(args, "synth path", {"targets": len(targets)}, why)
-    failing = _path_failing(d)
+    box = "every ground pivot was kept in the --pivots box, which may be why (try without it)" if cons.region is not None else ""
+    failing = _path_failing(d, f"{topology} six-bar", box)
     text = linkage_scene_text(
         f"synth-sixbar-{d.topology}",
         d.nodes(),

@@ -204,6 +204,47 @@ def _search(
     )
 
 
+def best_fourbar(
+    t: Array,
+    theta: Array | None,
+    cons: Constraints,
+    budget: str = "normal",
+    seed: int = 0,
+    atlas: Any = None,
+    ordered: bool = False,
+    tolerance: float = DEFAULT_TOLERANCE,
+) -> Any:
+    """The search of :func:`synthesise_path` on targets ``t`` already normalised (centroid 0, size 1; ``cons``
+    normalised with them): a :class:`planar.synth.search.SearchResult`."""
+    from threadpoolctl import threadpool_limits
+
+    if budget not in BUDGETS:
+        raise InputError("budget", budget, f"one of {', '.join(BUDGETS)}")
+    with threadpool_limits(1):
+        return _search(t, theta, cons, budget, seed, tolerance, atlas, ordered)[0]
+
+
+def unboxed_error(targets: Array, cons: Constraints, atlas: Any = None, budget: str = "normal") -> float:
+    """Largest distance from a target to the atlas's best four-bar (lookup and refinement, crank angles free),
+    as a fraction of the targets' size, with ``cons`` but no pivots box: what a ``--pivots`` box costs.
+    ``atlas``: as :func:`synthesise_path`'s (the cached one of ``budget`` when None)."""
+    from threadpoolctl import threadpool_limits
+
+    from planar.synth.search import max_distance, search_atlas
+
+    t = np.asarray(targets, float)
+    c, s = normalisation(t)
+    if atlas is None:
+        from planar.synth.atlas import DEFAULT_SIZE, QUICK_SIZE, load_atlas
+
+        atlas = load_atlas(QUICK_SIZE if budget == "quick" else DEFAULT_SIZE, progress=True)
+    free = Constraints(cons.full_turn, cons.max_ratio, None)
+    tn = (t - c) / s
+    with threadpool_limits(1):
+        r = search_atlas(tn, atlas, free)
+    return max_distance(PathObjective(tn, None, free), np.append(r.params, r.circuit), r.theta)
+
+
 def _prefixed(stages: dict[str, float]) -> dict[str, float]:
     """The global search's stages named as such (``global_sample_s``, ``global_de_s``, ``global_refine_s``)."""
     return {f"global_{k}": v for k, v in stages.items()}
