@@ -96,12 +96,7 @@ def _path_failing(d: Any, kind: str = "four-bar", box: str = "") -> list[str]:
             if d.checks["max_error"] > FAR_OFF * d.checks["tolerance"]:
                 out.append(_unreachable(d, kind, box))
         elif k == "ok_transmission":
-            out.append(
-                f"the transmission angle falls to {d.checks['min_transmission_deg']:.3g} deg from a toggle at crank "
-                f"angle {d.checks['min_transmission_at_rad']:.4g} rad from the ground line (limit "
-                f"{d.checks['transmission_limit_deg']:g} deg, --min-transmission): coupler and rocker fold nearly "
-                "flat there, the coupler point jumps between samples and the linkage may lock or flip"
-            )
+            out.append(_transmission_word(d.checks))
         elif k == "ok_order":
             out.append("the branch does not pass the targets in their order (--ordered)")
         elif k == "ok_valid_over_turn" and d.checks.get("failures"):
@@ -109,6 +104,23 @@ def _path_failing(d: Any, kind: str = "four-bar", box: str = "") -> list[str]:
         else:
             out.append(k[3:].replace("_", " "))
     return out
+
+
+def _transmission_word(c: dict[str, Any]) -> str:
+    """The failed transmission check in words: a near-toggle (under the 1 deg floor) or under the asked limit."""
+    from planar.synth.path import TOGGLE_FLOOR_DEG
+
+    head = (
+        f"the transmission angle falls to {c['min_transmission_deg']:.3g} deg from a toggle at crank angle "
+        f"{c['min_transmission_at_rad']:.4g} rad from the ground line (limit {c['transmission_limit_deg']:g} deg, "
+        "--min-transmission)"
+    )
+    if c["min_transmission_deg"] < TOGGLE_FLOOR_DEG:
+        return head + (
+            ": coupler and rocker fold nearly flat there, so the coupler point moves far for a small crank step "
+            "and the linkage may lock or flip"
+        )
+    return head + ": the coupler pushes the rocker mostly along its length there, so it drives it poorly (stiff, loads the pins)"
 
 
 #: a best design more than this many times the tolerance off is reported as no four-bar tracing the curve
@@ -147,10 +159,10 @@ def _unreachable(d: Any, kind: str = "four-bar", box: str = "") -> str:
     elif box:
         why = box
     else:
-        more = "; try --type sixbar" if kind == "four-bar" else ""
+        more = ", --type sixbar" if kind == "four-bar" else ""
         why = (
-            f"no {kind} the search found traces this shape closer (it may be a shape no {kind} traces, or one the "
-            f"search missed: try --budget thorough or another --seed{more}, or a larger --tolerance)"
+            f"no {kind} the search found traces this shape closer: it may be a shape no {kind} traces, or one the "
+            f"search missed (try --budget thorough, another --seed{more}, or a larger --tolerance)"
         )
     return (
         f"no {kind} found traces this curve within --tolerance {d.checks['tolerance']:g}: the best found is "

@@ -34,7 +34,7 @@ def test_far_off_sixbar_is_named_with_its_worst_target_not_an_internal_error():
     assert d.checks["worst_target"] == 4
     lines = _path_failing(d, "stephenson six-bar")
     assert any(ln.startswith("no stephenson six-bar found traces this curve") and "at target 4" in ln for ln in lines)
-    assert not any("try --type sixbar" in ln for ln in lines)
+    assert not any("--type sixbar" in ln for ln in lines)
 
 
 def test_sixbar_reports_whether_it_passes_the_targets_in_one_sweep():
@@ -95,7 +95,7 @@ def test_pivots_box_named_as_the_likely_reason(tmp_path, capsys):
     rc = main(["synth", "path", src, "-o", str(tmp_path / "k.toml"), "--pivots=-1,-1,0,0", "--budget", "quick"])
     out = capsys.readouterr().out
     assert rc == 3 and "the box is why" in out and "not one a four-bar" not in out, out
-    assert "try --type sixbar" not in out
+    assert "--type sixbar" not in out
 
 
 # four poses of a crank-rocker with a 54 deg transmission angle, as the trial drew them (degrees)
@@ -158,3 +158,47 @@ def test_transmission_margins_exact_against_a_dense_sweep():
         c = np.clip((b * b + r * r - (a * a + d * d - 2 * a * d * np.cos(s))) / (2 * b * r), -1, 1)
         mu = np.arccos(c)
         assert got == pytest.approx(np.minimum(mu, np.pi - mu).min(), abs=1e-3)
+
+
+def test_transmission_constraint_of_the_search_against_a_dense_sweep():
+    """The search's penalty is zero exactly when the transmission angle keeps the limit over the whole turn."""
+    from planar.synth.search import violation
+
+    rng = np.random.default_rng(11)
+    X = np.column_stack([rng.uniform(0.3, 3.0, (400, 4)), np.zeros((400, 5))])
+    th = np.linspace(0, 2 * np.pi, 4001)
+    lim = np.radians(25.0)
+    cons = Constraints(full_turn=False, max_ratio=np.inf, min_transmission=lim)
+    v = violation(X, cons, 1.0, 0.0)
+    d, a, b, r = (X[:, k : k + 1] for k in range(4))
+    c = (b * b + r * r - (a * a + d * d - 2 * a * d * np.cos(th))) / (2 * b * r)
+    closes = (np.abs(c) <= 1).all(1)  # the crank turns fully
+    mu = np.arccos(np.clip(c, -1, 1))
+    keeps = np.minimum(mu, np.pi - mu).min(1) >= lim
+    assert closes.sum() > 20 and keeps[closes].any() and (~keeps[closes]).any()
+    assert ((v == 0) == keeps)[closes].all()
+
+
+def test_transmission_failure_worded_by_what_it_is():
+    from planar.cli.synth import _transmission_word
+
+    c = {"min_transmission_at_rad": 3.1, "transmission_limit_deg": 30.0}
+    soft = _transmission_word({**c, "min_transmission_deg": 10.4})
+    assert "falls to 10.4 deg" in soft and "drives it poorly" in soft and "jumps" not in soft and "flip" not in soft
+    hard = _transmission_word({**c, "min_transmission_deg": 0.42})
+    assert "fold nearly flat" in hard and "lock or flip" in hard
+
+
+@pytest.mark.slow
+def test_path_min_transmission_selects_a_design_that_keeps_it(tmp_path, capsys):
+    """--min-transmission 30 on the bean: the design keeps 30 deg (it returned a 10.4 deg design before)."""
+    out = tmp_path / "b.toml"
+    argv = ["synth", "path", str(DATA / "bean.svg"), "--points", "25", "-o", str(out), "--budget", "quick", "--json"]
+    main([*argv, "--min-transmission", "30"])
+    rep = json.loads(capsys.readouterr().out)
+    assert rep["checks"]["ok_transmission"] and rep["checks"]["min_transmission_deg"] >= 30.0, rep["checks"]
+    # by the law of cosines over a dense turn, from the written lengths
+    g, a, b, r = (rep[k] for k in ("ground", "crank", "coupler", "rocker"))
+    th = np.linspace(0, 2 * np.pi, 100_001)
+    mu = np.degrees(np.arccos((b * b + r * r - (a * a + g * g - 2 * a * g * np.cos(th))) / (2 * b * r)))
+    assert np.minimum(mu, 180 - mu).min() >= 30.0 - 1e-6

@@ -143,7 +143,7 @@ def test_unreachable_square_stages_and_found_by(tmp_path, capsys):
     src = _csv(tmp_path / "sq.csv", 60 * sq)
     rc = main(["synth", "path", str(src), "-o", str(tmp_path / "s.toml"), "--atlas", str(f), "--budget", "quick"])
     out = capsys.readouterr().out
-    assert rc == 3 and "no four-bar traces this curve" in out and "corner" in out and "found by" in out
+    assert rc == 3 and "no four-bar found traces this curve" in out and "corner" in out and "found by" in out
     main(["synth", "path", str(src), "-o", str(tmp_path / "s.toml"), "--atlas", str(f), "--budget", "quick", "--json"])
     rep = json.loads(capsys.readouterr().out)
     st = rep["checks"]["stages_s"]
