@@ -257,7 +257,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
         amplitude=amp,
         centre=centre,
     )
-    report = {"command": "synth path", "targets": len(targets), **d.to_dict()}
+    report = {"command": "synth path", "targets": len(targets), "target_points": targets.tolist(), **d.to_dict()}
     return _finish_path(
         args,
         f"four-bar ({fb.grashof}, {d.circuit}), largest distance {d.checks['max_error']:.3g} of the targets' size "
@@ -341,7 +341,7 @@ def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | N
             "crank angle at each target (rad, from the ground line O2-O4): " + ", ".join(f"{t:.6g}" for t in wrapped(d.theta)),
         ],
     )
-    report = {"command": "synth path", "targets": len(targets), **d.to_dict()}
+    report = {"command": "synth path", "targets": len(targets), "target_points": targets.tolist(), **d.to_dict()}
     return _finish_path(
         args,
         f"{d.topology} six-bar, largest distance {d.checks['max_error']:.3g} of the targets' size "
@@ -620,10 +620,15 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--json",
         action="store_true",
-        help="print the design, sse, checks.rms_error and time_s as JSON (or ok false and the reason)",
+        help="print the design, sse, checks (max_error, rms_error, worst_target, evaluations...), time_s and "
+        "target_points (the targets read, y up) as JSON; reason when ok is false",
     )
     p.add_argument(
-        "--budget", choices=("quick", "normal", "thorough"), default="normal", help="search effort (normal: about 1-4 s)"
+        "--budget",
+        choices=("quick", "normal", "thorough"),
+        default="normal",
+        help="search effort (normal: about 4 s CPU when the atlas finds the curve, 6-8 s when the global search runs too; "
+        "sixbar: about twice that)",
     )
     p.add_argument(
         "--max-ratio",
@@ -634,7 +639,12 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--pivots", default=None, help="ground pivots inside XMIN,YMIN,XMAX,YMAX (write --pivots=-1,... when XMIN is negative)"
     )
-    p.add_argument("--points", type=int, default=None, help="points sampled along an SVG target (12; SVG only)")
+    p.add_argument(
+        "--points",
+        type=int,
+        default=None,
+        help="points at equal arc lengths along an SVG target, drawing (x, y) read as (x, -y) (12; SVG only)",
+    )
     p.add_argument("--deg", action="store_true", help="the theta column is in degrees")
     p.add_argument(
         "--tolerance",
@@ -658,13 +668,19 @@ def add_parser(sub: Any) -> None:
         type=float,
         default=0.0,
         help="four-bar: keep the transmission angle at least this far from 0 and 180 (a toggle) over the turn, "
-        "degrees (0; never nearer than 1 deg: beyond it the design is written and exits 3)",
+        "degrees, a constraint of the search (0; never nearer than 1 deg: when the best found does not keep it, "
+        "it is written and exits 3)",
     )
     p.add_argument("--seed", type=int, default=0, help="random seed of the search (same seed, same result)")
     p.set_defaults(func=_cmd_path)
 
     a = ss.add_parser("atlas", help="build the coupler-curve atlas untimed path synthesis searches (cached)")
-    a.add_argument("--size", type=int, default=1_000_000, help="four-bars in the atlas (1000000: about 40 s, 100 MB)")
+    a.add_argument(
+        "--size",
+        type=int,
+        default=1_000_000,
+        help="four-bars in the atlas (1000000: about 25 s CPU, a 112 MB file, 580 MB of memory while building)",
+    )
     a.add_argument("--seed", type=int, default=0, help="random seed (same size and seed, same atlas)")
     a.add_argument("-o", "--output", default=None, help="atlas file (.npz) to write (default: the user cache folder)")
     a.add_argument("--force", action="store_true", help="rebuild even if the file exists")
@@ -714,7 +730,8 @@ def add_parser(sub: Any) -> None:
         type=float,
         default=0.0,
         help="keep the transmission angle at least this far from 0 and 180 (a toggle) over the motion, degrees "
-        "(0); exit 3 naming the angle and where when the design does not",
+        "(0; never nearer than 1 deg); chooses among the four-bars through the poses, exit 3 naming the angle and "
+        "where when none keeps it",
     )
     m.add_argument("--json", action="store_true", help="print the design and its checks as JSON")
     m.set_defaults(func=_cmd_motion)

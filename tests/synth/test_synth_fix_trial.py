@@ -202,3 +202,42 @@ def test_path_min_transmission_selects_a_design_that_keeps_it(tmp_path, capsys):
     th = np.linspace(0, 2 * np.pi, 100_001)
     mu = np.degrees(np.arccos((b * b + r * r - (a * a + g * g - 2 * a * g * np.cos(th))) / (2 * b * r)))
     assert np.minimum(mu, 180 - mu).min() >= 30.0 - 1e-6
+
+
+def test_svg_targets_at_equal_arc_lengths_y_turned_up():
+    """Gaps along the bean measured on a dense polyline of each Bezier segment (svgelements' segment
+    evaluation, not the path's parameter mapping): equal; svgelements' ``point(k/n)`` varied 1.75 times."""
+    import svgelements as se
+
+    from planar.synth.targets import read_svg_points
+
+    pts = read_svg_points(DATA / "bean.svg", 25)
+    el = next(e for e in se.SVG.parse(str(DATA / "bean.svg")).elements() if isinstance(e, se.Shape))
+    dense = np.vstack([np.asarray(seg.npoint(np.linspace(0, 1, 10_001))) for seg in se.Path(el) if not isinstance(seg, se.Move)])
+    dense[:, 1] = -dense[:, 1]
+    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(dense, axis=0).T))])
+    at = cum[[int(np.argmin(np.hypot(*(dense - p).T))) for p in pts]]
+    gaps = np.diff(np.append(at, cum[-1]))
+    assert np.abs(gaps - cum[-1] / 25).max() < 1e-4 * cum[-1], gaps
+    assert np.hypot(*(pts[0] - dense[0])) < 1e-9  # from the path's start
+
+
+def test_svg_open_line_sampled_end_to_end_with_y_negated(tmp_path):
+    from planar.synth.targets import read_svg_points
+
+    f = tmp_path / "l.svg"
+    f.write_text('<svg xmlns="http://www.w3.org/2000/svg"><path d="M 0 0 Q 30 0 30 30"/></svg>')
+    pts = read_svg_points(f, 5)
+    # the quadratic Bezier's arc length by scipy's quadrature: the points at 0, 1/4 ... 1 of it
+    from scipy.integrate import quad
+
+    def speed(t: float) -> float:
+        return float(np.hypot(2 * (1 - t) * 30 + 2 * t * 0, 2 * t * 30))
+
+    total = quad(speed, 0, 1)[0]
+    for k, p in enumerate(pts):
+        t = np.linspace(0, 1, 20_001)
+        xy = np.column_stack([2 * (1 - t) * t * 30 + t * t * 30, -(t * t * 30)])
+        i = int(np.argmin(np.hypot(*(xy - p).T)))
+        assert quad(speed, 0, t[i])[0] == pytest.approx(k / 4 * total, abs=2e-3 * total)
+    assert pts[-1] == pytest.approx([30.0, -30.0])
