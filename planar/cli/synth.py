@@ -256,6 +256,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
         ],
         amplitude=amp,
         centre=centre,
+        targets=targets.tolist(),
     )
     report = {"command": "synth path", "targets": len(targets), "target_points": targets.tolist(), **d.to_dict()}
     return _finish_path(
@@ -335,6 +336,7 @@ def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | N
         d.nodes(),
         d.links(),
         {"tracer": "T"},
+        targets=targets.tolist(),
         comments=[
             f"planar synth path {args.target} --type sixbar --topology {d.topology}: {len(targets)} targets, "
             f"{'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",

@@ -241,3 +241,28 @@ def test_svg_open_line_sampled_end_to_end_with_y_negated(tmp_path):
         i = int(np.argmin(np.hypot(*(xy - p).T)))
         assert quad(speed, 0, t[i])[0] == pytest.approx(k / 4 * total, abs=2e-3 * total)
     assert pts[-1] == pytest.approx([30.0, -30.0])
+
+
+def _pink(img) -> np.ndarray:
+    a = np.asarray(img.convert("RGB"), int)
+    return (np.abs(a - np.array([0xE3, 0x77, 0xC2])).sum(-1) < 40).nonzero()
+
+
+@pytest.mark.slow
+def test_render_draws_the_targets_the_synthesis_wrote(tmp_path):
+    """The scene synth writes carries its targets; planar render draws them (pink), framed even far off."""
+    from PIL import Image
+
+    from planar.synth.scene_out import fourbar_scene_text
+
+    far = [[9.0, 7.0], [9.5, 7.0], [9.0, 7.5]]  # far from the linkage: the frame must take them in
+    text = fourbar_scene_text("t", 4.0, 1.0, 3.5, 3.0, (1.5, 1.0), "open", (0.0, 0.0, 0.0), targets=far)
+    for name, t in (("with", text), ("without", text.replace("targets = ", "# targets = "))):
+        (tmp_path / f"{name}.toml").write_text(t)
+        assert main(["render", str(tmp_path / f"{name}.toml"), "-o", str(tmp_path / f"{name}.gif")]) == 0
+    with Image.open(tmp_path / "with.gif") as im:
+        ys, xs = _pink(im)
+        w, h = im.size
+    assert len(xs) > 20 and xs.max() > 0.7 * w and ys.min() < 0.3 * h  # up and right, where the targets are
+    with Image.open(tmp_path / "without.gif") as im:
+        assert len(_pink(im)[0]) == 0
