@@ -160,6 +160,8 @@ def render_scene(
     given, receives what a user should hear: a cycle that plays slower than
     its speed, samples that cannot be assembled (drawn tinted red).
     """
+    import numpy as np
+
     from planar.draw.frames import Renderer, palette_colors
     from planar.draw.timing import animation_motion, resample
     from planar.errors import InputError
@@ -227,7 +229,10 @@ def render_scene(
         return len(motion)
     polys = {n: scene.polygons[n] for n in scene.spec.render.sweep}
     with numeric_guard(scene, "the animation"):
-        r = Renderer(scene.mechanism, motion, scene_style(scene), overlay=overlay, polygons=polys, trail_motion=fine)
+        targets = np.asarray(scene.spec.render.targets, float).reshape(-1, 2)
+        r = Renderer(
+            scene.mechanism, motion, scene_style(scene), overlay=overlay, polygons=polys, trail_motion=fine, targets=targets
+        )
         if suffix == ".gif":
             from planar.app.formats import writer
 

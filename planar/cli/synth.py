@@ -66,6 +66,8 @@ def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, An
         ok = False
         failing.append(f"the written scene's motion has {int((~mo.valid).sum())} invalid samples")
     report["ok"] = ok
+    if not ok:  # what failed, as the text output's "check failed" lines
+        report["reason"] = "; ".join(failing) or "a check failed (see checks)"
     report["output"] = str(args.output)
     if args.json:
         print(json.dumps(report, indent=2, default=float))
@@ -76,8 +78,9 @@ def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, An
     return 0 if ok else EXIT_CHECK
 
 
-def _path_failing(d: Any) -> list[str]:
-    """One line per failed check of a path design, naming what failed and by how much."""
+def _path_failing(d: Any, kind: str = "four-bar", box: str = "") -> list[str]:
+    """One line per failed check of a path design, naming what failed and by how much (``kind`` and ``box``:
+    as :func:`_unreachable`'s)."""
     out: list[str] = []
     for k, v in d.checks.items():
         if not k.startswith("ok_") or v:
@@ -91,14 +94,9 @@ def _path_failing(d: Any) -> list[str]:
                 f"(RMS distance {d.checks['rms_error']:.3g} of the size, sse {d.sse:.6g})"
             )
             if d.checks["max_error"] > FAR_OFF * d.checks["tolerance"]:
-                out.append(_unreachable(d))
+                out.append(_unreachable(d, kind, box))
         elif k == "ok_transmission":
-            out.append(
-                f"the transmission angle falls to {d.checks['min_transmission_deg']:.3g} deg from a toggle at crank "
-                f"angle {d.checks['min_transmission_at_rad']:.4g} rad from the ground line (limit "
-                f"{d.checks['transmission_limit_deg']:g} deg, --min-transmission): coupler and rocker fold nearly "
-                "flat there, the coupler point jumps between samples and the linkage may lock or flip"
-            )
+            out.append(_transmission_word(d.checks))
         elif k == "ok_order":
             out.append("the branch does not pass the targets in their order (--ordered)")
         elif k == "ok_valid_over_turn" and d.checks.get("failures"):
@@ -106,6 +104,23 @@ def _path_failing(d: Any) -> list[str]:
         else:
             out.append(k[3:].replace("_", " "))
     return out
+
+
+def _transmission_word(c: dict[str, Any]) -> str:
+    """The failed transmission check in words: a near-toggle (under the 1 deg floor) or under the asked limit."""
+    from planar.synth.path import TOGGLE_FLOOR_DEG
+
+    head = (
+        f"the transmission angle falls to {c['min_transmission_deg']:.3g} deg from a toggle at crank angle "
+        f"{c['min_transmission_at_rad']:.4g} rad from the ground line (limit {c['transmission_limit_deg']:g} deg, "
+        "--min-transmission)"
+    )
+    if c["min_transmission_deg"] < TOGGLE_FLOOR_DEG:
+        return head + (
+            ": coupler and rocker fold nearly flat there, so the coupler point moves far for a small crank step "
+            "and the linkage may lock or flip"
+        )
+    return head + ": the coupler pushes the rocker mostly along its length there, so it drives it poorly (stiff, loads the pins)"
 
 
 #: a best design more than this many times the tolerance off is reported as no four-bar tracing the curve
@@ -132,18 +147,25 @@ def _sharpest_turn(t: np.ndarray) -> tuple[float, int]:
     return float(np.degrees(turn[k])), (k + 1) % len(t) + 1
 
 
-def _unreachable(d: Any) -> str:
-    """The plain word for a best design far beyond the tolerance: no four-bar traces the curve, and likely why."""
+def _unreachable(d: Any, kind: str = "four-bar", box: str = "") -> str:
+    """The plain word for a best design far beyond the tolerance: nothing of ``kind`` found traces the curve,
+    and the likely reasons (a sharp corner; the ``--pivots`` box, ``box`` saying how the unboxed atlas does)."""
     deg, at = _sharpest_turn(d.targets)
-    why = (
-        f"the targets turn by {deg:.0f} deg at target {at}, a sharp corner, and a coupler curve is smooth: "
-        "it rounds corners (round them in the drawing, or accept a larger --tolerance)"
-        if deg >= 60
-        else "the curve's shape is not one a four-bar's coupler point traces (the atlas and the global search "
-        "found nothing nearer); try --type sixbar or a larger --tolerance"
-    )
+    if deg >= 60:
+        why = (
+            f"the targets turn by {deg:.0f} deg at target {at}, a sharp corner, and a coupler curve is smooth: "
+            "it rounds corners (round them in the drawing, or accept a larger --tolerance)"
+        )
+    elif box:
+        why = box
+    else:
+        more = ", --type sixbar" if kind == "four-bar" else ""
+        why = (
+            f"no {kind} the search found traces this shape closer: it may be a shape no {kind} traces, or one the "
+            f"search missed (try --budget thorough, another --seed{more}, or a larger --tolerance)"
+        )
     return (
-        f"no four-bar traces this curve within --tolerance {d.checks['tolerance']:g}: the best found is "
+        f"no {kind} found traces this curve within --tolerance {d.checks['tolerance']:g}: the best found is "
         f"{d.checks['max_error']:.3g} of the targets' size off at target {d.checks['worst_target']} "
         f"({d.checks['max_error'] / d.checks['tolerance']:.0f} times the tolerance). Likely why: {why}"
     )
@@ -216,7 +238,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
     why = _unusable(d, "four-bar", cons.region is not None)
     if why is not None:
         return _no_design(args, "synth path", {"targets": len(targets)}, why)
-    failing = _path_failing(d)
+    failing = _path_failing(d, "four-bar", _box_word(d, targets, cons, atlas, args))
     fb = d.fourbar()
     amp, centre = _rocking(fb, d.theta)
     text = fourbar_scene_text(
@@ -234,8 +256,9 @@ def _cmd_path(args: argparse.Namespace) -> int:
         ],
         amplitude=amp,
         centre=centre,
+        targets=targets.tolist(),
     )
-    report = {"command": "synth path", "targets": len(targets), **d.to_dict()}
+    report = {"command": "synth path", "targets": len(targets), "target_points": targets.tolist(), **d.to_dict()}
     return _finish_path(
         args,
         f"four-bar ({fb.grashof}, {d.circuit}), largest distance {d.checks['max_error']:.3g} of the targets' size "
@@ -246,6 +269,22 @@ def _cmd_path(args: argparse.Namespace) -> int:
         d.ok,
         failing,
     )
+
+
+def _box_word(d: Any, targets: np.ndarray, cons: Any, atlas: Any, args: argparse.Namespace) -> str:
+    """With a ``--pivots`` box and a design far off: how the atlas does without the box (one lookup), in words."""
+    if cons.region is None or not d.checks["max_error"] > FAR_OFF * d.checks["tolerance"]:
+        return ""
+    from planar.synth.path import unboxed_error
+
+    e = unboxed_error(targets, cons, atlas, args.budget)
+    head = f"every ground pivot was kept in the --pivots box; without the box the atlas's best four-bar is {e:.3g} of the size"
+    head += " off"
+    if e <= d.checks["tolerance"]:
+        return f"{head}, within the tolerance: the box is why (widen or move it)"
+    if e < 0.5 * d.checks["max_error"]:
+        return f"{head}: the box is part of why (widen or move it), and the shape is not traced exactly even without it"
+    return f"{head} too: the box is not why; no four-bar the search found traces this shape closer (try --type sixbar)"
 
 
 def _finish_path(args: argparse.Namespace, what: str, text: str, report: dict[str, Any], ok: bool, failing: list[str]) -> int:
@@ -271,23 +310,40 @@ def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | N
     from planar.synth.sixbar import synthesise_sixbar
 
     topology = args.topology or "stephenson"
-    d = synthesise_sixbar(targets, theta, topology, cons, budget=args.budget, seed=args.seed, tolerance=args.tolerance)
+    atlas = None
+    if args.atlas is not None and theta is None:
+        from planar.synth.atlas import read_atlas
+
+        atlas = read_atlas(args.atlas)
+    d = synthesise_sixbar(
+        targets,
+        theta,
+        topology,
+        cons,
+        budget=args.budget,
+        seed=args.seed,
+        tolerance=args.tolerance,
+        atlas=atlas,
+        ordered=args.ordered,
+    )
     why = _unusable(d, f"{topology} six-bar", cons.region is not None)
     if why is not None:
         return _no_design(args, "synth path", {"targets": len(targets)}, why)
-    failing = _path_failing(d)
+    box = "every ground pivot was kept in the --pivots box, which may be why (try without it)" if cons.region is not None else ""
+    failing = _path_failing(d, f"{topology} six-bar", box)
     text = linkage_scene_text(
         f"synth-sixbar-{d.topology}",
         d.nodes(),
         d.links(),
         {"tracer": "T"},
+        targets=targets.tolist(),
         comments=[
             f"planar synth path {args.target} --type sixbar --topology {d.topology}: {len(targets)} targets, "
             f"{'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
             "crank angle at each target (rad, from the ground line O2-O4): " + ", ".join(f"{t:.6g}" for t in wrapped(d.theta)),
         ],
     )
-    report = {"command": "synth path", "targets": len(targets), **d.to_dict()}
+    report = {"command": "synth path", "targets": len(targets), "target_points": targets.tolist(), **d.to_dict()}
     return _finish_path(
         args,
         f"{d.topology} six-bar, largest distance {d.checks['max_error']:.3g} of the targets' size "
@@ -566,10 +622,15 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--json",
         action="store_true",
-        help="print the design, sse, checks.rms_error and time_s as JSON (or ok false and the reason)",
+        help="print the design, sse, checks (max_error, rms_error, worst_target, evaluations...), time_s and "
+        "target_points (the targets read, y up) as JSON; reason when ok is false",
     )
     p.add_argument(
-        "--budget", choices=("quick", "normal", "thorough"), default="normal", help="search effort (normal: about 1-4 s)"
+        "--budget",
+        choices=("quick", "normal", "thorough"),
+        default="normal",
+        help="search effort (normal: about 4 s CPU when the atlas finds the curve, 6-8 s when the global search runs too; "
+        "sixbar: about twice that)",
     )
     p.add_argument(
         "--max-ratio",
@@ -580,7 +641,12 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--pivots", default=None, help="ground pivots inside XMIN,YMIN,XMAX,YMAX (write --pivots=-1,... when XMIN is negative)"
     )
-    p.add_argument("--points", type=int, default=None, help="points sampled along an SVG target (12; SVG only)")
+    p.add_argument(
+        "--points",
+        type=int,
+        default=None,
+        help="points at equal arc lengths along an SVG target, drawing (x, y) read as (x, -y) (12; SVG only)",
+    )
     p.add_argument("--deg", action="store_true", help="the theta column is in degrees")
     p.add_argument(
         "--tolerance",
@@ -604,13 +670,19 @@ def add_parser(sub: Any) -> None:
         type=float,
         default=0.0,
         help="four-bar: keep the transmission angle at least this far from 0 and 180 (a toggle) over the turn, "
-        "degrees (0; never nearer than 1 deg: beyond it the design is written and exits 3)",
+        "degrees, a constraint of the search (0; never nearer than 1 deg: when the best found does not keep it, "
+        "it is written and exits 3)",
     )
     p.add_argument("--seed", type=int, default=0, help="random seed of the search (same seed, same result)")
     p.set_defaults(func=_cmd_path)
 
     a = ss.add_parser("atlas", help="build the coupler-curve atlas untimed path synthesis searches (cached)")
-    a.add_argument("--size", type=int, default=1_000_000, help="four-bars in the atlas (1000000: about 40 s, 100 MB)")
+    a.add_argument(
+        "--size",
+        type=int,
+        default=1_000_000,
+        help="four-bars in the atlas (1000000: about 25 s CPU, a 112 MB file, 580 MB of memory while building)",
+    )
     a.add_argument("--seed", type=int, default=0, help="random seed (same size and seed, same atlas)")
     a.add_argument("-o", "--output", default=None, help="atlas file (.npz) to write (default: the user cache folder)")
     a.add_argument("--force", action="store_true", help="rebuild even if the file exists")
@@ -660,7 +732,8 @@ def add_parser(sub: Any) -> None:
         type=float,
         default=0.0,
         help="keep the transmission angle at least this far from 0 and 180 (a toggle) over the motion, degrees "
-        "(0); exit 3 naming the angle and where when the design does not",
+        "(0; never nearer than 1 deg); chooses among the four-bars through the poses, exit 3 naming the angle and "
+        "where when none keeps it",
     )
     m.add_argument("--json", action="store_true", help="print the design and its checks as JSON")
     m.set_defaults(func=_cmd_motion)

@@ -166,7 +166,9 @@ class Renderer:
     ``polygons`` maps a name to ``(part, points)`` in that part's frame: drawn
     swept with the part (the notes' foot).  ``trail_motion`` (default:
     ``motion``) is the finer motion the trails are drawn from when ``motion``
-    holds only the frames.
+    holds only the frames.  ``targets`` ``(M, 2)``: fixed points (world
+    coordinates of an ``xy`` view, model units; e.g. the targets a synthesis
+    aimed at) drawn as dots of the overlay colour over the trails in every frame, and framed.
 
     How: every part's outline is transformed for all frames at once (numpy);
     a frame is the static layer (ground, parts that do not move, drawn once,
@@ -184,6 +186,7 @@ class Renderer:
     polygons: Mapping[str, tuple[str, Array]] = field(default_factory=dict)
     view: str = ""  # default: the mechanism's own view plane ("xy" unless it says otherwise)
     trail_motion: Motion | None = None
+    targets: Array | None = None
 
     def __post_init__(self) -> None:
         from planar.draw.toyview import Marks, assembled
@@ -219,6 +222,8 @@ class Renderer:
         self.base = self._static_layer()
         self.trail_layer = self._trail_layer()
         self.dot = {c: self._dot(_rgb(c), 2.2) for c in (s.pin, s.trail, s.invalid)}
+        self.target_px = self._px(self._targets()) if len(self._targets()) else None
+        self.target_dot = self._dot(_rgb(s.overlay), 2.8)  # a colour of the GIF's fixed palette
         self.mark_px = (
             [(self._px(r), c) for r, c in self.marks.rings],
             [(self._px(r), c) for r, c in self.marks.lines],
@@ -297,7 +302,7 @@ class Renderer:
         valid = np.asarray(self.motion.valid, bool)
         keep = valid if valid.any() else np.ones_like(valid)
         fine_keep = self._fine_valid if self._fine_valid.any() else np.ones_like(self._fine_valid)
-        boxes = [_extent([np.asarray(v)[fine_keep] for v in self._trails(fine).values()])]
+        boxes = [_extent([np.asarray(v)[fine_keep] for v in self._trails(fine).values()]), _extent([self._targets()])]
         for start in range(0, len(self), CHUNK_FRAMES):
             idx = np.arange(start, min(len(self), start + CHUNK_FRAMES))
             world = self._world_geometry(self.motion.take(idx))
@@ -316,6 +321,10 @@ class Renderer:
         self.scale = scale
         centre = 0.5 * (lo + hi)
         self.origin = np.array([self.W / 2 - scale * centre[0], self.H / 2 + scale * centre[1]])
+
+    def _targets(self) -> Array:
+        """The fixed target points ``(M, 2)`` (none: ``(0, 2)``)."""
+        return np.empty((0, 2)) if self.targets is None else np.asarray(self.targets, float).reshape(-1, 2)
 
     def _px(self, xy: Array) -> Array:
         """World view coordinates -> output pixel coordinates (y flipped)."""
@@ -441,6 +450,10 @@ class Renderer:
         self._draw_marks(img, draw, i)
         if self.trail_layer is not None:
             img.paste(_rgb(s.trail), (0, 0, self.W, self.H), self.trail_layer)
+        if self.target_px is not None:
+            h = self.target_dot.size[0] // 2
+            for x, y in self.target_px:
+                img.paste(self.target_dot, (int(round(x)) - h, int(round(y)) - h), self.target_dot)
         for rings in c.overlay:
             for r in rings:
                 pts = np.vstack([r[k], r[k][:1]]).ravel().tolist()

@@ -520,6 +520,9 @@ class RenderSpec(_Strict):
     """Named points whose paths are drawn, e.g. ``["coupler_point"]``; default every named point."""
     sweep: list[Name] = []
     """Polygons drawn swept along the motion, e.g. ``["foot"]``."""
+    targets: list[tuple[Real, Real]] = []
+    """Fixed points drawn as pink dots in every frame, world ``[x, y]`` (model units), e.g. the targets ``planar
+    synth path`` aimed at (it writes them here): ``[[1.0, 2.0], [1.5, 2.2]]``."""
     background: Annotated[Name, Field(pattern=r"^#[0-9a-fA-F]{6}$")] = "#ffffff"
     """Background colour ``#rrggbb``, e.g. ``"#ffffff"``."""
     show_pins: StrictBool = True

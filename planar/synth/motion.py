@@ -242,7 +242,39 @@ def crank_order(
     return np.where(full, turn_ok, arc_ok), full, lo, hi
 
 
-def _choose(poses: Array, z: Array, c: Array, max_ratio: float) -> tuple[int, int, bool]:
+#: a design whose transmission angle comes nearer than this to a toggle (0 or 180 deg) fails its check whatever
+#: ``min_transmission`` asks (as path synthesis's floor)
+TOGGLE_FLOOR_DEG = 1.0
+#: the selection prefers a transmission angle farther from a toggle up to this, then the smaller link ratio
+GOOD_TRANSMISSION_DEG = 30.0
+
+
+def _contains(x: float, lo: Array, hi: Array) -> NDArray[np.bool_]:
+    """Whether angle ``x`` (mod 2 pi) lies in each unwrapped range ``[lo, hi]`` (narrower than a turn)."""
+    return np.mod(x - lo, 2 * np.pi) <= hi - lo
+
+
+def transmission_margins(d: Array, a: Array, b: Array, r: Array, full: NDArray[np.bool_], lo: Array, hi: Array) -> Array:
+    """Smallest distance (radians) of the transmission angle from a toggle (0 or pi) over each crank's sweep.
+
+    ``d, a, b, r`` ``(P,)``: ground, crank, coupler, rocker; ``full``: the crank turns fully, else it sweeps
+    ``[lo, hi]`` (radians from the ground line, unwrapped, as :func:`crank_order` gives).  The transmission
+    angle ``mu`` depends on the crank angle ``theta`` only through the diagonal ``|B - O4|^2 = a^2 + d^2 -
+    2 a d cos theta`` and is monotonic in it, so its extremes over the sweep are at the extremes of ``cos
+    theta`` there (exact, no sampling)."""
+    with np.errstate(invalid="ignore"):
+        ends = np.stack([np.cos(np.nan_to_num(lo)), np.cos(np.nan_to_num(hi))])
+        cmax = np.where(full | _contains(0.0, lo, hi), 1.0, ends.max(0))
+        cmin = np.where(full | _contains(np.pi, lo, hi), -1.0, ends.min(0))
+    out = np.full(len(d), np.pi / 2)
+    for cth in (cmin, cmax):
+        diag2 = a * a + d * d - 2 * a * d * cth
+        mu = np.arccos(np.clip((b * b + r * r - diag2) / np.maximum(2 * b * r, 1e-300), -1.0, 1.0))
+        out = np.minimum(out, np.minimum(mu, np.pi - mu))
+    return out
+
+
+def _choose(poses: Array, z: Array, c: Array, max_ratio: float, min_transmission: float = 0.0) -> tuple[int, int, bool]:
     """The best ordered pair (crank dyad, rocker dyad) among candidate dyads (see the module)."""
     K = len(z)
     if K < 2:
@@ -267,7 +299,7 @@ def _choose(poses: Array, z: Array, c: Array, max_ratio: float) -> tuple[int, in
     theta = (
         np.arctan2(B[..., 1] - O2[..., 1], B[..., 0] - O2[..., 0]) - np.arctan2(g[:, 1], g[:, 0])[:, None]
     )  # crank angle from the ground line
-    in_order, full, _, _ = crank_order(theta, d, a, b, r)
+    in_order, full, clo, chi = crank_order(theta, d, a, b, r)
     ratio = hi / np.maximum(lo, 1e-300)
     usable = one_circuit & (lo > 1e-3 * L) & (ratio <= max_ratio)
     if not usable.any():
@@ -283,8 +315,15 @@ def _choose(poses: Array, z: Array, c: Array, max_ratio: float) -> tuple[int, in
             "between them) as the crank moves in one direction (other poses, or their order)"
         )
     usable &= in_order
-    pick = usable & full if (usable & full).any() else usable
-    k = int(np.flatnonzero(pick)[np.argmin(ratio[pick])])
+    margin = transmission_margins(d, a, b, r, full, clo, chi)
+    keeps = usable & (margin >= max(min_transmission, np.radians(TOGGLE_FLOOR_DEG)) - 1e-9)
+    if not keeps.any():  # none keeps the transmission limit: the nearest, written and failing its check
+        k = int(np.flatnonzero(usable)[np.argmax(margin[usable])])
+        return int(I[k]), int(J[k]), bool(full[k])
+    pick = keeps & full if (keeps & full).any() else keeps
+    idx = np.flatnonzero(pick)
+    good = np.minimum(margin[idx], np.radians(GOOD_TRANSMISSION_DEG))
+    k = int(idx[np.lexsort((ratio[idx], -good))[0]])  # farthest from a toggle up to the good angle, then the ratio
     return int(I[k]), int(J[k]), bool(full[k])
 
 
@@ -325,7 +364,7 @@ def burmester(poses: Array, max_ratio: float = 10.0, grid: int = 24, min_transmi
             )
     ok = np.isfinite(c).all(1)
     z, c = z[ok], c[ok]
-    i, j, _ = _choose(poses, z, c, max_ratio)
+    i, j, _ = _choose(poses, z, c, max_ratio, min_transmission)
     return _design(poses, z[i], c[i], z[j], c[j], len(z), min_transmission)
 
 
@@ -419,7 +458,8 @@ def check_motion(md: MotionDesign, samples: int = 4096, min_transmission: float 
         "ok_reaches_every_pose": bool(m.valid.all() and dp.max() <= 1e-6 * L and da.max() <= 1e-6),
         "ok_poses_in_order": md.in_order,
         "ok_assembles_between_poses": bool(sweep.valid.all()),
-        "ok_transmission": bool(margin[worst] >= min_transmission - 1e-9),
+        "ok_transmission": bool(margin[worst] >= max(min_transmission, np.radians(TOGGLE_FLOOR_DEG)) - 1e-9),
+        "transmission_limit_deg": float(np.degrees(max(min_transmission, np.radians(TOGGLE_FLOOR_DEG)))),
         "min_transmission_deg": float(np.degrees(margin[worst])),
         "min_transmission_at": (
             f"crank angle {np.degrees(crank[worst]):.4g} deg, {_between(md.theta, float(crank[worst]), md.crank_range is None)}"

@@ -54,10 +54,12 @@ def wrapped(theta: Array) -> Array:
 
 def normalised(cons: Constraints, c: Array, s: float) -> Constraints:
     """``cons`` for targets moved by ``-c`` and divided by ``s`` (the pivots box moves with them)."""
+    import dataclasses
+
     if cons.region is None:
         return cons
     x0, y0, x1, y1 = cons.region
-    return Constraints(cons.full_turn, cons.max_ratio, ((x0 - c[0]) / s, (y0 - c[1]) / s, (x1 - c[0]) / s, (y1 - c[1]) / s))
+    return dataclasses.replace(cons, region=((x0 - c[0]) / s, (y0 - c[1]) / s, (x1 - c[0]) / s, (y1 - c[1]) / s))
 
 
 @dataclass
@@ -172,7 +174,7 @@ def _search(
             if timed is not None
             else float("inf")
         )
-        if timed is not None and timed.feasible and e_atlas <= tolerance:
+        if timed is not None and timed.feasible and _keeps_transmission(timed, cons) and e_atlas <= tolerance:
             timed.stages = {**load, **timed.stages}
             return timed, "the atlas lookup and refinement (the global search did not run: within the tolerance)"
         g = search_fourbar(t, theta, cons, seed=seed, **kw)
@@ -180,13 +182,13 @@ def _search(
         return g, f"the global search (--budget {budget}; the atlas's best was {e_atlas:.3g} of the size off)"
     r = search_atlas(t, atlas, cons, ordered=ordered)
     row = np.append(r.params, r.circuit)
-    good = r.feasible and (in_order(r.theta) or not ordered)
+    good = r.feasible and (in_order(r.theta) or not ordered) and _keeps_transmission(r, cons)
     e_atlas = max_distance(PathObjective(t, None, cons), row, r.theta)
     if good and e_atlas <= tolerance:
         r.stages = {**load, **r.stages}
         return r, "the atlas lookup and refinement (the global search did not run: within the tolerance)"
     g = search_fourbar(t, None, cons, seed=seed, **kw)
-    g_good = g.feasible and (in_order(g.theta) or not ordered)
+    g_good = g.feasible and (in_order(g.theta) or not ordered) and _keeps_transmission(g, cons)
     e_global = max_distance(PathObjective(t, None, cons), np.append(g.params, g.circuit), g.theta)
     stages = {**load, **r.stages, **_prefixed(g.stages)}
     # the better of the two: usable first, then the smaller largest distance (what the check judges)
@@ -202,6 +204,57 @@ def _search(
         f"the atlas lookup and refinement (largest distance {e_atlas:.3g} of the size; the global search, "
         f"--budget {budget}, ran too and {other})"
     )
+
+
+def best_fourbar(
+    t: Array,
+    theta: Array | None,
+    cons: Constraints,
+    budget: str = "normal",
+    seed: int = 0,
+    atlas: Any = None,
+    ordered: bool = False,
+    tolerance: float = DEFAULT_TOLERANCE,
+) -> Any:
+    """The search of :func:`synthesise_path` on targets ``t`` already normalised (centroid 0, size 1; ``cons``
+    normalised with them): a :class:`planar.synth.search.SearchResult`."""
+    from threadpoolctl import threadpool_limits
+
+    if budget not in BUDGETS:
+        raise InputError("budget", budget, f"one of {', '.join(BUDGETS)}")
+    with threadpool_limits(1):
+        return _search(t, theta, cons, budget, seed, tolerance, atlas, ordered)[0]
+
+
+def unboxed_error(targets: Array, cons: Constraints, atlas: Any = None, budget: str = "normal") -> float:
+    """Largest distance from a target to the atlas's best four-bar (lookup and refinement, crank angles free),
+    as a fraction of the targets' size, with ``cons`` but no pivots box: what a ``--pivots`` box costs.
+    ``atlas``: as :func:`synthesise_path`'s (the cached one of ``budget`` when None)."""
+    from threadpoolctl import threadpool_limits
+
+    from planar.synth.search import max_distance, search_atlas
+
+    t = np.asarray(targets, float)
+    c, s = normalisation(t)
+    if atlas is None:
+        from planar.synth.atlas import DEFAULT_SIZE, QUICK_SIZE, load_atlas
+
+        atlas = load_atlas(QUICK_SIZE if budget == "quick" else DEFAULT_SIZE, progress=True)
+    import dataclasses
+
+    free = dataclasses.replace(cons, region=None)
+    tn = (t - c) / s
+    with threadpool_limits(1):
+        r = search_atlas(tn, atlas, free)
+    return max_distance(PathObjective(tn, None, free), np.append(r.params, r.circuit), r.theta)
+
+
+def _keeps_transmission(r: Any, cons: Constraints) -> bool:
+    """Whether a search result keeps ``cons.min_transmission`` over the turn (True when none is asked)."""
+    from planar.synth.search import violation
+
+    only = Constraints(full_turn=False, max_ratio=np.inf, min_transmission=cons.min_transmission)
+    return bool(violation(np.asarray(r.params, float)[None, :], only, 1.0, 0.0)[0] <= 1e-12)
 
 
 def _prefixed(stages: dict[str, float]) -> dict[str, float]:
@@ -264,6 +317,10 @@ def synthesise_path(
     if budget not in BUDGETS:
         raise InputError("budget", budget, f"one of {', '.join(BUDGETS)}")
     t0 = time.perf_counter()
+    if min_transmission > cons.min_transmission:  # asked for: a constraint of the search, not only a check
+        import dataclasses
+
+        cons = dataclasses.replace(cons, min_transmission=float(min_transmission))
     # searched on the targets moved to their centroid and divided by their size, then mapped back
     c, s = normalisation(t)
     with threadpool_limits(1):
@@ -301,7 +358,7 @@ def synthesise_path(
     if ordered:
         d.checks["ok_order"] = in_order(d.theta)
     margin, where = transmission_margin(d.fourbar())
-    limit = max(float(min_transmission), math.radians(TOGGLE_FLOOR_DEG))
+    limit = max(float(cons.min_transmission), math.radians(TOGGLE_FLOOR_DEG))
     d.checks["min_transmission_deg"] = math.degrees(margin)
     d.checks["min_transmission_at_rad"] = where
     d.checks["transmission_limit_deg"] = math.degrees(limit)

@@ -38,8 +38,10 @@ def fourbar_scene_text(
     amplitude: float | None = None,
     centre: float = 0.0,
     samples_per_cycle: int = 72,
+    targets: Sequence[Sequence[float]] = (),
 ) -> str:
-    """The scene text of a four-bar (radians); ``amplitude``/``centre`` give a rocking driver."""
+    """The scene text of a four-bar (radians); ``amplitude``/``centre`` give a rocking driver; ``targets``
+    ``[x, y]`` each: fixed points ``planar render`` draws (``[render] targets``)."""
     lines = [f"# {c}" for c in comments]
     lines += [
         f"name = {name!r}".replace("'", '"'),
@@ -62,8 +64,15 @@ def fourbar_scene_text(
     ]
     if amplitude is not None:
         lines += [f"amplitude = {_f(amplitude)}", f"centre = {_f(centre)}"]
-    lines += ["", "[render]", 'trails = ["coupler_point"]', ""]
+    lines += ["", "[render]", 'trails = ["coupler_point"]', *_targets(targets), ""]
     return "\n".join(lines)
+
+
+def _targets(targets: Sequence[Sequence[float]]) -> list[str]:
+    """The ``[render] targets`` line (none for no targets)."""
+    if not len(targets):
+        return []
+    return ["targets = [" + ", ".join(_vec(p) for p in targets) + "]"]
 
 
 def _value(v: Any) -> str:
@@ -85,8 +94,10 @@ def linkage_scene_text(
     points: dict[str, str],
     comments: Sequence[str] = (),
     samples_per_cycle: int = 72,
+    targets: Sequence[Sequence[float]] = (),
 ) -> str:
-    """The scene text of a general linkage (``type = "linkage"``; node tables as the scene schema's)."""
+    """The scene text of a general linkage (``type = "linkage"``; node tables as the scene schema's; ``targets``
+    as :func:`fourbar_scene_text`'s)."""
     lines = [f"# {c}" for c in comments]
     lines += [
         f'name = "{name}"',
@@ -111,6 +122,7 @@ def linkage_scene_text(
         "",
         "[render]",
         "trails = [" + ", ".join(f'"{k}"' for k in points) + "]",
+        *_targets(targets),
         "",
     ]
     return "\n".join(lines)

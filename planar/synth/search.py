@@ -10,7 +10,9 @@ in proportion to how far it does:
 * the crank turns fully: Grashof (``s + l <= p + q``) with the crank or the
   ground the shortest link (crank-rocker or double-crank), by a margin;
 * link ratio: longest / shortest link at most ``max_ratio``;
-* ground pivots inside ``region`` ``(xmin, ymin, xmax, ymax)``.
+* ground pivots inside ``region`` ``(xmin, ymin, xmax, ymax)``;
+* the transmission angle at least ``min_transmission`` (radians) from a toggle (0 or pi) over the turn,
+  when asked (its extremes over a full turn are at crank angles 0 and pi, exact).
 
 The search: ``n_sample`` random candidates (uniform in the bounds; the
 "atlas" stage, cheap because it is one kernel call), the best of them seed
@@ -65,6 +67,8 @@ class Constraints:
     full_turn: bool = True
     max_ratio: float = 10.0
     region: tuple[float, float, float, float] | None = None
+    #: radians; 0 (the default) asks nothing
+    min_transmission: float = 0.0
 
 
 def violation(X: Array, cons: Constraints, scale: float, margin: float = GRASHOF_MARGIN) -> Array:
@@ -90,6 +94,13 @@ def violation(X: Array, cons: Constraints, scale: float, margin: float = GRASHOF
         o4x, o4y = ox + r1 * np.cos(X[:, 8]), oy + r1 * np.sin(X[:, 8])
         for px, py in ((ox, oy), (o4x, o4y)):
             v += np.maximum(0.0, x0 - px) + np.maximum(0.0, px - x1) + np.maximum(0.0, y0 - py) + np.maximum(0.0, py - y1)
+    if cons.min_transmission > 0:
+        # cos of the transmission angle at the shortest and longest diagonal B-O4 (crank angles 0 and pi)
+        cos_lim = np.cos(cons.min_transmission)
+        r3, r4 = X[:, 2], X[:, 3]
+        for diag in (np.abs(r1 - r2), r1 + r2):
+            cmu = (r3 * r3 + r4 * r4 - diag * diag) / np.maximum(2 * r3 * r4, 1e-300)
+            v += np.maximum(0.0, np.abs(cmu) - cos_lim) * scale
     return v / scale
 
 

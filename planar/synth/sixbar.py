@@ -35,7 +35,7 @@ from planar.errors import InputError
 from planar.synth.designs import Checked
 from planar.synth.kernel import coupler_points
 from planar.synth.path import DEFAULT_TOLERANCE, normalised
-from planar.synth.search import GRASHOF_MARGIN, Constraints, violation
+from planar.synth.search import GRASHOF_MARGIN, Constraints, in_order, violation
 from planar.synth.targets import normalisation
 
 __all__ = ["TOPOLOGIES", "SixBarDesign", "sixbar_points", "synthesise_sixbar"]
@@ -242,13 +242,17 @@ class SixBarDesign(Checked):
         }
 
 
-def _refine(obj: _Objective, row: Array, lo: Array, hi: Array, max_nfev: int) -> tuple[Array, Array, float]:
+def _refine(
+    obj: _Objective, row: Array, lo: Array, hi: Array, max_nfev: int, theta0: Array | None = None
+) -> tuple[Array, Array, float]:
     from scipy.optimize import least_squares
 
     timed = obj.theta is not None
     n = len(obj.targets)
     if timed:
         th0 = np.asarray(obj.theta)
+    elif theta0 is not None:
+        th0 = np.asarray(theta0, float)
     else:
         turn = np.linspace(0, 2 * np.pi, 720, endpoint=False)
         x, y, _ = sixbar_points(row[None], turn, obj.topology)
@@ -298,27 +302,56 @@ def _refine(obj: _Objective, row: Array, lo: Array, hi: Array, max_nfev: int) ->
     return out, np.asarray(th, float), e
 
 
-def _fourbar_seed(t: Array, th: Array | None, cons: Constraints, seed: int) -> Array | None:
-    """A Stephenson six-bar tracing the best four-bar's coupler curve: the tracer at ``E`` (the coupler
-    point) and a dyad that closes over the whole turn (``O6`` beside the curve, ``l6`` its mean distance,
-    ``l5`` a margin more than half its spread), so the six-bar search starts no worse than a four-bar."""
-    from planar.synth.search import search_fourbar
+def _fourbar_seed(
+    t: Array,
+    th: Array | None,
+    cons: Constraints,
+    seed: int,
+    budget: str,
+    atlas: Any,
+    ordered: bool,
+    tolerance: float,
+    lo: Array,
+    hi: Array,
+) -> tuple[Array, Array] | None:
+    """A Stephenson six-bar tracing the best four-bar's coupler curve, and its crank angles at the targets.
 
-    r = search_fourbar(t, th, cons, n_sample=20_000, maxiter=60, popsize=15, refine=2, seed=seed)
+    The four-bar is the one ``planar synth path`` finds (:func:`planar.synth.path.best_fourbar`: the atlas
+    and, when that is not within the tolerance, the global search); the tracer sits on ``E``, the coupler
+    point, so the six-bar's tracer path is the four-bar's.  The second dyad ``E - F - O6`` (``l5 = l6``,
+    at least 0.55 of ``O6``'s farthest distance from the curve: it closes over the whole turn with a margin)
+    is the one of a grid of ``O6`` in the bounds and lengths that breaks the constraints least.  None when
+    the four-bar breaks them or cannot close over the turn."""
+    from planar.synth.path import best_fourbar
+
+    r = best_fourbar(t, th, cons, budget, seed, atlas, ordered, tolerance)
     if not r.feasible:
         return None
-    turn = np.linspace(0, 2 * np.pi, 360, endpoint=False)
+    turn = np.linspace(0, 2 * np.pi, 720, endpoint=False)
     x, y, ok = coupler_points(r.params[None], turn, np.array([float(r.circuit)]))
     if not ok.all():
         return None
     L = float(max(np.hypot(*np.ptp(t, axis=0)), 1e-9))
-    o6 = np.array([x.mean(), y.mean() - 0.5 * np.ptp(y) - 0.5 * L])
-    dist = np.hypot(x[0] - o6[0], y[0] - o6[1])
-    l6 = float(dist.mean())
-    l5 = float(0.6 * np.ptp(dist) + 0.1 * L)
-    if max(l5, l6) > 4 * L:  # outside the search bounds: no seed
+    gx, gy = np.meshgrid(np.linspace(lo[9], hi[9], 17), np.linspace(lo[10], hi[10], 17))
+    o6 = np.column_stack([gx.ravel(), gy.ravel()])
+    dist = np.hypot(x[0][None, :] - o6[:, :1], y[0][None, :] - o6[:, 1:])
+    keep = dist.min(1) > 0.05 * L  # E never passes through O6 (the dyad's direction would be undefined)
+    rows = []
+    for k in (0.55, 0.75, 1.0, 1.5):
+        ln = np.clip(k * dist.max(1)[keep], lo[11], hi[11])
+        n = len(ln)
+        rows.append(
+            np.column_stack(
+                [np.broadcast_to(r.params, (n, 9)), o6[keep], ln, ln, np.zeros((n, 2)), np.full(n, float(r.circuit)), np.ones(n)]
+            )
+        )
+    if not rows or not sum(len(v) for v in rows):
         return None
-    return np.concatenate([r.params, o6, [l5, l6, 0.0, 0.0, float(r.circuit), 1.0]])
+    X = np.vstack(rows)
+    _, _, m = sixbar_points(X, turn[::4], "stephenson")
+    v = _violation6(X, cons, L, 2 * GRASHOF_MARGIN, "stephenson") + np.maximum(0.0, 2 * DYAD_MARGIN - m).max(1)
+    best = int(np.lexsort((X[:, 11], v))[0])  # least violation, then the shortest dyad
+    return X[best], np.asarray(r.theta, float)
 
 
 def synthesise_sixbar(
@@ -329,10 +362,17 @@ def synthesise_sixbar(
     budget: str | tuple[int, int, int, int] = "normal",
     seed: int = 0,
     tolerance: float = DEFAULT_TOLERANCE,
+    atlas: Any = None,
+    ordered: bool = False,
 ) -> SixBarDesign:
     """A six-bar (``topology`` ``"stephenson"`` or ``"watt"``) whose tracer passes through ``targets``.
 
-    ``tolerance``: as :func:`planar.synth.path.synthesise_path`'s.
+    ``tolerance``, ``atlas``, ``ordered``: as :func:`planar.synth.path.synthesise_path`'s.  The Stephenson
+    search also starts from the four-bar :func:`planar.synth.path.synthesise_path` would find (the tracer
+    on its coupler point, a dyad that always closes), kept unrefined among the candidates: the result is
+    never further from the targets (largest distance) than that four-bar when the dyad keeps the
+    constraints.  Of all candidates the one the check judges best is kept (constraints, order, largest
+    distance), not the smallest sum of squares.
     ``budget``: ``"quick"``, ``"normal"``, ``"thorough"`` or ``(random samples, DE generations, DE
     population per variable, refinement starts)``.
     """
@@ -392,33 +432,53 @@ def synthesise_sixbar(
         recombination=0.9,
     )
     pool = np.vstack([de.x[None], de.population[np.argsort(de.population_energies)], X[order[: 4 * refine]]])
-    if topology == "stephenson":
-        seed_row = _fourbar_seed(t, th, cons, seed)
-        if seed_row is not None:
-            pool = np.vstack([seed_row[None], pool])
     pool = np.clip(pool, lo, hi)
-    starts: list[Array] = []
+    starts: list[tuple[Array, Array | None]] = []
     for row in pool:
-        if all(np.linalg.norm((row - s) / (hi - lo)) > 0.05 for s in starts):
-            starts.append(row)
+        if all(np.linalg.norm((row - s) / (hi - lo)) > 0.05 for s, _ in starts):
+            starts.append((row, None))
         if len(starts) >= refine:
             break
-    best: tuple[float, Array, Array] | None = None
-    for row in starts:
-        r, tt, e = _refine(obj, row, lo, hi, max_nfev=40 * (N6 + (0 if th is not None else len(t))))
-        if not _closes(r, topology):
-            e += obj.penalty
-        if best is None or e < best[0]:
-            best = (e, r, tt)
-    assert best is not None
-    p = best[1].copy()
+    done: list[tuple[Array, Array]] = []
+    if topology == "stephenson":
+        seeded = _fourbar_seed(t, th, cons, seed, _named(budget), atlas, ordered, tolerance, lo, hi)
+        if seeded is not None:
+            row, tt = seeded
+            row[8] = (row[8] + np.pi) % (2 * np.pi) - np.pi  # the ground line's angle inside the bounds
+            lo, hi = np.minimum(lo, row), np.maximum(hi, row)  # the four-bar's lengths kept, even beyond the bounds
+            done.append((row, th if th is not None else tt))  # the four-bar's own curve, unrefined
+            starts.insert(0, (row, tt))
+    for row, t_start in starts:
+        r, rt, _ = _refine(obj, row, lo, hi, 40 * (N6 + (0 if th is not None else len(t))), None if th is not None else t_start)
+        done.append((r, rt))
+    best = _best_of(obj, done, topology, ordered)
+    p = best[0].copy()
     p[:6] *= s0
     p[6:8] = p[6:8] * s0 + c0
     p[9:11] = p[9:11] * s0 + c0
     p[11:15] *= s0
-    d = SixBarDesign(topology, p, best[2], tw, th is not None, float("nan"), time.perf_counter() - t0)
-    check_sixbar(d, cons_w, float(max(np.hypot(*np.ptp(tw, axis=0)), 1e-300)), tolerance)
+    d = SixBarDesign(topology, p, best[1], tw, th is not None, float("nan"), time.perf_counter() - t0)
+    check_sixbar(d, cons_w, float(max(np.hypot(*np.ptp(tw, axis=0)), 1e-300)), tolerance, ordered)
     return d
+
+
+def _named(budget: str | tuple[int, int, int, int]) -> str:
+    """The four-bar search's budget for a six-bar ``budget`` (a tuple of effort figures: ``"quick"``)."""
+    return budget if isinstance(budget, str) else "quick"
+
+
+def _best_of(obj: _Objective, done: list[tuple[Array, Array]], topology: str, ordered: bool) -> tuple[Array, Array]:
+    """The candidate ``(row, theta)`` the check judges best: keeping the constraints and closing over the turn
+    first, then (``ordered``) passing the targets in order, then the smallest largest distance to a target."""
+
+    def key(c: tuple[Array, Array]) -> tuple[bool, bool, float]:
+        row, tt = c
+        x, y, m = sixbar_points(row[None], tt, topology)
+        far = float(np.max(np.hypot(x[0] - obj.targets[:, 0], y[0] - obj.targets[:, 1]))) if (m > 0).all() else np.inf
+        bad = _violation6(row[None], obj.cons, obj.scale, 0.0, topology)[0] > 0 or not _closes(row, topology)
+        return bool(bad), bool(ordered and not in_order(tt)), far
+
+    return min(done, key=key)
 
 
 def _closes(row: Array, topology: str, n: int = 720) -> bool:
@@ -439,8 +499,14 @@ def invalid_ranges(bad: NDArray[np.bool_], turn: Array) -> list[tuple[float, flo
     return [(float(turn[a]), float(turn[b])) for a, b in zip(starts, ends)]
 
 
-def check_sixbar(d: SixBarDesign, cons: Constraints, scale: float, tolerance: float = DEFAULT_TOLERANCE) -> None:
+def check_sixbar(
+    d: SixBarDesign, cons: Constraints, scale: float, tolerance: float = DEFAULT_TOLERANCE, ordered: bool = False
+) -> None:
     """sse and checks from planar's solver: the whole turn valid and on the search's branches.
+
+    ``worst_target`` (1-based) is the target farthest from the tracer; ``in_order`` whether the crank angles
+    at the targets run one way round within one turn (the tracer passes them in one sweep), a check
+    (``ok_order``) with ``ordered``.
 
     Where the linkage cannot be assembled is found on 36,000 driver angles (the kernel, as the search's
     dyad margin) and 360 (planar's solver); ``failures`` names the driver ranges.
@@ -486,5 +552,9 @@ def check_sixbar(d: SixBarDesign, cons: Constraints, scale: float, tolerance: fl
         "tolerance": tolerance,
         "max_target_distance": float(np.max(np.hypot(*(pts - d.targets).T))) if at.valid.all() else float("inf"),
     }
+    d.checks["worst_target"] = int(np.argmax(np.hypot(*(pts - d.targets).T))) + 1 if at.valid.all() else 0
     d.checks["max_error"] = d.checks["max_target_distance"] / size
     d.checks["ok_accuracy"] = bool(d.checks["max_error"] <= tolerance)
+    d.checks["in_order"] = in_order(d.theta)
+    if ordered:
+        d.checks["ok_order"] = d.checks["in_order"]

@@ -105,3 +105,46 @@ def test_option_case(tmp_path: Path, command: str, option: str, value: str) -> N
     if rc == 2:
         assert len(msg.splitlines()) == 1 and msg.startswith("planar: error: "), msg
         assert {p.name for p in tmp_path.iterdir()} == before, f"{argv} wrote on a refusal"
+
+
+def _unreachable_inputs(tmp: Path) -> None:
+    side = [i / 3 for i in range(3)]
+    square = [(s, 0.0) for s in side] + [(1.0, s) for s in side] + [(1 - s, 1.0) for s in side] + [(0.0, 1 - s) for s in side]
+    (tmp / "square.csv").write_text("x,y\n" + "".join(f"{x!r},{y!r}\n" for x, y in square))
+    (tmp / "eight.svg").write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="200" height="100"><path d="M 100 50 C 130 10, 190 10, '
+        '190 50 C 190 90, 130 90, 100 50 C 70 10, 10 10, 10 50 C 10 90, 70 90, 100 50 Z"/></svg>'
+    )
+    (tmp / "pairs.csv").write_text("input,output\n10,60\n40,75\n70,95\n100,110\n")
+    (tmp / "poses.csv").write_text("x,y,angle\n0,0,0\n1,0.2,40\n1.5,1,-30\n0.3,1.4,80\n-0.5,0.6,10\n")
+
+
+#: every synth type on targets it cannot meet: exit 3 with the reason, never an internal error
+UNREACHABLE = {
+    "fourbar square": ["synth", "path", "{tmp}/square.csv", "--budget", "quick"],
+    "fourbar eight": ["synth", "path", "{tmp}/eight.svg", "--points", "15", "--budget", "quick", "--tolerance", "0.01"],
+    "stephenson eight": ["synth", "path", "{tmp}/eight.svg", "--points", "25", "--type", "sixbar", "--budget", "quick"],
+    "watt square": ["synth", "path", "{tmp}/square.csv", "--type", "sixbar", "--topology", "watt", "--budget", "quick"],
+    "function": ["synth", "function", "{tmp}/pairs.csv", "--deg"],
+    "motion": ["synth", "motion", "{tmp}/poses.csv", "--deg"],
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", list(UNREACHABLE))
+def test_unreachable_targets_exit_3_with_the_reason(tmp_path: Path, case: str, monkeypatch, tmp_path_factory) -> None:
+    import json
+
+    monkeypatch.setenv("PLANAR_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "atlas-cache"))  # not the user's
+    _unreachable_inputs(tmp_path)
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in UNREACHABLE[case]] + ["-o", str(tmp_path / "out.toml")]
+    for extra in ([], ["--json"]):
+        out, err = io.StringIO(), io.StringIO()
+        with redirect_stdout(out), redirect_stderr(err):
+            rc = main(argv + extra)
+        assert rc == 3, f"{argv + extra}: exit {rc}: {err.getvalue()}"
+        if extra:
+            rep = json.loads(out.getvalue())
+            assert rep["ok"] is False and isinstance(rep.get("reason"), str) and rep["reason"], rep
+        else:
+            assert "check failed" in out.getvalue(), out.getvalue()

@@ -142,7 +142,12 @@ def test_min_transmission_checked_like_function(tmp_path, capsys):
     own = min(margins)  # the design's circuit is one of the two; both circuits have the same |mu| here
     assert abs(d.checks["min_transmission_deg"] - own) < 0.05
     out = tmp_path / "m.toml"
-    rc = main(["synth", "motion", str(path), "-o", str(out), "--min-transmission", f"{own + 0.5:.4f}"])
+    # --min-transmission selects: asked for more than this design has, another four-bar through the poses
+    # that keeps it is chosen, or, when none does, the nearest is written and fails its check
+    rc = main(["synth", "motion", str(path), "-o", str(out), "--min-transmission", f"{own + 0.5:.4f}", "--json"])
+    rep = json.loads(capsys.readouterr().out)
+    assert (rc == 0 and rep["checks"]["min_transmission_deg"] >= own + 0.5) or (rc == 3 and not rep["checks"]["ok_transmission"])
+    rc = main(["synth", "motion", str(path), "-o", str(out), "--min-transmission", "89"])
     err = capsys.readouterr()
     assert rc == 3 and "check failed: transmission angle" in err.err + err.out and "crank angle" in err.err + err.out
     rc = main(["synth", "motion", str(path), "-o", str(out), "--min-transmission", f"{own - 0.5:.4f}", "--json"])

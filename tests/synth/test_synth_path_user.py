@@ -113,7 +113,7 @@ def test_far_off_says_plainly_no_four_bar_and_why_near_miss_does_not():
     near = _path_failing(_fake(0.0011))
     assert len(near) == 1 and "no four-bar" not in near[0]
     far = _path_failing(_fake(0.2))
-    assert len(far) == 2 and far[1].startswith("no four-bar traces this curve within --tolerance 0.001")
+    assert len(far) == 2 and far[1].startswith("no four-bar found traces this curve within --tolerance 0.001")
     assert "0.2 of the targets' size off at target 3" in far[1] and "90 deg at target" in far[1] and "corner" in far[1]
 
 
@@ -143,7 +143,7 @@ def test_unreachable_square_stages_and_found_by(tmp_path, capsys):
     src = _csv(tmp_path / "sq.csv", 60 * sq)
     rc = main(["synth", "path", str(src), "-o", str(tmp_path / "s.toml"), "--atlas", str(f), "--budget", "quick"])
     out = capsys.readouterr().out
-    assert rc == 3 and "no four-bar traces this curve" in out and "corner" in out and "found by" in out
+    assert rc == 3 and "no four-bar found traces this curve" in out and "corner" in out and "found by" in out
     main(["synth", "path", str(src), "-o", str(tmp_path / "s.toml"), "--atlas", str(f), "--budget", "quick", "--json"])
     rep = json.loads(capsys.readouterr().out)
     st = rep["checks"]["stages_s"]
