@@ -8,8 +8,8 @@ its driven part, the ``motor``, ``motor screw`` and ``mounting screw`` rows thei
 per tab-and-slot joint (``planar.fabrication.tabs``): its letter, the number of tabs,
 a tab's ``width x length``, ``piece -> xy piece`` and which slots they go into.  Layers and
 sheets count from 1; ``size_mm`` is the part's bounding box as laid out, a pin's
-``d x length``, a spacer's ``ID x OD x thickness``.  Fixed formatting, rows
-in mechanism order: the same input gives the same bytes.
+``d x length``, a spacer's ``ID x OD x thickness`` (its ``layer`` the layers its rings fill, each ring
+named).  Fixed formatting, rows in mechanism order: the same input gives the same bytes.
 """
 
 from __future__ import annotations
@@ -102,16 +102,20 @@ def bom_text(fab: Any) -> str:
                 if p.name.startswith(f"spacer {pp.letter}") and p.name[len(f"spacer {pp.letter}") :].isdigit()
             ]
             od = 2 * max((c.radius for c in [p.outer for p in sp] if hasattr(c, "radius")), default=0.0) - s.kerf
+            own = {asm.layers.get(p) for p in pp.parts}
+            free = [k + 1 for k in range(lo, hi + 1) if k not in own]
             w.writerow(
                 [
                     "spacer",
                     pp.letter,
                     pp.spacers,
-                    "",
+                    ", ".join(str(k) for k in free),
                     "+".join(str(p.sheet + 1) for p in sp),
                     f"{ri:g} x {od:g} x {s.thickness_mm:g}",
                     joins,
-                    "cut from the sheet; on the pin between its layers",
+                    f"cut from the sheet; on pin {pp.letter} (layers {lo + 1}-{hi + 1}) filling layer"
+                    f"{'s' if len(free) > 1 else ''} {_and(free)}: "
+                    + ", ".join(f"spacer {pp.letter}{j + 1} on layer {k}" for j, k in enumerate(free)),
                 ]
             )
     for jn in getattr(fab, "joins", []):  # tab-and-slot joints of pieces standing perpendicular (planar.fabrication.tabs)
@@ -147,6 +151,12 @@ def bom_text(fab: Any) -> str:
     _fixing_rows(w, fab)
     _buy_rows(w, fab)
     return buf.getvalue()
+
+
+def _and(xs: list[int]) -> str:
+    """``1``, ``1 and 2``, ``1, 2 and 3``."""
+    words = [str(x) for x in xs]
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
 
 
 def _plates(fab: Any) -> list[str]:
@@ -187,7 +197,8 @@ def _fixing_rows(w: Any, fab: Any) -> None:
                 "",
                 screw.size,
                 "",
-                f"{screw.item} + {washer.item} + {nut.item}, two per ground plate ({s.mounting_hole_mm:g} mm holes); "
+                f"{screw.item} + {washer.qty // screw.qty} {washer.item} + {nut.item} each, two per ground plate "
+                f"({s.mounting_hole_mm:g} mm holes); "
                 f"long enough for a {s.thickness_mm:g} mm base board under the plate (a thicker base: a longer screw)",
             ]
         )
