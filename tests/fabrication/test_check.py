@@ -143,3 +143,24 @@ def test_export_of_a_clean_scene_exits_0(tmp_path):
     )
     assert res.returncode == 0, res.stdout
     assert "build check: every part" in res.stdout
+
+
+def test_the_check_stacks_each_end_as_its_tiers_beyond_the_faces():
+    """A screw through layers 2-4 (3 mm each, 9 mm): the check's end bodies are the head (2.15 mm below the stack,
+    7 mm across), then above it the washers and nut to 6 mm (7 mm across) and the thread to the tip, 16 - 0.5 - 9 =
+    6.5 mm (3 mm across): the hand sums, as z-ranges."""
+    from types import SimpleNamespace
+
+    from planar.fabrication.check import pin_bodies
+    from planar.fabrication.parts import FabSettings
+
+    s = FabSettings(thickness_mm=3.0, pin_mm=3.0, hardware="screw")
+    spec = SimpleNamespace(parts=("a", "b"), at=((0.0, 0.0), (0.0, 0.0)))
+    pp = SimpleNamespace(letter="B", spec=spec, layers=(1, 3), shaft=False, diameter_mm=3.0, parts=("a", "b"))
+    poses = {"a": np.zeros((4, 3))}
+    ends = [(b.z0, b.z1, 2 * b.radius) for b in pin_bodies(pp, poses, s, {1, 3}) if b.kind == "end"]
+    assert ends == [
+        pytest.approx((3.0 - 2.15, 3.0, 7.0)),
+        pytest.approx((12.0, 12.0 + 6.0, 7.0)),
+        pytest.approx((18.0, 12.0 + 6.5, 3.0)),
+    ]
