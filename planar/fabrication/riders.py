@@ -4,7 +4,11 @@ A scene's ``[[mechanism.polygons]]`` entry with ``cut = "part"`` becomes a *ride
 polygon, its outline the polygon (the host part's own frame, so it moves exactly as its host), fixed to its host
 by two pins.  The pins stand where both pieces have room for a pin hole with ``min_wall_mm`` all round (the
 polygon and the host's cut material, each shrunk by a hole's radius plus the wall), as far apart as that room
-allows, so the two pins hold the rider against turning.  Each pin is a :class:`~planar.core.model.Pivot` between
+allows, so the two pins hold the rider against turning; they keep an end's width (washer and clip, or nut) from
+each other and from the host's own pins under the rider, so their ends clear.  A rounded host (a hull of
+circles) too narrow for them grows round them, as it grows round any hole (the part's note says so).  A host's
+pin under the rider goes on through it (one pin through host, rider and the host's other part), so no layer
+order puts the rider between that pin's ends without a hole.  Each pin is a :class:`~planar.core.model.Pivot` between
 host and rider with a pin hole in both: the layer planner puts the rider on a layer of its own (its area overlaps
 its host's), the BOM, ``plan.json`` and the assembly steps list its pins like any other, and the build check
 moves it with its host and checks it against every part on its layer.
