@@ -10,8 +10,8 @@ a ``sheet`` row first (how many sheets, their size and thickness), and the
 per tab-and-slot joint (``planar.fabrication.tabs``): its letter, the number of tabs,
 a tab's ``width x length``, ``piece -> xy piece`` and which slots they go into.  Layers and
 sheets count from 1; ``size_mm`` is the part's bounding box as laid out, a pin's
-``d x length``, a spacer's ``ID x OD x thickness``.  Fixed formatting, rows
-in mechanism order: the same input gives the same bytes.
+``d x length``, a spacer's ``ID x OD x thickness`` (its ``layer`` the layers its rings fill, each ring
+named).  Fixed formatting, rows in mechanism order: the same input gives the same bytes.
 """
 
 from __future__ import annotations
@@ -108,16 +108,20 @@ def bom_text(fab: Any) -> str:
                 if p.name.startswith(f"spacer {pp.letter}") and p.name[len(f"spacer {pp.letter}") :].isdigit()
             ]
             od = 2 * max((c.radius for c in [p.outer for p in sp] if hasattr(c, "radius")), default=0.0) - s.kerf
+            own = {asm.layers.get(p) for p in pp.parts}
+            free = [k + 1 for k in range(lo, hi + 1) if k not in own]
             w.writerow(
                 [
                     "spacer",
                     pp.letter,
                     pp.spacers,
-                    "",
+                    ", ".join(str(k) for k in free),
                     "+".join(str(p.sheet + 1) for p in sp),
                     f"{ri:g} x {od:g} x {s.thickness_mm:g}",
                     joins,
-                    "cut from the sheet; on the pin between its layers",
+                    f"cut from the sheet; on pin {pp.letter} (layers {lo + 1}-{hi + 1}) filling layer"
+                    f"{'s' if len(free) > 1 else ''} {_and(free)}: "
+                    + ", ".join(f"spacer {pp.letter}{j + 1} on layer {k}" for j, k in enumerate(free)),
                 ]
             )
     for jn in getattr(fab, "joins", []):  # tab-and-slot joints of pieces standing perpendicular (planar.fabrication.tabs)
@@ -172,6 +176,12 @@ def _sheet_row(w: Any, fab: Any) -> None:
             f"from it (kerf {lay.kerf:g} mm)",
         ]
     )
+
+
+def _and(xs: list[int]) -> str:
+    """``1``, ``1 and 2``, ``1, 2 and 3``."""
+    words = [str(x) for x in xs]
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
 
 
 def _plates(fab: Any) -> list[str]:

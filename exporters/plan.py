@@ -47,11 +47,19 @@ def _parts(fab: Any) -> list[dict[str, Any]]:
 
 
 def _pin(fab: Any, pp: Any) -> dict[str, Any]:
-    from planar.fabrication.hardware import driven_part, pin_ends, pin_items, shaft_items, shaft_length, shaft_retention
+    from planar.fabrication.hardware import (
+        driven_part,
+        end_height,
+        pin_ends,
+        pin_items,
+        shaft_items,
+        shaft_length,
+        shaft_retention,
+    )
 
     s = fab.settings
     lo, hi = pp.layers or (0, 0)
-    (hb, db), (ht, dt) = pin_ends(s, pp)
+    lower, upper = pin_ends(s, pp)
     d = {
         "name": pp.letter,
         "joints": list(pp.joints),
@@ -60,8 +68,8 @@ def _pin(fab: Any, pp: Any) -> dict[str, Any]:
         "layers": [lo + 1, hi + 1],
         "length_mm": _r(shaft_length(s, pp) if pp.shaft else pp.length_mm),
         "diameter_mm": _r(s.shaft_mm if pp.shaft else pp.diameter_mm),
-        "head_mm": _r(max(hb, ht)),
-        "ends": {"lower": {"height_mm": _r(hb), "diameter_mm": _r(db)}, "upper": {"height_mm": _r(ht), "diameter_mm": _r(dt)}},
+        "head_mm": _r(max(end_height(lower), end_height(upper))),
+        "ends": {"lower": _end(lower), "upper": _end(upper)},
         "anchor": {"part": pp.spec.parts[0], "at_mm": [_r(pp.spec.at[0][0] * s.unit_mm), _r(pp.spec.at[0][1] * s.unit_mm)]},
     }
     if pp.shaft:
@@ -70,6 +78,18 @@ def _pin(fab: Any, pp: Any) -> dict[str, Any]:
     items = shaft_items(s, pp) if pp.shaft else pin_items(s, pp)
     d["hardware"] = [{"item": i.item, "size": i.size, "qty": i.qty} for i in items]
     return d
+
+
+def _end(end: Any) -> dict[str, Any]:
+    """One end of a pin: how far it stands beyond the stack, its widest diameter, and its tiers (from the face
+    outwards, each a round body out to its height: a washer and nut or clip, then the thread or rod)."""
+    from planar.fabrication.hardware import end_height
+
+    return {
+        "height_mm": _r(end_height(end)),
+        "diameter_mm": _r(max((tr.diameter for tr in end), default=0.0)),
+        "tiers": [{"height_mm": _r(tr.height), "diameter_mm": _r(tr.diameter)} for tr in end],
+    }
 
 
 def _spacers(fab: Any) -> list[dict[str, Any]]:

@@ -70,6 +70,36 @@ def _shaft_pin(mech: Mechanism, pins) -> Any:
     return None
 
 
+def _with_riders(scene: Any, mech: Any, s: FabSettings) -> Any:
+    """``mech`` with the scene's ``cut = "part"`` polygons as parts pinned to their hosts
+    (:mod:`planar.fabrication.riders`); the pins' room is the host's material as cut without them."""
+    from planar.fabrication.riders import rider_polygons, with_riders
+
+    if not rider_polygons(scene, mech):
+        return mech
+    keyed: dict[str, float] = dict(getattr(mech, "keyed", {}))
+    pins, _ = joint_pins(mech)
+    pinned = pin_features(mech)
+    shaft = _shaft_pin(mech, pins)
+
+    def material(name: str) -> Any:
+        part = mech.part(name)
+        drive_at, motor_at, flat = _shaft_holes(name, shaft, mech.driver.part, keyed)
+        pc = part_cuts(
+            part,
+            s,
+            1,
+            {i for (pn, i) in pinned if pn == name},
+            drive_at,
+            motor_at,
+            mounting=part.ground and part.plane == "xy",
+            drive_flat=flat,
+        )
+        return nominal_material(pc.outer, pc.inner)
+
+    return with_riders(scene, mech, material, s)
+
+
 def _fab_mechanism(mech: Mechanism) -> Any:
     """The mechanism whose parts are cut: a wind-up toy is cut as its assembly (merged parts, one frame,
     cams keyed to the shaft; :mod:`planar.toys.assembly`), anything else as it is; pieces standing
@@ -130,8 +160,8 @@ def _cut_polygons(scene: Any, mech: Mechanism, s: FabSettings) -> dict[str, list
     names = {p.name for p in mech.parts}
     out: dict[str, list[Any]] = {}
     for i, poly in enumerate(getattr(getattr(scene.spec, "mechanism", None), "polygons", []) or []):
-        if not getattr(poly, "cut", False):
-            continue
+        if getattr(poly, "cut", False) is not True:
+            continue  # drawn only, or cut as a part of its own (planar.fabrication.riders)
         if poly.part not in names:
             raise InputError(f"mechanism.polygons[{i}].part", poly.part, "a part that is cut (" + ", ".join(sorted(names)) + ")")
         out.setdefault(poly.part, []).append(Polygon([(x * s.unit_mm, y * s.unit_mm) for x, y in poly.points]).buffer(0))
@@ -177,8 +207,15 @@ def _unplannable_tabs(layers: dict[str, int | None], used: dict[str, int | None]
     )
 
 
-def _hole_letters(mech: Mechanism, pins: list[Any], shaft: Any) -> dict[str, list[tuple[tuple[float, float], str]]]:
-    """Each part's hole letters: ``(hole centre, letter)``, a pin's letter once beside each hole it goes through."""
+def _hole_letters(
+    mech: Mechanism, pins: list[Any], shaft: Any, keyed: dict[str, float] | None = None
+) -> dict[str, list[tuple[tuple[float, float], str]]]:
+    """Each part's hole letters: ``(hole centre, letter)``, a pin's letter once beside each hole it goes through.
+
+    The motor shaft's holes (the driven part's D, the plate's clearance hole) carry the shaft's letter too, as
+    does every cam keyed to the shaft (``keyed``: a toy's cams, their D at their origin), so a maker finds where
+    the shaft goes; the BOM's and plan's motor shaft row has the same letter.
+    """
     letters: dict[str, list[tuple[tuple[float, float], str]]] = {p.name: [] for p in mech.parts}
     for k, stack in enumerate(pin_stacks(pins)):
         marked: set[tuple[str, tuple[float, float]]] = set()
@@ -186,9 +223,14 @@ def _hole_letters(mech: Mechanism, pins: list[Any], shaft: Any) -> dict[str, lis
             pin = pins[i]
             for side in (0, 1):
                 key = (pin.parts[side], pin.at[side])
-                if pin.kinds[side] == "hole" and pin is not shaft and key not in marked:
+                if pin.kinds[side] == "hole" and key not in marked:
                     marked.add(key)
                     letters[pin.parts[side]].append((pin.at[side], letter(k)))
+            if pin is shaft:
+                for name in keyed or {}:
+                    if name in letters and (name, (0.0, 0.0)) not in marked and name not in pin.parts:
+                        marked.add((name, (0.0, 0.0)))
+                        letters[name].append(((0.0, 0.0), letter(k)))
     return letters
 
 
@@ -255,7 +297,7 @@ def _build(scene: Any, settings: FabSettings) -> Fabrication:
         raise InputError("kerf", s.kerf, "a kerf between 0 and 2 mm")
     from planar.fabrication.tabs import merge_travel, plan_tabs, slot_features, travel_slots
 
-    mech = _fab_mechanism(scene.mechanism)
+    mech = _with_riders(scene, _fab_mechanism(scene.mechanism), s)
     keyed: dict[str, float] = dict(getattr(mech, "keyed", {}))
     pins, contacts = joint_pins(mech)
     pinned = pin_features(mech)
@@ -263,7 +305,7 @@ def _build(scene: Any, settings: FabSettings) -> Fabrication:
     notes: list[str] = list(getattr(mech, "design_notes", ()))  # what a mechanism reports of its own design
     notes += list(mech.notes)
     notes += _drive_notes(mech, shaft)
-    letters = _hole_letters(mech, pins, shaft)
+    letters = _hole_letters(mech, pins, shaft, keyed)
     merged = _cut_polygons(scene, mech, s)
 
     cut_cache: dict[Any, PartCut] = {}

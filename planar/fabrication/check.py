@@ -283,12 +283,9 @@ def pin_bodies(pp: Any, poses: dict[str, np.ndarray], s: Any, own_layers: set[in
     r = (s.shaft_mm if pp.shaft else pp.diameter_mm) / 2
     kind = "shaft" if pp.shaft else "pin"
     out = [BodyZ(name, _swept_discs(xy, r), z0, (hi + 1) * t, kind, tuple(pp.parts), xy, r)]
-    (hb, db), (ht, dt) = pin_ends(s, pp)
-    if hb > 0:
-        out.append(BodyZ(f"{name} lower end", _swept_discs(xy, db / 2), lo * t - hb, lo * t, "end", (name,), xy, db / 2))
-    if ht > 0:
-        top = (hi + 1) * t
-        out.append(BodyZ(f"{name} upper end", _swept_discs(xy, dt / 2), top, top + ht, "end", (name,), xy, dt / 2))
+    lower, upper = pin_ends(s, pp)
+    out += _end_bodies(f"{name} lower end", lower, xy, lo * t, -1.0, name)
+    out += _end_bodies(f"{name} upper end", upper, xy, (hi + 1) * t, 1.0, name)
     ro = spacer_radius(s)
     for layer in range(lo, hi + 1):
         if layer not in own_layers:
@@ -304,6 +301,21 @@ def pin_bodies(pp: Any, poses: dict[str, np.ndarray], s: Any, own_layers: set[in
                     ro,
                 )
             )
+    return out
+
+
+def _end_bodies(name: str, end: Any, xy: np.ndarray, face: float, side: float, pin: str) -> list[BodyZ]:
+    """A pin's end as bodies of the check: each tier (:class:`~planar.fabrication.hardware.Tier`) a disc swept
+    between samples, from the tier before it (or the stack's ``face``, mm) out to its height, on ``side`` (-1
+    below the stack, +1 above).  Every tier is named as the end, so a strike reads ``pin B upper end``."""
+    out = []
+    z = 0.0
+    for tr in end:
+        if tr.height > z + 1e-9:
+            a, b = sorted((face + side * z, face + side * tr.height))
+            r = tr.diameter / 2
+            out.append(BodyZ(name, _swept_discs(xy, r), a, b, "end", (pin,), xy, r))
+            z = tr.height
     return out
 
 

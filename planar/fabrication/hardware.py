@@ -4,10 +4,19 @@ A pin is one of these kinds (``[fabrication] hardware``), sized from ``pin_diame
 
 * ``"rod-eclip"`` (the default): a steel rod (silver steel, drill rod) of the pin's diameter, cut to
   length, a DIN 125 washer and a DIN 6799 e-clip at each end (a groove for the clip near each end).
-  Each end stands a washer plus a clip above its layer (1.1 mm for 3 mm).
+  Each end stands a washer plus a clip above its layer (1.1 mm for 3 mm), and the rod 0.5 to 0.75 mm past the
+  clip (cut to 0.5 mm steps): 1.75 mm for 3 mm on 9 mm of layers (a 12.5 mm rod).
 * ``"screw"``: an ISO 7380 button-head screw, a DIN 125 washer under the head and under the nut,
-  and a DIN 985 nylon lock nut (the lock nut keeps the joint free without tightening it).  The nut's end
-  stands a washer, the nut and a thread past it above its layer (5.5 mm for M3).
+  and a DIN 985 nylon lock nut (the lock nut keeps the joint free without tightening it).  The head end stands
+  the head and a washer (2.15 mm for M3).  The length is the shortest sold one whose thread passes the whole nut
+  and at least one pitch (ISO 261 coarse: the chamfered end, ISO 4753, so full thread fills the nylon insert);
+  where a sold length leaves more, extra washers go under the nut until less than a pitch plus a washer stands
+  proud (1 to 2 pitches for M3).  The nut end stands ``length - washer - stack`` (the screw's tip): M3 x 16 on
+  9 mm of layers (14.5 mm needed, 16 sold) takes 3 more washers under the nut, the nut's top 6 mm above the
+  stack (4 washers 7 mm across and the nut) and the tip 6.5 mm: :func:`screw_fit` gives the numbers of any stack.
+
+Each end is a list of :class:`Tier` (round bodies stacked outwards from the stack's face, each to its height),
+which the build check (:mod:`planar.fabrication.check`) and ``plan.json`` use as they are.
 
 The motor shaft (an N20 gearmotor's D shaft: no groove for a clip) is held by its driven part: that part's D
 hole fits the shaft's flat (snug: the flat carries the torque) and a drop of glue (cyanoacrylate or epoxy) on the
@@ -39,12 +48,16 @@ __all__ = [
     "HARDWARE",
     "Item",
     "PinHardware",
+    "ScrewFit",
+    "Tier",
     "below_mm",
+    "end_height",
     "hardware_of",
     "mounting_items",
     "pin_closing",
     "pin_ends",
     "pin_items",
+    "screw_fit",
     "shaft_check",
     "shaft_items",
     "shaft_length",
@@ -67,6 +80,8 @@ ECLIP = {
 BUTTON = {2.0: (3.5, 1.1), 2.5: (4.7, 1.3), 3.0: (5.7, 1.65), 4.0: (7.6, 2.2), 5.0: (9.5, 2.75), 6.0: (10.5, 3.3)}
 #: DIN 985 nylon lock nut: (width across corners, height) mm
 NYLOC = {2.0: (4.4, 2.8), 2.5: (5.5, 3.5), 3.0: (6.0, 4.0), 4.0: (7.7, 5.0), 5.0: (8.8, 5.0), 6.0: (11.1, 6.0)}
+#: ISO 261 coarse thread pitch per nominal diameter (mm)
+PITCH = {2.0: 0.4, 2.5: 0.45, 3.0: 0.5, 4.0: 0.7, 5.0: 0.8, 6.0: 1.0}
 #: screw lengths sold (mm)
 SCREW_LENGTHS = (4, 5, 6, 8, 10, 12, 14, 16, 18, 20, 22, 25, 28, 30, 35, 40, 45, 50, 55, 60, 70, 80)
 
@@ -81,11 +96,29 @@ class Item:
 
 
 @dataclass(frozen=True)
+class Tier:
+    """A round body of a pin's end beyond the stack's face: from the tier below it (or the face) out to ``height``
+    mm from the face, ``diameter`` mm across (a washer and nut, a head, the thread or rod standing proud)."""
+
+    height: float
+    diameter: float
+
+
+#: one end of a pin: its tiers from the stack's face outwards (heights increasing); empty: nothing stands there
+End = tuple[Tier, ...]
+
+
+def end_height(end: End) -> float:
+    """How far an end stands beyond the stack's face (mm): its outermost tier's height (0 for none)."""
+    return max((tr.height for tr in end), default=0.0)
+
+
+@dataclass(frozen=True)
 class PinHardware:
-    """One kind of fastener: its two ends ``(height, diameter)`` mm beyond the stack, its length and items."""
+    """One kind of fastener: its two ends (tiers beyond the stack: ``ends(d, stack)``, mm), its length and items."""
 
     name: str
-    ends: Callable[[float], tuple[tuple[float, float], tuple[float, float]]]
+    ends: Callable[[float, float], tuple[End, End]]
     length: Callable[[float, float], float]
     items: Callable[[float, float], list[Item]]
     #: what closes the lower end, fitted first (e.g. ``"washer, e-clip"``)
@@ -106,17 +139,20 @@ def _size(d: float, table: dict[float, Any]) -> Any:
     raise InputError("fabrication.pin_diameter_mm", d, "a diameter hardware is sold in: " + ", ".join(f"{k:g}" for k in table))
 
 
-def _rod_ends(d: float) -> tuple[tuple[float, float], tuple[float, float]]:
+def _rod_ends(d: float, stack: float) -> tuple[End, End]:
+    """Each end: a washer and an e-clip against the face, then the rod past the clip to half the rod's spare length."""
     wd, wt = _size(d, WASHER)
     _, cd, ct = _size(d, ECLIP)
-    end = (wt + ct, max(wd, cd))
+    proud = (_rod_length(d, stack) - stack) / 2
+    end = (Tier(wt + ct, max(wd, cd)), Tier(proud, d))
     return end, end
 
 
 def _rod_length(d: float, stack: float) -> float:
     """Rod length (mm): the stack, a washer and a clip each end and 0.5 mm past each groove, up to 0.5 mm."""
-    (h, _), _ = _rod_ends(d)
-    return math.ceil((stack + 2 * (h + 0.5)) * 2 - 1e-9) / 2
+    _, wt = _size(d, WASHER)
+    _, _, ct = _size(d, ECLIP)
+    return math.ceil((stack + 2 * (wt + ct + 0.5)) * 2 - 1e-9) / 2
 
 
 def _rod_items(d: float, stack: float) -> list[Item]:
@@ -133,29 +169,64 @@ def _rod_items(d: float, stack: float) -> list[Item]:
     ]
 
 
-def _screw_ends(d: float) -> tuple[tuple[float, float], tuple[float, float]]:
-    wd, wt = _size(d, WASHER)
-    hd, hh = _size(d, BUTTON)
+@dataclass(frozen=True)
+class ScrewFit:
+    """How a screw sits on a stack (mm): its sold ``length`` under the head, the ``washers`` under its nut (one,
+    plus any taking up a sold length's spare), the nut's top and the screw's tip above the stack's top face,
+    and the thread standing ``proud`` of the nut (at least a pitch, less than a pitch plus a washer)."""
+
+    length: float
+    washers: int
+    nut_top: float
+    tip: float
+    proud: float
+    head: float
+
+
+def screw_fit(d: float, stack: float) -> ScrewFit:
+    """The screw an M``d`` joint through ``stack`` mm of layers takes, and where its ends stand.
+
+    Head side: a washer and the ISO 7380 head (``head`` mm below the stack).  Nut side: the shortest sold length
+    that passes both washers, the DIN 985 nut and one ISO 261 pitch (the chamfered end: the full thread then
+    fills the nut's nylon insert); extra DIN 125 washers under the nut take up what the sold length leaves beyond
+    that, so the thread stands between one pitch and a pitch plus a washer proud of the nut.  ``tip`` =
+    ``length - washer - stack``: the screw's end above the stack's top face (6.5 mm for M3 x 16 on 9 mm).
+    """
+    _, wt = _size(d, WASHER)
+    _, hh = _size(d, BUTTON)
     _, nh = _size(d, NYLOC)
-    return (hh + wt, max(wd, hd)), (wt + nh + 1.0, wd)
+    p = _size(d, PITCH)
+    need = stack + 2 * wt + nh + p
+    length = next((float(n) for n in SCREW_LENGTHS if n >= need - 1e-9), None)
+    if length is None:
+        raise InputError("fabrication.hardware", "screw", f"a stack under {SCREW_LENGTHS[-1] - 2 * wt - nh - p:g} mm")
+    extra = int(math.floor((length - need) / wt + 1e-9))
+    washers = 1 + extra
+    nut_top = washers * wt + nh
+    tip = length - wt - stack
+    return ScrewFit(length, washers, nut_top, tip, tip - nut_top, wt + hh)
+
+
+def _screw_ends(d: float, stack: float) -> tuple[End, End]:
+    """The head end (a washer and the head) and the nut end (washers and the nut, then the thread to its tip)."""
+    wd, _ = _size(d, WASHER)
+    hd, _ = _size(d, BUTTON)
+    ne, _ = _size(d, NYLOC)
+    fit = screw_fit(d, stack)
+    return (Tier(fit.head, max(wd, hd)),), (Tier(fit.nut_top, max(wd, ne)), Tier(fit.tip, d))
 
 
 def _screw_length(d: float, stack: float) -> float:
-    """Screw length sold (mm): under the head through the stack, both washers, the nut and a thread past it."""
-    _, wt = _size(d, WASHER)
-    _, nh = _size(d, NYLOC)
-    need = stack + 2 * wt + nh + 1.0
-    for n in SCREW_LENGTHS:
-        if n >= need - 1e-9:
-            return float(n)
-    raise InputError("fabrication.hardware", "screw", f"a stack under {SCREW_LENGTHS[-1] - 2 * wt - nh - 1:g} mm")
+    """Screw length sold (mm): :func:`screw_fit`'s."""
+    return screw_fit(d, stack).length
 
 
 def _screw_items(d: float, stack: float) -> list[Item]:
     wd, wt = _size(d, WASHER)
+    fit = screw_fit(d, stack)
     return [
-        Item("button head screw ISO 7380", f"M{d:g} x {_screw_length(d, stack):g}", 1),
-        Item("washer DIN 125", f"M{d:g} ({wd:g} x {wt:g} mm)", 2),
+        Item("button head screw ISO 7380", f"M{d:g} x {fit.length:g}", 1),
+        Item("washer DIN 125", f"M{d:g} ({wd:g} x {wt:g} mm)", 1 + fit.washers),
         Item("nylon lock nut DIN 985", f"M{d:g}", 1),
     ]
 
@@ -195,14 +266,14 @@ def hardware_of(settings: Any) -> PinHardware:
     return HARDWARE[name]
 
 
-def pin_ends(settings: Any, pin: Any) -> tuple[tuple[float, float], tuple[float, float]]:
-    """``((height, diameter) below, (height, diameter) above)`` mm of a pin's ends beyond its layers.
+def pin_ends(settings: Any, pin: Any) -> tuple[End, End]:
+    """``(lower, upper)``: the tiers of a pin's ends beyond its layers (mm from the stack's faces).
 
     The motor shaft has none: the motor is below it, and it ends flush with its top layer (held by glue).
     """
     if pin.shaft:
-        return (0.0, 0.0), (0.0, 0.0)
-    return hardware_of(settings).ends(pin.diameter_mm)
+        return (), ()
+    return hardware_of(settings).ends(pin.diameter_mm, stack_mm(settings, pin))
 
 
 def stack_mm(settings: Any, pin: Any) -> float:

@@ -65,16 +65,16 @@ def settle(fab: Any, samples: int = 120, final: int = 240) -> list[Any]:
     samples per cycle (the rounds check at ``samples``).
     """
     from planar.fabrication.check import build_check
-    from planar.fabrication.hardware import pin_ends
+    from planar.fabrication.hardware import end_height, pin_ends
 
     asm, s = fab.assembly, fab.settings
     refit_pins(asm, s)
-    ends: dict[str, float] = {}
-    for pp in asm.pins:
-        (hb, _), (ht, _) = pin_ends(s, pp)
-        ends[f"{pp.letter} lower"], ends[f"{pp.letter} upper"] = hb, ht
     violations = build_check(fab, samples)
     for _ in range(MAX_ROUNDS):
+        ends: dict[str, float] = {}  # a longer pin (a gap opened across it) may stand further out
+        for pp in asm.pins:
+            lower, upper = pin_ends(s, pp)
+            ends[f"{pp.letter} lower"], ends[f"{pp.letter} upper"] = end_height(lower), end_height(upper)
         gaps = _gaps(asm, violations, s.thickness_mm, ends)
         if not gaps:
             break

@@ -48,9 +48,10 @@ class PolygonSpec(_Strict):
     """The part it is fixed to, e.g. ``"coupler"`` (a four-bar's parts: crank, coupler, rocker)."""
     points: Annotated[list[tuple[Real, Real]], Field(min_length=3)]
     """At least three ``[x, y]`` vertices in the part's frame (model units), e.g. ``[[0, 0], [1, 0], [1, 0.2]]``."""
-    cut: StrictBool = False
+    cut: StrictBool | Literal["part"] = False
     """``true``: ``planar export`` cuts the polygon as part of its part, merged into the part's outline (joined to
-    it by their convex hull where they do not touch); ``false`` (default): drawn only."""
+    it by their convex hull where they do not touch); ``"part"``: cut as a part of its own (named as the polygon)
+    on a layer of its own, fixed to its part by two pins where both have room; ``false`` (default): drawn only."""
 
 
 class FourBarSpec(_Strict):

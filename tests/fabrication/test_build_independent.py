@@ -135,15 +135,11 @@ def independent_check(plan: dict, dxfs: list[Path], cols: dict[str, np.ndarray])
             if (1 if shaft else lo) <= layer[n] <= hi and not (shaft and n in pin["parts"]) and _hits(disc, placed[n]):
                 found.append(f"pin {pin['name']} through {n} on layer {layer[n]}")
         for side in ("lower", "upper"):
-            end = pin["ends"][side]
-            if end["height_mm"] <= 0:
-                continue
-            n_layers = math.ceil(end["height_mm"] / t - 1e-9)
-            span = range(lo - n_layers, lo) if side == "lower" else range(hi + 1, hi + 1 + n_layers)
-            ring = shapely.buffer(xy, end["diameter_mm"] / 2)
-            for n in mats:
-                if layer[n] in span and _hits(ring, placed[n]):
-                    found.append(f"pin {pin['name']} {side} end strikes {n} on layer {layer[n]}")
+            for z0, z1, dia in _tiers(pin, side, t):
+                ring = shapely.buffer(xy, dia / 2)
+                for n in mats:
+                    if min(z1, layer[n] * t) - max(z0, (layer[n] - 1) * t) > 1e-9 and _hits(ring, placed[n]):
+                        found.append(f"pin {pin['name']} {side} end strikes {n} on layer {layer[n]}")
     for sp in plan["spacers"]:
         if sp["pin"] not in tracks:
             continue
@@ -170,14 +166,68 @@ def _cylinders(plan: dict, pins: list[dict]) -> list[tuple[str, float, float, fl
         lo, hi = pin["layers"]
         shaft = pin is plan["motor_shaft"]
         out.append((pin["name"], -1e3 if shaft else (lo - 1) * t, hi * t, pin["diameter_mm"] / 2))
-        lower, upper = pin["ends"]["lower"], pin["ends"]["upper"]
-        if lower["height_mm"] > 0:
-            out.append((pin["name"], (lo - 1) * t - lower["height_mm"], (lo - 1) * t, lower["diameter_mm"] / 2))
-        if upper["height_mm"] > 0:
-            out.append((pin["name"], hi * t, hi * t + upper["height_mm"], upper["diameter_mm"] / 2))
+        for side in ("lower", "upper"):
+            out += [(pin["name"], z0, z1, dia / 2) for z0, z1, dia in _tiers(pin, side, t)]
     for sp in plan["spacers"]:
         out.append((sp["pin"], (sp["layer"] - 1) * t, sp["layer"] * t, sp["outer_mm"] / 2))
     return [c for c in out if any(c[0] == p["name"] for p in pins)]
+
+
+def _tiers(pin: dict, side: str, t: float) -> list[tuple[float, float, float]]:
+    """A pin end's round bodies ``(z0, z1, diameter)`` mm (z from the bottom layer's lower face), from plan.json."""
+    lo, hi = pin["layers"]
+    face, sign = ((lo - 1) * t, -1.0) if side == "lower" else (hi * t, 1.0)
+    out, z = [], 0.0
+    for tier in pin["ends"][side]["tiers"]:
+        if tier["height_mm"] > z + 1e-9:
+            a, b = sorted((face + sign * z, face + sign * tier["height_mm"]))
+            out.append((a, b, tier["diameter_mm"]))
+            z = tier["height_mm"]
+    return out
+
+
+#: M3 fastener sizes by hand from the standards (mm): DIN 125-A washer (outer, thickness), DIN 6799 e-clip
+#: (outer, thickness), ISO 7380 button head (diameter, height), DIN 985 nut (across corners, height), ISO 261 pitch
+M3 = {"washer": (7.0, 0.5), "eclip": (6.0, 0.6), "head": (5.7, 1.65), "nut": (6.01, 4.0), "pitch": 0.5}
+
+
+def _bought(pin: dict, word: str) -> dict:
+    return next(h for h in pin["hardware"] if word in h["item"])
+
+
+def expected_ends(pin: dict, plan: dict) -> dict[str, list[tuple[float, float]]]:
+    """Each end's tiers ``(height, diameter)`` mm worked out by hand from what plan.json says is bought (the rod's
+    or screw's length, the washers) and the M3 tables above: nothing of planar's hardware module."""
+    t = plan["thickness_mm"]
+    lo, hi = pin["layers"]
+    stack = (hi - lo + 1) * t
+    wd, wt = M3["washer"]
+    if plan["hardware"] == "rod-eclip":
+        length = float(_bought(pin, "steel rod")["size"].split(" x ")[1].split()[0])
+        cd, ct = M3["eclip"]
+        end = [(wt + ct, max(wd, cd)), ((length - stack) / 2, pin["diameter_mm"])]
+        return {"lower": end, "upper": end}
+    length = float(_bought(pin, "screw")["size"].split(" x ")[1])
+    washers = _bought(pin, "washer")["qty"]
+    hd, hh = M3["head"]
+    ne, nh = M3["nut"]
+    nut_top = (washers - 1) * wt + nh  # one washer under the head, the rest under the nut
+    tip = length - wt - stack
+    # the thread passes the whole nut by at least the chamfered pitch, and by less than a pitch and a washer
+    assert M3["pitch"] - 1e-9 <= tip - nut_top < M3["pitch"] + wt, (pin["name"], length, stack)
+    return {"lower": [(wt + hh, max(wd, hd))], "upper": [(nut_top, max(wd, ne)), (tip, pin["diameter_mm"])]}
+
+
+def check_ends(plan: dict) -> None:
+    """plan.json's pin ends are the hand sums of what it says is bought (M3 only)."""
+    for pin in plan["pins"]:
+        if plan["pin_diameter_mm"] != 3.0:
+            continue
+        want = expected_ends(pin, plan)
+        for side in ("lower", "upper"):
+            got = [(tr["height_mm"], tr["diameter_mm"]) for tr in pin["ends"][side]["tiers"]]
+            assert got == [pytest.approx(w, abs=1e-6) for w in want[side]], (pin["name"], side)
+            assert pin["ends"][side]["height_mm"] == pytest.approx(max(h for h, _ in want[side]), abs=1e-6)
 
 
 SCENES = sorted(GALLERY.glob("*.toml"))
@@ -187,6 +237,7 @@ SCENES = sorted(GALLERY.glob("*.toml"))
 @pytest.mark.parametrize("scene", SCENES, ids=[p.stem for p in SCENES])
 def test_the_files_alone_agree_with_the_build_check(scene, tmp_path):
     plan, dxfs, cols = _export(scene, tmp_path)
+    check_ends(plan)
     found = independent_check(plan, dxfs, cols)
     if scene.stem in BLOCKED:
         assert plan["violations"] and found, "planar and the files should both find the known collisions"
@@ -204,3 +255,51 @@ def test_the_independent_check_can_fail(tmp_path):
     for p in parts:
         p["layer"] = 1
     assert any("overlap" in f for f in independent_check(plan, dxfs, cols))
+
+
+def _with_screws(name: str, where: Path) -> Path:
+    """A copy of a gallery scene cut with ``hardware = "screw"``."""
+    text = (GALLERY / f"{name}.toml").read_text()
+    line = 'hardware = "screw"\n'
+    if "[fabrication]\n" in text:
+        text = text.replace("[fabrication]\n", "[fabrication]\n" + line)
+    else:
+        text += "\n[fabrication]\n" + line
+    scene = where / f"{name}.toml"
+    scene.write_text(text)
+    return scene
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["slider-crank", "cam-automaton", "stephenson-six-bar"])
+def test_screws_stand_their_true_height_and_the_files_alone_agree(name, tmp_path):
+    """Scenes cut with screws (their nut ends 6 mm and more above the stack): plan.json's ends are the hand sums
+    of the screws, washers and nuts it lists, and the files alone find no fastener striking a neighbour."""
+    scene = _with_screws(name, tmp_path)
+    plan, dxfs, cols = _export(scene, tmp_path)
+    assert plan["hardware"] == "screw"
+    check_ends(plan)
+    assert max(p["ends"]["upper"]["height_mm"] for p in plan["pins"]) >= 5.5
+    assert plan["violations"] == []
+    assert independent_check(plan, dxfs, cols) == []
+
+
+@pytest.mark.slow
+def test_the_files_alone_find_a_nut_end_striking_the_layer_above(tmp_path):
+    """Take the gap the planner opened over a screw's nut end away (every part above moves down a layer): the
+    files-only check sees the nut end (6 mm tall, 7 mm across) strike the part now lying on it."""
+    scene = _with_screws("slider-crank", tmp_path)
+    plan, dxfs, cols = _export(scene, tmp_path)
+    assert independent_check(plan, dxfs, cols) == []
+    used = {p["layer"] for p in plan["parts"] if p["layer"] is not None}
+    empty = [k for k in range(1, plan["layers"] + 1) if k not in used]
+    assert empty, "the planner opened no gap for the screws' nut ends"
+    gap = empty[0]
+    for p in plan["parts"]:
+        if p["layer"] is not None and p["layer"] > gap:
+            p["layer"] -= 1
+    for pin in plan["pins"] + ([plan["motor_shaft"]] if plan["motor_shaft"] else []):
+        lo, hi = pin["layers"]
+        pin["layers"] = [lo - (lo > gap), hi - (hi > gap)]
+    plan["spacers"] = [{**sp, "layer": sp["layer"] - (sp["layer"] > gap)} for sp in plan["spacers"] if sp["layer"] != gap]
+    assert any("end strikes" in f for f in independent_check(plan, dxfs, cols))

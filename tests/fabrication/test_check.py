@@ -62,18 +62,59 @@ def test_round_bodies_keep_their_radii_plus_clearance_apart():
 @pytest.mark.parametrize(
     ("kind", "stack", "length", "ends"),
     [
-        # rod: stack + 2 x (washer 0.5 + clip 0.6 + 0.5 past the groove), up to 0.5 mm
-        ("rod-eclip", 9.0, 12.5, ((1.1, 7.0), (1.1, 7.0))),
-        # screw: stack + 2 washers + nut 4 + 1 thread = 15 -> sold 16
-        ("screw", 9.0, 16.0, ((2.15, 7.0), (5.5, 7.0))),
+        # rod: stack + 2 x (washer 0.5 + clip 0.6 + 0.5 past the groove) = 12.2, up to 0.5 mm: 12.5, 1.75 each side
+        ("rod-eclip", 9.0, 12.5, (((1.1, 7.0), (1.75, 3.0)), ((1.1, 7.0), (1.75, 3.0)))),
+        # screw: stack + 2 washers + nut 4 + a pitch 0.5 = 14.5 -> sold 16; its tip 16 - 0.5 - 9 = 6.5 mm proud of
+        # the stack, 3 more washers under the nut (nut top 4 x 0.5 + 4 = 6 mm), the head 1.65 + a washer 0.5 below
+        ("screw", 9.0, 16.0, (((2.15, 7.0),), ((6.0, 7.0), (6.5, 3.0)))),
     ],
 )
 def test_hardware_lengths_and_ends_from_the_standard_tables(kind, stack, length, ends):
     hw = HARDWARE[kind]
     assert hw.length(3.0, stack) == pytest.approx(length)
-    got = hw.ends(3.0)
-    assert np.allclose(np.array(got, float), np.array(ends, float))
+    got = hw.ends(3.0, stack)
+    assert [[(t.height, t.diameter) for t in end] for end in got] == [[pytest.approx(t) for t in end] for end in ends]
     assert all(i.qty >= 1 and i.size for i in hw.items(3.0, stack))
+
+
+#: by hand from the standards: ISO 261 pitch, DIN 125-A washer thickness, DIN 985 nut height, ISO 7380 head height
+HAND = {3.0: (0.5, 0.5, 4.0, 1.65), 4.0: (0.7, 0.8, 5.0, 2.2), 5.0: (0.8, 1.0, 5.0, 2.75)}
+
+
+@pytest.mark.parametrize("d", sorted(HAND))
+def test_the_chosen_screw_engages_its_whole_nut_and_its_extents_are_the_hand_sum(d):
+    """Random stacks: the screw is a sold length, its thread passes the whole nut by a pitch to a pitch plus a
+    washer (1 to 2 pitches for M3), no shorter sold screw would, and the check's ends are the hand sums."""
+    from planar.fabrication.hardware import SCREW_LENGTHS, screw_fit
+
+    pitch, washer, nut, head = HAND[d]
+    rng = np.random.default_rng(int(d * 10))
+    for stack in rng.uniform(1.0, 40.0, 60):
+        fit = screw_fit(d, float(stack))
+        assert fit.length in SCREW_LENGTHS
+        need = stack + 2 * washer + nut + pitch  # head washer, layers, nut washer, nut, the chamfered pitch
+        assert fit.length >= need - 1e-9
+        assert not any(need - 1e-9 <= n < fit.length for n in SCREW_LENGTHS)  # the shortest that does
+        nut_top = fit.washers * washer + nut  # above the stack's top face
+        proud = fit.length - washer - stack - nut_top
+        assert pitch - 1e-9 <= proud < pitch + washer - 1e-9, (stack, fit)
+        lower, upper = HARDWARE["screw"].ends(d, float(stack))
+        assert lower[-1].height == pytest.approx(head + washer)
+        assert upper[0].height == pytest.approx(nut_top)
+        assert upper[-1].height == pytest.approx(fit.length - washer - stack)  # the tip
+        assert upper[-1].diameter == pytest.approx(d)
+        items = {i.item: i for i in HARDWARE["screw"].items(d, float(stack))}
+        assert items["washer DIN 125"].qty == 1 + fit.washers
+
+
+def test_a_rod_stands_its_clip_and_half_its_spare_length_past_each_face():
+    rng = np.random.default_rng(5)
+    for stack in rng.uniform(1.0, 40.0, 40):
+        length = HARDWARE["rod-eclip"].length(3.0, float(stack))
+        lower, upper = HARDWARE["rod-eclip"].ends(3.0, float(stack))
+        assert lower == upper
+        assert lower[-1].height == pytest.approx((length - stack) / 2)
+        assert 0.5 - 1e-9 <= lower[-1].height - (0.5 + 0.6) < 0.75  # 0.5 mm past the groove, cut to 0.5 mm
 
 
 @pytest.mark.slow
@@ -102,3 +143,24 @@ def test_export_of_a_clean_scene_exits_0(tmp_path):
     )
     assert res.returncode == 0, res.stdout
     assert "build check: every part" in res.stdout
+
+
+def test_the_check_stacks_each_end_as_its_tiers_beyond_the_faces():
+    """A screw through layers 2-4 (3 mm each, 9 mm): the check's end bodies are the head (2.15 mm below the stack,
+    7 mm across), then above it the washers and nut to 6 mm (7 mm across) and the thread to the tip, 16 - 0.5 - 9 =
+    6.5 mm (3 mm across): the hand sums, as z-ranges."""
+    from types import SimpleNamespace
+
+    from planar.fabrication.check import pin_bodies
+    from planar.fabrication.parts import FabSettings
+
+    s = FabSettings(thickness_mm=3.0, pin_mm=3.0, hardware="screw")
+    spec = SimpleNamespace(parts=("a", "b"), at=((0.0, 0.0), (0.0, 0.0)))
+    pp = SimpleNamespace(letter="B", spec=spec, layers=(1, 3), shaft=False, diameter_mm=3.0, parts=("a", "b"))
+    poses = {"a": np.zeros((4, 3))}
+    ends = [(b.z0, b.z1, 2 * b.radius) for b in pin_bodies(pp, poses, s, {1, 3}) if b.kind == "end"]
+    assert ends == [
+        pytest.approx((3.0 - 2.15, 3.0, 7.0)),
+        pytest.approx((12.0, 12.0 + 6.0, 7.0)),
+        pytest.approx((18.0, 12.0 + 6.5, 3.0)),
+    ]

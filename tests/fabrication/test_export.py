@@ -158,9 +158,7 @@ def test_every_gallery_scene_exports_checked_files(tmp_path, path):
     for p in fab.layout.parts:
         assert p.label == "" or p.label_height >= s.min_label - 1e-9
     # parts on one layer never overlap at any instant of the cycle (shapely, from the parts' own outlines)
-    from planar.fabrication.build import _fab_mechanism
-
-    cut = _fab_mechanism(scene.mechanism)  # a wind-up toy is cut as its assembly
+    cut = fab.mechanism  # as cut: a wind-up toy's assembly, polygons cut as parts of their own
     motion = cut.run(samples_per_cycle=24)
     from shapely import affinity
 
