@@ -369,7 +369,7 @@ def below_mm(settings: Any, pins: Any, hang: float = 0.0) -> float:
         if pp.shaft:
             low = max(low, settings.motor_body_mm)
         elif lo == 0:
-            low = max(low, pin_ends(settings, pp)[0][0])
+            low = max(low, end_height(pin_ends(settings, pp)[0]))
     return low
 
 

@@ -180,7 +180,7 @@ def test_below_and_standoff_clear_the_motor_and_the_lower_ends(hardware):
         s = _settings(hardware=hardware, motor_body_mm=float(body))
         pins = [_pin("A", (0, 2), shaft=True), _pin("B", (0, 1)), _pin("C", (2, 4))]
         low = below_mm(s, pins)
-        lower_end = pin_ends(s, pins[1])[0][0]  # pin C starts on layer 3: nothing of it hangs below
+        lower_end = max(tier.height for tier in pin_ends(s, pins[1])[0])  # pin C starts on layer 3: nothing of it hangs below
         assert low == pytest.approx(max(body, lower_end))
         n = standoff_length(s, low)
         assert n >= low + 1.0 and n in STANDOFF_LENGTHS
