@@ -81,6 +81,7 @@ def _spread(values: list[float]) -> dict[str, float]:
 
 def _calls_for(fn: Any) -> int:
     """How many calls of ``fn`` make one measurement of at least :data:`MIN_MEASURE_S` of processor time."""
+    fn()  # a first call may load a kernel (the poses' on their first read)
     c0 = time.process_time()
     fn()
     once = max(time.process_time() - c0, 1e-7)
