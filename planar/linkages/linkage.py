@@ -472,7 +472,9 @@ class Linkage(Mechanism):
         poses, checks, pts = solved
         if checks is None:  # every sample closes
             table: list[tuple[str, str]] = []
-            valid, code = np.empty(n, dtype=bool), np.empty(n, dtype=np.int16)
+            big = 2 * n >= MIN_BYTES  # recycled memory: new pages would cost a fault each
+            valid = new_block((n,), bool) if big else np.empty(n, dtype=bool)
+            code = new_block((n,), np.int16) if big else np.empty(n, dtype=np.int16)
             valid.fill(True)
             code.fill(-1)
         else:
