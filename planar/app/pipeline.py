@@ -205,9 +205,6 @@ def render_scene(
             f"{plan.delay_ms / 1000:.4g} s): a higher speed or frame rate",
         )
     motion, fine = animation_motion(scene, plan)
-    from planar.core.buffers import release
-
-    release()  # the solves are done: recycled blocks nobody holds go back (frames are drawn in bounded chunks)
     if notes is not None:
         if plan.note():
             notes.append(plan.note())

@@ -81,6 +81,7 @@ def _spread(values: list[float]) -> dict[str, float]:
 
 def _calls_for(fn: Any) -> int:
     """How many calls of ``fn`` make one measurement of at least :data:`MIN_MEASURE_S` of processor time."""
+    fn()  # a first call may load a kernel (the poses' on their first read)
     c0 = time.process_time()
     fn()
     once = max(time.process_time() - c0, 1e-7)
@@ -127,19 +128,25 @@ def _size_row(mech: Any, step: float, n: int, repeats: int) -> dict[str, Any]:
         nonlocal valid
         valid = bool(mech.solve(q).valid.all()) and valid
 
+    def poses_call() -> None:
+        motion = mech.solve(q)
+        _ = motion.poses  # every part's pose (computed on first access)
+
     peer = _pylinkage_of(mech, step)
 
     def peer_call() -> None:
         peer.step_fast(iterations=n)
 
+    fns = {"planar": planar_call, "peer": peer_call, "poses": poses_call}
     # warm-up outside the timing (pylinkage's numba compile, cached; planar's first call of a size takes new
     # memory, which its later calls recycle), and the number of calls that make one measurement
-    calls = {"planar": _calls_for(planar_call), "peer": _calls_for(peer_call)}
-    cpu: dict[str, list[float]] = {"planar": [], "peer": []}
-    wall: dict[str, list[float]] = {"planar": [], "peer": []}
+    calls = {who: _calls_for(fn) for who, fn in fns.items()}
+    cpu: dict[str, list[float]] = {who: [] for who in fns}
+    wall: dict[str, list[float]] = {who: [] for who in fns}
+    order = ("planar", "peer", "poses")
     for r in range(repeats):
-        for who in ("planar", "peer") if r % 2 == 0 else ("peer", "planar"):
-            c, w = _measure(planar_call if who == "planar" else peer_call, calls[who])
+        for who in order[r % 3 :] + order[: r % 3]:  # each first in turn
+            c, w = _measure(fns[who], calls[who])
             cpu[who].append(c)
             wall[who].append(w)
     cpu_ratios = [b / a for a, b in zip(cpu["planar"], cpu["peer"])]
@@ -151,9 +158,12 @@ def _size_row(mech: Any, step: float, n: int, repeats: int) -> dict[str, Any]:
         "peer_cpu_s": _spread(cpu["peer"]),
         "planar_wall_s": _spread(wall["planar"]),
         "peer_wall_s": _spread(wall["peer"]),
+        "poses_cpu_s": _spread(cpu["poses"]),
+        "poses_wall_s": _spread(wall["poses"]),
         # peer time / planar time: above 1 planar is the faster
         "cpu_ratio": float(np.median(cpu["peer"]) / np.median(cpu["planar"])),
         "wall_ratio": float(np.median(wall["peer"]) / np.median(wall["planar"])),
+        "poses_cpu_ratio": float(np.median(cpu["peer"]) / np.median(cpu["poses"])),
         "cpu_ratio_per_repeat": _spread(cpu_ratios),
         "wall_ratio_per_repeat": _spread(wall_ratios),
         "planar_samples_per_s": n / float(np.median(wall["planar"])),
@@ -199,7 +209,12 @@ def bench_kinematics(n: int | None = None, repeats: int = 7, sizes: tuple[int, .
     :data:`SIZES`; ``n`` alone: that one size).  The two alternate,
     ``repeats`` times each (order swapped every repeat); a measurement repeats
     the call until it lasts :data:`MIN_MEASURE_S` of processor time and gives
-    the time of one call.  Per size: processor time (all of a process's
+    the time of one call.  ``solve`` returns the joints' positions (named
+    points), validity and failure codes, as the peer returns its joints; the
+    parts' poses (an ``atan2`` per part and sample) are computed when the
+    motion's ``poses`` are first read: a third measurement, interleaved with
+    the two, times ``solve`` and that read (``poses_cpu_s``,
+    ``poses_cpu_ratio``: peer over planar with every pose).  Per size: processor time (all of a process's
     threads: the work each does, which other load on the machine disturbs
     less) and wall time, median with min and max, and the ratios of the
     medians, peer over planar (``cpu_ratio``, ``wall_ratio``: above 1 planar
@@ -242,12 +257,13 @@ def format_kinematics(r: dict[str, Any]) -> str:
     lines = [
         (
             f"public solve vs {r['peer']}: time per call, median of {r['repeats']} interleaved repeats "
-            f"(ratio: peer / planar, the repeats' range in brackets), {r['cores']} cores"
+            f"(ratio: peer / planar, the repeats' range in brackets), {r['cores']} cores; "
+            "+poses: solve and every part's pose read (computed on first access)"
         )
     ]
     head = (
         f"    {'N':>9}  {'planar cpu':>10}  {'peer cpu':>10}  {'cpu ratio':>20}  "
-        f"{'planar wall':>11}  {'peer wall':>10}  {'wall ratio':>20}"
+        f"{'planar wall':>11}  {'peer wall':>10}  {'wall ratio':>20}  {'+poses cpu':>10}  {'ratio':>6}"
     )
     for c in r["cases"]:
         lines += [
@@ -261,7 +277,8 @@ def format_kinematics(r: dict[str, Any]) -> str:
                 f"    {row['n']:>9,}  {_t(row['planar_cpu_s']['median']):>10}  {_t(row['peer_cpu_s']['median']):>10}  "
                 f"{row['cpu_ratio']:6.2f} ({cr['min']:5.2f}-{cr['max']:5.2f})  "
                 f"{_t(row['planar_wall_s']['median']):>11}  {_t(row['peer_wall_s']['median']):>10}  "
-                f"{row['wall_ratio']:6.2f} ({wr['min']:5.2f}-{wr['max']:5.2f})"
+                f"{row['wall_ratio']:6.2f} ({wr['min']:5.2f}-{wr['max']:5.2f})  "
+                f"{_t(row['poses_cpu_s']['median']):>10}  {row['poses_cpu_ratio']:6.2f}"
                 + ("" if row["all_valid"] else "  INVALID SAMPLES")
             )
         lines.append(

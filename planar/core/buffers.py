@@ -14,11 +14,16 @@ result's per-part rows, a user's slice of them) references the block itself
 (numpy collapses the chain of bases), so the block's reference count is the
 pool's own references exactly when no view of it is alive anywhere: only then
 is it handed out again (a released block up to twice the size of a request
-serves it).  When a solve needs a new block, released blocks are dropped,
-oldest first, so that they and the new block stay within :data:`MAX_BYTES`
-(a block released after that counts at the next solve); :func:`release` drops
-them all.  Set ``PLANAR_RECYCLE=0`` to turn recycling off (every block is
-new).
+serves it).  When a request finds no released block of its size, released
+blocks are dropped, oldest first, until they are no more than the blocks in
+use (:func:`held_bytes`) and they and the new block stay within
+:data:`MAX_BYTES`: the pool follows what its caller holds, so a long-running
+caller that asks for many sizes (a render solving motion after motion) keeps
+at most as much memory in released blocks as in results it holds, without
+calling :func:`release` (which drops them all, and asks the allocator to
+return free memory to the system).  A loop that asks for the same sizes again
+and again finds its released blocks every time and drops none.  Set
+``PLANAR_RECYCLE=0`` to turn recycling off (every block is new).
 
 The reference count test needs CPython's reference counting; where it does
 not behave as measured at import (another interpreter, a free-threaded
@@ -34,10 +39,11 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["MAX_BYTES", "MIN_BYTES", "block", "pooled_bytes", "release"]
+__all__ = ["MAX_BYTES", "MIN_BYTES", "block", "held_bytes", "pooled_bytes", "release"]
 
-#: smallest block worth recycling (below it new memory costs little)
-MIN_BYTES = 1 << 20
+#: smallest block worth recycling (below it new memory costs little; above it glibc maps new pages, a fault
+#: each: a 1e5-sample solve's driver copy, validity and codes, 1.1 MB, cost Jansen's leg 0.1-0.3 ms of 2.4)
+MIN_BYTES = 1 << 16
 #: most bytes the pool keeps in blocks nothing else holds
 MAX_BYTES = 1 << 29
 
@@ -94,7 +100,10 @@ def block(shape: tuple[int, ...], dtype: Any = float) -> np.ndarray[Any, Any]:
             b = _POOL.pop(best)
             _POOL.append(b)  # most recently used last
             return b[:nbytes].view(dt).reshape(shape)  # a view: the pool's block stays referenced while it lives
-        _trim(MAX_BYTES - nbytes)  # room for the new block within the cap, released blocks dropped oldest first
+        # released blocks that serve no request of this size are dropped, oldest first, until they are no
+        # more than the blocks in use (and within the cap with the new block): the pool follows what
+        # the caller holds, however many sizes it asks for
+        _trim(min(MAX_BYTES - nbytes, _held()))
         new = np.empty(nbytes, np.uint8)
         _POOL.append(new)
         return new.view(dt).reshape(shape)
@@ -112,6 +121,17 @@ def _trim(keep: int = MAX_BYTES) -> None:
         drop.append(i)
     for i in reversed(drop):
         del _POOL[i]
+
+
+def _held() -> int:
+    """Bytes of the pool's blocks that something else holds (call with the lock held)."""
+    return sum(_POOL[i].nbytes for i in range(len(_POOL)) if _count(_POOL, i) != _FREE)
+
+
+def held_bytes() -> int:
+    """Bytes of the pool's blocks in use (held by results, or views of them, alive now)."""
+    with _LOCK:
+        return _held()
 
 
 def _free_indices() -> list[int]:

@@ -13,7 +13,7 @@ are radians, counter-clockwise positive.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from types import MappingProxyType
@@ -40,6 +40,7 @@ __all__ = [
     "Hole",
     "Joint",
     "JointProtocol",
+    "LazyPoses",
     "Mechanism",
     "Motion",
     "Part",
@@ -82,6 +83,23 @@ def check_finite(field_name: str, value: ArrayLike) -> NDArray[np.float64]:
 class FinitePoses(dict[str, "NDArray[np.float64]"]):
     """Poses from a solver that screened every number it wrote (poses and named points) and found
     them finite: :meth:`Mechanism.solve` skips its own finite screen for them."""
+
+
+class LazyPoses(FinitePoses):
+    """Poses a solver computes on first access: an empty marker holding the function that computes them.
+
+    A solver that has every node's position can leave the parts' poses (an
+    ``atan2`` per part and sample) until someone reads them: :class:`Motion`
+    takes this marker as its ``poses`` and calls ``make()`` the first time
+    ``motion.poses`` is read, once, keeping the result.  The solver guarantees
+    that the poses it will compute are finite (a :class:`FinitePoses`).
+    ``parts``: how many parts (for a motion's ``repr`` without computing them).
+    """
+
+    def __init__(self, make: Callable[[], dict[str, NDArray[np.float64]]], parts: int) -> None:
+        super().__init__()
+        self.make = make
+        self.parts = parts
 
 
 def check_positive(field_name: str, value: float) -> float:
@@ -514,7 +532,9 @@ class Motion:
     world.  ``valid`` is ``(N,)``.  ``fail_code[i]`` indexes ``fail_table``
     (``-1`` where valid); each table entry is ``(joint, why)``.  Invalid
     samples hold finite, nearest-real poses (never NaN) so they can be drawn
-    and marked.
+    and marked.  A solver may hand over the poses as :class:`LazyPoses`
+    (a linkage's compiled solve does): they are then computed the first
+    time ``poses`` is read, and kept.
     """
 
     driver: Array
@@ -527,6 +547,28 @@ class Motion:
     #: the mechanism solved (set by :meth:`Mechanism.solve`; what ``animate`` and the notebook display draw)
     mechanism: Any = field(default=None, repr=False, compare=False)
 
+    def __post_init__(self) -> None:
+        if isinstance(self.poses, LazyPoses):  # computed on first access (see __getattr__)
+            self.__dict__["_lazy_poses"] = self.__dict__.pop("poses")
+
+    if not TYPE_CHECKING:  # (the type checker keeps reporting unknown attributes)
+
+        def __getattr__(self, name: str) -> Any:
+            """``poses`` given as :class:`LazyPoses`: computed now, once, and kept (an ordinary attribute then)."""
+            if name == "poses":
+                lazy = self.__dict__.get("_lazy_poses")
+                if lazy is not None:
+                    poses = lazy.make()
+                    self.__dict__["poses"] = poses
+                    self.__dict__.pop("_lazy_poses", None)
+                    return poses
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickled (and deep-copied) with its poses computed."""
+        _ = self.poses
+        return dict(self.__dict__)
+
     def __len__(self) -> int:
         return int(self.driver.shape[0])
 
@@ -535,7 +577,9 @@ class Motion:
         bad = n - int(np.count_nonzero(self.valid))
         src = f" of {self.mechanism.name!r}" if self.mechanism is not None else ""
         span = f", driver {float(self.driver[0]):.4g} to {float(self.driver[-1]):.4g}" if n else ""
-        return f"<Motion{src}: {n} samples, {len(self.poses)} parts, {bad} invalid{span}>"
+        lazy = self.__dict__.get("_lazy_poses")
+        parts = lazy.parts if lazy is not None else len(self.poses)
+        return f"<Motion{src}: {n} samples, {parts} parts, {bad} invalid{span}>"
 
     def _repr_html_(self) -> str | None:
         from planar.core.display import html

@@ -38,7 +38,7 @@ from numpy.typing import NDArray
 from planar.core.geometry import CONCENTRIC, TANGENCY_RTOL
 from planar.linkages.plan import _Plan
 
-__all__ = ["ENCODERS", "Program", "program_for", "solve_range"]
+__all__ = ["ENCODERS", "SCREEN", "Program", "poses_range", "program_for", "solve_range"]
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -53,6 +53,9 @@ CHECKED = (RRR, RRP, RIGID)
 _RTOL = TANGENCY_RTOL
 _CONCENTRIC = CONCENTRIC
 _TINY = float(np.finfo(float).tiny)
+#: the finite screen's bound on a node's coordinates (model units): below it every difference of two
+#: coordinates, every placed coordinate (placement offsets below it too) and so every atan2 is finite
+SCREEN = 1e300
 
 # Cody-Waite pi/2 in three parts of 33 bits (fdlibm's pio2_1, pio2_2, pio2_2t): exact products
 # n * part for |n| < 2**20
@@ -446,6 +449,86 @@ def _k_point(x: FloatArray, y: FloatArray, m: int, pl: FloatArray, out: FloatArr
 
 
 @njit(**_JIT)
+def _finite(q: FloatArray, lo: int, hi: int) -> bool:
+    """Whether every ``q[lo:hi]`` is finite (a vectorised count)."""
+    bad = 0
+    for i in range(lo, hi):
+        bad += not math.isfinite(q[i])
+    return bad == 0
+
+
+@njit(**_JIT)
+def _k_store(x: FloatArray, y: FloatArray, m: int, out: FloatArray) -> int:
+    """Node rows ``out[:m]`` (x and y side by side); returns how many the finite screen flags (a
+    coordinate beyond :data:`SCREEN`, or not a number)."""
+    F = out.ravel()
+    bad = 0
+    for i in range(m):
+        u, v = x[i], y[i]
+        F[2 * i] = u
+        F[2 * i + 1] = v
+        bad += not ((abs(u) <= SCREEN) & (abs(v) <= SCREEN))
+    return bad
+
+
+@njit(**_JIT)
+def _store_nodes(X: FloatArray, Y: FloatArray, off: int, m: int, store: IntArray, nodes: FloatArray, i: int) -> int:
+    """Every written node's window ``X[nd, off:off + m]`` into ``nodes[store[nd], i:i + m]``; the screen's count."""
+    bad = 0
+    for nd in range(store.shape[0]):
+        if store[nd] >= 0:
+            bad += _k_store(X[nd, off:], Y[nd, off:], m, nodes[store[nd], i : i + m])
+    return bad
+
+
+@njit(**_JIT)
+def poses_range(
+    nodes: FloatArray,
+    fixed: FloatArray,
+    store: IntArray,
+    links: IntArray,
+    pl: FloatArray,
+    poses: FloatArray,
+    lo: int,
+    hi: int,
+    chunk: int,
+) -> int:
+    """Pose rows ``poses[j, lo:hi]`` of every moving part from the node rows :func:`solve_range` wrote.
+
+    ``store[i]``: node ``i``'s row in ``nodes`` (-1: a fixed node, at
+    ``fixed[i]``); ``links`` ``(m, 3)``: origin, direction from, direction to
+    of each moving part (node indices).  The arithmetic is :func:`_k_pose`'s on
+    the same numbers, so the poses are the same bits as if written while
+    solving.  Returns how many rows hold a non-finite number.
+    """
+    nn = store.shape[0]
+    W = max(1, min(chunk, hi - lo))
+    X = np.empty((nn, W))
+    Y = np.empty((nn, W))
+    for nd in range(nn):
+        if store[nd] < 0:
+            for t in range(W):
+                X[nd, t] = fixed[nd, 0]
+                Y[nd, t] = fixed[nd, 1]
+    bad = 0
+    for i in range(lo, hi, chunk):
+        j = min(i + chunk, hi)
+        m = j - i
+        for nd in range(nn):
+            r = store[nd]
+            if r >= 0:
+                F = nodes[r, i:j].ravel()
+                xr, yr = X[nd], Y[nd]
+                for t in range(m):
+                    xr[t] = F[2 * t]
+                    yr[t] = F[2 * t + 1]
+        for li in range(links.shape[0]):
+            o, a, b = links[li, 0], links[li, 1], links[li, 2]
+            bad += _k_pose(X[o], Y[o], X[a], Y[a], X[b], Y[b], m, pl, poses[li, i:j])
+    return bad
+
+
+@njit(**_JIT)
 def solve_range(
     q: FloatArray,
     lo: int,
@@ -456,28 +539,33 @@ def solve_range(
     par: FloatArray,
     tols: FloatArray,
     check_row: IntArray,
-    links: IntArray,
+    store: IntArray,
     pts: IntArray,
     pl: FloatArray,
-    poses: FloatArray,
+    nodes: FloatArray,
     points: FloatArray,
     oks: BoolArray,
     fails: IntArray,
     bad_chunks: BoolArray,
 ) -> int:
-    """Solve samples ``lo:hi`` chunk by chunk; returns -1 where a branch may switch (then it stops
-    early), else the number of pose and point rows holding a non-finite number.
+    """Solve samples ``lo:hi`` chunk by chunk; returns -1 where a driver value is not finite or a
+    branch may switch (then it stops early), else the number of node and point rows the finite
+    screen flags.
 
     ``kinds[i]``, ``refs[i]``, ``par[i]``: node ``i``'s kind code, referenced
     nodes and numbers (:data:`ENCODERS`); ``tols[i]`` its branch-screen
     tolerance; ``check_row[i]`` its row in ``oks`` (-1: it cannot fail).
-    ``links`` ``(m, 3)``: origin, direction from, direction to of each moving
-    part, written to ``poses[j]`` ``(n, 3)``; ``pts`` the node of each named
-    point (``points[j]`` ``(n, 2)``); ``pl``: placement ``x, y, angle, cos,
-    sin``.  ``fails[row]`` counts the samples of this range that fail;
-    ``oks[row]`` is written only for the chunks where a sample fails (marked in
-    ``bad_chunks``, indexed by sample // chunk).
+    ``store[i]``: node ``i``'s row in ``nodes`` ``(s, n, 2)`` (its positions
+    in the linkage's frame; -1: not written); ``pts`` the node of each named
+    point written to ``points[j]`` ``(n, 2)`` with placement ``pl`` (``x, y,
+    angle, cos, sin``).  A node row is flagged where a coordinate is beyond
+    :data:`SCREEN` (or not a number): below it every pose and point computed
+    from the nodes is finite.  ``fails[row]`` counts the samples of this range
+    that fail; ``oks[row]`` is written only for the chunks where a sample fails
+    (marked in ``bad_chunks``, indexed by sample // chunk).
     """
+    if not _finite(q, lo, hi):
+        return -1
     nn = kinds.shape[0]
     W = min(chunk, hi - lo) + 3
     X = np.empty((nn, W))
@@ -536,9 +624,7 @@ def solve_range(
                     o = oks[row, i:j]
                     for t in range(m):
                         o[t] = okw[t]
-        for li in range(links.shape[0]):
-            o, a, b = links[li, 0], links[li, 1], links[li, 2]
-            nonfinite += _k_pose(X[o, off:], Y[o, off:], X[a, off:], Y[a, off:], X[b, off:], Y[b, off:], m, pl, poses[li, i:j])
+        nonfinite += _store_nodes(X, Y, off, m, store, nodes, i)
         for pi in range(pts.shape[0]):
             nonfinite += _k_point(X[pts[pi], off:], Y[pts[pi], off:], m, pl, points[pi, i:j])
     return nonfinite
@@ -573,12 +659,28 @@ class Program:
         plan: _Plan,
     ) -> None:
         self.kinds, self.refs, self.par, self.check_row = kinds, refs, par, check_row
-        self.links, self.pts, self.pl = links, pts, pl
-        self.n_links, self.n_pts, self.n_checks = int(links.shape[0]), int(pts.shape[0]), len(plan.checks)
+        self.links, self.pl = links, pl
+        self.n_links, self.n_checks = int(links.shape[0]), len(plan.checks)
         #: each part in the plan's order with its row of the pose block (-1: the ground)
         moving = [name for name, o, _, _ in plan.links if o >= 0]
         self.parts = [(name, moving.index(name) if o >= 0 else -1) for name, o, _, _ in plan.links]
         self.pt_names = [name for name, _ in plan.points]
+        # the nodes written while solving: every node a moving part or a named point reads but a fixed
+        # one a part reads (the poses take those from ``fixed``)
+        used = {int(i) for i in links.ravel()}
+        named = {int(i) for i in pts}
+        keep = [i for i in range(kinds.shape[0]) if i in named or (i in used and kinds[i] != FIXED)]
+        self.store = np.full(kinds.shape[0], -1, np.int64)
+        self.store[keep] = np.arange(len(keep))
+        self.n_store = len(keep)
+        self.fixed = np.ascontiguousarray(par[:, :2])
+        #: no placement: a named point is its node's row (no copy); else the kernels write it placed
+        self.unplaced = bool(pl[0] == 0.0 and pl[1] == 0.0 and pl[2] == 0.0)
+        self.pt_rows = [int(self.store[i]) for i in pts]
+        self.pts = np.zeros(0, np.int64) if self.unplaced else pts
+        self.n_pts = int(self.pts.shape[0])
+        self.no_points = np.empty((0, 1, 2))
+        self.solve_range = solve_range
         #: a node moves with ``|q|`` (its tolerance depends on the batch)
         self.grows = any(plan.grows)
         #: the branch-screen tolerances when no node moves with ``|q|`` (as ``chunked._tols``)
@@ -587,6 +689,8 @@ class Program:
         row.flags.writeable = False
         self._ground_row = row
         self._ground_last: FloatArray | None = None
+        #: the placement within the finite screen (else the poses are computed and screened at once)
+        self.screened = bool(abs(pl[0]) <= SCREEN and abs(pl[1]) <= SCREEN)
 
     def ground_pose(self, n: int) -> FloatArray:
         """The ground's track: the placement row seen ``n`` times (read-only, no memory; the last one kept)."""

@@ -452,29 +452,34 @@ class Linkage(Mechanism):
 
     def _solve_warm(self, q: Array) -> Motion | None:
         n = q.shape[0]
-        if n > limit("samples") or not math.isfinite(np.add.reduce(q)):
-            return None  # Mechanism.solve raises the error (a sum of finite numbers may overflow: it looks closer)
-        plan = self._fast_plan()
+        if n > limit("samples"):
+            return None  # Mechanism.solve raises the error
+        plan = self.__dict__.get("_plan") or self._fast_plan()
         prog = None if plan is None else compiled_ready(plan, n)
         if plan is None or prog is None:
             return None
-        qa = np.empty(n) if n * 8 < MIN_BYTES else new_block((n,))  # the motion's own copy
-        qa[...] = q
+        if n * 8 < MIN_BYTES:
+            qa = q.copy()  # the motion's own copy
+        else:
+            qa = new_block((n,))
+            qa[...] = q
         lead = self._lead_in(qa)
         if lead.size and not self._declared_branches_hold(qa, lead):
             return None
-        solved = solve_compiled(self, plan, prog, qa)
+        solved = solve_compiled(self, plan, prog, qa, lazy=True)  # None for a driver value not finite
         if solved is None or not isinstance(solved[0], FinitePoses):
             return None
         poses, checks, pts = solved
         if checks is None:  # every sample closes
             table: list[tuple[str, str]] = []
-            valid, code = np.empty(n, dtype=bool), np.empty(n, dtype=np.int16)
+            big = 2 * n >= MIN_BYTES  # recycled memory: new pages would cost a fault each
+            valid = new_block((n,), bool) if big else np.empty(n, dtype=bool)
+            code = new_block((n,), np.int16) if big else np.empty(n, dtype=np.int16)
             valid.fill(True)
             code.fill(-1)
         else:
             valid, code, table = merge_failures(n, checks)
-        return Motion(driver=qa, poses=poses, valid=valid, fail_code=code, fail_table=table, points=pts or {})
+        return Motion(driver=qa, poses=poses, valid=valid, fail_code=code, fail_table=table, points=pts or {}, mechanism=self)
 
     def _solve_points(self, q: Array) -> Solved:
         """The chunked, threaded path (:mod:`planar.linkages.chunked`), else the reference path.
@@ -484,7 +489,7 @@ class Linkage(Mechanism):
         """
         lead = self._lead_in(q) if q.ndim == 1 else None
         if lead is not None and self._fast_plan() is not None and self._declared_branches_hold(q, lead):
-            fast = fast_solve(self, q)
+            fast = fast_solve(self, q, lazy=True)
             if fast is not None:
                 return fast
         poses, checks = self._solve_poses(q, lead)

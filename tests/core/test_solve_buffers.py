@@ -157,3 +157,25 @@ def test_bad_settings_and_inputs_are_one_line_errors(monkeypatch: pytest.MonkeyP
         leg.solve(np.ma.masked_greater(q, 0.5))
     with pytest.raises(InputError, match="bool"):
         leg.solve(q > 0.5)
+
+
+@needs_pool
+def test_released_blocks_follow_what_is_held() -> None:
+    """A long-running caller solving many sizes (a render: motion after motion) never calls release(): when a
+    solve takes a new block, the released blocks are trimmed to at most the bytes held in results (they were
+    allowed up to MAX_BYTES, 512 MiB, whatever was held)."""
+    leg = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(2.0, 1.0))
+    gc.collect()
+    buffers.release()
+    keep = leg.solve(np.linspace(0.0, 2 * np.pi, 100_000))
+    assert len(keep.poses) == 4
+    seen = []
+    for n in np.geomspace(30_000, 99_000, 14).astype(int):  # growing: no released block serves the next solve
+        m = leg.solve(np.linspace(0.0, 2 * np.pi, int(n)))
+        assert len(m.poses) == 4
+        seen.append((buffers.pooled_bytes(), buffers.held_bytes()))
+        del m
+    assert all(free <= held for free, held in seen), seen
+    assert max(held for _, held in seen) < 64 << 20  # the held result and one solve's blocks
+    del keep
+    buffers.release()
