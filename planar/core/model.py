@@ -13,6 +13,7 @@ are radians, counter-clockwise positive.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -49,6 +50,7 @@ __all__ = [
     "Slide",
     "Slot",
     "check_finite",
+    "check_point",
     "check_positive",
     "joint_kind",
     "joint_residuals",
@@ -84,8 +86,11 @@ class FinitePoses(dict[str, "NDArray[np.float64]"]):
     them finite: :meth:`Mechanism.solve` skips its own finite screen for them."""
 
 
-def check_positive(field_name: str, value: float) -> float:
-    """Return ``value`` as float or raise :class:`InputError` unless a finite number > 0 (not a bool or a string)."""
+def check_positive(field_name: str, value: float, what: str = "length") -> float:
+    """Return ``value`` as float or raise :class:`InputError` unless a finite number > 0 (not a bool or a string).
+
+    ``what`` names the quantity in the message (``"a positive, finite rate"``).
+    """
     if isinstance(value, (bool, str, bytes, np.bool_)):
         raise InputError(field_name, value, "a positive number")
     try:
@@ -93,8 +98,16 @@ def check_positive(field_name: str, value: float) -> float:
     except (TypeError, ValueError):
         raise InputError(field_name, value, "a positive number") from None
     if not np.isfinite(v) or v <= 0.0:
-        raise InputError(field_name, value, "a positive, finite length")
+        raise InputError(field_name, value, f"a positive, finite {what}")
     return v
+
+
+def check_point(field_name: str, value: ArrayLike, what: str = "a point (x, y): two finite numbers") -> Vec:
+    """Return ``value`` as ``(x, y)`` or raise :class:`InputError` unless it is two finite numbers."""
+    a = check_finite(field_name, value)
+    if a.shape != (2,):
+        raise InputError(field_name, value, what)
+    return (float(a[0]), float(a[1]))
 
 
 def _check_name(field: str, name: object) -> None:
@@ -454,6 +467,7 @@ class Driver:
     def __post_init__(self) -> None:
         if not isinstance(self.part, str) or not self.part:
             raise InputError("driver.part", self.part, "the name of the part it drives (a non-empty string)")
+        _check_name("driver.part", self.part)
         if self.kind not in ("rotation", "translation", "path"):
             raise InputError("driver.kind", self.kind, "'rotation', 'translation' or 'path'")
         for f in ("origin", "axis"):
@@ -468,7 +482,13 @@ class Driver:
             amp = check_finite("driver.amplitude", self.amplitude)
             if amp.shape != () or not float(amp) > 0:
                 raise InputError("driver.amplitude", self.amplitude, "a positive amplitude (the phase sets the direction)")
-        check_positive("driver.rate", self.rate)
+        check_positive("driver.rate", self.rate, "rate (rad/s)")
+        from planar.core.limits import check_angle  # an angle float64 resolves (not a phase of 1e300 rad)
+
+        check_angle("driver.phase", self.phase)
+        if self.kind != "translation":  # a translation's centre and amplitude are lengths
+            check_angle("driver.centre", self.centre)
+            check_angle("driver.amplitude", self.amplitude or 0.0)
         if self.kind == "translation" and self.amplitude is None:
             raise InputError("driver.amplitude", None, "a stroke amplitude for a translation driver")
 
@@ -758,8 +778,34 @@ class Mechanism:
             check_scale(self.name, self, size_range=False)
             self.__dict__["_placement_checked"] = True
 
+    def _check_driver_resolution(self, q: Array) -> None:
+        """Refuse driver values so large that float64's spacing there is coarser than the mechanism needs.
+
+        An angle (rad) must be resolved to :data:`planar.core.limits.RESOLUTION` rad (up to about
+        8.4e6 rad), a translation (model units) to that fraction of the mechanism's size: at
+        ``q = 1e300`` every sample would be computed from noise and marked valid.
+        """
+        from planar.core.limits import RESOLUTION
+
+        if not q.size:
+            return
+        qmax = float(np.abs(q).max())
+        unit, fine = ("rad", RESOLUTION) if self.driver.kind != "translation" else ("model units", RESOLUTION * self.size)
+        if float(np.spacing(qmax)) > fine:
+            far = math.ldexp(1.0, math.frexp(fine)[1] + 52)  # the largest power of two float64 resolves that finely
+            raise InputError(
+                f"{self.name}.solve(q)",
+                f"a driver value of {qmax:.6g} {unit}",
+                f"driver values within about {far:.3g} {unit} of zero: float64 resolves {float(np.spacing(qmax)):.3g} "
+                f"{unit} there, coarser than {fine:.3g} {unit} (take the value modulo a turn, or move it nearer zero)",
+            )
+
     def solve(self, q: ArrayLike, t: ArrayLike | None = None) -> Motion:
-        """Solve all samples at once for driver values ``q`` (scalar or array)."""
+        """Solve all samples at once for driver values ``q`` (scalar or array).
+
+        Raises :class:`~planar.errors.InputError` for driver values float64 cannot resolve finely
+        enough (beyond about 8.4e6 rad for a turning driver).
+        """
         self._check_placement()
         if isinstance(q, np.ma.MaskedArray) or np.asarray(q).dtype == bool:
             raise InputError(
@@ -781,6 +827,7 @@ class Mechanism:
             need = limits.motion_bytes(len(self.parts), len(self.points), float(n_q))
         limits.check_memory(f"{self.name}.solve(q)", f"{n_q:,} driver values", need + held, "a motion")
         qin = np.atleast_1d(check_finite(f"{self.name}.driver value", q))
+        self._check_driver_resolution(qin)
         qa = new_block(qin.shape)  # the motion's own copy (recycled memory for a large batch)
         np.copyto(qa, qin)
         if qa.ndim != 1:  # an OzT driver's path is a function of its 1-D driver value too

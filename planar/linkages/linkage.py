@@ -67,6 +67,9 @@ class Link:
     guide: tuple[str, str] | None = None
 
     def __post_init__(self) -> None:
+        from planar.core.model import _check_name
+
+        _check_name("Link.name", self.name)
         if isinstance(self.nodes, (str, bytes)) or not all(isinstance(n, str) for n in self.nodes):
             raise InputError(f"Link {self.name!r}.nodes", self.nodes, "a sequence of node names (('O', 'A'), not 'OA')")
 
