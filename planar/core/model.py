@@ -118,6 +118,18 @@ def _check_name(field: str, name: object) -> None:
         raise InputError(field, name, "a name without control characters (newline, tab, NUL)")
 
 
+def _check_joint(joint: Any, points: tuple[str, ...], size: str | None) -> None:
+    """Refuse a joint whose names are not names, whose points are not two finite numbers or whose ``size``
+    (a pin diameter or a slot width, when given) is not a positive length; the message names the joint's field."""
+    kind = type(joint).__name__
+    for f in ("name", "a", "b"):
+        _check_name(f"{kind}.{f}", getattr(joint, f))
+    for f in points:
+        check_point(f"{kind} {joint.name!r}.{f}", getattr(joint, f))
+    if size is not None and getattr(joint, size) is not None:
+        check_positive(f"{kind} {joint.name!r}.{size}", getattr(joint, size))
+
+
 def _vec(v: ArrayLike) -> Vec:
     a = np.asarray(v, dtype=float).reshape(2)
     return (float(a[0]), float(a[1]))
@@ -271,6 +283,9 @@ class Pivot:
     anchor_b: Vec
     diameter: float | None = None
 
+    def __post_init__(self) -> None:
+        _check_joint(self, ("anchor_a", "anchor_b"), "diameter")
+
     def residual(self, poses: Mapping[str, Array]) -> Array:
         """Distance between the two anchor points, per sample."""
         pa = poses_apply(_pose(poses, self.a), self.anchor_a)
@@ -305,6 +320,9 @@ class PinInSlot:
     end: Vec
     pin: Vec
     width: float | None = None
+
+    def __post_init__(self) -> None:
+        _check_joint(self, ("start", "end", "pin"), "width")
 
     def residual(self, poses: Mapping[str, Array]) -> Array:
         p = poses_apply(_pose(poses, self.b), self.pin)
@@ -378,6 +396,9 @@ class Slide:
     anchor: Vec
     axis: Vec
     width: float | None = None
+
+    def __post_init__(self) -> None:
+        _check_joint(self, ("start", "end", "anchor", "axis"), "width")
 
     def pin_points(self) -> tuple[Vec, Vec]:
         """The two pins of ``b`` in its own frame: ``anchor`` and ``anchor + axis``."""
@@ -955,4 +976,8 @@ def _with_joint_features(parts: tuple[Part, ...], joints: Sequence[Any]) -> tupl
 
 def joint_residuals(mech: Mechanism, motion: Motion) -> dict[str, Array]:
     """Residual (model units) of every joint of ``mech`` on every sample of ``motion``."""
+    if not isinstance(mech, Mechanism):
+        raise InputError("mech", type(mech).__name__, "a Mechanism")
+    if not isinstance(motion, Motion):
+        raise InputError("motion", type(motion).__name__, "a Motion (from mech.solve or mech.run)")
     return {j.name: np.asarray(j.residual(motion.poses)) for j in mech.joints}
