@@ -610,7 +610,7 @@ def add_parser(sub: Any) -> None:
     p.set_defaults(func=_cmd_path)
 
     a = ss.add_parser("atlas", help="build the coupler-curve atlas untimed path synthesis searches (cached)")
-    a.add_argument("--size", type=int, default=1_000_000, help="four-bars in the atlas (1000000: about 40 s, 100 MB)")
+    a.add_argument("--size", type=int, default=1_000_000, help="four-bars in the atlas (1000000: about 25 s of CPU, 112 MB)")
     a.add_argument("--seed", type=int, default=0, help="random seed (same size and seed, same atlas)")
     a.add_argument("-o", "--output", default=None, help="atlas file (.npz) to write (default: the user cache folder)")
     a.add_argument("--force", action="store_true", help="rebuild even if the file exists")

@@ -215,7 +215,8 @@ def _chunk(seed: int, index: int, n: int) -> tuple[Array, Array, Array]:
 def build_atlas(size: int = DEFAULT_SIZE, seed: int = 0, progress: bool = False) -> Atlas:
     """Build an atlas of ``size`` four-bars (deterministic for ``size`` and ``seed``; see the module).
 
-    ``progress``: show a progress bar (on standard error when it is a terminal).  About 40 s of CPU per million entries.
+    ``progress``: show a progress bar (on standard error when it is a terminal).  About 25 s of CPU per
+    million entries (:data:`BUILD_S_PER_MILLION`).
     """
     if size < 100:
         raise InputError("atlas size", size, "at least 100 four-bars")

@@ -191,7 +191,7 @@ def test_synth_atlas_into_an_unwritable_folder_is_refused_before_the_build(tmp_p
     "argv",
     [
         ["motion", str(GALLERY / "kangaroo-leg.toml"), "-o", "{d}/m.csv"],
-        ["plot", str(GALLERY / "kangaroo-leg.toml"), "-o", "{d}/p.png"],
+        pytest.param(["plot", str(GALLERY / "kangaroo-leg.toml"), "-o", "{d}/p.png"], marks=pytest.mark.slow),
         pytest.param(["design", "{tmp}/req.toml", "-o", "{d}/toy.toml"], marks=pytest.mark.slow),
     ],
 )
@@ -213,6 +213,7 @@ def test_an_output_under_a_regular_file_says_it_is_a_file(tmp_path: Path, capsys
 # ----------------------------------------------------------------------------- 4. progress bars only on a terminal
 
 
+@pytest.mark.slow
 def test_progress_bars_are_silent_when_stderr_is_not_a_terminal(tmp_path: Path, capsys) -> None:
     """``synth atlas`` printed tqdm bars into a pipe."""
     out = tmp_path / "a.npz"
@@ -273,7 +274,10 @@ def test_plot_mechanism_takes_one_chart_name_and_names_the_python_argument(tmp_p
 # ----------------------------------------------------------------------------- 7. non-finite SVG coordinates
 
 
-@pytest.mark.parametrize("name,value", [("cx", "nan"), ("cy", "inf"), ("r", "NaN")])
+@pytest.mark.parametrize(
+    "name,value",
+    [("cx", "nan"), pytest.param("cy", "inf", marks=pytest.mark.slow), pytest.param("r", "NaN", marks=pytest.mark.slow)],
+)
 def test_an_svg_with_a_nan_coordinate_is_refused(tmp_path: Path, capsys, name: str, value: str) -> None:
     """svgelements reads ``cx="nan"`` as 0: the synthesis ran on a made-up circle and wrote a scene."""
     attrs = {"cx": "30", "cy": "20", "r": "5", name: value}
@@ -298,7 +302,11 @@ def test_tiny_targets_give_their_real_size(tmp_path: Path, capsys) -> None:
     "edit,needle",
     [
         (("local = [", "local = [0.0, "), "mechanism.nodes.T1.local = [0.0, "),
-        (("members = [", 'members = ["T2"]\n# '), "mechanism.nodes.T1.members = ['T2']: expected more items"),
+        pytest.param(
+            ("members = [", 'members = ["T2"]\n# '),
+            "mechanism.nodes.T1.members = ['T2']: expected more items",
+            marks=pytest.mark.slow,
+        ),
     ],
 )
 def test_scene_type_errors_name_the_node_in_planars_words(tmp_path: Path, capsys, edit, needle: str) -> None:
