@@ -272,17 +272,36 @@ def check_output(
     if directory:
         if p.exists() and not p.is_dir():
             raise InputError(option, text, "a folder (it is an existing file)")
+        home = p if p.is_dir() else (p.parent if str(p.parent) else Path("."))
+        if home.is_dir():
+            _check_writable(option, text, home)
         return
     if p.is_dir() or text.endswith(("/", os.sep)):
         raise InputError(option, text, "a file name (it is a folder)")
     parent = p.parent if str(p.parent) else Path(".")
     if not parent.is_dir():
+        where = next((a for a in (parent, *parent.parents) if a.exists()), None)
+        if where is not None and not where.is_dir():
+            raise InputError(option, text, f"a path in a folder ({where} is a file, not a folder)")
         raise InputError(option, text, f"a path in an existing folder ({parent} does not exist)")
     if suffixes and p.suffix.lower() not in suffixes:
         raise InputError(option, text, f"a file name ending in {' or '.join(suffixes)} (the format it writes)")
     for src in inputs:
         if _same_file(p, Path(src)) or os.path.realpath(p) == os.path.realpath(src):
             raise InputError(option, text, f"an output other than the input {src} (it would be overwritten)")
+    _check_writable(option, text, parent)
+
+
+def _check_writable(option: str, text: str, parent: Path) -> None:
+    """Refuse a folder no file can be created in, before any work (a temporary is made there and removed:
+    permission bits alone do not tell, e.g. for root on a read-only mount)."""
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{Path(text).name}.{os.getpid()}.", suffix=".part", dir=parent)
+    except OSError as e:
+        raise InputError(option, text, f"a path in a folder it can write to ({parent}: {e.strerror})") from None
+    os.close(fd)
+    with contextlib.suppress(OSError):
+        os.unlink(tmp)
 
 
 def check_name(field: str, name: str) -> str:

@@ -312,7 +312,7 @@ def write_scene_motion(scene: Scene, out: str | Path, derivatives: bool = False,
     from planar.fileio import write_motion_csv
 
     if Path(out).suffix.lower() != ".csv":
-        raise InputError("output", str(out), "a .csv file (the motion table is CSV)")
+        raise InputError("out", str(out), "a .csv file (the motion table is CSV)")
     mech, motion = table_motion(scene.mechanism, scene.motion(), notes=notes)
     if not derivatives:
         write_motion_csv(out, mech, motion)
@@ -483,8 +483,11 @@ def write_mechanism_motion(mech: Mechanism, out: str | Path, derivatives: bool =
     return write_scene_motion(scene_from_mechanism(mech, **tables), out, derivatives=derivatives)
 
 
-def plot_mechanism(mech: Mechanism, out: str | Path, what: list[str] | None = None, **tables: Any) -> list[str]:
-    """The charts of a mechanism built in Python (PNG or SVG), as ``planar plot`` draws them."""
+def plot_mechanism(mech: Mechanism, out: str | Path, what: list[str] | str | None = None, **tables: Any) -> list[str]:
+    """The charts of a mechanism built in Python (PNG or SVG), as ``planar plot`` draws them.
+
+    ``what``: a chart name (``"curve"``) or a list of them; all that apply when ``None``.
+    """
     from planar.draw.charts import write_plot
     from planar.scene.load import scene_from_mechanism
 

@@ -127,7 +127,6 @@ def bench_accuracy(
     over the first ``effects_fraction`` of a four-bar's cycle.
     """
     import csv
-    import sys
     from dataclasses import replace
     from pathlib import Path
 
@@ -164,9 +163,9 @@ def bench_accuracy(
     total = len(measured) * len(settings)
     bar = None
     if progress:
-        from tqdm import tqdm
+        from planar.core.progress import progress_bar
 
-        bar = tqdm(total=total, desc="accuracy", unit="run", disable=not sys.stderr.isatty(), leave=False)
+        bar = progress_bar(total, "accuracy", "run")
     for sc in measured:
         ref = sc.motion()
         t_ref = _times(ref)

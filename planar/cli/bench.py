@@ -38,10 +38,10 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     if args.name == "accuracy":
         from planar.fileio import check_output
 
-        check_output("-o", args.output, (), directory=True)  # before the minutes of work, not after
+        check_output("-o/--output", args.output, (), directory=True)  # before the minutes of work, not after
         parent = os.path.dirname(os.path.abspath(args.output))
         if not os.path.isdir(parent):
-            raise InputError("-o", args.output, f"a folder in an existing folder ({parent} does not exist)")
+            raise InputError("-o/--output", args.output, f"a folder in an existing folder ({parent} does not exist)")
         if not os.path.isdir(args.scenes):
             raise InputError("--scenes", args.scenes, "an existing folder of scene files")
         kwargs["scenes"] = args.scenes

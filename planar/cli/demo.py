@@ -14,7 +14,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     from planar.fileio import check_output
 
     # each file is written atomically; not one transaction, as DEMO_EXTRAS may read what the demo wrote
-    check_output("-o", args.output, (), directory=True)
+    check_output("-o/--output", args.output, (), directory=True)
     for line in run_demo(args.output):
         print(line)
     return 0

@@ -28,14 +28,10 @@ def _cmd_design(args: argparse.Namespace) -> int:
     import tomllib
 
     from planar.errors import InputError
+    from planar.fileio import check_output
     from planar.synth.design import TOLERANCE, design_scene, design_toy, load_request, physics_check
 
-    out = Path(args.output)
-    parent = out.parent if str(out.parent) else Path(".")
-    if not parent.is_dir() or out.is_dir() or out.suffix != ".toml":
-        raise InputError("--output", args.output, "a .toml file name in an existing directory")
-    if out.exists() and out.resolve() == Path(args.request).resolve():
-        raise InputError("--output", args.output, "a file other than the request")
+    check_output("-o/--output", args.output, (".toml",), (args.request,))  # before any work, as every command
     from planar.core.limits import check_count
 
     if args.max_length < 1:

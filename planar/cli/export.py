@@ -14,7 +14,7 @@ __all__ = ["add_parser"]
 
 #: export's outputs: (option, attribute, suffixes)
 _EXPORT_OUTPUTS = (
-    ("-o", "output", (".dxf",)),
+    ("-o/--output", "output", (".dxf",)),
     ("--svg", "svg", (".svg",)),
     ("--preview", "preview", (".png",)),
     ("--bom", "bom", (".csv",)),

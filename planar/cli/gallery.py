@@ -12,7 +12,7 @@ def _cmd_gallery(args: argparse.Namespace) -> int:
     from planar.app.pipeline import build_gallery
     from planar.fileio import check_output, output_transaction
 
-    check_output("-o", args.output, (), directory=True)
+    check_output("-o/--output", args.output, (), directory=True)
     with output_transaction():  # all GIFs or none: a bad scene leaves no half gallery
         done = list(build_gallery(args.source, args.output))
     for path, target, n in done:

@@ -14,7 +14,7 @@ import argparse
 import os
 import sys
 from collections.abc import Sequence
-from typing import NoReturn
+from typing import ClassVar, NoReturn
 
 from planar.errors import PlanarError
 
@@ -24,9 +24,32 @@ __all__ = ["COMMANDS", "build_parser", "main"]
 class _Parser(argparse.ArgumentParser):
     """An argument parser whose errors are one line: ``planar: error: render: ... (see planar render --help)``."""
 
+    #: the command line being parsed (for :meth:`_explain`)
+    argv: ClassVar[list[str]] = []
+
     def error(self, message: str) -> NoReturn:
         sub = self.prog.split(" ", 1)[1] + ": " if " " in self.prog else ""
-        self.exit(2, f"planar: error: {sub}{message} (see {self.prog} --help)\n")
+        self.exit(2, f"planar: error: {sub}{self._explain(message)} (see {self.prog} --help)\n")
+
+    def _explain(self, message: str) -> str:
+        """argparse's "expected one argument" said with what the option takes; a value that starts with '-'
+        (read as an option) is shown in the form that passes it (``--sheet=-5x-5``)."""
+        import re
+
+        m = re.fullmatch(r"argument (\S+): expected one argument", message)
+        if m is None:
+            return message
+        names = m.group(1).split("/")
+        action = next((a for a in self._actions if set(a.option_strings) & set(names)), None)
+        what = re.sub(r"\s*\(default[^)]*\)", "", action.help) if action is not None and action.help else "a value"
+        text = f"argument {m.group(1)}: expected a value after it ({what})"
+        argv = type(self).argv
+        for i, tok in enumerate(argv[:-1]):
+            nxt = argv[i + 1]
+            if tok in names and nxt.startswith("-") and len(nxt) > 1:
+                text += f"; {nxt!r} was read as an option: a value starting with '-' is written {tok}={nxt}"
+                break
+        return text
 
 
 #: every command: its name and the module that adds it (``add_parser(sub)``); a module is imported only
@@ -117,6 +140,7 @@ def _main(argv: Sequence[str] | None) -> int:
     import warnings
 
     parser = build_parser()
+    _Parser.argv = list(argv) if argv is not None else sys.argv[1:]
     try:
         args = parser.parse_args(argv)
     except SystemExit as e:  # --help, or a usage error already printed on one line

@@ -14,7 +14,7 @@ def _cmd_motion(args: argparse.Namespace) -> int:
     from planar.app.pipeline import write_scene_motion
     from planar.scene.load import load_scene
 
-    outputs(args, (args.scene,), ("-o", "output", (".csv",)))
+    outputs(args, (args.scene,), ("-o/--output", "output", (".csv",)))
     scene = load_scene(args.scene)
     notes: list[str] = []
     motion = write_scene_motion(scene, args.output, derivatives=args.derivatives, notes=notes)
@@ -34,7 +34,7 @@ def _cmd_motion_catalog(args: argparse.Namespace) -> int:
     from planar.core.limits import MIN_SAMPLES_PER_CYCLE, check_count
     from planar.errors import InputError
 
-    outputs(args, (), ("-o", "output", (".csv",)))
+    outputs(args, (), ("-o/--output", "output", (".csv",)))
     positive("--samples", args.samples, integer=True)
     if args.samples < MIN_SAMPLES_PER_CYCLE:
         raise InputError("--samples", args.samples, f"at least {MIN_SAMPLES_PER_CYCLE} samples (a whole number)")

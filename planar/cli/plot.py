@@ -17,10 +17,12 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     if what is not None and not all(what):
         raise InputError("--what", args.what, "comma-separated chart names, e.g. curve,torque (no empty item)")
     from planar.app.pipeline import numeric_guard
+    from planar.cli.common import outputs
 
+    outputs(args, (args.scene,), ("-o/--output", "output", (".png", ".svg")))
     scene = load_scene(args.scene)
     with numeric_guard(scene, "the charts"):
-        charts = write_plot(scene, args.output, what, args.samples)
+        charts = write_plot(scene, args.output, what, args.samples, option="--what")
     print(f"wrote {args.output}: {', '.join(charts)}")
     return 0
 

@@ -16,7 +16,7 @@ def _cmd_render(args: argparse.Namespace) -> int:
     from planar.cli.compare import settings_from_args
     from planar.scene.load import load_scene
 
-    outputs(args, (args.scene,), ("-o", "output", ANIMATION_SUFFIXES))
+    outputs(args, (args.scene,), ("-o/--output", "output", ANIMATION_SUFFIXES))
     settings = settings_from_args(args)
     scene = load_scene(args.scene)
     notes: list[str] = []

@@ -18,7 +18,7 @@ def _cmd_schema(args: argparse.Namespace) -> int:
     from planar.scene.load import scene_schema
 
     text = json.dumps(scene_schema(), indent=2, sort_keys=True) + "\n"
-    outputs(args, (), ("-o", "output", (".json",)))
+    outputs(args, (), ("-o/--output", "output", (".json",)))
     if args.output is not None:
         with atomic_write(args.output, "w") as fh:
             fh.write(text)

@@ -52,7 +52,7 @@ def _check_output(args: argparse.Namespace, source: str) -> None:
     """The scene to write, checked before the search: a .toml file in an existing folder, not the input."""
     from planar.fileio import check_output
 
-    check_output("-o", args.output, (".toml",), (source,))
+    check_output("-o/--output", args.output, (".toml",), (source,))
 
 
 def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, Any], ok: bool, failing: list[str]) -> int:
@@ -220,7 +220,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
     if args.type == "sixbar":
         return _sixbar(args, targets, theta, cons)
     atlas = None
-    if args.atlas is not None and theta is None:
+    if args.atlas is not None:  # timed targets search the atlas too (it was ignored, and the cache built)
         from planar.synth.atlas import read_atlas
 
         atlas = read_atlas(args.atlas)
@@ -368,10 +368,10 @@ def _cmd_atlas(args: argparse.Namespace) -> int:
     if args.output is not None:  # like every output: an existing folder, no folder made for it
         from planar.fileio import check_output
 
-        check_output("-o", args.output, (".npz",))
+        check_output("-o/--output", args.output, (".npz",))
     path = args.output if args.output is not None else str(atlas_path(args.size, args.seed))
     if not path.endswith(".npz"):
-        raise InputError("-o", path, "an .npz file")
+        raise InputError("-o/--output", path, "an .npz file")
     if os.path.exists(path) and not args.force:
         a = read_atlas(path)
         print(f"{path}: atlas of {len(a)} four-bars exists (built in {a.build_seconds:.1f} s CPU); --force rebuilds it")
@@ -662,8 +662,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--atlas",
         default=None,
-        help="coupler-curve atlas file (from planar synth atlas -o) for untimed targets (default: the cached one, "
-        "built on first use)",
+        help="coupler-curve atlas file (from planar synth atlas -o) the search starts from (default: the cached one, "
+        "built on first use: 1,000,000 curves, about 25 s of CPU; 20,000 with --budget quick)",
     )
     p.add_argument(
         "--min-transmission",

@@ -13,6 +13,7 @@ are radians, counter-clockwise positive.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -50,6 +51,7 @@ __all__ = [
     "Slide",
     "Slot",
     "check_finite",
+    "check_point",
     "check_positive",
     "joint_kind",
     "joint_residuals",
@@ -102,8 +104,11 @@ class LazyPoses(FinitePoses):
         self.parts = parts
 
 
-def check_positive(field_name: str, value: float) -> float:
-    """Return ``value`` as float or raise :class:`InputError` unless a finite number > 0 (not a bool or a string)."""
+def check_positive(field_name: str, value: float, what: str = "length") -> float:
+    """Return ``value`` as float or raise :class:`InputError` unless a finite number > 0 (not a bool or a string).
+
+    ``what`` names the quantity in the message (``"a positive, finite rate"``).
+    """
     if isinstance(value, (bool, str, bytes, np.bool_)):
         raise InputError(field_name, value, "a positive number")
     try:
@@ -111,8 +116,16 @@ def check_positive(field_name: str, value: float) -> float:
     except (TypeError, ValueError):
         raise InputError(field_name, value, "a positive number") from None
     if not np.isfinite(v) or v <= 0.0:
-        raise InputError(field_name, value, "a positive, finite length")
+        raise InputError(field_name, value, f"a positive, finite {what}")
     return v
+
+
+def check_point(field_name: str, value: ArrayLike, what: str = "a point (x, y): two finite numbers") -> Vec:
+    """Return ``value`` as ``(x, y)`` or raise :class:`InputError` unless it is two finite numbers."""
+    a = check_finite(field_name, value)
+    if a.shape != (2,):
+        raise InputError(field_name, value, what)
+    return (float(a[0]), float(a[1]))
 
 
 def _check_name(field: str, name: object) -> None:
@@ -121,6 +134,18 @@ def _check_name(field: str, name: object) -> None:
         raise InputError(field, name, "a non-empty string")
     if any(ord(c) < 32 or ord(c) == 127 for c in name):
         raise InputError(field, name, "a name without control characters (newline, tab, NUL)")
+
+
+def _check_joint(joint: Any, points: tuple[str, ...], size: str | None) -> None:
+    """Refuse a joint whose names are not names, whose points are not two finite numbers or whose ``size``
+    (a pin diameter or a slot width, when given) is not a positive length; the message names the joint's field."""
+    kind = type(joint).__name__
+    for f in ("name", "a", "b"):
+        _check_name(f"{kind}.{f}", getattr(joint, f))
+    for f in points:
+        check_point(f"{kind} {joint.name!r}.{f}", getattr(joint, f))
+    if size is not None and getattr(joint, size) is not None:
+        check_positive(f"{kind} {joint.name!r}.{size}", getattr(joint, size))
 
 
 def _vec(v: ArrayLike) -> Vec:
@@ -276,6 +301,9 @@ class Pivot:
     anchor_b: Vec
     diameter: float | None = None
 
+    def __post_init__(self) -> None:
+        _check_joint(self, ("anchor_a", "anchor_b"), "diameter")
+
     def residual(self, poses: Mapping[str, Array]) -> Array:
         """Distance between the two anchor points, per sample."""
         pa = poses_apply(_pose(poses, self.a), self.anchor_a)
@@ -310,6 +338,9 @@ class PinInSlot:
     end: Vec
     pin: Vec
     width: float | None = None
+
+    def __post_init__(self) -> None:
+        _check_joint(self, ("start", "end", "pin"), "width")
 
     def residual(self, poses: Mapping[str, Array]) -> Array:
         p = poses_apply(_pose(poses, self.b), self.pin)
@@ -383,6 +414,9 @@ class Slide:
     anchor: Vec
     axis: Vec
     width: float | None = None
+
+    def __post_init__(self) -> None:
+        _check_joint(self, ("start", "end", "anchor", "axis"), "width")
 
     def pin_points(self) -> tuple[Vec, Vec]:
         """The two pins of ``b`` in its own frame: ``anchor`` and ``anchor + axis``."""
@@ -472,6 +506,7 @@ class Driver:
     def __post_init__(self) -> None:
         if not isinstance(self.part, str) or not self.part:
             raise InputError("driver.part", self.part, "the name of the part it drives (a non-empty string)")
+        _check_name("driver.part", self.part)
         if self.kind not in ("rotation", "translation", "path"):
             raise InputError("driver.kind", self.kind, "'rotation', 'translation' or 'path'")
         for f in ("origin", "axis"):
@@ -486,7 +521,13 @@ class Driver:
             amp = check_finite("driver.amplitude", self.amplitude)
             if amp.shape != () or not float(amp) > 0:
                 raise InputError("driver.amplitude", self.amplitude, "a positive amplitude (the phase sets the direction)")
-        check_positive("driver.rate", self.rate)
+        check_positive("driver.rate", self.rate, "rate (rad/s)")
+        from planar.core.limits import check_angle  # an angle float64 resolves (not a phase of 1e300 rad)
+
+        check_angle("driver.phase", self.phase)
+        if self.kind != "translation":  # a translation's centre and amplitude are lengths
+            check_angle("driver.centre", self.centre)
+            check_angle("driver.amplitude", self.amplitude or 0.0)
         if self.kind == "translation" and self.amplitude is None:
             raise InputError("driver.amplitude", None, "a stroke amplitude for a translation driver")
 
@@ -802,8 +843,34 @@ class Mechanism:
             check_scale(self.name, self, size_range=False)
             self.__dict__["_placement_checked"] = True
 
+    def _check_driver_resolution(self, q: Array) -> None:
+        """Refuse driver values so large that float64's spacing there is coarser than the mechanism needs.
+
+        An angle (rad) must be resolved to :data:`planar.core.limits.RESOLUTION` rad (up to about
+        8.4e6 rad), a translation (model units) to that fraction of the mechanism's size: at
+        ``q = 1e300`` every sample would be computed from noise and marked valid.
+        """
+        from planar.core.limits import RESOLUTION
+
+        if not q.size:
+            return
+        qmax = float(np.abs(q).max())
+        unit, fine = ("rad", RESOLUTION) if self.driver.kind != "translation" else ("model units", RESOLUTION * self.size)
+        if float(np.spacing(qmax)) > fine:
+            far = math.ldexp(1.0, math.frexp(fine)[1] + 52)  # the largest power of two float64 resolves that finely
+            raise InputError(
+                f"{self.name}.solve(q)",
+                f"a driver value of {qmax:.6g} {unit}",
+                f"driver values within about {far:.3g} {unit} of zero: float64 resolves {float(np.spacing(qmax)):.3g} "
+                f"{unit} there, coarser than {fine:.3g} {unit} (take the value modulo a turn, or move it nearer zero)",
+            )
+
     def solve(self, q: ArrayLike, t: ArrayLike | None = None) -> Motion:
-        """Solve all samples at once for driver values ``q`` (scalar or array)."""
+        """Solve all samples at once for driver values ``q`` (scalar or array).
+
+        Raises :class:`~planar.errors.InputError` for driver values float64 cannot resolve finely
+        enough (beyond about 8.4e6 rad for a turning driver).
+        """
         self._check_placement()
         if isinstance(q, np.ma.MaskedArray) or np.asarray(q).dtype == bool:
             raise InputError(
@@ -825,6 +892,7 @@ class Mechanism:
             need = limits.motion_bytes(len(self.parts), len(self.points), float(n_q))
         limits.check_memory(f"{self.name}.solve(q)", f"{n_q:,} driver values", need + held, "a motion")
         qin = np.atleast_1d(check_finite(f"{self.name}.driver value", q))
+        self._check_driver_resolution(qin)
         qa = new_block(qin.shape)  # the motion's own copy (recycled memory for a large batch)
         np.copyto(qa, qin)
         if qa.ndim != 1:  # an OzT driver's path is a function of its 1-D driver value too
@@ -952,4 +1020,8 @@ def _with_joint_features(parts: tuple[Part, ...], joints: Sequence[Any]) -> tupl
 
 def joint_residuals(mech: Mechanism, motion: Motion) -> dict[str, Array]:
     """Residual (model units) of every joint of ``mech`` on every sample of ``motion``."""
+    if not isinstance(mech, Mechanism):
+        raise InputError("mech", type(mech).__name__, "a Mechanism")
+    if not isinstance(motion, Motion):
+        raise InputError("motion", type(motion).__name__, "a Motion (from mech.solve or mech.run)")
     return {j.name: np.asarray(j.residual(motion.poses)) for j in mech.joints}

@@ -74,14 +74,22 @@ def _is_cam(mech: Mechanism) -> bool:
     return isinstance(mech, CamMechanism)
 
 
-def _parse_what(scene: Scene, what: Sequence[str] | None) -> list[str]:
+def _parse_what(scene: Scene, what: Sequence[str] | str | None, option: str = "what") -> list[str]:
+    """The charts asked for (a name or a list of names; all that apply when ``None``); ``option`` names the
+    argument in messages (``what`` from Python, ``--what`` on the command line)."""
     avail = available_charts(scene)
     if what is None:
         return avail
+    if isinstance(what, str):  # one chart's name, not its letters
+        what = [what]
+    try:
+        items = list(what)
+    except TypeError:
+        raise InputError(option, what, f"a chart name or a list of them, of {', '.join(avail)}") from None
     chosen = []
-    for w in what:
-        if w not in CHARTS:
-            raise InputError("--what", w, f"one of {', '.join(CHARTS)}")
+    for w in items:
+        if not isinstance(w, str) or w not in CHARTS:
+            raise InputError(option, w, f"one of {', '.join(CHARTS)}")
         if w not in avail:
             why = (
                 "it has no named points"
@@ -90,11 +98,11 @@ def _parse_what(scene: Scene, what: Sequence[str] | None) -> list[str]:
                 if w in ("follower", "pressure")
                 else "it has no RRR dyad"
             )
-            raise InputError("--what", w, f"a chart that applies to {scene.name!r} ({why}); it has {', '.join(avail)}")
+            raise InputError(option, w, f"a chart that applies to {scene.name!r} ({why}); it has {', '.join(avail)}")
         if w not in chosen:
             chosen.append(w)
     if not chosen:
-        raise InputError("--what", ",".join(what), f"at least one chart, of {', '.join(avail)}")
+        raise InputError(option, ",".join(items), f"at least one chart, of {', '.join(avail)}")
     return chosen
 
 
@@ -133,7 +141,7 @@ def _motion(scene: Scene, samples_per_cycle: int | None) -> Motion:
 
 
 def scene_figure(
-    scene: Scene, what: Sequence[str] | None = None, width_in: float = 6.4, samples_per_cycle: int | None = None
+    scene: Scene, what: Sequence[str] | str | None = None, width_in: float = 6.4, samples_per_cycle: int | None = None
 ) -> Figure:
     """The charts ``what`` (default: every chart that applies) of ``scene``, stacked in one figure.
 
@@ -272,18 +280,23 @@ def _render(fig: Any, fmt: str) -> bytes:
 
 
 def write_plot(
-    scene: Scene, out: str | os.PathLike[str], what: Sequence[str] | None = None, samples_per_cycle: int | None = None
+    scene: Scene,
+    out: str | os.PathLike[str],
+    what: Sequence[str] | str | None = None,
+    samples_per_cycle: int | None = None,
+    option: str = "what",
 ) -> list[str]:
     """Write the charts of ``scene`` to ``out`` (``.png`` or ``.svg``, reproducible bytes); returns the charts.
 
-    ``what`` and ``samples_per_cycle`` as for :func:`scene_figure`.
+    ``what`` (a chart name or a list of them) and ``samples_per_cycle`` as for :func:`scene_figure`;
+    ``option`` names ``what`` in messages (``--what`` for the command line).
     """
     from planar.fileio import atomic_write
 
     ext = os.path.splitext(str(out))[1].lower().lstrip(".")
     if ext not in ("png", "svg"):
-        raise InputError("-o", str(out), "a .png or .svg file name")
-    charts = _parse_what(scene, what)
+        raise InputError("out", str(out), "a .png or .svg file name")
+    charts = _parse_what(scene, what, option)
     fig = scene_figure(scene, charts, samples_per_cycle=samples_per_cycle)
     data = _render(fig, ext)
     with atomic_write(out, "wb") as fh:

@@ -515,11 +515,9 @@ class Renderer:
         threads = threads or os.cpu_count() or 1
         bar = None
         if progress:
-            import sys
+            from planar.core.progress import progress_bar
 
-            from tqdm import tqdm
-
-            bar = tqdm(total=n, desc="render", unit="frame", disable=not sys.stderr.isatty(), leave=False)
+            bar = progress_bar(n, "render", "frame")
         from concurrent.futures import ThreadPoolExecutor
 
         # the geometry is computed a chunk at a time and only that chunk's frames are queued: memory stays flat

@@ -60,6 +60,10 @@ def _omega(pos: Mapping[str, Array], vel: Mapping[str, Array], node: str, centre
     return (r[:, 0] * v[:, 1] - r[:, 1] * v[:, 0]) / (r * r).sum(-1)
 
 
+#: the gear ratios (their size, ``|ratio|``) a pair of pitch circles can have in a drawing and a cut file
+RATIO_RANGE = (1e-6, 1e6)
+
+
 @node_kind
 @dataclass(frozen=True)
 class Geared(NodeKind):
@@ -78,9 +82,6 @@ class Geared(NodeKind):
     #: the node it meshes with (set when the linkage is built, :meth:`bind`)
     base: NodeKind | None = field(default=None, compare=False, repr=False)
 
-    def __post_init__(self) -> None:  # refused where it is built, not first at the linkage
-        self.validate(f"nodes.{self.name}")
-
     def refs(self) -> tuple[str, ...]:
         return (self.centre, self.mesh)
 
@@ -94,9 +95,19 @@ class Geared(NodeKind):
             raise InputError(f"{where}.mesh", self.mesh, "the gear it meshes with, not its own centre")
         check_positive(f"{where}.radius", self.radius)
         check_finite(f"{where}.phase", self.phase)
+        from planar.core.limits import check_angle  # an angle float64 resolves: not phase = 1e300
+
+        check_angle(f"{where}.phase", self.phase)
         if isinstance(self.ratio, (str, bytes, bool)):
             raise InputError(f"{where}.ratio", self.ratio, "a negative number")
         r = float(check_finite(f"{where}.ratio", self.ratio))
+        if r < 0 and not RATIO_RANGE[0] <= -r <= RATIO_RANGE[1]:
+            raise InputError(
+                f"{where}.ratio",
+                self.ratio,
+                f"a ratio from -{RATIO_RANGE[1]:g} to -{RATIO_RANGE[0]:g} (beyond, one gear's pitch circle is less "
+                f"than {RATIO_RANGE[0]:g} of the distance between the centres)",
+            )
         if not r < 0:
             raise InputError(
                 f"{where}.ratio",

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from planar.core.model import Mechanism, Part, Pivot
+from planar.core.model import LazyPoses, Mechanism, Part, Pivot
 from planar.core.registry import Registry
 from planar.errors import InputError
 from planar.linkages.linkage import Link, Linkage
@@ -328,7 +328,7 @@ class LegsAssembly(Mechanism):
 
     def _solve_points(self, q: Array) -> tuple[dict[str, Array], Any, Any]:
         poses, checks, pts = self.legs._solve_points(q)
-        out = dict(poses)
+        out = dict(poses.make() if isinstance(poses, LazyPoses) else poses)  # the parts' poses, renamed below
         shaft = out.pop("crankshaft")
         g = out.pop(self.legs.ground_name)
         for w in self.webs:

@@ -67,6 +67,9 @@ class Link:
     guide: tuple[str, str] | None = None
 
     def __post_init__(self) -> None:
+        from planar.core.model import _check_name
+
+        _check_name("Link.name", self.name)
         if isinstance(self.nodes, (str, bytes)) or not all(isinstance(n, str) for n in self.nodes):
             raise InputError(f"Link {self.name!r}.nodes", self.nodes, "a sequence of node names (('O', 'A'), not 'OA')")
 
@@ -127,6 +130,17 @@ class Linkage(Mechanism):
         pin_diameter: float | None = None,
         ground: str = "ground",
     ) -> None:
+        from planar.core.model import _check_name
+
+        _check_name("Linkage.name", name)
+        for arg, seq, cls in (("nodes", nodes, NodeKind), ("links", links, Link)):
+            if isinstance(seq, (str, bytes)) or not hasattr(seq, "__iter__"):
+                raise InputError(f"{name}.{arg}", seq, f"a list of {cls.__name__} objects")
+            bad = next((x for x in seq if not isinstance(x, cls)), None)
+            if bad is not None:
+                raise InputError(f"{name}.{arg}", bad, f"a list of {cls.__name__} objects (planar.linkages)")
+        if points is not None and not isinstance(points, Mapping):
+            raise InputError(f"{name}.points", points, "a dict of point name -> node name (or None)")
         self.name = name
         self.nodes: tuple[NodeKind, ...] = tuple(nodes)
         pl = check_finite(f"{name}.placement", placement)

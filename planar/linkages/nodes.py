@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planar.core.geometry import circle_circle, line_circle
-from planar.core.model import check_finite, check_positive
+from planar.core.model import _check_name, check_finite, check_point, check_positive
 from planar.errors import InputError
 
 __all__ = [
@@ -213,6 +213,11 @@ class NodeKind:
         """The nodes this one is placed from (declared before it)."""
         return ()
 
+    def __post_init__(self) -> None:
+        """Refused where it is built, not first at the linkage: its name and its kind's own checks."""
+        _check_name(f"{type(self).__name__}.name", self.name)
+        self.validate(f"nodes.{self.name}")
+
     def validate(self, where: str) -> None:
         """Raise :class:`InputError` (naming ``where``) for unusable values."""
 
@@ -293,11 +298,8 @@ class Fixed(NodeKind):
     name: str
     xy: Vec
 
-    def __post_init__(self) -> None:  # refused where it is built, not first at the linkage
-        self.validate(f"nodes.{self.name}")
-
     def validate(self, where: str) -> None:
-        check_finite(f"{where}.xy", self.xy)
+        check_point(f"{where}.xy", self.xy)
 
     def position(self, pos: Mapping[str, Array], q: Array, path: Mask) -> tuple[Array, Check | None]:
         return np.broadcast_to(np.asarray(self.xy, float), (q.shape[0], 2)), None
@@ -334,6 +336,9 @@ class Crank(NodeKind):
     def validate(self, where: str) -> None:
         check_positive(f"{where}.radius", self.radius)
         check_finite(f"{where}.phase", self.phase)
+        from planar.core.limits import check_angle  # an angle float64 resolves: not phase = 1e300
+
+        check_angle(f"{where}.phase", self.phase)
 
     def position(self, pos: Mapping[str, Array], q: Array, path: Mask) -> tuple[Array, Check | None]:
         a = q + self.phase
@@ -367,7 +372,7 @@ class Actuator(NodeKind):
         return (self.origin,)
 
     def validate(self, where: str) -> None:
-        ax = check_finite(f"{where}.axis", self.axis)
+        ax = check_point(f"{where}.axis", self.axis, "a direction (x, y): two finite numbers")
         if np.hypot(*ax) == 0:
             raise InputError(f"{where}.axis", self.axis, "a non-zero direction")
         check_finite(f"{where}.offset", self.offset)
@@ -390,7 +395,7 @@ class Actuator(NodeKind):
 
 
 def _check_branch(where: str, branch: int) -> None:
-    if branch not in (1, -1):
+    if isinstance(branch, (bool, np.bool_)) or branch not in (1, -1):
         raise InputError(f"{where}.branch", branch, "+1 or -1")
 
 
@@ -573,7 +578,7 @@ class Rigid(NodeKind):
         return (self.a, self.b)
 
     def validate(self, where: str) -> None:
-        check_finite(f"{where}.local", self.local)
+        check_point(f"{where}.local", self.local)
 
     def held_by(self) -> tuple[tuple[str, ...], ...]:
         # its distance from ``a``; the direction ``a -> b`` may be held by a guide (a cylinder along its rod)

@@ -44,7 +44,7 @@ from typing import ClassVar, cast
 import numpy as np
 from numpy.typing import NDArray
 
-from planar.core.model import check_finite, check_positive
+from planar.core.model import check_point, check_positive
 from planar.errors import InputError
 from planar.linkages.nodes import Check, Mask, NodeKind, Vec, node_kind
 
@@ -250,9 +250,11 @@ class Triad(NodeKind):
 
     def validate(self, where: str) -> None:
         check_positive(f"{where}.ra", self.ra)
-        check_finite(f"{where}.local", self.local)
-        check_finite(f"{where}.at", self.at)
+        check_point(f"{where}.local", self.local)
+        check_point(f"{where}.at", self.at)
         if self.members is not None:
+            if isinstance(self.members, (str, bytes)):
+                raise InputError(f"{where}.members", self.members, "the two other nodes of the triad (a list of two names)")
             ms = tuple(self.members)
             if len(ms) != 2 or len(set(ms)) != 2 or self.name in ms:
                 raise InputError(f"{where}.members", list(ms), "the two other nodes of the triad")

@@ -487,6 +487,29 @@ def _simulated_motion(
     return Motion(driver=analytic.driver, poses=out, valid=valid, fail_code=code, fail_table=table, points=pts, t=t)
 
 
+def _check_simulate_args(mech: Any, t: Any, effects: Any, settings: Any, mode: Any, densities: Any) -> NDArray[np.float64]:
+    """:func:`simulate`'s arguments checked at its entrance (each named); the output times as a 1-D array."""
+    from planar.core.model import check_finite
+    from planar.errors import InputError
+
+    if not isinstance(mech, Mechanism):
+        raise InputError("mech", type(mech).__name__, "a Mechanism (planar.FourBar, a Linkage, a scene's .mechanism)")
+    times = check_finite("t", t)
+    if times.ndim != 1:
+        raise InputError("t", f"an array of shape {times.shape}", "a 1-D array of output times (s)")
+    if times.size >= 2 and not bool(np.all(np.diff(times) > 0)):
+        raise InputError("t", times, "increasing output times (s), evenly spaced")
+    if effects is not None and not all(hasattr(effects, f) for f in ("gravity", "damping", "density", "springs", "loads")):
+        raise InputError("effects", type(effects).__name__, "an Effects record, or a scene's effects (or None)")
+    if not isinstance(settings, SimSettings):
+        raise InputError("settings", type(settings).__name__, "a SimSettings")
+    if not isinstance(mode, str):
+        raise InputError("mode", mode, "'kinematic' or 'motor'")
+    if densities is not None and not (isinstance(densities, dict) and all(isinstance(k, str) for k in densities)):
+        raise InputError("densities", type(densities).__name__, "a dict of part name -> density (or None)")
+    return times
+
+
 def simulate(
     mech: Mechanism,
     t: Array,
@@ -507,9 +530,9 @@ def simulate(
     poses of the physics steps are solved a chunk at a time, so memory grows
     with the samples, not with the steps.
     """
+    t = _check_simulate_args(mech, t, effects, settings, mode, densities)
     _check_mechanism(mech)
     _check_mode(mech, mode)
-    t = np.asarray(t, float)
     if t.size < 2:
         raise PlanarError("simulate: needs at least two output times")
     dt_out = float(t[1] - t[0])

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -129,8 +130,72 @@ class Scene:
         )
 
 
-def _angle(spec: SceneSpec, v: float) -> float:
-    return math.radians(v) if spec.angle_unit == "deg" else float(v)
+#: while a scene builds: each angle converted to radians -> the value as the file gives it (for messages)
+_SHOWN: ContextVar[dict[float, Any] | None] = ContextVar("planar_scene_angles", default=None)
+
+
+def _angle(spec: SceneSpec, v: float, field: str = "") -> float:
+    """``v`` (the scene's angle unit) in radians; ``field`` named: refused first if float64 cannot resolve it."""
+    if field:
+        _check_scene_angle(spec, field, v)
+    r = math.radians(v) if spec.angle_unit == "deg" else float(v)
+    shown = _SHOWN.get()
+    if shown is not None and spec.angle_unit == "deg":
+        shown[r] = v
+    return r
+
+
+def _check_scene_angle(spec: SceneSpec, field: str, v: float) -> None:
+    """:class:`InputError` if the angle ``v`` (the scene's unit) reaches beyond :data:`~planar.core.limits.MAX_ANGLE`
+    rad; the value as written and the bound in the scene's unit (a NaN or a non-number is the model's to refuse)."""
+    from planar.core.limits import MAX_ANGLE, RESOLUTION
+
+    deg = spec.angle_unit == "deg"
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        return
+    bound = math.degrees(MAX_ANGLE) if deg else MAX_ANGLE
+    if math.isfinite(x) and abs(x) > bound:
+        fine = math.degrees(RESOLUTION) if deg else RESOLUTION
+        raise InputError(
+            field,
+            v,
+            f"an angle of at most {bound:.4g} {spec.angle_unit} (about {MAX_ANGLE / (2 * math.pi):.0f} turns): "
+            f"beyond, float64 resolves an angle coarser than {fine:.2g} {spec.angle_unit}",
+        )
+
+
+def _as_written(e: PlanarError) -> PlanarError:
+    """``e`` showing an angle it names as the scene file gives it (degrees), not as converted to radians."""
+    shown = _SHOWN.get() or {}
+    if isinstance(e, InputError) and isinstance(e.value, float) and not isinstance(e.value, bool) and e.value in shown:
+        return type(e)(e.field, shown[e.value], e.expected)
+    return e
+
+
+def _build_mechanism(spec: SceneSpec, m: Any, path: str, rate: float) -> Mechanism:
+    """The scene's mechanism; an error names the file, and an angle as the file gives it."""
+    token = _SHOWN.set({})
+    try:
+        try:
+            phase = _angle(spec, spec.driver.phase, "driver.phase")
+            rock = _rocking(spec, m)
+            _link_width(spec.fabrication, m.type)
+        except InputError as e:
+            raise SceneError(f"{path}: {_as_written(e)}") from None
+        try:
+            with np.errstate(all="ignore"):
+                return _build(spec, m, rate, phase, rock)
+        except PlanarError as e:
+            raise SceneError(f"{path}: mechanism: {_as_written(e)}") from None
+        except (ValueError, ArithmeticError) as e:  # numbers past what a builder's arithmetic holds (NaN, overflow)
+            raise SceneError(
+                f"{path}: mechanism: cannot be built from these numbers "
+                f"({type(e).__name__}: {' '.join(str(e).split())}); check for extreme values"
+            ) from None
+    finally:
+        _SHOWN.reset(token)
 
 
 def build_scene(spec: SceneSpec, path: str = "<scene>") -> Scene:
@@ -142,22 +207,7 @@ def build_scene(spec: SceneSpec, path: str = "<scene>") -> Scene:
             f"{path}: driver.speed = {spec.driver.speed!r}: expected a speed whose period "
             "(1 / speed seconds) and angular rate are finite numbers"
         )
-    phase = _angle(spec, spec.driver.phase)
-    try:
-        rock = _rocking(spec, m)
-        _link_width(spec.fabrication, m.type)
-    except InputError as e:
-        raise SceneError(f"{path}: {e}") from None
-    try:
-        with np.errstate(all="ignore"):
-            mech = _build(spec, m, rate, phase, rock)
-    except PlanarError as e:
-        raise SceneError(f"{path}: mechanism: {e}") from None
-    except (ValueError, ArithmeticError) as e:  # numbers past what a builder's arithmetic holds (NaN, overflow)
-        raise SceneError(
-            f"{path}: mechanism: cannot be built from these numbers "
-            f"({type(e).__name__}: {' '.join(str(e).split())}); check for extreme values"
-        ) from None
+    mech = _build_mechanism(spec, m, path, rate)
     try:
         check_scale(path, mech)  # numbers float64 holds faithfully (not a placement at 1e16 or a size of 1e-200)
     except InputError as e:
@@ -220,7 +270,7 @@ def _rocking(spec: SceneSpec, m: Any) -> dict[str, Any]:
         first = next((n for n in m.nodes if NODE_KINDS[n.kind].is_input), None)
         if first is not None and first.kind == "actuator":  # a translating input: model units
             return {"amplitude": float(d.amplitude), "centre": float(d.centre)}
-    return {"amplitude": _angle(spec, d.amplitude), "centre": _angle(spec, d.centre)}
+    return {"amplitude": _angle(spec, d.amplitude, "driver.amplitude"), "centre": _angle(spec, d.centre, "driver.centre")}
 
 
 @dataclass(frozen=True)
@@ -241,7 +291,7 @@ BUILDERS: Registry[Callable[[SceneSpec, Any, _Build], Mechanism]] = Registry("sc
 def _build(spec: SceneSpec, m: Any, rate: float, phase: float, rock: dict[str, Any]) -> Mechanism:
     placement: tuple[float, float, float] = (0.0, 0.0, 0.0)
     if hasattr(m, "placement"):
-        placement = (m.placement[0], m.placement[1], _angle(spec, m.placement[2]))
+        placement = (m.placement[0], m.placement[1], _angle(spec, m.placement[2], "placement[2]"))
     return BUILDERS.get(m, f"mechanism type {getattr(m, 'type', '?')!r}")(spec, m, _Build(rate, phase, rock, placement))
 
 
@@ -289,7 +339,9 @@ def _build_linkage(spec: SceneSpec, m: LinkageSpec, b: _Build) -> Mechanism:
     for n in m.nodes:
         cls = NODE_KINDS[n.kind]  # each node kind declares the scene keys it is built from
         args = [
-            _angle(spec, getattr(n, f)) if f in cls.angle_fields and getattr(n, f) is not None else getattr(n, f)
+            _angle(spec, getattr(n, f), f"nodes.{n.name}.{f}")
+            if f in cls.angle_fields and getattr(n, f) is not None
+            else getattr(n, f)
             for f in cls.scene_fields
         ]
         nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
@@ -316,12 +368,14 @@ def _build_legs(spec: SceneSpec, m: LegsSpec, b: _Build) -> Mechanism:
     for n in m.nodes:
         cls = NODE_KINDS[n.kind]
         args = [
-            _angle(spec, getattr(n, f)) if f in cls.angle_fields and getattr(n, f) is not None else getattr(n, f)
+            _angle(spec, getattr(n, f), f"nodes.{n.name}.{f}")
+            if f in cls.angle_fields and getattr(n, f) is not None
+            else getattr(n, f)
             for f in cls.scene_fields
         ]
         nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
     links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
-    phases = None if m.phases is None else [_angle(spec, v) for v in m.phases]
+    phases = None if m.phases is None else [_angle(spec, v, f"phases[{i}]") for i, v in enumerate(m.phases)]
     return Legs(
         spec.name or "legs",
         nodes,
@@ -360,13 +414,16 @@ def _link_width(fab: Any, kind: str) -> float | None:
     return float(w) / fab.unit_mm
 
 
-def _scene_angles(spec: SceneSpec, kw: dict[str, Any], angle_params: tuple[str, ...]) -> dict[str, Any]:
+def _scene_angles(spec: SceneSpec, kw: dict[str, Any], angle_params: tuple[str, ...], where: str = "params") -> dict[str, Any]:
     """``kw`` with the parameters a scene gives in its angle unit turned to radians (a number or a vector)."""
     out = dict(kw)
     for k in angle_params:
         if k in out:
             val = out[k]
-            out[k] = tuple(_angle(spec, x) for x in val) if isinstance(val, tuple) else _angle(spec, val)
+            if isinstance(val, tuple):
+                out[k] = tuple(_angle(spec, x, f"{where}.{k}[{j}]") for j, x in enumerate(val))
+            else:
+                out[k] = _angle(spec, val, f"{where}.{k}")
     return out
 
 
@@ -416,12 +473,13 @@ def _build_toy(spec: SceneSpec, m: ToySpec, b: _Build) -> Mechanism:
         if not any(tuple(c[: len(key[1])]) == key[1] for c in cams.get(sg.cam, [])):
             raise InputError(f"mechanism.stages[{i}].chain", sg.chain, f"a prefix of a chain on the {sg.cam} cam")
         kw = {k: tuple(v) if isinstance(v, list) else v for k, v in sg.params.items()}
-        kw = _scene_angles(spec, kw, ELEMENTAL[realise(sg.chain[-1]).number].angle_params)
+        kw = _scene_angles(spec, kw, ELEMENTAL[realise(sg.chain[-1]).number].angle_params, f"stages[{i}].params")
         if kw:
             overrides[key] = kw
         if sg.name is not None:
             names[key] = sg.name
-    return ToyMechanism(cams, phase=_angle(spec, m.phase), rate=b.rate, name=spec.name or "toy", overrides=overrides, names=names)
+    phase = _angle(spec, m.phase, "phase")
+    return ToyMechanism(cams, phase=phase, rate=b.rate, name=spec.name or "toy", overrides=overrides, names=names)
 
 
 @BUILDERS.register(CamSpec)
@@ -452,7 +510,14 @@ def _build_cam(spec: SceneSpec, m: CamSpec, rate: float, phase: float) -> Mechan
     f = m.follower
     osc = f.motion == "oscillating"
     program = Program(
-        [Segment(sg.law, _angle(spec, sg.angle), _angle(spec, sg.lift) if osc else float(sg.lift)) for sg in m.segments],
+        [
+            Segment(
+                sg.law,
+                _angle(spec, sg.angle, f"segments[{i}].angle"),
+                _angle(spec, sg.lift, f"segments[{i}].lift") if osc else float(sg.lift),
+            )
+            for i, sg in enumerate(m.segments)
+        ],
         "mechanism.segments",
         lift_unit="deg" if osc and spec.angle_unit == "deg" else "",
     )
@@ -468,11 +533,18 @@ def _build_cam(spec: SceneSpec, m: CamSpec, rate: float, phase: float) -> Mechan
         int(f.branch),
     )
     profile = CamProfile(program, float(m.base_radius), geom, "mechanism")
-    limit = math.radians(45.0 if osc else 30.0) if m.max_pressure_angle is None else _angle(spec, m.max_pressure_angle)
+    limit = (
+        math.radians(45.0 if osc else 30.0)
+        if m.max_pressure_angle is None
+        else _angle(spec, m.max_pressure_angle, "max_pressure_angle")
+    )
     nodes = []
     for n in m.nodes:
         cls = NODE_KINDS[n.kind]
-        args = [_angle(spec, getattr(n, k)) if k in cls.angle_fields else getattr(n, k) for k in cls.scene_fields]
+        args = [
+            _angle(spec, getattr(n, k), f"nodes.{n.name}.{k}") if k in cls.angle_fields else getattr(n, k)
+            for k in cls.scene_fields
+        ]
         nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
     links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
     return CamMechanism(

@@ -33,11 +33,16 @@ __all__ = ["Scene", "SceneSpec", "build_scene", "load_scene", "parse_scene", "sc
 # --------------------------------------------------------------------------- loading
 
 
-def _loc(loc: tuple) -> str:
+def _loc(loc: tuple, data: Any = None) -> str:
+    """The field path of a pydantic error location; a list item with a name (a node, a link) is named by it."""
     out = ""
+    node = data
     for i, part in enumerate(loc):
+        child = _child(node, part)
         if isinstance(part, int):
-            out += f"[{part}]"
+            name = child.get("name") if isinstance(child, dict) else None
+            named = isinstance(name, str) and re.fullmatch(r"[A-Za-z0-9_\-]+", name) is not None
+            out += f".{name}" if named else f"[{part}]"
         elif (
             i == 1
             and loc[0] == "mechanism"
@@ -50,20 +55,78 @@ def _loc(loc: tuple) -> str:
             out += f"[{str(part)!r}]"  # a key with spaces, dots or control characters, shown quoted on one line
         else:
             out += ("." if out else "") + str(part)
+        if child is not None:
+            node = child
     return out
 
 
-def _format_validation(path: str, e: ValidationError) -> str:
+def _child(node: Any, part: Any) -> Any:
+    """``node[part]`` of the parsed document, or None (a union member's tag is not in the document)."""
+    if isinstance(part, int) and isinstance(node, list) and -len(node) <= part < len(node):
+        return node[part]
+    if isinstance(part, str) and isinstance(node, dict):
+        return node.get(part)
+    return None
+
+
+#: pydantic's error types said in planar's words: "FIELD = VALUE: expected ..." (ctx holds the bounds)
+_WORDS: dict[str, str] = {
+    "missing": "a value here (it is missing)",
+    "greater_than": "a number greater than {gt}",
+    "greater_than_equal": "a number of at least {ge}",
+    "less_than": "a number less than {lt}",
+    "less_than_equal": "a number of at most {le}",
+    "finite_number": "a finite number",
+    "literal_error": "one of {expected}",
+    "too_long": "at most {max_length} items (it has {actual_length})",
+    "too_short": "at least {min_length} items (it has {actual_length})",
+    "float_type": "a number",
+    "float_parsing": "a number",
+    "int_type": "a whole number (written without a point)",
+    "int_parsing": "a whole number (written without a point)",
+    "int_from_float": "a whole number (written without a point)",
+    "bool_type": "true or false",
+    "bool_parsing": "true or false",
+    "string_type": "text in double quotes",
+    "list_type": "a list [...]",
+    "tuple_type": "a list [...]",
+    "dict_type": "a table",
+    "model_type": "a table",
+    "extra_forbidden": "no such key here (a misspelt or misplaced key)",
+}
+
+
+def _expected(err: Any) -> str:
+    """What a pydantic error says was expected, in planar's words."""
+    kind = err["type"]
+    ctx = err.get("ctx") or {}
+    if kind == "string_pattern_mismatch" and ctx.get("pattern") == _NAME:
+        return "a name without control characters (newline, tab), commas or double quotes"
+    if kind in _WORDS:
+        try:
+            return _WORDS[kind].format(**ctx)
+        except (KeyError, IndexError):
+            pass
+    msg = str(err["msg"]).removeprefix("Value error, ")
+    return msg[:1].lower() + msg[1:]
+
+
+def _format_validation(path: str, e: ValidationError, data: Any = None) -> str:
     errs = e.errors(include_url=False)
     first = errs[0]
-    where = _loc(tuple(first["loc"]))
-    msg = first["msg"]
-    if first["type"] == "string_pattern_mismatch" and (first.get("ctx") or {}).get("pattern") == _NAME:
-        msg = "expected a name without control characters (newline, tab), commas or double quotes"
+    where = _loc(tuple(first["loc"]), data) or "scene"
     got = first.get("input")
-    text = f"{path}: {where or 'scene'}: {msg}"
-    if first["type"] not in ("missing",) and not isinstance(got, dict):
-        text += f" (got {got!r})"
+    loc = tuple(first["loc"])
+    if first["type"] == "missing" and loc and isinstance(loc[-1], int):  # a list of fixed length, too short
+        owner = _loc(loc[:-1], data)
+        have = data
+        for part in loc[:-1]:  # a union member's tag is not in the document: stay where it is
+            have = _child(have, part) if _child(have, part) is not None else have
+        text = f"{path}: {owner} = {have!r}: expected more items (item {loc[-1]} is missing)"
+    elif first["type"] == "missing" or isinstance(got, dict):
+        text = f"{path}: {where}: expected {_expected(first)}"
+    else:
+        text = f"{path}: {where} = {got!r}: expected {_expected(first)}"
     if len(errs) > 1:
         text += f" (and {len(errs) - 1} more problem{'s' if len(errs) > 2 else ''})"
     return text
@@ -74,7 +137,7 @@ def parse_scene(data: dict[str, Any], path: str = "<scene>") -> SceneSpec:
     try:
         return SceneSpec.model_validate(data)
     except ValidationError as e:
-        raise SceneError(_format_validation(path, e)) from None
+        raise SceneError(_format_validation(path, e, data)) from None
 
 
 def _read_text(p: str) -> str:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import csv
 import math
+import re
 from pathlib import Path
 from typing import Any
 
@@ -115,6 +116,7 @@ def read_svg_points(path: str | Path, n: int) -> Array:
         raise InputError(p, "missing", "an existing SVG file") from None
     except Exception as e:  # svgelements raises parser errors of several kinds
         raise InputError(p, type(e).__name__, "a readable SVG file") from None
+    _check_finite_attributes(p)
     for el in svg.elements():
         if isinstance(el, se.Shape) and not isinstance(el, se.Group):
             path_ = se.Path(el)
@@ -135,6 +137,29 @@ def read_svg_points(path: str | Path, n: int) -> Array:
             pts[:, 1] = -pts[:, 1]
             return pts
     raise InputError(p, "no path", "an SVG with a path or shape of non-zero length")
+
+
+#: the SVG attributes that carry coordinates or lengths (svgelements reads ``cx="nan"`` as 0)
+_GEOMETRY = ("cx", "cy", "r", "rx", "ry", "x", "y", "width", "height", "x1", "y1", "x2", "y2", "points", "d", "transform")
+_NON_FINITE = re.compile(r"(?i)(?<![a-z])(nan|inf(inity)?)(?![a-z])")
+
+
+def _check_finite_attributes(path: str) -> None:
+    """:class:`InputError` naming the file, the element and the attribute if a coordinate is NaN or infinite
+    (svgelements reads ``cx="nan"`` as 0, or drops the element).  A file XML cannot parse is left to
+    svgelements, which names it."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.parse(path).getroot()
+    except (ET.ParseError, OSError, ValueError):
+        return
+    for el in root.iter():
+        tag = str(el.tag).rsplit("}", 1)[-1]
+        for name in _GEOMETRY:
+            text = el.attrib.get(name)
+            if text is not None and _NON_FINITE.search(text):
+                raise InputError(f"{path}: <{tag}> {name}", text, "finite numbers (SVG coordinates)")
 
 
 def read_path_targets(path: str | Path, svg_points: int | None = 12) -> tuple[Array, Array | None]:
@@ -167,7 +192,9 @@ def normalisation(targets: Array, name: str = "targets") -> tuple[Array, float]:
             f"coordinates within {hi:g} model units (the solvers multiply four lengths; scale the targets down)",
         )
     c = t.mean(0)
-    s = float(np.sqrt(np.mean(np.sum((t - c) ** 2, axis=1))))
+    d = t - c
+    m = float(np.max(np.abs(d)))  # squares of 1e-300 underflow to 0: the RMS is taken of d / m, then scaled back
+    s = m * float(np.sqrt(np.mean(np.sum((d / m) ** 2, axis=1)))) if m > 0 else 0.0
     if not lo <= s <= hi:
         raise InputError(
             name,

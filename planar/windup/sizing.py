@@ -209,8 +209,9 @@ def size_for_range(
     """
     from scipy.optimize import brentq
 
-    if not np.isfinite(target) or target <= 0:
-        raise InputError(f"#{number}.target", target, "a positive motion range")
+    from planar.core.model import check_positive
+
+    target = check_positive(f"#{number}.target", target, "motion range")
     f, lo, hi = _setup(number, parameter, component, bracket, fixed)
     runs = _refined_runs(f, lo, hi)
     if not runs:

@@ -97,7 +97,7 @@ def test_plot_bytes_reproducible(tmp_path) -> None:
 @pytest.mark.parametrize(
     "args, msg",
     [
-        (["-o", "x.pdf"], "a .png or .svg"),
+        (["-o", "x.pdf"], ".png or .svg"),
         (["-o", "x.png", "--what", "jerk"], "one of curve"),
         (["-o", "x.png", "--what", "transmission"], "no RRR dyad"),
     ],

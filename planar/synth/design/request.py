@@ -144,6 +144,16 @@ class Design:
 # ----------------------------------------------------------------------------- the request
 
 
+class _Missing:
+    """A key the request does not give, as a message shows it (``effector[0].name = (missing)``)."""
+
+    def __repr__(self) -> str:
+        return "(missing)"
+
+
+_MISSING = _Missing()
+
+
 def load_request(path: str | Path) -> list[Effector]:
     """Read a request file (TOML ``[[effector]]`` tables); bad input is an :class:`InputError` naming the field."""
     p = str(path)
@@ -166,8 +176,13 @@ def load_request(path: str | Path) -> list[Effector]:
         if bad:
             raise InputError(f"{where}.{bad[0]}", r[bad[0]], "one of name, motion, range, cam, phase")
         for req in ("name", "motion", "range"):
-            if req not in r:
-                raise InputError(f"{where}.{req}", None, f"a {req} (the field is required)")
+            if req not in r:  # missing, not None (TOML has no None): said so, with the keys it has
+                raise InputError(
+                    f"{where}.{req}",
+                    _MISSING,
+                    f"a {req} (a required field: every [[effector]] gives name, motion and range; "
+                    f"this one has {', '.join(sorted(r)) or 'no keys'})",
+                )
         name = r.get("name")
         if isinstance(name, str) and name.strip():
             where = f"{p}: effector {name!r}"
