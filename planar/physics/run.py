@@ -487,6 +487,26 @@ def _simulated_motion(
     return Motion(driver=analytic.driver, poses=out, valid=valid, fail_code=code, fail_table=table, points=pts, t=t)
 
 
+def _check_memory(mech: Mechanism, n: int) -> None:
+    """:class:`~planar.errors.LimitError` before a run of ``n`` samples would pass the memory limit.
+
+    A run holds the analytic motion with its velocities, the recorded poses and the simulated motion built
+    from them, and its caller the analytic motion it compares with: estimated at three times the motion's own
+    bytes (:func:`planar.core.limits.motion_bytes`; a run of the Jansen leg measured 1.86 kB a sample by
+    tracemalloc, estimated 2.88 kB), on top of what this process already holds."""
+    from planar.core import limits
+
+    per = 1.5 * limits.motion_bytes(len(mech.parts), len(mech.points), 2.0)  # 3 x one sample's (the bytes of 2)
+    held = limits.resident_bytes()
+    limits.check_memory(
+        f"{mech.name}: simulation",
+        f"{n:,} samples",
+        held + per * n,
+        "a simulated run",
+        fits=f"{limits.units_within(held, per):,} samples",
+    )
+
+
 def simulate(
     mech: Mechanism,
     t: Array,
@@ -512,6 +532,7 @@ def simulate(
     t = np.asarray(t, float)
     if t.size < 2:
         raise PlanarError("simulate: needs at least two output times")
+    _check_memory(mech, t.size)
     dt_out = float(t[1] - t[0])
     poses_a, vel_a, analytic = _analytic_pose_velocity(mech, t)
     if not analytic.valid.all():
