@@ -222,10 +222,10 @@ def test_gallery_at_the_small_limit(tmp_path: Path) -> None:
 
 @pytest.mark.slow
 def test_atlas_build_at_a_small_limit(tmp_path: Path) -> None:
-    """The atlas is built into its float32 arrays a chunk at a time: its size is bounded by the limit (160 MiB here:
-    about 300,000 four-bars), refused beyond before any four-bar is solved."""
+    """The atlas is built into its float32 arrays a chunk at a time: its size is bounded by the limit (420 MiB here,
+    beside one chunk's 300 MiB of temporaries: about 450,000 four-bars), refused beyond before any is solved."""
     out = tmp_path / "a.npz"
-    _at_the_limit(lambda n: ["synth", "atlas", "--size", str(n), "-o", str(out)], 100_000_000, tmp_path, [out], 160)
+    _at_the_limit(lambda n: ["synth", "atlas", "--size", str(n), "-o", str(out)], 100_000_000, tmp_path, [out], 420)
 
 
 @pytest.mark.slow
@@ -239,9 +239,9 @@ def test_a_searched_atlas_is_checked_from_its_header(tmp_path: Path) -> None:
     target.write_text("x,y\n" + "".join(f"{math.cos(a):.6f},{0.5 * math.sin(a):.6f}\n" for a in (0.0, 1.0, 2.0, 3.0, 4.0, 5.0)))
     out = tmp_path / "d.toml"
     argv = ["synth", "path", str(target), "--atlas", str(atlas), "-o", str(out), "--budget", "quick"]
-    rc, mib, text = peak(argv, tmp_path, 60)  # below what the interpreter and numpy hold: no atlas fits
+    rc, mib, text = peak(argv, tmp_path, 1)  # below what the interpreter holds: no atlas fits
     _refused(rc, mib, text, [out])
-    assert "four-bars" in text and str(atlas) in text, text
+    assert "an atlas search" in text and "at most 0 four-bars fit" in text and str(atlas) in text, text
     rc, mib, text = peak(argv, tmp_path, SMALL_MIB)
     assert rc in (0, 3) and mib <= SMALL_MIB * 1.25, (rc, mib, text)
 
