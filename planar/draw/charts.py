@@ -98,6 +98,11 @@ def _parse_what(scene: Scene, what: Sequence[str] | None) -> list[str]:
     return chosen
 
 
+#: bytes a chart figure adds beyond its samples: matplotlib's import, the figure and its rendering (measured, see
+#: :func:`_motion`)
+FIGURE_BYTES = 128 * 2**20
+
+
 def _motion(scene: Scene, samples_per_cycle: int | None) -> Motion:
     """The scene's motion, over its own cycles or duration, at ``samples_per_cycle`` (default: the scene's)."""
     if samples_per_cycle is not None and samples_per_cycle < 4:
@@ -127,10 +132,11 @@ def _motion(scene: Scene, samples_per_cycle: int | None) -> Motion:
     from planar.core.limits import check_memory, resident_bytes, units_within
 
     # the motion and, over all of it at once, its rates, torque and lines: measured 1.5 kB a sample for the
-    # Jansen leg (2 958 MiB at 2e6 samples), about twice what the motion alone is estimated at; and what this
-    # process holds already (the figure's libraries are loaded before)
+    # Jansen leg (2 958 MiB at 2e6 samples), about twice what the motion alone is estimated at; what this
+    # process holds already, and the figure's own drawing (matplotlib's import and Agg rendering: a Jansen plot of
+    # 96,132 samples peaked at 342 MiB resident with 80 MiB held and 176 MiB estimated for its samples)
     per = 2 * 8.0 * 4 * (3 * len(scene.mechanism.parts) + 2 * len(scene.mechanism.points) + 4)
-    held = resident_bytes()
+    held = resident_bytes() + FIGURE_BYTES
     check_memory(where, shown, held + per * n, "the charts' motion and rates", fits=f"{units_within(held, per):,} samples")
     if samples_per_cycle is None:
         return scene.motion()
