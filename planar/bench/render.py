@@ -127,6 +127,26 @@ def render_peak_memory(name: str, frames: int) -> dict[str, Any]:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+#: bytes the peer holds per frame and pixel: matplotlib's PillowWriter keeps every frame (RGBA) until it saves,
+#: and converts them to palette images then (measured: see docs/explanation/memory.md)
+PEER_FRAME_BYTES_PER_PX = 5.0
+#: what the peer's libraries (matplotlib, its figure) add to this process before its first frame, bytes
+PEER_LOAD_BYTES = 80 * 2**20
+
+
+def _check_frames(n: int, width: int, height: int) -> None:
+    """:class:`~planar.errors.LimitError` before ``n`` frames of ``width`` x ``height`` pixels would pass the
+    frame limit, or the memory limit with the peer's frames held (``-n`` named)."""
+    from planar.core.limits import check_count, check_memory, resident_bytes, units_within
+
+    check_count("frames", "-n", n, "frames")
+    per = PEER_FRAME_BYTES_PER_PX * width * height
+    held = resident_bytes() + PEER_LOAD_BYTES
+    check_memory(
+        "-n", n, held + per * n, "the peer's frames (held until its GIF is saved)", fits=f"{units_within(held, per):,} frames"
+    )
+
+
 def bench_render(
     n: int = 120, repeats: int = 5, width: int = 480, height: int = 360, memory_frames: int = 10_000
 ) -> dict[str, Any]:
@@ -144,6 +164,7 @@ def bench_render(
     from planar.draw.frames import Renderer, Style, palette_colors
     from planar.scene.catalog import get
 
+    _check_frames(n, width, height)
     gif = writer("gif")
     frame_delay_ms, indexer, write_gif = gif.frame_delay_ms, gif.indexer, gif.write_gif
     mech = get("fourbar-crank-rocker")

@@ -359,12 +359,13 @@ def _cmd_atlas(args: argparse.Namespace) -> int:
     import os
     import time
 
-    from planar.synth.atlas import atlas_path, build_atlas, read_atlas
+    from planar.synth.atlas import atlas_path, build_atlas, check_atlas_memory, read_atlas
 
     if args.size < 100:
         raise InputError("--size", args.size, "at least 100 four-bars")
     if args.seed < 0:
         raise InputError("--seed", args.seed, "a seed of 0 or more")
+    check_atlas_memory("--size", args.size)  # before any output is checked or any four-bar solved
     if args.output is not None:  # like every output: an existing folder, no folder made for it
         from planar.fileio import check_output
 

@@ -39,6 +39,7 @@ __all__ = [
     "pilot_bytes",
     "resident_bytes",
     "sample_count",
+    "units_within",
 ]
 
 #: name -> (environment variable, default)
@@ -98,15 +99,27 @@ def check_count(name: str, field: str, value: float, what: str, shown: object = 
     return int(value)
 
 
-def check_memory(field: str, value: object, n_bytes: float, what: str) -> None:
-    """:class:`LimitError` if an estimated ``n_bytes`` exceed the memory limit (MiB)."""
+def check_memory(field: str, value: object, n_bytes: float, what: str, fits: str | None = None) -> None:
+    """:class:`LimitError` if an estimated ``n_bytes`` exceed the memory limit (MiB).
+
+    ``fits``: what would fit, named in the message (e.g. ``"1,234 samples"``, from :func:`units_within`).
+    """
     var, _ = DEFAULTS["memory"]
     cap = limit("memory")
     mib = n_bytes / 2**20
     if not math.isfinite(mib) or mib > cap:
+        room = f"; at most {fits} fit" if fits else ""
         raise LimitError(
-            field, value, f"{what} within {cap:,} MiB (it needs about {mib:,.0f} MiB; raise the limit with {var}=MIB)"
+            field,
+            value,
+            f"{what} within {cap:,} MiB (it needs about {mib:,.0f} MiB{room}; raise the limit with {var}=MIB)",
         )
+
+
+def units_within(fixed_bytes: float, unit_bytes: float) -> int:
+    """How many units of ``unit_bytes`` each fit in the memory limit beside ``fixed_bytes`` (0 if none)."""
+    room = limit("memory") * 2.0**20 - fixed_bytes
+    return max(0, int(room // unit_bytes)) if unit_bytes > 0 and math.isfinite(room) else 0
 
 
 def motion_bytes(parts: int, points: int, n: float) -> float:

@@ -890,7 +890,8 @@ class Mechanism:
             need, held = limits.pilot_bytes(lambda k: self.solve(qf[:k]), n_q), limits.resident_bytes()
         if need is None:
             need = limits.motion_bytes(len(self.parts), len(self.points), float(n_q))
-        limits.check_memory(f"{self.name}.solve(q)", f"{n_q:,} driver values", need + held, "a motion")
+        fits = f"{limits.units_within(held, need / max(n_q, 1)):,} samples"
+        limits.check_memory(f"{self.name}.solve(q)", f"{n_q:,} driver values", need + held, "a motion", fits=fits)
         qin = np.atleast_1d(check_finite(f"{self.name}.driver value", q))
         self._check_driver_resolution(qin)
         qa = new_block(qin.shape)  # the motion's own copy (recycled memory for a large batch)

@@ -106,37 +106,49 @@ def _parse_what(scene: Scene, what: Sequence[str] | str | None, option: str = "w
     return chosen
 
 
+#: bytes a chart figure adds beyond its samples: matplotlib's import, the figure and its rendering (measured, see
+#: :func:`_motion`)
+FIGURE_BYTES = 128 * 2**20
+
+
 def _motion(scene: Scene, samples_per_cycle: int | None) -> Motion:
     """The scene's motion, over its own cycles or duration, at ``samples_per_cycle`` (default: the scene's)."""
-    if samples_per_cycle is None:
-        return scene.motion()
-    if samples_per_cycle < 4:
+    if samples_per_cycle is not None and samples_per_cycle < 4:
         raise InputError("--samples", samples_per_cycle, "at least 4 samples per cycle")
     d = scene.spec.driver
     drv = scene.mechanism.driver
-    cycles = d.duration / drv.period if d.duration is not None else (d.cycles if d.cycles is not None else 1.0)
-    from planar.core.limits import check_count, check_memory
+    if samples_per_cycle is None:
+        n = scene.sample_count()  # the scene's own count, checked as its motion is
+        spc: float = d.samples_per_cycle
+        where, shown = f"{scene.path}: driver.samples_per_cycle", d.samples_per_cycle
+    else:
+        cycles = d.duration / drv.period if d.duration is not None else (d.cycles if d.cycles is not None else 1.0)
+        from planar.core.limits import check_count
 
-    total = samples_per_cycle * cycles  # bounded before anything is allocated (planar.core.limits)
-    n = max(
-        2,
-        check_count(
-            "samples",
-            "--samples",
-            round(total) if math.isfinite(total) else total,
-            "samples in all (--samples x the scene's cycles)",
-            shown=samples_per_cycle,
-        ),
-    )
-    check_memory(
-        "--samples",
-        samples_per_cycle,
-        # the motion and, over all of it at once, its rates, torque and lines: measured 1.5 kB a sample for the
-        # Jansen leg (2 958 MiB at 2e6 samples), about twice what the motion alone is estimated at
-        2 * 8.0 * 4 * n * (3 * len(scene.mechanism.parts) + 2 * len(scene.mechanism.points) + 4),
-        "the charts' motion and rates",
-    )
-    t = np.arange(n) * (drv.period / samples_per_cycle)
+        total = samples_per_cycle * cycles  # bounded before anything is allocated (planar.core.limits)
+        n = max(
+            2,
+            check_count(
+                "samples",
+                "--samples",
+                round(total) if math.isfinite(total) else total,
+                "samples in all (--samples x the scene's cycles)",
+                shown=samples_per_cycle,
+            ),
+        )
+        spc, where, shown = samples_per_cycle, "--samples", samples_per_cycle
+    from planar.core.limits import check_memory, resident_bytes, units_within
+
+    # the motion and, over all of it at once, its rates, torque and lines: measured 1.5 kB a sample for the
+    # Jansen leg (2 958 MiB at 2e6 samples), about twice what the motion alone is estimated at; what this
+    # process holds already, and the figure's own drawing (matplotlib's import and Agg rendering: a Jansen plot of
+    # 96,132 samples peaked at 342 MiB resident with 80 MiB held and 176 MiB estimated for its samples)
+    per = 2 * 8.0 * 4 * (3 * len(scene.mechanism.parts) + 2 * len(scene.mechanism.points) + 4)
+    held = resident_bytes() + FIGURE_BYTES
+    check_memory(where, shown, held + per * n, "the charts' motion and rates", fits=f"{units_within(held, per):,} samples")
+    if samples_per_cycle is None:
+        return scene.motion()
+    t = np.arange(n) * (drv.period / spc)
     return scene.mechanism.solve(drv.value(t), t=t)
 
 

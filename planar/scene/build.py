@@ -52,7 +52,7 @@ class Scene:
     def sample_count(self) -> int:
         """Samples of :meth:`motion`, checked against :mod:`planar.core.limits` (samples and memory)
         before anything is allocated; :class:`~planar.errors.LimitError` names the scene's field."""
-        from planar.core.limits import check_count, check_memory
+        from planar.core.limits import check_count, check_memory, units_within
 
         d = self.spec.driver
         period = self.mechanism.driver.period
@@ -75,7 +75,7 @@ class Scene:
         )
         # poses (x, y, angle) of every part, points (x, y), driver, time and the solver's working copies
         per_sample = 8 * (3 * len(self.mechanism.parts) + 2 * len(self.mechanism.points) + 4) * 4
-        check_memory(where, value, float(per_sample) * max(n, 2), "a motion")
+        check_memory(where, value, float(per_sample) * max(n, 2), "a motion", fits=f"{units_within(0.0, per_sample):,} samples")
         return max(2, n)
 
     def motion(self) -> Motion:

@@ -73,7 +73,7 @@ MAX_RATIO = 10.0
 DEFAULT_SIZE = 1_000_000
 #: entries of the atlas the quick budget uses (builds in about a second)
 QUICK_SIZE = 20_000
-#: linkages per chunk of the build (memory: about 40 MB of temporaries)
+#: linkages per chunk of the build (memory: about 300 MiB of temporaries, :data:`CHUNK_BYTES`)
 CHUNK = 20_000
 
 
@@ -212,6 +212,27 @@ def _chunk(seed: int, index: int, n: int) -> tuple[Array, Array, Array]:
     return p[good], frame[good], desc[good]
 
 
+#: bytes the build holds per entry beyond the entry itself (measured: see :func:`check_atlas_memory`)
+BUILD_EXTRA_BYTES = 0.0
+#: bytes of one chunk's temporaries in the build (solved curves, their resampling and FFT; tracemalloc measured
+#: 299 MiB for a chunk of :data:`CHUNK` linkages, and 3e6 four-bars peaked at 680 MiB resident: 50 + 320 + 300)
+CHUNK_BYTES = 320 * 2**20
+#: bytes a search over the atlas holds per entry: the entry, its float64 descriptor and the k-d tree over it
+SEARCH_BYTES = 400.0
+
+
+def check_atlas_memory(where: str, size: int, search: bool = False) -> None:
+    """:class:`~planar.errors.LimitError` (naming ``where`` and ``size``) before an atlas of ``size`` entries is
+    built (``search=False``) or read and searched (``search=True``) beyond the memory limit (``PLANAR_MAX_MEMORY``).
+    What this process already holds counts."""
+    from planar.core.limits import check_memory, resident_bytes, units_within
+
+    per = SEARCH_BYTES if search else ENTRY_BYTES + BUILD_EXTRA_BYTES
+    fixed = resident_bytes() + (0.0 if search else CHUNK_BYTES)
+    what = "an atlas search" if search else "an atlas build"
+    check_memory(where, size, fixed + per * size, what, fits=f"{units_within(fixed, per):,} four-bars")
+
+
 def build_atlas(size: int = DEFAULT_SIZE, seed: int = 0, progress: bool = False) -> Atlas:
     """Build an atlas of ``size`` four-bars (deterministic for ``size`` and ``seed``; see the module).
 
@@ -220,8 +241,13 @@ def build_atlas(size: int = DEFAULT_SIZE, seed: int = 0, progress: bool = False)
     """
     if size < 100:
         raise InputError("atlas size", size, "at least 100 four-bars")
+    check_atlas_memory("atlas size", size)
     t0 = time.process_time()
-    parts: list[tuple[Array, Array, Array]] = []
+    # the entries go straight into their float32 arrays a chunk at a time: the build holds the atlas once
+    # (ENTRY_BYTES an entry) and one chunk's temporaries, not every chunk's float64 rows and their copies
+    params = np.empty((size, 6), np.float32)
+    frame = np.empty((size, 4), np.float32)
+    desc = np.empty((size, 2 + 4 * (HARMONICS - 1)), np.float32)
     have, index = 0, 0
     bar = None
     if progress:
@@ -231,16 +257,14 @@ def build_atlas(size: int = DEFAULT_SIZE, seed: int = 0, progress: bool = False)
     while have < size:
         n = min(CHUNK, size - have)
         p, f, d = _chunk(seed, index, n)
-        parts.append((p, f, d))
-        have += len(p)
+        k = min(len(p), size - have)
+        params[have : have + k], frame[have : have + k], desc[have : have + k] = p[:k], f[:k], d[:k]
+        have += k
         index += 1
         if bar is not None:
-            bar.update(len(p))
+            bar.update(k)
     if bar is not None:
         bar.close()
-    params = np.concatenate([a[0] for a in parts])[:size].astype(np.float32)
-    frame = np.concatenate([a[1] for a in parts])[:size].astype(np.float32)
-    desc = np.concatenate([a[2] for a in parts])[:size].astype(np.float32)
     return Atlas(params, frame, desc, seed, time.process_time() - t0)
 
 
@@ -279,11 +303,31 @@ def build_notice(size: int, path: str | Path) -> str:
 _LOADED: dict[str, Atlas] = {}
 
 
+def _stored_rows(path: str) -> int:
+    """Entries of the atlas file ``path``, read from its ``params`` array's header (nothing loaded)."""
+    import zipfile
+
+    with zipfile.ZipFile(path) as zf, zf.open("params.npy") as fh:
+        version = np.lib.format.read_magic(fh)
+        read = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+        shape = read(fh)[0]
+    return int(shape[0]) if shape else 0
+
+
 def read_atlas(path: str | Path) -> Atlas:
     """An atlas written by :meth:`Atlas.save`; raises :class:`InputError` naming the file if it is not one."""
     p = str(path)
     if p in _LOADED:
         return _LOADED[p]
+    import zipfile
+
+    try:
+        rows = _stored_rows(p)
+    except FileNotFoundError:
+        raise InputError(p, "missing", "an atlas file written by planar synth atlas") from None
+    except (KeyError, ValueError, OSError, zipfile.BadZipFile) as e:
+        raise InputError(p, type(e).__name__, "an atlas file written by planar synth atlas") from None
+    check_atlas_memory(p, rows, search=True)  # from the file's header, before its arrays are read
     try:
         with np.load(p) as z:
             meta = z["meta"]

@@ -9,10 +9,12 @@ that command's own).  A refusal must come before the work: exit 2, one line nami
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -32,10 +34,13 @@ _PEAK = (
 )
 
 
-def peak(argv: list[str], cwd: Path) -> tuple[int, float, str]:
-    """Exit status, peak resident memory (MiB) and output of ``planar ARGV`` in a fresh process."""
+def peak(argv: list[str], cwd: Path, limit_mib: int | None = None) -> tuple[int, float, str]:
+    """Exit status, peak resident memory (MiB) and output of ``planar ARGV`` in a fresh process
+    (``PLANAR_MAX_MEMORY=limit_mib`` when given, else the default limit)."""
     env = {k: v for k, v in os.environ.items() if not k.startswith("PLANAR_")}
     env["PYTHONPATH"] = str(ROOT)
+    if limit_mib is not None:
+        env["PLANAR_MAX_MEMORY"] = str(limit_mib)
     r = subprocess.run(
         [sys.executable, "-c", _PEAK, sys.executable, "-m", "planar", *argv], capture_output=True, text=True, cwd=cwd, env=env
     )
@@ -94,3 +99,235 @@ def test_a_low_limit_refuses_before_the_work(tmp_path: Path) -> None:
     argv = ["motion", str(_big(tmp_path, "jansen-leg", 200_000)), "-o", str(tmp_path / "m.csv"), "--derivatives"]
     r = subprocess.run([sys.executable, "-m", "planar", *argv], capture_output=True, text=True, cwd=tmp_path, env=env)
     assert r.returncode == 2 and "PLANAR_MAX_MEMORY" in r.stderr and not (tmp_path / "m.csv").exists(), r.stderr
+
+
+# --------------------------------------------------------------------------- every command, at a small limit
+# The same checks at PLANAR_MAX_MEMORY=SMALL_MIB, where the sizes at the limit are cheap to run: asked for far
+# too much, each command refuses up front naming the limit and the size that fits; at that size it runs within
+# the limit x 1.25; a little more is refused with nothing written.  That the size named fits proves the estimate
+# counts what the command allocates, at every limit (the estimate is the held memory plus a cost per unit).
+
+#: the small limit, MiB
+SMALL_MIB = 256
+#: a refusal names what fits: "at most 123,456 samples fit"
+_FITS = re.compile(r"at most ([\d,]+) ([a-z-]+(?: [a-z-]+)?) fit")
+
+
+def _fits(out: str) -> int:
+    m = _FITS.search(out)
+    assert m is not None, f"the refusal names no size that fits: {out}"
+    return int(m.group(1).replace(",", ""))
+
+
+def _refused(rc: int, mib: float, out: str, written: list[Path]) -> None:
+    assert rc == 2 and len(out.splitlines()) == 1 and "PLANAR_MAX_MEMORY" in out, out
+    assert mib <= REFUSAL_MIB, f"refused after {mib:.0f} MiB (not up front): {out}"
+    assert not [p for p in written if p.exists()], f"written on a refusal: {out}"
+
+
+def _at_the_limit(
+    argv: Callable[[int], list[str]],
+    big: int,
+    cwd: Path,
+    written: list[Path],
+    limit_mib: int = SMALL_MIB,
+    search: bool = True,
+) -> tuple[int, float]:
+    """The largest size ``argv(n)`` accepts at ``limit_mib`` and its peak (MiB): ``big`` is refused up front naming
+    the size that fits; from there, each size accepted peaks within ``limit_mib`` x 1.25 and the next, 25 % more, is
+    tried until one is refused (up front, nothing written); the size named is a lower bound (what is held at a
+    larger request counts too).  Returns the largest size accepted and its peak."""
+
+    def run(n: int) -> tuple[int, float, str]:
+        for p in written:
+            p.unlink(missing_ok=True)
+        return peak(argv(n), cwd, limit_mib)
+
+    rc, mib, out = run(big)
+    _refused(rc, mib, out, written)
+    n, best = _fits(out), None
+    assert n > 0, out
+    for _ in range(8):
+        rc, mib, out = run(n)
+        if rc != 0:
+            _refused(rc, mib, out, written)
+            if best is not None:  # accepted, then refused 25 % above: the boundary is found
+                return best
+            assert 0 < _fits(out) < n, out  # a finer estimate (a pilot solve of what the kind allocates) names less
+            n = _fits(out)
+            continue
+        assert mib <= limit_mib * 1.25, f"{n:,}: peak {mib:.0f} MiB over {limit_mib} x 1.25: {out}"
+        best = (n, mib)
+        if not search:  # the size named runs within the limit (the boundary above it is not looked for)
+            return best
+        n = int(n * 1.25) + 1
+    raise AssertionError(f"no boundary found near the size named: last {n:,} ({rc}: {out})")
+
+
+def _scene(tmp_path: Path, name: str, samples: int, cycles: float | None = None) -> Path:
+    text = (GALLERY / f"{name}.toml").read_text()
+    text = re.sub(r"samples_per_cycle = \d+", f"samples_per_cycle = {samples}", text, count=1)
+    if cycles is not None:
+        text = re.sub(r"\[driver\]\n", f"[driver]\ncycles = {cycles}\n", text, count=1)
+    p = tmp_path / f"{name}-{samples}.toml"
+    p.write_text(text)
+    return p
+
+
+@pytest.mark.slow
+def test_motion_with_rates_at_the_small_limit(tmp_path: Path) -> None:
+    out = tmp_path / "m.csv"
+
+    def argv(n: int) -> list[str]:
+        return ["motion", str(_scene(tmp_path, "jansen-leg", n)), "-o", str(out), "--derivatives"]
+
+    _at_the_limit(argv, 2_000_000, tmp_path, [out])
+
+
+@pytest.mark.slow
+def test_catalog_at_the_small_limit(tmp_path: Path) -> None:
+    out = tmp_path / "c.csv"
+    _at_the_limit(lambda n: ["catalog", "kangaroo", "-o", str(out), "--samples", str(n)], 2_000_000, tmp_path, [out])
+
+
+@pytest.mark.slow
+def test_plot_at_the_small_limit(tmp_path: Path) -> None:
+    out = tmp_path / "p.png"
+    scene = str(GALLERY / "jansen-leg.toml")
+    _at_the_limit(lambda n: ["plot", scene, "-o", str(out), "--samples", str(n)], 2_000_000, tmp_path, [out])
+
+
+@pytest.mark.slow
+def test_plot_of_a_fine_scene_counts_the_charts(tmp_path: Path) -> None:
+    """Without --samples the scene's own count is checked with the charts' cost, not the motion's alone."""
+    out = tmp_path / "p.png"
+    _at_the_limit(lambda n: ["plot", str(_scene(tmp_path, "jansen-leg", n)), "-o", str(out)], 2_000_000, tmp_path, [out])
+
+
+@pytest.mark.slow
+def test_render_at_the_small_limit(tmp_path: Path) -> None:
+    """The samples a render draws from (its frames are bounded by PLANAR_MAX_FRAMES and drawn a chunk at a time)."""
+    out = tmp_path / "r.gif"
+    _at_the_limit(lambda n: ["render", str(_scene(tmp_path, "jansen-leg", n)), "-o", str(out)], 2_000_000, tmp_path, [out])
+
+
+@pytest.mark.slow
+def test_gallery_at_the_small_limit(tmp_path: Path) -> None:
+    """A folder of scenes renders each within the limit; one scene too fine is refused before any GIF."""
+    src = tmp_path / "scenes"
+    src.mkdir()
+    out = tmp_path / "gifs"
+    out.mkdir()
+
+    def argv(n: int) -> list[str]:
+        for p in src.iterdir():
+            p.unlink()
+        (src / "horse.toml").write_text((GALLERY / "horse.toml").read_text())
+        _scene(tmp_path, "jansen-leg", n).rename(src / "jansen-leg.toml")
+        return ["gallery", "--source", str(src), "-o", str(out)]
+
+    _at_the_limit(argv, 2_000_000, tmp_path, [out / "horse.gif", out / "jansen-leg.gif"])
+
+
+@pytest.mark.slow
+def test_atlas_build_at_a_small_limit(tmp_path: Path) -> None:
+    """The atlas is built into its float32 arrays a chunk at a time: its size is bounded by the limit (420 MiB here,
+    beside one chunk's 300 MiB of temporaries: about 450,000 four-bars), refused beyond before any is solved."""
+    out = tmp_path / "a.npz"
+    _at_the_limit(lambda n: ["synth", "atlas", "--size", str(n), "-o", str(out)], 100_000_000, tmp_path, [out], 420)
+
+
+@pytest.mark.slow
+def test_a_searched_atlas_is_checked_from_its_header(tmp_path: Path) -> None:
+    """An atlas file too large to search within the limit is refused before its arrays are read."""
+    from planar.synth.atlas import build_atlas
+
+    atlas = tmp_path / "a.npz"
+    build_atlas(20_000, 0).save(atlas)
+    target = tmp_path / "t.csv"
+    target.write_text("x,y\n" + "".join(f"{math.cos(a):.6f},{0.5 * math.sin(a):.6f}\n" for a in (0.0, 1.0, 2.0, 3.0, 4.0, 5.0)))
+    out = tmp_path / "d.toml"
+    argv = ["synth", "path", str(target), "--atlas", str(atlas), "-o", str(out), "--budget", "quick"]
+    rc, mib, text = peak(argv, tmp_path, 1)  # below what the interpreter holds: no atlas fits
+    _refused(rc, mib, text, [out])
+    assert "an atlas search" in text and "at most 0 four-bars fit" in text and str(atlas) in text, text
+    rc, mib, text = peak(argv, tmp_path, SMALL_MIB)
+    assert rc in (0, 3) and mib <= SMALL_MIB * 1.25, (rc, mib, text)
+
+
+@pytest.mark.slow
+def test_bench_render_frames_are_checked(tmp_path: Path) -> None:
+    """The peer holds every frame until it saves: -n is refused up front where those frames pass the limit,
+    naming how many fit (running it at that size renders 10,000-frame memory checks too: minutes of CPU)."""
+    rc, mib, out = peak(["bench", "render", "-n", "20000", "--repeats", "1"], tmp_path)
+    _refused(rc, mib, out, [])
+    n = _fits(out)
+    assert 1_000 < n < 20_000, out  # 480 x 360 px at 5 bytes a pixel: about 2,400 frames in 2 GiB
+
+
+@pytest.mark.slow
+def test_compare_at_a_small_limit(tmp_path: Path) -> None:
+    """A simulated run holds its recorded poses and motions: refused up front beyond the limit."""
+
+    def argv(n: int) -> list[str]:
+        return ["compare", str(_scene(tmp_path, "slider-crank", n)), "--time-cap", "5"]
+
+    _at_the_limit(argv, 2_000_000, tmp_path, [])
+
+
+@pytest.mark.slow
+def test_bench_sim_at_a_small_limit(tmp_path: Path) -> None:
+    """Refused up front, and the size named runs within the limit (the refusal at 2e6 holds that request's time
+    arrays, so the size it names is far below the boundary: 8 steps of 25 % did not reach it)."""
+    argv = ["bench", "sim", "--repeats", "1", "-n"]
+    _at_the_limit(lambda n: [*argv, str(n)], 2_000_000, tmp_path, [], search=False)
+
+
+@pytest.mark.slow
+def test_toy_refuses_a_fine_toy_up_front(tmp_path: Path) -> None:
+    """A toy's coupled run (128 substeps a sample) at the largest size would take an hour: here its refusal, and a
+    gallery toy's peak, within the small limit."""
+    rc, mib, out = peak(["toy", str(_scene(tmp_path, "horse", 2_000_000))], tmp_path, SMALL_MIB)
+    _refused(rc, mib, out, [])
+    rc, mib, out = peak(["toy", str(GALLERY / "horse.toml")], tmp_path, SMALL_MIB)
+    assert rc in (0, 3) and mib <= SMALL_MIB * 1.25, (rc, mib, out)
+
+
+#: commands whose work does not grow with any option beyond what their inputs hold (a scene's parts, a request's
+#: effectors, a file's targets: each bounded where it is read): their peak at the small limit on the largest inputs
+_FIXED: dict[str, list[str]] = {
+    "info": ["info", "{fine}"],
+    "export": [
+        "export",
+        "{fine}",
+        "-o",
+        "{tmp}/p.dxf",
+        "--svg",
+        "{tmp}/p.svg",
+        "--preview",
+        "{tmp}/p.png",
+        "--bom",
+        "{tmp}/b.csv",
+        "--assembly",
+        "{tmp}/a.svg",
+        "--plan",
+        "{tmp}/p.json",
+        "--motion",
+        "{tmp}/m.csv",
+        "--steps",
+        "{tmp}/s.svg",
+    ],
+    # 6, not the limit's 8: at 8 it ran 8 minutes of CPU and reached 88 MiB (stopped); at 6, 27 s and 46 MiB
+    "chains": ["chains", "--max-length", "6", "--optional"],
+    "schema": ["schema", "-o", "{tmp}/s.json"],
+    "demo": ["demo", "-o", "{tmp}/demo"],
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(_FIXED))
+def test_fixed_size_commands_within_the_small_limit(tmp_path: Path, name: str) -> None:
+    fine = _scene(tmp_path, "jansen-leg", 2_000_000)
+    argv = [a.format(fine=fine, tmp=tmp_path) for a in _FIXED[name]]
+    rc, mib, out = peak(argv, tmp_path, SMALL_MIB)
+    assert rc == 0 and mib <= SMALL_MIB * 1.25, (rc, f"{mib:.0f} MiB", out[-500:])
