@@ -426,7 +426,8 @@ class ShortShaft:
     def __init__(self, pin: str, need: float, have: float, layers: tuple[int, int], at: tuple[float, float]) -> None:
         self.a, self.b = f"motor shaft {pin}", "motor"
         self.need, self.have = need, have
-        self.layer, self.sample, self.count, self.depth = layers[1] + 1, 0, 0, need - have
+        # too short in every sample of the cycle: first at sample 0, counted as one (no sample is better or worse)
+        self.layer, self.sample, self.count, self.depth = layers[1] + 1, 0, 1, need - have
         self.layers = layers
         self.at = at
 

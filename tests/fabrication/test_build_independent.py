@@ -258,9 +258,11 @@ def test_the_independent_check_can_fail(tmp_path):
 
 
 def _with_screws(name: str, where: Path) -> Path:
-    """A copy of a gallery scene cut with ``hardware = "screw"``."""
+    """A copy of a gallery scene cut with ``hardware = "screw"`` (on a motor with a 20 mm shaft: screw ends
+    open more layers than the gallery's rods, and this test is about the screws)."""
     text = (GALLERY / f"{name}.toml").read_text()
-    line = 'hardware = "screw"\n'
+    text = "\n".join(ln for ln in text.splitlines() if not ln.startswith("motor_shaft_mm")) + "\n"
+    line = 'hardware = "screw"\nmotor_shaft_mm = 20.0\n'
     if "[fabrication]\n" in text:
         text = text.replace("[fabrication]\n", "[fabrication]\n" + line)
     else:

@@ -345,6 +345,10 @@ def test_a_plan_needing_a_longer_shaft_exits_3_and_a_long_enough_motor_passes(tm
     need = out["plan"]["motor_shaft"]["length_mm"]
     assert f"{need:g} mm" in line and "9 mm" in line and "motor_shaft_mm" in line, line
     assert any(v["what"] == "motor shaft too short" for v in out["plan"]["violations"])
+    import jsonschema
+
+    schema = json.loads((Path(__file__).parents[2] / "docs" / "reference" / "plan.schema.json").read_text())
+    jsonschema.validate(out["plan"], schema)  # the shaft's violation is a record the schema allows
     assert (out["dir"] / "parts.dxf").exists()  # the outputs are written, to look at
     long = tmp_path / "long"
     long.mkdir()
