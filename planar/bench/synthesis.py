@@ -257,7 +257,8 @@ def bench_synthesis(
     orientation grid; ``n`` (``-n``): candidates in the kernel-rate measurement;
     ``problems``: a subset of :data:`PROBLEMS` by name (all by default);
     ``reachable``: random reachable curves per number of targets in :func:`bench_reachable` (25, or 2 with
-    ``quick``; 0 leaves that benchmark and the targets scaling out).
+    ``quick``; 0 leaves that benchmark, the targets scaling and :func:`bench_unreachable` out: 7 problems
+    per group, 56 in all, or 1 per group with ``quick``).
     """
     if repeats < 1:
         raise PlanarError("planar bench synthesis needs repeats >= 1")
@@ -329,6 +330,7 @@ def bench_synthesis(
     if count > 0:
         extra["reachable"] = bench_reachable(count=count, quick=quick)
         extra["targets_scaling"] = bench_targets_scaling(quick=quick)
+        extra["unreachable"] = bench_unreachable(count=1 if quick else 7, quick=quick)
     return {
         **extra,
         "benchmark": "synthesis",
@@ -400,6 +402,8 @@ def format_synthesis(r: dict[str, Any]) -> str:
         lines.append("  published errors not found: --json's published_searched (and the README) say where this looked")
     if "reachable" in r:
         lines.append(format_reachable(r["reachable"], r["targets_scaling"]))
+    if "unreachable" in r:
+        lines.append(format_unreachable(r["unreachable"]))
     return "\n".join(lines)
 
 
@@ -584,4 +588,118 @@ def format_reachable(r: dict[str, Any], scaling: list[dict[str, Any]]) -> str:
             f"{s['noisy_planar_median_error']:.3g} / {s['noisy_scipy_median_error']:.3g}"
         )
     lines.append("  untimed CPU against targets: " + ", ".join(f"{x['targets']}: {x['cpu_s']:.2f} s" for x in scaling))
+    return "\n".join(lines)
+
+
+# --- unreachable targets: noisy four-bar curves and six-bar curves, planar against the scipy baseline ---
+
+#: the unreachable groups: (what, targets, noise as a fraction of the size or a six-bar topology)
+UNREACHABLE_GROUPS: tuple[tuple[str, int, float | str], ...] = (
+    ("noise 0.5 %", 12, 0.005),
+    ("noise 0.5 %", 25, 0.005),
+    ("noise 2 %", 12, 0.02),
+    ("noise 2 %", 25, 0.02),
+    ("stephenson six-bar", 12, "stephenson"),
+    ("stephenson six-bar", 25, "stephenson"),
+    ("watt six-bar", 12, "watt"),
+    ("watt six-bar", 25, "watt"),
+)
+
+
+def random_sixbar(rng: np.random.Generator, topology: str, samples: int = 256) -> Array:
+    """A random six-bar of planar's ``topology`` (:data:`planar.synth.sixbar.TOPOLOGIES`) whose crank turns
+    fully and whose second dyad closes over the whole turn with a margin: its 15 parameters and two circuit
+    signs (:func:`planar.synth.sixbar.sixbar_points`).  The four-bar is :func:`random_crank_rocker`; the
+    point ``E`` anywhere within a box twice the coupler's (rocker's) length, the fixed pivot ``O6`` within
+    two ground lengths of the crank pivot, the dyad's links and the tracer in proportion to them."""
+    from planar.synth.sixbar import sixbar_points
+
+    th = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
+    while True:
+        row, circ = random_crank_rocker(rng)
+        g, side = row[0], row[2] if topology == "stephenson" else row[3]
+        e = side * rng.uniform(-1.0, 1.0, 2) + np.array([0.5 * side, 0.0])
+        o6 = row[6:8] + 2.0 * g * rng.uniform(-1.0, 1.0, 2)
+        l5, l6 = g * np.exp(rng.uniform(np.log(0.3), np.log(3.0), 2))
+        tu, tv = l5 * rng.uniform(-1.0, 2.0), l5 * rng.uniform(-1.0, 1.0)
+        X = np.concatenate([row[:4], e, row[6:9], o6, [l5, l6, tu, tv, circ, rng.choice([-1.0, 1.0])]])
+        _, _, margin = sixbar_points(X[None, :], th, topology)
+        if margin.min() > 1e-2:
+            return X
+
+
+def unreachable_problem(rng: np.random.Generator, n: int, kind: float | str) -> Array:
+    """``n`` targets no four-bar passes through exactly: a random crank-rocker's curve at sorted random crank
+    angles with Gaussian noise of ``kind`` (a float, a fraction of the targets' size) in each coordinate, or a
+    random six-bar's tracer curve (``kind`` its topology)."""
+    th = np.sort(rng.uniform(0.0, 2 * np.pi, n))
+    if isinstance(kind, str):
+        from planar.synth.sixbar import sixbar_points
+
+        x, y, _ = sixbar_points(random_sixbar(rng, kind)[None, :], th, kind)
+        return np.column_stack([x[0], y[0]])
+    T, _ = reachable_problem(rng, n)
+    size = float(np.sqrt(np.mean(np.sum((T - T.mean(0)) ** 2, 1))))
+    return T + kind * size * rng.standard_normal(T.shape)
+
+
+def bench_unreachable(count: int = 7, seed: int = 4711, quick: bool = False) -> dict[str, Any]:
+    """``count`` problems of every group of :data:`UNREACHABLE_GROUPS` (seeded ``seed``, never used to tune
+    anything): planar's untimed path synthesis (``normal`` budget, or ``quick``; CPU time by
+    ``time.process_time``), then :func:`scipy_baseline` given the same CPU time; each by the largest distance
+    from a target to the coupler point over the targets' size.  ``as_good``: planar's at most the
+    baseline's (relative 1e-9)."""
+    from threadpoolctl import threadpool_limits
+
+    from planar.synth.atlas import DEFAULT_SIZE, QUICK_SIZE, load_atlas
+    from planar.synth.path import synthesise_path
+
+    atlas = load_atlas(QUICK_SIZE if quick else DEFAULT_SIZE)
+    atlas.tree  # noqa: B018 (built here, not inside the first timed problem)
+    rows: list[dict[str, Any]] = []
+    with threadpool_limits(1):
+        for g, (what, n, kind) in enumerate(UNREACHABLE_GROUPS):
+            rng = np.random.default_rng([seed, g])
+            for _ in range(count):
+                T = unreachable_problem(rng, n, kind)
+                c0 = time.process_time()
+                d = synthesise_path(T, None, budget="quick" if quick else "normal", atlas=atlas)
+                cpu = time.process_time() - c0
+                base, starts = scipy_baseline(T, None, cpu)
+                e = float(d.checks["max_error"])
+                rows.append(
+                    {
+                        "group": what,
+                        "targets": n,
+                        "cpu_s": cpu,
+                        "planar_max_error": e,
+                        "scipy_max_error": base,
+                        "scipy_starts": starts,
+                        "as_good": bool(e <= base * (1 + 1e-9)),
+                    }
+                )
+    groups: dict[str, Any] = {}
+    for what, n, _ in UNREACHABLE_GROUPS:
+        rs = [r for r in rows if r["group"] == what and r["targets"] == n]
+        groups[f"{what}, {n} targets"] = {
+            "problems": len(rs),
+            "as_good": float(np.mean([r["as_good"] for r in rs])),
+            "planar_median_error": float(np.median([r["planar_max_error"] for r in rs])),
+            "scipy_median_error": float(np.median([r["scipy_max_error"] for r in rs])),
+            "median_cpu_s": float(np.median([r["cpu_s"] for r in rs])),
+        }
+    return {"rows": rows, "groups": groups, "as_good": float(np.mean([r["as_good"] for r in rows])), "problems": len(rows)}
+
+
+def format_unreachable(r: dict[str, Any]) -> str:
+    lines = [
+        f"unreachable targets ({r['problems']} problems): planar as good as a many-start scipy least_squares given "
+        f"the same CPU time in {r['as_good']:.0%}",
+        "  group                              as good  median err planar / scipy  median CPU",
+    ]
+    for k, s in r["groups"].items():
+        lines.append(
+            f"  {k:<34} {s['as_good']:>7.0%}  {s['planar_median_error']:.3g} / {s['scipy_median_error']:.3g}"
+            f"  {s['median_cpu_s']:.2f} s"
+        )
     return "\n".join(lines)

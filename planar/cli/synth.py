@@ -198,8 +198,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
         raise InputError("--seed", args.seed, "a seed of 0 or more")
     if not (args.tolerance > 0 and math.isfinite(args.tolerance)):
         raise InputError("--tolerance", args.tolerance, "a positive fraction of the targets' size")
-    if not 0 <= args.min_transmission < 90:
-        raise InputError("--min-transmission", args.min_transmission, "degrees from 0 up to (not including) 90")
+    min_transmission = _min_transmission_rad(args)
     if args.topology is not None and args.type != "sixbar":
         raise InputError("--topology", args.topology, "--topology only with --type sixbar")
     if args.points is not None and not 3 <= args.points <= MAX_TARGETS:
@@ -233,7 +232,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
         tolerance=args.tolerance,
         atlas=atlas,
         ordered=args.ordered,
-        min_transmission=math.radians(args.min_transmission),
+        min_transmission=min_transmission,
     )
     why = _unusable(d, "four-bar", cons.region is not None)
     if why is not None:
@@ -420,8 +419,7 @@ def _cmd_function(args: argparse.Namespace) -> int:
 
     if not (math.isfinite(args.ground) and SIZE_RANGE[0] <= args.ground <= SIZE_RANGE[1]):
         raise InputError("--ground", args.ground, f"a ground length from {SIZE_RANGE[0]:g} to {SIZE_RANGE[1]:g} (model units)")
-    if not 0 <= args.min_transmission < 90:
-        raise InputError("--min-transmission", args.min_transmission, "degrees from 0 up to (not including) 90")
+    min_transmission = _min_transmission_rad(args)
     if not (args.tolerance > 0 and math.isfinite(args.tolerance)):
         raise InputError("--tolerance", args.tolerance, "a positive angle in radians")
     t = read_table(args.pairs, ("input", "output"), min_rows=3)
@@ -447,7 +445,7 @@ def _cmd_function(args: argparse.Namespace) -> int:
         free_offsets=args.free_offsets,
         full_turn=args.full_turn,
         max_ratio=args.max_ratio,
-        min_transmission=math.radians(args.min_transmission),
+        min_transmission=min_transmission,
     )
     d, why = synthesise_function(phi, psi, args.ground, cons, args.tolerance)
     hint = "" if (d is not None and d.ok) or args.free_offsets else _free_hint(phi, psi, args, cons)
@@ -545,8 +543,7 @@ def _cmd_motion(args: argparse.Namespace) -> int:
 
     if not (args.max_ratio > 1 and math.isfinite(args.max_ratio)):
         raise InputError("--max-ratio", args.max_ratio, "a finite ratio greater than 1")
-    if not 0 <= args.min_transmission < 90:
-        raise InputError("--min-transmission", args.min_transmission, "degrees from 0 up to (not including) 90")
+    min_transmission = _min_transmission_rad(args)
     t = read_table(args.poses, ("x", "y", "angle"), min_rows=3)
     ang = np.radians(t["angle"]) if args.deg else t["angle"]
     poses = np.column_stack([t["x"], t["y"], ang])
@@ -557,7 +554,7 @@ def _cmd_motion(args: argparse.Namespace) -> int:
     normalisation(poses[:, :2], str(args.poses))  # coordinates float64 holds faithfully at the poses' size
     _check_poses(str(args.poses), poses)
     try:
-        d = burmester(poses, max_ratio=args.max_ratio, min_transmission=math.radians(args.min_transmission))
+        d = burmester(poses, max_ratio=args.max_ratio, min_transmission=min_transmission)
     except NoMotionDesign as e:
         return _no_design(args, "synth motion", {"poses": len(poses)}, str(e))
     amp, centre = (
@@ -605,12 +602,35 @@ MAX_TARGETS = 500
 MAX_PAIRS = 5000
 
 
+def _min_transmission_parent() -> argparse.ArgumentParser:
+    """The ``--min-transmission`` option path, function and motion share (one parent parser)."""
+    parent = argparse.ArgumentParser(add_help=False)
+    parent.add_argument(
+        "--min-transmission",
+        type=float,
+        default=0.0,
+        help="keep the transmission angle (between coupler and rocker) at least this far from 0 and 180 (a toggle) "
+        "over the motion (path: the crank's whole turn), degrees (0; never accepted nearer than 1 deg). path: a "
+        "constraint of the search; motion: chooses among the four-bars through the poses; when the best found does "
+        "not keep it, it is written and exits 3 naming the angle and where",
+    )
+    return parent
+
+
+def _min_transmission_rad(args: argparse.Namespace) -> float:
+    """``--min-transmission`` in radians; :class:`InputError` naming the option unless 0 <= it < 90 degrees."""
+    if not 0 <= args.min_transmission < 90:
+        raise InputError("--min-transmission", args.min_transmission, "degrees from 0 up to (not including) 90")
+    return math.radians(args.min_transmission)
+
+
 def add_parser(sub: Any) -> None:
     """Register ``planar synth`` on the top-level subparsers."""
     s = sub.add_parser("synth", help="synthesise a four-bar from a path, angle pairs or poses (writes a scene)")
     ss = s.add_subparsers(dest="synth_kind", required=True, metavar="KIND")
 
-    p = ss.add_parser("path", help="coupler curve through target points (CSV x,y[,theta] or an SVG path)")
+    trans = _min_transmission_parent()
+    p = ss.add_parser("path", parents=[trans], help="coupler curve through target points (CSV x,y[,theta] or an SVG path)")
     p.add_argument("target", help="CSV with columns x,y and optional theta (crank angle), or an .svg file")
     p.add_argument("-o", "--output", required=True, help="scene file (TOML) to write")
     p.add_argument("--type", choices=("fourbar", "sixbar"), default="fourbar", help="linkage type (fourbar)")
@@ -666,14 +686,6 @@ def add_parser(sub: Any) -> None:
         help="coupler-curve atlas file (from planar synth atlas -o) the search starts from (default: the cached one, "
         "built on first use: 1,000,000 curves, about 25 s of CPU; 20,000 with --budget quick)",
     )
-    p.add_argument(
-        "--min-transmission",
-        type=float,
-        default=0.0,
-        help="four-bar: keep the transmission angle at least this far from 0 and 180 (a toggle) over the turn, "
-        "degrees, a constraint of the search (0; never nearer than 1 deg: when the best found does not keep it, "
-        "it is written and exits 3)",
-    )
     p.add_argument("--seed", type=int, default=0, help="random seed of the search (same seed, same result)")
     p.set_defaults(func=_cmd_path)
 
@@ -689,7 +701,7 @@ def add_parser(sub: Any) -> None:
     a.add_argument("--force", action="store_true", help="rebuild even if the file exists")
     a.set_defaults(func=_cmd_atlas)
 
-    f = ss.add_parser("function", help="input/output angle pairs (Freudenstein): CSV input,output")
+    f = ss.add_parser("function", parents=[trans], help="input/output angle pairs (Freudenstein): CSV input,output")
     f.add_argument(
         "pairs",
         help="CSV with columns input,output (crank and rocker angles counter-clockwise from "
@@ -709,16 +721,10 @@ def add_parser(sub: Any) -> None:
     )
     f.add_argument("--full-turn", action="store_true", help="the crank must turn fully (Grashof crank)")
     f.add_argument("--max-ratio", type=float, default=10.0, help="longest / shortest link at most this (10)")
-    f.add_argument(
-        "--min-transmission",
-        type=float,
-        default=0.0,
-        help="keep the transmission angle at least this far from 0 and 180 (a toggle) over the motion, degrees (0)",
-    )
     f.add_argument("--json", action="store_true", help="print the design and its errors as JSON")
     f.set_defaults(func=_cmd_function)
 
-    m = ss.add_parser("motion", help="3, 4 or 5 poses of the coupler (Burmester): CSV x,y,angle")
+    m = ss.add_parser("motion", parents=[trans], help="3, 4 or 5 poses of the coupler (Burmester): CSV x,y,angle")
     m.add_argument(
         "poses",
         help="CSV with columns x,y,angle (the guided body's origin and angle), 3 to 5 rows, "
@@ -728,13 +734,5 @@ def add_parser(sub: Any) -> None:
     m.add_argument("-o", "--output", required=True, help="scene file (TOML) to write")
     m.add_argument("--max-ratio", type=float, default=10.0, help="longest / shortest link at most this, a finite number > 1 (10)")
     m.add_argument("--deg", action="store_true", help="angles in degrees")
-    m.add_argument(
-        "--min-transmission",
-        type=float,
-        default=0.0,
-        help="keep the transmission angle at least this far from 0 and 180 (a toggle) over the motion, degrees "
-        "(0; never nearer than 1 deg); chooses among the four-bars through the poses, exit 3 naming the angle and "
-        "where when none keeps it",
-    )
     m.add_argument("--json", action="store_true", help="print the design and its checks as JSON")
     m.set_defaults(func=_cmd_motion)

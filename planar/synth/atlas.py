@@ -53,6 +53,7 @@ __all__ = [
     "atlas_path",
     "build_atlas",
     "candidates",
+    "curve_candidates",
     "describe",
     "load_atlas",
 ]
@@ -402,6 +403,24 @@ def smooth_closed(z: NDArray[np.complex128], n: int = CURVE_SAMPLES) -> NDArray[
     cs = CubicSpline(s, np.column_stack([zz.real, zz.imag]), bc_type="periodic")
     q = cs(np.linspace(0.0, s[-1], n, endpoint=False))
     return np.asarray(q[:, 0] + 1j * q[:, 1])
+
+
+def curve_candidates(atlas: Atlas, z: NDArray[np.complex128], k: int = 32) -> Array:
+    """Four-bars whose curves are near the closed curve ``z`` (complex points in the crank's order, e.g. a
+    refined four-bar's coupler curve), placed onto it: ``2 k`` rows as :func:`candidates` (both normalisations,
+    not reversed or mirrored: an atlas curve runs the way its crank turns, as ``z`` does)."""
+    d, fr = describe(np.asarray(z, complex)[None, :])
+    if not np.isfinite(d).all():
+        return np.empty((0, 10))
+    out = []
+    for flipped in (False, True):
+        q = _flip(d) if flipped else d
+        wf = fr[0].copy()
+        if flipped:
+            wf[3] += np.pi
+        _, idx = atlas.tree.query(q[0], k=min(k, len(atlas)))
+        out.append(_place(atlas, np.atleast_1d(idx), wf))
+    return np.concatenate(out)
 
 
 def candidates(atlas: Atlas, targets: Array, k: int = 32) -> Array:

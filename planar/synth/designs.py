@@ -26,6 +26,23 @@ class PlacedFourBar:
     coupler_point: tuple[float, float]
     circuit: str
     placement: tuple[float, float, float]
+    theta: Any  # the crank angle at each target, pose or pair (radians)
+
+    def fourbar_dict(self) -> dict[str, Any]:
+        """The four-bar's record shared by every design's ``to_dict``: ``type``, the four lengths,
+        ``coupler_point``, ``circuit``, ``placement`` and ``theta`` (the crank angle at each target, pose or
+        pair, radians)."""
+        return {
+            "type": "fourbar",
+            "ground": self.ground,
+            "crank": self.crank,
+            "coupler": self.coupler,
+            "rocker": self.rocker,
+            "coupler_point": list(self.coupler_point),
+            "circuit": self.circuit,
+            "placement": list(self.placement),
+            "theta": [float(t) for t in self.theta],
+        }
 
     def fourbar(self, **kw: Any):
         """The design as a :class:`planar.linkages.FourBar`."""

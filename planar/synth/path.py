@@ -82,15 +82,7 @@ class FourBarDesign(Checked, PlacedFourBar):
 
     def to_dict(self) -> dict[str, Any]:
         return {
-            "type": "fourbar",
-            "ground": self.ground,
-            "crank": self.crank,
-            "coupler": self.coupler,
-            "rocker": self.rocker,
-            "coupler_point": list(self.coupler_point),
-            "circuit": self.circuit,
-            "placement": list(self.placement),
-            "theta": [float(t) for t in self.theta],
+            **self.fourbar_dict(),
             "sse": self.sse,
             "timed": self.timed,
             "time_s": self.seconds,

@@ -88,3 +88,29 @@ def test_subset4_and_format():
     k = {"median": 1.0, "min": 1.0, "max": 1.0, "samples": 64, "threads": 1, "float64": {"median": 1.0, "min": 1.0, "max": 1.0}}
     out = format_synthesis({"repeats": 1, "cores": 2, "kernel_candidates_per_s": k, "cases": [case]})
     assert "pylinkage optimisers" in out and "published_searched" in out
+
+
+def test_unreachable_problems_are_seeded_and_noisy_by_their_level():
+    from planar.bench.synthesis import reachable_problem, unreachable_problem
+    from planar.synth.sixbar import sixbar_points
+
+    for kind in (0.005, 0.02, "stephenson", "watt"):
+        a = unreachable_problem(np.random.default_rng(5), 12, kind)
+        b = unreachable_problem(np.random.default_rng(5), 12, kind)
+        assert a.shape == (12, 2) and np.isfinite(a).all() and np.array_equal(a, b)
+    # the noise is Gaussian of the level given, a fraction of the targets' size
+    rng = np.random.default_rng(9)
+    st = rng.bit_generator.state
+    noisy = unreachable_problem(rng, 200, 0.02)
+    rng2 = np.random.default_rng(9)
+    rng2.bit_generator.state = st
+    rng2.uniform(0.0, 2 * np.pi, 200)  # the angles unreachable_problem draws first
+    clean, _ = reachable_problem(rng2, 200)
+    size = np.sqrt(np.mean(np.sum((clean - clean.mean(0)) ** 2, 1)))
+    assert np.std(noisy - clean) / size == pytest.approx(0.02, rel=0.15)
+    # a six-bar's second dyad closes over the whole turn (checked at 3600 crank angles)
+    from planar.bench.synthesis import random_sixbar
+
+    X = random_sixbar(np.random.default_rng(2), "watt")
+    _, _, margin = sixbar_points(X[None, :], np.linspace(0, 2 * np.pi, 3600, endpoint=False), "watt")
+    assert margin.min() > 0
