@@ -360,6 +360,7 @@ def test_gallery_cam_scene_compare_is_refused_with_the_reason(capsys):
     assert err.count("\n") == 1 and "'cam-profile'" in err and "joint 'contact'" in err and "Traceback" not in err
 
 
+@pytest.mark.slow
 def test_gallery_cam_dxf_cuts_the_exact_outline(tmp_path):
     import ezdxf
     from shapely.geometry import Polygon

@@ -461,6 +461,7 @@ def test_export_failure_after_some_outputs_leaves_none(tmp_path: Path, capsys: p
     assert _snapshot(tmp_path) == before
 
 
+@pytest.mark.slow
 def test_limits_are_configurable(tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
     """The message names the variable; raising it lets the same request through."""
     src = tmp_path / "scene.toml"
@@ -542,6 +543,7 @@ def test_subprocess_errors_are_one_line_without_traceback(tmp_path: Path) -> Non
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml", "loop.toml"]
 
 
+@pytest.mark.slow
 def test_awkward_names_survive_every_format_or_are_refused(tmp_path: Path) -> None:
     """From Python a link may be named with a comma, quotes and XML specials: ezdxf, the csv module and
     svgelements read the outputs back; a newline is refused with the name, and nothing is written."""

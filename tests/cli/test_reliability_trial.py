@@ -69,6 +69,7 @@ def test_rates_at_extreme_scales_are_one_line_or_computed(tmp_path, capsys, scal
         assert rc == 0
 
 
+@pytest.mark.slow
 def test_synth_seed_and_design_options(tmp_path, capsys):
     t = tmp_path / "t.csv"
     t.write_text("x,y\n0,0\n1,0.2\n2,0\n1,-0.5\n")

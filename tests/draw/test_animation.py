@@ -204,6 +204,7 @@ def test_video_without_the_extra_is_one_clear_line(tmp_path, monkeypatch, capsys
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_mp4_through_ffmpeg(tmp_path):
     pytest.importorskip("imageio_ffmpeg")  # the test extra installs it; the video extra for users
     import imageio.v3 as iio

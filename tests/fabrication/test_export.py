@@ -205,6 +205,7 @@ def test_every_gallery_scene_exports_checked_files(tmp_path, path):
     assert len(shapes) == sum(1 for v in asm.layers.values() if v is not None)
 
 
+@pytest.mark.slow
 def test_svg_conventions(tmp_path):
     from svgelements import SVG, Rect, Text
     from svgelements import Circle as SCircle
@@ -285,6 +286,7 @@ def test_export_errors_are_user_errors(tmp_path, capsys):
     assert r.returncode == 2 and "Traceback" not in r.stderr and len(r.stderr.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_narrow_links_are_widened_or_refused(tmp_path):
     scene = load_scene(GALLERY / "paddle-boat.toml")
     fab = build(scene, FabSettings.from_spec(scene.spec.fabrication))
@@ -381,6 +383,7 @@ def test_nesting_horse_on_two_sheets_and_several_files(tmp_path):
         check_dxf(p, len(fab.layout.on_sheet(k)), fab.settings.kerf, (320, 200))
 
 
+@pytest.mark.slow
 def test_drive_and_mounting_holes(tmp_path):
     scene = load_scene(GALLERY / "jansen-leg.toml")
     export_scene(scene, tmp_path / "j.dxf", kerf=0.0)
@@ -395,6 +398,7 @@ def test_drive_and_mounting_holes(tmp_path):
     assert radii.count(1.6) == 2 and radii.count(0.9) == 2  # M3 mounting holes (3.2 as cut), motor screws
 
 
+@pytest.mark.slow
 def test_kerf_test_piece(tmp_path):
     assert main(["export", str(GALLERY / "jansen-leg.toml"), "--kerf", "0.2", "--kerf-test", str(tmp_path / "k.dxf")]) == 0
     doc = ezdxf.readfile(tmp_path / "k.dxf")
@@ -417,6 +421,7 @@ def test_preview_png(tmp_path):
     assert len(np.unique(im.reshape(-1, 3), axis=0)) > 3
 
 
+@pytest.mark.slow
 def test_no_duplicate_cut_entities_and_jansen_link_lengths(tmp_path):
     scene = load_scene(GALLERY / "jansen-leg.toml")
     export_scene(scene, tmp_path / "j.dxf", kerf=0.0)

@@ -160,6 +160,7 @@ def test_toy_every_pin_hole_is_pin_plus_clearance(tmp_path, text, least):
     assert _check_pin_holes(scene, fab, dxf, rows) >= least
 
 
+@pytest.mark.slow
 def test_mounting_holes_in_bom_and_cut_agree(bunny):
     scene, fab, dxf, rows = bunny
     (row,) = [r for r in rows if r["item"] == "mounting screw"]

@@ -140,6 +140,7 @@ def test_slots_and_tabs_meet_in_the_assembled_pose(bunny, reader):
     assert abs((xz["s2.driver"] - xz["frame.xz"]) - (layers["s2.driver"] - layers["frame.xz"]) * t) < 1e-9
 
 
+@pytest.mark.slow
 def test_walls_nesting_and_bom(bunny):
     fab, tmp, _ = bunny
     s = fab.settings

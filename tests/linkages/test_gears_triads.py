@@ -119,6 +119,7 @@ def test_geared_refusals() -> None:
         Linkage("bad", nodes, links)
 
 
+@pytest.mark.slow
 def test_geared_five_bar_scene_export_and_compare(tmp_path: Path) -> None:
     from planar.physics.compare import compare_scene
 

@@ -103,6 +103,7 @@ def test_compare_exit_status_3_when_the_error_passes_the_threshold():
     assert run_cli("compare", str(GALLERY / "nope.toml")).returncode == 2
 
 
+@pytest.mark.slow
 def test_compare_exit_status_3_on_a_branch_flip():
     args = ("compare", str(GALLERY / "jansen-leg.toml"), "--error-bias", "0", "--iterations", "40", "--substeps", "64")
     # no time for the settings search: the flip at the given budget is the verdict, as its own kind
@@ -210,6 +211,7 @@ def test_inverse_dynamics_matches_an_independent_newton_euler_solve():
     assert w > 0
 
 
+@pytest.mark.slow
 def test_motor_saturation_is_reported_with_its_samples_and_fails_compare(tmp_path):
     from planar.physics.simulate import torque_comparison
 
@@ -249,6 +251,7 @@ def test_contact_and_friction_keys_are_refused_in_one_line(tmp_path, key):
     assert sorted(x.name for x in tmp_path.iterdir()) == ["c.toml"]
 
 
+@pytest.mark.slow
 def test_bench_sim_json_has_both_timings_and_ratio():
     r = run_cli("bench", "sim", "--json", "-n", "24", "--repeats", "3")
     assert r.returncode == 0, r.stderr

@@ -96,6 +96,7 @@ def test_purely_kinematic_render_builds_no_space(monkeypatch, tmp_path):
     assert render_scene(scene_of(LEG), tmp_path / "k.gif", progress=False) == 25  # 1 cycle/s at 25 frames/s
 
 
+@pytest.mark.slow
 def test_spatial_mechanisms_are_refused_with_a_clear_message():
     for k in (6, 9):
         m = elemental(k)
@@ -113,6 +114,7 @@ def test_contact_held_by_gravity_needs_the_effect():
         simulate(m, m.driver.times(12), None)
 
 
+@pytest.mark.slow
 def test_compare_json_has_max_rel_error_per_part():
     r = subprocess.run(
         [sys.executable, "-m", "planar", "compare", str(GALLERY / "kangaroo-leg.toml"), "--json", "--motor"],

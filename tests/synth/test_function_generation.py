@@ -89,6 +89,7 @@ def test_known_fourbar_recovered_fixed_offsets():
     assert abs(d.crank - 1.5) < 1e-6 and abs(d.coupler - 4.0) < 1e-6 and abs(d.rocker - 3.5) < 1e-6
 
 
+@pytest.mark.slow
 def test_known_fourbar_recovered_with_free_offsets_and_root_finder_agrees():
     # a double-rocker's pairs, given with unknown zeros: only the differences are the request
     fb = FourBar(4.0, 3.0, 1.6, 3.5, circuit="crossed")
@@ -148,6 +149,7 @@ def test_cli_free_offsets_three_pairs_exact_with_good_transmission(tmp_path, cap
     assert np.minimum(mu, np.pi - mu).min() >= np.radians(30) - 1e-9
 
 
+@pytest.mark.slow
 def test_cli_full_turn_is_a_grashof_crank(tmp_path, capsys):
     fb = FourBar(5.0, 1.5, 4.0, 3.5)
     phi = np.linspace(0.0, 3.0, 6)

@@ -36,6 +36,7 @@ def test_kernel_matches_fourbar_solve(circuit):
     assert np.abs(np.column_stack([x[0], y[0]]) - ref).max() < 1e-12
 
 
+@pytest.mark.slow
 def test_path_timed_recovers_known_coupler_curve():
     th = np.linspace(0.2, 2.6, 5)
     pts = KNOWN.solve(th).points["coupler_point"]
@@ -47,6 +48,7 @@ def test_path_timed_recovers_known_coupler_curve():
     assert np.hypot(*(got - pts).T).max() < 1e-4
 
 
+@pytest.mark.slow
 def test_path_untimed_passes_through_points_of_known_curve():
     pts = KNOWN.solve(np.linspace(0.0, 2 * np.pi, 6, endpoint=False)).points["coupler_point"]
     d = synthesise_path(pts, None, budget="quick", seed=1)
@@ -222,6 +224,7 @@ def test_failed_checks_are_loud(tmp_path, capsys):
     assert "check failed: output angle error" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_sixbar_search_recovers_known_watt_tracer_points():
     from planar.synth.sixbar import sixbar_points, synthesise_sixbar
 

@@ -98,6 +98,7 @@ def test_a_toy_that_cannot_be_assembled_gets_its_panels_and_a_note(tmp_path: Pat
     assert "s0.ground.x" in _table(out)  # the stages' panels
 
 
+@pytest.mark.slow
 def test_chains_says_which_chains_assemble(capsys) -> None:
     assert main(["chains"]) == 0
     out = capsys.readouterr().out

@@ -70,6 +70,7 @@ def test_bad_pattern_and_chain_are_named():
         enumerate_chains("Rz")
 
 
+@pytest.mark.slow
 def test_cli_chains_json_and_target():
     r = subprocess.run([sys.executable, "-m", "planar", "chains", "--json"], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
