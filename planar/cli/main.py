@@ -94,15 +94,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _version() -> str:
-    """The installed distribution's version (the package's own when run from a checkout)."""
+    """The installed distribution's version (``unknown`` when run from a checkout that was never installed)."""
     from importlib import metadata
 
     try:
         return metadata.version("planar")
     except metadata.PackageNotFoundError:
-        import planar
-
-        return str(planar.__version__)
+        return "unknown (not installed: pip install .)"
 
 
 def _one_line(text: object) -> str:
