@@ -185,9 +185,9 @@ def _and(xs: list[int]) -> str:
 
 
 def _plates(fab: Any) -> list[str]:
-    """The ground plates cut flat (each has two mounting holes)."""
+    """The ground plates cut flat with two mounting holes each (the plates that stand on the standoffs)."""
     asm = fab.assembly
-    return [p.name for p in fab.layout.parts if asm.layers.get(p.name) is not None and p.name in fab.grounds]
+    return [p.name for p in fab.layout.parts if asm.layers.get(p.name) is not None and p.name in fab.mounts]
 
 
 def _fixing_rows(w: Any, fab: Any) -> None:

@@ -214,7 +214,24 @@ def _lay_action(fab: Any, flat: list[Any], name: str, k: int, started: list[Any]
         what += f" over pin(s) {', '.join(through)}, each up through its hole of that letter"
     if shaft:
         what += f", its D hole down onto the motor shaft {shaft[0].letter}: {shaft_retention(driven_part(shaft[0], fab.grounds))}"
+    glued = _glued_on(fab, name, [pp for pp in flat if name in pp.parts])
+    if glued:
+        what += (
+            f"; glue it on {', '.join(glued)} (a drop of cyanoacrylate or epoxy in the hole) at the angle the "
+            "assembly drawing shows, before the glue sets: it turns with the rod"
+        )
     return what
+
+
+def _glued_on(fab: Any, name: str, pins: list[Any]) -> list[str]:
+    """The pins (``rod B``) that part ``name`` is glued on: the mechanism as cut names its glued joints (a walker's
+    crank webs on the short shafts through the frame plates)."""
+    mech = fab.mechanism
+    glued = set(getattr(mech, "glued", ()))
+    if not glued:
+        return []
+    parts = {jt.name: (jt.a, jt.b) for jt in mech.joints if jt.name in glued}
+    return [f"pin {pp.letter}" for pp in pins if not pp.shaft and any(name in parts[j] for j in glued & set(pp.joints))]
 
 
 def _motor_actions(fab: Any, flat: list[Any], name: str) -> list[str]:

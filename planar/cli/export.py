@@ -69,7 +69,12 @@ def _cmd_export(args: argparse.Namespace) -> int:
     for v in fab.violations:  # the build check: the files are written (to look at), the exit status says it fails
         print(f"build check: {v.text()}")
     if fab.violations:
-        print(f"build check failed: {len(fab.violations)} problem(s); see the assembly drawing's red marks")
+        where = (
+            f"; the assembly drawing {args.assembly} rings them red"
+            if args.assembly
+            else " (--assembly FILE.svg draws them, ringed red)"
+        )
+        print(f"build check failed: {len(fab.violations)} problem(s){where}")
         return 3
     print("build check: every part, pin, spacer and the motor shaft clear through the cycle")
     return 0

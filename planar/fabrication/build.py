@@ -92,7 +92,7 @@ def _with_riders(scene: Any, mech: Any, s: FabSettings) -> Any:
             {i for (pn, i) in pinned if pn == name},
             drive_at,
             motor_at,
-            mounting=part.ground and part.plane == "xy",
+            mounting=_mounted(mech, part, shaft),
             drive_flat=flat,
         )
         return nominal_material(pc.outer, pc.inner)
@@ -130,6 +130,17 @@ def _phase_mark(pc: PartCut, at: tuple[float, float], flat: float, phase: float,
     cam = f"{math.degrees(phase - turn) % 360:.0f}"
     why = f" = cam phase {cam} + the stage's own turn {own}" if own != "0" else ""
     pc.notes.append(f"{pc.name}: keyed to the motor shaft at {deg} degrees{why} (engraved tick along the D's flat)")
+
+
+def _mounted(mech: Any, part: Any, shaft: Any) -> bool:
+    """Whether ground plate ``part`` gets mounting holes (it stands on the standoffs): every ground plate cut flat,
+    but where one of them holds the motor only that one (a walker's other frame plates sit higher in the stack,
+    held by its standoff rods)."""
+    if not (part.ground and part.plane == "xy"):
+        return False
+    if shaft is None or part.name in shaft.parts:
+        return True
+    return not any(mech.part(p).ground for p in shaft.parts)
 
 
 def _shaft_holes(
@@ -330,7 +341,7 @@ def _build(scene: Any, settings: FabSettings) -> Fabrication:
                     {i for (pn, i) in pinned if pn == part.name},
                     drive_at,
                     motor_at,
-                    mounting=part.ground and part.plane == "xy",
+                    mounting=_mounted(mech, part, shaft),
                     letters=letters[part.name],
                     drive_flat=flat,
                     extra=extra,

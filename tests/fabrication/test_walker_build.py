@@ -111,3 +111,40 @@ def test_the_gallery_walker_stacks_its_legs_in_slabs(tmp_path):
         (shaft,) = [p for p in plan["pins"] if f"frame_{k}" in p["parts"] and sum(q[:6] == "crank_" for q in p["parts"]) == 2]
         webs = sorted(layer[w] for w in shaft["parts"] if w.startswith("crank_"))
         assert webs[0] < layer[f"frame_{k}"] < webs[1], shaft
+
+
+@pytest.mark.slow
+def test_a_walker_stands_on_its_motor_plate_and_its_steps_glue_the_crank_webs(tmp_path):
+    """A random three-legged four-bar walker, read from its files alone: only the plate holding the motor stands on
+    standoffs (one pair in the BOM, one plate in plan.json's mounting); every other frame plate is laid on its layer
+    over the rods in a step; and each crank web the export's notes say to glue is glued in the step that lays it."""
+    scene = tmp_path / "walker.toml"
+    _random_scene("fourbar", 3, False, True, scene)
+    out = tmp_path / "out"
+    out.mkdir()
+    run = subprocess.run(
+        [sys.executable, "-m", "planar", "export", str(scene), "-o", str(out / "p.dxf"), "--plan", str(out / "plan.json"),
+         "--bom", str(out / "bom.csv"), "--steps", str(out / "steps.svg")],
+        capture_output=True, text=True, timeout=600,
+    )  # fmt: skip
+    assert run.returncode in (0, 3), run.stderr
+    plan = json.loads((out / "plan.json").read_text())
+    shaft = plan["motor_shaft"]["parts"]
+    frames = sorted(p["name"] for p in plan["parts"] if re.fullmatch(r"frame_\d+", p["name"]))
+    assert len(frames) == 4
+    mounted = [p["part"] for p in plan["mounting"]["plates"]]
+    assert mounted == [f for f in frames if f in shaft] and len(mounted) == 1, (mounted, shaft)
+    bom = (out / "bom.csv").read_text()
+    standoffs = [ln for ln in bom.splitlines() if ln.startswith("standoff,")]
+    assert len(standoffs) == 1 and standoffs[0].split(",")[2] == "2", standoffs
+    steps = {int(p.stem.split("-")[1]): p.read_text() for p in out.glob("steps-*.svg")}
+    text = "\n".join(steps[k] for k in sorted(steps))
+    for f in frames:
+        if f not in mounted:
+            assert re.search(rf"lay {f} on layer \d+", text), f
+            assert f"under {f}" not in text  # no standoffs under a plate in the middle of the stack
+    glue = re.findall(r"pin (\w): glue (\w+) and (\w+) on it", run.stdout)
+    assert glue, run.stdout
+    for letter, a, b in glue:
+        for web in (a, b):
+            assert re.search(rf"lay {web} on layer \d+[^<]*glue it on [^<]*pin {letter}\b", text), (web, letter)
