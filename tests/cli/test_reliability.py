@@ -168,7 +168,11 @@ BAD_SCENES: list[tuple[str, Any, str]] = [
         fb(polygons=[{"name": "foot", "part": "nope", "points": [[0, 0], [1, 0], [1, 1]]}]),
         "mechanism.polygons[0].part",
     ),
-    ("poly-2pts", fb(polygons=[{"name": "foot", "part": "coupler", "points": [[0, 0], [1, 0]]}]), "mechanism.polygons.foot.points"),
+    (
+        "poly-2pts",
+        fb(polygons=[{"name": "foot", "part": "coupler", "points": [[0, 0], [1, 0]]}]),
+        "mechanism.polygons.foot.points",
+    ),
     (
         "poly-comma",
         fb(polygons=[{"name": "a,b", "part": "coupler", "points": [[0, 0], [1, 0], [1, 1]]}]),
