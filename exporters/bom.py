@@ -206,8 +206,9 @@ def _fixing_rows(w: Any, fab: Any) -> None:
                     "",
                     screw.size,
                     "",
-                    f"{screw.item}, down through the ground plate into the motor's face under it, heads on the plate "
-                    f"({s.motor_screw_mm:g} mm clearance holes, {s.motor_screw_spacing_mm:g} mm apart)",
+                    f"{screw.item}, down through the ground plate into the motor's face under it, heads countersunk "
+                    f"flush with the plate's top face ({s.motor_screw_mm:g} mm clearance holes, "
+                    f"{s.motor_screw_spacing_mm:g} mm apart, countersunk from the top to 3.2 mm across)",
                 ]
             )
     plates = _plates(fab)

@@ -246,8 +246,10 @@ def _motor_actions(fab: Any, flat: list[Any], name: str) -> list[str]:
     a = shaft[0].letter
     return [
         f"hold the motor ({motor.item}) under {name}, its shaft up through {name}'s hole {a} (the shaft is pin {a})",
-        f"screw it on: {screw.qty} motor screws ({screw.item} {screw.size}) down through the "
-        f"{s.motor_screw_mm:g} mm holes either side of {a} into the motor's face (heads on {name})",
+        f"countersink the {s.motor_screw_mm:g} mm holes either side of {a} from {name}'s top face (a 90 degree "
+        "countersink bit, to 3.2 mm across) so the screws' heads sit flush: the part above turns over them",
+        f"screw it on: {screw.qty} motor screws ({screw.item} {screw.size}) down through those holes into the "
+        f"motor's face (heads flush in {name})",
     ]
 
 

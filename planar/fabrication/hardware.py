@@ -319,6 +319,9 @@ METRIC = (1.6, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0)
 SMALL_LENGTHS = (2, 2.5, 3, 4, 5, 6, 8, 10)
 #: thread a motor screw engages in an N20 gearmotor's face (its holes are 2-3 mm deep) (mm)
 MOTOR_THREAD_MM = 1.5
+#: the motor screws' countersunk heads (ISO 7046 M1.6: 3.0 mm across, 0.96 mm tall) sink into the plate's top face,
+#: flush: the part turning on the layer above passes over them (pan heads, 1.3 mm proud, would strike it)
+MOTOR_SCREW_HEAD = "countersunk head screw ISO 7046"
 
 
 def _metric_for(hole: float) -> float:
@@ -336,8 +339,9 @@ def _sold(need: float) -> float:
 
 
 def motor_items(settings: Any) -> list[Item]:
-    """The motor (an N20 gearmotor with the settings' D shaft) and its two face screws: through the plate holding
-    it and ``MOTOR_THREAD_MM`` into the motor's face (M1.6 for the default 1.7 mm holes: check your motor)."""
+    """The motor (an N20 gearmotor with the settings' D shaft) and its two face screws: countersunk flush into the
+    plate holding it (nothing stands above its top face) and ``MOTOR_THREAD_MM`` into the motor's face (M1.6 for
+    the default 1.8 mm holes: check your motor)."""
     m = _metric_for(settings.motor_screw_mm)
     n = _sold(settings.thickness_mm + MOTOR_THREAD_MM)
     return [
@@ -347,7 +351,7 @@ def motor_items(settings: Any) -> list[Item]:
             f"face screws {settings.motor_screw_spacing_mm:g} mm apart",
             1,
         ),
-        Item("pan head screw ISO 7045", f"M{m:g} x {n:g} (check your motor)", 2),
+        Item(MOTOR_SCREW_HEAD, f"M{m:g} x {n:g} (check your motor)", 2),
     ]
 
 

@@ -414,3 +414,17 @@ def test_kerf_test_message_says_what_each_file_holds(tmp_path, capsys):
     parts_line = next(ln for ln in lines if " parts " in ln and "->" in ln)
     assert str(kerf) not in parts_line and "no part file written" in parts_line, parts_line
     assert any(ln.startswith("kerf test piece") and ln.endswith(str(kerf)) for ln in lines), lines
+
+
+def test_the_motor_screws_are_countersunk_flush():
+    """The build check models nothing above the ground plate's top face at the motor screws: true only if their
+    heads sink flush (a pan head stands 1.3 mm proud, under the part turning on the layer above). The BOM's motor
+    screws are a countersunk kind whose head height (ISO 7046: k 0.96 mm for M1.6, 1.2 for M2) fits the sheet."""
+    from planar.fabrication.hardware import motor_items
+
+    head = {1.6: 0.96, 2.0: 1.2}
+    for t in (1.5, 3.0, 6.0):
+        _, screw = motor_items(_settings(thickness_mm=t))
+        m = float(screw.size.split(" x ")[0][1:])
+        assert "countersunk" in screw.item and "ISO 7046" in screw.item, screw
+        assert head[m] < t, (screw, t)
