@@ -331,9 +331,10 @@ def _build_slidercrank(spec: SceneSpec, m: SliderCrankSpec, b: _Build) -> Mechan
     )
 
 
-@BUILDERS.register(LinkageSpec)
-def _build_linkage(spec: SceneSpec, m: LinkageSpec, b: _Build) -> Mechanism:
-    from planar.linkages import NODE_KINDS, Link, Linkage
+def _nodes_and_links(spec: SceneSpec, m: LinkageSpec | LegsSpec) -> tuple[list[Any], list[Any]]:
+    """A linkage or leg table's node kinds and links, built from their scene keys (angles in radians, each
+    named ``nodes.NAME.FIELD`` where float64 cannot resolve it)."""
+    from planar.linkages import NODE_KINDS, Link
 
     nodes = []
     for n in m.nodes:
@@ -345,7 +346,14 @@ def _build_linkage(spec: SceneSpec, m: LinkageSpec, b: _Build) -> Mechanism:
             for f in cls.scene_fields
         ]
         nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
-    links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
+    return nodes, [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
+
+
+@BUILDERS.register(LinkageSpec)
+def _build_linkage(spec: SceneSpec, m: LinkageSpec, b: _Build) -> Mechanism:
+    from planar.linkages import Linkage
+
+    nodes, links = _nodes_and_links(spec, m)
     return Linkage(
         spec.name or "linkage",
         nodes,
@@ -361,20 +369,9 @@ def _build_linkage(spec: SceneSpec, m: LinkageSpec, b: _Build) -> Mechanism:
 
 @BUILDERS.register(LegsSpec)
 def _build_legs(spec: SceneSpec, m: LegsSpec, b: _Build) -> Mechanism:
-    from planar.linkages import NODE_KINDS, Link
     from planar.linkages.legs import Legs
 
-    nodes = []
-    for n in m.nodes:
-        cls = NODE_KINDS[n.kind]
-        args = [
-            _angle(spec, getattr(n, f), f"nodes.{n.name}.{f}")
-            if f in cls.angle_fields and getattr(n, f) is not None
-            else getattr(n, f)
-            for f in cls.scene_fields
-        ]
-        nodes.append(cls(n.name, *args))  # type: ignore[call-arg]  # each kind's dataclass fields
-    links = [Link(lk.name, tuple(lk.nodes), lk.guide) for lk in m.links]
+    nodes, links = _nodes_and_links(spec, m)
     phases = None if m.phases is None else [_angle(spec, v, f"phases[{i}]") for i, v in enumerate(m.phases)]
     return Legs(
         spec.name or "legs",
