@@ -25,6 +25,7 @@ import numpy as np
 
 from planar.core.model import Hole, Part, Pivot
 from planar.errors import InputError
+from planar.fabrication.views import PartsView
 
 __all__ = ["ROOM_MARGIN", "RiderView", "pin_sites", "rider_polygons", "with_riders"]
 
@@ -108,25 +109,14 @@ def _farthest(room: Any, least: float) -> tuple[tuple[float, float], tuple[float
     return a, b
 
 
-class RiderView:
+class RiderView(PartsView):
     """A mechanism with its riders: each host part with two more pin holes, each rider a part with two pin holes,
     two pivots between them; the rider's pose is its host's at every sample.  Everything else is the wrapped
     mechanism's."""
 
     def __init__(self, mech: Any, parts: list[Part], joints: list[Any], hosts: dict[str, str]) -> None:
-        self._mech = mech
-        self.parts = tuple(parts)
-        self.joints = tuple(joints)
+        super().__init__(mech, parts, joints)
         self.hosts = dict(hosts)
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self._mech, name)
-
-    def part(self, name: str) -> Part:
-        for p in self.parts:
-            if p.name == name:
-                return p
-        return self._mech.part(name)
 
     def run(self, *args: Any, **kw: Any) -> Any:
         m = self._mech.run(*args, **kw)

@@ -67,6 +67,7 @@ import numpy as np
 from planar.core.model import Hole, Mechanism, Part, Pivot, Slide
 from planar.fabrication.joints import FabricationError
 from planar.fabrication.parts import Feature
+from planar.fabrication.views import PartsView
 
 __all__ = ["FabView", "TabJoin", "TabPlan", "fab_view", "merge_travel", "plan_tabs", "slot_features", "travel_slots"]
 
@@ -101,28 +102,17 @@ class TabJoin:
     tabs: list[Any] = field(default_factory=list)
 
 
-class FabView:
+class FabView(PartsView):
     """A mechanism as fabrication cuts it: repeated perpendicular guides dropped, brackets added.
 
     Everything else (driver, notes, keyed cams, poses) is the wrapped mechanism's; a bracket stands still.
     """
 
     def __init__(self, mech: Mechanism, parts: list[Part], joints: list[Any], extra: list[str], notes: list[str]) -> None:
-        self._mech = mech
-        self.parts = tuple(parts)
-        self.joints = tuple(joints)
+        super().__init__(mech, parts, joints)
         self.extra = extra
         self.notes = list(mech.notes) + notes
         self.bodies: dict[str, list[str]] = {k: list(v) for k, v in mech.bodies.items()}
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self._mech, name)
-
-    def part(self, name: str) -> Part:
-        for p in self.parts:
-            if p.name == name:
-                return p
-        return self._mech.part(name)
 
     def run(self, *args: Any, **kw: Any) -> Any:
         m = self._mech.run(*args, **kw)
