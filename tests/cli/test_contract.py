@@ -16,25 +16,13 @@ import time
 from pathlib import Path
 
 import pytest
+from clicheck import fails_cleanly as _fails_cleanly
 
 from planar.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[2]
 GALLERY = ROOT / "gallery"
 KANGAROO = (GALLERY / "kangaroo-leg.toml").read_text()
-
-
-def _fails_cleanly(capsys: pytest.CaptureFixture[str], argv: list[str], *needles: str, out: Path | None = None) -> str:
-    """``main(argv)`` exits 2 with one line holding every needle, and leaves ``out`` unwritten."""
-    rc = main(argv)
-    err = capsys.readouterr().err.strip()
-    assert rc == 2, err
-    assert len(err.splitlines()) == 1 and err.startswith("planar: error: "), err
-    for n in needles:
-        assert n in err, err
-    if out is not None:
-        assert not out.exists()
-    return err
 
 
 def _scene(tmp_path: Path, text: str, name: str = "s.toml") -> Path:
