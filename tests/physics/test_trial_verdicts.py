@@ -175,10 +175,10 @@ def test_a_crank_that_cannot_turn_is_refused_with_what_to_change():
 
 def test_a_genuine_torque_peak_is_not_capped(monkeypatch):
     # a quick return's inertia peak is brief but real: the robust cap must leave it standing
-    from planar.physics import run
+    from planar.physics import torquescale
 
     scene = load_scene(SCENES / "shaper-saturated.toml")
     mech, t = scene.mechanism, scene.motion().t
     capped = torque_scale(mech, t, scene.effects)
-    monkeypatch.setattr(run, "_SCALE_SPREAD", 1e12)
+    monkeypatch.setattr(torquescale, "_SCALE_SPREAD", 1e12)
     assert capped == pytest.approx(torque_scale(mech, t, scene.effects), rel=1e-12)
