@@ -25,6 +25,7 @@ Built, each leg lies in its own slab of layers between two frame plates (``frame
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, fields, replace
@@ -327,15 +328,24 @@ class LegsAssembly(Mechanism):
         return replace(jt, a=new if jt.a in ("crankshaft", g) else jt.a, b=new if jt.b in ("crankshaft", g) else jt.b)
 
     def _solve_points(self, q: Array) -> tuple[dict[str, Array], Any, Any]:
+        """The walker's solve with its poses renamed onto the built parts; lazy poses stay lazy (renamed when
+        first read), so a solve that reads only the points never holds every part's pose track."""
         poses, checks, pts = self.legs._solve_points(q)
-        out = dict(poses.make() if isinstance(poses, LazyPoses) else poses)  # the parts' poses, renamed below
+        if isinstance(poses, LazyPoses):
+            return LazyPoses(functools.partial(self._renamed_poses, poses.make), len(self.parts)), checks, pts
+        return self._renamed_poses(lambda: poses), checks, pts
+
+    def _renamed_poses(self, make: Callable[[], Mapping[str, Array]]) -> dict[str, Array]:
+        """The walker's poses (``make()``) as the built parts': each web moves as the crankshaft, each plate
+        stands as the ground (the same arrays, not copies)."""
+        out = dict(make())
         shaft = out.pop("crankshaft")
         g = out.pop(self.legs.ground_name)
         for w in self.webs:
             out[w] = shaft
         for pl in self.layer_stack[0]:
             out[pl] = g
-        return out, checks, pts
+        return out
 
 
 def auto_standoffs(legs: Legs, samples: int = 72) -> tuple[tuple[float, float], ...]:

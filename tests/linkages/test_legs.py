@@ -87,6 +87,28 @@ def test_the_built_walker_moves_as_the_walker():
     assert b.driver.part == "crank_1b" and sum(p.ground for p in b.parts) == 5
 
 
+def test_the_built_walker_leaves_its_poses_lazy():
+    """The built walker's solve hands over its poses uncomputed, as the walker's does: reading the points
+    computes none of them; read, they are the walker's renamed (webs the crankshaft's, plates the ground's)."""
+    nodes, links = jansen_leg()
+    w = Legs("w", nodes, links, 4, mirror=True, points={"foot": "F"}, standoffs=[(0.0, -32.0)])
+    b = w.as_built()
+    q = np.linspace(0, 2 * math.pi, 2001)
+    mw = w.solve(q)
+    if "_lazy_poses" not in mw.__dict__:
+        pytest.skip("the walker's own solve computes its poses at once here (no compiled kernels)")
+    mb = b.solve(q)
+    assert "_lazy_poses" in mb.__dict__
+    np.testing.assert_array_equal(mb.points["foot_3"], mw.points["foot_3"])
+    assert "_lazy_poses" in mb.__dict__  # the points are read without the poses
+    assert set(mb.poses) == {p.name for p in b.parts}
+    for name in ("crank_1a", "crank_2b", "crank_4a"):
+        np.testing.assert_array_equal(mb.poses[name], mw.poses["crankshaft"])
+    for name in ("frame_0", "frame_2", "frame_4"):
+        np.testing.assert_array_equal(mb.poses[name], mw.poses["ground"])
+    np.testing.assert_array_equal(mb.poses["upper_2"], mw.poses["upper_2"])
+
+
 def _scene(**mech) -> dict:
     nodes = [
         {"name": "O", "kind": "fixed", "at": [0.0, 0.0]},
