@@ -51,28 +51,10 @@ DEFAULTS: dict[str, tuple[str, int]] = {
 }
 
 
-def env_text(var: str) -> str | None:
-    """``os.environ.get(var)``, read where CPython keeps it: a solve of a few dozen samples reads three
-    settings, and ``os.environ.get`` of an unset name raises and catches a ``KeyError`` inside (0.7 us
-    each on the project's machine, against 0.05 us for a look-up in the bytes mapping ``os.environ``
-    keeps on POSIX).  Anywhere else (another platform or interpreter, ``os.environ`` replaced by
-    another mapping) it is ``os.environ.get`` itself; the result is the same."""
-    env = os.environ
-    data = getattr(env, "_data", None)
-    if _BYTES_ENV and type(data) is dict:
-        raw = data.get(var.encode())
-        return None if raw is None else os.fsdecode(raw)
-    return env.get(var)
-
-
-#: ``os.environ`` keeps bytes names and values (POSIX CPython)
-_BYTES_ENV = os.name == "posix" and all(type(k) is bytes for k in list(getattr(os.environ, "_data", {"": 0}))[:1])
-
-
 def limit(name: str) -> int:
     """The current value of limit ``name`` (the environment variable, else the default)."""
     var, default = DEFAULTS[name]
-    text = env_text(var)
+    text = os.environ.get(var)
     if text is None or not text.strip():
         return default
     try:

@@ -50,7 +50,6 @@ from numpy.typing import NDArray
 from planar.core.buffers import MIN_BYTES as _BLOCK_MIN
 from planar.core.buffers import block as _pool_block
 from planar.core.geometry import CONCENTRIC, TANGENCY_RTOL, line_circle, poses_apply
-from planar.core.limits import env_text
 from planar.core.model import FinitePoses, LazyPoses
 from planar.linkages.plan import Linkage, NodeKind, _Plan
 
@@ -373,7 +372,7 @@ def _cores() -> int:
 
 def threads_default() -> int:
     """Threads the fast solve uses: ``PLANAR_THREADS`` if set, else the number of cores."""
-    env = (env_text("PLANAR_THREADS") or "").strip()
+    env = os.environ.get("PLANAR_THREADS", "").strip()
     if not env:
         return _cores()
     try:
@@ -627,7 +626,7 @@ JIT_RANGES_PER_THREAD = 4
 
 def jit_available() -> bool:
     """Whether the compiled kernels can be used (numba installed and ``PLANAR_JIT`` is not ``0``)."""
-    if env_text("PLANAR_JIT") == "0":
+    if os.environ.get("PLANAR_JIT", "1") == "0":
         return False
     if _NUMBA[0] is None:
         try:

@@ -23,21 +23,3 @@ def test_samples_per_cycle_follows_the_documented_limit(tmp_path, capsys, monkey
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "driver.samples_per_cycle = 150000" in err and "PLANAR_MAX_SAMPLES" in err
     assert not out.exists()
-
-
-def test_env_text_reads_what_os_environ_get_reads(monkeypatch: pytest.MonkeyPatch) -> None:
-    """The settings' quick read gives os.environ.get's answer: unset, set, changed, non-ASCII, deleted."""
-    import os
-
-    from planar.core.limits import env_text
-
-    name = "PLANAR_TEST_ENV_TEXT"
-    monkeypatch.delenv(name, raising=False)
-    assert env_text(name) is None and os.environ.get(name) is None
-    for value in ("1", "", " 2 ", "caf\u00e9", "x" * 300):
-        monkeypatch.setenv(name, value)
-        assert env_text(name) == os.environ.get(name) == value
-    monkeypatch.delenv(name)
-    assert env_text(name) is None
-    monkeypatch.setattr(os, "environ", {name: "other mapping"})  # not CPython's: os.environ.get itself
-    assert env_text(name) == "other mapping"
