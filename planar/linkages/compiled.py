@@ -171,6 +171,21 @@ def _k_actuator(par: FloatArray, q: FloatArray, L: int, xs: FloatArray, ys: Floa
 
 
 @njit(**_JIT)
+def _rrr_sample(dx: float, dy: float, s2: float, f2: float, tiny: float, hb: float) -> tuple[bool, float, float, float]:
+    """One sample of :func:`_k_rrr` from the centres' offset ``(dx, dy)``: whether the circles meet, the
+    clamped Heron product ``(s^2 - d^2)(d^2 - f^2)``, ``1 / d^2`` (1 for concentric centres) and the
+    half-chord factor ``t`` (signed by the branch)."""
+    d2 = dx * dx + dy * dy
+    prod = (s2 - d2) * (d2 - f2)
+    scale = max(s2, d2)
+    good = (prod >= -_RTOL * scale * scale) & (d2 > tiny)
+    d2 = 1.0 if d2 <= tiny else d2
+    prod = max(prod, 0.0)
+    inv = 1.0 / d2
+    return good, prod, inv, math.sqrt(prod) * inv * hb
+
+
+@njit(**_JIT)
 def _k_rrr(
     par: FloatArray,
     L: int,
@@ -201,16 +216,9 @@ def _k_rrr(
         for i in range(L):
             dx = xb[i] - xa[i]
             dy = yb[i] - ya[i]
-            d2 = dx * dx + dy * dy
-            prod = (s2 - d2) * (d2 - f2)
-            scale = max(s2, d2)
-            good = (prod >= -_RTOL * scale * scale) & (d2 > tiny)
+            good, prod, inv, t = _rrr_sample(dx, dy, s2, f2, tiny, hb)
             ok[i] = good
             fails += not good
-            d2 = 1.0 if d2 <= tiny else d2
-            prod = max(prod, 0.0)
-            inv = 1.0 / d2
-            t = math.sqrt(prod) * inv * hb
             sep[i] = prod * inv
             fr = inv * hr + 0.5
             xo[i] = (fr * dx + xa[i]) - t * dy
@@ -219,16 +227,9 @@ def _k_rrr(
     for i in range(L):
         dx = (xb[i] - xa[i]) * k
         dy = (yb[i] - ya[i]) * k
-        d2 = dx * dx + dy * dy
-        prod = (s2 - d2) * (d2 - f2)
-        scale = max(s2, d2)
-        good = (prod >= -_RTOL * scale * scale) & (d2 > tiny)
+        good, prod, inv, t = _rrr_sample(dx, dy, s2, f2, tiny, hb)
         ok[i] = good
         fails += not good
-        d2 = 1.0 if d2 <= tiny else d2
-        prod = max(prod, 0.0)
-        inv = 1.0 / d2
-        t = math.sqrt(prod) * inv * hb
         sep[i] = prod * inv / (k * k)
         fr = inv * hr + 0.5
         dx /= k  # back to model units (exact)
