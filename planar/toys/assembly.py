@@ -123,56 +123,52 @@ def _xf_feature(m: XForm, f: Feature) -> Feature:
     raise InputError("feature", type(f).__name__, "a Hole, Slot or ArcSlot (no rule to move it into a merged part)")
 
 
-#: how a stage's joint moves into the assembly: (joint, name, a, b, xform of a, xform of b, stage) -> joint
-PLACERS: Registry[Callable[..., Any]] = Registry("toy assembly")
+#: how a stage's joint moves into the assembly: (joint, xform of a, xform of b, stage) -> the joint's fields
+#: that move with its parts (its geometry); the assembly renames it and its parts (:func:`_placed`)
+PLACERS: Registry[Callable[..., dict[str, Any]]] = Registry("toy assembly")
 
 
 @PLACERS.register(Pivot)
-def _place_pivot(j: Pivot, name: str, a: str, b: str, ma: XForm, mb: XForm, st: Any) -> Pivot:
-    return replace(j, name=name, a=a, b=b, anchor_a=_xf_point(ma, j.anchor_a), anchor_b=_xf_point(mb, j.anchor_b))
+def _place_pivot(j: Pivot, ma: XForm, mb: XForm, st: Any) -> dict[str, Any]:
+    return {"anchor_a": _xf_point(ma, j.anchor_a), "anchor_b": _xf_point(mb, j.anchor_b)}
 
 
 @PLACERS.register(PinInSlot)
-def _place_pin_slot(j: PinInSlot, name: str, a: str, b: str, ma: XForm, mb: XForm, st: Any) -> PinInSlot:
-    return replace(j, name=name, a=a, b=b, start=_xf_point(ma, j.start), end=_xf_point(ma, j.end), pin=_xf_point(mb, j.pin))
+def _place_pin_slot(j: PinInSlot, ma: XForm, mb: XForm, st: Any) -> dict[str, Any]:
+    return {"start": _xf_point(ma, j.start), "end": _xf_point(ma, j.end), "pin": _xf_point(mb, j.pin)}
 
 
 @PLACERS.register(PinInArcSlot)
-def _place_pin_arc(j: PinInArcSlot, name: str, a: str, b: str, ma: XForm, mb: XForm, st: Any) -> PinInArcSlot:
-    return replace(j, name=name, a=a, b=b, centre=_xf_point(ma, j.centre), pin=_xf_point(mb, j.pin))
+def _place_pin_arc(j: PinInArcSlot, ma: XForm, mb: XForm, st: Any) -> dict[str, Any]:
+    return {"centre": _xf_point(ma, j.centre), "pin": _xf_point(mb, j.pin)}
 
 
 @PLACERS.register(Slide)
-def _place_slide(j: Slide, name: str, a: str, b: str, ma: XForm, mb: XForm, st: Any) -> Slide:
-    return replace(
-        j,
-        name=name,
-        a=a,
-        b=b,
-        start=_xf_point(ma, j.start),
-        end=_xf_point(ma, j.end),
-        anchor=_xf_point(mb, j.anchor),
-        axis=_xf_vec(mb, j.axis),
-    )
+def _place_slide(j: Slide, ma: XForm, mb: XForm, st: Any) -> dict[str, Any]:
+    return {
+        "start": _xf_point(ma, j.start),
+        "end": _xf_point(ma, j.end),
+        "anchor": _xf_point(mb, j.anchor),
+        "axis": _xf_vec(mb, j.axis),
+    }
 
 
 @PLACERS.register(CamOnLine)
-def _place_cam_line(j: CamOnLine, name: str, a: str, b: str, ma: XForm, mb: XForm, st: Any) -> CamOnLine:
-    return replace(j, name=name, a=a, b=b, start=_xf_point(ma, j.start), end=_xf_point(ma, j.end), centre=_xf_point(mb, j.centre))
+def _place_cam_line(j: CamOnLine, ma: XForm, mb: XForm, st: Any) -> dict[str, Any]:
+    return {"start": _xf_point(ma, j.start), "end": _xf_point(ma, j.end), "centre": _xf_point(mb, j.centre)}
 
 
 @PLACERS.register(SkewContact)
-def _place_skew(j: SkewContact, name: str, a: str, b: str, ma: XForm, mb: XForm, st: Any) -> SkewContact:
+def _place_skew(j: SkewContact, ma: XForm, mb: XForm, st: Any) -> dict[str, Any]:
     # the driver (xy) moves with ma; the follower (yz) keeps its frame and its axis moves to x + tx
-    return replace(
-        j,
-        name=name,
-        a=a,
-        b=b,
-        edge_point=_xf_point(ma, j.edge_point),
-        edge_dir=_xf_vec(ma, j.edge_dir),
-        pin_x=j.pin_x + st.place[0],
-    )
+    return {"edge_point": _xf_point(ma, j.edge_point), "edge_dir": _xf_vec(ma, j.edge_dir), "pin_x": j.pin_x + st.place[0]}
+
+
+def _placed(j: Any, name: str, a: str, b: str, ma: XForm, mb: XForm, st: Any, where: str) -> Any:
+    """Joint ``j`` of a stage placed in the assembly: renamed ``name`` between pieces ``a`` and ``b``, its
+    geometry moved with its parts (``ma``, ``mb``) by its kind's :data:`PLACERS` entry."""
+    moved = PLACERS.get(j, where)(j, ma, mb, st)
+    return replace(j, name=name, a=a, b=b, **moved)
 
 
 # ---------------------------------------------------------------------------- the assembly
@@ -482,8 +478,8 @@ class ToyAssembly(Mechanism):
                     and cam_name[p.stage.index] != main_cam
                 ):
                     continue  # the axle of a second cam: it is keyed to the first instead (below)
-                placer = PLACERS.get(j, f"joint {j.name!r} of stage {p.label}")
-                joints.append(placer(j, f"{p.label}.{j.name}", self.piece_of[a], self.piece_of[b], xf[a], xf[b], p))
+                where = f"joint {j.name!r} of stage {p.label}"
+                joints.append(_placed(j, f"{p.label}.{j.name}", self.piece_of[a], self.piece_of[b], xf[a], xf[b], p, where))
         return joints
 
     def _keyed_shafts(self, cam_name: dict[int, str], main_cam: str) -> list[Any]:
