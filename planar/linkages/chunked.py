@@ -688,11 +688,12 @@ def solve_compiled(
     chunk = chunk or JIT_CHUNK
     tols = _tols(plan, q) if prog.grows else None
     n = q.shape[0]
-    if threads is None:
-        nthreads = threads_default()  # read (and checked) on every call
-        nthreads = 1 if n < JIT_THREADS_MIN else nthreads
-    else:
+    if threads is not None:
         nthreads = 1 if n <= chunk else threads
+    elif n < JIT_THREADS_MIN:
+        nthreads = 1
+    else:  # PLANAR_THREADS is read (and checked) on every call where threads may run
+        nthreads = threads_default()
     return _solve_compiled(lk, plan, prog, q, tols, nthreads, chunk, lazy)
 
 

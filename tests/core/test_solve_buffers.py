@@ -11,7 +11,7 @@ pytest.importorskip("numba")
 
 from planar.core import buffers
 from planar.linkages import FourBar
-from planar.linkages.chunked import JIT_MIN, solver_for
+from planar.linkages.chunked import JIT_MIN, JIT_THREADS_MIN, solver_for
 from planar.scene.catalog import get
 
 N = max(JIT_MIN, 40_000)  # large enough for the compiled path and for blocks the pool takes
@@ -142,10 +142,12 @@ def test_bad_settings_and_inputs_are_one_line_errors(monkeypatch: pytest.MonkeyP
 
     leg = FourBar(4.0, 1.0, 4.0, 3.0)
     q = np.linspace(0.0, 1.0, N)
+    # PLANAR_THREADS is read where threads may run: from JIT_THREADS_MIN samples
+    threaded = np.linspace(0.0, 1.0, max(N, JIT_THREADS_MIN))
     for var, bad in (("PLANAR_THREADS", "abc"), ("PLANAR_THREADS", "0"), ("PLANAR_RECYCLE", "maybe")):
         monkeypatch.setenv(var, bad)
         with pytest.raises(InputError, match=var):
-            leg.solve(q)
+            leg.solve(threaded if var == "PLANAR_THREADS" else q)
         monkeypatch.delenv(var)
     monkeypatch.setenv("PLANAR_RECYCLE", "off")
     assert leg.solve(q).valid.all()
