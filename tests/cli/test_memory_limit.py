@@ -301,6 +301,41 @@ def test_toy_at_a_small_limit(tmp_path: Path) -> None:
     _at_the_limit(lambda n: ["toy", str(_scene(tmp_path, "horse", n))], 5_000, tmp_path, [], 160)
 
 
+@pytest.mark.slow
+def test_chains_table_at_the_chain_limit_holds_one_assembly_at_a_time(tmp_path: Path) -> None:
+    """The table form of `chains --max-length 8 --optional` checks each of its 128,054 chains' assembly, one at a
+    time (4.6 ms each: about 10 minutes of CPU, too long to run here): its memory is the enumeration (the --json
+    form, run whole in the fixed-size test: 95 MiB) and one chain's assembly.  Here with a time budget: the process
+    is stopped after 10 s of CPU (RLIMIT_CPU), past the enumeration of all 128,054 and a few thousand assemblies of
+    chains of up to 8 stages; its peak is within the default limit, and at most 64 MiB above the --json form's."""
+    import resource
+    import signal
+
+    def run(argv: list[str]) -> tuple[int, float]:
+        def budget() -> None:
+            resource.setrlimit(resource.RLIMIT_CPU, (10, 10))
+
+        env = {k: v for k, v in os.environ.items() if not k.startswith("PLANAR_")}
+        env["PYTHONPATH"] = str(ROOT)
+        r = subprocess.run(
+            [sys.executable, "-c", _PEAK, sys.executable, "-m", "planar", *argv],
+            capture_output=True,
+            text=True,
+            cwd=tmp_path,
+            env=env,
+            preexec_fn=budget,
+        )
+        m = re.search(r"rc=(-?\d+) peak_kib=(\d+)", r.stdout)
+        assert m is not None, r.stdout[-500:] + r.stderr[-500:]
+        return int(m.group(1)), int(m.group(2)) / 1024
+
+    rc_json, enum_mib = run(["chains", "--max-length", "8", "--optional", "--json"])
+    assert rc_json == 0, rc_json
+    rc, mib = run(["chains", "--max-length", "8", "--optional"])
+    assert rc in (-signal.SIGXCPU, -signal.SIGKILL), rc  # still at work when its budget ran out (not refused, not failed)
+    assert mib <= LIMIT_MIB * 1.25 and mib <= enum_mib + 64, (f"{mib:.0f} MiB", f"--json {enum_mib:.0f} MiB")
+
+
 #: commands whose work does not grow with any option beyond what their inputs hold (a scene's parts, a request's
 #: effectors, a file's targets: each bounded where it is read): their peak at the small limit on the largest inputs
 _FIXED: dict[str, list[str]] = {
