@@ -213,12 +213,33 @@ def _pylinkage_optimise(prob: dict[str, Any], quick: bool) -> dict[str, Any]:
     }
 
 
+def kernel_bytes(samples: int = 64) -> float:
+    """Bytes one candidate of :func:`kernel_rate` holds at its peak (the float64 pass): its parameters (9
+    float64) and its coupler point ``x``, ``y`` (float64) and validity (1 byte) at each of ``samples`` angles,
+    plus the parameters again while they are drawn (``column_stack`` of the random columns)."""
+    return 2 * 9 * 8.0 + samples * (8 + 8 + 1)
+
+
+def check_kernel_rate(n: int, samples: int = 64) -> None:
+    """:class:`~planar.errors.LimitError` before :func:`kernel_rate` of ``n`` candidates would pass the memory
+    limit (``-n`` named, with the count that fits): ``n`` x :func:`kernel_bytes` beside what is held."""
+    from planar.core.limits import check_memory, resident_bytes, units_within
+
+    held, per = resident_bytes(), kernel_bytes(samples)
+    check_memory(
+        "-n", n, held + per * n, "the kernel-rate measurement's candidates", fits=f"{units_within(held, per):,} candidates"
+    )
+
+
 def kernel_rate(n: int = 200_000, samples: int = 64, repeats: int = 5) -> dict[str, Any]:
     """Candidate four-bars evaluated per second by the kernel (coupler point and validity at ``samples`` angles).
 
-    float32 (the search's screening precision) and float64 (refinement), interleaved.
+    float32 (the search's screening precision) and float64 (refinement), interleaved.  Refused up front
+    (:func:`check_kernel_rate`) when ``n`` candidates would pass the memory limit.
     """
     from planar.synth.kernel import coupler_points
+
+    check_kernel_rate(n, samples)
 
     rng = np.random.default_rng(0)
     X = np.column_stack([rng.uniform(1, 3, (n, 4)), rng.uniform(-2, 2, (n, 2)), rng.uniform(-1, 1, (n, 3))])
@@ -264,6 +285,8 @@ def bench_synthesis(
         raise PlanarError("planar bench synthesis needs repeats >= 1")
     if quick:
         repeats = 1
+    n_rate = n or (50_000 if quick else 250_000)
+    check_kernel_rate(n_rate)  # before the minutes of the problems, not after them
     budget = "quick" if quick else "normal"
     cases = []
     names = tuple(PROBLEMS) if problems is None else problems
@@ -324,7 +347,7 @@ def bench_synthesis(
                 "planar_sixbar": six,
             }
         )
-    rate = kernel_rate(n or (50_000 if quick else 250_000), repeats=1 if quick else 5)
+    rate = kernel_rate(n_rate, repeats=1 if quick else 5)
     count = (2 if quick else 25) if reachable is None else reachable
     extra: dict[str, Any] = {}
     if count > 0:

@@ -131,24 +131,36 @@ def _check_simulate_args(mech: Any, t: Any, effects: Any, settings: Any, mode: A
     return times
 
 
-def _check_memory(mech: Mechanism, n: int) -> None:
+def _chunk_bytes(mech: Mechanism, steps: int) -> float:
+    """Bytes the imposed poses of ``steps`` physics steps hold while a chunk of them is solved (:class:`_Imposed`):
+    the solve's own (:func:`planar.core.limits.motion_bytes`) and the targets kept as Python floats (x, y and
+    angle of each part, 32 bytes each with its list slot)."""
+    from planar.core import limits
+
+    return limits.motion_bytes(len(mech.parts), len(mech.points), float(steps)) + 3 * 32.0 * len(mech.parts) * steps
+
+
+def _check_memory(mech: Mechanism, n: int, substeps: int = 1) -> None:
     """:class:`~planar.errors.LimitError` before a run of ``n`` samples would pass the memory limit.
 
     A run holds the analytic motion with its velocities, the recorded poses and the simulated motion built
     from them, and its caller the analytic motion it compares with: estimated at three times the motion's own
     bytes (:func:`planar.core.limits.motion_bytes`; a run of the Jansen leg measured 1.86 kB a sample by
-    tracemalloc, estimated 2.88 kB), on top of what this process already holds."""
+    tracemalloc, estimated 2.88 kB), on top of what this process already holds and of one chunk of the
+    imposed poses (and of the analytic torque a comparison averages) of its ``substeps`` steps a sample
+    (:func:`_chunk_bytes`, at most :data:`_STEP_CHUNK` steps: a toy's coupled run at 128 substeps measured
+    120 MiB more at 900 samples than at 36)."""
     from planar.core import limits
 
     per = 1.5 * limits.motion_bytes(len(mech.parts), len(mech.points), 2.0)  # 3 x one sample's (the bytes of 2)
-    held = limits.resident_bytes()
-    limits.check_memory(
-        f"{mech.name}: simulation",
-        f"{n:,} samples",
-        held + per * n,
-        "a simulated run",
-        fits=f"{limits.units_within(held, per):,} samples",
-    )
+    sub = max(substeps, 1)
+    base = limits.resident_bytes()
+    held = base + _chunk_bytes(mech, min(_STEP_CHUNK, max(n - 1, 1) * sub))
+    # what fits: with a whole chunk when that many samples fill one, else with the chunk growing with the samples
+    fits = limits.units_within(base + _chunk_bytes(mech, _STEP_CHUNK), per)
+    if fits * sub < _STEP_CHUNK:
+        fits = limits.units_within(base, per + sub * _chunk_bytes(mech, 2) / 2)
+    limits.check_memory(f"{mech.name}: simulation", f"{n:,} samples", held + per * n, "a simulated run", fits=f"{fits:,} samples")
 
 
 def simulate(
@@ -176,7 +188,7 @@ def simulate(
     _check_mode(mech, mode)
     if t.size < 2:
         raise PlanarError("simulate: needs at least two output times")
-    _check_memory(mech, t.size)
+    _check_memory(mech, t.size, settings.substeps)
     dt_out = float(t[1] - t[0])
     poses_a, vel_a, analytic = _analytic_pose_velocity(mech, t)
     if not analytic.valid.all():
