@@ -33,7 +33,7 @@ from planar.physics.settings import (
     moving_masses,
     substeps_for,
 )
-from planar.physics.stepping import _Imposed, _loads, _MotorReader, _rebuilt, _run_steps
+from planar.physics.stepping import _STEP_CHUNK, _Imposed, _loads, _MotorReader, _rebuilt, _run_steps
 from planar.physics.torquescale import _SCALE_SAMPLES, _interval_torque, torque_scale
 
 if TYPE_CHECKING:
