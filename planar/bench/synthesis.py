@@ -334,6 +334,9 @@ def bench_synthesis(
         extra["reachable"] = bench_reachable(count=count, quick=quick)
         extra["targets_scaling"] = bench_targets_scaling(quick=quick)
         extra["unreachable"] = bench_unreachable(count=1 if quick else 7, quick=quick)
+        from planar.bench.synthesis_heldout import bench_reachable_pylinkage
+
+        extra["reachable_pylinkage"] = bench_reachable_pylinkage(count=count)
     per = (2 if quick else 50) if heldout is None else heldout
     if per > 0:
         from planar.bench.synthesis_heldout import bench_function_heldout, bench_motion_heldout
@@ -413,6 +416,10 @@ def format_synthesis(r: dict[str, Any]) -> str:
         lines.append(format_reachable(r["reachable"], r["targets_scaling"]))
     if "unreachable" in r:
         lines.append(format_unreachable(r["unreachable"]))
+    if "reachable_pylinkage" in r:
+        from planar.bench.synthesis_heldout import format_reachable_pylinkage
+
+        lines.append(format_reachable_pylinkage(r["reachable_pylinkage"]))
     if "function_heldout" in r:
         from planar.bench.synthesis_heldout import format_heldout
 

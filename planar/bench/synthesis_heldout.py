@@ -30,7 +30,9 @@ produced), and whether the design fails its check (the CLI's exit 3).
 The peer: pylinkage 1.3's ``synthesis.function_generation(angle_pairs)`` and
 ``synthesis.motion_generation(poses)`` on the same problems, their solutions
 scored by planar's measure (a pylinkage call that raises or returns no
-solution counts as a miss, and the exception's text is kept).
+solution counts as a miss, and the exception's text is kept); and its
+``path_generation`` / ``path_generation_with_timing`` on the reachable-curve
+benchmark's own problems (:func:`bench_reachable_pylinkage`).
 """
 
 from __future__ import annotations
@@ -45,9 +47,12 @@ from numpy.typing import NDArray
 __all__ = [
     "bench_function_heldout",
     "bench_motion_heldout",
+    "bench_reachable_pylinkage",
     "format_heldout",
+    "format_reachable_pylinkage",
     "function_problem",
     "motion_problem",
+    "reachable_problems",
 ]
 
 Array = NDArray[np.float64]
@@ -526,4 +531,93 @@ def format_heldout(fn: dict[str, Any], mo: dict[str, Any]) -> str:
             f"  motion, {key} poses: recovered {s['recovered']:.0%} of {s['problems']}, median error {s['median_error']:.3g}, "
             f"CPU {s['median_cpu_s']:.2f} s; pylinkage {s['pylinkage_recovered']:.0%} (median {s['pylinkage_median_error']:.3g})"
         )
+    return "\n".join(lines)
+
+
+# --- pylinkage's path synthesis on the reachable-curve benchmark's problems ---
+
+
+def reachable_problems(sizes: tuple[int, ...] = (8, 12, 25, 50), count: int = 25, seed: int = 2026) -> list[dict[str, Any]]:
+    """The problems of :func:`planar.bench.synthesis.bench_reachable` with the same arguments, drawn in its order
+    (each problem's targets and crank angles, then the noise it adds, so the next problem is the same)."""
+    from planar.bench.synthesis import reachable_problem
+
+    rng = np.random.default_rng(seed)
+    out = []
+    for n in sizes:
+        for _ in range(count):
+            T, th = reachable_problem(rng, n)
+            rng.standard_normal(T.shape)  # bench_reachable's noisy copy
+            out.append({"targets": T, "theta": th, "n": n})
+    return out
+
+
+def _pylinkage_path(T: Array, theta: Array | None) -> tuple[float, float, str]:
+    """pylinkage's ``path_generation`` (untimed) or ``path_generation_with_timing`` on all the targets: the best
+    solution's largest distance over the targets' size (planar's measure, :func:`planar.bench.synthesis.score_params`
+    on its solutions), its CPU seconds, and what it returned."""
+    import warnings
+
+    from planar.bench.synthesis import _from_pylinkage
+
+    pts = [(float(x), float(y)) for x, y in T]
+    size = float(np.sqrt(np.mean(np.sum((T - T.mean(0)) ** 2, axis=1))))
+    c0 = time.process_time()
+    try:
+        from pylinkage.synthesis import path_generation, path_generation_with_timing
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            if theta is None:
+                res = path_generation(pts, require_grashof=False)
+            else:
+                res = path_generation_with_timing(pts, [float(t) for t in theta], require_grashof=False)
+    except Exception as exc:  # any failure of the peer is recorded, not raised
+        return math.inf, time.process_time() - c0, f"raised {type(exc).__name__}: {exc}"
+    cpu = time.process_time() - c0
+    designs = [d for d in (_from_pylinkage(s, T, theta) for s in res.raw_solutions) if d is not None]
+    if not designs:
+        first = res.warnings[0].splitlines()[0] if res.warnings else ""
+        return math.inf, cpu, f"no solution ({len(res.raw_solutions)} returned){': ' + first if first else ''}"
+    best = min(d.checks["max_target_distance"] for d in designs)
+    return best / size, cpu, f"{len(designs)} solution(s)"
+
+
+def bench_reachable_pylinkage(sizes: tuple[int, ...] = (8, 12, 25, 50), count: int = 25, seed: int = 2026) -> dict[str, Any]:
+    """pylinkage 1.3's path synthesis on :func:`reachable_problems` (the reachable-curve benchmark's problems),
+    untimed and timed, ``require_grashof=False``: success (largest distance <= 1e-6 and <= 1e-3 of the targets'
+    size) and CPU per call.  Its calls take no budget (they run to completion): their CPU is reported."""
+    rows = []
+    for p in reachable_problems(sizes, count, seed):
+        rec: dict[str, Any] = {"targets": p["n"]}
+        for mode, th in (("untimed", None), ("timed", p["theta"])):
+            e, cpu, note = _pylinkage_path(p["targets"], th)
+            rec[mode] = {"max_error": e, "cpu_s": cpu, "note": note}
+        rows.append(rec)
+    summary: dict[str, Any] = {}
+    for n in sizes:
+        rs = [r for r in rows if r["targets"] == n]
+        summary[str(n)] = {
+            mode: {
+                "problems": len(rs),
+                "within_1e-6": float(np.mean([r[mode]["max_error"] <= 1e-6 for r in rs])),
+                "within_1e-3": float(np.mean([r[mode]["max_error"] <= 1e-3 for r in rs])),
+                "median_error": _median([r[mode]["max_error"] for r in rs]),
+                "median_cpu_s": _median([r[mode]["cpu_s"] for r in rs]),
+                "notes": sorted({r[mode]["note"] for r in rs})[:3],
+            }
+            for mode in ("untimed", "timed")
+        }
+    return {"seed": seed, "count": count, "rows": rows, "summary": summary}
+
+
+def format_reachable_pylinkage(r: dict[str, Any]) -> str:
+    """pylinkage on the reachable curves, as text."""
+    lines = [f"pylinkage 1.3 synthesis on the reachable curves (seed {r['seed']}, {r['count']} per size; no budget)"]
+    for n, s in r["summary"].items():
+        for mode, m in s.items():
+            lines.append(
+                f"  {n} targets, {mode}: within 1e-6 {m['within_1e-6']:.0%}, within 1e-3 {m['within_1e-3']:.0%}, "
+                f"median error {m['median_error']:.3g}, CPU {m['median_cpu_s']:.2f} s; returned: {'; '.join(m['notes'])}"
+            )
     return "\n".join(lines)
