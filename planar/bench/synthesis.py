@@ -334,9 +334,10 @@ def bench_synthesis(
         extra["reachable"] = bench_reachable(count=count, quick=quick)
         extra["targets_scaling"] = bench_targets_scaling(quick=quick)
         extra["unreachable"] = bench_unreachable(count=1 if quick else 7, quick=quick)
-        from planar.bench.synthesis_heldout import bench_reachable_pylinkage
+        from planar.bench.synthesis_heldout import bench_reachable_pylinkage, reachable_problems
 
-        extra["reachable_pylinkage"] = bench_reachable_pylinkage(count=count)
+        peer_problems = reachable_problems(reachable_problem, count=count)
+        extra["reachable_pylinkage"] = bench_reachable_pylinkage(peer_problems, _from_pylinkage)
     per = (2 if quick else 50) if heldout is None else heldout
     if per > 0:
         from planar.bench.synthesis_heldout import bench_function_heldout, bench_motion_heldout

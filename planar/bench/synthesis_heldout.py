@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -537,11 +538,15 @@ def format_heldout(fn: dict[str, Any], mo: dict[str, Any]) -> str:
 # --- pylinkage's path synthesis on the reachable-curve benchmark's problems ---
 
 
-def reachable_problems(sizes: tuple[int, ...] = (8, 12, 25, 50), count: int = 25, seed: int = 2026) -> list[dict[str, Any]]:
+def reachable_problems(
+    reachable_problem: Callable[[np.random.Generator, int], tuple[Array, Array]],
+    sizes: tuple[int, ...] = (8, 12, 25, 50),
+    count: int = 25,
+    seed: int = 2026,
+) -> list[dict[str, Any]]:
     """The problems of :func:`planar.bench.synthesis.bench_reachable` with the same arguments, drawn in its order
-    (each problem's targets and crank angles, then the noise it adds, so the next problem is the same)."""
-    from planar.bench.synthesis import reachable_problem
-
+    by its ``reachable_problem`` (each problem's targets and crank angles, then the noise it adds, so the next
+    problem is the same)."""
     rng = np.random.default_rng(seed)
     out = []
     for n in sizes:
@@ -552,13 +557,11 @@ def reachable_problems(sizes: tuple[int, ...] = (8, 12, 25, 50), count: int = 25
     return out
 
 
-def _pylinkage_path(T: Array, theta: Array | None) -> tuple[float, float, str]:
+def _pylinkage_path(T: Array, theta: Array | None, score: Callable[..., Any]) -> tuple[float, float, str]:
     """pylinkage's ``path_generation`` (untimed) or ``path_generation_with_timing`` on all the targets: the best
-    solution's largest distance over the targets' size (planar's measure, :func:`planar.bench.synthesis.score_params`
-    on its solutions), its CPU seconds, and what it returned."""
+    solution's largest distance over the targets' size (planar's measure: ``score(solution, targets, theta)``,
+    :func:`planar.bench.synthesis._from_pylinkage`, a design or None), its CPU seconds, and what it returned."""
     import warnings
-
-    from planar.bench.synthesis import _from_pylinkage
 
     pts = [(float(x), float(y)) for x, y in T]
     size = float(np.sqrt(np.mean(np.sum((T - T.mean(0)) ** 2, axis=1))))
@@ -575,7 +578,7 @@ def _pylinkage_path(T: Array, theta: Array | None) -> tuple[float, float, str]:
     except Exception as exc:  # any failure of the peer is recorded, not raised
         return math.inf, time.process_time() - c0, f"raised {type(exc).__name__}: {exc}"
     cpu = time.process_time() - c0
-    designs = [d for d in (_from_pylinkage(s, T, theta) for s in res.raw_solutions) if d is not None]
+    designs = [d for d in (score(s, T, theta) for s in res.raw_solutions) if d is not None]
     if not designs:
         first = res.warnings[0].splitlines()[0] if res.warnings else ""
         return math.inf, cpu, f"no solution ({len(res.raw_solutions)} returned){': ' + first if first else ''}"
@@ -583,15 +586,18 @@ def _pylinkage_path(T: Array, theta: Array | None) -> tuple[float, float, str]:
     return best / size, cpu, f"{len(designs)} solution(s)"
 
 
-def bench_reachable_pylinkage(sizes: tuple[int, ...] = (8, 12, 25, 50), count: int = 25, seed: int = 2026) -> dict[str, Any]:
-    """pylinkage 1.3's path synthesis on :func:`reachable_problems` (the reachable-curve benchmark's problems),
-    untimed and timed, ``require_grashof=False``: success (largest distance <= 1e-6 and <= 1e-3 of the targets'
-    size) and CPU per call.  Its calls take no budget (they run to completion): their CPU is reported."""
+def bench_reachable_pylinkage(problems: list[dict[str, Any]], score: Callable[..., Any], seed: int = 2026) -> dict[str, Any]:
+    """pylinkage 1.3's path synthesis on ``problems`` (:func:`reachable_problems`: the reachable-curve benchmark's
+    own, drawn with ``seed``), untimed and timed, ``require_grashof=False``, each solution scored by ``score``
+    (see :func:`_pylinkage_path`): success (largest distance <= 1e-6 and <= 1e-3 of the targets' size) and CPU
+    per call.  Its calls take no budget (they run to completion): their CPU is reported."""
     rows = []
-    for p in reachable_problems(sizes, count, seed):
+    sizes = tuple(sorted({p["n"] for p in problems}))
+    count = max((sum(p["n"] == n for p in problems) for n in sizes), default=0)
+    for p in problems:
         rec: dict[str, Any] = {"targets": p["n"]}
         for mode, th in (("untimed", None), ("timed", p["theta"])):
-            e, cpu, note = _pylinkage_path(p["targets"], th)
+            e, cpu, note = _pylinkage_path(p["targets"], th, score)
             rec[mode] = {"max_error": e, "cpu_s": cpu, "note": note}
         rows.append(rec)
     summary: dict[str, Any] = {}
