@@ -271,6 +271,7 @@ def bench_synthesis(
     n: int | None = None,
     problems: tuple[str, ...] | None = None,
     reachable: int | None = None,
+    heldout: int | None = None,
 ) -> dict[str, Any]:
     """Both problems, planar and pylinkage alternating ``repeats`` times (see the module).
 
@@ -279,7 +280,9 @@ def bench_synthesis(
     ``problems``: a subset of :data:`PROBLEMS` by name (all by default);
     ``reachable``: random reachable curves per number of targets in :func:`bench_reachable` (25, or 2 with
     ``quick``; 0 leaves that benchmark, the targets scaling and :func:`bench_unreachable` out: 7 problems
-    per group, 56 in all, or 1 per group with ``quick``).
+    per group, 56 in all, or 1 per group with ``quick``);
+    ``heldout``: function and motion problems per size in :mod:`planar.bench.synthesis_heldout` (50, or 2 with
+    ``quick``; 0 leaves them out).
     """
     if repeats < 1:
         raise PlanarError("planar bench synthesis needs repeats >= 1")
@@ -354,6 +357,16 @@ def bench_synthesis(
         extra["reachable"] = bench_reachable(count=count, quick=quick)
         extra["targets_scaling"] = bench_targets_scaling(quick=quick)
         extra["unreachable"] = bench_unreachable(count=1 if quick else 7, quick=quick)
+        from planar.bench.synthesis_heldout import bench_reachable_pylinkage, reachable_problems
+
+        peer_problems = reachable_problems(reachable_problem, count=count)
+        extra["reachable_pylinkage"] = bench_reachable_pylinkage(peer_problems, _from_pylinkage)
+    per = (2 if quick else 50) if heldout is None else heldout
+    if per > 0:
+        from planar.bench.synthesis_heldout import bench_function_heldout, bench_motion_heldout
+
+        extra["function_heldout"] = bench_function_heldout(count=per)
+        extra["motion_heldout"] = bench_motion_heldout(count=per)
     return {
         **extra,
         "benchmark": "synthesis",
@@ -427,6 +440,14 @@ def format_synthesis(r: dict[str, Any]) -> str:
         lines.append(format_reachable(r["reachable"], r["targets_scaling"]))
     if "unreachable" in r:
         lines.append(format_unreachable(r["unreachable"]))
+    if "reachable_pylinkage" in r:
+        from planar.bench.synthesis_heldout import format_reachable_pylinkage
+
+        lines.append(format_reachable_pylinkage(r["reachable_pylinkage"]))
+    if "function_heldout" in r:
+        from planar.bench.synthesis_heldout import format_heldout
+
+        lines.append(format_heldout(r["function_heldout"], r["motion_heldout"]))
     return "\n".join(lines)
 
 

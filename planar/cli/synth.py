@@ -223,23 +223,29 @@ def _cmd_path(args: argparse.Namespace) -> int:
         from planar.synth.atlas import read_atlas
 
         atlas = read_atlas(args.atlas)
-    d = synthesise_path(
-        targets,
-        theta,
-        cons,
-        budget=args.budget,
-        seed=args.seed,
-        tolerance=args.tolerance,
-        atlas=atlas,
-        ordered=args.ordered,
-        min_transmission=min_transmission,
-    )
+    if args.rocking:
+        d = _rocking_design(args, targets, theta, cons)
+    else:
+        d = synthesise_path(
+            targets,
+            theta,
+            cons,
+            budget=args.budget,
+            seed=args.seed,
+            tolerance=args.tolerance,
+            atlas=atlas,
+            ordered=args.ordered,
+            min_transmission=min_transmission,
+        )
     why = _unusable(d, "four-bar", cons.region is not None)
     if why is not None:
         return _no_design(args, "synth path", {"targets": len(targets)}, why)
     failing = _path_failing(d, "four-bar", _box_word(d, targets, cons, atlas, args))
     fb = d.fourbar()
     amp, centre = _rocking(fb, d.theta)
+    if "input_swing_rad" in d.checks:  # --rocking: the input swings over its found range
+        lo, hi = d.checks["input_swing_rad"]
+        amp, centre = max(0.5 * (hi - lo), 1e-6), 0.5 * (hi + lo)
     text = fourbar_scene_text(
         "synth-path",
         d.ground,
@@ -268,6 +274,21 @@ def _cmd_path(args: argparse.Namespace) -> int:
         d.ok,
         failing,
     )
+
+
+def _rocking_design(args: argparse.Namespace, targets: np.ndarray, theta: Any, cons: Any) -> Any:
+    """``--rocking``: a four-bar whose input swings between two angles, from the rocking-arc atlas."""
+    from planar.synth.arcs import synthesise_rocking_path
+
+    if theta is not None:
+        raise InputError("--rocking", str(args.target), "untimed targets (x, y only: the swing finds its own input angles)")
+    if args.pivots is not None:
+        raise InputError("--rocking", args.pivots, "no --pivots box (the rocking search does not keep one)")
+    d = synthesise_rocking_path(targets, args.tolerance, args.ordered, cons.max_ratio, budget=args.budget)
+    if "input_swing_deg" in d.checks:
+        a, b = d.checks["input_swing_deg"]
+        d.checks["found_by"] += f"; the input rocks between {a:.4g} and {b:.4g} deg from the ground line"
+    return d
 
 
 def _box_word(d: Any, targets: np.ndarray, cons: Any, atlas: Any, args: argparse.Namespace) -> str:
@@ -553,16 +574,24 @@ def _cmd_motion(args: argparse.Namespace) -> int:
 
     normalisation(poses[:, :2], str(args.poses))  # coordinates float64 holds faithfully at the poses' size
     _check_poses(str(args.poses), poses)
+    why = ""
     try:
         d = burmester(poses, max_ratio=args.max_ratio, min_transmission=min_transmission)
     except NoMotionDesign as e:
-        return _no_design(args, "synth motion", {"poses": len(poses)}, str(e))
+        if e.nearest is None:
+            return _no_design(args, "synth motion", {"poses": len(poses)}, str(e))
+        d, why = e.nearest, str(e)  # the nearest four-bar, written and failing its check
     amp, centre = (
         (None, 0.0)
         if d.crank_range is None
         else (max(0.5 * (d.crank_range[1] - d.crank_range[0]), 1e-6), 0.5 * (d.crank_range[0] + d.crank_range[1]))
     )
     failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]
+    if why and "reaches every pose" in failing:
+        failing[failing.index("reaches every pose")] = (
+            f"no four-bar meets every pose ({why}); the nearest, written, is "
+            f"{d.checks['max_position_error']:.3g} off in position and {d.checks['max_angle_error_rad']:.3g} rad in angle"
+        )
     if not d.checks["ok_transmission"]:
         failing[failing.index("transmission")] = (
             f"transmission angle {d.checks['min_transmission_deg']:.3g} deg from a toggle (limit "
@@ -679,6 +708,12 @@ def add_parser(sub: Any) -> None:
     )
     p.add_argument(
         "--ordered", action="store_true", help="the coupler point must pass the targets in their order (one way round)"
+    )
+    p.add_argument(
+        "--rocking",
+        action="store_true",
+        help="a four-bar whose input swings between two angles (double-rocker, rocker-crank or triple-rocker) "
+        "tracing the targets as an open arc, from the rocking-arc atlas (untimed targets)",
     )
     p.add_argument(
         "--atlas",

@@ -194,7 +194,12 @@ class MotionDesign(Checked, PlacedFourBar):
 
 
 class NoMotionDesign(PlanarError):
-    """No candidate four-bar meets the constraints (the CLI exits 3 and writes nothing)."""
+    """No candidate four-bar meets the constraints exactly (the CLI exits 3).
+
+    ``nearest``: for 4 or 5 poses, the four-bar nearest to meeting them in order on one circuit
+    (:func:`nearest_motion`; its checks fail and give its errors), or None (the CLI then writes nothing)."""
+
+    nearest: MotionDesign | None = None
 
 
 def crank_order(
@@ -266,11 +271,11 @@ def transmission_margins(d: Array, a: Array, b: Array, r: Array, full: NDArray[n
     return out
 
 
-def _choose(poses: Array, z: Array, c: Array, max_ratio: float, min_transmission: float = 0.0) -> tuple[int, int, bool]:
-    """The best ordered pair (crank dyad, rocker dyad) among candidate dyads (see the module)."""
+def _pair_table(poses: Array, z: Array, c: Array, max_ratio: float) -> dict[str, Any]:
+    """Every ordered pair (crank dyad ``I``, rocker dyad ``J``) of candidate dyads as four-bars through the poses:
+    ``usable`` (one circuit at every pose, links within ``max_ratio``), ``in_order``, ``full`` (the crank turns
+    fully), the swept crank range ``clo, chi``, the links ``d, a, b, r`` and their ``ratio``."""
     K = len(z)
-    if K < 2:
-        raise NoMotionDesign(f"only {K} dyad found for these {len(poses)} poses: a four-bar needs two")
     I, J = np.meshgrid(np.arange(K), np.arange(K), indexing="ij")
     I, J = I[I != J], J[I != J]
     R = _rot(poses[:, 2])
@@ -294,20 +299,33 @@ def _choose(poses: Array, z: Array, c: Array, max_ratio: float, min_transmission
     in_order, full, clo, chi = crank_order(theta, d, a, b, r)
     ratio = hi / np.maximum(lo, 1e-300)
     usable = one_circuit & (lo > 1e-3 * L) & (ratio <= max_ratio)
+    return {
+        "I": I, "J": J, "usable": usable, "in_order": in_order, "full": full, "clo": clo, "chi": chi,
+        "d": d, "a": a, "b": b, "r": r, "ratio": ratio,
+    }  # fmt: skip
+
+
+def _choose(poses: Array, z: Array, c: Array, max_ratio: float, min_transmission: float = 0.0) -> tuple[int, int, bool]:
+    """The best ordered pair (crank dyad, rocker dyad) among candidate dyads (see the module)."""
+    K = len(z)
+    if K < 2:
+        raise NoMotionDesign(f"only {K} dyad found for these {len(poses)} poses: a four-bar needs two")
+    t = _pair_table(poses, z, c, max_ratio)
+    I, J, usable, full, ratio = t["I"], t["J"], t["usable"], t["full"], t["ratio"]
     if not usable.any():
         raise NoMotionDesign(
             f"none of the {len(I)} pairs of the {K} dyads found takes the body through all "
             f"{len(poses)} poses on one circuit with links within the ratio {max_ratio:g} "
             "(a larger --max-ratio, or other poses)"
         )
-    if not (usable & in_order).any():
+    if not (usable & t["in_order"]).any():
         raise NoMotionDesign(
             f"order defect: each of the {int(usable.sum())} four-bars that reach all {len(poses)} "
             "poses on one circuit meets them out of the given order (or with a dead zone "
             "between them) as the crank moves in one direction (other poses, or their order)"
         )
-    usable &= in_order
-    margin = transmission_margins(d, a, b, r, full, clo, chi)
+    usable = usable & t["in_order"]
+    margin = transmission_margins(t["d"], t["a"], t["b"], t["r"], full, t["clo"], t["chi"])
     keeps = usable & (margin >= max(min_transmission, np.radians(TOGGLE_FLOOR_DEG)) - 1e-9)
     if not keeps.any():  # none keeps the transmission limit: the nearest, written and failing its check
         k = int(np.flatnonzero(usable)[np.argmax(margin[usable])])
@@ -319,13 +337,8 @@ def _choose(poses: Array, z: Array, c: Array, max_ratio: float, min_transmission
     return int(I[k]), int(J[k]), bool(full[k])
 
 
-def burmester(poses: Array, max_ratio: float = 10.0, grid: int = 24, min_transmission: float = 0.0) -> MotionDesign:
-    """A four-bar guiding a body through 3, 4 or 5 ``poses`` ``(n, 3)`` (see the module).
-
-    ``min_transmission`` (radians, default 0) is the least distance of the transmission
-    angle from 0 and pi (a toggle) over the crank's sweep that the design's check
-    ``ok_transmission`` accepts (:func:`check_motion`).
-    """
+def _burmester(poses: Array, max_ratio: float, grid: int, min_transmission: float) -> MotionDesign:
+    """:func:`burmester` without the nearest design."""
     poses = np.asarray(poses, float)
     if poses.ndim != 2 or poses.shape[1] != 3 or not 3 <= len(poses) <= 5:
         raise InputError("poses", poses.shape, "3, 4 or 5 poses (x, y, angle)")
@@ -358,6 +371,28 @@ def burmester(poses: Array, max_ratio: float = 10.0, grid: int = 24, min_transmi
     z, c = z[ok], c[ok]
     i, j, _ = _choose(poses, z, c, max_ratio, min_transmission)
     return _design(poses, z[i], c[i], z[j], c[j], len(z), min_transmission)
+
+
+def burmester(poses: Array, max_ratio: float = 10.0, grid: int = 24, min_transmission: float = 0.0) -> MotionDesign:
+    """A four-bar guiding a body through 3, 4 or 5 ``poses`` ``(n, 3)`` (see the module).
+
+    ``min_transmission`` (radians, default 0) is the least distance of the transmission
+    angle from 0 and pi (a toggle) over the crank's sweep that the design's check
+    ``ok_transmission`` accepts (:func:`check_motion`).  Raises :class:`NoMotionDesign` when no four-bar
+    meets the poses exactly in order on one circuit; for 4 or 5 poses its ``nearest`` is the four-bar nearest
+    to it (:func:`nearest_motion`).
+    """
+    try:
+        return _burmester(poses, max_ratio, grid, min_transmission)
+    except NoMotionDesign as e:
+        p = np.asarray(poses, float)
+        if len(p) >= 4:
+            e.nearest = nearest_motion(p, max_ratio, min_transmission)
+        if e.nearest is not None and e.nearest.checks["ok_reaches_every_pose"]:
+            # the fit found an exact four-bar the Burmester points missed (on 50 held-out 5-pose problems the
+            # root finding found 1 of a pair twice; the fit reached the poses to 4e-16 both times)
+            return e.nearest
+        raise
 
 
 def _design(
@@ -459,3 +494,247 @@ def check_motion(md: MotionDesign, samples: int = 4096, min_transmission: float 
         "sweep_samples": samples,
         "crank_turns_fully": md.crank_range is None,
     }
+
+
+# --- the nearest four-bar when none meets the poses exactly ---
+
+
+def coupler_poses(p: Array, circuit: float, offset: float, theta: Array) -> tuple[Array, NDArray[np.bool_]]:
+    """Body poses ``(n, 3)`` (x, y, angle in rad) of the four-bar ``p`` (the kernel's 9 parameters:
+    ground, crank, coupler, rocker, coupler point ``u, v``, placement ``x0, y0, phi``) at crank angles
+    ``theta`` (rad from the ground line) on ``circuit`` (+1 open, -1 crossed); the body's angle is the
+    coupler's (crank pin to rocker pin) plus ``offset``.  Also where the four-bar closes."""
+    from planar.synth.kernel import coupler_points
+
+    q = np.vstack([p, p, p]).astype(float)
+    q[1, 4], q[1, 5] = p[2], 0.0  # the rocker pin
+    q[2, 4], q[2, 5] = 0.0, 0.0  # the crank pin
+    th = np.vstack([theta, theta, theta])
+    x, y, ok = coupler_points(q, th, np.full(3, float(circuit)))
+    ang = np.arctan2(y[1] - y[2], x[1] - x[2]) + offset
+    return np.column_stack([x[0], y[0], ang]), ok[0]
+
+
+def _ordered_angles(W: Array, sign: float) -> Array:
+    """Crank angles ``(K, n)`` from rows ``W`` ``(K, n)`` = (the first angle, log of each step): every step of one
+    sign (``sign``)."""
+    return W[:, :1] + sign * np.concatenate([np.zeros((len(W), 1)), np.cumsum(np.exp(np.minimum(W[:, 1:], 3.0)), axis=1)], axis=1)
+
+
+def _pose_residuals(Z: Array, poses: Array, circuit: float, L: float, sign: float, max_ratio: float) -> Array:
+    """Residuals ``(K, 3 n + n + 1)`` of rows ``Z`` ``(K, 10 + n)`` (9 parameters, the body's angle offset, the
+    first crank angle and the log of each step between poses; ``sign``: the crank's direction), in one kernel
+    call: position errors over ``L`` and angle errors (rad) at every pose, then penalties
+    (:data:`SWEEP_WEIGHT` per radian) for a step into a dead zone, steps over a turn, and the log of the link
+    ratio over ``max_ratio``."""
+    from planar.synth.kernel import coupler_points
+
+    K, n = len(Z), len(poses)
+    th = _ordered_angles(Z[:, 10:], sign)
+    q = np.repeat(Z[:, :9], 3, axis=0)
+    q[1::3, 4], q[1::3, 5] = Z[:, 2], 0.0  # the rocker pin
+    q[2::3, 4], q[2::3, 5] = 0.0, 0.0  # the crank pin
+    x, y, ok = coupler_points(q, np.repeat(th, 3, axis=0), np.full(3 * K, float(circuit)))
+    ang = np.arctan2(y[1::3] - y[2::3], x[1::3] - x[2::3]) + Z[:, 9:10]
+    good = ok[0::3]
+    dx, dy = (x[0::3] - poses[:, 0]) / L, (y[0::3] - poses[:, 1]) / L
+    da = (ang - poses[:, 2] + np.pi) % (2 * np.pi) - np.pi
+    r = np.stack([dx, dy, da], axis=2)  # (K, n, 3)
+    r[~good] = 1.0
+    # the crank must assemble all the way between poses (no dead zone): cmin <= cos t <= cmax (crank_order)
+    d, a, b, c4 = (np.abs(Z[:, i]) + 1e-300 for i in range(4))
+    cmin = ((a * a + d * d - (b + c4) ** 2) / (2 * a * d))[:, None]
+    cmax = ((a * a + d * d - (b - c4) ** 2) / (2 * a * d))[:, None]
+    t0, t1 = np.minimum(th[:, :-1], th[:, 1:]), np.maximum(th[:, :-1], th[:, 1:])
+    zone0 = np.where(cmax < 1.0, np.arccos(np.clip(cmax, -1.0, 1.0)) + SWEEP_MARGIN, 0.0)
+    zone_pi = np.where(cmin > -1.0, np.pi - np.arccos(np.clip(cmin, -1.0, 1.0)) + SWEEP_MARGIN, 0.0)
+    # how deep (rad) each step between poses goes into a dead zone: about 0 where cos t > cmax, about pi where
+    # cos t < cmin (exact: the step's nearest angle to the zone's centre)
+    dead = np.maximum(0.0, zone0 - _arc_distance(t0, t1, 0.0)) + np.maximum(0.0, zone_pi - _arc_distance(t0, t1, np.pi))
+    over = np.maximum(0.0, th.max(1) - th.min(1) - (2 * np.pi - SWEEP_MARGIN)) if n > 1 else np.zeros(K)
+    Ls = np.column_stack([d, a, b, c4])
+    ratio = np.maximum(0.0, np.log(Ls.max(1) / Ls.min(1)) - np.log(max_ratio) + SWEEP_MARGIN)
+    return np.concatenate([r.reshape(K, 3 * n), SWEEP_WEIGHT * dead, SWEEP_WEIGHT * np.column_stack([over, ratio])], 1)
+
+
+#: the weight of a step between poses into a dead zone (per radian), and the margin (rad) kept from the zone's edge
+SWEEP_WEIGHT, SWEEP_MARGIN = 10.0, 1e-4
+
+
+def _arc_distance(t0: Array, t1: Array, c: float) -> Array:
+    """Smallest angular distance (rad) from ``c`` to the arcs ``[t0, t1]`` (unwrapped, ``t0 <= t1``): 0 when an arc
+    holds ``c`` (mod 2 pi)."""
+    two = 2 * np.pi
+    holds = np.floor((t1 - c) / two) >= np.ceil((t0 - c) / two)
+    ends = np.minimum(np.abs((t0 - c + np.pi) % two - np.pi), np.abs((t1 - c + np.pi) % two - np.pi))
+    return np.where(holds, 0.0, ends)
+
+
+#: evaluations of the least squares that fits a four-bar to poses it cannot meet exactly
+NEAREST_NFEV = 400
+
+
+def fit_poses(poses: Array, z0: Array, circuit: float, nfev: int = NEAREST_NFEV, max_ratio: float = 10.0) -> tuple[Array, float]:
+    """Least squares of the pose errors from ``z0`` (9 parameters, the body's angle offset, a crank angle per pose
+    in the poses' order one way round): the crank angles stay in that order (each step between poses is kept of
+    one sign), so the fit cannot slide to a four-bar that meets the poses out of order.  Returns the fitted
+    vector (9 parameters, offset, crank angles) and its largest error (position over the poses' extent, or angle
+    in rad, whichever is larger)."""
+    from scipy.optimize import least_squares
+
+    L = _scale(poses)
+    th = np.asarray(z0[10:], float)
+    fwd = np.mod(np.diff(th), 2 * np.pi)
+    sign = 1.0 if fwd.sum() < 2 * np.pi * (len(th) - 1) / 2 else -1.0
+    steps = fwd if sign > 0 else np.mod(-np.diff(th), 2 * np.pi)
+    w0 = np.concatenate([z0[:10], [th[0]], np.log(np.maximum(steps, 1e-6))])
+    args = (poses, circuit, L, sign, max_ratio)
+
+    def fun(w: Array) -> Array:
+        return _pose_residuals(w[None, :], *args)[0]
+
+    def jac(w: Array) -> Array:
+        """Forward differences, every perturbed row in one kernel call."""
+        h = 1e-7 * np.maximum(1.0, np.abs(w))
+        R = _pose_residuals(np.vstack([w, w + np.diag(h)]), *args)
+        D = R[1:] - R[0]
+        k = 3 * len(poses)
+        D[:, 2:k:3] = (D[:, 2:k:3] + np.pi) % (2 * np.pi) - np.pi  # angle errors: no jump of a turn
+        return (D / h[:, None]).T
+
+    r = least_squares(fun, w0, jac=jac, method="lm", max_nfev=nfev)
+    res = fun(r.x)[: 3 * len(poses)].reshape(-1, 3)
+    out = np.concatenate([r.x[:10], _ordered_angles(r.x[None, 10:], sign)[0]])
+    return out, float(np.max(np.maximum(np.hypot(res[:, 0], res[:, 1]), np.abs(res[:, 2]))))
+
+
+def _pair_start(poses: Array, zi: Array, ci: Array, zj: Array, cj: Array) -> tuple[Array, float]:
+    """The four-bar of a dyad pair at pose 1 (as :func:`_design` builds it) as a start for :func:`fit_poses`:
+    9 parameters, the body's angle offset and the crank angle at each pose; and the circuit's sign."""
+    R = _rot(poses[:, 2])
+    B = poses[:, :2] + R @ zi
+    C = poses[:, :2] + R @ zj
+    g = cj - ci
+    phi = float(np.arctan2(g[1], g[0]))
+    b = float(np.hypot(*(zi - zj)))
+    e = (C[0] - B[0]) / b
+    q = poses[0, :2] - B[0]
+    u, v = float(q @ e), float(-q[0] * e[1] + q[1] * e[0])
+    off = float(poses[0, 2] - np.arctan2(e[1], e[0]))
+    e1 = cj - B[0]
+    circ = 1.0 if e1[0] * e[1] - e1[1] * e[0] > 0 else -1.0
+    theta = np.arctan2(B[:, 1] - ci[1], B[:, 0] - ci[0]) - phi
+    p = [float(np.hypot(*g)), float(np.hypot(*(B[0] - ci))), b, float(np.hypot(*(C[0] - cj))), u, v, *ci, phi]
+    return np.array([*p, off, *theta]), circ
+
+
+def _near_dyads(poses: Array) -> tuple[Array, Array, Array]:
+    """Moving pivots (body frame) of dyads near meeting every pose, their least-squares fixed pivots and radius
+    mismatch over all the poses (model units): the circle-point curves of every 4 of the poses, and a grid."""
+    from itertools import combinations
+
+    L = _scale(poses)
+    zs = []
+    for keep in combinations(range(len(poses)), 4):
+        z, _ = circle_point_curve(poses[list(keep)])
+        zs.append(z[np.linspace(0, len(z) - 1, min(len(z), 240)).round().astype(int)] if len(z) else z)
+    g = np.linspace(-2 * L, 2 * L, 16)
+    centre = _rot(-poses[0, 2]) @ (poses[:, :2].mean(0) - poses[0, :2])
+    zs.append(np.stack(np.meshgrid(g, g), -1).reshape(-1, 2) + centre)
+    z = np.concatenate(zs)
+    c, mismatch = fixed_pivots(poses, z)
+    ok = np.isfinite(c).all(1) & np.isfinite(mismatch)
+    return z[ok], c[ok], mismatch[ok]
+
+
+#: dyads (least radius mismatch) paired, and pairs fitted, by :func:`nearest_motion`
+NEAREST_DYADS, NEAREST_STARTS = 60, 12
+
+
+def nearest_motion(poses: Array, max_ratio: float = 10.0, min_transmission: float = 0.0) -> MotionDesign | None:
+    """The four-bar nearest to meeting ``poses`` (4 or 5; none meets them all exactly) in order on one circuit.
+
+    Dyads near meeting every pose (:func:`_near_dyads`: the :data:`NEAREST_DYADS` with the least radius
+    mismatch) are paired; :data:`NEAREST_STARTS` pairs (those that take the body through the poses on one
+    circuit in order with links within ``max_ratio`` first, least mismatch first) are fitted to the poses by least
+    squares (:func:`fit_poses`), and the one with the smallest largest error still in order is kept, checked
+    (``ok_reaches_every_pose`` fails; its errors are in its checks).  None when no pair qualifies."""
+    z, c, mismatch = _near_dyads(poses)
+    top = np.argsort(mismatch, kind="stable")[:NEAREST_DYADS]
+    z, c, mismatch = z[top], c[top], mismatch[top]
+    if len(z) < 2:
+        return None
+    t = _pair_table(poses, z, c, max_ratio)
+    # pairs meeting the poses in order on one circuit first, then those on one circuit, then the rest (the fit
+    # keeps the crank angles in the poses' order whatever the start's), each least mismatch first
+    rank = np.lexsort((mismatch[t["I"]] + mismatch[t["J"]], ~t["usable"], ~(t["usable"] & t["in_order"])))
+    good = rank[:NEAREST_STARTS]
+    best: tuple[float, Array, float] | None = None
+    for k in good:
+        i, j = int(t["I"][k]), int(t["J"][k])
+        z0, circ = _pair_start(poses, z[i], c[i], z[j], c[j])
+        zf, err = fit_poses(poses, z0, circ, max_ratio=max_ratio)
+        L4 = np.abs(zf[:4])
+        ordered, *_ = crank_order(zf[None, 10:], *(np.array([v]) for v in L4))
+        keep = ordered[0] and L4.min() > 0 and L4.max() <= max_ratio * L4.min() and np.isfinite(err)
+        if keep and (best is None or err < best[0]):
+            best = (err, zf, circ)
+    if best is None:
+        return None
+    return _fitted_design(poses, best[1], best[2], min_transmission)
+
+
+def _fitted_design(poses: Array, z: Array, circ: float, min_transmission: float) -> MotionDesign:
+    """A MotionDesign from a fitted vector (see :func:`fit_poses`), checked by :func:`check_motion`."""
+    from planar.linkages import grashof_class
+
+    d, a, b, r = (float(abs(v)) for v in z[:4])
+    u, v, x0, y0, phi, off = (float(w) for w in z[4:10])
+    theta = np.asarray(z[10:], float)
+    ordered, full, lo, hi = crank_order(theta[None], *(np.array([w]) for w in (d, a, b, r)))
+    if not full[0]:
+        cmin = (a * a + d * d - (b + r) ** 2) / (2 * a * d)
+        theta = theta % (2 * np.pi) if cmin <= -1.0 else (theta + np.pi) % (2 * np.pi) - np.pi
+    got, _ = coupler_poses(np.array([d, a, b, r, u, v, x0, y0, phi]), circ, off, theta[:1])
+    pins, _ = coupler_points_world(np.array([d, a, b, r, u, v, x0, y0, phi]), circ, theta[:1])
+    ca, sa = np.cos(got[0, 2]), np.sin(got[0, 2])
+    to_body = np.array([[ca, sa], [-sa, ca]])
+    O2 = np.array([x0, y0])
+    O4 = O2 + d * np.array([np.cos(phi), np.sin(phi)])
+    dyads = np.array([[*(to_body @ (pins[0] - got[0, :2])), *O2], [*(to_body @ (pins[1] - got[0, :2])), *O4]])
+    md = MotionDesign(
+        d,
+        a,
+        b,
+        r,
+        (u, v),
+        off,
+        "open" if circ > 0 else "crossed",
+        (x0, y0, phi),
+        theta,
+        poses,
+        dyads,
+        grashof_class(a, b, r, d),
+        0,
+        None if full[0] else (float(lo[0]), float(hi[0])),
+        bool(ordered[0]),
+    )
+    check_motion(md, min_transmission=min_transmission)
+    return md
+
+
+def coupler_points_world(p: Array, circuit: float, theta: Array) -> tuple[Array, NDArray[np.bool_]]:
+    """The crank pin and the rocker pin ``(2, 2)`` (world) of the four-bar ``p`` at one crank angle ``theta[0]``."""
+    from planar.synth.kernel import coupler_points
+
+    q = np.vstack([p, p]).astype(float)
+    q[0, 4], q[0, 5] = 0.0, 0.0
+    q[1, 4], q[1, 5] = p[2], 0.0
+    x, y, ok = coupler_points(q, np.asarray(theta[:1], float), np.full(2, float(circuit)))
+    return np.column_stack([x[:, 0], y[:, 0]]), ok[:, 0]
+
+
+def nearest_motion_error(poses: Array, p: Array, circuit: float, offset: float, theta: Array) -> float:
+    """Largest error (as :func:`fit_poses`) of least squares started at the four-bar ``p`` with body angle
+    ``offset`` and crank angles ``theta``: a reference for the nearest design (used by the benchmark)."""
+    return fit_poses(poses, np.concatenate([p[:9], [offset], theta]), circuit)[1]

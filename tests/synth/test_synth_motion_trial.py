@@ -35,13 +35,17 @@ def _coupler_pose(L, theta, sign):
     return B, ang, ok
 
 
-def test_order_defect_exits_3_naming_it_nothing_written(tmp_path, capsys):
-    out = tmp_path / "m.toml"
-    for text in (P8, P0):
+@pytest.mark.slow
+def test_order_defect_exits_3_naming_it_nearest_written(tmp_path, capsys):
+    # no four-bar meets these 4 poses in order: the nearest one that does pass them in order is written, its
+    # error named, exit 3
+    for i, text in enumerate((P8, P0)):
+        out = tmp_path / f"m{i}.toml"
         rc = main(["synth", "motion", str(_write(tmp_path, text)), "--deg", "-o", str(out), "--json"])
         rep = json.loads(capsys.readouterr().out)
-        assert rc == 3 and rep["ok"] is False and "order defect" in rep["reason"]
-        assert not out.exists()
+        assert rc == 3 and rep["ok"] is False and "order defect" in rep["reason"] and "the nearest" in rep["reason"]
+        assert out.exists() and rep["checks"]["ok_poses_in_order"] and not rep["checks"]["ok_reaches_every_pose"]
+        assert 1e-6 < rep["checks"]["max_position_error"] < 1.0
 
 
 def test_old_p0_design_crosses_a_dead_zone():
@@ -94,13 +98,16 @@ def test_design_meets_poses_in_order_checked_by_own_sweep(tmp_path):
         assert _coupler_pose(L, t0 + direction * np.linspace(0, s, 2000), sign)[2].all()
 
 
+@pytest.mark.slow
 def test_no_design_exits_3_with_reason(tmp_path, capsys):
     # the trial's poses5.csv read as radians: two Burmester dyads, no pair usable
     five = "x,y,angle\n0,0,0\n1,0.5,20\n2,0.6,45\n2.8,0.2,70\n3.2,-0.5,95\n"
     out = tmp_path / "m.toml"
     rc = main(["synth", "motion", str(_write(tmp_path, five)), "-o", str(out), "--json"])
     rep = json.loads(capsys.readouterr().out)
-    assert rc == 3 and rep["ok"] is False and rep["reason"] and not out.exists()
+    # the nearest four-bar is written, its errors named (its own check finds them), exit 3
+    assert rc == 3 and rep["ok"] is False and "the nearest" in rep["reason"] and out.exists()
+    assert not rep["checks"]["ok_reaches_every_pose"] and rep["checks"]["ok_poses_in_order"]
     with pytest.raises(NoMotionDesign):
         burmester(np.loadtxt(_write(tmp_path, five), delimiter=",", skiprows=1))
 

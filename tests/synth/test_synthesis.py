@@ -164,7 +164,7 @@ def test_svg_target_read_by_svgelements(tmp_path):
 def test_bench_synthesis_quick_timed_problem():
     from planar.bench.synthesis import bench_synthesis
 
-    r = bench_synthesis(quick=True, n=20_000, problems=("cabrera-2002-case-2",), reachable=0)
+    r = bench_synthesis(quick=True, n=20_000, problems=("cabrera-2002-case-2",), reachable=0, heldout=0)
     c = r["cases"][0]
     assert c["planar"]["ok"] and c["planar"]["sse_min"] < 1e-3
     assert "pylinkage" in c["pylinkage"]["call"] and c["published_best_error"]

@@ -1,0 +1,540 @@
+"""Rocking inputs: an atlas of the open coupler arcs of four-bars whose input link cannot turn fully.
+
+A double-rocker (Grashof, the coupler shortest), a rocker-crank (Grashof, the
+rocker shortest) or a triple-rocker (not Grashof) has an input that swings
+between two limits (where the coupler and the rocker line up); driven within
+them on one circuit, its coupler point traces an *arc*, back and forth.  The
+closed-curve atlas (:mod:`planar.synth.atlas`) holds only linkages whose crank
+turns fully, so it cannot describe these; this atlas does.
+
+Each entry is one four-bar (unit ground along +x from the input pivot at the
+origin; input, coupler and rocker lengths log-uniform with longest / shortest
+at most :data:`MAX_RATIO`; the coupler point within about two coupler
+lengths; either circuit) and one *window* of its input's range (the range
+shrunk by 1 % at each end, then the fractions :data:`WINDOWS` of it: targets
+usually cover part of the swing).  The coupler point is solved at
+:data:`ARC_SAMPLES` input angles over the window, resampled to
+:data:`ARC_POINTS` points evenly spaced by arc length from one end to the
+other, and described as those points normalised for position (centroid at
+0), scale (RMS distance from it 1) and rotation (the chord, first point to
+last, along +x): ``2 ARC_POINTS`` numbers.  A query describes the targets the
+same way (a natural cubic spline through them in their order, by chord
+length), also reversed and mirrored, finds the nearest entries with
+:class:`scipy.spatial.cKDTree`, places each on the targets by the similarity
+the two descriptions differ by, and the best are refined by least squares with
+the input angle at each target free (:func:`planar.synth.search.reassigned_refine`).
+
+The interface to the path search is :func:`arc_candidates` (targets in, rows of
+the kernel's 9 parameters and the circuit out, as
+:func:`planar.synth.atlas.candidates`) and :func:`search_arcs` (lookup and
+refinement in one call, for targets already normalised).  :func:`rocking_range`
+says whether a refined four-bar passes the targets on one swing of its input
+and between which angles.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planar.errors import InputError
+from planar.synth.kernel import coupler_points
+
+__all__ = [
+    "ARC_POINTS",
+    "Arcs",
+    "arc_candidates",
+    "build_arcs",
+    "describe_open",
+    "load_arcs",
+    "rocking_range",
+    "search_arcs",
+]
+
+Array = NDArray[np.float64]
+
+#: format version of the files on disk (a change rebuilds them)
+VERSION = 1
+#: points of an arc after arc-length resampling (the descriptor has twice as many numbers)
+ARC_POINTS = 16
+#: input angles each window is solved at
+ARC_SAMPLES = 96
+#: windows of the input's range (fractions of it) stored per four-bar
+WINDOWS = ((0.0, 1.0), (0.0, 0.6), (0.4, 1.0), (0.2, 0.8))
+#: longest / shortest link at most this
+MAX_RATIO = 10.0
+#: four-bars of the default arc atlas (each gives len(WINDOWS) entries) and of the quick one
+DEFAULT_FOURBARS = 250_000
+QUICK_FOURBARS = 5_000
+#: four-bars per chunk of the build
+CHUNK = 10_000
+#: an arc whose chord (first point to last) is shorter than this fraction of its RMS size is not stored (its
+#: rotation is ill-defined)
+MIN_CHORD = 0.2
+
+
+@dataclass
+class Arcs:
+    """Rocking four-bars' arc descriptors (see the module).
+
+    ``params`` ``(M, 6)``: input, coupler, rocker, u, v, circuit (ground 1); ``window`` ``(M, 2)``: the input
+    angles (rad from the ground line) the arc runs between; ``frame`` ``(M, 4)``: centroid x, y, size and
+    rotation of the stored description; ``desc`` ``(M, 2 ARC_POINTS)``.
+    """
+
+    params: NDArray[np.float32]
+    window: NDArray[np.float32]
+    frame: NDArray[np.float32]
+    desc: NDArray[np.float32]
+    seed: int
+    build_seconds: float = 0.0
+    _tree: Any = field(default=None, repr=False)
+
+    def __len__(self) -> int:
+        return len(self.params)
+
+    @property
+    def tree(self) -> Any:
+        """The :class:`scipy.spatial.cKDTree` over the descriptors (built on first use)."""
+        if self._tree is None:
+            from scipy.spatial import cKDTree
+
+            self._tree = cKDTree(np.asarray(self.desc, float), balanced_tree=False, compact_nodes=False)
+        return self._tree
+
+    def save(self, path: str | Path) -> None:
+        """Write the arcs as one ``.npz`` file (a temporary beside it, then moved into place)."""
+        from planar.fileio import atomic_write
+
+        p = Path(path)
+        p.parent.mkdir(parents=True, exist_ok=True)
+        meta = np.array([VERSION, ARC_POINTS, ARC_SAMPLES, len(WINDOWS), self.seed], dtype=np.int64)
+        with atomic_write(p) as fh:
+            np.savez(
+                fh,
+                params=self.params,
+                window=self.window,
+                frame=self.frame,
+                desc=self.desc,
+                meta=meta,
+                seconds=np.float64(self.build_seconds),
+            )
+
+
+def describe_open(z: NDArray[np.complex128]) -> tuple[Array, Array]:
+    """Descriptors ``(P, 2 ARC_POINTS)`` and frames ``(P, 4)`` of open curves ``z`` ``(P, S)`` (points in order).
+
+    Resampled to :data:`ARC_POINTS` points evenly spaced by arc length from the first point to the last, then
+    moved to their centroid, turned so the chord lies along +x and divided by their RMS distance from the
+    centroid.  NaN for a curve of zero length or chord."""
+    P, _S = z.shape
+    seg = np.abs(np.diff(z, axis=1))
+    cum = np.concatenate([np.zeros((P, 1)), np.cumsum(seg, axis=1)], axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u = cum / cum[:, -1:]
+    q = np.linspace(0.0, 1.0, ARC_POINTS)
+    w = np.empty((P, ARC_POINTS), complex)
+    for i in range(P):  # np.interp per row: P is a chunk, ARC_POINTS small
+        if not np.isfinite(u[i]).all():
+            w[i] = np.nan
+            continue
+        w[i] = np.interp(q, u[i], z[i].real) + 1j * np.interp(q, u[i], z[i].imag)
+    c = w.mean(1)
+    d = w - c[:, None]
+    size = np.sqrt(np.mean(np.abs(d) ** 2, axis=1))
+    chord = w[:, -1] - w[:, 0]
+    rot = np.angle(chord)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        n = d * np.exp(-1j * rot)[:, None] / size[:, None]
+    bad = ~(np.abs(chord) > 1e-12 * np.maximum(size, 1e-300))
+    n[bad] = np.nan
+    desc = np.concatenate([n.real, n.imag], axis=1)
+    frame = np.column_stack([c.real, c.imag, size, rot])
+    return desc, frame
+
+
+def input_range(a: Array, b: Array, c: Array) -> tuple[Array, Array, NDArray[np.bool_]]:
+    """The input angles (rad from the ground line; unit ground) where four-bars of input ``a``, coupler ``b``
+    and rocker ``c`` assemble, as one arc ``lo, hi`` each (of two symmetric arcs, the upper one), and whether
+    the input rocks (does not turn fully) and assembles somewhere."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cmin = (a * a + 1.0 - (b + c) ** 2) / (2.0 * a)
+        cmax = (a * a + 1.0 - (b - c) ** 2) / (2.0 * a)
+    full = (cmin <= -1.0) & (cmax >= 1.0)
+    none = (cmin > 1.0) | (cmax < -1.0) | (cmin >= cmax)
+    ac_max = np.arccos(np.clip(cmax, -1.0, 1.0))
+    ac_min = np.arccos(np.clip(cmin, -1.0, 1.0))
+    lo = np.where(cmin <= -1.0, ac_max, np.where(cmax >= 1.0, -ac_min, ac_max))
+    hi = np.where(cmin <= -1.0, 2 * np.pi - ac_max, ac_min)
+    return lo, hi, ~full & ~none & (hi - lo > 1e-3)
+
+
+def _sample_rocking(rng: np.random.Generator, n: int) -> Array:
+    """``n`` rows of input, coupler, rocker, u, v, circuit (ground 1) whose input rocks, ratio <= MAX_RATIO."""
+    out: list[Array] = []
+    have = 0
+    while have < n:
+        m = 3 * (n - have) + 64
+        L = np.exp(rng.uniform(np.log(1 / MAX_RATIO), np.log(MAX_RATIO), (m, 3)))
+        allL = np.column_stack([np.ones(m), L])
+        lo, hi, rocks = input_range(L[:, 0], L[:, 1], L[:, 2])
+        keep = rocks & (allL.max(1) <= MAX_RATIO * allL.min(1)) & (hi - lo > np.radians(10))
+        L = L[keep]
+        k = len(L)
+        u = L[:, 1] * rng.uniform(-1.5, 2.5, k)
+        v = L[:, 1] * rng.uniform(-2.0, 2.0, k)
+        circ = np.where(rng.random(k) < 0.5, 1.0, -1.0)
+        out.append(np.column_stack([L, u, v, circ]))
+        have += k
+    return np.concatenate(out)[:n]
+
+
+def _chunk(seed: int, index: int, n: int) -> tuple[Array, Array, Array, Array]:
+    rng = np.random.default_rng([seed, 7, index])
+    p = _sample_rocking(rng, n)
+    lo, hi, _ = input_range(p[:, 0], p[:, 1], p[:, 2])
+    pad = 0.01 * (hi - lo)
+    lo, hi = lo + pad, hi - pad
+    X = np.column_stack([np.ones(n), p[:, :5], np.zeros((n, 3))])
+    f = np.linspace(0.0, 1.0, ARC_SAMPLES)
+    P, W, F, D = [], [], [], []
+    for w0, w1 in WINDOWS:
+        a0, a1 = lo + w0 * (hi - lo), lo + w1 * (hi - lo)
+        th = a0[:, None] + (a1 - a0)[:, None] * f[None, :]
+        x, y, ok = coupler_points(X, th, p[:, 5], threads=1)
+        desc, frame = describe_open(x + 1j * y)
+        chord = np.abs((x[:, -1] - x[:, 0]) + 1j * (y[:, -1] - y[:, 0]))
+        good = ok.all(1) & np.isfinite(desc).all(1) & (frame[:, 2] > 1e-9) & (chord > MIN_CHORD * frame[:, 2])
+        P.append(p[good])
+        W.append(np.column_stack([a0, a1])[good])
+        F.append(frame[good])
+        D.append(desc[good])
+    return np.concatenate(P), np.concatenate(W), np.concatenate(F), np.concatenate(D)
+
+
+def build_arcs(fourbars: int = DEFAULT_FOURBARS, seed: int = 0, progress: bool = False) -> Arcs:
+    """The arcs of ``fourbars`` rocking four-bars, :data:`WINDOWS` each (deterministic for both arguments; an arc
+    too short a chord is left out, so the entries are a little fewer than ``fourbars * len(WINDOWS)``)."""
+    if fourbars < 100:
+        raise InputError("arc atlas size", fourbars, "at least 100 four-bars")
+    t0 = time.process_time()
+    parts: list[tuple[Array, Array, Array, Array]] = []
+    have, index = 0, 0
+    bar = None
+    if progress:
+        from planar.core.progress import progress_bar
+
+        bar = progress_bar(fourbars, "rocking arcs", "four-bar", unit_scale=True)
+    while have < fourbars:
+        n = min(CHUNK, fourbars - have)
+        parts.append(tuple(a.astype(np.float32) for a in _chunk(seed, index, n)))  # type: ignore[arg-type]
+        have += n
+        index += 1
+        if bar is not None:
+            bar.update(n)
+    if bar is not None:
+        bar.close()
+    p, w, f, d = (np.concatenate([q[i] for q in parts]) for i in range(4))
+    return Arcs(p, w, f, d, seed, time.process_time() - t0)
+
+
+def arcs_path(fourbars: int = DEFAULT_FOURBARS, seed: int = 0) -> Path:
+    """The cache file of the arcs of ``fourbars`` four-bars and ``seed`` (beside the closed-curve atlas)."""
+    from planar.synth.atlas import cache_dir
+
+    return cache_dir() / f"arcs-v{VERSION}-{fourbars}-{seed}.npz"
+
+
+_LOADED: dict[str, Arcs] = {}
+
+
+def read_arcs(path: str | Path) -> Arcs:
+    """Arcs written by :meth:`Arcs.save`; :class:`InputError` naming the file if it is not one."""
+    p = str(path)
+    if p in _LOADED:
+        return _LOADED[p]
+    try:
+        with np.load(p) as z:
+            meta = z["meta"]
+            if meta[:4].tolist() != [VERSION, ARC_POINTS, ARC_SAMPLES, len(WINDOWS)]:
+                raise InputError(p, f"arc atlas format {meta[:4].tolist()}", "an arc atlas of this planar (rebuild it)")
+            a = Arcs(z["params"], z["window"], z["frame"], z["desc"], int(meta[4]), float(z["seconds"]))
+    except FileNotFoundError:
+        raise InputError(p, "missing", "an arc atlas file written by planar") from None
+    except (KeyError, ValueError, OSError) as e:
+        raise InputError(p, type(e).__name__, "an arc atlas file written by planar") from None
+    _LOADED[p] = a
+    return a
+
+
+def load_arcs(fourbars: int = DEFAULT_FOURBARS, seed: int = 0, progress: bool = False) -> Arcs:
+    """The cached arcs of ``fourbars`` four-bars, built and cached first if missing (kept in memory only when the
+    cache folder cannot be written)."""
+    path = arcs_path(fourbars, seed)
+    if path.exists():
+        return read_arcs(path)
+    if progress:
+        import sys
+
+        print(
+            f"planar: building the rocking-arc atlas once ({fourbars:,} four-bars, {len(WINDOWS)} arcs each), cached at {path}",
+            file=sys.stderr,
+            flush=True,
+        )
+    a = build_arcs(fourbars, seed, progress)
+    try:
+        a.save(path)
+        _LOADED[str(path)] = a
+    except (OSError, InputError):
+        pass
+    return a
+
+
+def smooth_open(z: NDArray[np.complex128], n: int = ARC_SAMPLES) -> NDArray[np.complex128]:
+    """``n`` points on the natural cubic spline through the points ``z`` in order (parametrised by chord length)."""
+    from scipy.interpolate import CubicSpline
+
+    seg = np.abs(np.diff(z))
+    if len(z) < 3 or np.any(seg <= 1e-12 * max(float(seg.max()), 1e-300)):
+        return z
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    cs = CubicSpline(s, np.column_stack([z.real, z.imag]), bc_type="natural")
+    q = cs(np.linspace(0.0, s[-1], n))
+    return np.asarray(q[:, 0] + 1j * q[:, 1])
+
+
+def arc_candidates(arcs: Arcs, targets: Array, k: int = 64) -> Array:
+    """Rocking four-bars whose arcs are near the targets ``(N, 2)`` (in order along the arc), placed onto them:
+    rows of the kernel's 9 parameters and the circuit (as :func:`planar.synth.atlas.candidates`), ``4 k`` of them
+    (the targets' description both ways along and mirrored), nearest first within each query."""
+    from planar.synth.atlas import _mirror
+
+    t = np.asarray(targets, float)
+    z = t[:, 0] + 1j * t[:, 1]
+    out: list[Array] = []
+    for mirrored in (False, True):
+        zm = np.conj(z) if mirrored else z
+        for seq in (zm, zm[::-1]):
+            d, fr = describe_open(smooth_open(seq)[None, :])
+            if not np.isfinite(d).all():
+                continue
+            _, idx = arcs.tree.query(d[0], k=min(k, len(arcs)))
+            rows = _place(arcs, np.atleast_1d(idx), fr[0])
+            out.append(_mirror(rows) if mirrored else rows)
+    return np.concatenate(out) if out else np.empty((0, 10))
+
+
+def _place(arcs: Arcs, idx: NDArray[np.intp], wframe: Array) -> Array:
+    """Entries ``idx`` mapped onto a query described by ``wframe`` (centroid x, y, size, rotation)."""
+    p = arcs.params[idx].astype(float)
+    fr = arcs.frame[idx].astype(float)
+    k = wframe[2] / fr[:, 2]
+    e = np.exp(1j * (wframe[3] - fr[:, 3]))
+    o2 = (wframe[0] + 1j * wframe[1]) - k * e * (fr[:, 0] + 1j * fr[:, 1])
+    return np.column_stack(
+        [k, k * p[:, 0], k * p[:, 1], k * p[:, 2], k * p[:, 3], k * p[:, 4], o2.real, o2.imag, np.angle(e), p[:, 5]]
+    )
+
+
+def rocking_range(row: Array, theta: Array) -> tuple[float, float] | None:
+    """The input angles (rad from the ground line, ``lo <= hi``) a rocking four-bar (kernel row ``row``: 9
+    parameters) must swing between to pass crank angles ``theta`` on one swing (all on the same arc of its
+    range, none across a dead zone), or None when they are not on one arc (or its input turns fully)."""
+    r1, r2, r3, r4 = (abs(float(v)) for v in row[:4])
+    lo, hi, rocks = input_range(np.array([r2 / r1]), np.array([r3 / r1]), np.array([r4 / r1]))
+    if not rocks[0]:
+        return None
+    lo0, hi0 = float(lo[0]), float(hi[0])
+    th = np.asarray(theta, float)
+    for arc_lo, arc_hi in ((lo0, hi0), (-hi0, -lo0)):  # the upper arc and its mirror (two-arc linkages)
+        u = arc_lo + np.mod(th - arc_lo, 2 * np.pi)
+        if np.all(u <= arc_hi + 1e-12):
+            return float(u.min()), float(u.max())
+    return None
+
+
+#: lookup and refinement effort: neighbours per query, starts refined, evaluations per start
+SEARCH_K, SEARCH_REFINE, SEARCH_NFEV = 64, 16, 200
+#: evaluations of the best start's last refinement (its crank angles kept, not re-assigned)
+POLISH_NFEV = 1000
+
+
+def search_arcs(targets: Array, arcs: Arcs, cons: Any = None, stop: float = 1e-9) -> tuple[Any, tuple[float, float] | None]:
+    """Untimed targets (normalised: centroid 0, size 1) from the rocking arcs, refined: the best result (as
+    :class:`planar.synth.search.SearchResult`) whose targets lie on one swing of its input, and that swing's input
+    range (:func:`rocking_range`; None when no result keeps the targets on one swing).  ``cons``: the path's
+    :class:`~planar.synth.search.Constraints` with the full turn not required (its link ratio is kept)."""
+    import dataclasses
+
+    from planar.synth.search import (
+        Constraints,
+        PathObjective,
+        SearchResult,
+        _refine,
+        default_bounds,
+        max_distance,
+        reassigned_refine,
+        violation,
+    )
+
+    cons = dataclasses.replace(cons if cons is not None else Constraints(), full_turn=False)
+    t = np.asarray(targets, float)
+    obj = PathObjective(t, None, cons, 256)
+    b = default_bounds(t, cons, False)
+    b[8] = (-3 * np.pi, 3 * np.pi)
+    t0 = time.perf_counter()
+    every = arc_candidates(arcs, t, SEARCH_K)
+    stages = {"arcs_s": time.perf_counter() - t0}
+    t1 = time.perf_counter()
+    f = obj.population(every, np.float64) if len(every) else np.zeros(0)
+    best: tuple[float, Array, Array, tuple[float, float]] | None = None
+    tried: list[Array] = []
+    for row in every[np.argsort(f, kind="stable")]:
+        if len(tried) >= SEARCH_REFINE:
+            break
+        if any(np.allclose(row, s, rtol=1e-6, atol=1e-9) for s in tried):
+            continue
+        tried.append(row)
+        r, tt, _ = reassigned_refine(obj, row, b, SEARCH_NFEV, stop)
+        swing = rocking_range(r[:9], tt)
+        if swing is None or violation(r[None, :9], cons, obj.scale, 0.0)[0] > 0:
+            continue
+        e = max_distance(obj, r, tt)
+        if best is None or e < best[0]:
+            best = (e, r, tt, swing)
+        if e <= stop:
+            break
+    if best is not None and best[0] > stop:  # the best goes on with its own angles (no re-assignment)
+        e0, r0, tt0, _ = best
+        r, tt, _ = _refine(obj, r0, b, max_nfev=POLISH_NFEV, method="lm", theta0=tt0)
+        swing = rocking_range(r[:9], tt)
+        e = max_distance(obj, r, tt)
+        if swing is not None and e < e0 and violation(r[None, :9], cons, obj.scale, 0.0)[0] == 0:
+            best = (e, r, tt, swing)
+    stages["refine_s"] = time.perf_counter() - t1
+    if best is None:
+        return None, None
+    e, r, tt, swing = best
+    sse = float(np.sum(np.square(_points(r, tt) - t)))
+    return SearchResult(r[:9], 1 if r[9] >= 0 else -1, tt, sse, True, len(tried), stages), swing
+
+
+def _points(row: Array, theta: Array) -> Array:
+    x, y, _ = coupler_points(row[None, :9], theta[None, :], np.array([1.0 if row[9] >= 0 else -1.0]))
+    return np.column_stack([x[0], y[0]])
+
+
+def synthesise_rocking_path(
+    targets: Array,
+    tolerance: float = 1e-3,
+    ordered: bool = False,
+    max_ratio: float = 10.0,
+    arcs: Arcs | None = None,
+    budget: str = "normal",
+) -> Any:
+    """A four-bar whose input *rocks* (swings between two angles, never turning fully) and whose coupler point
+    passes through ``targets`` ``(N, 2)`` (untimed, in order along its arc), from the rocking-arc atlas.
+
+    ``arcs``: the atlas (default: the cached one of :data:`DEFAULT_FOURBARS` four-bars, or
+    :data:`QUICK_FOURBARS` for ``budget="quick"``, built on first use).  Returns a
+    :class:`planar.synth.path.FourBarDesign` whose ``checks`` hold ``input_swing_rad`` and
+    ``input_swing_deg`` (the input's swing, from the ground line, as ``[from, to]``), ``input_swing_world_deg``
+    (the same from the world's +x axis), ``ok_accuracy`` (largest distance over the targets' size within
+    ``tolerance``), ``ok_swing_assembles`` (planar's solver assembles the whole swing on the design's
+    circuit), ``ok_on_one_swing`` (every target on that swing), ``ok_constraints`` (link ratio) and, with
+    ``ordered``, ``ok_order`` (the targets met in their order as the input swings one way).  When no four-bar
+    keeps the targets on one swing, the design is None-valued in ``checks["error"]`` and ``sse`` is inf.
+    """
+    import math
+
+    from threadpoolctl import threadpool_limits
+
+    from planar.synth.path import FourBarDesign, wrapped
+    from planar.synth.search import Constraints, constraint_failures
+    from planar.synth.targets import normalisation
+
+    t = np.asarray(targets, float)
+    if t.ndim != 2 or t.shape[1] != 2 or len(t) < 3:
+        raise InputError("targets", t.shape, "3 or more (x, y) points")
+    t0 = time.perf_counter()
+    if arcs is None:
+        arcs = load_arcs(QUICK_FOURBARS if budget == "quick" else DEFAULT_FOURBARS, progress=True)
+    c, s = normalisation(t)
+    cons = Constraints(full_turn=False, max_ratio=max_ratio)
+    with threadpool_limits(1):
+        r, swing = search_arcs((t - c) / s, arcs, cons)
+    if r is None or swing is None:
+        d = FourBarDesign(1.0, 1.0, 1.0, 1.0, (0.0, 0.0), "open", (0.0, 0.0, 0.0), np.zeros(len(t)), math.inf, t, False, 0.0)
+        d.checks = {"error": "no four-bar of the rocking-arc atlas keeps the targets on one swing of its input"}
+        d.checks["ok_found"] = False
+        return d
+    p = r.params.copy()
+    p[:6] *= s
+    p[6:8] = p[6:8] * s + c
+    d = FourBarDesign(
+        float(p[0]),
+        float(p[1]),
+        float(p[2]),
+        float(p[3]),
+        (float(p[4]), float(p[5])),
+        "open" if r.circuit > 0 else "crossed",
+        (float(p[6]), float(p[7]), float(p[8])),
+        wrapped(r.theta),
+        math.nan,
+        t,
+        False,
+        time.perf_counter() - t0,
+    )
+    _check_rocking(d, r.theta, swing, tolerance, ordered, s)
+    d.checks["constraint_failures"] = list(constraint_failures(p, cons))
+    d.checks["ok_constraints"] = not d.checks["constraint_failures"]
+    d.checks["stages_s"] = r.stages
+    d.checks["found_by"] = "the rocking-arc atlas lookup and refinement"
+    return d
+
+
+def _check_rocking(d: Any, theta: Array, swing: tuple[float, float], tolerance: float, ordered: bool, size: float) -> None:
+    """Fill ``d.sse`` and ``d.checks`` from planar's solver: at the targets, and over the swing (dense, as a
+    path, against the same angles as a scattered batch: the circuit never switches)."""
+    import math
+
+    fb = d.fourbar()
+    lo, hi = swing
+    th = np.asarray(theta, float)
+    u = lo - 1e-9 + np.mod(th - lo + 1e-9, 2 * np.pi)  # the targets' input angles on the swing (lo itself included)
+    at = fb.solve(u)
+    pts = at.points["coupler_point"]
+    dist = np.hypot(*(pts - d.targets).T)
+    d.sse = float(np.sum(dist**2)) if at.valid.all() else math.inf
+    sweep = np.linspace(lo, hi, 721)
+    path = fb.solve(sweep)
+    perm = np.random.default_rng(0).permutation(len(sweep))
+    batch = fb.solve(sweep[perm])
+    same = bool(path.valid.all() and batch.valid.all()) and bool(
+        np.max(np.abs(batch.points["coupler_point"] - path.points["coupler_point"][perm])) <= 1e-9 * size
+    )
+    du = np.diff(u)
+    phi = d.placement[2]
+    d.checks = {
+        "grashof": fb.grashof,
+        "input_swing_rad": [lo, hi],
+        "input_swing_deg": [math.degrees(lo), math.degrees(hi)],
+        "input_swing_world_deg": [math.degrees(lo + phi), math.degrees(hi + phi)],
+        "ok_valid_at_targets": bool(at.valid.all()),
+        "ok_on_one_swing": bool(np.all((u >= lo - 1e-9) & (u <= hi + 1e-9))),
+        "ok_swing_assembles": same,
+        "max_target_distance": float(dist.max()) if at.valid.all() else math.inf,
+        "worst_target": int(np.argmax(dist)) + 1,
+        "size": size,
+        "max_error": float(dist.max()) / size if at.valid.all() else math.inf,
+        "rms_error": math.sqrt(d.sse / len(th)) / size if math.isfinite(d.sse) else math.inf,
+        "tolerance": tolerance,
+    }
+    d.checks["ok_accuracy"] = bool(d.checks["max_error"] <= tolerance)
+    if ordered:
+        d.checks["ok_order"] = bool(np.all(du > 0) or np.all(du < 0))
