@@ -31,6 +31,7 @@ __all__ = [
     "RESOLUTION",
     "SIZE_RANGE",
     "check_angle",
+    "check_coordinates",
     "check_count",
     "check_memory",
     "check_scale",
@@ -252,6 +253,37 @@ def check_scale(where: str, mech: object, size_range: bool = True) -> None:
             f"{float(np.spacing(extent)) if math.isfinite(extent) else math.inf:.3g} there, coarser than "
             f"{RESOLUTION:g} of the mechanism's smallest length {smallest:.6g} (move it nearer the origin)",
         )
+
+
+def _smallest_length(mech: object) -> float:
+    """The mechanism's smallest length (model units): its smallest pin or hull radius, at most its size."""
+    import numpy as np
+
+    size = float(getattr(mech, "size", 1.0))
+    radii = [float(r) for p in getattr(mech, "parts", ()) for _, _, r in (getattr(p, "hull", None) or ()) if r > 0]
+    return min([size, *radii]) if np.isfinite(size) else min(radii, default=1.0)
+
+
+def check_coordinates(field: str, points: object, mech: object, shown: object = None) -> None:
+    """:class:`InputError` naming ``field`` if a point of ``points`` (model units, ``[[x, y], ...]``) lies so far
+    from the origin that float64 resolves it coarser than :data:`RESOLUTION` of ``mech``'s smallest length (the
+    rule :func:`check_scale` applies to the placement: a standoff or a polygon vertex at 1e300 is refused, not cut
+    into nonsense).  ``shown``: the value as the user wrote it (default ``points``)."""
+    with _quiet_numpy():
+        import numpy as np
+
+        pts = np.asarray(points, dtype=float).reshape(-1)
+        extent = float(np.abs(pts).max(initial=0.0))
+        smallest = _smallest_length(mech)
+        if math.isfinite(extent) and float(np.spacing(extent)) <= RESOLUTION * smallest:
+            return
+        far = smallest * RESOLUTION / float(np.finfo(float).eps)
+    raise InputError(
+        field,
+        points if shown is None else shown,
+        f"coordinates within about {far:.3g} model units of the origin (float64 resolves coarser there than "
+        f"{RESOLUTION:g} of the mechanism's smallest length {smallest:.6g})",
+    )
 
 
 def _quiet_numpy() -> Any:
