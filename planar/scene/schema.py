@@ -47,8 +47,7 @@ def _some_points(v: list[Any]) -> list[Any]:
 
 
 #: the slowest and fastest ``[driver] speed`` (cycles per second): a calendar wheel's turn a year is 3e-8, a
-#: machine's crank at 60 000 rpm 1e3; beyond 1e6 the accelerations (speed squared times the size) and a motor
-#: torque (times the masses) leave float64 for a large mechanism, and the CSV fills with overflowed samples
+#: 60 000 rpm spindle 1e3; far beyond (1e300) the accelerations, speed squared, overflow float64
 SPEED_RANGE = (1e-9, 1e6)
 
 
