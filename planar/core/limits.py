@@ -235,8 +235,7 @@ def check_scale(where: str, mech: object, size_range: bool = True) -> None:
         h = np.concatenate(hulls) if hulls else np.zeros((0, 3))
         place = np.asarray(getattr(mech, "placement", (0.0, 0.0, 0.0)), dtype=float).ravel()[:2]
         extent = float(np.abs(place).max(initial=0.0)) + float(np.abs(h[:, :2]).max(initial=0.0))
-        radii = h[:, 2][h[:, 2] > 0]
-        smallest = min(size, float(radii.min())) if radii.size else size
+        smallest = _smallest_length(mech)
     if size_range and not (math.isfinite(size) and SIZE_RANGE[0] <= size <= SIZE_RANGE[1]):
         raise InputError(
             f"{where}: mechanism size",
@@ -260,8 +259,10 @@ def _smallest_length(mech: object) -> float:
     import numpy as np
 
     size = float(getattr(mech, "size", 1.0))
-    radii = [float(r) for p in getattr(mech, "parts", ()) for _, _, r in (getattr(p, "hull", None) or ()) if r > 0]
-    return min([size, *radii]) if np.isfinite(size) else min(radii, default=1.0)
+    hulls = [np.asarray(p.hull, dtype=float).reshape(-1, 3) for p in getattr(mech, "parts", ()) if getattr(p, "hull", None)]
+    radii = np.concatenate(hulls)[:, 2] if hulls else np.zeros(0)
+    radii = radii[radii > 0]
+    return min(size, float(radii.min())) if radii.size else size
 
 
 def check_coordinates(field: str, points: object, mech: object, shown: object = None) -> None:

@@ -11,6 +11,8 @@ from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, Strict, StrictBool, model_validator
 
+from planar.core.limits import SIZE_RANGE
+
 Vec2 = tuple[float, float]
 # strict types: a number is a TOML number (true is not 1.0, "4" is not 4.0), a flag is true or false
 Pos = Annotated[float, Strict(), Field(gt=0, allow_inf_nan=False)]
@@ -20,15 +22,15 @@ _NAME = r'^[^\x00-\x1f\x7f,"]*$'
 Name = Annotated[str, Strict(), Field(min_length=1, max_length=80, pattern=_NAME)]
 Title = Annotated[str, Strict(), Field(max_length=80, pattern=_NAME)]
 
-#: the largest length or coordinate a linkage node takes (model units): :data:`planar.core.limits.SIZE_RANGE`'s
-#: bound, written here so the schema refuses ``ra = 1e300`` naming the key before a solver squares it
-MAX_LENGTH = 1e60
+#: the largest length or coordinate a linkage node takes (model units): the bound of a mechanism's size, checked
+#: here too so that the schema refuses ``ra = 1e300`` naming the key before a solver squares it
+MAX_LENGTH = SIZE_RANGE[1]
 
 
 def _length(v: float) -> float:
-    if not MAX_LENGTH**-1 <= v <= MAX_LENGTH:
+    if not SIZE_RANGE[0] <= v <= SIZE_RANGE[1]:
         raise ValueError(
-            f"a length from {MAX_LENGTH**-1:g} to {MAX_LENGTH:g} model units (beyond, the squares and products of "
+            f"a length from {SIZE_RANGE[0]:g} to {SIZE_RANGE[1]:g} model units (beyond, the squares and products of "
             "lengths the solvers form leave float64; choose another model unit)"
         )
     return v
@@ -43,6 +45,9 @@ def _coordinates(v: tuple[float, ...]) -> tuple[float, ...]:
 def _some_points(v: list[Any]) -> list[Any]:
     if not v:
         raise ValueError("at least one point [x, y]; leave the key out to have two chosen (clear of every leg)")
+    for i, p in enumerate(v):
+        if p in v[:i]:  # one rod, not two: the plates would be held at one point fewer than written
+            raise ValueError(f"distinct points (item {i} repeats item {v.index(p)}, {list(p)})")
     return v
 
 
