@@ -110,6 +110,7 @@ CASES = [
     pytest.param(
         "kangaroo-leg.toml", [("unit_mm = 15.0", "unit_mm = 15.0\npin_diameter_mm = 3.3")], _export,
         ("in/s.toml: fabrication.pin_diameter_mm = 3.3",), id="pin-diameter-path",
+        marks=pytest.mark.slow,  # 0.3 s CPU: refused where the hardware is chosen, after the parts are cut
     ),
     pytest.param(
         "kangaroo-leg.toml", [("cut = true", 'cut = "part"')], _export,
@@ -166,7 +167,7 @@ def test_toy_speeds_of_0_says_the_real_range(capsys) -> None:
     assert "greater than 0 and at most 1000" in err and "from 0" not in err
 
 
-@pytest.mark.parametrize("target", ["Rz", "ox"])
+@pytest.mark.parametrize("target", ["ox", pytest.param("Rz", marks=pytest.mark.slow)])
 def test_chains_names_the_same_motions_it_accepts(capsys, target: str) -> None:
     """``chains ox`` listed Rz among the valid motions, and ``chains Rz`` was refused."""
     err = fails_cleanly(capsys, ["chains", target], f"target = {target!r}", "one of Ox, Oy, Oz, Tx, Ty, Tz, OzT")
