@@ -197,8 +197,9 @@ def derivative_columns(mech: Mechanism, motion: Motion, effects: Any = None) -> 
     linkage (a four-bar's is ``C.transmission``), ``torque`` (the inverse
     dynamics of everything ``effects`` names, see :func:`motor_torque`) and
     ``torque.loads`` (the loads alone, ideal: ``sum F . dX/dq``), and
-    ``rates_valid`` (0 where a rate is undefined: a toggle or an invalid
-    sample, whose rate cells are ``nan``).
+    ``rates_valid`` (0 where a rate is undefined: a toggle, an invalid
+    sample or a number that overflowed float64; those samples' rate cells
+    hold 0, never NaN, as every validity mask's invalid samples do).
     """
     from planar.core.effects import Effects
 
@@ -224,7 +225,7 @@ def derivative_columns(mech: Mechanism, motion: Motion, effects: Any = None) -> 
     good = der.valid & ok
     for c in cols:  # a final finite check: a sample whose rates or torque overflowed is not valid
         good &= np.isfinite(c)
-    cols = [np.where(good, c, np.nan) for c in cols]
+    cols = [np.where(good, c, 0.0) for c in cols]
     names.append("rates_valid")
     cols.append(good.astype(float))
     return names, cols

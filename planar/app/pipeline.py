@@ -417,6 +417,13 @@ def export_scene(
             f"parts that fit the {w:g} x {h:g} mm sheet (the largest part is {across:.4g} mm across; "
             "a smaller unit_mm or a larger sheet)",
         )
+    if not across >= spec.min_part_mm:  # 1e-300 mm per unit: refused for the unit, not for a pin hole in a speck
+        raise InputError(
+            f"{scene.path}: fabrication.unit_mm",
+            spec.unit_mm,
+            f"a unit whose largest part is at least min_part_mm = {spec.min_part_mm:g} mm across (it is "
+            f"{across:.4g} mm; a larger unit_mm)",
+        )
     fab = build(scene, FabSettings.from_spec(spec, kerf, sheet))
     fab.written = write_outputs(fab, dxf, svg, preview, bom, assembly, kerf_test, plan=plan, motion=motion, steps=steps)
     return fab

@@ -42,7 +42,7 @@ def _speeds(text: str) -> list[float]:
     except ValueError:
         raise InputError("--speeds", text, "comma-separated speeds in cycles per second, e.g. 0.5,1,2") from None
     if any(not (math.isfinite(v) and 0 < v <= MAX_SPEED) for v in out):
-        raise InputError("--speeds", text, f"speeds from 0 to {MAX_SPEED:g} cycles per second, e.g. 0.5,1,2")
+        raise InputError("--speeds", text, f"speeds greater than 0 and at most {MAX_SPEED:g} cycles per second, e.g. 0.5,1,2")
     return sorted(out)
 
 

@@ -31,6 +31,7 @@ __all__ = [
     "RESOLUTION",
     "SIZE_RANGE",
     "check_angle",
+    "check_coordinates",
     "check_count",
     "check_memory",
     "check_scale",
@@ -216,8 +217,7 @@ def check_scale(where: str, mech: object, size_range: bool = True) -> None:
         h = np.concatenate(hulls) if hulls else np.zeros((0, 3))
         place = np.asarray(getattr(mech, "placement", (0.0, 0.0, 0.0)), dtype=float).ravel()[:2]
         extent = float(np.abs(place).max(initial=0.0)) + float(np.abs(h[:, :2]).max(initial=0.0))
-        radii = h[:, 2][h[:, 2] > 0]
-        smallest = min(size, float(radii.min())) if radii.size else size
+        smallest = _smallest_length(mech)
     if size_range and not (math.isfinite(size) and SIZE_RANGE[0] <= size <= SIZE_RANGE[1]):
         raise InputError(
             f"{where}: mechanism size",
@@ -234,6 +234,39 @@ def check_scale(where: str, mech: object, size_range: bool = True) -> None:
             f"{float(np.spacing(extent)) if math.isfinite(extent) else math.inf:.3g} there, coarser than "
             f"{RESOLUTION:g} of the mechanism's smallest length {smallest:.6g} (move it nearer the origin)",
         )
+
+
+def _smallest_length(mech: object) -> float:
+    """The mechanism's smallest length (model units): its smallest pin or hull radius, at most its size."""
+    import numpy as np
+
+    size = float(getattr(mech, "size", 1.0))
+    hulls = [np.asarray(p.hull, dtype=float).reshape(-1, 3) for p in getattr(mech, "parts", ()) if getattr(p, "hull", None)]
+    radii = np.concatenate(hulls)[:, 2] if hulls else np.zeros(0)
+    radii = radii[radii > 0]
+    return min(size, float(radii.min())) if radii.size else size
+
+
+def check_coordinates(field: str, points: object, mech: object, shown: object = None) -> None:
+    """:class:`InputError` naming ``field`` if a point of ``points`` (model units, ``[[x, y], ...]``) lies so far
+    from the origin that float64 resolves it coarser than :data:`RESOLUTION` of ``mech``'s smallest length (the
+    rule :func:`check_scale` applies to the placement: a standoff or a polygon vertex at 1e300 is refused, not cut
+    into nonsense).  ``shown``: the value as the user wrote it (default ``points``)."""
+    with _quiet_numpy():
+        import numpy as np
+
+        pts = np.asarray(points, dtype=float).reshape(-1)
+        extent = float(np.abs(pts).max(initial=0.0))
+        smallest = _smallest_length(mech)
+        if math.isfinite(extent) and float(np.spacing(extent)) <= RESOLUTION * smallest:
+            return
+        far = smallest * RESOLUTION / float(np.finfo(float).eps)
+    raise InputError(
+        field,
+        points if shown is None else shown,
+        f"coordinates within about {far:.3g} model units of the origin (float64 resolves coarser there than "
+        f"{RESOLUTION:g} of the mechanism's smallest length {smallest:.6g})",
+    )
 
 
 def _quiet_numpy() -> Any:

@@ -173,7 +173,8 @@ def scene_figure(
     mech = scene.mechanism
     motion = _motion(scene, samples_per_cycle)
     names, cols = derivative_columns(mech, motion, scene.effects)
-    col = dict(zip(names, cols))
+    ok = cols[names.index("rates_valid")] == 1.0
+    col = {n: c if n == "rates_valid" else np.where(ok, c, np.nan) for n, c in zip(names, cols)}  # gaps, not 0
     drv = mech.driver
     cam = _is_cam(mech)
     if drv.kind == "rotation" and drv.amplitude is None:

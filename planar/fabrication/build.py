@@ -16,7 +16,7 @@ from planar.core.model import Mechanism
 from planar.errors import InputError
 from planar.fabrication.check import spacer_radius
 from planar.fabrication.hardware import below_mm, shaft_check
-from planar.fabrication.joints import joint_pins, pin_features
+from planar.fabrication.joints import FabricationError, joint_pins, pin_features
 from planar.fabrication.layers import Assembly, letter, pin_stacks, plan_assembly
 from planar.fabrication.nesting import nest
 from planar.fabrication.parts import FabSettings, nominal_material, part_cuts
@@ -289,16 +289,21 @@ def _tab_notes(cuts: list[PartCut], joins: list[Any], s: FabSettings) -> list[st
 def build(scene: Any, settings: FabSettings) -> Fabrication:
     """Cut-ready, checked, layered and nested parts of ``scene`` (raises FabricationError/InputError).
 
-    An error in a ``[fabrication]`` value read from a scene file starts with the file's name
-    (``bird.toml: fabrication.pin_diameter_mm = 3.5: ...``), as every scene error does.
+    An error in a ``[fabrication]`` value or a ``mechanism.`` key read from a scene file starts with the file's
+    path as given (``toys/bird.toml: fabrication.pin_diameter_mm = 3.5: ...``), as every scene error does.
     """
+    where = getattr(scene, "path", None)
+    in_file = bool(where) and Path(str(where)).is_file()
     try:
         return _build(scene, settings)
     except InputError as e:
-        where = getattr(scene, "path", None)
-        if not (e.field.startswith("fabrication.") and where and Path(str(where)).is_file()):
+        if not (e.field.startswith("fabrication.") and in_file):
             raise
-        raise InputError(f"{Path(str(where)).name}: {e.field}", e.value, e.expected) from e
+        raise InputError(f"{where}: {e.field}", e.value, e.expected) from e  # the path as the user gave it
+    except FabricationError as e:
+        if not (str(e).startswith("mechanism.") and in_file):
+            raise
+        raise FabricationError(f"{where}: {e}") from e
 
 
 def _build(scene: Any, settings: FabSettings) -> Fabrication:

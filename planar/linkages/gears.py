@@ -206,6 +206,10 @@ class Driven(NodeKind):
 
     kind: ClassVar[str] = "driven"
     scene_fields: ClassVar[tuple[str, ...]] = ("centre", "radius", "cycles", "phase", "amplitude", "mean")
+    #: without ``amplitude`` the node turns fully (``phase + cycles theta``)
+    required_fields: ClassVar[tuple[str, ...]] = ("centre", "radius")
+    #: scene keys that mean something only beside another: ``mean`` is a rocking node's (with ``amplitude``)
+    paired_fields: ClassVar[tuple[tuple[str, str], ...]] = (("mean", "amplitude"),)
     angle_fields: ClassVar[tuple[str, ...]] = ("phase", "amplitude", "mean")
     is_input: ClassVar[bool] = True
     #: its value follows the clock through a law of its own

@@ -165,6 +165,12 @@ class Legs(Linkage):
     @staticmethod
     def _crank_of(name: str, nodes: list[NodeKind], links: list[Link]) -> tuple[Crank, Fixed, Link]:
         inputs = [n for n in nodes if n.is_input]
+        if len(inputs) == 1 and not isinstance(inputs[0], Crank):
+            raise InputError(
+                f"{name}.leg.nodes.{inputs[0].name}.kind",
+                inputs[0].kind,
+                "'crank': a walker's legs turn on one crankshaft, driven by its crank node",
+            )
         if len(inputs) != 1 or not isinstance(inputs[0], Crank):
             raise InputError(f"{name}.leg.nodes", [n.name for n in inputs], "exactly one input node, a crank")
         crank = inputs[0]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable
 from contextvars import ContextVar
 from dataclasses import dataclass, field
@@ -12,11 +13,12 @@ from typing import Any
 import numpy as np
 
 from planar.core.effects import Effects, Load, Spring
-from planar.core.limits import check_scale
+from planar.core.limits import check_coordinates, check_scale
 from planar.core.model import Mechanism, Motion
 from planar.core.registry import Registry
 from planar.errors import InputError, PlanarError, SceneError
 from planar.scene.schema import (
+    MAX_G,
     CamSpec,
     CatalogSpec,
     ChainSpec,
@@ -207,9 +209,11 @@ def build_scene(spec: SceneSpec, path: str = "<scene>") -> Scene:
             f"{path}: driver.speed = {spec.driver.speed!r}: expected a speed whose period "
             "(1 / speed seconds) and angular rate are finite numbers"
         )
+    _check_gravity(spec, path)
     mech = _build_mechanism(spec, m, path, rate)
     try:
         check_scale(path, mech)  # numbers float64 holds faithfully (not a placement at 1e16 or a size of 1e-200)
+        _check_extents(spec, mech, path)
     except InputError as e:
         raise SceneError(str(e)) from None
     polygons: dict[str, tuple[str, np.ndarray]] = {}
@@ -247,6 +251,36 @@ def build_scene(spec: SceneSpec, path: str = "<scene>") -> Scene:
                     f"(got {getattr(s, side)!r}; parts are {sorted(names)})"
                 )
     return Scene(spec, mech, path, polygons)
+
+
+#: standard gravity, mm/s^2
+STANDARD_GRAVITY_MM = 9806.65
+
+
+def _check_gravity(spec: SceneSpec, path: str) -> None:
+    """:class:`SceneError` if ``[effects] gravity`` is beyond :data:`~planar.scene.schema.MAX_G` standard
+    gravities (model units per s^2 converted with ``unit_mm``): ``[1e300, 0]`` is refused, not simulated."""
+    g = spec.effects.gravity
+    if g is None:
+        return
+    u = spec.fabrication.unit_mm
+    most = MAX_G * STANDARD_GRAVITY_MM / u  # model units / s^2
+    if not math.hypot(*g) <= most:
+        raise SceneError(
+            f"{path}: effects.gravity = {list(g)!r}: expected a gravity of at most {MAX_G:g} g, {most:.4g} model "
+            f"units/s^2 at unit_mm = {u:g} (one g is {STANDARD_GRAVITY_MM / u:.4g})"
+        )
+
+
+def _check_extents(spec: SceneSpec, mech: Mechanism, path: str) -> None:
+    """:class:`InputError` for a standoff or a polygon vertex float64 cannot place faithfully (the rule
+    :func:`~planar.core.limits.check_scale` applies to the placement)."""
+    m = spec.mechanism
+    for i, xy in enumerate(getattr(m, "standoffs", None) or ()):
+        check_coordinates(f"{path}: mechanism.standoffs[{i}]", xy, mech, list(xy))
+    for i, poly in enumerate(getattr(m, "polygons", ())):
+        which = f".{poly.name}" if re.fullmatch(r"[A-Za-z0-9_\-]+", poly.name) else f"[{i}]"  # as the schema's errors
+        check_coordinates(f"{path}: mechanism.polygons{which}.points", poly.points, mech, [list(p) for p in poly.points])
 
 
 #: mechanism types whose driver can rock (``[driver] amplitude``)
@@ -381,7 +415,7 @@ def _build_legs(spec: SceneSpec, m: LegsSpec, b: _Build) -> Mechanism:
         phases,
         mirror=m.mirror,
         points=m.points,
-        standoffs=[tuple(p) for p in m.standoffs],
+        standoffs=[tuple(p) for p in m.standoffs or ()],
         rate=b.rate,
         phase=b.phase,
     )

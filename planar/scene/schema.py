@@ -9,7 +9,9 @@ from __future__ import annotations
 import math
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, Strict, StrictBool, model_validator
+from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, Strict, StrictBool, model_validator
+
+from planar.core.limits import SIZE_RANGE
 
 Vec2 = tuple[float, float]
 # strict types: a number is a TOML number (true is not 1.0, "4" is not 4.0), a flag is true or false
@@ -19,6 +21,82 @@ Real = Annotated[float, Strict(), Field(allow_inf_nan=False)]
 _NAME = r'^[^\x00-\x1f\x7f,"]*$'
 Name = Annotated[str, Strict(), Field(min_length=1, max_length=80, pattern=_NAME)]
 Title = Annotated[str, Strict(), Field(max_length=80, pattern=_NAME)]
+
+#: the largest length or coordinate a linkage node takes (model units): the bound of a mechanism's size, checked
+#: here too so that the schema refuses ``ra = 1e300`` naming the key before a solver squares it
+MAX_LENGTH = SIZE_RANGE[1]
+
+
+def _length(v: float) -> float:
+    if not SIZE_RANGE[0] <= v <= SIZE_RANGE[1]:
+        raise ValueError(
+            f"a length from {SIZE_RANGE[0]:g} to {SIZE_RANGE[1]:g} model units (beyond, the squares and products of "
+            "lengths the solvers form leave float64; choose another model unit)"
+        )
+    return v
+
+
+def _coordinates(v: tuple[float, ...]) -> tuple[float, ...]:
+    if not all(abs(x) <= MAX_LENGTH for x in v):
+        raise ValueError(f"coordinates of at most {MAX_LENGTH:g} model units (beyond, their squares leave float64)")
+    return v
+
+
+def _some_points(v: list[Any]) -> list[Any]:
+    if not v:
+        raise ValueError("at least one point [x, y]; leave the key out to have two chosen (clear of every leg)")
+    for i, p in enumerate(v):
+        if p in v[:i]:  # one rod, not two: the plates would be held at one point fewer than written
+            raise ValueError(f"distinct points (item {i} repeats item {v.index(p)}, {list(p)})")
+    return v
+
+
+#: the slowest and fastest ``[driver] speed`` (cycles per second): a calendar wheel's turn a year is 3e-8, a
+#: 60 000 rpm spindle 1e3; far beyond (1e300) the accelerations, speed squared, overflow float64
+SPEED_RANGE = (1e-9, 1e6)
+
+
+def _speed(v: float) -> float:
+    if not SPEED_RANGE[0] <= v <= SPEED_RANGE[1]:
+        raise ValueError(f"a speed from {SPEED_RANGE[0]:g} to {SPEED_RANGE[1]:g} cycles per second")
+    return v
+
+
+#: the strongest gravity a scene takes, in standard gravities (9.80665 m/s^2, converted with ``unit_mm``)
+MAX_G = 1000.0
+#: the largest force component a load exerts (model force units): :data:`MAX_LENGTH`'s bound, so that a torque
+#: (a force times a length of at most 1e60) and its square stay within float64
+MAX_FORCE = 1e60
+
+
+def _force(v: tuple[float, ...]) -> tuple[float, ...]:
+    if not all(abs(x) <= MAX_FORCE for x in v):
+        raise ValueError(f"a force whose components are at most {MAX_FORCE:g} (model force units) in size")
+    return v
+
+
+def _mm_up_to(most: float, what: str) -> Any:
+    """A check of a positive length in millimetres: at most ``most`` (``what`` it is, for the message)."""
+
+    def check(v: float) -> float:
+        if not v <= most:
+            raise ValueError(f"{what} greater than 0 and at most {most:g} mm")
+        return v
+
+    return check
+
+
+#: a small gearmotor's dimensions (mm): an N20's, or a 37 mm gearmotor's with an encoder, are well within
+MotorMm = Annotated[float, Strict(), Field(gt=0, allow_inf_nan=False), AfterValidator(_mm_up_to(100.0, "a motor dimension"))]
+MotorBodyMm = Annotated[
+    float, Strict(), Field(gt=0, allow_inf_nan=False), AfterValidator(_mm_up_to(250.0, "a motor body length"))
+]
+
+
+#: a node's link length or radius (model units): positive, finite, within what float64 squares
+Length = Annotated[float, Strict(), Field(gt=0, allow_inf_nan=False), AfterValidator(_length)]
+#: a node's point ``[x, y]`` (model units)
+Point = Annotated[tuple[Real, Real], AfterValidator(_coordinates)]
 
 
 def _whole(v: Any) -> Any:
@@ -140,12 +218,12 @@ class NodeSpec(_Strict):
     kind: Literal["fixed", "crank", "actuator", "rrr", "rrp", "rigid", "geared", "driven", "triad"]
     """One of ``fixed``, ``crank``, ``actuator``, ``rrr``, ``rrp``, ``rigid``, ``geared``, ``driven``, ``triad``
     (see the node's description)."""
-    at: tuple[Real, Real] | None = None
+    at: Point | None = None
     """``fixed``: the ground point ``[x, y]`` (model units), e.g. ``[-38.0, -7.8]``; ``triad``: roughly where the
     node is with the driver at 0 (picks the assembly)."""
     centre: Name | None = None
     """``crank``, ``geared``, ``driven``: the node it turns about, e.g. ``"O"``."""
-    radius: Pos | None = None
+    radius: Length | None = None
     """``crank``, ``geared``, ``driven``: its radius (model units), e.g. ``15.0``."""
     phase: Real = 0.0
     """``crank``: added to the driver angle; ``geared``: added to ratio * angle(mesh); ``driven``: in its law
@@ -156,11 +234,11 @@ class NodeSpec(_Strict):
     """``actuator``: the direction it translates along (normalised), e.g. ``[0.0, 1.0]``."""
     a: Name | None = None
     """``rrr``, ``rrp``, ``triad``: the node at distance ``ra``; ``rigid``: the frame's origin node. E.g. ``"A"``."""
-    ra: Pos | None = None
+    ra: Length | None = None
     """``rrr``, ``rrp``, ``triad``: the link length from ``a`` (model units), e.g. ``50.0``."""
     b: Name | None = None
     """``rrr``: the node at distance ``rb``; ``rigid``: the node the frame's x axis points to. E.g. ``"Z"``."""
-    rb: Pos | None = None
+    rb: Length | None = None
     """``rrr``: the link length from ``b`` (model units), e.g. ``41.5``."""
     p: Name | None = None
     """``rrp``: the slot line's first node (the line runs p -> q), e.g. ``"G1"``."""
@@ -172,7 +250,7 @@ class NodeSpec(_Strict):
     offset: Real = 0.0
     """``rrp``: the slot line shifted left of p -> q by this (model units); ``actuator``: added to the
     driver value."""
-    local: tuple[Real, Real] | None = None
+    local: Point | None = None
     """``rigid``: ``[u, v]`` in the frame of ``a`` (origin) and ``b`` (x axis), model units, e.g. ``[4.0, 0.0]``;
     ``triad``: the node's place on the ternary link (any frame), e.g. ``[3.0, 0.0]``."""
     mesh: Name | None = None
@@ -199,7 +277,11 @@ class NodeSpec(_Strict):
         kind = NODE_KINDS[self.kind]
         missing = [f for f in getattr(kind, "required_fields", kind.scene_fields) if getattr(self, f) is None]
         if missing:
-            raise ValueError(f"a {self.kind!r} node needs {', '.join(missing)}")
+            keys = ", ".join(f for f in getattr(kind, "required_fields", kind.scene_fields))
+            raise ValueError(f"the keys a {self.kind!r} node needs ({keys}): {', '.join(missing)} missing")
+        for key, needs in getattr(kind, "paired_fields", ()):
+            if key in self.model_fields_set and getattr(self, needs) is None:
+                raise ValueError(f"{key} only with {needs} (a {self.kind!r} node without {needs} turns fully): give both")
         return self
 
 
@@ -256,12 +338,13 @@ class LegsSpec(_Strict):
     phases: list[Real] | None = None
     """Each leg's crank angle ahead of the shaft (scene's angle unit), e.g. ``[0, 180, 90, 270]``; default
     evenly spread over a turn (with ``mirror``: over the pairs, both legs of a pair on one angle)."""
-    mirror: bool = False
+    mirror: StrictBool = False
     """Every second leg is the one before it mirrored about the vertical through the crank centre (a
     Strandbeest's pairs)."""
-    standoffs: list[tuple[Real, Real]] = []
+    standoffs: Annotated[list[tuple[Real, Real]], AfterValidator(_some_points)] | None = None
     """Where rods hold the built frame plates apart: points ``[x, y]`` (model units) clear of every leg's
-    swept area, e.g. ``[[0.0, -30.0]]``."""
+    swept area, e.g. ``[[0.0, -30.0]]``; leave the key out to have two chosen (an empty list is refused: a
+    walker's plates need rods between them)."""
 
 
 class ElementalSpec(_Strict):
@@ -423,8 +506,8 @@ class DriverSpec(_Strict):
     model units along its axis.
     """
 
-    speed: Pos = 1.0
-    """Cycles per second of the input (a turn, or a rocking period), e.g. ``0.5``."""
+    speed: Annotated[Pos, AfterValidator(_speed)] = 1.0
+    """Cycles per second of the input (a turn, or a rocking period), 1e-9 to 1e6, e.g. ``0.5``."""
     cycles: Pos | None = None
     """How many cycles to solve (default 1), e.g. ``2``; or give ``duration``."""
     duration: Pos | None = None
@@ -454,8 +537,9 @@ class LoadSpec(_Strict):
 
     point: Name
     """The named point it acts at, e.g. ``"coupler_point"``, ``"foot"``."""
-    force: tuple[Real, Real]
-    """``[fx, fy]`` the mechanism exerts there (model force units, world frame), e.g. ``[0.0, 10.0]``."""
+    force: Annotated[tuple[Real, Real], AfterValidator(_force)]
+    """``[fx, fy]`` the mechanism exerts there (model force units, world frame; each at most 1e60 in size), e.g.
+    ``[0.0, 10.0]``."""
 
 
 class SpringSpec(_Strict):
@@ -490,7 +574,7 @@ class EffectsSpec(_Strict):
     """Damped springs between parts: ``[{ a = "crank", b = "rocker", stiffness = 10.0 }]``."""
     loads: list[LoadSpec] = []
     """Forces at named points: ``[{ point = "coupler_point", force = [0.0, 10.0] }]``."""
-    motor: bool = False
+    motor: StrictBool = False
     """``compare`` also drives the mechanism with a motor and checks its torque against inverse dynamics,
     e.g. ``true``; implied by ``motor_force_limit``.  Without it only the motion is compared."""
     motor_force_limit: Pos | None = None
@@ -569,22 +653,22 @@ class FabricationSpec(_Strict):
     # screws either side of the shaft, ground-plate mounting holes
     pin_head_mm: Annotated[float, Strict(), Field(ge=0, le=50)] = 1.5
     """Pin head allowance per end (pin length = thickness x layers + two heads)."""
-    shaft_diameter_mm: Pos = 3.0
+    shaft_diameter_mm: MotorMm = 3.0
     """Motor shaft diameter (the driven part's D hole)."""
-    shaft_flat_mm: Pos = 2.5
+    shaft_flat_mm: MotorMm = 2.5
     """Distance across the shaft's flat (the D)."""
-    motor_screw_mm: Pos = 1.8
+    motor_screw_mm: MotorMm = 1.8
     """Motor screw hole diameter as cut (a clearance hole: the screws thread into the motor's face); 1.8 is
     ISO 273's medium clearance hole for the N20's M1.6 screws."""
-    motor_screw_spacing_mm: Pos = 9.0
+    motor_screw_spacing_mm: MotorMm = 9.0
     """Distance between the two motor screws, across the shaft (N20: 9)."""
-    motor_shaft_mm: Pos = 9.0
-    """Length of the motor's shaft above its face (an N20 micro gearmotor's D shaft: 9); a plan whose shaft must
+    motor_shaft_mm: MotorMm = 9.0
+    """Length of the motor's shaft above its face, up to 100 (an N20 micro gearmotor's D shaft: 9); a plan whose shaft must
     reach higher fails the build check (exit 3)."""
-    motor_body_mm: Pos = 26.0
+    motor_body_mm: MotorBodyMm = 26.0
     """Length of the motor's body below its face (an N20: 9 gearbox + 15 motor + its end cap and terminals, about
     26; more with an encoder): the mounting standoffs clear it."""
-    mounting_hole_mm: Pos = 3.2
+    mounting_hole_mm: MotorMm = 3.2
     """Diameter of the ground plates' mounting holes (on ears), as cut: M3 screws into the standoffs."""
     link_width_mm: Pos | None = None
     """Width of every link of a ``linkage`` scene (mm, the cut and the drawings), at least ``pin_diameter_mm +

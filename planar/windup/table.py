@@ -139,10 +139,8 @@ def enumerate_chains(target: str | None = None, max_length: int = 3, optional: b
     """
     if max_length < 1:
         raise InputError("max_length", max_length, "at least 1")
-    if target is not None:
-        _parse(target)
-        if target == "Rz":
-            raise InputError("target", target, f"an end-effector motion, one of {', '.join(MOTION_TYPES)}")
+    if target is not None and target not in MOTION_TYPES:  # Rz is the motor's, never an end effector's
+        raise InputError("target", target, f"an end-effector motion, one of {', '.join(MOTION_TYPES)}")
     table = {a: list(bs) for a, bs in TABLE.items()}
     if optional:
         for a, bs in OPTIONAL.items():

@@ -110,6 +110,7 @@ def test_a_leg_scaled_out_of_range_is_refused(tmp_path: Path, capsys, scale: flo
     for a, b in (("ground = 4.0", 4.0), ("crank = 1.0", 1.0), ("coupler = 4.0", 4.0), ("rocker = 3.0", 3.0)):
         text = text.replace(a, f"{a.split(' = ')[0]} = {b * scale!r}", 1)
     text = re.sub(r"-?\d+\.\d+(?=[,\]])", lambda m: repr(float(m.group()) * scale), text)  # every point
+    text = re.sub(r"force = \[[^\]]*\]", "force = [0.0, 10.0]", text)  # a force is no length: as it was
     scene = _scene(tmp_path, text)
     out = tmp_path / "k.dxf"
     _fails_cleanly(capsys, ["export", str(scene), "-o", str(out)], "mechanism size", out=out)

@@ -375,7 +375,7 @@ BAD_JOBS: list[tuple[str, dict, str, str]] = [
     ("sheet-too-large", fb() | {"fabrication": {"sheet_mm": [1e30, 200.0]}}, "export", "fabrication.sheet_mm"),
     (
         "cycle-too-slow-to-draw",
-        scene({"type": "elemental", "number": 3}, driver={"speed": 1e-12}),
+        scene({"type": "elemental", "number": 3}, driver={"speed": 1e-9}),
         "render",
         "driver.cycles = 1.0: expected an animation of at most",
     ),
