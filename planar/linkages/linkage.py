@@ -46,6 +46,7 @@ from planar.core.model import (
     Slide,
     check_finite,
     check_positive,
+    check_samples,
     merge_failures,
 )
 from planar.core.rates import PartRates, RatesResult, rotate_vectors
@@ -523,8 +524,8 @@ class Linkage(Mechanism):
         Each node kind differentiates its own closure (:meth:`NodeKind.velocity`);
         ``qdot = 1`` gives velocity coefficients ``dX/dq``.
         """
-        qa = np.atleast_1d(np.asarray(q, float))
-        qd = np.broadcast_to(np.asarray(qdot, float), qa.shape)
+        qa = check_samples(f"{self.name}.node_velocities(q)", q)
+        qd = np.broadcast_to(check_samples(f"{self.name}.node_velocities(qdot)", qdot, qa.shape[0]), qa.shape)
         pos, checks = self.solve_nodes(qa)
         valid = np.ones(qa.shape, bool)
         for m, _, _ in checks:
@@ -554,9 +555,10 @@ class Linkage(Mechanism):
         not close or a differentiated closure is singular (a toggle).
         ``solved``: :meth:`solve_nodes` of ``q`` if the caller has it already.
         """
-        qa = np.atleast_1d(np.asarray(q, float))
-        qd = np.broadcast_to(np.asarray(qdot, float), qa.shape)
-        qdd = np.broadcast_to(np.asarray(qddot, float), qa.shape)
+        where = f"{self.name}.node_accelerations"
+        qa = check_samples(f"{where}(q)", q)
+        qd = np.broadcast_to(check_samples(f"{where}(qdot)", qdot, qa.shape[0]), qa.shape)
+        qdd = np.broadcast_to(check_samples(f"{where}(qddot)", qddot, qa.shape[0]), qa.shape)
         pos, checks = solved if solved is not None else self.solve_nodes(qa)
         valid = np.ones(qa.shape, bool)
         for m, _, _ in checks:
@@ -737,7 +739,7 @@ class Linkage(Mechanism):
         inputs = [n for n in self.nodes if n.is_input]
         if len(inputs) < 2:
             return {}
-        qa = np.atleast_1d(np.asarray(q, float))
+        qa = check_samples(f"{self.name}.input_values(q)", q)
         out: dict[str, Array] = {}
         for n in inputs:
             own = getattr(n, "input_angle", None)  # a geared or driven node's law
@@ -751,7 +753,7 @@ class Linkage(Mechanism):
 
     def node_positions(self, q: ArrayLike) -> dict[str, Array]:
         """World positions ``(N, 2)`` of every node, placement applied."""
-        pos, _ = self.solve_nodes(np.atleast_1d(np.asarray(q, float)))
+        pos, _ = self.solve_nodes(check_samples(f"{self.name}.node_positions(q)", q))
         if any(self.placement):
             pl = np.asarray(self.placement)
             return {k: poses_apply(pl, v) for k, v in pos.items()}

@@ -71,6 +71,6 @@ class SliderCrank(Linkage):
         ``r cos(theta) + branch sqrt(l^2 - (r sin(theta) - e)^2)``; where the rod cannot reach the
         guide the root is taken at zero (see :meth:`solve` for the validity mask).
         """
-        th = np.asarray(theta, float)
+        th = check_finite(f"{self.name}.slider_position(theta)", theta)
         h = self.r * np.sin(th) - self.e
         return self.r * np.cos(th) + self.branch * np.sqrt(np.maximum((self.l - h) * (self.l + h), 0.0))
