@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     import numpy as np
     from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["check_fields", "check_finite", "check_number", "check_point", "check_positive", "check_samples"]
+__all__ = ["check_fields", "check_finite", "check_kind", "check_number", "check_point", "check_positive", "check_samples"]
 
 Vec = tuple[float, float]
 
@@ -133,3 +133,10 @@ def check_fields(obj: Any, where: str, skip: tuple[str, ...] = ()) -> None:
     for f in dataclasses.fields(obj):
         if f.name not in skip and isinstance(f.type, str):
             _check_field(f"{where}.{f.name}", f.type, getattr(obj, f.name))
+
+
+def check_kind(field_name: str, value: object, kind: type | tuple[type, ...], what: str = "") -> None:
+    """:class:`InputError` unless ``value`` is an instance of ``kind`` (``what`` says it in words)."""
+    if not isinstance(value, kind):
+        names = " or ".join(k.__name__ for k in (kind if isinstance(kind, tuple) else (kind,)))
+        raise InputError(field_name, value, what or f"a {names}")

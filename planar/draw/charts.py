@@ -56,6 +56,10 @@ GOOD_TRANSMISSION = (40.0, 140.0)
 def available_charts(scene: Scene) -> list[str]:
     """The charts that apply to ``scene`` (``transmission`` only where the mechanism has dyads)."""
     from planar.analysis.rates import transmission_angles
+    from planar.core.fields import check_kind
+    from planar.scene.build import Scene as SceneKind
+
+    check_kind("available_charts(scene)", scene, SceneKind)
 
     out = ["curve"] if scene.mechanism.points else []
     if _is_cam(scene.mechanism):
