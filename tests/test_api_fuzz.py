@@ -500,7 +500,7 @@ PARAMS: dict[str, Callable[[Ctx, Any], Any]] = {
     "unit": lambda c, i: "deg",
     "name": _instance_part,
     "path": lambda c, i: c.out(".toml"),
-    "max_pressure_angle": lambda c, i: 40.0,
+    "max_pressure_angle": lambda c, i: 0.7,
     "samples": lambda c, i: 31,
     "sag": lambda c, i: None,
     "n_max": lambda c, i: 1024,

@@ -102,7 +102,7 @@ class Segment:
 
 
 def _check_unit(unit: object) -> None:
-    if unit not in ("deg", "rad"):
+    if not isinstance(unit, str) or unit not in ("deg", "rad"):
         raise InputError("unit", unit, "'deg' or 'rad'")
 
 

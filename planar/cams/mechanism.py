@@ -68,6 +68,15 @@ class CamMechanism(Mechanism):
         unit: str = "deg",
         width: float | None = None,
     ) -> None:
+        from planar.core.fields import _check_name, check_kind
+
+        _check_name("CamMechanism.name", name)
+        check_kind("CamMechanism(profile)", profile, CamProfile)
+        if not isinstance(unit, str) or unit not in ("deg", "rad"):
+            raise InputError("CamMechanism(unit)", unit, "'deg' or 'rad' (how angles are shown in messages)")
+        for arg, items in (("nodes", nodes), ("links", links)):
+            if isinstance(items, (str, bytes)) or not isinstance(items, Sequence):
+                raise InputError(f"CamMechanism({arg})", items, f"a sequence of {'node kinds' if arg == 'nodes' else 'Link'}")
         self.profile = profile
         self._width = width
         self._unit = unit

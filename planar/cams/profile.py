@@ -40,7 +40,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from planar.cams.laws import TWO_PI, Program
-from planar.core.fields import check_fields, check_finite, check_number, check_positive
+from planar.core.fields import check_fields, check_number, check_positive, check_samples
 from planar.errors import InputError, PlanarError
 
 __all__ = ["CamError", "CamProfile", "CamReport", "FollowerGeometry"]
@@ -100,9 +100,9 @@ class FollowerGeometry:
     branch: int = 1
 
     def __post_init__(self) -> None:
-        if self.kind not in ("knife", "roller", "flat"):
+        if not isinstance(self.kind, str) or self.kind not in ("knife", "roller", "flat"):
             raise InputError("follower.kind", self.kind, "'knife', 'roller' or 'flat'")
-        if self.motion not in ("translating", "oscillating"):
+        if not isinstance(self.motion, str) or self.motion not in ("translating", "oscillating"):
             raise InputError("follower.motion", self.motion, "'translating' or 'oscillating'")
         check_fields(self, "follower")
         if self.branch not in (1, -1):
@@ -219,7 +219,7 @@ class CamProfile:
     def follower_point(self, theta: ArrayLike) -> tuple[Array, Array, Array]:
         """World position ``W`` (N, 2) of the knife tip / roller centre (flat: the face's reference point:
         on the axis, or ``arm`` along the arm) and ``dW/dtheta``, ``d2W/dtheta2``."""
-        th = np.atleast_1d(check_finite("theta", theta))
+        th = check_samples("theta", theta)
         q, q1, q2 = self.follower_output(th)
         f = self.follower
         if f.motion == "translating":
@@ -235,7 +235,7 @@ class CamProfile:
     # ------------------------------------------------------------------ knife and roller
     def pitch(self, theta: ArrayLike) -> tuple[Array, Array, Array]:
         """The pitch curve ``P`` in the cam's frame and ``dP/dtheta``, ``d2P/dtheta2`` (knife, roller)."""
-        th = np.atleast_1d(check_finite("theta", theta))
+        th = check_samples("theta", theta)
         W, W1, W2 = self.follower_point(th)
         P = _rot(-th, W)
         P1 = _rot(-th, W1 - _J(W))
@@ -246,7 +246,7 @@ class CamProfile:
     def face(self, theta: ArrayLike) -> dict[str, Array]:
         """The face line in the cam's frame: normal angle ``beta`` (away from the cam) and its
         distance ``h`` from the cam's centre, with derivatives in ``theta`` (flat faces)."""
-        th = np.atleast_1d(check_finite("theta", theta))
+        th = check_samples("theta", theta)
         q, q1, q2 = self.follower_output(th)
         f = self.follower
         if f.motion == "translating":
@@ -299,7 +299,7 @@ class CamProfile:
 
     def pressure_angle(self, theta: ArrayLike) -> Array:
         """Angle (rad, 0 to pi/2) between the contact normal and the path of the follower's contact point."""
-        th = np.atleast_1d(check_finite("theta", theta))
+        th = check_samples("theta", theta)
         x, N = self.outline(th)
         Nw = _rot(th, N)
         f = self.follower
@@ -316,7 +316,7 @@ class CamProfile:
     def face_position(self, theta: ArrayLike) -> Array:
         """Flat faces: the contact's position along the face (model units) from the face's reference point
         (translating: the axis, positive along ``J axis``; oscillating: the pivot's foot, positive along the arm)."""
-        th = np.atleast_1d(check_finite("theta", theta))
+        th = check_samples("theta", theta)
         x, _ = self.outline(th)
         xw = _rot(th, x)
         if self.follower.motion == "translating":
@@ -385,7 +385,7 @@ class CamProfile:
             self.__dict__["_cum"] = np.concatenate([[0.0], np.cumsum(self._gauss(edges[:-1], edges[1:]))])
         cum: Array = self.__dict__["_cum"]
         n = cum.shape[0] - 1
-        th = np.atleast_1d(check_finite("theta", theta))
+        th = check_samples("theta", theta)
         turns = np.floor(th / TWO_PI)
         t = th - turns * TWO_PI
         k = np.clip((t / TWO_PI * n).astype(np.intp), 0, n - 1)
@@ -419,11 +419,11 @@ class CamProfile:
     def check(self, max_pressure_angle: float, samples: int = 721, unit: str = "deg") -> CamReport:
         """Refuse (:class:`CamError`, one line naming the segment) an undercut, a cusp or a pressure angle
         over ``max_pressure_angle`` (rad); otherwise the worst figures."""
-        if not 0 < check_number("check(max_pressure_angle)", max_pressure_angle) < math.pi / 2:
+        if not 0 < check_number("check(max_pressure_angle)", max_pressure_angle) <= math.pi / 2:
             raise InputError("check(max_pressure_angle)", max_pressure_angle, "an angle between 0 and pi/2 rad")
         if not 2 <= check_number("check(samples)", samples, integer=True) <= 1 << 20:
             raise InputError("check(samples)", samples, "a whole number of samples per segment, 2 to 1 048 576")
-        if unit not in ("deg", "rad"):
+        if not isinstance(unit, str) or unit not in ("deg", "rad"):
             raise InputError("check(unit)", unit, "'deg' or 'rad'")
         prog = self.program
         segs: list[tuple[float, float]] = []

@@ -145,7 +145,7 @@ class Part:
     def __post_init__(self) -> None:
         _check_name("Part.name", self.name)
         where = f"Part {self.name!r}"
-        if isinstance(self.hull, (str, bytes)) or not (len(self.hull) or self.polygon is not None):
+        if not isinstance(self.hull, (tuple, list, np.ndarray)) or not (len(self.hull) or self.polygon is not None):
             raise InputError(f"{where}.hull", self.hull, "one or more circles (x, y, r) (or a polygon)")
         if not isinstance(self.ground, (bool, np.bool_)):
             raise InputError(f"{where}.ground", self.ground, "True or False")
@@ -158,9 +158,11 @@ class Part:
             poly = check_finite(f"{where}.polygon", self.polygon)
             if poly.ndim != 2 or poly.shape[1] != 2 or len(poly) < 3:
                 raise InputError(f"{where}.polygon", self.polygon, "three or more points (x, y)")
-        if self.plane not in ("xy", "xz", "yz"):
+        if not isinstance(self.plane, str) or self.plane not in ("xy", "xz", "yz"):
             raise InputError(f"{where}.plane", self.plane, "'xy', 'xz' or 'yz'")
-        check_finite(f"{where}.offset", self.offset)
+        check_number(f"{where}.offset", self.offset)
+        if not isinstance(self.features, (tuple, list)) or not all(isinstance(f, (Hole, Slot, ArcSlot)) for f in self.features):
+            raise InputError(f"{where}.features", self.features, "a tuple of Hole, Slot or ArcSlot")
 
     @cached_property
     def outline(self) -> shapely.Polygon:

@@ -96,6 +96,22 @@ class FabSettings:
     #: side of a reference square cut in a corner of each sheet (mm; 0: none), to measure the scale after cutting
     reference_square_mm: float = 0.0
 
+    def __post_init__(self) -> None:
+        from planar.core.fields import check_fields
+        from planar.errors import InputError
+
+        check_fields(self, "fabrication")
+        for f in ("unit_mm", "thickness_mm", "pin_mm"):
+            if not getattr(self, f) > 0:
+                raise InputError(f"fabrication.{f}", getattr(self, f), "a positive size in mm")
+        if not min(self.sheet) > 0:
+            raise InputError("fabrication.sheet", self.sheet, "a sheet (width, height) of positive sides in mm")
+        for name, value in vars(self).items():
+            if isinstance(value, float) and value < 0:
+                raise InputError(f"fabrication.{name}", value, "a size >= 0 in mm")
+        if self.colours not in COLOUR_PRESETS:
+            raise InputError("fabrication.colours", self.colours, "one of " + ", ".join(sorted(COLOUR_PRESETS)))
+
     def layer_colours(self) -> dict[str, str]:
         """``#rrggbb`` of each cut-file layer under the colour preset: ``"planar"`` (both cuts ``cut_colour``,
         engraving ``engrave_colour``) or ``"boxes"`` (Boxes.py's: outer cut black, inner cut blue, engrave green)."""
@@ -112,6 +128,15 @@ class FabSettings:
 
     @classmethod
     def from_spec(cls, fab: Any, kerf: float | None = None, sheet: tuple[float, float] | None = None) -> FabSettings:
+        from planar.core.fields import check_number, check_point
+        from planar.errors import InputError
+
+        if not all(hasattr(fab, f) for f in ("unit_mm", "thickness_mm", "kerf_mm", "sheet_mm")):
+            raise InputError("from_spec(fab)", fab, "a scene's fabrication table (scene.spec.fabrication)")
+        if kerf is not None:
+            check_number("kerf", kerf)
+        if sheet is not None:
+            sheet = check_point("sheet", sheet, "a sheet (width, height) in mm: two finite numbers")
         return cls(
             unit_mm=fab.unit_mm,
             thickness_mm=fab.thickness_mm,

@@ -71,8 +71,14 @@ class Link:
         from planar.core.model import _check_name
 
         _check_name("Link.name", self.name)
-        if isinstance(self.nodes, (str, bytes)) or not all(isinstance(n, str) for n in self.nodes):
+        nodes = self.nodes
+        if isinstance(nodes, (str, bytes)) or not isinstance(nodes, (tuple, list)) or not all(isinstance(n, str) for n in nodes):
             raise InputError(f"Link {self.name!r}.nodes", self.nodes, "a sequence of node names (('O', 'A'), not 'OA')")
+        guide = self.guide
+        if guide is not None and (
+            not isinstance(guide, (tuple, list)) or len(guide) != 2 or not all(isinstance(n, str) for n in guide)
+        ):
+            raise InputError(f"Link {self.name!r}.guide", guide, "two node names (p, q) the block slides along, or None")
 
 
 #: most steps of a lead-in (:meth:`Linkage._lead_in`)
