@@ -326,9 +326,17 @@ def burmester(poses: Array, max_ratio: float = 10.0, grid: int = 24, min_transmi
     angle from 0 and pi (a toggle) over the crank's sweep that the design's check
     ``ok_transmission`` accepts (:func:`check_motion`).
     """
-    poses = np.asarray(poses, float)
+    from planar.core.fields import check_finite, check_number
+
+    poses = check_finite("poses", poses)
     if poses.ndim != 2 or poses.shape[1] != 3 or not 3 <= len(poses) <= 5:
         raise InputError("poses", poses.shape, "3, 4 or 5 poses (x, y, angle)")
+    if not 1.0 <= check_number("max_ratio", max_ratio) <= 1e6:
+        raise InputError("max_ratio", max_ratio, "a longest-to-shortest link ratio from 1 to 1e6")
+    if not 2 <= check_number("grid", grid, integer=True) <= 4096:
+        raise InputError("grid", grid, "a whole number of grid points a side, 2 to 4096")
+    if not 0.0 <= check_number("min_transmission", min_transmission) < np.pi / 2:
+        raise InputError("min_transmission", min_transmission, "an angle from 0 to below pi/2 rad")
     L = _scale(poses)
     if len(poses) == 3:
         g = np.linspace(-2 * L, 2 * L, grid)
