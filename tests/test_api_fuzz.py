@@ -556,8 +556,8 @@ def _insane(result: Any, depth: int = 0) -> str | None:
         items = list(result)[:64]
         masks = [x for x in items if isinstance(x, np.ndarray) and x.dtype == bool]
         for x in items:
-            if masks and isinstance(x, np.ndarray) and x.dtype.kind == "f" and x.shape[:1] == masks[-1].shape[:1]:
-                x = x[masks[-1]]
+            if masks:  # values beside a validity mask: finite where it says valid (NaN may mark an invalid sample)
+                x = _at_valid(x, masks[-1])
             why = _insane(x, depth + 1)
             if why:
                 return why
@@ -571,6 +571,17 @@ def _insane(result: Any, depth: int = 0) -> str | None:
     if dataclasses.is_dataclass(result) and not isinstance(result, type):
         return _insane([getattr(result, f.name) for f in dataclasses.fields(result)], depth + 1)
     return None
+
+
+def _at_valid(x: Any, mask: np.ndarray) -> Any:
+    """``x`` (an array, a dict of arrays or a record of them) at the samples ``mask`` marks valid."""
+    if isinstance(x, np.ndarray) and x.dtype.kind == "f" and x.shape[:1] == mask.shape[:1]:
+        return x[mask]
+    if isinstance(x, dict):
+        return {k: _at_valid(v, mask) for k, v in x.items()}
+    if dataclasses.is_dataclass(x) and not isinstance(x, type):
+        return [_at_valid(getattr(x, f.name), mask) for f in dataclasses.fields(x)]
+    return x
 
 
 def judge(where: str, fn: Callable[..., Any], kwargs: dict[str, Any]) -> str | None:

@@ -103,7 +103,10 @@ def mechanism_rates(mech: Mechanism, q: ArrayLike, qd: ArrayLike = 1.0, qdd: Arr
     qa = check_samples("mechanism_rates(q)", q)
     qdv = np.broadcast_to(check_samples("mechanism_rates(qd)", qd, qa.shape[0]), qa.shape)
     qddv = np.broadcast_to(check_samples("mechanism_rates(qdd)", qdd, qa.shape[0]), qa.shape)
-    return mech.part_rates(qa, qdv, qddv)
+    parts, valid, method = mech.part_rates(qa, qdv, qddv)
+    for r in parts.values():  # a rate beyond float64 (a speed of 1e300) is no rate: invalid, not inf
+        valid = valid & np.isfinite(r.v).all(-1) & np.isfinite(r.a).all(-1) & np.isfinite(r.omega) & np.isfinite(r.alpha)
+    return parts, valid, method
 
 
 def rates_method(mech: Mechanism) -> str:

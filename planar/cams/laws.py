@@ -117,7 +117,7 @@ class Program:
             raise InputError(where, segments, "a list of Segment")
         if not all(isinstance(sg, Segment) for sg in segments):
             raise InputError(where, segments, "a list of Segment (cam.Segment(law, angle, lift))")
-        if not isinstance(where, str) or lift_unit not in ("", "deg", "rad"):
+        if not isinstance(where, str) or not isinstance(lift_unit, str) or lift_unit not in ("", "deg", "rad"):
             raise InputError("Program(where, lift_unit)", (where, lift_unit), "a string and '', 'deg' or 'rad'")
         self.segments = tuple(segments)
         self.where = where

@@ -75,7 +75,7 @@ def freudenstein_angles(
     theta3, verified against the circle-circle solution in the tests.
     """
     a, b, c, d = (check_positive(f"freudenstein_angles({k})", v) for k, v in zip("abcd", (a, b, c, d), strict=True))
-    if circuit not in ("open", "crossed"):
+    if not isinstance(circuit, str) or circuit not in ("open", "crossed"):
         raise InputError("freudenstein_angles(circuit)", circuit, "'open' or 'crossed'")
     th = check_finite("freudenstein_angles(theta)", theta)
     ct, st = np.cos(th), np.sin(th)
@@ -136,7 +136,7 @@ class FourBar(Linkage):
         b = check_positive(f"{name}.coupler", coupler)
         c = check_positive(f"{name}.rocker", rocker)
         d = check_positive(f"{name}.ground", ground)
-        if circuit not in ("open", "crossed"):
+        if not isinstance(circuit, str) or circuit not in ("open", "crossed"):
             raise InputError(f"{name}.circuit", circuit, "'open' or 'crossed'")
         self.dims = _Dims(a, b, c, d)
         self.circuit: Circuit = circuit

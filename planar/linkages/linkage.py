@@ -140,6 +140,7 @@ class Linkage(Mechanism):
         from planar.core.model import _check_name
 
         _check_name("Linkage.name", name)
+        _check_name(f"{name}.ground", ground)
         for arg, seq, cls in (("nodes", nodes, NodeKind), ("links", links, Link)):
             if isinstance(seq, (str, bytes)) or not hasattr(seq, "__iter__"):
                 raise InputError(f"{name}.{arg}", seq, f"a list of {cls.__name__} objects")
@@ -565,6 +566,8 @@ class Linkage(Mechanism):
         qa = check_samples(f"{where}(q)", q)
         qd = np.broadcast_to(check_samples(f"{where}(qdot)", qdot, qa.shape[0]), qa.shape)
         qdd = np.broadcast_to(check_samples(f"{where}(qddot)", qddot, qa.shape[0]), qa.shape)
+        if solved is not None and not (isinstance(solved, tuple) and len(solved) == 2 and isinstance(solved[0], dict)):
+            raise InputError(f"{where}(solved)", solved, "solve_nodes(q) of the same q (or None)")
         pos, checks = solved if solved is not None else self.solve_nodes(qa)
         valid = np.ones(qa.shape, bool)
         for m, _, _ in checks:
@@ -579,6 +582,7 @@ class Linkage(Mechanism):
             for mask in (ok, ok2):
                 if mask is not None:
                     valid &= mask
+            valid &= np.isfinite(v).all(-1) & np.isfinite(a).all(-1)  # a rate beyond float64 is no rate
         return pos, vel, acc, valid
 
     def link_rates(

@@ -237,6 +237,9 @@ def torque_line(t: dict[str, Any]) -> str:
 
 def format_comparison(c: Comparison) -> str:
     """A table for the terminal."""
+    from planar.core.fields import check_kind
+
+    check_kind("format_comparison(c)", c, Comparison, "a Comparison (compare_scene's first result)")
     lines = [
         f"{c.mechanism}: {c.samples} samples, size {c.size:.4g}, threshold {c.threshold:g} of size",
         f"  {'part':<16}{'max err':>11}{'rms err':>11}{'max/size':>11}{'max angle':>11}  first over",
@@ -341,6 +344,10 @@ def compare_scene(
     until the run holds or two budgets agree, within ``time_cap`` CPU seconds
     each).  Returns the comparison and the last kinematic simulation.
     """
+    from planar.core.fields import check_kind
+    from planar.scene.build import Scene as SceneKind
+
+    check_kind("scene", scene, SceneKind, "a Scene (planar.load_scene, or scene_from_mechanism)")
     from dataclasses import replace
 
     from planar.errors import PlanarError

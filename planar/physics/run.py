@@ -621,6 +621,10 @@ def simulate(
 
 def simulate_scene(scene: Scene, settings: SimSettings = DEFAULT_SETTINGS, mode: str | None = None) -> SimResult:
     """Simulate a scene over its cycles with its effects (kinematic driver unless a motor limit is named)."""
+    from planar.core.fields import check_kind
+    from planar.scene.build import Scene as SceneKind
+
+    check_kind("scene", scene, SceneKind, "a Scene (planar.load_scene, or scene_from_mechanism)")
     e = scene.effects
     if mode is None:
         mode = "motor" if e.motor_force_limit is not None else "kinematic"

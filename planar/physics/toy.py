@@ -138,6 +138,10 @@ def simulate_toy(
     follower's plane.  A stage that cannot be simulated is reported with the
     reason.
     """
+    from planar.core.fields import check_kind
+    from planar.windup.chain import ToyMechanism
+
+    check_kind("simulate_toy(toy)", toy, ToyMechanism, "a ToyMechanism (planar.windup.chain)")
     from planar.analysis.dynamics import gravity_and_damping, plane_gravity
     from planar.physics.simulate import SimSettings, torque_comparison
 

@@ -113,6 +113,8 @@ class Scene:
         from planar.fileio import check_output
         from planar.scene.write import write_scene
 
+        if path is None:
+            raise InputError("path", None, "a file name ending in .toml")
         check_output("path", path, (".toml",))  # TOML never goes into s.csv
         write_scene(self.spec, path)
 

@@ -261,6 +261,8 @@ def write_scene(spec: SceneSpec, path: str | os.PathLike[str]) -> None:
     """Write ``spec`` to ``path`` as a scene file (atomically; ``planar.scene.load.load_scene`` reads it back)."""
     from planar.fileio import atomic_write, check_output
 
+    if path is None:
+        raise InputError("path", None, "a file name ending in .toml")
     check_output("path", path, (".toml",))  # TOML never goes into s.csv
     text = scene_toml(spec)
     with atomic_write(path, "w") as fh:
