@@ -117,7 +117,9 @@ FIGURE_BYTES = 128 * 2**20
 
 def _motion(scene: Scene, samples_per_cycle: int | None) -> Motion:
     """The scene's motion, over its own cycles or duration, at ``samples_per_cycle`` (default: the scene's)."""
-    if samples_per_cycle is not None and samples_per_cycle < 4:
+    if samples_per_cycle is not None and (
+        isinstance(samples_per_cycle, bool) or not isinstance(samples_per_cycle, int) or samples_per_cycle < 4
+    ):
         raise InputError("--samples", samples_per_cycle, "at least 4 samples per cycle")
     d = scene.spec.driver
     drv = scene.mechanism.driver

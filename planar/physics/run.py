@@ -15,7 +15,7 @@ from planar.analysis.dynamics import inverse_dynamics_torque
 from planar.core.effects import Effects
 from planar.core.geometry import poses_apply, wrap_angle
 from planar.core.model import Mechanism, Motion, joint_residuals
-from planar.errors import PlanarError
+from planar.errors import InputError, PlanarError
 from planar.physics.cycle import check_cycle
 from planar.physics.rebuild import _JACC, _motor_impulse_offset, _Rebuild
 from planar.physics.settings import (
@@ -653,6 +653,11 @@ def torque_comparison(
     failure are compared.  ``saturated`` lists the samples where the motor
     reached ``effects.motor_force_limit``.
     """
+    from planar.core.fields import check_samples
+
+    t = check_samples("torque_comparison(t)", t)
+    if len(t) < 2:
+        raise InputError("torque_comparison(t)", t, "two or more sample times (s)")
     t = np.asarray(t, float)
     dt = float(t[1] - t[0])
     # one sample of lead-in, so that the first compared interval starts with settled joint forces
