@@ -265,6 +265,8 @@ def check_output(
     """
     if path is None:
         return
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError(option, path, "a file name (a string or a pathlib.Path)")
     text = str(path)
     if not text.strip():
         raise InputError(option, text, "a file name (got an empty one)")

@@ -35,6 +35,7 @@ from numpy.typing import ArrayLike, NDArray
 from planar.core.geometry import poses_apply
 from planar.core.model import Mechanism, Motion
 from planar.core.rates import PartRates, point_rates
+from planar.errors import InputError
 
 __all__ = [
     "gravity_and_damping",
@@ -101,6 +102,12 @@ def mass_properties(part: Any, density: float) -> tuple[float, tuple[float, floa
     """
     from shapely.geometry.polygon import orient
 
+    from planar.core.fields import check_kind, check_number
+    from planar.core.model import Part
+
+    check_kind("mass_properties(part)", part, Part)
+    if check_number("mass_properties(density)", density) < 0:  # 0: a massless part
+        raise InputError("mass_properties(density)", density, "a density >= 0")
     poly = orient(part.outline, sign=1.0)  # exterior counter-clockwise, holes clockwise: signed sums
     rings = [np.asarray(poly.exterior.coords)[:-1]] + [np.asarray(r.coords)[:-1] for r in poly.interiors]
     A = Sx = Sy = J = 0.0
@@ -149,7 +156,19 @@ def inverse_dynamics_torque(
     the density per part; ``t_rest``: the time at which a spring with no
     rest length has its rest length (default ``t[0]``, as the rebuild does).
     """
-    t = np.asarray(t, float)
+    from planar.core.fields import check_kind, check_number, check_samples
+    from planar.core.model import Mechanism
+
+    check_kind("inverse_dynamics_torque(mech)", mech, Mechanism)
+    t = check_samples("inverse_dynamics_torque(t)", t)
+    if effects is not None and not all(hasattr(effects, a) for a in ("gravity", "loads", "springs", "damping", "density")):
+        raise InputError(
+            "inverse_dynamics_torque(effects)", effects, "an Effects (gravity, loads, springs, damping, density) or None"
+        )
+    if densities is not None:
+        check_kind("inverse_dynamics_torque(densities)", densities, dict, "a dict of part name to density")
+    if t_rest is not None:
+        check_number("inverse_dynamics_torque(t_rest)", t_rest)
     drv = mech.driver
     w = float(drv.rate)
     h = 1e-4 * drv.period

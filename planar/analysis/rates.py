@@ -96,10 +96,17 @@ def mechanism_rates(mech: Mechanism, q: ArrayLike, qd: ArrayLike = 1.0, qdd: Arr
     a kind with no closed-form rates raises
     :class:`~planar.core.registry.UnsupportedError` naming it (never a difference).
     """
-    qa = np.atleast_1d(np.asarray(q, float))
-    qdv = np.broadcast_to(np.asarray(qd, float), qa.shape)
-    qddv = np.broadcast_to(np.asarray(qdd, float), qa.shape)
-    return mech.part_rates(qa, qdv, qddv)
+    from planar.core.fields import check_kind, check_samples
+    from planar.core.model import Mechanism
+
+    check_kind("mechanism_rates(mech)", mech, Mechanism)
+    qa = check_samples("mechanism_rates(q)", q)
+    qdv = np.broadcast_to(check_samples("mechanism_rates(qd)", qd, qa.shape[0]), qa.shape)
+    qddv = np.broadcast_to(check_samples("mechanism_rates(qdd)", qdd, qa.shape[0]), qa.shape)
+    parts, valid, method = mech.part_rates(qa, qdv, qddv)
+    for r in parts.values():  # a rate beyond float64 (a speed of 1e300) is no rate: invalid, not inf
+        valid = valid & np.isfinite(r.v).all(-1) & np.isfinite(r.a).all(-1) & np.isfinite(r.omega) & np.isfinite(r.alpha)
+    return parts, valid, method
 
 
 def rates_method(mech: Mechanism) -> str:
@@ -116,8 +123,12 @@ def transmission_angles(mech: Mechanism, q: ArrayLike) -> dict[str, Array]:
     the linkage toggles.  Only dyads whose two links are different parts (a
     node fixed on a ternary link has none).  Empty for mechanisms without dyads.
     """
+    from planar.core.fields import check_kind, check_samples
+    from planar.core.model import Mechanism
     from planar.linkages import Linkage
 
+    check_kind("transmission_angles(mech)", mech, Mechanism)
+    qa = check_samples("transmission_angles(q)", q)
     if not isinstance(mech, Linkage):
         return {}
     # the node kinds that join two links at a transmitting angle; a node whose links are one part (a node on
@@ -125,13 +136,21 @@ def transmission_angles(mech: Mechanism, q: ArrayLike) -> dict[str, Array]:
     nodes = [n for n in mech.nodes if n.transmits and not any({n.name, *n.refs()} <= set(lk.nodes) for lk in mech.links)]
     if not nodes:
         return {}
-    pos, _ = _node_solve(mech, np.atleast_1d(np.asarray(q, float)))
+    pos, _ = _node_solve(mech, qa)
     angles = {n.name: n.transmission(pos) for n in nodes}
     return {k: v for k, v in angles.items() if v is not None}
 
 
 def motion_derivatives(mech: Mechanism, motion: Motion) -> Derivatives:
     """Rates of a solved motion whose sample times ``motion.t`` are set (the driver's law gives the rates)."""
+    from planar.core.fields import check_kind
+    from planar.core.model import Mechanism
+    from planar.core.model import Motion as MotionKind
+
+    check_kind("motion_derivatives(mech)", mech, Mechanism)
+    check_kind("motion_derivatives(motion)", motion, MotionKind, "a Motion (from mech.solve or mech.run)")
+    if len(motion.poses) and set(motion.poses) != {p.name for p in mech.parts}:
+        raise InputError("motion_derivatives(motion)", motion, f"a motion of {mech.name!r}'s parts")
     if motion.t is None:
         raise InputError(f"{mech.name}.motion.t", None, "sample times (solve with t=..., or Mechanism.run)")
     qd, qdd = driver_rates(mech.driver, motion.t)

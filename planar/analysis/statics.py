@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from planar.core.fields import check_finite, check_kind, check_number, check_samples
 from planar.errors import InputError
 
 if TYPE_CHECKING:
@@ -93,8 +94,9 @@ def fourbar_velocities(fb: FourBar, theta: ArrayLike, omega2: ArrayLike = 1.0) -
     (coupler and rocker in line) or where a result is not finite; invalid
     samples hold 0.
     """
-    th2 = np.atleast_1d(np.asarray(theta, float))
-    w2 = np.broadcast_to(np.asarray(omega2, float), th2.shape)
+    _check_fourbar("fourbar_velocities(fb)", fb)
+    th2 = check_samples("fourbar_velocities(theta)", theta)
+    w2 = np.broadcast_to(check_samples("fourbar_velocities(omega2)", omega2, th2.shape[0]), th2.shape)
     th3, th4, ok = fb.angles(th2)
     g = fb.dims
     b, c = g.b / g.a, g.c / g.a  # scale-free: lengths in crank lengths
@@ -164,6 +166,7 @@ def node_velocities(link: Linkage, q: ArrayLike, qdot: ArrayLike = 1.0) -> tuple
     samples hold 0.  Velocities are in the linkage's own frame before
     placement; rotate them by ``placement[2]`` for the world.
     """
+    _check_linkage("node_velocities(link)", link)
     vel, valid = link.node_velocities(q, qdot)
     ok = np.asarray(valid, bool) & _dyad_mask(link, q)
     for v in vel.values():
@@ -191,6 +194,7 @@ def _dyad_mask(link: Linkage, q: ArrayLike) -> NDArray[np.bool_]:
 
 def point_velocities(link: Linkage, q: ArrayLike, qdot: ArrayLike = 1.0) -> tuple[dict[str, Array], NDArray[np.bool_]]:
     """World velocities ``(N, 2)`` of the linkage's named points (placement applied)."""
+    _check_linkage("point_velocities(link)", link)
     vel, valid = node_velocities(link, q, qdot)
     ang = link.placement[2]
     c, s = np.cos(ang), np.sin(ang)
@@ -227,7 +231,14 @@ def instant_centre(p1: ArrayLike, v1: ArrayLike, p2: ArrayLike, v2: ArrayLike) -
     ``v1 = omega perp(p1 - centre)``.  ``valid`` is false where the normals
     are parallel (the body translates: centre at infinity, ``omega = 0``).
     """
-    p1, v1, p2, v2 = (np.asarray(a, float) for a in (p1, v1, p2, v2))
+    p1, v1, p2, v2 = (
+        check_finite(f"instant_centre({k})", a) for k, a in zip(("p1", "v1", "p2", "v2"), (p1, v1, p2, v2), strict=True)
+    )
+    if p1.shape[-1:] != (2,) or not p1.shape == v1.shape == p2.shape == v2.shape:
+        shapes = ", ".join(str(a.shape) for a in (p1, v1, p2, v2))
+        raise InputError(
+            "instant_centre(p1, v1, p2, v2)", f"arrays of shapes {shapes}", "points and velocities of one shape (..., 2)"
+        )
     n1, n2 = _perp(v1), _perp(v2)  # directions of the normals
     den = _cross(n1, n2)
     scale = np.hypot(*n1.T) * np.hypot(*n2.T)
@@ -236,7 +247,8 @@ def instant_centre(p1: ArrayLike, v1: ArrayLike, p2: ArrayLike, v2: ArrayLike) -
     centre = p1 + s[..., None] * n1
     r1 = p1 - centre
     omega = np.where(ok, _cross(r1, v1) / np.maximum((r1 * r1).sum(-1), np.finfo(float).tiny), 0.0)
-    return centre, omega, ok
+    ok = ok & np.isfinite(centre).all(-1) & np.isfinite(omega)  # beyond float64: no centre
+    return np.where(ok[..., None], centre, 0.0), np.where(ok, omega, 0.0), ok
 
 
 def velocity_about_centre(point: ArrayLike, centre: ArrayLike, omega: ArrayLike) -> Array:
@@ -254,7 +266,9 @@ def fourbar_instant_centre(fb: FourBar, theta: ArrayLike, omega2: float = 1.0) -
     translates: ``omega = 0``, centre at infinity).  ``omega`` is 0 where
     invalid.
     """
-    th = np.atleast_1d(np.asarray(theta, float))
+    _check_fourbar("fourbar_instant_centre(fb)", fb)
+    th = check_samples("fourbar_instant_centre(theta)", theta)
+    omega2 = check_number("fourbar_instant_centre(omega2)", omega2)
     pos, _ = fb.solve_nodes(th)
     B, C, O2, O4 = pos["B"], pos["C"], pos["O2"], pos["O4"]
     vB = omega2 * _perp(B - O2)
@@ -343,19 +357,27 @@ def virtual_work_torque(
     torque is valid where its sample and both neighbours of the difference
     are valid and it is finite (0 where not).
     """
-    P = np.asarray(points, float)
-    qa = np.asarray(q, float)
+    P = check_finite("virtual_work_torque(points)", points)
+    qa = check_finite("virtual_work_torque(q)", q)
+    if not isinstance(periodic, (bool, np.bool_)):
+        raise InputError("virtual_work_torque(periodic)", periodic, "True or False")
     if P.ndim != 3 or P.shape[-1] != 2 or qa.shape != P.shape[:1] or len(qa) < 3:
         raise InputError("points, q", f"arrays of shapes {P.shape}, {qa.shape}", "points (N, k, 2) and q (N,) with N >= 3")
-    f = np.asarray(forces, float)
-    if not np.isfinite(f).all():
-        raise InputError("forces", f, "finite forces")
+    f = check_finite("virtual_work_torque(forces)", forces)
+    try:
+        np.broadcast_shapes(f.shape, P.shape)
+    except ValueError:
+        raise InputError(
+            "virtual_work_torque(forces)", f"an array of shape {f.shape}", f"forces of a shape that fits points {P.shape}"
+        ) from None
     dq = float(qa[1] - qa[0])
     if not (np.isfinite(dq) and dq != 0):
         raise InputError("q", qa, "evenly spaced, distinct driver values")
     dX = finite_difference(P, dq, periodic)
     f = np.broadcast_to(f, P.shape)
     tau = (dX * f).sum(axis=(-1, -2))
+    if valid is not None and (np.asarray(valid).dtype != bool or np.shape(valid) != qa.shape):
+        raise InputError("virtual_work_torque(valid)", valid, f"truth values, one per driver value ({len(qa)})")
     ok = np.ones(len(qa), bool) if valid is None else np.asarray(valid, bool).copy()
     ok &= np.isfinite(P).all(axis=(-1, -2))
     if periodic:
@@ -443,9 +465,14 @@ def static_foot_loads(weight: float, com_x: ArrayLike, foot_x: ArrayLike, contac
     ``stable`` is false where the centre of mass is outside the feet's span
     (the balance needs a negative, pulling foot) or no foot touches.
     """
-    fx = np.atleast_2d(np.asarray(foot_x, float))
+    weight = check_number("static_foot_loads(weight)", weight)
+    fx = np.atleast_2d(check_finite("static_foot_loads(foot_x)", foot_x))
+    if fx.ndim != 2:
+        raise InputError("static_foot_loads(foot_x)", f"an array of shape {fx.shape}", "foot positions (N, k)")
+    if np.asarray(contact).dtype != bool or np.atleast_2d(contact).shape != fx.shape:
+        raise InputError("static_foot_loads(contact)", contact, f"truth values of foot_x's shape {fx.shape}")
     on = np.atleast_2d(np.asarray(contact, bool))
-    xc = np.broadcast_to(np.asarray(com_x, float), fx.shape[:1])
+    xc = np.broadcast_to(check_samples("static_foot_loads(com_x)", com_x, fx.shape[0]), fx.shape[:1])
     n, k = fx.shape
     A = np.zeros((n, 2, k))
     A[:, 0, :] = on
@@ -495,3 +522,15 @@ def friction_limit(f_t: ArrayLike, f_n: ArrayLike, mu: float) -> tuple[Array, ND
     ft = np.asarray(f_t, float)
     cap = mu * np.maximum(np.asarray(f_n, float), 0.0)
     return np.clip(ft, -cap, cap), np.abs(ft) > cap
+
+
+def _check_fourbar(field: str, fb: object) -> None:
+    from planar.linkages.fourbar import FourBar
+
+    check_kind(field, fb, FourBar)
+
+
+def _check_linkage(field: str, link: object) -> None:
+    from planar.linkages.linkage import Linkage
+
+    check_kind(field, link, Linkage)

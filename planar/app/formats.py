@@ -44,7 +44,7 @@ def writer(suffix: str) -> ModuleType:
     InputError
         For a suffix no writer is registered for, naming it and the known ones.
     """
-    key = suffix.lower().lstrip(".")
+    key = suffix.lower().lstrip(".") if isinstance(suffix, str) else None
     if key not in FORMATS:
         raise InputError("format", suffix, "one of " + ", ".join(suffixes()))
     return importlib.import_module(FORMATS[key][0])

@@ -17,6 +17,25 @@ from typing import TYPE_CHECKING, Any
 
 from planar.errors import InputError
 
+
+def _check_scene(field: str, scene: object) -> None:
+    """:class:`InputError` unless ``scene`` is a :class:`~planar.scene.build.Scene` (``load_scene``'s)."""
+    from planar.core.fields import check_kind
+    from planar.scene.build import Scene as SceneKind
+
+    check_kind(field, scene, SceneKind, "a Scene (planar.load_scene, or scene_from_mechanism)")
+
+
+def _check_path(field: str, path: object) -> None:
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError(field, path, "a file name (a string or a pathlib.Path)")
+
+
+def _check_flag(field: str, value: object) -> None:
+    if not isinstance(value, bool):
+        raise InputError(field, value, "True or False")
+
+
 if TYPE_CHECKING:
     from planar.core.model import Mechanism, Motion
     from planar.draw.frames import Style
@@ -166,6 +185,17 @@ def render_scene(
     from planar.draw.timing import animation_motion, resample
     from planar.errors import InputError
 
+    _check_scene("scene", scene)
+    _check_path("out", out)
+    _check_flag("progress", progress)
+    from planar.core.model import Motion as MotionKind
+
+    if overlay is not None and not isinstance(overlay, MotionKind):
+        raise InputError("overlay", overlay, "a Motion with sample times (a simulated run), or None")
+    if fps is not None:
+        from planar.core.fields import check_number
+
+        check_number("fps", fps)
     suffix = Path(out).suffix.lower()
     if suffix not in ANIMATION_SUFFIXES:
         raise InputError("-o", str(out), f"an animation file ending in {', '.join(ANIMATION_SUFFIXES)}")
@@ -311,6 +341,9 @@ def write_scene_motion(scene: Scene, out: str | Path, derivatives: bool = False,
     """
     from planar.fileio import write_motion_csv
 
+    _check_scene("scene", scene)
+    _check_path("out", out)
+    _check_flag("derivatives", derivatives)
     if Path(out).suffix.lower() != ".csv":
         raise InputError("out", str(out), "a .csv file (the motion table is CSV)")
     mech, motion = table_motion(scene.mechanism, scene.motion(), notes=notes)
@@ -388,10 +421,16 @@ def export_scene(
     renamed only when all succeeded.
     """
     from planar.app.export import write_outputs
+    from planar.core.fields import check_number, check_point
     from planar.fabrication.build import build
     from planar.fabrication.parts import FabSettings
     from planar.fileio import check_output
 
+    _check_scene("scene", scene)
+    if kerf is not None:
+        check_number("kerf", kerf)
+    if sheet is not None:
+        sheet = check_point("sheet", sheet, "a sheet (width, height) in mm: two finite numbers")
     for arg, path, ends in (
         ("dxf", dxf, (".dxf",)),
         ("svg", svg, (".svg",)),
@@ -448,6 +487,7 @@ def compare_scene(
     """
     from planar.physics.compare import compare_scene as _compare_scene
 
+    _check_scene("scene", scene)
     return _compare_scene(scene, settings, threshold, torque_threshold, with_series, motor, time_cap)
 
 
@@ -549,6 +589,7 @@ def run_demo(output: str | Path) -> Iterator[str]:
     from planar.linkages import Linkage
     from planar.scene.load import build_scene, parse_scene
 
+    _check_path("output", output)
     out = Path(output)
     out.mkdir(parents=True, exist_ok=True)
     for name, data in DEMO_SCENES.items():

@@ -27,5 +27,9 @@ BENCHMARKS: dict[str, str] = {
 
 def benchmark(name: str) -> tuple[Callable[..., dict[str, Any]], Callable[[dict[str, Any]], str]]:
     """The ``(run, format)`` functions of benchmark ``name``, imported now."""
+    if not isinstance(name, str) or name not in BENCHMARKS:
+        from planar.errors import InputError
+
+        raise InputError("benchmark", name, "one of " + ", ".join(BENCHMARKS))
     mod = importlib.import_module(BENCHMARKS[name])
     return getattr(mod, f"bench_{name}"), getattr(mod, f"format_{name}")

@@ -10,8 +10,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planar.cams.profile import CamProfile
+from planar.core.fields import check_kind
 from planar.core.geometry import poses_apply
-from planar.core.model import Feature, joint_kind
+from planar.core.model import Feature, _check_joint, joint_kind
 
 __all__ = ["CamContact"]
 
@@ -41,6 +42,10 @@ class CamContact:
     profile: CamProfile
     point: Vec
     normal: Vec = (0.0, 1.0)
+
+    def __post_init__(self) -> None:
+        _check_joint(self, ("point", "normal"), None)
+        check_kind(f"CamContact {self.name!r}.profile", self.profile, CamProfile)
 
     def residual(self, poses: Mapping[str, Array]) -> Array:
         cam = np.atleast_2d(poses[self.a])

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from planar.core.fields import check_fields, check_finite, check_number
 from planar.errors import InputError
 
 __all__ = ["LAWS", "Law", "Program", "Segment"]
@@ -83,14 +84,26 @@ class Segment:
     angle: float
     lift: float = 0.0
 
+    def __post_init__(self) -> None:
+        if not isinstance(self.law, str) or self.law not in LAWS:
+            raise InputError("Segment.law", self.law, f"one of {sorted(LAWS)}")
+        check_fields(self, "Segment")
+
     def describe(self, start: float, unit: str = "deg") -> str:
         """``"cycloidal rise of 0.5 over 0-120 deg"``: what a message names (``start`` in rad)."""
+        check_number("Segment.describe(start)", start)
+        _check_unit(unit)
         what = "dwell" if self.law == "dwell" else f"{self.law} {'rise' if self.lift > 0 else 'return'}"
         if unit == "deg":
             span = f"{math.degrees(start):.4g}-{math.degrees(start + self.angle):.4g} deg"
         else:
             span = f"{start:.4g}-{start + self.angle:.4g} rad"
         return f"{what} over {span}"
+
+
+def _check_unit(unit: object) -> None:
+    if not isinstance(unit, str) or unit not in ("deg", "rad"):
+        raise InputError("unit", unit, "'deg' or 'rad'")
 
 
 class Program:
@@ -100,6 +113,12 @@ class Program:
     """
 
     def __init__(self, segments: list[Segment] | tuple[Segment, ...], where: str = "segments", lift_unit: str = "") -> None:
+        if isinstance(segments, (str, bytes)) or not isinstance(segments, (list, tuple)):
+            raise InputError(where, segments, "a list of Segment")
+        if not all(isinstance(sg, Segment) for sg in segments):
+            raise InputError(where, segments, "a list of Segment (cam.Segment(law, angle, lift))")
+        if not isinstance(where, str) or not isinstance(lift_unit, str) or lift_unit not in ("", "deg", "rad"):
+            raise InputError("Program(where, lift_unit)", (where, lift_unit), "a string and '', 'deg' or 'rad'")
         self.segments = tuple(segments)
         self.where = where
         #: how a lift is shown in a message: ``"deg"`` for an oscillating follower's lift given in degrees
@@ -154,7 +173,7 @@ class Program:
     @staticmethod
     def _wrap(theta: ArrayLike) -> Array:
         """Cam angles in ``[0, 2 pi)`` (``np.mod`` of a tiny negative angle rounds to ``2 pi`` itself)."""
-        t = np.mod(np.asarray(theta, float), TWO_PI)
+        t = np.mod(check_finite("theta", theta), TWO_PI)
         return np.where(t >= TWO_PI, 0.0, t)
 
     def segment_of(self, theta: ArrayLike) -> NDArray[np.intp]:
@@ -182,4 +201,6 @@ class Program:
 
     def describe(self, i: int, unit: str = "deg") -> str:
         """``"mechanism.segments[1] (cycloidal rise over 120-240 deg)"``."""
+        if not -len(self.segments) <= check_number("Program.describe(i)", i, integer=True) < len(self.segments):
+            raise InputError("Program.describe(i)", i, f"a segment's index, 0 to {len(self.segments) - 1}")
         return f"{self.where}[{i}] ({self.segments[i].describe(float(self.starts[i]), unit)})"

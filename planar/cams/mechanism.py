@@ -68,6 +68,16 @@ class CamMechanism(Mechanism):
         unit: str = "deg",
         width: float | None = None,
     ) -> None:
+        from planar.core.fields import _check_name, check_kind, check_number
+
+        _check_name("CamMechanism.name", name)
+        check_kind("CamMechanism(profile)", profile, CamProfile)
+        check_number("CamMechanism(max_pressure_angle)", max_pressure_angle)
+        if not isinstance(unit, str) or unit not in ("deg", "rad"):
+            raise InputError("CamMechanism(unit)", unit, "'deg' or 'rad' (how angles are shown in messages)")
+        for arg, items in (("nodes", nodes), ("links", links)):
+            if isinstance(items, (str, bytes)) or not isinstance(items, Sequence):
+                raise InputError(f"CamMechanism({arg})", items, f"a sequence of {'node kinds' if arg == 'nodes' else 'Link'}")
         self.profile = profile
         self._width = width
         self._unit = unit
@@ -278,7 +288,9 @@ class CamMechanism(Mechanism):
 
     def follower_motion(self, q: Array) -> dict[str, Array]:
         """The follower's coordinate (lift or arm angle) and its first two derivatives in time (driver law)."""
-        qa = np.asarray(q, float)
+        from planar.core.fields import check_samples
+
+        qa = check_samples(f"{self.name}.follower_motion(q)", q)
         s, v, a = self.profile.follower_output(qa)
         w = self.driver.rate
         return {"q": s, "dq_dt": v * w, "d2q_dt2": a * w * w}

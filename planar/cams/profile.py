@@ -40,6 +40,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from planar.cams.laws import TWO_PI, Program
+from planar.core.fields import check_fields, check_number, check_positive, check_samples
 from planar.errors import InputError, PlanarError
 
 __all__ = ["CamError", "CamProfile", "CamReport", "FollowerGeometry"]
@@ -98,6 +99,18 @@ class FollowerGeometry:
     face_offset: float = 0.0
     branch: int = 1
 
+    def __post_init__(self) -> None:
+        if not isinstance(self.kind, str) or self.kind not in ("knife", "roller", "flat"):
+            raise InputError("follower.kind", self.kind, "'knife', 'roller' or 'flat'")
+        if not isinstance(self.motion, str) or self.motion not in ("translating", "oscillating"):
+            raise InputError("follower.motion", self.motion, "'translating' or 'oscillating'")
+        check_fields(self, "follower")
+        if self.branch not in (1, -1):
+            raise InputError("follower.branch", self.branch, "+1 or -1")
+        if self.roller_radius < 0 or self.arm < 0:
+            bad = "roller_radius" if self.roller_radius < 0 else "arm"
+            raise InputError(f"follower.{bad}", getattr(self, bad), "a length >= 0")
+
 
 @dataclass
 class CamReport:
@@ -128,11 +141,14 @@ class CamProfile:
     """
 
     def __init__(self, program: Program, base_radius: float, follower: FollowerGeometry, where: str = "mechanism") -> None:
+        if not isinstance(program, Program):
+            raise InputError(f"{where}.program", program, "a cams.Program")
+        if not isinstance(follower, FollowerGeometry):
+            raise InputError(f"{where}.follower", follower, "a cams.FollowerGeometry")
         self.program = program
         self.follower = f = follower
         self.where = where
-        if not (math.isfinite(base_radius) and base_radius > 0):
-            raise InputError(f"{where}.base_radius", base_radius, "a positive length")
+        check_positive(f"{where}.base_radius", base_radius)
         self.base_radius = rb = float(base_radius)
         fw = f"{where}.follower"
         if f.kind not in ("knife", "roller", "flat"):
@@ -203,7 +219,7 @@ class CamProfile:
     def follower_point(self, theta: ArrayLike) -> tuple[Array, Array, Array]:
         """World position ``W`` (N, 2) of the knife tip / roller centre (flat: the face's reference point:
         on the axis, or ``arm`` along the arm) and ``dW/dtheta``, ``d2W/dtheta2``."""
-        th = np.atleast_1d(np.asarray(theta, float))
+        th = check_samples("theta", theta)
         q, q1, q2 = self.follower_output(th)
         f = self.follower
         if f.motion == "translating":
@@ -219,7 +235,7 @@ class CamProfile:
     # ------------------------------------------------------------------ knife and roller
     def pitch(self, theta: ArrayLike) -> tuple[Array, Array, Array]:
         """The pitch curve ``P`` in the cam's frame and ``dP/dtheta``, ``d2P/dtheta2`` (knife, roller)."""
-        th = np.atleast_1d(np.asarray(theta, float))
+        th = check_samples("theta", theta)
         W, W1, W2 = self.follower_point(th)
         P = _rot(-th, W)
         P1 = _rot(-th, W1 - _J(W))
@@ -230,7 +246,7 @@ class CamProfile:
     def face(self, theta: ArrayLike) -> dict[str, Array]:
         """The face line in the cam's frame: normal angle ``beta`` (away from the cam) and its
         distance ``h`` from the cam's centre, with derivatives in ``theta`` (flat faces)."""
-        th = np.atleast_1d(np.asarray(theta, float))
+        th = check_samples("theta", theta)
         q, q1, q2 = self.follower_output(th)
         f = self.follower
         if f.motion == "translating":
@@ -283,7 +299,7 @@ class CamProfile:
 
     def pressure_angle(self, theta: ArrayLike) -> Array:
         """Angle (rad, 0 to pi/2) between the contact normal and the path of the follower's contact point."""
-        th = np.atleast_1d(np.asarray(theta, float))
+        th = check_samples("theta", theta)
         x, N = self.outline(th)
         Nw = _rot(th, N)
         f = self.follower
@@ -300,7 +316,7 @@ class CamProfile:
     def face_position(self, theta: ArrayLike) -> Array:
         """Flat faces: the contact's position along the face (model units) from the face's reference point
         (translating: the axis, positive along ``J axis``; oscillating: the pivot's foot, positive along the arm)."""
-        th = np.atleast_1d(np.asarray(theta, float))
+        th = check_samples("theta", theta)
         x, _ = self.outline(th)
         xw = _rot(th, x)
         if self.follower.motion == "translating":
@@ -313,7 +329,9 @@ class CamProfile:
         """The closed outline as a counter-clockwise polygon ``(M, 2)`` (cam frame, no repeated end point)
         whose chords stay within ``sag`` (default 1e-5 of the base radius) of the exact curve where they can
         (at most ``n_max`` points); returns the polygon and the largest sag estimated."""
-        tol = 1e-5 * self.base_radius if sag is None else sag
+        tol = 1e-5 * self.base_radius if sag is None else check_positive("outline_polygon(sag)", sag)
+        if not 16 <= check_number("outline_polygon(n_max)", n_max, integer=True) <= 1 << 24:
+            raise InputError("outline_polygon(n_max)", n_max, "a whole number of points, 16 to 16 777 216")
         n = 1024
         while True:
             th = self._grid(n)
@@ -360,12 +378,14 @@ class CamProfile:
         Gauss-Legendre over ``cells`` equal cells per turn, cumulated once, plus the part cell up to
         ``theta``; a whole turn adds the pitch curve's length.
         """
+        if not 1 <= check_number("pitch_length(cells)", cells, integer=True) <= 1 << 22:
+            raise InputError("pitch_length(cells)", cells, "a whole number of cells, 1 to 4 194 304")
         if "_cum" not in self.__dict__:
             edges = np.linspace(0.0, TWO_PI, cells + 1)
             self.__dict__["_cum"] = np.concatenate([[0.0], np.cumsum(self._gauss(edges[:-1], edges[1:]))])
         cum: Array = self.__dict__["_cum"]
         n = cum.shape[0] - 1
-        th = np.atleast_1d(np.asarray(theta, float))
+        th = check_samples("theta", theta)
         turns = np.floor(th / TWO_PI)
         t = th - turns * TWO_PI
         k = np.clip((t / TWO_PI * n).astype(np.intp), 0, n - 1)
@@ -399,6 +419,12 @@ class CamProfile:
     def check(self, max_pressure_angle: float, samples: int = 721, unit: str = "deg") -> CamReport:
         """Refuse (:class:`CamError`, one line naming the segment) an undercut, a cusp or a pressure angle
         over ``max_pressure_angle`` (rad); otherwise the worst figures."""
+        if not 0 < check_number("check(max_pressure_angle)", max_pressure_angle) <= math.pi / 2:
+            raise InputError("check(max_pressure_angle)", max_pressure_angle, "an angle between 0 and pi/2 rad")
+        if not 2 <= check_number("check(samples)", samples, integer=True) <= 1 << 20:
+            raise InputError("check(samples)", samples, "a whole number of samples per segment, 2 to 1 048 576")
+        if not isinstance(unit, str) or unit not in ("deg", "rad"):
+            raise InputError("check(unit)", unit, "'deg' or 'rad'")
         prog = self.program
         segs: list[tuple[float, float]] = []
         worst_p = (-1.0, 0.0, 0)

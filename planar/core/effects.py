@@ -10,6 +10,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from planar.core.fields import _check_name, check_fields, check_positive
+from planar.errors import InputError
+
 __all__ = ["NO_EFFECTS", "Effects", "Load", "Spring"]
 
 Vec = tuple[float, float]
@@ -30,6 +33,16 @@ class Spring:
     rest_length: float | None = None
     damping: float = 0.0
 
+    def __post_init__(self) -> None:
+        _check_name("Spring.a", self.a)
+        _check_name("Spring.b", self.b)
+        check_fields(self, "Spring")
+        check_positive("Spring.stiffness", self.stiffness, "stiffness")
+        if self.rest_length is not None and self.rest_length < 0:
+            raise InputError("Spring.rest_length", self.rest_length, "a length >= 0 (or None: the first sample's)")
+        if self.damping < 0:
+            raise InputError("Spring.damping", self.damping, "a damping >= 0")
+
 
 @dataclass(frozen=True)
 class Load:
@@ -37,6 +50,10 @@ class Load:
 
     point: str
     force: Vec
+
+    def __post_init__(self) -> None:
+        _check_name("Load.point", self.point)
+        check_fields(self, "Load")
 
 
 @dataclass(frozen=True)
@@ -56,6 +73,21 @@ class Effects:
     loads: tuple[Load, ...] = ()
     motor_force_limit: float | None = None
     motor: bool = False
+
+    def __post_init__(self) -> None:
+        check_fields(self, "effects")
+        if self.damping is not None and not 0.0 < self.damping <= 1.0:
+            raise InputError("effects.damping", self.damping, "a fraction of velocity kept per second, in (0, 1]")
+        check_positive("effects.density", self.density, "density")
+        if self.motor_force_limit is not None:
+            check_positive("effects.motor_force_limit", self.motor_force_limit, "torque")
+        for f, kind in (("springs", Spring), ("loads", Load)):
+            items = getattr(self, f)
+            if isinstance(items, (str, bytes)) or not isinstance(items, (tuple, list)):
+                raise InputError(f"effects.{f}", items, f"a tuple of {kind.__name__}")
+            for item in items:
+                if not isinstance(item, kind):
+                    raise InputError(f"effects.{f}", item, f"a {kind.__name__}")
 
     @property
     def wants_motor(self) -> bool:

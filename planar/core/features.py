@@ -1,7 +1,7 @@
 """Features cut from a part (holes and slots), as exact geometry in the part's own frame.
 
 Lengths are model units; angles radians, counter-clockwise.  This module
-imports nothing from planar, so :mod:`planar.core.model` (which re-exports these
+imports nothing from planar but its checks (:mod:`planar.core.fields`), so :mod:`planar.core.model` (which re-exports these
 classes) and :mod:`planar.core.outlines` (which turns them into shapely geometry)
 can both use it without importing each other.
 """
@@ -9,6 +9,8 @@ can both use it without importing each other.
 from __future__ import annotations
 
 from dataclasses import dataclass
+
+from planar.core.fields import check_fields, check_positive
 
 __all__ = ["ArcSlot", "Hole", "Slot"]
 
@@ -28,6 +30,10 @@ class Hole:
     diameter: float
     role: str = "sized"
 
+    def __post_init__(self) -> None:
+        check_fields(self, "Hole")
+        check_positive("Hole.diameter", self.diameter)
+
 
 @dataclass(frozen=True)
 class Slot:
@@ -37,6 +43,10 @@ class Slot:
     end: Vec
     width: float
     role: str = "sized"
+
+    def __post_init__(self) -> None:
+        check_fields(self, "Slot")
+        check_positive("Slot.width", self.width)
 
 
 @dataclass(frozen=True)
@@ -49,3 +59,8 @@ class ArcSlot:
     angle1: float
     width: float
     role: str = "sized"
+
+    def __post_init__(self) -> None:
+        check_fields(self, "ArcSlot")
+        check_positive("ArcSlot.radius", self.radius)
+        check_positive("ArcSlot.width", self.width)

@@ -21,6 +21,7 @@ For example ``PLANAR_MAX_SAMPLES=50000000 planar motion big.toml -o big.csv``.
 from __future__ import annotations
 
 import math
+import numbers
 import os
 from typing import Any
 
@@ -54,6 +55,8 @@ DEFAULTS: dict[str, tuple[str, int]] = {
 
 def limit(name: str) -> int:
     """The current value of limit ``name`` (the environment variable, else the default)."""
+    if not isinstance(name, str) or name not in DEFAULTS:
+        raise InputError("limit", name, "one of " + ", ".join(DEFAULTS))
     var, default = DEFAULTS[name]
     text = os.environ.get(var)
     if text is None or not text.strip():
@@ -72,8 +75,10 @@ def check_count(name: str, field: str, value: float, what: str, shown: object = 
 
     The message names ``field`` with ``shown`` (default ``value``): what the user wrote.
     """
-    var, _ = DEFAULTS[name]
     cap = limit(name)
+    var, _ = DEFAULTS[name]
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise InputError(field, value if shown is None else shown, f"a number of {what}")
     if not math.isfinite(value) or value > cap:
         asked = "" if shown is None else f"; this asks for {value:.4g}"
         raise LimitError(
@@ -89,6 +94,8 @@ def check_memory(field: str, value: object, n_bytes: float, what: str, fits: str
     """
     var, _ = DEFAULTS["memory"]
     cap = limit("memory")
+    if isinstance(n_bytes, bool) or not isinstance(n_bytes, numbers.Real):
+        raise InputError(field, value, f"{what} of a size in bytes (a number)")
     mib = n_bytes / 2**20
     if not math.isfinite(mib) or mib > cap:
         room = f"; at most {fits} fit" if fits else ""

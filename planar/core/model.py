@@ -24,6 +24,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from planar.core.buffers import block as new_block
+from planar.core.fields import (
+    _check_name,
+    check_fields,
+    check_finite,
+    check_number,
+    check_point,
+    check_positive,
+    check_samples,
+)
 from planar.core.geometry import poses_apply
 from planar.errors import InputError
 
@@ -50,36 +59,17 @@ __all__ = [
     "Pivot",
     "Slide",
     "Slot",
+    "check_fields",
     "check_finite",
     "check_point",
     "check_positive",
+    "check_samples",
     "joint_kind",
     "joint_residuals",
 ]
 
 Vec = tuple[float, float]
 Array = NDArray[np.float64]
-
-
-def check_finite(field_name: str, value: ArrayLike) -> NDArray[np.float64]:
-    """Return ``value`` as a float array or raise :class:`InputError` on NaN/inf (or what is not numbers)."""
-    try:
-        raw = np.asarray(value)
-    except (TypeError, ValueError, OverflowError):  # ragged nesting
-        raise InputError(field_name, value, "numbers (a number or an array of them)") from None
-    if raw.dtype.kind == "c":  # numpy would drop the imaginary part with only a warning
-        raise InputError(field_name, "complex numbers", "real numbers")
-    if isinstance(value, (str, bytes)) or raw.dtype.kind in "USVb":  # "1.0" is text, True no number
-        raise InputError(field_name, value, "numbers (not text or truth values)")
-    try:
-        arr = np.asarray(raw, dtype=float)
-    except (TypeError, ValueError, OverflowError):
-        raise InputError(field_name, value, "numbers (a number or an array of them)") from None
-    # a sum is finite only if every term is (NaN and inf propagate); a finite array whose sum
-    # overflows is looked at element by element
-    if not np.isfinite(arr.sum()) and not np.all(np.isfinite(arr)):
-        raise InputError(field_name, value, "finite numbers")
-    return arr
 
 
 class FinitePoses(dict[str, "NDArray[np.float64]"]):
@@ -102,38 +92,6 @@ class LazyPoses(FinitePoses):
         super().__init__()
         self.make = make
         self.parts = parts
-
-
-def check_positive(field_name: str, value: float, what: str = "length") -> float:
-    """Return ``value`` as float or raise :class:`InputError` unless a finite number > 0 (not a bool or a string).
-
-    ``what`` names the quantity in the message (``"a positive, finite rate"``).
-    """
-    if isinstance(value, (bool, str, bytes, np.bool_)):
-        raise InputError(field_name, value, "a positive number")
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(field_name, value, "a positive number") from None
-    if not np.isfinite(v) or v <= 0.0:
-        raise InputError(field_name, value, f"a positive, finite {what}")
-    return v
-
-
-def check_point(field_name: str, value: ArrayLike, what: str = "a point (x, y): two finite numbers") -> Vec:
-    """Return ``value`` as ``(x, y)`` or raise :class:`InputError` unless it is two finite numbers."""
-    a = check_finite(field_name, value)
-    if a.shape != (2,):
-        raise InputError(field_name, value, what)
-    return (float(a[0]), float(a[1]))
-
-
-def _check_name(field: str, name: object) -> None:
-    """Refuse a name that is not a non-empty string or holds a control character (it names CSV columns, DXF groups)."""
-    if not isinstance(name, str) or not name:
-        raise InputError(field, name, "a non-empty string")
-    if any(ord(c) < 32 or ord(c) == 127 for c in name):
-        raise InputError(field, name, "a name without control characters (newline, tab, NUL)")
 
 
 def _check_joint(joint: Any, points: tuple[str, ...], size: str | None) -> None:
@@ -187,7 +145,7 @@ class Part:
     def __post_init__(self) -> None:
         _check_name("Part.name", self.name)
         where = f"Part {self.name!r}"
-        if isinstance(self.hull, (str, bytes)) or not (len(self.hull) or self.polygon is not None):
+        if not isinstance(self.hull, (tuple, list, np.ndarray)) or not (len(self.hull) or self.polygon is not None):
             raise InputError(f"{where}.hull", self.hull, "one or more circles (x, y, r) (or a polygon)")
         if not isinstance(self.ground, (bool, np.bool_)):
             raise InputError(f"{where}.ground", self.ground, "True or False")
@@ -200,9 +158,11 @@ class Part:
             poly = check_finite(f"{where}.polygon", self.polygon)
             if poly.ndim != 2 or poly.shape[1] != 2 or len(poly) < 3:
                 raise InputError(f"{where}.polygon", self.polygon, "three or more points (x, y)")
-        if self.plane not in ("xy", "xz", "yz"):
+        if not isinstance(self.plane, str) or self.plane not in ("xy", "xz", "yz"):
             raise InputError(f"{where}.plane", self.plane, "'xy', 'xz' or 'yz'")
-        check_finite(f"{where}.offset", self.offset)
+        check_number(f"{where}.offset", self.offset)
+        if not isinstance(self.features, (tuple, list)) or not all(isinstance(f, (Hole, Slot, ArcSlot)) for f in self.features):
+            raise InputError(f"{where}.features", self.features, "a tuple of Hole, Slot or ArcSlot")
 
     @cached_property
     def outline(self) -> shapely.Polygon:
@@ -380,6 +340,9 @@ class PinInArcSlot:
     radius: float
     pin: Vec
 
+    def __post_init__(self) -> None:
+        _check_joint(self, ("centre", "pin"), "radius")
+
     def residual(self, poses: Mapping[str, Array]) -> Array:
         p = poses_apply(_pose(poses, self.b), self.pin)
         c = poses_apply(_pose(poses, self.a), self.centre)
@@ -461,6 +424,11 @@ class CamOnLine:
     centre: Vec
     radius: float
 
+    def __post_init__(self) -> None:
+        _check_joint(self, ("start", "end", "centre"), None)
+        if not check_number(f"CamOnLine {self.name!r}.radius", self.radius) >= 0:  # 0: a point touching the face
+            raise InputError(f"CamOnLine {self.name!r}.radius", self.radius, "a radius >= 0")
+
     def residual(self, poses: Mapping[str, Array]) -> Array:
         c = poses_apply(_pose(poses, self.b), self.centre)
         s0 = poses_apply(_pose(poses, self.a), self.start)
@@ -507,8 +475,9 @@ class Driver:
         if not isinstance(self.part, str) or not self.part:
             raise InputError("driver.part", self.part, "the name of the part it drives (a non-empty string)")
         _check_name("driver.part", self.part)
-        if self.kind not in ("rotation", "translation", "path"):
+        if not isinstance(self.kind, str) or self.kind not in ("rotation", "translation", "path"):
             raise InputError("driver.kind", self.kind, "'rotation', 'translation' or 'path'")
+        check_fields(self, "driver", skip=("part", "origin", "axis"))
         for f in ("origin", "axis"):
             v = check_finite(f"driver.{f}", getattr(self, f))
             if v.shape != (2,):
@@ -538,14 +507,14 @@ class Driver:
 
     def value(self, t: ArrayLike) -> Array:
         """Driver value at times ``t`` (s)."""
-        t = np.asarray(t, dtype=float)
+        t = check_samples("driver.value(t)", t) if np.ndim(t) else check_finite("driver.value(t)", t)
         if self.amplitude is None:
             return self.phase + self.rate * t
         return self.centre + self.amplitude * np.sin(self.rate * t + self.phase)
 
     def speed(self, t: ArrayLike) -> Array:
         """Time derivative of :meth:`value` (rad/s or units/s)."""
-        t = np.asarray(t, dtype=float)
+        t = check_samples("driver.speed(t)", t) if np.ndim(t) else check_finite("driver.speed(t)", t)
         if self.amplitude is None:
             return np.full_like(t, self.rate)
         return self.amplitude * self.rate * np.cos(self.rate * t + self.phase)
@@ -589,8 +558,34 @@ class Motion:
     mechanism: Any = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
+        self._check()
         if isinstance(self.poses, LazyPoses):  # computed on first access (see __getattr__)
             self.__dict__["_lazy_poses"] = self.__dict__.pop("poses")
+
+    def _check(self) -> None:
+        """Refuse what is not a motion: driver values one finite 1-D array; ``valid``, ``fail_code`` (and
+        ``t``) one entry per sample; each pose ``(N, 3)`` and each point ``(N, 2)`` (their numbers are the
+        solver's to screen)."""
+        d = self.driver
+        if not (isinstance(d, np.ndarray) and d.dtype == np.float64 and d.ndim == 1 and np.isfinite(d.sum())):
+            self.driver = d = check_samples("Motion.driver", d)
+        n = d.shape[0]
+        for f, kinds in (("valid", "b"), ("fail_code", "iu")):
+            v = getattr(self, f)
+            if not isinstance(v, np.ndarray) or v.dtype.kind not in kinds or v.shape != (n,):
+                what = "truth values" if f == "valid" else "whole numbers"
+                raise InputError(f"Motion.{f}", v, f"an array of {what}, one per driver value ({n})")
+        if self.t is not None:
+            self.t = check_samples("Motion.t", self.t, n) if np.ndim(self.t) else check_samples("Motion.t", [self.t], n)
+        for f, width in (("poses", 3), ("points", 2)):
+            table = getattr(self, f)
+            if not isinstance(table, Mapping):
+                raise InputError(f"Motion.{f}", table, f"a mapping of name to an (N, {width}) array")
+            for key, arr in table.items():
+                if not isinstance(arr, np.ndarray) or arr.shape != (n, width):
+                    raise InputError(f"Motion.{f}.{key}", arr, f"an array of shape ({n}, {width})")
+        if not isinstance(self.fail_table, list):
+            raise InputError("Motion.fail_table", self.fail_table, "a list of (joint, why)")
 
     if not TYPE_CHECKING:  # (the type checker keeps reporting unknown attributes)
 
@@ -767,6 +762,8 @@ class Mechanism:
         self.parts = tuple(parts)
         self.joints = tuple(joints)
         self.driver = driver
+        if points is not None and not isinstance(points, Mapping):
+            raise InputError(f"{name}.points", points, "a mapping of point name to (part, (x, y))")
         self.points = dict(points or {})
         names = [p.name for p in self.parts]
         if len(set(names)) != len(names):
@@ -830,6 +827,8 @@ class Mechanism:
     # -- shared ------------------------------------------------------------
     def part(self, name: str) -> Part:
         """The part called ``name``."""
+        if not isinstance(name, str):
+            raise InputError(f"{self.name}.part", name, f"a part's name, one of {[p.name for p in self.parts]}")
         for p in self.parts:
             if p.name == name:
                 return p

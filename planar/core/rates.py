@@ -20,6 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from planar.errors import InputError
+
 __all__ = ["PartRates", "RatesResult", "point_rates", "rotate_vectors"]
 
 Array = NDArray[np.float64]
@@ -55,7 +57,15 @@ def point_rates(poses: ArrayLike, rates: PartRates, world_points: ArrayLike) -> 
     ``poses``: the part's pose track ``(N, 3)``; ``rates``: its :class:`PartRates`.
     Model units per s and per s^2.
     """
-    P, O = np.asarray(world_points, float), np.asarray(poses, float)
+    from planar.core.fields import check_finite, check_kind
+
+    P, O = check_finite("point_rates(world_points)", world_points), check_finite("point_rates(poses)", poses)
+    check_kind("point_rates(rates)", rates, PartRates)
+    n = rates.omega.shape[0] if isinstance(rates.omega, np.ndarray) and rates.omega.ndim == 1 else -1
+    if P.shape != (n, 2) or O.shape != (n, 3):
+        raise InputError(
+            "point_rates(poses, world_points)", f"arrays of shapes {O.shape}, {P.shape}", f"poses ({n}, 3) and points ({n}, 2)"
+        )
     rx, ry = P[:, 0] - O[:, 0], P[:, 1] - O[:, 1]
     om, al = rates.omega, rates.alpha
     om2 = om * om

@@ -56,6 +56,10 @@ GOOD_TRANSMISSION = (40.0, 140.0)
 def available_charts(scene: Scene) -> list[str]:
     """The charts that apply to ``scene`` (``transmission`` only where the mechanism has dyads)."""
     from planar.analysis.rates import transmission_angles
+    from planar.core.fields import check_kind
+    from planar.scene.build import Scene as SceneKind
+
+    check_kind("available_charts(scene)", scene, SceneKind)
 
     out = ["curve"] if scene.mechanism.points else []
     if _is_cam(scene.mechanism):
@@ -113,7 +117,9 @@ FIGURE_BYTES = 128 * 2**20
 
 def _motion(scene: Scene, samples_per_cycle: int | None) -> Motion:
     """The scene's motion, over its own cycles or duration, at ``samples_per_cycle`` (default: the scene's)."""
-    if samples_per_cycle is not None and samples_per_cycle < 4:
+    if samples_per_cycle is not None and (
+        isinstance(samples_per_cycle, bool) or not isinstance(samples_per_cycle, int) or samples_per_cycle < 4
+    ):
         raise InputError("--samples", samples_per_cycle, "at least 4 samples per cycle")
     d = scene.spec.driver
     drv = scene.mechanism.driver

@@ -26,8 +26,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from planar.core.fields import check_fields, check_finite, check_kind
 from planar.core.geometry import poses_apply
 from planar.core.model import Mechanism, Motion, Part
+from planar.errors import InputError
 
 __all__ = ["CHUNK_FRAMES", "Renderer", "Style", "palette_colors", "project"]
 
@@ -100,6 +102,27 @@ class Style:
     #: a wind-up toy as its exploded stage panels instead of assembled (planar.draw.toyview)
     exploded: bool = False
 
+    def __post_init__(self) -> None:
+        check_fields(self, "render")
+        for f, low, high in (("width", 8, 16384), ("height", 8, 16384), ("supersample", 1, 8)):
+            if not low <= getattr(self, f) <= high:
+                raise InputError(f"render.{f}", getattr(self, f), f"a whole number from {low} to {high}")
+        for name, least, most in (("margin", 0.0, 0.49), ("line_width", 1e-3, 100.0), ("opacity", 1e-3, 1.0)):
+            if not least <= getattr(self, name) <= most:
+                raise InputError(f"render.{name}", getattr(self, name), f"a number from {least:g} to {most:g}")
+        if not isinstance(self.part_colors, (tuple, list)) or not self.part_colors:
+            raise InputError("render.part_colors", self.part_colors, "one or more colours '#rrggbb'")
+        if self.trails is not None and (isinstance(self.trails, str) or not isinstance(self.trails, Sequence)):
+            raise InputError("render.trails", self.trails, "a list of point names (or None: every point)")
+        named = [(f, getattr(self, f)) for f in _COLOUR_FIELDS] + [("part_colors", c) for c in self.part_colors]
+        for f, c in named:
+            if not (isinstance(c, str) and len(c.lstrip("#")) == 6 and all(ch in _HEX for ch in c.lstrip("#"))):
+                raise InputError(f"render.{f}", c, "a colour '#rrggbb'")
+
+
+_COLOUR_FIELDS = ("background", "ground", "ground_outline", "outline", "pin", "trail", "invalid", "overlay", "sweep")
+_HEX = frozenset("0123456789abcdefABCDEF")
+
 
 def project(part: Part, pts: Array, view: str) -> Array:
     """Points in a part's plane coordinates -> view coordinates (orthographic).
@@ -159,6 +182,24 @@ def palette_colors(style: Style, n_parts: int) -> list[RGB]:
     return out
 
 
+def _check_renderer(r: Renderer) -> None:
+    """Refuse what a renderer cannot draw, naming the argument."""
+    check_kind("Renderer(mech)", r.mech, Mechanism)
+    for f in ("motion", "overlay", "trail_motion"):
+        v = getattr(r, f)
+        if v is not None or f == "motion":
+            check_kind(f"Renderer({f})", v, Motion, "a Motion of the mechanism")
+    check_kind("Renderer(style)", r.style, Style)
+    if not isinstance(r.polygons, Mapping):
+        raise InputError("Renderer(polygons)", r.polygons, "a mapping of name to (part, (M, 2) points)")
+    if not isinstance(r.view, str) or r.view not in ("", "xy", "xz", "yz"):
+        raise InputError("Renderer(view)", r.view, "'xy', 'xz' or 'yz' (or '': the mechanism's)")
+    if r.targets is not None:
+        t = check_finite("Renderer(targets)", r.targets)
+        if t.ndim != 2 or t.shape[1] != 2:
+            raise InputError("Renderer(targets)", f"an array of shape {t.shape}", "points (M, 2)")
+
+
 @dataclass
 class Renderer:
     """Renders ``motion`` of ``mech`` (and optionally an ``overlay`` motion) frame by frame.
@@ -191,6 +232,7 @@ class Renderer:
     def __post_init__(self) -> None:
         from planar.draw.toyview import Marks, assembled
 
+        _check_renderer(self)
         self.marks = Marks()
         if not self.style.exploded and self.overlay is None:  # toys, #6, #8, #9: the assembled view
             orig = self.mech

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from planar.core.fields import check_fields, check_kind, check_number
 from planar.core.model import Motion
 from planar.errors import InputError
 
@@ -54,6 +55,12 @@ class FramePlan:
     delay_ms: float
     frames_per_cycle: int
     frames: int
+
+    def __post_init__(self) -> None:
+        check_fields(self, "FramePlan")
+        for f in ("period_s", "delay_ms", "frames_per_cycle", "frames"):
+            if not getattr(self, f) > 0:
+                raise InputError(f"FramePlan.{f}", getattr(self, f), "a positive number")
 
     @property
     def fps(self) -> float:
@@ -97,6 +104,12 @@ def plan_frames(period_s: float, duration_s: float, fps: float | None = None, ti
     Raises :class:`InputError` for a rate a GIF cannot play, an ``fps`` that
     gives fewer than 4 frames a cycle, or more than :data:`MAX_FRAMES` frames.
     """
+    check_number("speed", period_s)
+    check_number("duration", duration_s)
+    if fps is not None:
+        check_number("--fps", fps)
+    if tick_ms is not None and not check_number("tick_ms", tick_ms) > 0:
+        raise InputError("tick_ms", tick_ms, "a positive frame tick in ms (GIF: 10), or None (video)")
     if not (math.isfinite(period_s) and period_s > 0):
         raise InputError("speed", period_s, "a finite, positive speed (cycles per second)")
     if not (math.isfinite(duration_s) and duration_s > 0):
@@ -159,6 +172,10 @@ def animation_motion(scene: Scene, plan: FramePlan) -> tuple[Motion, Motion]:
     holds every frame instant, so branch continuity is what the scene's own
     motion has; the trails are drawn from it.
     """
+    from planar.scene.build import Scene as SceneKind
+
+    check_kind("animation_motion(scene)", scene, SceneKind)
+    check_kind("animation_motion(plan)", plan, FramePlan)
     drv = scene.mechanism.driver
     m = max(1, math.ceil(scene.spec.driver.samples_per_cycle / plan.frames_per_cycle))
     t = np.arange(plan.frames * m, dtype=np.float64) * (plan.period_s / (plan.frames_per_cycle * m))

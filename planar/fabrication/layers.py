@@ -120,6 +120,20 @@ def _swept(poly, poses: np.ndarray, u: float):
     return shapely.union_all([_placed(poly, p, u) for p in poses]).buffer(0)
 
 
+def _check_sizes(unit_mm: Any, thickness: Any, pin_mm: Any, pin_head: Any, ring_mm: Any, samples: Any) -> None:
+    """:func:`plan_assembly`'s sizes (mm) and sample count, each named when wrong."""
+    from planar.core.fields import check_number
+    from planar.errors import InputError
+
+    for name, value in (("unit_mm", unit_mm), ("thickness", thickness), ("pin_mm", pin_mm), ("pin_head", pin_head)):
+        if not check_number(name, value) > 0:
+            raise InputError(name, value, "a positive size in mm")
+    if ring_mm is not None and not check_number("ring_mm", ring_mm) > 0:
+        raise InputError("ring_mm", ring_mm, "a positive diameter in mm (or None)")
+    if not 2 <= check_number("samples", samples, integer=True) <= 100_000:
+        raise InputError("samples", samples, "a whole number of samples, 2 to 100 000")
+
+
 def plan_assembly(
     mech: Mechanism,
     material: dict[str, Any],
@@ -138,6 +152,7 @@ def plan_assembly(
     ``ring_mm``: the outer diameter of a spacer ring (default ``pin_mm``): a part between a pin's ends must clear
     the ring on the pin, not only the pin.
     """
+    _check_sizes(unit_mm, thickness, pin_mm, pin_head, ring_mm, samples)
     from shapely.geometry import LineString, Point
 
     u = unit_mm

@@ -52,7 +52,14 @@ def nest(
     """Place every part on as few sheets as rectpack finds; coordinates per sheet, mm."""
     import rectpack
 
-    W, H = sheet
+    from planar.core.fields import check_number, check_point
+
+    if not isinstance(cuts, (list, tuple)) or not cuts or not all(isinstance(c, PartCut) for c in cuts):
+        raise InputError("cuts", cuts, "a list of one or more PartCut (planar.fabrication.part_cuts)")
+    W, H = check_point("sheet", sheet, "a sheet (width, height) in mm: two finite numbers")
+    for name, value in (("spacing", spacing), ("margin", margin), ("kerf", kerf), ("unit_mm", unit_mm)):
+        if check_number(name, value) < 0:
+            raise InputError(name, value, "a size >= 0 in mm")
     if not (math.isfinite(W) and math.isfinite(H)) or 2 * margin >= W or 2 * margin >= H:
         raise InputError("sheet", f"{W:g} x {H:g}", f"a finite sheet larger than the {margin:g} mm margins")
     binw, binh = int(math.floor((W - 2 * margin + spacing) * _Q)), int(math.floor((H - 2 * margin + spacing) * _Q))

@@ -96,6 +96,22 @@ class FabSettings:
     #: side of a reference square cut in a corner of each sheet (mm; 0: none), to measure the scale after cutting
     reference_square_mm: float = 0.0
 
+    def __post_init__(self) -> None:
+        from planar.core.fields import check_fields
+        from planar.errors import InputError
+
+        check_fields(self, "fabrication")
+        for f in ("unit_mm", "thickness_mm", "pin_mm"):
+            if not getattr(self, f) > 0:
+                raise InputError(f"fabrication.{f}", getattr(self, f), "a positive size in mm")
+        if not min(self.sheet) > 0:
+            raise InputError("fabrication.sheet", self.sheet, "a sheet (width, height) of positive sides in mm")
+        for name, value in vars(self).items():
+            if isinstance(value, float) and value < 0:
+                raise InputError(f"fabrication.{name}", value, "a size >= 0 in mm")
+        if self.colours not in COLOUR_PRESETS:
+            raise InputError("fabrication.colours", self.colours, "one of " + ", ".join(sorted(COLOUR_PRESETS)))
+
     def layer_colours(self) -> dict[str, str]:
         """``#rrggbb`` of each cut-file layer under the colour preset: ``"planar"`` (both cuts ``cut_colour``,
         engraving ``engrave_colour``) or ``"boxes"`` (Boxes.py's: outer cut black, inner cut blue, engrave green)."""
@@ -112,6 +128,15 @@ class FabSettings:
 
     @classmethod
     def from_spec(cls, fab: Any, kerf: float | None = None, sheet: tuple[float, float] | None = None) -> FabSettings:
+        from planar.core.fields import check_number, check_point
+        from planar.errors import InputError
+
+        if not all(hasattr(fab, f) for f in ("unit_mm", "thickness_mm", "kerf_mm", "sheet_mm")):
+            raise InputError("from_spec(fab)", fab, "a scene's fabrication table (scene.spec.fabrication)")
+        if kerf is not None:
+            check_number("kerf", kerf)
+        if sheet is not None:
+            sheet = check_point("sheet", sheet, "a sheet (width, height) in mm: two finite numbers")
         return cls(
             unit_mm=fab.unit_mm,
             thickness_mm=fab.thickness_mm,
@@ -528,6 +553,45 @@ def letter_marks(material, holes: list[tuple[tuple[float, float], float, str]], 
     return out
 
 
+def _check_cut_args(
+    part: Any,
+    s: Any,
+    number: Any,
+    pinned: Any,
+    drive_at: Any,
+    motor_at: Any,
+    mounting: Any,
+    letters: Any,
+    flat: Any,
+    extra: Any,
+    tabs: Any,
+) -> None:
+    """:func:`part_cuts`' arguments, each named when wrong (its entrance from Python)."""
+    from planar.core.fields import check_kind, check_number, check_point
+    from planar.errors import InputError
+
+    check_kind("part_cuts(part)", part, Part)
+    check_kind("part_cuts(s)", s, FabSettings)
+    check_number("part_cuts(number)", number, integer=True)
+    if not isinstance(pinned, (set, frozenset)) or not all(isinstance(i, int) for i in pinned):
+        raise InputError("part_cuts(pinned)", pinned, "a set of feature indices")
+    for name, at in (("drive_at", drive_at), ("motor_at", motor_at)):
+        if at is not None:
+            check_point(f"part_cuts({name})", at)
+    if not isinstance(mounting, bool):
+        raise InputError("part_cuts(mounting)", mounting, "True or False")
+    check_number("part_cuts(drive_flat)", flat)
+    ok_letters = isinstance(letters, (tuple, list)) and all(
+        isinstance(x, (tuple, list)) and len(x) == 2 and isinstance(x[1], str) for x in letters
+    )
+    if not ok_letters:
+        raise InputError("part_cuts(letters)", letters, "a list of ((x, y), letter)")
+    if not isinstance(extra, (tuple, list)) or not all(isinstance(f, Feature) for f in extra):
+        raise InputError("part_cuts(extra)", extra, "a list of cut features (mm)")
+    if tabs is not None and not hasattr(tabs, "edge"):
+        raise InputError("part_cuts(tabs)", tabs, "a TabJoin (or None)")
+
+
 def part_cuts(
     part: Part,
     s: FabSettings,
@@ -550,6 +614,7 @@ def part_cuts(
     ``extra``: more cuts in mm (a perpendicular piece's tab slots); ``tabs``: a
     :class:`~planar.fabrication.tabs.TabJoin` whose piece this is (cut flat along its edge, tabs added).
     """
+    _check_cut_args(part, s, number, pinned, drive_at, motor_at, mounting, letters, drive_flat, extra, tabs)
     k2 = s.kerf / 2.0
     feats = _features(part, s, set(pinned), drive_at, motor_at, drive_flat) + list(extra)
     for f in feats:

@@ -23,7 +23,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from planar.core.model import check_finite, check_positive
+from planar.core.model import check_finite, check_positive, check_samples
 from planar.errors import InputError
 from planar.linkages.linkage import Link, Linkage
 from planar.linkages.nodes import RRR, Crank, Fixed, Rigid
@@ -43,7 +43,9 @@ def grashof_class(a: float, b: float, c: float, d: float, tol: float = 1e-12) ->
     (``s + l == p + q`` within ``tol`` of the sum) or ``"non-Grashof"``
     (triple rocker).
     """
-    lengths = [a, b, c, d]
+    lengths = [check_positive(f"grashof_class({k})", v) for k, v in zip("abcd", (a, b, c, d), strict=True)]
+    if isinstance(tol, (bool, str)) or not (isinstance(tol, (int, float)) and 0.0 <= tol < 1.0):
+        raise InputError("grashof_class(tol)", tol, "a relative tolerance, 0 <= tol < 1")
     s, l = min(lengths), max(lengths)
     pq = sum(lengths) - s - l
     scale = sum(lengths)
@@ -72,7 +74,10 @@ def freudenstein_angles(
     root ``(-B - sqrt(disc)) / (2A)`` for theta4 and ``(-E - sqrt)/(2D)`` for
     theta3, verified against the circle-circle solution in the tests.
     """
-    th = np.asarray(theta, dtype=float)
+    a, b, c, d = (check_positive(f"freudenstein_angles({k})", v) for k, v in zip("abcd", (a, b, c, d), strict=True))
+    if not isinstance(circuit, str) or circuit not in ("open", "crossed"):
+        raise InputError("freudenstein_angles(circuit)", circuit, "'open' or 'crossed'")
+    th = check_finite("freudenstein_angles(theta)", theta)
     ct, st = np.cos(th), np.sin(th)
     K1, K2, K3 = d / a, d / c, (a * a - b * b + c * c + d * d) / (2 * a * c)
     K4, K5 = d / b, (c * c - d * d - a * a - b * b) / (2 * a * b)
@@ -131,7 +136,7 @@ class FourBar(Linkage):
         b = check_positive(f"{name}.coupler", coupler)
         c = check_positive(f"{name}.rocker", rocker)
         d = check_positive(f"{name}.ground", ground)
-        if circuit not in ("open", "crossed"):
+        if not isinstance(circuit, str) or circuit not in ("open", "crossed"):
             raise InputError(f"{name}.circuit", circuit, "'open' or 'crossed'")
         self.dims = _Dims(a, b, c, d)
         self.circuit: Circuit = circuit
@@ -222,11 +227,11 @@ class FourBar(Linkage):
     def transmission_angle(self, theta: ArrayLike) -> Array:
         """Transmission angle (radians, in ``[0, pi]``) between coupler and rocker at ``C``."""
         g = self.dims
-        th = np.asarray(theta, float)
+        th = check_finite(f"{self.name}.transmission_angle(theta)", theta)
         bo2 = g.a**2 + g.d**2 - 2 * g.a * g.d * np.cos(th)
         return np.arccos(np.clip((g.b**2 + g.c**2 - bo2) / (2 * g.b * g.c), -1.0, 1.0))
 
     def coupler_curve(self, theta: ArrayLike) -> tuple[Array, NDArray[np.bool_]]:
         """World coupler-point curve ``(N, 2)`` and validity for crank angles ``theta``."""
-        m = self.solve(theta)
+        m = self.solve(check_samples(f"{self.name}.coupler_curve(theta)", theta))
         return m.points["coupler_point"], m.valid

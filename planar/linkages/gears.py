@@ -89,6 +89,8 @@ class Geared(NodeKind):
         return ((self.name, self.centre),)
 
     def validate(self, where: str) -> None:
+        if self.base is not None and not isinstance(self.base, NodeKind):
+            raise InputError(f"{where}.base", self.base, "the node kind the gear rides on (or None)")
         if self.mesh == self.name:
             raise InputError(f"{where}.mesh", self.mesh, "another gear's node (a gear cannot mesh with itself)")
         if self.mesh == self.centre:

@@ -46,6 +46,7 @@ from planar.core.model import (
     Slide,
     check_finite,
     check_positive,
+    check_samples,
     merge_failures,
 )
 from planar.core.rates import PartRates, RatesResult, rotate_vectors
@@ -70,8 +71,14 @@ class Link:
         from planar.core.model import _check_name
 
         _check_name("Link.name", self.name)
-        if isinstance(self.nodes, (str, bytes)) or not all(isinstance(n, str) for n in self.nodes):
+        nodes = self.nodes
+        if isinstance(nodes, (str, bytes)) or not isinstance(nodes, (tuple, list)) or not all(isinstance(n, str) for n in nodes):
             raise InputError(f"Link {self.name!r}.nodes", self.nodes, "a sequence of node names (('O', 'A'), not 'OA')")
+        guide = self.guide
+        if guide is not None and (
+            not isinstance(guide, (tuple, list)) or len(guide) != 2 or not all(isinstance(n, str) for n in guide)
+        ):
+            raise InputError(f"Link {self.name!r}.guide", guide, "two node names (p, q) the block slides along, or None")
 
 
 #: most steps of a lead-in (:meth:`Linkage._lead_in`)
@@ -133,6 +140,7 @@ class Linkage(Mechanism):
         from planar.core.model import _check_name
 
         _check_name("Linkage.name", name)
+        _check_name(f"{name}.ground", ground)
         for arg, seq, cls in (("nodes", nodes, NodeKind), ("links", links, Link)):
             if isinstance(seq, (str, bytes)) or not hasattr(seq, "__iter__"):
                 raise InputError(f"{name}.{arg}", seq, f"a list of {cls.__name__} objects")
@@ -523,8 +531,8 @@ class Linkage(Mechanism):
         Each node kind differentiates its own closure (:meth:`NodeKind.velocity`);
         ``qdot = 1`` gives velocity coefficients ``dX/dq``.
         """
-        qa = np.atleast_1d(np.asarray(q, float))
-        qd = np.broadcast_to(np.asarray(qdot, float), qa.shape)
+        qa = check_samples(f"{self.name}.node_velocities(q)", q)
+        qd = np.broadcast_to(check_samples(f"{self.name}.node_velocities(qdot)", qdot, qa.shape[0]), qa.shape)
         pos, checks = self.solve_nodes(qa)
         valid = np.ones(qa.shape, bool)
         for m, _, _ in checks:
@@ -554,9 +562,12 @@ class Linkage(Mechanism):
         not close or a differentiated closure is singular (a toggle).
         ``solved``: :meth:`solve_nodes` of ``q`` if the caller has it already.
         """
-        qa = np.atleast_1d(np.asarray(q, float))
-        qd = np.broadcast_to(np.asarray(qdot, float), qa.shape)
-        qdd = np.broadcast_to(np.asarray(qddot, float), qa.shape)
+        where = f"{self.name}.node_accelerations"
+        qa = check_samples(f"{where}(q)", q)
+        qd = np.broadcast_to(check_samples(f"{where}(qdot)", qdot, qa.shape[0]), qa.shape)
+        qdd = np.broadcast_to(check_samples(f"{where}(qddot)", qddot, qa.shape[0]), qa.shape)
+        if solved is not None and not (isinstance(solved, tuple) and len(solved) == 2 and isinstance(solved[0], dict)):
+            raise InputError(f"{where}(solved)", solved, "solve_nodes(q) of the same q (or None)")
         pos, checks = solved if solved is not None else self.solve_nodes(qa)
         valid = np.ones(qa.shape, bool)
         for m, _, _ in checks:
@@ -571,6 +582,7 @@ class Linkage(Mechanism):
             for mask in (ok, ok2):
                 if mask is not None:
                     valid &= mask
+            valid &= np.isfinite(v).all(-1) & np.isfinite(a).all(-1)  # a rate beyond float64 is no rate
         return pos, vel, acc, valid
 
     def link_rates(
@@ -737,7 +749,7 @@ class Linkage(Mechanism):
         inputs = [n for n in self.nodes if n.is_input]
         if len(inputs) < 2:
             return {}
-        qa = np.atleast_1d(np.asarray(q, float))
+        qa = check_samples(f"{self.name}.input_values(q)", q)
         out: dict[str, Array] = {}
         for n in inputs:
             own = getattr(n, "input_angle", None)  # a geared or driven node's law
@@ -751,7 +763,7 @@ class Linkage(Mechanism):
 
     def node_positions(self, q: ArrayLike) -> dict[str, Array]:
         """World positions ``(N, 2)`` of every node, placement applied."""
-        pos, _ = self.solve_nodes(np.atleast_1d(np.asarray(q, float)))
+        pos, _ = self.solve_nodes(check_samples(f"{self.name}.node_positions(q)", q))
         if any(self.placement):
             pl = np.asarray(self.placement)
             return {k: poses_apply(pl, v) for k, v in pos.items()}

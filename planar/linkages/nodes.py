@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planar.core.geometry import circle_circle, line_circle
-from planar.core.model import _check_name, check_finite, check_point, check_positive
+from planar.core.model import _check_name, check_fields, check_finite, check_point, check_positive
 from planar.errors import InputError
 
 __all__ = [
@@ -216,6 +216,9 @@ class NodeKind:
     def __post_init__(self) -> None:
         """Refused where it is built, not first at the linkage: its name and its kind's own checks."""
         _check_name(f"{type(self).__name__}.name", self.name)
+        check_fields(self, f"nodes.{self.name}")
+        for ref in self.refs():
+            _check_name(f"nodes.{self.name}: a node it is placed from", ref)
         self.validate(f"nodes.{self.name}")
 
     def validate(self, where: str) -> None:

@@ -8,12 +8,14 @@ cancellation).  ``branch=+1`` puts the slider on the +x side.
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from planar.core.fields import check_number
 from planar.core.model import check_finite, check_positive
 from planar.errors import InputError
 from planar.linkages.linkage import Link, Linkage
@@ -41,15 +43,17 @@ class SliderCrank(Linkage):
     ) -> None:
         r = check_positive(f"{name}.crank", crank)
         l = check_positive(f"{name}.rod", rod)
-        e = float(check_finite(f"{name}.offset", offset))
+        e = float(check_number(f"{name}.offset", offset))
         if abs(e) >= r + l:
             raise InputError(
                 f"{name}.offset", offset, f"|offset| < crank + rod = {r + l:g} (else the rod never reaches the guide)"
             )
-        if isinstance(branch, bool) or branch not in (1, -1):
+        if isinstance(branch, bool) or not isinstance(branch, numbers.Integral) or branch not in (1, -1):
             raise InputError(f"{name}.branch", branch, "1 (slider on the +x side) or -1")
-        self.r, self.l, self.e = r, l, e
-        self.branch = int(branch)
+        self.r: float = r
+        self.l: float = l
+        self.e: float = e
+        self.branch: int = int(branch)
         span = r + l
         nodes = [
             Fixed("O", (0.0, 0.0)),
@@ -71,6 +75,6 @@ class SliderCrank(Linkage):
         ``r cos(theta) + branch sqrt(l^2 - (r sin(theta) - e)^2)``; where the rod cannot reach the
         guide the root is taken at zero (see :meth:`solve` for the validity mask).
         """
-        th = np.asarray(theta, float)
+        th = check_finite(f"{self.name}.slider_position(theta)", theta)
         h = self.r * np.sin(th) - self.e
         return self.r * np.cos(th) + self.branch * np.sqrt(np.maximum((self.l - h) * (self.l + h), 0.0))

@@ -252,8 +252,10 @@ class Triad(NodeKind):
         check_positive(f"{where}.ra", self.ra)
         check_point(f"{where}.local", self.local)
         check_point(f"{where}.at", self.at)
+        if not isinstance(self.group, tuple) or not all(isinstance(g, Triad) for g in self.group):
+            raise InputError(f"{where}.group", self.group, "a tuple of Triad (the triad's other members, or ())")
         if self.members is not None:
-            if isinstance(self.members, (str, bytes)):
+            if not isinstance(self.members, (tuple, list)) or not all(isinstance(m, str) for m in self.members):
                 raise InputError(f"{where}.members", self.members, "the two other nodes of the triad (a list of two names)")
             ms = tuple(self.members)
             if len(ms) != 2 or len(set(ms)) != 2 or self.name in ms:

@@ -237,6 +237,9 @@ def torque_line(t: dict[str, Any]) -> str:
 
 def format_comparison(c: Comparison) -> str:
     """A table for the terminal."""
+    from planar.core.fields import check_kind
+
+    check_kind("format_comparison(c)", c, Comparison, "a Comparison (compare_scene's first result)")
     lines = [
         f"{c.mechanism}: {c.samples} samples, size {c.size:.4g}, threshold {c.threshold:g} of size",
         f"  {'part':<16}{'max err':>11}{'rms err':>11}{'max/size':>11}{'max angle':>11}  first over",
@@ -341,6 +344,11 @@ def compare_scene(
     until the run holds or two budgets agree, within ``time_cap`` CPU seconds
     each).  Returns the comparison and the last kinematic simulation.
     """
+    from planar.core.fields import check_kind
+    from planar.scene.build import Scene as SceneKind
+
+    check_kind("scene", scene, SceneKind, "a Scene (planar.load_scene, or scene_from_mechanism)")
+    _check_compare_args(settings, threshold, torque_threshold, with_series, motor, time_cap)
     from dataclasses import replace
 
     from planar.errors import PlanarError
@@ -403,3 +411,20 @@ def compare_scene(
     if with_series:
         result.torque.update(analytic=tc["analytic"], simulated=tc["simulated"])
     return result, sim
+
+
+def _check_compare_args(settings: Any, threshold: Any, torque_threshold: Any, series: Any, motor: Any, cap: Any) -> None:
+    """:func:`compare_scene`'s options, each named when wrong."""
+    from planar.core.fields import check_kind, check_number
+    from planar.errors import InputError
+    from planar.physics.settings import SimSettings
+
+    if settings is not None:
+        check_kind("settings", settings, SimSettings, "a SimSettings (or None)")
+    for name, value in (("threshold", threshold), ("torque_threshold", torque_threshold)):
+        if not check_number(name, value) > 0:
+            raise InputError(name, value, "a positive fraction")
+    if cap is not None and not check_number("time_cap", cap) > 0:
+        raise InputError("time_cap", cap, "a positive number of seconds (or None)")
+    if not isinstance(series, bool) or (motor is not None and not isinstance(motor, bool)):
+        raise InputError("with_series, motor", (series, motor), "True or False (motor: or None)")

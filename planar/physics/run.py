@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 from planar.core.effects import Effects
 from planar.core.geometry import poses_apply
 from planar.core.model import Mechanism, Motion, joint_residuals
-from planar.errors import PlanarError
+from planar.errors import InputError, PlanarError
 from planar.physics.cycle import check_cycle
 from planar.physics.failure import _failure_at, _PoseCheck, change_point
 from planar.physics.rebuild import _Rebuild
@@ -254,6 +254,10 @@ def simulate(
 
 def simulate_scene(scene: Scene, settings: SimSettings = DEFAULT_SETTINGS, mode: str | None = None) -> SimResult:
     """Simulate a scene over its cycles with its effects (kinematic driver unless a motor limit is named)."""
+    from planar.core.fields import check_kind
+    from planar.scene.build import Scene as SceneKind
+
+    check_kind("scene", scene, SceneKind, "a Scene (planar.load_scene, or scene_from_mechanism)")
     e = scene.effects
     if mode is None:
         mode = "motor" if e.motor_force_limit is not None else "kinematic"
@@ -282,6 +286,11 @@ def torque_comparison(
     failure are compared.  ``saturated`` lists the samples where the motor
     reached ``effects.motor_force_limit``.
     """
+    from planar.core.fields import check_samples
+
+    t = check_samples("torque_comparison(t)", t)
+    if len(t) < 2:
+        raise InputError("torque_comparison(t)", t, "two or more sample times (s)")
     t = np.asarray(t, float)
     dt = float(t[1] - t[0])
     # one sample of lead-in, so that the first compared interval starts with settled joint forces

@@ -138,6 +138,16 @@ def simulate_toy(
     follower's plane.  A stage that cannot be simulated is reported with the
     reason.
     """
+    from planar.core.fields import check_kind
+    from planar.windup.chain import ToyMechanism
+
+    check_kind("simulate_toy(toy)", toy, ToyMechanism, "a ToyMechanism (planar.windup.chain)")
+    from planar.core.fields import check_samples
+    from planar.errors import InputError
+
+    t = check_samples("simulate_toy(t)", t)
+    if len(t) < 2:
+        raise InputError("simulate_toy(t)", t, "two or more sample times (s)")
     from planar.analysis.dynamics import gravity_and_damping, plane_gravity
     from planar.physics.simulate import SimSettings, torque_comparison
 

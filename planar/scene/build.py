@@ -43,6 +43,18 @@ class Scene:
     path: str = "<scene>"
     polygons: dict[str, tuple[str, np.ndarray]] = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        if not isinstance(self.spec, SceneSpec):
+            raise InputError("Scene.spec", self.spec, "a SceneSpec (planar.scene.parse_scene of a table)")
+        if not isinstance(self.mechanism, Mechanism):
+            raise InputError("Scene.mechanism", self.mechanism, "a Mechanism (build_scene makes one from the spec)")
+        if not isinstance(self.path, str):
+            raise InputError("Scene.path", self.path, "a string naming the scene in messages")
+        if not isinstance(self.polygons, dict) or not all(
+            isinstance(v, tuple) and len(v) == 2 and isinstance(v[0], str) for v in self.polygons.values()
+        ):
+            raise InputError("Scene.polygons", self.polygons, "a dict of name to (part, (M, 2) array)")
+
     def __repr__(self) -> str:
         return f"<Scene {self.spec.name!r} from {self.path}: {self.mechanism!r}>"
 
@@ -103,6 +115,8 @@ class Scene:
         from planar.fileio import check_output
         from planar.scene.write import write_scene
 
+        if path is None:
+            raise InputError("path", None, "a file name ending in .toml")
         check_output("path", path, (".toml",))  # TOML never goes into s.csv
         write_scene(self.spec, path)
 
@@ -202,6 +216,10 @@ def _build_mechanism(spec: SceneSpec, m: Any, path: str, rate: float) -> Mechani
 
 def build_scene(spec: SceneSpec, path: str = "<scene>") -> Scene:
     """Build the mechanism a validated scene describes."""
+    if not isinstance(spec, SceneSpec):
+        raise InputError("spec", spec, "a SceneSpec (planar.scene.parse_scene of a table)")
+    if not isinstance(path, str):
+        raise InputError("path", path, "a string naming the scene in messages")
     m = spec.mechanism
     rate = 2 * math.pi * spec.driver.speed
     if not (math.isfinite(rate) and math.isfinite(2 * math.pi / rate) and rate > 0):
@@ -540,15 +558,20 @@ def _build_cam(spec: SceneSpec, m: CamSpec, rate: float, phase: float) -> Mechan
 
     f = m.follower
     osc = f.motion == "oscillating"
-    program = Program(
-        [
-            Segment(
-                sg.law,
-                _angle(spec, sg.angle, f"segments[{i}].angle"),
-                _angle(spec, sg.lift, f"segments[{i}].lift") if osc else float(sg.lift),
+    segments = []
+    for i, sg in enumerate(m.segments):
+        try:
+            segments.append(
+                Segment(
+                    sg.law,
+                    _angle(spec, sg.angle, f"segments[{i}].angle"),
+                    _angle(spec, sg.lift, f"segments[{i}].lift") if osc else float(sg.lift),
+                )
             )
-            for i, sg in enumerate(m.segments)
-        ],
+        except InputError as e:  # the segment's own check, named by its place in the file
+            raise InputError(f"mechanism.segments[{i}].{e.field.rpartition('.')[2]}", e.value, e.expected) from None
+    program = Program(
+        segments,
         "mechanism.segments",
         lift_unit="deg" if osc and spec.angle_unit == "deg" else "",
     )

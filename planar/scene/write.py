@@ -240,6 +240,10 @@ def _table(path: str, d: Mapping[str, Any], lines: list[str]) -> None:
 
 def scene_toml(spec: SceneSpec) -> str:
     """A scene's keys as TOML text: the keys it was given (defaults left out), tables in schema order."""
+    from planar.scene.schema import SceneSpec
+
+    if not isinstance(spec, SceneSpec):
+        raise InputError("spec", spec, "a SceneSpec (Scene.spec, or planar.scene.parse_scene of a table)")
     data = spec.model_dump(mode="json", exclude_unset=True, exclude_none=True)
     data.setdefault("mechanism", {})["type"] = spec.mechanism.type
     top = {k: v for k, v in data.items() if not isinstance(v, dict)}
@@ -255,8 +259,11 @@ def scene_toml(spec: SceneSpec) -> str:
 
 def write_scene(spec: SceneSpec, path: str | os.PathLike[str]) -> None:
     """Write ``spec`` to ``path`` as a scene file (atomically; ``planar.scene.load.load_scene`` reads it back)."""
-    from planar.fileio import atomic_write
+    from planar.fileio import atomic_write, check_output
 
+    if path is None:
+        raise InputError("path", None, "a file name ending in .toml")
+    check_output("path", path, (".toml",))  # TOML never goes into s.csv
     text = scene_toml(spec)
     with atomic_write(path, "w") as fh:
         fh.write(text)

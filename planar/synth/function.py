@@ -241,6 +241,8 @@ def synthesise_function(
     """
     from planar.synth.function_search import FunctionConstraints, output_errors, search_function, violations
 
+    if cons is not None and not isinstance(cons, FunctionConstraints):
+        raise InputError("cons", cons, "a FunctionConstraints (or None)")
     cons = FunctionConstraints() if cons is None else cons
     phi, psi = _pairs(phi, psi, ground)
     if len(np.unique(phi)) < len(phi):

@@ -263,6 +263,18 @@ def search_function(
     The seeds are judged at up to ``SCREEN`` pairs spread over the inputs (the arc test uses all of
     them); the refinement and the choice at every pair.
     """
+    from planar.core.fields import check_kind, check_number, check_samples
+    from planar.errors import InputError
+
+    phi, psi = check_samples("phi", phi), check_samples("psi", psi)
+    if len(phi) != len(psi) or len(phi) < 3:
+        raise InputError("phi, psi", (len(phi), len(psi)), "3 or more input and output angles, as many of each")
+    check_kind("cons", cons, FunctionConstraints)
+    for name, value, least, most in (("n_random", n_random, 1, 1 << 22), ("grid", grid, 2, 4096), ("starts", starts, 1, 4096)):
+        if not least <= check_number(name, value, integer=True) <= most:
+            raise InputError(name, value, f"a whole number from {least} to {most}")
+    if check_number("seed", seed, integer=True) < 0:
+        raise InputError("seed", seed, "a whole number >= 0")
     order = np.argsort(phi, kind="stable")  # seeds judged at most SCREEN pairs, spread over the arc
     sub = order[np.unique(np.round(np.linspace(0, len(phi) - 1, min(len(phi), SCREEN))).astype(int))]
     X = _seeds(phi[sub], psi[sub], cons, n_random, grid, seed)

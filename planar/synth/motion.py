@@ -338,10 +338,7 @@ def _choose(poses: Array, z: Array, c: Array, max_ratio: float, min_transmission
 
 
 def _burmester(poses: Array, max_ratio: float, grid: int, min_transmission: float) -> MotionDesign:
-    """:func:`burmester` without the nearest design."""
-    poses = np.asarray(poses, float)
-    if poses.ndim != 2 or poses.shape[1] != 3 or not 3 <= len(poses) <= 5:
-        raise InputError("poses", poses.shape, "3, 4 or 5 poses (x, y, angle)")
+    """:func:`burmester` without the nearest design (the arguments checked)."""
     L = _scale(poses)
     if len(poses) == 3:
         g = np.linspace(-2 * L, 2 * L, grid)
@@ -382,10 +379,21 @@ def burmester(poses: Array, max_ratio: float = 10.0, grid: int = 24, min_transmi
     meets the poses exactly in order on one circuit; for 4 or 5 poses its ``nearest`` is the four-bar nearest
     to it (:func:`nearest_motion`).
     """
+    from planar.core.fields import check_finite, check_number
+
+    poses = check_finite("poses", poses)
+    if poses.ndim != 2 or poses.shape[1] != 3 or not 3 <= len(poses) <= 5:
+        raise InputError("poses", poses.shape, "3, 4 or 5 poses (x, y, angle)")
+    if not 1.0 <= check_number("max_ratio", max_ratio) <= 1e6:
+        raise InputError("max_ratio", max_ratio, "a longest-to-shortest link ratio from 1 to 1e6")
+    if not 2 <= check_number("grid", grid, integer=True) <= 4096:
+        raise InputError("grid", grid, "a whole number of grid points a side, 2 to 4096")
+    if not 0.0 <= check_number("min_transmission", min_transmission) < np.pi / 2:
+        raise InputError("min_transmission", min_transmission, "an angle from 0 to below pi/2 rad")
     try:
         return _burmester(poses, max_ratio, grid, min_transmission)
     except NoMotionDesign as e:
-        p = np.asarray(poses, float)
+        p = poses
         if len(p) >= 4:
             e.nearest = nearest_motion(p, max_ratio, min_transmission)
         if e.nearest is not None and e.nearest.checks["ok_reaches_every_pose"]:

@@ -28,10 +28,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from planar.core.fields import check_number
 from planar.errors import InputError
 from planar.synth.designs import Checked, PlacedFourBar
 from planar.synth.search import Constraints, PathObjective, constraint_failures, search_fourbar
-from planar.synth.targets import normalisation
+from planar.synth.targets import check_search_args, normalisation
 
 __all__ = ["FourBarDesign", "synthesise_path"]
 
@@ -212,7 +213,7 @@ def best_fourbar(
     normalised with them): a :class:`planar.synth.search.SearchResult`."""
     from threadpoolctl import threadpool_limits
 
-    if budget not in BUDGETS:
+    if not isinstance(budget, str) or budget not in BUDGETS:
         raise InputError("budget", budget, f"one of {', '.join(BUDGETS)}")
     with threadpool_limits(1):
         return _search(t, theta, cons, budget, seed, tolerance, atlas, ordered)[0]
@@ -298,12 +299,12 @@ def synthesise_path(
     """
     from threadpoolctl import threadpool_limits
 
+    t, theta = check_search_args(targets, theta, seed, tolerance, {"ordered": ordered})
+    if cons is not None and not isinstance(cons, Constraints):
+        raise InputError("cons", cons, "a synth.search.Constraints (or None)")
     cons = cons if cons is not None else Constraints()
-    t = np.asarray(targets, float)
-    if t.ndim != 2 or t.shape[1] != 2 or len(t) < 3:
-        raise InputError("targets", t.shape, "3 or more (x, y) points")
-    if theta is not None and len(theta) != len(t):
-        raise InputError("theta", len(theta), f"one crank angle per target ({len(t)})")
+    if not 0.0 <= check_number("min_transmission", min_transmission) < math.pi / 2:
+        raise InputError("min_transmission", min_transmission, "an angle from 0 to below pi/2 rad")
     if np.ptp(t, axis=0).max() <= 0:
         raise InputError("targets", t[0].tolist(), "targets that are not all the same point")
     if budget not in BUDGETS:

@@ -379,19 +379,20 @@ def synthesise_sixbar(
     from scipy.optimize import differential_evolution
 
     from planar.synth.search import default_bounds
+    from planar.synth.targets import check_search_args
 
+    t, theta = check_search_args(targets, theta, seed, tolerance, {"ordered": ordered})
+    if cons is not None and not isinstance(cons, Constraints):
+        raise InputError("cons", cons, "a synth.search.Constraints (or None)")
     cons = cons if cons is not None else Constraints()
-    if topology not in TOPOLOGIES:
+    if not isinstance(topology, str) or topology not in TOPOLOGIES:
         raise InputError("topology", topology, f"one of {', '.join(TOPOLOGIES)}")
-    t = np.asarray(targets, float)
-    if t.ndim != 2 or t.shape[1] != 2 or len(t) < 3:
-        raise InputError("targets", t.shape, "3 or more (x, y) points")
-    if theta is not None and len(theta) != len(t):
-        raise InputError("theta", len(theta), f"one crank angle per target ({len(t)})")
     kw = {"quick": (20_000, 60, 10, 2), "normal": (100_000, 200, 15, 4), "thorough": (400_000, 600, 25, 8)}
     if isinstance(budget, tuple):
+        if len(budget) != 4 or not all(isinstance(v, int) and not isinstance(v, bool) and 0 < v <= 10**7 for v in budget):
+            raise InputError("budget", budget, "(samples, iterations, population, refinements): four whole numbers from 1 to 1e7")
         n_sample, maxiter, popsize, refine = budget
-    elif budget in kw:
+    elif isinstance(budget, str) and budget in kw:
         n_sample, maxiter, popsize, refine = kw[budget]
     else:
         raise InputError("budget", budget, f"one of {', '.join(kw)}")

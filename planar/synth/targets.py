@@ -233,3 +233,27 @@ def check_theta(theta: Array, name: str, deg: bool) -> None:
             f"targets {i + 1} and {j + 1} (in data-row order) at the same crank angle {theta[i]:.6g}",
             "a different crank angle (modulo a turn) at every target",
         )
+
+
+def check_search_args(
+    targets: Any, theta: Any = None, seed: Any = 0, tolerance: Any = 1.0, flags: dict[str, Any] | None = None, width: int = 2
+) -> tuple[Array, Array | None]:
+    """The Python entrance of a synthesis: ``targets`` ``(N, width)`` finite numbers (``N >= 3``), ``theta`` one
+    finite crank angle per target (or ``None``), ``seed`` a whole number >= 0, ``tolerance`` a positive number and
+    each of ``flags`` True or False; :class:`InputError` naming the argument.  Returns ``(targets, theta)`` as arrays.
+    """
+    from planar.core.fields import check_finite, check_number, check_positive, check_samples
+
+    t = check_finite("targets", targets)
+    if t.ndim != 2 or t.shape[1] != width or len(t) < 3:
+        raise InputError("targets", f"an array of shape {t.shape}", f"3 or more points, an array ({'N'}, {width})")
+    th = None if theta is None else check_samples("theta", theta, len(t))
+    if th is not None and len(th) != len(t):
+        raise InputError("theta", len(th), f"one crank angle per target ({len(t)})")
+    if check_number("seed", seed, integer=True) < 0:
+        raise InputError("seed", seed, "a whole number >= 0")
+    check_positive("tolerance", tolerance, "tolerance")
+    for name, value in (flags or {}).items():
+        if not isinstance(value, (bool, np.bool_)):
+            raise InputError(name, value, "True or False")
+    return t, th

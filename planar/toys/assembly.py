@@ -345,6 +345,9 @@ class ToyAssembly(Mechanism):
     """
 
     def __init__(self, toy: ToyMechanism) -> None:
+        from planar.core.fields import check_kind
+
+        check_kind("ToyAssembly(toy)", toy, ToyMechanism, "a ToyMechanism (planar.windup.chain)")
         self.toy = toy
         self.placed = _placements(toy)
         self.notes: list[str] = []
@@ -580,6 +583,9 @@ class ToyAssembly(Mechanism):
 
 def toy_assembly(toy: Any) -> ToyAssembly:
     """The assembly of a :class:`~planar.windup.chain.ToyMechanism` (cached on the toy)."""
+    from planar.core.fields import check_kind
+
+    check_kind("toy_assembly(toy)", toy, ToyMechanism, "a ToyMechanism (planar.windup.chain)")
     got = getattr(toy, "_assembly", None)
     if got is None:
         got = ToyAssembly(toy)

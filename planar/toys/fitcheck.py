@@ -25,6 +25,7 @@ CAM_STAGES = (1, 2, 3)
 
 def fit_play(settings: Any) -> float:
     """The fit's play (mm): the larger of the pin clearance and the kerf of the fabrication settings."""
+    _check_settings("fit_play(settings)", settings)
     return float(max(settings.clearance, settings.kerf))
 
 
@@ -35,6 +36,14 @@ def _travel(track: np.ndarray) -> float:
 
 def small_motions(toy: Any, settings: Any, samples: int = 73) -> list[dict[str, Any]]:
     """The items of :func:`motion_sizes` under ``FIT_MARGIN`` x :func:`fit_play` (mm)."""
+    from planar.core.fields import check_kind, check_number
+    from planar.errors import InputError
+    from planar.windup.chain import ToyMechanism
+
+    check_kind("small_motions(toy)", toy, ToyMechanism, "a ToyMechanism (planar.windup.chain)")
+    _check_settings("small_motions(settings)", settings)
+    if not 3 <= check_number("small_motions(samples)", samples, integer=True) <= 100_000:
+        raise InputError("small_motions(samples)", samples, "a whole number of samples, 3 to 100 000")
     return [m for m in motion_sizes(toy, settings, samples) if m["mm"] < m["limit_mm"]]
 
 
@@ -88,3 +97,11 @@ def small_motion_text(item: dict[str, Any], settings: Any) -> str:
         f"({fit_play(settings):g} mm, the larger of clearance_mm {settings.clearance:g} and kerf_mm "
         f"{settings.kerf:g}): the cut parts will not make this motion (ask for a larger range)"
     )
+
+
+def _check_settings(field: str, settings: Any) -> None:
+    """Fabrication settings (:class:`planar.fabrication.FabSettings`: its ``unit_mm``, ``clearance`` and ``kerf``)."""
+    from planar.errors import InputError
+
+    if not all(isinstance(getattr(settings, f, None), float | int) for f in ("unit_mm", "clearance", "kerf")):
+        raise InputError(field, settings, "fabrication settings (planar.fabrication.FabSettings)")

@@ -27,6 +27,7 @@ from numpy.typing import NDArray
 
 from planar.core.model import Mechanism
 from planar.core.rates import RatesResult
+from planar.errors import InputError
 from planar.windup import params as P_
 from planar.windup import rates as R
 from planar.windup.builders import ElementalBuilders, _xy
@@ -79,7 +80,13 @@ class ElementalMechanism(ElementalBuilders, Mechanism):
         by default one cycle of the standalone driver law."""
         self.record = rec = elemental_record(number)
         self.number = rec.number
-        self._sizing_input = None if sizing_input is None else np.asarray(sizing_input, float)
+        from planar.core.fields import check_finite, check_kind
+
+        self._sizing_input = None if sizing_input is None else check_finite("sizing_input", sizing_input)
+        if self._sizing_input is not None and (self._sizing_input.ndim not in (1, 2) or not len(self._sizing_input)):
+            raise InputError("sizing_input", sizing_input, "driver motions: one value (or one row) per sample")
+        if params is not None:
+            check_kind("params", params, rec.params, f"the parameters of mechanism #{rec.number} (params_for({rec.number}))")
         #: the mechanism's parameter record (its ``ElementalRecord.params`` class; fields vary by mechanism)
         self.params: Any = params.replace(**overrides) if params is not None else params_for(self.number, **overrides)
         check_params(self.number, self.params)

