@@ -659,17 +659,50 @@ def align_candidates(obj: PathObjective, C: Array, samples: int = 64, block: int
             b0 = t.mean() - a * m.mean(1)
         w = a[:, None] * z + b0[:, None]
         sc = np.sum(np.min(np.abs(w[:, None, :] - t[None, :, None]) ** 2, axis=2), axis=1)
-        k = np.abs(a)
-        o = a * (R[:, 6] + 1j * R[:, 7]) + b0
-        moved = R.copy()
-        moved[:, :6] *= k[:, None]
-        moved[:, 6], moved[:, 7] = o.real, o.imag
-        moved[:, 8] = R[:, 8] + np.angle(a)
-        moved[:, 8] = np.mod(moved[:, 8] + np.pi, 2 * np.pi) - np.pi
-        use = good & np.isfinite(sc) & (k > 0)
+        moved = _moved(R, a, b0)
+        use = good & np.isfinite(sc) & (np.abs(a) > 0)
         out[i : i + block][use] = moved[use]
         score[i : i + block][use] = sc[use]
     return out, score
+
+
+def _moved(R: Array, a: NDArray[np.complex128], b0: NDArray[np.complex128]) -> Array:
+    """Candidate rows ``R`` ``(K, 10)`` moved by the similarities ``w = a z + b0`` (complex, one per row): lengths
+    and coupler point scaled by ``|a|``, the crank pivot mapped, the ground line turned by ``arg a``."""
+    k = np.abs(a)
+    o = a * (R[:, 6] + 1j * R[:, 7]) + b0
+    moved = R.copy()
+    moved[:, :6] *= k[:, None]
+    moved[:, 6], moved[:, 7] = o.real, o.imag
+    moved[:, 8] = np.mod(R[:, 8] + np.angle(a) + np.pi, 2 * np.pi) - np.pi
+    return moved
+
+
+def timed_starts(atlas: Any, obj: PathObjective, k: int = 64) -> Array:
+    """Starts for timed targets (``obj.theta`` given): the targets' atlas neighbours (:func:`planar.synth.atlas.candidates`,
+    ``k`` per query), each moved by the similarity that best maps its coupler points at the prescribed crank angles
+    onto the targets (the correspondence is known: closed-form complex least squares), best first by what remains.
+
+    The crank angle is measured from the ground line, which the similarity turns with the linkage, so an atlas
+    neighbour of the four-bar itself lands near it; a cognate or a mirror image (same curve, other timing) does
+    not, and ranks low."""
+    from planar.synth.atlas import candidates
+
+    C = candidates(atlas, obj.targets, k)
+    if len(C) == 0:
+        return C
+    th = np.broadcast_to(np.asarray(obj.theta, float), (len(C), len(obj.targets)))
+    x, y, ok = coupler_points(C[:, :N_PARAMS], np.ascontiguousarray(th), np.where(C[:, 9] >= 0, 1.0, -1.0))
+    z = x + 1j * y
+    t = obj.targets[:, 0] + 1j * obj.targets[:, 1]
+    zc = z - z.mean(1, keepdims=True)
+    den = np.sum(np.abs(zc) ** 2, axis=1)
+    a = np.where(den > 0, np.sum(np.conj(zc) * (t - t.mean())[None, :], axis=1) / np.where(den > 0, den, 1.0), 0.0)
+    b0 = t.mean() - a * z.mean(1)
+    score = np.sum(np.abs(a[:, None] * z + b0[:, None] - t[None, :]) ** 2, axis=1)
+    score = np.where(ok.all(1) & (np.abs(a) > 0) & np.isfinite(score), score, np.inf)
+    order = np.argsort(score, kind="stable")
+    return _moved(C, a, b0)[order[np.isfinite(score[order])]]
 
 
 def _refine_starts(
@@ -775,12 +808,18 @@ def _reached(obj: PathObjective, row: Array, theta: Array, stop: float | Any) ->
 #: crank angles fixed, and the timed largest distance that ends the search
 TIMED_FROM, TIMED_STOP = 1e-6, 1e-9
 
+#: timed targets: how many direct starts (:func:`timed_starts`) are refined before the untimed search
+TIMED_DIRECT = 4
+
 
 def timed_from_atlas(
     targets: Array, theta: Array, atlas: Any, cons: Constraints | None = None, starts: int = 3
 ) -> SearchResult | None:
-    """Timed targets (normalised) from the atlas: the untimed curve (:func:`search_atlas`), then least squares
-    with the crank angles fixed at ``theta`` from it (None when no start closes at every crank angle)."""
+    """Timed targets (normalised) from the atlas: the :data:`TIMED_DIRECT` best direct starts
+    (:func:`timed_starts`) refined with the crank angles fixed at ``theta``; when none is exact, the untimed
+    curve (:func:`search_atlas`, each refined start within :data:`TIMED_FROM` refined again with the angles
+    fixed, until one is exact), then least squares with the angles fixed from its best (None when no start
+    closes at every crank angle)."""
     import time
 
     cons = cons if cons is not None else Constraints()
@@ -800,6 +839,13 @@ def timed_from_atlas(
         timed.append((e, r, tt))
         return max_distance(obj, r, obj.theta) <= TIMED_STOP and not constraint_failures(r[:N_PARAMS], cons)  # type: ignore[arg-type]
 
+    # first the direct starts: the neighbours placed by the prescribed timing, refined with the angles fixed
+    for row in timed_starts(atlas, obj)[:TIMED_DIRECT]:
+        r, tt, e = _refine(obj, row, b, max_nfev=REFINE_NFEV, method="lm")
+        if max_distance(obj, r, obj.theta) <= TIMED_STOP and not constraint_failures(r[:N_PARAMS], cons):  # type: ignore[arg-type]
+            stages = {"timed_s": time.perf_counter() - t0}
+            return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), True, 0, stages)
+        timed.append((e, r, tt))
     u = search_atlas(targets, atlas, cons, stop=exact_timed)
     r0, tt0, e0 = _refine(obj, np.append(u.params, u.circuit), b, max_nfev=REFINE_NFEV, method="lm")
     timed.append((e0, r0, tt0))

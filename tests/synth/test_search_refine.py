@@ -15,6 +15,8 @@ from planar.synth.search import (
     max_distance,
     min_norm_newton,
     search_atlas,
+    timed_from_atlas,
+    timed_starts,
 )
 from planar.synth.targets import normalisation
 
@@ -130,3 +132,24 @@ def test_eight_targets_the_targets_own_neighbours_miss_are_recovered():
     obj = PathObjective(t, None, Constraints())
     assert r.feasible
     assert max_distance(obj, np.append(r.params, r.circuit), r.theta) <= 1e-9
+
+
+def test_timed_targets_are_placed_by_their_timing_and_refined_exactly():
+    """Timed targets (10, random crank-rockers not in the atlas, a 1,500-curve atlas): the direct starts, placed by
+    the similarity fitted at the prescribed crank angles, fit the targets better than the best entry placed by
+    the curves' descriptors, and the first few refined with the angles fixed are exact, so the untimed search
+    never runs (its stages are absent)."""
+    from planar.synth.atlas import candidates
+
+    atlas = build_atlas(1500, seed=1)
+    for k in range(2):
+        T, th = reachable_problem(np.random.default_rng(40 + k), 10)
+        c, s = normalisation(T)
+        obj = PathObjective((T - c) / s, th, Constraints())
+        direct = timed_starts(atlas, obj)
+        placed = candidates(atlas, obj.targets, 64)
+        assert obj.population(direct[:1], np.float64)[0] < obj.population(placed, np.float64).min()
+        r = timed_from_atlas(obj.targets, th, atlas)
+        assert r is not None and r.feasible
+        assert max_distance(obj, np.append(r.params, r.circuit), th) <= 1e-9
+        assert set(r.stages) == {"timed_s"}
