@@ -301,36 +301,22 @@ def ordered_theta(d2: Array, th: Array, starts: int = 4) -> tuple[Array, float]:
     return best[1], best[0]
 
 
-def _refine(
-    obj: PathObjective,
-    row: Array,
-    bounds: list[tuple[float, float]],
-    max_nfev: int,
-    method: str = "trf",
-    theta0: Array | None = None,
-) -> tuple[Array, Array, float]:
-    """least_squares from ``row``: returns (row, theta at the targets, sse with penalties).
-
-    ``method="lm"`` (Levenberg-Marquardt, no bounds: the constraints stay penalties) converges in far fewer
-    evaluations on reachable targets; it needs at least as many residuals as variables (else trf is used).
-    """
-    from scipy.optimize import least_squares
-
-    circ = np.array([1.0 if row[9] >= 0 else -1.0])
-    lo = np.array([b[0] for b in bounds[:N_PARAMS]])
-    hi = np.array([b[1] for b in bounds[:N_PARAMS]])
+def _residual_functions(obj: PathObjective, circuit: float, hi: Array) -> tuple[Any, Any]:
+    """The residuals of the least-squares refinement and their Jacobian, as functions of the variables ``z``
+    (the kernel's 9 parameters, then the crank angle at each target when ``obj`` is untimed): ``2 n``
+    distances along x and y, then the weighted constraint violation.  ``hi``: the parameters' upper bounds (a
+    difference step that would cross one goes the other way)."""
     timed = obj.theta is not None
     n = len(obj.targets)
-    th0: Array = obj.theta if obj.theta is not None else (_nearest_theta(obj, row) if theta0 is None else theta0)
+    th0 = obj.theta
+    circ = np.array([circuit])
     w = np.sqrt(obj.penalty)
-
-    def split(z: Array) -> tuple[Array, Array]:
-        return z[:N_PARAMS], (obj.theta if timed else z[N_PARAMS:])  # type: ignore[return-value]
+    hi = hi[:N_PARAMS] if timed else np.concatenate([hi[:N_PARAMS], np.full(n, np.inf)])
 
     def rows(Z: Array) -> Array:
         """Residuals of many variable vectors ``Z`` ``(K, m)`` in one kernel call: ``(K, 2 n + 1)``."""
         P = Z[:, :N_PARAMS]
-        th = np.broadcast_to(th0, (len(Z), n)) if timed else Z[:, N_PARAMS:]
+        th = np.broadcast_to(th0, (len(Z), n)) if th0 is not None else Z[:, N_PARAMS:]
         x, y, ok = coupler_points(P, np.ascontiguousarray(th), np.full(len(Z), circ[0]))
         r = np.concatenate([x - obj.targets[:, 0], y - obj.targets[:, 1]], axis=1)
         r = np.where(np.concatenate([ok, ok], axis=1), r, obj.scale)
@@ -361,6 +347,36 @@ def _refine(
             J[n + i, N_PARAMS + i] = d[n:] / h[N_PARAMS:]
         return J
 
+    return resid, jac
+
+
+def _refine(
+    obj: PathObjective,
+    row: Array,
+    bounds: list[tuple[float, float]],
+    max_nfev: int,
+    method: str = "trf",
+    theta0: Array | None = None,
+    polish: bool = True,
+) -> tuple[Array, Array, float]:
+    """least_squares from ``row``: returns (row, theta at the targets, sse with penalties).
+
+    ``method="lm"`` (Levenberg-Marquardt, no bounds: the constraints stay penalties) converges in far fewer
+    evaluations on reachable targets; it needs at least as many residuals as variables (else trf is used).
+    """
+    from scipy.optimize import least_squares
+
+    circ = np.array([1.0 if row[9] >= 0 else -1.0])
+    lo = np.array([b[0] for b in bounds[:N_PARAMS]])
+    hi = np.array([b[1] for b in bounds[:N_PARAMS]])
+    timed = obj.theta is not None
+    n = len(obj.targets)
+    th0: Array = obj.theta if obj.theta is not None else (_nearest_theta(obj, row) if theta0 is None else theta0)
+    resid, jac = _residual_functions(obj, float(circ[0]), hi)
+
+    def split(z: Array) -> tuple[Array, Array]:
+        return z[:N_PARAMS], (obj.theta if timed else z[N_PARAMS:])  # type: ignore[return-value]
+
     z0 = np.clip(row[:N_PARAMS], lo, hi)
     if not timed:
         z0 = np.concatenate([z0, th0])
@@ -375,15 +391,53 @@ def _refine(
         res = least_squares(resid, z0, jac=jac, method="lm", x_scale="jac", max_nfev=max_nfev, **tight)
     else:
         res = least_squares(resid, z0, jac=jac, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=max_nfev, **tight)
-    p, th = split(res.x)
+    z, fun = res.x, res.fun
+    if polish and np.sqrt(np.sum(fun**2)) <= NEWTON_FROM * obj.scale:
+        z, fun = min_norm_newton(resid, jac, z, fun)
+    p, th = split(z)
     out = np.append(p, row[9])
     return (
         out,
         np.asarray(th, float).copy(),
         float(obj.population(out[None, :], np.float64)[0])
         if timed
-        else float(np.sum(res.fun[: 2 * n] ** 2) + (obj.penalty if violation(p[None, :], obj.cons, obj.scale)[0] > 0 else 0.0)),
+        else float(np.sum(fun[: 2 * n] ** 2) + (obj.penalty if violation(p[None, :], obj.cons, obj.scale)[0] > 0 else 0.0)),
     )
+
+
+#: the residual norm (a fraction of the targets' size) under which a least-squares result is finished by
+#: :func:`min_norm_newton`, and that finish's most iterations
+NEWTON_FROM, NEWTON_ITERS = 0.05, 30
+
+
+def min_norm_newton(resid: Any, jac: Any, z: Array, r: Array, iters: int = NEWTON_ITERS) -> tuple[Array, Array]:
+    """Gauss-Newton from ``z`` (residuals ``r``) with minimum-norm steps (:func:`numpy.linalg.lstsq`), halving a
+    step that does not lower the residual norm: the variables and residuals it ends at.
+
+    On targets a four-bar passes through (a zero-residual problem) this converges quadratically onto the
+    solutions; with fewer equations than unknowns (8 targets: 16 equations, 17 unknowns) the solutions form
+    a curve and Levenberg-Marquardt crawls along its valley, while the minimum-norm step goes straight to
+    the nearest solution.  Stops when the norm no longer falls or is at rounding level."""
+    f = float(np.sum(r**2))
+    for _ in range(iters):
+        if f <= 1e-28:
+            break
+        dz = np.linalg.lstsq(jac(z), -r, rcond=None)[0]
+        step = 1.0
+        for _ in range(6):
+            zn = z + step * dz
+            rn = resid(zn)
+            fn = float(np.sum(rn**2))
+            if fn < f:
+                break
+            step *= 0.5
+        else:
+            break
+        gain = f - fn
+        z, r, f = zn, rn, fn
+        if gain <= 1e-6 * f and f > 0:
+            break
+    return z, r
 
 
 def search_fourbar(
@@ -484,7 +538,7 @@ def search_atlas(
     cons: Constraints | None = None,
     neighbours: int = 64,
     refine: int = 16,
-    stop: float = 1e-9,
+    stop: float | Any = 1e-9,
     samples: int = 128,
     ordered: bool = False,
 ) -> SearchResult:
@@ -493,8 +547,9 @@ def search_atlas(
     The atlas gives ``8 neighbours`` candidates (:func:`planar.synth.atlas.candidates`); they are scored
     by the untimed objective at ``samples`` crank angles, and the ``refine`` best distinct ones are refined
     by least squares (crank angles at the targets free), best first, stopping early once the largest
-    distance to a target is at most ``stop`` (model units of the normalised targets).  ``ordered``: a
-    result whose branch passes the targets out of order (:func:`in_order`) is kept only if no other is found.
+    distance to a target is at most ``stop`` (model units of the normalised targets; or, a function of a row and
+    its crank angles at the targets, once it returns True).  ``ordered``: a result whose branch passes the targets
+    out of order (:func:`in_order`) is kept only if no other is found.
     """
     import time
 
@@ -512,7 +567,9 @@ def search_atlas(
     t1 = time.perf_counter()
     done: list[tuple[float, Array, Array]] = []
     tried: list[Array] = []
-    if not _refine_starts(obj, cons, b, every, refine, ordered, stop, done, tried):
+    if not _refine_starts(obj, cons, b, every, refine, ordered, stop, done, tried) and not _refine_starts(
+        obj, cons, b, _wide_candidates(atlas, obj), WIDE_REFINE, ordered, stop, done, tried
+    ):
         # none reached ``stop``: look up the curves of the best refined four-bars (they pass near every target,
         # so they describe the targets' curve better than the targets' own spline, which is rough across the
         # gaps between sparse targets), and refine their neighbours
@@ -532,6 +589,26 @@ def search_atlas(
     e, r, tt = best
     feasible = not constraint_failures(r[:N_PARAMS], cons)
     return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), feasible, len(tried), stages)
+
+
+#: the wide lookup, when the targets' nearest entries fail: neighbours per query (8 queries), the best kept by a
+#: cheap similarity fit on a coarse curve (samples) and how many of them are refined
+WIDE_K, WIDE_KEEP, WIDE_SAMPLES, WIDE_REFINE = 4000, 256, 32, 16
+
+
+def _wide_candidates(atlas: Any, obj: PathObjective) -> Array:
+    """Many more of the targets' atlas neighbours (:data:`WIDE_K` per query), ranked by the distance from each
+    target to the nearest point of the candidate's coupler curve after a similarity fit on a coarse curve
+    (:func:`align_candidates` at :data:`WIDE_SAMPLES` crank angles): the :data:`WIDE_KEEP` best.
+
+    Across the gaps between sparse targets their spline differs from the true curve, so the true curve's own
+    neighbours can rank thousands deep among the spline's; the fit to the targets themselves ranks them again."""
+    from planar.synth.atlas import candidates
+
+    C = candidates(atlas, obj.targets, WIDE_K)
+    A, score = align_candidates(obj, C, samples=WIDE_SAMPLES)
+    keep = np.argsort(score, kind="stable")[:WIDE_KEEP]
+    return A[keep]
 
 
 #: after the targets' own lookup: rounds of looking up the best refined curves, from how many of them, the
@@ -582,17 +659,50 @@ def align_candidates(obj: PathObjective, C: Array, samples: int = 64, block: int
             b0 = t.mean() - a * m.mean(1)
         w = a[:, None] * z + b0[:, None]
         sc = np.sum(np.min(np.abs(w[:, None, :] - t[None, :, None]) ** 2, axis=2), axis=1)
-        k = np.abs(a)
-        o = a * (R[:, 6] + 1j * R[:, 7]) + b0
-        moved = R.copy()
-        moved[:, :6] *= k[:, None]
-        moved[:, 6], moved[:, 7] = o.real, o.imag
-        moved[:, 8] = R[:, 8] + np.angle(a)
-        moved[:, 8] = np.mod(moved[:, 8] + np.pi, 2 * np.pi) - np.pi
-        use = good & np.isfinite(sc) & (k > 0)
+        moved = _moved(R, a, b0)
+        use = good & np.isfinite(sc) & (np.abs(a) > 0)
         out[i : i + block][use] = moved[use]
         score[i : i + block][use] = sc[use]
     return out, score
+
+
+def _moved(R: Array, a: NDArray[np.complex128], b0: NDArray[np.complex128]) -> Array:
+    """Candidate rows ``R`` ``(K, 10)`` moved by the similarities ``w = a z + b0`` (complex, one per row): lengths
+    and coupler point scaled by ``|a|``, the crank pivot mapped, the ground line turned by ``arg a``."""
+    k = np.abs(a)
+    o = a * (R[:, 6] + 1j * R[:, 7]) + b0
+    moved = R.copy()
+    moved[:, :6] *= k[:, None]
+    moved[:, 6], moved[:, 7] = o.real, o.imag
+    moved[:, 8] = np.mod(R[:, 8] + np.angle(a) + np.pi, 2 * np.pi) - np.pi
+    return moved
+
+
+def timed_starts(atlas: Any, obj: PathObjective, k: int = 64) -> Array:
+    """Starts for timed targets (``obj.theta`` given): the targets' atlas neighbours (:func:`planar.synth.atlas.candidates`,
+    ``k`` per query), each moved by the similarity that best maps its coupler points at the prescribed crank angles
+    onto the targets (the correspondence is known: closed-form complex least squares), best first by what remains.
+
+    The crank angle is measured from the ground line, which the similarity turns with the linkage, so an atlas
+    neighbour of the four-bar itself lands near it; a cognate or a mirror image (same curve, other timing) does
+    not, and ranks low."""
+    from planar.synth.atlas import candidates
+
+    C = candidates(atlas, obj.targets, k)
+    if len(C) == 0:
+        return C
+    th = np.broadcast_to(np.asarray(obj.theta, float), (len(C), len(obj.targets)))
+    x, y, ok = coupler_points(C[:, :N_PARAMS], np.ascontiguousarray(th), np.where(C[:, 9] >= 0, 1.0, -1.0))
+    z = x + 1j * y
+    t = obj.targets[:, 0] + 1j * obj.targets[:, 1]
+    zc = z - z.mean(1, keepdims=True)
+    den = np.sum(np.abs(zc) ** 2, axis=1)
+    a = np.where(den > 0, np.sum(np.conj(zc) * (t - t.mean())[None, :], axis=1) / np.where(den > 0, den, 1.0), 0.0)
+    b0 = t.mean() - a * z.mean(1)
+    score = np.sum(np.abs(a[:, None] * z + b0[:, None] - t[None, :]) ** 2, axis=1)
+    score = np.where(ok.all(1) & (np.abs(a) > 0) & np.isfinite(score), score, np.inf)
+    order = np.argsort(score, kind="stable")
+    return _moved(C, a, b0)[order[np.isfinite(score[order])]]
 
 
 def _refine_starts(
@@ -602,7 +712,7 @@ def _refine_starts(
     every: Array,
     refine: int,
     ordered: bool,
-    stop: float,
+    stop: float | Any,
     done: list[tuple[float, Array, Array]],
     tried: list[Array],
 ) -> bool:
@@ -645,7 +755,7 @@ def assign_theta(obj: PathObjective, row: Array, n: int = 256) -> Array:
 
 
 def reassigned_refine(
-    obj: PathObjective, row: Array, b: list[tuple[float, float]], nfev: int, stop: float
+    obj: PathObjective, row: Array, b: list[tuple[float, float]], nfev: int, stop: float | Any
 ) -> tuple[Array, Array, float]:
     """Levenberg-Marquardt on the targets with the crank angles free, in short runs of :data:`REASSIGN_NFEV`
     evaluations between which the angles are assigned afresh on the current curve (:func:`assign_theta`), then
@@ -662,7 +772,7 @@ def reassigned_refine(
             break
         r, tt, e = _refine(obj, r, b, max_nfev=REASSIGN_NFEV, method="lm", theta0=assign_theta(obj, r))
         spent += REASSIGN_NFEV
-        if max_distance(obj, r, tt) <= stop:
+        if _reached(obj, r, tt, stop):
             return r, tt, e
     return _refine(obj, r, b, max_nfev=max(nfev - spent, REASSIGN_NFEV), method="lm", theta0=assign_theta(obj, r))
 
@@ -675,7 +785,7 @@ def _refined(
     theta0: Array | None,
     nfev: int,
     ordered: bool,
-    stop: float,
+    stop: float | Any,
     done: list[tuple[float, Array, Array]],
 ) -> bool:
     """Refine one start (appended to ``done``); whether it reached ``stop`` keeping the constraints (and order)."""
@@ -685,23 +795,61 @@ def _refined(
         r, tt, e = _refine(obj, row, b, max_nfev=nfev, method="lm", theta0=theta0)
     ok_order = in_order(tt) or not ordered
     done.append((e if ok_order else e + obj.penalty, r, tt))  # out of order: worse than any in-order result
-    return ok_order and max_distance(obj, r, tt) <= stop and not violation(r[None, :N_PARAMS], cons, obj.scale, 0.0)[0] > 0
+    return ok_order and _reached(obj, r, tt, stop) and not violation(r[None, :N_PARAMS], cons, obj.scale, 0.0)[0] > 0
+
+
+def _reached(obj: PathObjective, row: Array, theta: Array, stop: float | Any) -> bool:
+    """Whether a refined ``row`` (crank angles ``theta`` at the targets) ends the search: its largest distance is
+    at most ``stop``, or ``stop`` (a function of the row and the angles) says so."""
+    return bool(stop(row, theta)) if callable(stop) else max_distance(obj, row, theta) <= stop
+
+
+#: timed targets: the untimed largest distance (the targets' size 1) from which a refined curve is refined with the
+#: crank angles fixed, and the timed largest distance that ends the search
+TIMED_FROM, TIMED_STOP = 1e-6, 1e-9
+
+#: timed targets: how many direct starts (:func:`timed_starts`) are refined before the untimed search
+TIMED_DIRECT = 4
 
 
 def timed_from_atlas(
     targets: Array, theta: Array, atlas: Any, cons: Constraints | None = None, starts: int = 3
 ) -> SearchResult | None:
-    """Timed targets (normalised) from the atlas: the untimed curve (:func:`search_atlas`), then least squares
-    with the crank angles fixed at ``theta`` from it (None when no start closes at every crank angle)."""
+    """Timed targets (normalised) from the atlas: the :data:`TIMED_DIRECT` best direct starts
+    (:func:`timed_starts`) refined with the crank angles fixed at ``theta``; when none is exact, the untimed
+    curve (:func:`search_atlas`, each refined start within :data:`TIMED_FROM` refined again with the angles
+    fixed, until one is exact), then least squares with the angles fixed from its best (None when no start
+    closes at every crank angle)."""
     import time
 
     cons = cons if cons is not None else Constraints()
     t0 = time.perf_counter()
-    u = search_atlas(targets, atlas, cons)
     obj = PathObjective(np.asarray(targets, float), np.asarray(theta, float), cons)
+    free = PathObjective(obj.targets, None, cons)
     b = default_bounds(obj.targets, cons, True)
     b[8] = (-3 * np.pi, 3 * np.pi)
-    r, tt, e = _refine(obj, np.append(u.params, u.circuit), b, max_nfev=REFINE_NFEV, method="lm")
+    timed: list[tuple[float, Array, Array]] = []
+
+    def exact_timed(row: Array, th: Array) -> bool:
+        # a curve through the targets is this four-bar or a cognate (the same curve at other crank angles): only
+        # the angles fixed at ``theta`` tell; a cognate's timed refinement fails and the untimed search goes on
+        if max_distance(free, row, th) > TIMED_FROM:
+            return False
+        r, tt, e = _refine(obj, row, b, max_nfev=REFINE_NFEV, method="lm")
+        timed.append((e, r, tt))
+        return max_distance(obj, r, obj.theta) <= TIMED_STOP and not constraint_failures(r[:N_PARAMS], cons)  # type: ignore[arg-type]
+
+    # first the direct starts: the neighbours placed by the prescribed timing, refined with the angles fixed
+    for row in timed_starts(atlas, obj)[:TIMED_DIRECT]:
+        r, tt, e = _refine(obj, row, b, max_nfev=REFINE_NFEV, method="lm")
+        if max_distance(obj, r, obj.theta) <= TIMED_STOP and not constraint_failures(r[:N_PARAMS], cons):  # type: ignore[arg-type]
+            stages = {"timed_s": time.perf_counter() - t0}
+            return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), True, 0, stages)
+        timed.append((e, r, tt))
+    u = search_atlas(targets, atlas, cons, stop=exact_timed)
+    r0, tt0, e0 = _refine(obj, np.append(u.params, u.circuit), b, max_nfev=REFINE_NFEV, method="lm")
+    timed.append((e0, r0, tt0))
+    e, r, tt = min(timed, key=lambda d: d[0])
     if not np.isfinite(e):
         return None
     stages = {**u.stages, "timed_s": time.perf_counter() - t0}

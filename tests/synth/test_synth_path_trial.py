@@ -64,11 +64,13 @@ def test_same_relative_error_at_any_scale_and_refusal_of_unrepresentable(tmp_pat
         assert d.ok, d.checks
         rel.append(d.sse / k**2)
     assert max(rel) < 1.01 * min(rel), rel  # timed: a real (non-zero) error, the same at every scale
-    # planar's own solver of the mapped-back design at scale 1e-6, not the search, gives that error
-    d = synthesise_path(ELL * 1e-6, th, budget="quick", seed=0)
+    # planar's own solver of the mapped-back design at scale 1e-6, not the search, gives that error (the same
+    # tolerance: a tighter one can send the search on to the global stage and another design)
+    d = synthesise_path(ELL * 1e-6, th, budget="quick", seed=0, tolerance=0.05)
     got = d.fourbar().solve(th).points["coupler_point"]
     assert np.sum((got - ELL * 1e-6) ** 2) / 1e-12 == pytest.approx(rel[1], rel=1e-3)
     src = _csv(tmp_path / "huge.csv", ELL * 1e300)
+    capsys.readouterr()  # what came before (the atlas's one-time build notice when this test runs alone)
     assert main(["synth", "path", src, "-o", str(tmp_path / "h.toml"), "--budget", "quick"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "huge.csv" in err and "1e+60" in err
