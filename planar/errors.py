@@ -24,8 +24,13 @@ def short_repr(value: object, limit: int = 80) -> str:
 
         if isinstance(value, np.ndarray) and value.size > 4:
             finite = value[np.isfinite(value)] if value.dtype.kind == "f" else value
-            rng = f", from {finite.min()!r} to {finite.max()!r}" if finite.size and value.dtype.kind in "fiu" else ""
-            return f"<array of shape {value.shape}{rng}>"
+            rng = (
+                f", from {finite.min().item()!r} to {finite.max().item()!r}" if finite.size and value.dtype.kind in "fiu" else ""
+            )
+            odd = int(value.size - finite.size) if value.dtype.kind == "f" else 0
+            nan = int(np.isnan(value).sum()) if odd else 0
+            odd_text = ", ".join(t for t in (f"{nan} NaN" if nan else "", f"{odd - nan} inf" if odd - nan else "") if t)
+            return f"<array of shape {value.shape}{rng}{', with ' + odd_text if odd else ''}>"
         if isinstance(value, np.generic):
             value = value.item()
     except Exception:  # pragma: no cover - numpy is a dependency; repr below still works

@@ -174,6 +174,9 @@ def atomic_write(path: str | os.PathLike, mode: str = "wb") -> Iterator[IO[Any]]
         raise InputError("output", str(path), "a file name (got an empty one)")
     parent = target.parent if str(target.parent) else Path(".")
     if not parent.is_dir():
+        where = next((a for a in (parent, *parent.parents) if a.exists()), None)
+        if where is not None and not where.is_dir():
+            raise InputError("output", str(path), f"a path in a folder ({where} is a file, not a folder)")
         raise InputError("output", str(path), f"a path in an existing directory ({parent} does not exist)")
     if target.is_dir():
         raise InputError("output", str(path), "a file name (it is a directory)")

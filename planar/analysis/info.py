@@ -351,6 +351,14 @@ def info(mech: Mechanism, samples: int = SAMPLES) -> Info:
     """
     import numpy as np
 
+    from planar.core.fields import check_kind, check_number
+    from planar.core.limits import check_count
+    from planar.core.model import Mechanism
+
+    check_kind("info(mech)", mech, Mechanism, "a Mechanism (a four-bar, a linkage, a cam, a wind-up toy ...)")
+    if check_number("info(samples)", samples, integer=True) < 8:
+        raise InputError("info(samples)", samples, "a whole number of samples, 8 or more")
+    samples = check_count("samples", "info(samples)", samples, "samples")
     d = mech.driver
     full_input = d.kind == "rotation" and d.amplitude is None
     if full_input:

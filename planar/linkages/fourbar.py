@@ -110,6 +110,10 @@ class _Dims:
     d: float
 
 
+#: the keyword options a four-bar passes on to :class:`Linkage` (the driver's and the drawing's)
+_LINKAGE_OPTIONS = frozenset({"rate", "phase", "amplitude", "centre", "width", "pin_diameter"})
+
+
 class FourBar(Linkage):
     """A four-bar linkage driven by its crank (part ``crank``).
 
@@ -132,6 +136,9 @@ class FourBar(Linkage):
         name: str = "fourbar",
         **kw: Any,
     ) -> None:
+        unknown = sorted(set(kw) - _LINKAGE_OPTIONS)
+        if unknown:
+            raise InputError(f"{name}: {unknown[0]}", kw[unknown[0]], f"one of the options {sorted(_LINKAGE_OPTIONS)}")
         a = check_positive(f"{name}.crank", crank)
         b = check_positive(f"{name}.coupler", coupler)
         c = check_positive(f"{name}.rocker", rocker)

@@ -239,10 +239,12 @@ def synthesise_function(
     :class:`.function_search.FunctionConstraints` (default: fixed offsets,
     link ratio 10).
     """
+    from planar.core.fields import check_positive
     from planar.synth.function_search import FunctionConstraints, output_errors, search_function, violations
 
     if cons is not None and not isinstance(cons, FunctionConstraints):
         raise InputError("cons", cons, "a FunctionConstraints (or None)")
+    tolerance = check_positive("tolerance", tolerance, "tolerance (rad)")
     cons = FunctionConstraints() if cons is None else cons
     phi, psi = _pairs(phi, psi, ground)
     if len(np.unique(phi)) < len(phi):

@@ -302,6 +302,11 @@ def synthesise_path(
     t, theta = check_search_args(targets, theta, seed, tolerance, {"ordered": ordered})
     if cons is not None and not isinstance(cons, Constraints):
         raise InputError("cons", cons, "a synth.search.Constraints (or None)")
+    if atlas is not None:
+        from planar.synth.atlas import Atlas
+
+        if not isinstance(atlas, Atlas):
+            raise InputError("atlas", atlas, "an Atlas (planar.synth.atlas.load_atlas), or None for the cached one")
     cons = cons if cons is not None else Constraints()
     if not 0.0 <= check_number("min_transmission", min_transmission) < math.pi / 2:
         raise InputError("min_transmission", min_transmission, "an angle from 0 to below pi/2 rad")
