@@ -303,7 +303,9 @@ def _check_writable(option: str, text: str, parent: Path) -> None:
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{Path(text).name}.{os.getpid()}.", suffix=".part", dir=parent)
     except OSError as e:
-        raise InputError(option, text, f"a path in a folder it can write to ({parent}: {e.strerror})") from None
+        raise InputError(
+            option, text, f"a path in a folder it can write to (no file can be created in {parent}: {e.strerror})"
+        ) from None
     os.close(fd)
     with contextlib.suppress(OSError):
         os.unlink(tmp)

@@ -39,8 +39,10 @@ def _cmd_export(args: argparse.Namespace) -> int:
             "(nothing would be written)",
         )
     outputs(args, (args.scene,), *_EXPORT_OUTPUTS)
-    if args.kerf is not None and not (0 <= args.kerf <= 2):
-        raise InputError("--kerf", args.kerf, "a kerf between 0 and 2 mm")
+    from planar.fabrication.build import KERF_RANGE, kerf_ok
+
+    if args.kerf is not None and not kerf_ok(args.kerf):
+        raise InputError("--kerf", args.kerf, KERF_RANGE)
     scene = load_scene(args.scene)
     size = sheet(args.sheet) if args.sheet else None
     fab = export_scene(

@@ -194,8 +194,8 @@ def _cmd_path(args: argparse.Namespace) -> int:
 
     if not (args.max_ratio > 1 and math.isfinite(args.max_ratio)):
         raise InputError("--max-ratio", args.max_ratio, "a finite ratio greater than 1")
-    if args.seed < 0:
-        raise InputError("--seed", args.seed, "a seed of 0 or more")
+    if not 0 <= args.seed < 2**32:
+        raise InputError("--seed", args.seed, "a seed from 0 to 2**32 - 1")
     if not (args.tolerance > 0 and math.isfinite(args.tolerance)):
         raise InputError("--tolerance", args.tolerance, "a positive fraction of the targets' size")
     min_transmission = _min_transmission_rad(args)
@@ -383,8 +383,8 @@ def _cmd_atlas(args: argparse.Namespace) -> int:
 
     if args.size < 100:
         raise InputError("--size", args.size, "at least 100 four-bars")
-    if args.seed < 0:
-        raise InputError("--seed", args.seed, "a seed of 0 or more")
+    if not 0 <= args.seed < 2**32:
+        raise InputError("--seed", args.seed, "a seed from 0 to 2**32 - 1")
     check_atlas_memory("--size", args.size)  # before any output is checked or any four-bar solved
     if args.output is not None:  # like every output: an existing folder, no folder made for it
         from planar.fileio import check_output
@@ -566,6 +566,10 @@ def _cmd_motion(args: argparse.Namespace) -> int:
         raise InputError("--max-ratio", args.max_ratio, "a finite ratio greater than 1")
     min_transmission = _min_transmission_rad(args)
     t = read_table(args.poses, ("x", "y", "angle"), min_rows=3)
+    from planar.core.limits import check_angle
+
+    for i, a in enumerate(t["angle"]):
+        check_angle(f"{args.poses}: row {i + 1}: angle", a, math.pi / 180 if args.deg else 1.0)
     ang = np.radians(t["angle"]) if args.deg else t["angle"]
     poses = np.column_stack([t["x"], t["y"], ang])
     if len(poses) > 5:

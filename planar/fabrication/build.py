@@ -306,11 +306,21 @@ def build(scene: Any, settings: FabSettings) -> Fabrication:
         raise FabricationError(f"{where}: {e}") from e
 
 
+#: the kerfs a cut accepts, in words (see :func:`kerf_ok`)
+KERF_RANGE = "a kerf of 0, or from 0.001 to 2 mm"
+
+
+def kerf_ok(kerf: float) -> bool:
+    """Whether ``kerf`` (mm) can be cut: 0 (no compensation) or 0.001 to 2 mm (an offset below a micrometre
+    collapses the outlines' offset geometry, and no laser cuts that fine)."""
+    return kerf == 0 or 1e-3 <= kerf <= 2
+
+
 def _build(scene: Any, settings: FabSettings) -> Fabrication:
     """:func:`build` without the file name on its errors."""
     s = settings
-    if not (0 <= s.kerf <= 2):
-        raise InputError("kerf", s.kerf, "a kerf between 0 and 2 mm")
+    if not kerf_ok(s.kerf):
+        raise InputError("kerf", s.kerf, KERF_RANGE)
     from planar.fabrication.tabs import merge_travel, plan_tabs, slot_features, travel_slots
 
     mech = _with_riders(scene, _fab_mechanism(scene.mechanism), s)

@@ -43,6 +43,9 @@ def read_table(
     if not rows:
         raise InputError(p, "empty", f"a header row with columns {', '.join(required)}")
     header = [h.strip().lower() for h in rows[0]]
+    twice = next((h for i, h in enumerate(header) if h and h in header[:i]), None)
+    if twice is not None:
+        raise InputError(f"{p}: header: column", twice, "each column once (which of the two would be read?)")
     for col in required:
         if col not in header:
             raise InputError(
@@ -250,8 +253,8 @@ def check_search_args(
     th = None if theta is None else check_samples("theta", theta, len(t))
     if th is not None and len(th) != len(t):
         raise InputError("theta", len(th), f"one crank angle per target ({len(t)})")
-    if check_number("seed", seed, integer=True) < 0:
-        raise InputError("seed", seed, "a whole number >= 0")
+    if not 0 <= check_number("seed", seed, integer=True) < 2**32:
+        raise InputError("seed", seed, "a whole number from 0 to 2**32 - 1")
     check_positive("tolerance", tolerance, "tolerance")
     for name, value in (flags or {}).items():
         if not isinstance(value, (bool, np.bool_)):
