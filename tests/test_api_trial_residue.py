@@ -13,9 +13,12 @@ import numpy as np
 import pytest
 
 from planar.analysis.info import info
+from planar.draw import plan_frames
 from planar.errors import InputError, LimitError, PlanarError, short_repr
-from planar.linkages import FourBar
+from planar.fabrication.layers import plan_assembly
+from planar.linkages import FourBar, GearMesh, freudenstein_angles
 from planar.synth import synthesise_function, synthesise_path
+from planar.toys import KeyedShaft
 
 LEG = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(5.5, -2.0))
 TARGETS = np.c_[np.cos(np.linspace(0.0, 5.0, 10)), np.sin(np.linspace(0.0, 5.0, 10))]
@@ -64,3 +67,57 @@ def test_an_output_under_a_file_says_it_is_a_file(tmp_path: Path) -> None:
     (tmp_path / "afile").write_text("x")
     with pytest.raises(InputError, match="is a file, not a folder"), atomic_write(tmp_path / "afile" / "x.gif"):
         pass
+
+
+def _theta() -> np.ndarray:
+    return np.linspace(0.0, 6.0, 7)
+
+
+@pytest.mark.parametrize(
+    "call,needle",
+    [
+        # raw exceptions the fifth trial found (AttributeError, OverflowError, ZeroDivisionError, OSError)
+        (lambda: plan_assembly(None, {}, [], [], 10, 3, 3, 1.5), "mech"),
+        (lambda: plan_frames(1e-300, 1e300), "duration"),
+        (lambda: freudenstein_angles(1e-300, 4, 3e-300, 4, _theta()), "freudenstein_angles(a)"),
+        (lambda: freudenstein_angles(1, 4, 3, 4, np.zeros((2, 2))), "theta"),
+        # NaN and inf stored silently; a negative pitch radius
+        (lambda: KeyedShaft("k", "a", "b", (0, 0), (math.nan, 0), 0), "anchor_b"),
+        (lambda: KeyedShaft("k", "a", "b", (0, 0), (0, 0), math.inf), "phase"),
+        (lambda: GearMesh("m", "a", "b", math.nan, 0, (0, 0), (1, 0), 0.5, 0.5), "ratio"),
+        (lambda: GearMesh("m", "a", "b", -1, 0, (0, 0), (1, 0), -0.5, 0.5), "radius_a"),
+    ],
+)
+def test_the_fifth_trial_call_raises_a_named_planar_error(call, needle: str) -> None:
+    with pytest.raises(PlanarError) as e:
+        call()
+    assert needle in str(e.value), str(e.value)
+
+
+def test_a_huge_animation_is_a_limit_error() -> None:
+    with pytest.raises(LimitError, match="PLANAR_MAX_FRAMES"):
+        plan_frames(1e-300, 1e300)
+
+
+@pytest.mark.parametrize("where", ["/proc/demo", "FILE/demo"])
+def test_the_demo_refuses_a_folder_it_cannot_make(tmp_path: Path, where: str) -> None:
+    from planar.app import run_demo
+
+    (tmp_path / "FILE").write_text("x", encoding="utf-8")
+    where = where.replace("FILE", str(tmp_path / "FILE"))
+    if where.startswith("/proc") and not Path("/proc").is_dir():
+        pytest.skip("no /proc here")
+    with pytest.raises(InputError, match="output"):
+        next(iter(run_demo(where)))
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-3, 1.0, 1e3, 1e300])
+def test_freudenstein_angles_do_not_depend_on_the_scale(scale: float) -> None:
+    """The angles of a four-bar depend on its ratios only; at 1e300 they were all NaN, at 1e-300 a ZeroDivisionError."""
+    th3, th4, ok = freudenstein_angles(1.0 * scale, 4.0 * scale, 3.0 * scale, 4.0 * scale, _theta())
+    ref3, ref4, ref_ok = freudenstein_angles(1.0, 4.0, 3.0, 4.0, _theta())
+    assert ok.all() and (ok == ref_ok).all()
+    np.testing.assert_allclose(np.c_[th3, th4], np.c_[ref3, ref4], rtol=0, atol=1e-12)
+    # the closed loop, checked independently: crank tip to rocker tip is the coupler's length
+    b = np.hypot(3 * np.cos(th4) + 4 - np.cos(_theta()), 3 * np.sin(th4) - np.sin(_theta()))
+    np.testing.assert_allclose(b, 4.0, rtol=1e-12)

@@ -586,10 +586,12 @@ def run_demo(output: str | Path) -> Iterator[str]:
     import numpy as np
 
     from planar.analysis import statics as analysis
+    from planar.fileio import check_output
     from planar.linkages import Linkage
     from planar.scene.load import build_scene, parse_scene
 
     _check_path("output", output)
+    check_output("output", output, (), directory=True)
     out = Path(output)
     out.mkdir(parents=True, exist_ok=True)
     for name, data in DEMO_SCENES.items():

@@ -23,7 +23,7 @@ import numpy as np
 
 from planar.core.fields import check_fields, check_kind, check_number
 from planar.core.model import Motion
-from planar.errors import InputError
+from planar.errors import InputError, LimitError
 
 if TYPE_CHECKING:  # pragma: no cover
     from planar.scene.load import Scene
@@ -136,7 +136,6 @@ def plan_frames(period_s: float, duration_s: float, fps: float | None = None, ti
         if 1000.0 * period_s / delay < MIN_FRAMES_PER_CYCLE:
             delay = 20.0 if tick_ms is not None else 1000.0 * period_s / MIN_FRAMES_PER_CYCLE
     per_cycle = max(MIN_FRAMES_ASKED, int(round(1000.0 * period_s / delay)))
-    frames = max(1, int(round(per_cycle * duration_s / period_s)))
     from planar.core.limits import limit
 
     if fps is not None and per_cycle > limit("frames"):  # one cycle alone too many: the rate is at fault
@@ -146,14 +145,17 @@ def plan_frames(period_s: float, duration_s: float, fps: float | None = None, ti
             f"at most {limit('frames') / period_s:.3g} frames per second: one cycle of {period_s:.3g} s would take "
             f"{per_cycle} frames, over the limit of {limit('frames')} (PLANAR_MAX_FRAMES)",
         )
-    if frames > limit("frames"):  # MAX_FRAMES unless PLANAR_MAX_FRAMES raises it
-        raise InputError(
+    # MAX_FRAMES unless PLANAR_MAX_FRAMES raises it
+    frames_f = per_cycle * duration_s / period_s  # inf for a duration 1e300 periods long: refused below
+    if not frames_f <= limit("frames"):
+        raise LimitError(
             "duration",
             duration_s,
-            f"an animation of at most {limit('frames')} frames ({frames} asked "
+            f"an animation of at most {limit('frames')} frames ({frames_f:.3g} asked "
             f"for at {1000.0 / delay:.3g} frames per second; shorten the duration, "
             "lower --fps or raise PLANAR_MAX_FRAMES)",
         )
+    frames = max(1, int(round(frames_f)))
     return FramePlan(float(period_s), float(delay), per_cycle, frames)
 
 
