@@ -13,10 +13,14 @@ import numpy as np
 import pytest
 
 from planar.analysis.info import info
+from planar.cams import CamProfile, FollowerGeometry, Program, Segment
+from planar.core.model import Slide
 from planar.draw import plan_frames
 from planar.errors import InputError, LimitError, PlanarError, short_repr
+from planar.fabrication import FabSettings, part_cuts
 from planar.fabrication.layers import plan_assembly
-from planar.linkages import FourBar, GearMesh, freudenstein_angles
+from planar.linkages import FourBar, GearMesh, Link, freudenstein_angles
+from planar.physics.settings import SimSettings
 from planar.synth import synthesise_function, synthesise_path
 from planar.toys import KeyedShaft
 
@@ -121,3 +125,54 @@ def test_freudenstein_angles_do_not_depend_on_the_scale(scale: float) -> None:
     # the closed loop, checked independently: crank tip to rocker tip is the coupler's length
     b = np.hypot(3 * np.cos(th4) + 4 - np.cos(_theta()), 3 * np.sin(th4) - np.sin(_theta()))
     np.testing.assert_allclose(b, 4.0, rtol=1e-12)
+
+
+def _cam_program() -> Program:
+    return Program([Segment("cycloidal", 2.0, 1.0), Segment("cycloidal", 2.0 * math.pi - 2.0, -1.0)])
+
+
+def _fab(**kw: object) -> FabSettings:
+    return FabSettings(**kw)
+
+
+def _reason(unit: str) -> str:
+    return LEG.run(36).reason(0, angle_unit=unit)
+
+
+@pytest.mark.parametrize(
+    "call,needle",
+    [
+        # out of range, accepted by the constructors until now
+        (lambda: _fab(kerf=-1), "kerf"),
+        (lambda: _fab(sheet=(1e300, 1)), "sheet"),
+        (lambda: _fab(motor_shaft_mm=1e300), "motor_shaft_mm"),
+        (lambda: _fab(hardware="glue"), "hardware"),
+        (lambda: part_cuts(LEG.parts[1], _fab(), -1), "number"),
+        (lambda: Segment("cycloidal", -1), "angle"),
+        (lambda: FollowerGeometry(axis=(0, 0)), "axis"),
+        (
+            lambda: CamProfile(_cam_program(), 1e-300, FollowerGeometry(roller_radius=0.5)),
+            "base_radius",
+        ),
+        (lambda: SimSettings(blowup_tol=0), "blowup_tol"),
+        (lambda: Link("l", ()), "nodes"),
+        (lambda: Link("l", ("O", "O")), "nodes"),
+        (lambda: Slide("s", "a", "b", (0, 0), (1, 0), (0, 0), (0, 0)), "axis"),
+        (lambda: _reason("furlong"), "angle_unit"),
+    ],
+)
+def test_a_value_out_of_range_is_refused_where_it_is_built(call, needle: str) -> None:
+    with pytest.raises(PlanarError) as e:
+        call()
+    assert needle in str(e.value), str(e.value)
+
+
+def test_the_fabrication_bounds_are_the_scene_files() -> None:
+    """One place for both: a scene with the bound's value loads, FabSettings takes it; just past, both refuse."""
+    from planar.core.limits import MAX_MOTOR_MM, MAX_SHEET_MM
+
+    assert _fab(motor_shaft_mm=MAX_MOTOR_MM, sheet=(MAX_SHEET_MM, 1.0)).motor_shaft_mm == MAX_MOTOR_MM
+    with pytest.raises(InputError):
+        _fab(motor_shaft_mm=MAX_MOTOR_MM * 1.001)
+    with pytest.raises(InputError):
+        _fab(sheet=(1.0, MAX_SHEET_MM * 1.001))

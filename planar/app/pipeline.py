@@ -15,6 +15,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from planar.core import limits as _limits
 from planar.errors import InputError
 
 
@@ -91,7 +92,7 @@ def gallery_scenes(folder: str | os.PathLike[str]) -> list[Path]:
 GIF_MAX_DELAY_MS = 655_350.0
 
 #: the largest sheet side (mm) the fabrication geometry is computed for
-MAX_SHEET_MM = 100_000.0
+MAX_SHEET_MM = _limits.MAX_SHEET_MM
 
 
 def scene_style(scene: Scene) -> Style:

@@ -380,6 +380,8 @@ class Slide:
 
     def __post_init__(self) -> None:
         _check_joint(self, ("start", "end", "anchor", "axis"), "width")
+        if self.axis[0] == 0 and self.axis[1] == 0:  # its two pins would be one: nothing stops it turning
+            raise InputError(f"Slide {self.name!r}.axis", self.axis, "a non-zero vector (the second pin's offset)")
 
     def pin_points(self) -> tuple[Vec, Vec]:
         """The two pins of ``b`` in its own frame: ``anchor`` and ``anchor + axis``."""
@@ -640,6 +642,8 @@ class Motion:
         ``angle_unit``); otherwise the driver value is as stored (radians, or a length).
         """
         n = len(self)
+        if not isinstance(angle_unit, str) or angle_unit not in ("rad", "deg"):
+            raise InputError("Motion.reason(angle_unit)", angle_unit, "'rad' or 'deg'")
         if isinstance(i, (bool, np.bool_)) or not isinstance(i, (int, np.integer)):
             raise InputError("Motion.reason(i)", i, "a sample index (a whole number)")
         if not -n <= i < n:
