@@ -103,6 +103,7 @@ def test_a_huge_animation_is_a_limit_error() -> None:
         plan_frames(1e-300, 1e300)
 
 
+@pytest.mark.slow  # the demo's imports
 @pytest.mark.parametrize("where", ["/proc/demo", "FILE/demo"])
 def test_the_demo_refuses_a_folder_it_cannot_make(tmp_path: Path, where: str) -> None:
     from planar.app import run_demo
@@ -158,7 +159,7 @@ def _reason(unit: str) -> str:
         (lambda: Link("l", ()), "nodes"),
         (lambda: Link("l", ("O", "O")), "nodes"),
         (lambda: Slide("s", "a", "b", (0, 0), (1, 0), (0, 0), (0, 0)), "axis"),
-        (lambda: _reason("furlong"), "angle_unit"),
+        pytest.param(lambda: _reason("furlong"), "angle_unit", marks=pytest.mark.slow),  # a solve: >= 0.5 s CPU
     ],
 )
 def test_a_value_out_of_range_is_refused_where_it_is_built(call, needle: str) -> None:
@@ -176,3 +177,52 @@ def test_the_fabrication_bounds_are_the_scene_files() -> None:
         _fab(motor_shaft_mm=MAX_MOTOR_MM * 1.001)
     with pytest.raises(InputError):
         _fab(sheet=(1.0, MAX_SHEET_MM * 1.001))
+
+
+def _kangaroo():  # type: ignore[no-untyped-def]
+    from planar import load_scene
+
+    return load_scene(Path(__file__).parents[1] / "gallery" / "kangaroo-leg.toml")
+
+
+def _plot(tmp: Path) -> None:
+    from planar.draw.charts import write_plot
+
+    write_plot(_kangaroo(), tmp / "x.png", samples_per_cycle=2)
+
+
+def _render(tmp: Path) -> None:
+    from planar.app.pipeline import render_scene
+
+    render_scene(_kangaroo(), tmp / "x.bmp")
+
+
+def _torque() -> None:
+    from planar.analysis.dynamics import inverse_dynamics_torque
+
+    inverse_dynamics_torque(LEG, np.linspace(0.0, 1.0, 5), densities={"crank": -1})
+
+
+@pytest.mark.parametrize(
+    "call,starts",
+    [
+        # each message names the argument as the Python caller wrote it (not an internal or a command-line name)
+        (lambda tmp: LEG.solve(None), "fourbar.solve(q) = None"),
+        (lambda tmp: LEG.solve("1.0"), "fourbar.solve(q) = '1.0'"),
+        (lambda tmp: __import__("planar").load_scene(None), "load_scene(path) = None: expected a path to a scene file"),
+        (lambda tmp: __import__("planar").load_scene(123), "load_scene(path) = 123"),
+        (lambda tmp: plan_frames(math.nan, 1), "period_s = nan"),
+        (lambda tmp: plan_frames(1, -1), "duration_s = -1"),
+        (lambda tmp: plan_frames(1.0, 1.0, fps=60), "fps = 60"),
+        pytest.param(_plot, "samples_per_cycle = 2", marks=pytest.mark.slow),  # matplotlib's import
+        (_render, "out = "),
+        (lambda tmp: synthesise_function([0, 0.5, 1], [0, 0.2]), "psi = '2 output angles': expected one output angle per input"),
+        (lambda tmp: __import__("planar.fabrication").fabrication.nest([], (math.nan, 1), 1, 1, 1, 1), "sheet = (nan, 1)"),
+        (lambda tmp: _torque(), "densities['crank'] = -1"),
+    ],
+)
+def test_the_message_names_the_python_argument(tmp_path: Path, call, starts: str) -> None:
+    with pytest.raises(PlanarError) as e:
+        call(tmp_path)
+    assert str(e.value).startswith(starts), str(e.value)
+    assert not list(tmp_path.iterdir())

@@ -889,13 +889,13 @@ class Mechanism:
         )
         need, held = None, 0.0
         if n_q > limits.PILOT_ABOVE:  # a large solve: what this kind really allocates (a pilot), and what is held
-            qf = np.ravel(check_finite(f"{self.name}.driver value", q))
+            qf = np.ravel(check_finite(f"{self.name}.solve(q)", q))
             need, held = limits.pilot_bytes(lambda k: self.solve(qf[:k]), n_q), limits.resident_bytes()
         if need is None:
             need = limits.motion_bytes(len(self.parts), len(self.points), float(n_q))
         fits = f"{limits.units_within(held, need / max(n_q, 1)):,} samples"
         limits.check_memory(f"{self.name}.solve(q)", f"{n_q:,} driver values", need + held, "a motion", fits=fits)
-        qin = np.atleast_1d(check_finite(f"{self.name}.driver value", q))
+        qin = np.atleast_1d(check_finite(f"{self.name}.solve(q)", q))
         self._check_driver_resolution(qin)
         qa = new_block(qin.shape)  # the motion's own copy (recycled memory for a large batch)
         np.copyto(qa, qin)
