@@ -277,9 +277,11 @@ def check_output(
     if directory:
         if p.exists() and not p.is_dir():
             raise InputError(option, text, "a folder (it is an existing file)")
-        home = p if p.is_dir() else (p.parent if str(p.parent) else Path("."))
-        if home.is_dir():
-            _check_writable(option, text, home)
+        # the nearest folder that exists: the folder is made under it (a file there cannot hold one)
+        home = next((a for a in (p, *p.parents) if a.exists()), Path("."))
+        if not home.is_dir():
+            raise InputError(option, text, f"a folder path ({home} is a file, not a folder)")
+        _check_writable(option, text, home)
         return
     if p.is_dir() or text.endswith(("/", os.sep)):
         raise InputError(option, text, "a file name (it is a folder)")

@@ -13,9 +13,16 @@ import numpy as np
 import pytest
 
 from planar.analysis.info import info
+from planar.cams import CamProfile, FollowerGeometry, Program, Segment
+from planar.core.model import Slide
+from planar.draw import plan_frames
 from planar.errors import InputError, LimitError, PlanarError, short_repr
-from planar.linkages import FourBar
+from planar.fabrication import FabSettings, part_cuts
+from planar.fabrication.layers import plan_assembly
+from planar.linkages import FourBar, GearMesh, Link, freudenstein_angles
+from planar.physics.settings import SimSettings
 from planar.synth import synthesise_function, synthesise_path
+from planar.toys import KeyedShaft
 
 LEG = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(5.5, -2.0))
 TARGETS = np.c_[np.cos(np.linspace(0.0, 5.0, 10)), np.sin(np.linspace(0.0, 5.0, 10))]
@@ -64,3 +71,158 @@ def test_an_output_under_a_file_says_it_is_a_file(tmp_path: Path) -> None:
     (tmp_path / "afile").write_text("x")
     with pytest.raises(InputError, match="is a file, not a folder"), atomic_write(tmp_path / "afile" / "x.gif"):
         pass
+
+
+def _theta() -> np.ndarray:
+    return np.linspace(0.0, 6.0, 7)
+
+
+@pytest.mark.parametrize(
+    "call,needle",
+    [
+        # raw exceptions the fifth trial found (AttributeError, OverflowError, ZeroDivisionError, OSError)
+        (lambda: plan_assembly(None, {}, [], [], 10, 3, 3, 1.5), "mech"),
+        (lambda: plan_frames(1e-300, 1e300), "duration"),
+        (lambda: freudenstein_angles(1e-300, 4, 3e-300, 4, _theta()), "freudenstein_angles(a)"),
+        (lambda: freudenstein_angles(1, 4, 3, 4, np.zeros((2, 2))), "theta"),
+        # NaN and inf stored silently; a negative pitch radius
+        (lambda: KeyedShaft("k", "a", "b", (0, 0), (math.nan, 0), 0), "anchor_b"),
+        (lambda: KeyedShaft("k", "a", "b", (0, 0), (0, 0), math.inf), "phase"),
+        (lambda: GearMesh("m", "a", "b", math.nan, 0, (0, 0), (1, 0), 0.5, 0.5), "ratio"),
+        (lambda: GearMesh("m", "a", "b", -1, 0, (0, 0), (1, 0), -0.5, 0.5), "radius_a"),
+    ],
+)
+def test_the_fifth_trial_call_raises_a_named_planar_error(call, needle: str) -> None:
+    with pytest.raises(PlanarError) as e:
+        call()
+    assert needle in str(e.value), str(e.value)
+
+
+def test_a_huge_animation_is_a_limit_error() -> None:
+    with pytest.raises(LimitError, match="PLANAR_MAX_FRAMES"):
+        plan_frames(1e-300, 1e300)
+
+
+@pytest.mark.slow  # the demo's imports
+@pytest.mark.parametrize("where", ["/proc/demo", "FILE/demo"])
+def test_the_demo_refuses_a_folder_it_cannot_make(tmp_path: Path, where: str) -> None:
+    from planar.app import run_demo
+
+    (tmp_path / "FILE").write_text("x", encoding="utf-8")
+    where = where.replace("FILE", str(tmp_path / "FILE"))
+    if where.startswith("/proc") and not Path("/proc").is_dir():
+        pytest.skip("no /proc here")
+    with pytest.raises(InputError, match="output"):
+        next(iter(run_demo(where)))
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-3, 1.0, 1e3, 1e300])
+def test_freudenstein_angles_do_not_depend_on_the_scale(scale: float) -> None:
+    """The angles of a four-bar depend on its ratios only; at 1e300 they were all NaN, at 1e-300 a ZeroDivisionError."""
+    th3, th4, ok = freudenstein_angles(1.0 * scale, 4.0 * scale, 3.0 * scale, 4.0 * scale, _theta())
+    ref3, ref4, ref_ok = freudenstein_angles(1.0, 4.0, 3.0, 4.0, _theta())
+    assert ok.all() and (ok == ref_ok).all()
+    np.testing.assert_allclose(np.c_[th3, th4], np.c_[ref3, ref4], rtol=0, atol=1e-12)
+    # the closed loop, checked independently: crank tip to rocker tip is the coupler's length
+    b = np.hypot(3 * np.cos(th4) + 4 - np.cos(_theta()), 3 * np.sin(th4) - np.sin(_theta()))
+    np.testing.assert_allclose(b, 4.0, rtol=1e-12)
+
+
+def _cam_program() -> Program:
+    return Program([Segment("cycloidal", 2.0, 1.0), Segment("cycloidal", 2.0 * math.pi - 2.0, -1.0)])
+
+
+def _fab(**kw: object) -> FabSettings:
+    return FabSettings(**kw)
+
+
+def _reason(unit: str) -> str:
+    return LEG.run(36).reason(0, angle_unit=unit)
+
+
+@pytest.mark.parametrize(
+    "call,needle",
+    [
+        # out of range, accepted by the constructors until now
+        (lambda: _fab(kerf=-1), "kerf"),
+        (lambda: _fab(sheet=(1e300, 1)), "sheet"),
+        (lambda: _fab(motor_shaft_mm=1e300), "motor_shaft_mm"),
+        (lambda: _fab(hardware="glue"), "hardware"),
+        (lambda: part_cuts(LEG.parts[1], _fab(), -1), "number"),
+        (lambda: Segment("cycloidal", -1), "angle"),
+        (lambda: FollowerGeometry(axis=(0, 0)), "axis"),
+        (
+            lambda: CamProfile(_cam_program(), 1e-300, FollowerGeometry(roller_radius=0.5)),
+            "base_radius",
+        ),
+        (lambda: SimSettings(blowup_tol=0), "blowup_tol"),
+        (lambda: Link("l", ()), "nodes"),
+        (lambda: Link("l", ("O", "O")), "nodes"),
+        (lambda: Slide("s", "a", "b", (0, 0), (1, 0), (0, 0), (0, 0)), "axis"),
+        pytest.param(lambda: _reason("furlong"), "angle_unit", marks=pytest.mark.slow),  # a solve: >= 0.5 s CPU
+    ],
+)
+def test_a_value_out_of_range_is_refused_where_it_is_built(call, needle: str) -> None:
+    with pytest.raises(PlanarError) as e:
+        call()
+    assert needle in str(e.value), str(e.value)
+
+
+def test_the_fabrication_bounds_are_the_scene_files() -> None:
+    """One place for both: a scene with the bound's value loads, FabSettings takes it; just past, both refuse."""
+    from planar.core.limits import MAX_MOTOR_MM, MAX_SHEET_MM
+
+    assert _fab(motor_shaft_mm=MAX_MOTOR_MM, sheet=(MAX_SHEET_MM, 1.0)).motor_shaft_mm == MAX_MOTOR_MM
+    with pytest.raises(InputError):
+        _fab(motor_shaft_mm=MAX_MOTOR_MM * 1.001)
+    with pytest.raises(InputError):
+        _fab(sheet=(1.0, MAX_SHEET_MM * 1.001))
+
+
+def _kangaroo():  # type: ignore[no-untyped-def]
+    from planar import load_scene
+
+    return load_scene(Path(__file__).parents[1] / "gallery" / "kangaroo-leg.toml")
+
+
+def _plot(tmp: Path) -> None:
+    from planar.draw.charts import write_plot
+
+    write_plot(_kangaroo(), tmp / "x.png", samples_per_cycle=2)
+
+
+def _render(tmp: Path) -> None:
+    from planar.app.pipeline import render_scene
+
+    render_scene(_kangaroo(), tmp / "x.bmp")
+
+
+def _torque() -> None:
+    from planar.analysis.dynamics import inverse_dynamics_torque
+
+    inverse_dynamics_torque(LEG, np.linspace(0.0, 1.0, 5), densities={"crank": -1})
+
+
+@pytest.mark.parametrize(
+    "call,starts",
+    [
+        # each message names the argument as the Python caller wrote it (not an internal or a command-line name)
+        (lambda tmp: LEG.solve(None), "fourbar.solve(q) = None"),
+        (lambda tmp: LEG.solve("1.0"), "fourbar.solve(q) = '1.0'"),
+        (lambda tmp: __import__("planar").load_scene(None), "load_scene(path) = None: expected a path to a scene file"),
+        (lambda tmp: __import__("planar").load_scene(123), "load_scene(path) = 123"),
+        (lambda tmp: plan_frames(math.nan, 1), "period_s = nan"),
+        (lambda tmp: plan_frames(1, -1), "duration_s = -1"),
+        (lambda tmp: plan_frames(1.0, 1.0, fps=60), "fps = 60"),
+        pytest.param(_plot, "samples_per_cycle = 2", marks=pytest.mark.slow),  # matplotlib's import
+        (_render, "out = "),
+        (lambda tmp: synthesise_function([0, 0.5, 1], [0, 0.2]), "psi = '2 output angles': expected one output angle per input"),
+        (lambda tmp: __import__("planar.fabrication").fabrication.nest([], (math.nan, 1), 1, 1, 1, 1), "sheet = (nan, 1)"),
+        (lambda tmp: _torque(), "densities['crank'] = -1"),
+    ],
+)
+def test_the_message_names_the_python_argument(tmp_path: Path, call, starts: str) -> None:
+    with pytest.raises(PlanarError) as e:
+        call(tmp_path)
+    assert str(e.value).startswith(starts), str(e.value)
+    assert not list(tmp_path.iterdir())

@@ -167,6 +167,9 @@ def inverse_dynamics_torque(
         )
     if densities is not None:
         check_kind("inverse_dynamics_torque(densities)", densities, dict, "a dict of part name to density")
+        for part, rho in densities.items():  # named as the caller wrote it, not as mass_properties takes it
+            if check_number(f"densities[{part!r}]", rho) < 0:
+                raise InputError(f"densities[{part!r}]", rho, "a density >= 0 (0: a massless part)")
     if t_rest is not None:
         check_number("inverse_dynamics_torque(t_rest)", t_rest)
     drv = mech.driver

@@ -15,6 +15,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from planar.core import limits as _limits
 from planar.errors import InputError
 
 
@@ -91,7 +92,7 @@ def gallery_scenes(folder: str | os.PathLike[str]) -> list[Path]:
 GIF_MAX_DELAY_MS = 655_350.0
 
 #: the largest sheet side (mm) the fabrication geometry is computed for
-MAX_SHEET_MM = 100_000.0
+MAX_SHEET_MM = _limits.MAX_SHEET_MM
 
 
 def scene_style(scene: Scene) -> Style:
@@ -134,8 +135,9 @@ def overlay_motion(scene: Scene, settings: SimSettings | None = None, notes: lis
 ANIMATION_SUFFIXES = (".gif", ".mp4", ".webm", ".html")
 
 
-def animation_plan(scene: Scene, out: str | Path, fps: float | None = None) -> FramePlan:
-    """The frames ``render_scene`` draws for ``out`` (GIF delays are whole 10 ms ticks; video any rate)."""
+def animation_plan(scene: Scene, out: str | Path, fps: float | None = None, fps_option: str = "fps") -> FramePlan:
+    """The frames ``render_scene`` draws for ``out`` (GIF delays are whole 10 ms ticks; video any rate);
+    ``fps_option`` names ``fps`` in messages (``--fps`` for the command line)."""
     from planar.draw.timing import plan_frames, scene_duration
 
     fps = fps if fps is not None else scene.spec.render.fps
@@ -145,18 +147,19 @@ def animation_plan(scene: Scene, out: str | Path, fps: float | None = None) -> F
             scene_duration(scene),
             fps,
             tick_ms=10.0 if Path(out).suffix.lower() == ".gif" else None,
+            fps_option=fps_option,
         )
-    except InputError as e:  # the planner names "duration" or "speed": say which key of which scene
+    except InputError as e:  # the planner names "duration_s" or "period_s": say which key of which scene
         d = scene.spec.driver
-        if e.field == "duration":
+        if e.field == "duration_s":
             key, value = (
                 ("driver.duration", d.duration)
                 if d.duration is not None
                 else ("driver.cycles", d.cycles if d.cycles is not None else 1.0)
             )
-            raise InputError(f"{scene.path}: {key}", value, e.expected) from None
-        if e.field == "speed":
-            raise InputError(f"{scene.path}: driver.speed", d.speed, e.expected) from None
+            raise type(e)(f"{scene.path}: {key}", value, e.expected) from None
+        if e.field == "period_s":
+            raise InputError(f"{scene.path}: driver.speed", d.speed, "a finite, positive speed (cycles per second)") from None
         raise
 
 
@@ -167,6 +170,7 @@ def render_scene(
     progress: bool = True,
     fps: float | None = None,
     notes: list[str] | None = None,
+    options: tuple[str, str] = ("out", "fps"),
 ) -> int:
     """Render a scene's analytic motion (and optionally an overlay motion) to ``out``; returns the frame count.
 
@@ -177,7 +181,8 @@ def render_scene(
     ``[render] fps``) sets the frame rate.  The overlay, a simulated motion
     with sample times, is interpolated to the frame instants.  ``notes``, if
     given, receives what a user should hear: a cycle that plays slower than
-    its speed, samples that cannot be assembled (drawn tinted red).
+    its speed, samples that cannot be assembled (drawn tinted red).  ``options`` names ``out`` and ``fps``
+    in messages (``("-o", "--fps")`` for the command line).
     """
     import numpy as np
 
@@ -195,10 +200,10 @@ def render_scene(
     if fps is not None:
         from planar.core.fields import check_number
 
-        check_number("fps", fps)
+        check_number(options[1], fps)
     suffix = Path(out).suffix.lower()
     if suffix not in ANIMATION_SUFFIXES:
-        raise InputError("-o", str(out), f"an animation file ending in {', '.join(ANIMATION_SUFFIXES)}")
+        raise InputError(options[0], str(out), f"an animation file ending in {', '.join(ANIMATION_SUFFIXES)}")
     if suffix not in (".gif", ".html"):
         from planar.app.formats import writer
 
@@ -206,7 +211,7 @@ def render_scene(
 
         if not video_available():
             raise InputError(
-                "-o",
+                options[0],
                 str(out),
                 f"the video extra for {suffix} output: pip install 'planar[video]' (imageio-ffmpeg), or write a .gif",
             )
@@ -218,7 +223,7 @@ def render_scene(
     field_name = "driver.duration" if scene.spec.driver.duration is not None else "driver.cycles"
     shown = getattr(scene.spec.driver, field_name.split(".")[1])
     shown = 1.0 if shown is None else shown  # one cycle unless the scene says
-    plan = animation_plan(scene, out, fps)
+    plan = animation_plan(scene, out, fps, options[1])
     check_count("frames", f"{scene.path}: {field_name}", plan.frames, "frames", shown=shown)
     check_count(
         "samples",
@@ -586,10 +591,12 @@ def run_demo(output: str | Path) -> Iterator[str]:
     import numpy as np
 
     from planar.analysis import statics as analysis
+    from planar.fileio import check_output
     from planar.linkages import Linkage
     from planar.scene.load import build_scene, parse_scene
 
     _check_path("output", output)
+    check_output("output", output, (), directory=True)
     out = Path(output)
     out.mkdir(parents=True, exist_ok=True)
     for name, data in DEMO_SCENES.items():

@@ -88,6 +88,8 @@ class Segment:
         if not isinstance(self.law, str) or self.law not in LAWS:
             raise InputError("Segment.law", self.law, f"one of {sorted(LAWS)}")
         check_fields(self, "Segment")
+        if not self.angle > 0:
+            raise InputError("Segment.angle", self.angle, "a positive angle of cam turn (rad)")
 
     def describe(self, start: float, unit: str = "deg") -> str:
         """``"cycloidal rise of 0.5 over 0-120 deg"``: what a message names (``start`` in rad)."""

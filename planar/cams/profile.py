@@ -41,6 +41,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from planar.cams.laws import TWO_PI, Program
 from planar.core.fields import check_fields, check_number, check_positive, check_samples
+from planar.core.limits import RESOLUTION
 from planar.errors import InputError, PlanarError
 
 __all__ = ["CamError", "CamProfile", "CamReport", "FollowerGeometry"]
@@ -110,6 +111,8 @@ class FollowerGeometry:
         if self.roller_radius < 0 or self.arm < 0:
             bad = "roller_radius" if self.roller_radius < 0 else "arm"
             raise InputError(f"follower.{bad}", getattr(self, bad), "a length >= 0")
+        if self.axis[0] == 0 and self.axis[1] == 0:
+            raise InputError("follower.axis", self.axis, "a non-zero direction")
 
 
 @dataclass
@@ -159,6 +162,10 @@ class CamProfile:
             raise InputError(f"{fw}.roller_radius", f.roller_radius, "a positive radius for a roller follower")
         self.rr = float(f.roller_radius) if f.kind == "roller" else 0.0
         rp = rb + self.rr  # prime circle
+        if rb < RESOLUTION * rp:  # the base circle below float64's grain at the roller's size: no cam outline
+            raise InputError(
+                f"{where}.base_radius", base_radius, f"a base radius at least {RESOLUTION:g} of the roller's ({self.rr:g})"
+            )
         self.prime_radius = rp
         if f.motion == "translating":
             a = np.asarray(f.axis, float)

@@ -22,7 +22,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     outputs(args, (args.scene,), ("-o/--output", "output", (".png", ".svg")))
     scene = load_scene(args.scene)
     with numeric_guard(scene, "the charts"):
-        charts = write_plot(scene, args.output, what, args.samples, option="--what")
+        charts = write_plot(scene, args.output, what, args.samples, option="--what", samples_option="--samples")
     print(f"wrote {args.output}: {', '.join(charts)}")
     return 0
 

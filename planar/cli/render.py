@@ -21,10 +21,10 @@ def _cmd_render(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
     notes: list[str] = []
     overlay = overlay_motion(scene, settings, notes) if args.overlay else None
-    n = render_scene(scene, args.output, overlay=overlay, fps=args.fps, notes=notes)
+    n = render_scene(scene, args.output, overlay=overlay, fps=args.fps, notes=notes, options=("-o", "--fps"))
     for note in notes:
         print(f"note: {note}")
-    plan = animation_plan(scene, args.output, args.fps)  # arithmetic only: what render_scene drew
+    plan = animation_plan(scene, args.output, args.fps, "--fps")  # arithmetic only: what render_scene drew
     print(f"wrote {args.output}: {n} frames, {plan.fps:.3g} frames/s, a cycle plays {plan.cycle_play_s:.3g} s")
     return 0
 

@@ -188,6 +188,16 @@ SIZE_RANGE = (1e-60, 1e60)
 RESOLUTION = 1e-9
 
 
+#: fabrication's bounds (mm), one place for the scene files' ``[fabrication]`` table and
+#: :class:`planar.fabrication.FabSettings`: the largest sheet side the geometry is computed for, a small
+#: gearmotor's dimensions (an N20's, or a 37 mm gearmotor's with an encoder, are well within), its body's
+#: length, and the largest kerf or running clearance
+MAX_SHEET_MM = 100_000.0
+MAX_MOTOR_MM = 100.0
+MAX_MOTOR_BODY_MM = 250.0
+MAX_KERF_MM = 2.0
+
+
 #: the largest angle (rad, about 159 000 turns) a phase, amplitude or a clock's turns may reach: float64
 #: spaces its numbers 1.2e-10 apart there, finer than :data:`RESOLUTION`; at 1e300 a phase is noise
 MAX_ANGLE = 1e6

@@ -380,6 +380,8 @@ class Slide:
 
     def __post_init__(self) -> None:
         _check_joint(self, ("start", "end", "anchor", "axis"), "width")
+        if self.axis[0] == 0 and self.axis[1] == 0:  # its two pins would be one: nothing stops it turning
+            raise InputError(f"Slide {self.name!r}.axis", self.axis, "a non-zero vector (the second pin's offset)")
 
     def pin_points(self) -> tuple[Vec, Vec]:
         """The two pins of ``b`` in its own frame: ``anchor`` and ``anchor + axis``."""
@@ -640,6 +642,8 @@ class Motion:
         ``angle_unit``); otherwise the driver value is as stored (radians, or a length).
         """
         n = len(self)
+        if not isinstance(angle_unit, str) or angle_unit not in ("rad", "deg"):
+            raise InputError("Motion.reason(angle_unit)", angle_unit, "'rad' or 'deg'")
         if isinstance(i, (bool, np.bool_)) or not isinstance(i, (int, np.integer)):
             raise InputError("Motion.reason(i)", i, "a sample index (a whole number)")
         if not -n <= i < n:
@@ -885,13 +889,13 @@ class Mechanism:
         )
         need, held = None, 0.0
         if n_q > limits.PILOT_ABOVE:  # a large solve: what this kind really allocates (a pilot), and what is held
-            qf = np.ravel(check_finite(f"{self.name}.driver value", q))
+            qf = np.ravel(check_finite(f"{self.name}.solve(q)", q))
             need, held = limits.pilot_bytes(lambda k: self.solve(qf[:k]), n_q), limits.resident_bytes()
         if need is None:
             need = limits.motion_bytes(len(self.parts), len(self.points), float(n_q))
         fits = f"{limits.units_within(held, need / max(n_q, 1)):,} samples"
         limits.check_memory(f"{self.name}.solve(q)", f"{n_q:,} driver values", need + held, "a motion", fits=fits)
-        qin = np.atleast_1d(check_finite(f"{self.name}.driver value", q))
+        qin = np.atleast_1d(check_finite(f"{self.name}.solve(q)", q))
         self._check_driver_resolution(qin)
         qa = new_block(qin.shape)  # the motion's own copy (recycled memory for a large batch)
         np.copyto(qa, qin)

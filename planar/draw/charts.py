@@ -115,12 +115,13 @@ def _parse_what(scene: Scene, what: Sequence[str] | str | None, option: str = "w
 FIGURE_BYTES = 128 * 2**20
 
 
-def _motion(scene: Scene, samples_per_cycle: int | None) -> Motion:
-    """The scene's motion, over its own cycles or duration, at ``samples_per_cycle`` (default: the scene's)."""
+def _motion(scene: Scene, samples_per_cycle: int | None, name: str = "samples_per_cycle") -> Motion:
+    """The scene's motion, over its own cycles or duration, at ``samples_per_cycle`` (default: the scene's);
+    ``name`` names it in messages (``--samples`` for the command line)."""
     if samples_per_cycle is not None and (
         isinstance(samples_per_cycle, bool) or not isinstance(samples_per_cycle, int) or samples_per_cycle < 4
     ):
-        raise InputError("--samples", samples_per_cycle, "at least 4 samples per cycle")
+        raise InputError(name, samples_per_cycle, "at least 4 samples per cycle")
     d = scene.spec.driver
     drv = scene.mechanism.driver
     if samples_per_cycle is None:
@@ -136,13 +137,13 @@ def _motion(scene: Scene, samples_per_cycle: int | None) -> Motion:
             2,
             check_count(
                 "samples",
-                "--samples",
+                name,
                 round(total) if math.isfinite(total) else total,
-                "samples in all (--samples x the scene's cycles)",
+                f"samples in all ({name} x the scene's cycles)",
                 shown=samples_per_cycle,
             ),
         )
-        spc, where, shown = samples_per_cycle, "--samples", samples_per_cycle
+        spc, where, shown = samples_per_cycle, name, samples_per_cycle
     from planar.core.limits import check_memory, resident_bytes, units_within
 
     # the motion and, over all of it at once, its rates, torque and lines: measured 1.5 kB a sample for the
@@ -159,12 +160,16 @@ def _motion(scene: Scene, samples_per_cycle: int | None) -> Motion:
 
 
 def scene_figure(
-    scene: Scene, what: Sequence[str] | str | None = None, width_in: float = 6.4, samples_per_cycle: int | None = None
+    scene: Scene,
+    what: Sequence[str] | str | None = None,
+    width_in: float = 6.4,
+    samples_per_cycle: int | None = None,
+    samples_option: str = "samples_per_cycle",
 ) -> Figure:
     """The charts ``what`` (default: every chart that applies) of ``scene``, stacked in one figure.
 
     ``samples_per_cycle``: sample the motion this finely instead of the
-    scene's ``[driver] samples_per_cycle`` (smoother curves).
+    scene's ``[driver] samples_per_cycle`` (smoother curves); ``samples_option`` names it in messages.
 
     Each axes carries a ``gid`` naming its chart (``"chart-curve"``, ...), and
     each line a ``gid`` naming what it plots (``"curve:coupler_point"``,
@@ -177,7 +182,7 @@ def scene_figure(
 
     charts = _parse_what(scene, what)
     mech = scene.mechanism
-    motion = _motion(scene, samples_per_cycle)
+    motion = _motion(scene, samples_per_cycle, samples_option)
     names, cols = derivative_columns(mech, motion, scene.effects)
     ok = cols[names.index("rates_valid")] == 1.0
     col = {n: c if n == "rates_valid" else np.where(ok, c, np.nan) for n, c in zip(names, cols)}  # gaps, not 0
@@ -304,11 +309,13 @@ def write_plot(
     what: Sequence[str] | str | None = None,
     samples_per_cycle: int | None = None,
     option: str = "what",
+    samples_option: str = "samples_per_cycle",
 ) -> list[str]:
     """Write the charts of ``scene`` to ``out`` (``.png`` or ``.svg``, reproducible bytes); returns the charts.
 
     ``what`` (a chart name or a list of them) and ``samples_per_cycle`` as for :func:`scene_figure`;
-    ``option`` names ``what`` in messages (``--what`` for the command line).
+    ``option`` names ``what`` in messages (``--what`` for the command line), ``samples_option``
+    ``samples_per_cycle`` (``--samples``).
     """
     from planar.fileio import atomic_write
 
@@ -316,7 +323,7 @@ def write_plot(
     if ext not in ("png", "svg"):
         raise InputError("out", str(out), "a .png or .svg file name")
     charts = _parse_what(scene, what, option)
-    fig = scene_figure(scene, charts, samples_per_cycle=samples_per_cycle)
+    fig = scene_figure(scene, charts, samples_per_cycle=samples_per_cycle, samples_option=samples_option)
     data = _render(fig, ext)
     with atomic_write(out, "wb") as fh:
         fh.write(data)

@@ -23,7 +23,7 @@ import numpy as np
 
 from planar.core.fields import check_fields, check_kind, check_number
 from planar.core.model import Motion
-from planar.errors import InputError
+from planar.errors import InputError, LimitError
 
 if TYPE_CHECKING:  # pragma: no cover
     from planar.scene.load import Scene
@@ -92,7 +92,9 @@ class FramePlan:
         return np.arange(self.frames, dtype=np.float64) * (self.period_s / self.frames_per_cycle)
 
 
-def plan_frames(period_s: float, duration_s: float, fps: float | None = None, tick_ms: float | None = 10.0) -> FramePlan:
+def plan_frames(
+    period_s: float, duration_s: float, fps: float | None = None, tick_ms: float | None = 10.0, fps_option: str = "fps"
+) -> FramePlan:
     """The frames that play ``duration_s`` of motion (period ``period_s``) at the scene's speed.
 
     ``fps``: frames per second asked for; the delay is ``1000 / fps`` rounded
@@ -102,31 +104,32 @@ def plan_frames(period_s: float, duration_s: float, fps: float | None = None, ti
     otherwise get fewer than 12 frames; a cycle gets at least 4 frames, so a
     cycle faster than 80 ms plays slower in a GIF (:meth:`FramePlan.note`).
     Raises :class:`InputError` for a rate a GIF cannot play, an ``fps`` that
-    gives fewer than 4 frames a cycle, or more than :data:`MAX_FRAMES` frames.
+    gives fewer than 4 frames a cycle, or more than :data:`MAX_FRAMES` frames (a :class:`LimitError`);
+    the message names the argument (``fps_option`` names ``fps``: ``--fps`` for the command line).
     """
-    check_number("speed", period_s)
-    check_number("duration", duration_s)
+    check_number("period_s", period_s)
+    check_number("duration_s", duration_s)
     if fps is not None:
-        check_number("--fps", fps)
+        check_number(fps_option, fps)
     if tick_ms is not None and not check_number("tick_ms", tick_ms) > 0:
         raise InputError("tick_ms", tick_ms, "a positive frame tick in ms (GIF: 10), or None (video)")
     if not (math.isfinite(period_s) and period_s > 0):
-        raise InputError("speed", period_s, "a finite, positive speed (cycles per second)")
+        raise InputError("period_s", period_s, "a finite, positive period (s)")
     if not (math.isfinite(duration_s) and duration_s > 0):
-        raise InputError("duration", duration_s, "a finite, positive duration (or number of cycles)")
+        raise InputError("duration_s", duration_s, "a finite, positive duration (or number of cycles)")
     if fps is not None:
         if not (math.isfinite(fps) and fps > 0):
-            raise InputError("--fps", fps, "a positive number of frames per second")
+            raise InputError(fps_option, fps, "a positive number of frames per second")
         delay = 1000.0 / fps
         if tick_ms is not None:
             delay = round(delay / tick_ms) * tick_ms
             if fps > 50 or delay < 20:
                 raise InputError(
-                    "--fps", fps, "at most 50 frames per second in a GIF (browsers slow shorter frame delays than 20 ms)"
+                    fps_option, fps, "at most 50 frames per second in a GIF (browsers slow shorter frame delays than 20 ms)"
                 )
         if period_s * 1000.0 / delay < MIN_FRAMES_ASKED:
             raise InputError(
-                "--fps",
+                fps_option,
                 fps,
                 f"at least {MIN_FRAMES_ASKED} frames per cycle: {MIN_FRAMES_ASKED / period_s:.3g} "
                 f"frames per second or more for a cycle of {period_s:.3g} s",
@@ -136,24 +139,26 @@ def plan_frames(period_s: float, duration_s: float, fps: float | None = None, ti
         if 1000.0 * period_s / delay < MIN_FRAMES_PER_CYCLE:
             delay = 20.0 if tick_ms is not None else 1000.0 * period_s / MIN_FRAMES_PER_CYCLE
     per_cycle = max(MIN_FRAMES_ASKED, int(round(1000.0 * period_s / delay)))
-    frames = max(1, int(round(per_cycle * duration_s / period_s)))
     from planar.core.limits import limit
 
     if fps is not None and per_cycle > limit("frames"):  # one cycle alone too many: the rate is at fault
         raise InputError(
-            "--fps",
+            fps_option,
             fps,
             f"at most {limit('frames') / period_s:.3g} frames per second: one cycle of {period_s:.3g} s would take "
             f"{per_cycle} frames, over the limit of {limit('frames')} (PLANAR_MAX_FRAMES)",
         )
-    if frames > limit("frames"):  # MAX_FRAMES unless PLANAR_MAX_FRAMES raises it
-        raise InputError(
-            "duration",
+    # MAX_FRAMES unless PLANAR_MAX_FRAMES raises it
+    frames_f = per_cycle * duration_s / period_s  # inf for a duration 1e300 periods long: refused below
+    if not frames_f <= limit("frames"):
+        raise LimitError(
+            "duration_s",
             duration_s,
-            f"an animation of at most {limit('frames')} frames ({frames} asked "
+            f"an animation of at most {limit('frames')} frames ({frames_f:.3g} asked "
             f"for at {1000.0 / delay:.3g} frames per second; shorten the duration, "
             "lower --fps or raise PLANAR_MAX_FRAMES)",
         )
+    frames = max(1, int(round(frames_f)))
     return FramePlan(float(period_s), float(delay), per_cycle, frames)
 
 

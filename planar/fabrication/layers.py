@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from planar.core.model import Mechanism
+from planar.errors import InputError
 from planar.fabrication.joints import Contact, PinSpec
 
 __all__ = ["Assembly", "PinPlan", "letter", "plan_assembly"]
@@ -120,6 +121,12 @@ def _swept(poly, poses: np.ndarray, u: float):
     return shapely.union_all([_placed(poly, p, u) for p in poses]).buffer(0)
 
 
+def _check_mech(mech: object) -> None:
+    """:func:`plan_assembly`'s mechanism: a Mechanism, or a view of one (what runs and has parts)."""
+    if not callable(getattr(mech, "run", None)) or not hasattr(mech, "parts"):
+        raise InputError("mech", mech, "a Mechanism (a linkage, a cam or a toy)")
+
+
 def _check_sizes(unit_mm: Any, thickness: Any, pin_mm: Any, pin_head: Any, ring_mm: Any, samples: Any) -> None:
     """:func:`plan_assembly`'s sizes (mm) and sample count, each named when wrong."""
     from planar.core.fields import check_number
@@ -152,6 +159,7 @@ def plan_assembly(
     ``ring_mm``: the outer diameter of a spacer ring (default ``pin_mm``): a part between a pin's ends must clear
     the ring on the pin, not only the pin.
     """
+    _check_mech(mech)
     _check_sizes(unit_mm, thickness, pin_mm, pin_head, ring_mm, samples)
     from shapely.geometry import LineString, Point
 

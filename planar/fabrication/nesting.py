@@ -54,9 +54,9 @@ def nest(
 
     from planar.core.fields import check_number, check_point
 
+    W, H = check_point("sheet", sheet, "a sheet (width, height) in mm: two finite numbers")
     if not isinstance(cuts, (list, tuple)) or not cuts or not all(isinstance(c, PartCut) for c in cuts):
         raise InputError("cuts", cuts, "a list of one or more PartCut (planar.fabrication.part_cuts)")
-    W, H = check_point("sheet", sheet, "a sheet (width, height) in mm: two finite numbers")
     for name, value in (("spacing", spacing), ("margin", margin), ("kerf", kerf), ("unit_mm", unit_mm)):
         if check_number(name, value) < 0:
             raise InputError(name, value, "a size >= 0 in mm")

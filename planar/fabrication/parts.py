@@ -59,6 +59,28 @@ MAX_LABEL = 6.0  # mm, tallest label
 WALL_TOL = 5e-3  # mm: sampled arcs lie inside the true ones by less than this
 
 
+#: the FabSettings fields that are a gearmotor's dimensions (bounded as the scene files bound them)
+_MOTOR_FIELDS = ("shaft_mm", "shaft_flat_mm", "motor_screw_mm", "motor_screw_spacing_mm", "motor_shaft_mm", "mounting_hole_mm")
+
+
+def _check_bounds(s: Any) -> None:
+    """The upper bounds the scene files' ``[fabrication]`` table has, from the same place (mm)."""
+    from planar.core import limits
+    from planar.errors import InputError
+    from planar.fabrication.hardware import HARDWARE
+
+    if not max(s.sheet) <= limits.MAX_SHEET_MM:
+        raise InputError("fabrication.sheet", s.sheet, f"sides of at most {limits.MAX_SHEET_MM:g} mm (100 m)")
+    bounds = dict.fromkeys(_MOTOR_FIELDS, (limits.MAX_MOTOR_MM, "a motor dimension"))
+    bounds |= {"motor_body_mm": (limits.MAX_MOTOR_BODY_MM, "a motor body length")}
+    bounds |= dict.fromkeys(("kerf", "clearance"), (limits.MAX_KERF_MM, "a width"))
+    for name, (most, what) in bounds.items():
+        if not getattr(s, name) <= most:
+            raise InputError(f"fabrication.{name}", getattr(s, name), f"{what} of at most {most:g} mm")
+    if s.hardware not in HARDWARE:
+        raise InputError("fabrication.hardware", s.hardware, "one of " + ", ".join(sorted(HARDWARE)))
+
+
 @dataclass(frozen=True)
 class FabSettings:
     """Everything fabrication needs, in millimetres (from the scene's ``[fabrication]`` table)."""
@@ -107,8 +129,9 @@ class FabSettings:
         if not min(self.sheet) > 0:
             raise InputError("fabrication.sheet", self.sheet, "a sheet (width, height) of positive sides in mm")
         for name, value in vars(self).items():
-            if isinstance(value, float) and value < 0:
+            if isinstance(value, (int, float)) and not isinstance(value, bool) and value < 0:
                 raise InputError(f"fabrication.{name}", value, "a size >= 0 in mm")
+        _check_bounds(self)
         if self.colours not in COLOUR_PRESETS:
             raise InputError("fabrication.colours", self.colours, "one of " + ", ".join(sorted(COLOUR_PRESETS)))
 
@@ -572,7 +595,8 @@ def _check_cut_args(
 
     check_kind("part_cuts(part)", part, Part)
     check_kind("part_cuts(s)", s, FabSettings)
-    check_number("part_cuts(number)", number, integer=True)
+    if check_number("part_cuts(number)", number, integer=True) < 0:
+        raise InputError("part_cuts(number)", number, "a part number >= 0")
     if not isinstance(pinned, (set, frozenset)) or not all(isinstance(i, int) for i in pinned):
         raise InputError("part_cuts(pinned)", pinned, "a set of feature indices")
     for name, at in (("drive_at", drive_at), ("motor_at", motor_at)):

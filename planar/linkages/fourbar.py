@@ -78,6 +78,15 @@ def freudenstein_angles(
     if not isinstance(circuit, str) or circuit not in ("open", "crossed"):
         raise InputError("freudenstein_angles(circuit)", circuit, "'open' or 'crossed'")
     th = check_finite("freudenstein_angles(theta)", theta)
+    if th.ndim > 1:
+        raise InputError("freudenstein_angles(theta)", f"an array of shape {th.shape}", "a number or a 1-D array of angles")
+    # the angles depend on the ratios only: lengths in units of the longest, so 1e-300 or 1e300 neither
+    # underflows nor overflows the squares below; ratios past 1e100 (no mechanism) are refused
+    s = max(a, b, c, d)
+    small = min(zip((a, b, c, d), "abcd"))
+    if small[0] < 1e-100 * s:
+        raise InputError(f"freudenstein_angles({small[1]})", small[0], f"a length within 1e100 of the longest ({s:g})")
+    a, b, c, d = a / s, b / s, c / s, d / s
     ct, st = np.cos(th), np.sin(th)
     K1, K2, K3 = d / a, d / c, (a * a - b * b + c * c + d * d) / (2 * a * c)
     K4, K5 = d / b, (c * c - d * d - a * a - b * b) / (2 * a * b)

@@ -318,6 +318,18 @@ class GearMesh:
     radius_a: float
     radius_b: float
 
+    def __post_init__(self) -> None:
+        """Refused where it is built: finite numbers, a nonzero ratio (negative: external gears turning opposite
+        ways), positive pitch radii."""
+        from planar.core.fields import check_fields
+
+        where = f"GearMesh {self.name!r}"
+        check_fields(self, where)
+        if self.ratio == 0:
+            raise InputError(f"{where}.ratio", self.ratio, "a nonzero ratio (negative for external gears)")
+        check_positive(f"{where}.radius_a", self.radius_a, "pitch radius")
+        check_positive(f"{where}.radius_b", self.radius_b, "pitch radius")
+
     def residual(self, poses: Mapping[str, Array]) -> Array:
         pa = np.asarray(poses[self.a]).reshape(-1, 3)
         pb = np.asarray(poses[self.b]).reshape(-1, 3)

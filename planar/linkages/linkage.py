@@ -74,6 +74,8 @@ class Link:
         nodes = self.nodes
         if isinstance(nodes, (str, bytes)) or not isinstance(nodes, (tuple, list)) or not all(isinstance(n, str) for n in nodes):
             raise InputError(f"Link {self.name!r}.nodes", self.nodes, "a sequence of node names (('O', 'A'), not 'OA')")
+        if not nodes or len(set(nodes)) != len(nodes):
+            raise InputError(f"Link {self.name!r}.nodes", self.nodes, "one or more node names, each once")
         guide = self.guide
         if guide is not None and (
             not isinstance(guide, (tuple, list)) or len(guide) != 2 or not all(isinstance(n, str) for n in guide)

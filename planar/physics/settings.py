@@ -95,6 +95,8 @@ class SimSettings:
             raise InputError("error_bias", self.error_bias, "a fraction in [0, 1)")
         if not (self.tolerance > 0.0):
             raise InputError("tolerance", self.tolerance, "a positive fraction of the size")
+        if not (self.blowup_tol > 0.0):
+            raise InputError("blowup_tol", self.blowup_tol, "a positive fraction of the size")
         if self.step_drift is not None and not (self.step_drift > 0.0):
             raise InputError("step_drift", self.step_drift, "a positive fraction of the size")
 

@@ -168,6 +168,8 @@ def _read_text(p: str) -> str:
 
 def load_scene(path: str | Path) -> Scene:
     """Read, validate and build the scene in ``path`` (UTF-8, or UTF-16 with a byte-order mark)."""
+    if not isinstance(path, (str, Path)) and not hasattr(path, "__fspath__"):
+        raise InputError("load_scene(path)", path, "a path to a scene file (a string or a pathlib.Path)")
     p = str(path)
     text = _read_text(p)
     try:

@@ -11,7 +11,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, Strict, StrictBool, model_validator
 
-from planar.core.limits import SIZE_RANGE
+from planar.core.limits import MAX_KERF_MM, MAX_MOTOR_BODY_MM, MAX_MOTOR_MM, SIZE_RANGE
 
 Vec2 = tuple[float, float]
 # strict types: a number is a TOML number (true is not 1.0, "4" is not 4.0), a flag is true or false
@@ -87,9 +87,11 @@ def _mm_up_to(most: float, what: str) -> Any:
 
 
 #: a small gearmotor's dimensions (mm): an N20's, or a 37 mm gearmotor's with an encoder, are well within
-MotorMm = Annotated[float, Strict(), Field(gt=0, allow_inf_nan=False), AfterValidator(_mm_up_to(100.0, "a motor dimension"))]
+MotorMm = Annotated[
+    float, Strict(), Field(gt=0, allow_inf_nan=False), AfterValidator(_mm_up_to(MAX_MOTOR_MM, "a motor dimension"))
+]
 MotorBodyMm = Annotated[
-    float, Strict(), Field(gt=0, allow_inf_nan=False), AfterValidator(_mm_up_to(250.0, "a motor body length"))
+    float, Strict(), Field(gt=0, allow_inf_nan=False), AfterValidator(_mm_up_to(MAX_MOTOR_BODY_MM, "a motor body length"))
 ]
 
 
@@ -628,11 +630,11 @@ class FabricationSpec(_Strict):
     """What one model unit is in millimetres, e.g. ``15.0``."""
     thickness_mm: Pos = 3.0
     """Sheet thickness (pin lengths, spacers), e.g. ``3.0``."""
-    kerf_mm: Annotated[float, Strict(), Field(ge=0, le=2)] = 0.15
+    kerf_mm: Annotated[float, Strict(), Field(ge=0, le=MAX_KERF_MM)] = 0.15
     """Beam width 0-2 mm: outlines grow and holes shrink by half of it."""
     pin_diameter_mm: Pos = 3.0
     """Diameter of every pin (holes and slots are cut at this plus ``clearance_mm``)."""
-    clearance_mm: Annotated[float, Strict(), Field(ge=0, le=2)] = 0.1
+    clearance_mm: Annotated[float, Strict(), Field(ge=0, le=MAX_KERF_MM)] = 0.1
     """Running clearance added to pivot holes and slots, 0-2 mm."""
     sheet_mm: tuple[Pos, Pos] = (300.0, 200.0)
     """Sheet ``[width, height]``; parts that do not fit go on more sheets."""

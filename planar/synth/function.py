@@ -110,7 +110,9 @@ def _pairs(phi: Array, psi: Array, ground: float) -> tuple[Array, Array]:
 
     phi = check_finite("pairs: input", phi).ravel()
     psi = check_finite("pairs: output", psi).ravel()
-    if len(phi) < 3 or len(phi) != len(psi):
+    if len(phi) != len(psi):
+        raise InputError("psi", f"{len(psi)} output angles", f"one output angle per input angle (phi has {len(phi)})")
+    if len(phi) < 3:
         raise InputError("pairs", len(phi), "3 or more (input, output) angle pairs")
     if not SIZE_RANGE[0] <= check_positive("ground", ground) <= SIZE_RANGE[1]:
         raise InputError("ground", ground, f"a ground length from {SIZE_RANGE[0]:g} to {SIZE_RANGE[1]:g} (model units)")

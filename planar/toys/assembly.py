@@ -87,6 +87,14 @@ class KeyedShaft:
     phase: float
     size: float = 1.0
 
+    def __post_init__(self) -> None:
+        """Refused where it is built: finite anchors and phase, a positive size (NaN would be stored silently)."""
+        from planar.core.fields import check_fields
+
+        check_fields(self, f"KeyedShaft {self.name!r}")
+        if not self.size > 0:
+            raise InputError(f"KeyedShaft {self.name!r}.size", self.size, "a positive, finite size (model units)")
+
     def residual(self, poses: Mapping[str, Array]) -> Array:
         pa = poses_apply(poses[self.a], self.anchor_a)
         pb = poses_apply(poses[self.b], self.anchor_b)

@@ -60,8 +60,10 @@ def test_fps_asked_for_and_refused():
     assert plan.delay_ms == 100 and plan.frames_per_cycle == 10 and plan.frames == 30
     with pytest.raises(InputError, match="50 frames per second"):
         plan_frames(1.0, 1.0, fps=60)
-    with pytest.raises(InputError, match="--fps"):
+    with pytest.raises(InputError, match=r"^fps = nan"):  # the Python argument; the command line names --fps
         plan_frames(1.0, 1.0, fps=float("nan"))
+    with pytest.raises(InputError, match=r"^--fps = nan"):
+        plan_frames(1.0, 1.0, fps=float("nan"), fps_option="--fps")
     with pytest.raises(InputError, match="at most"):
         plan_frames(1.0, 1e6)
     # video: any rate
