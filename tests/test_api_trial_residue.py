@@ -82,6 +82,8 @@ def _theta() -> np.ndarray:
     [
         # raw exceptions the fifth trial found (AttributeError, OverflowError, ZeroDivisionError, OSError)
         (lambda: plan_assembly(None, {}, [], [], 10, 3, 3, 1.5), "mech"),
+        (lambda: plan_assembly(LEG, {}, [], [], 10, 3, 3, 1.5), "material"),  # a KeyError: 'ground'
+        (lambda: plan_assembly(LEG, {p.name: () for p in LEG.parts}, [], [], 10, 3, 3, 1.5, shaft_pin=1e300), "shaft_pin"),
         (lambda: plan_frames(1e-300, 1e300), "duration"),
         (lambda: freudenstein_angles(1e-300, 4, 3e-300, 4, _theta()), "freudenstein_angles(a)"),
         (lambda: freudenstein_angles(1, 4, 3, 4, np.zeros((2, 2))), "theta"),

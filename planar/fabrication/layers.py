@@ -121,10 +121,16 @@ def _swept(poly, poses: np.ndarray, u: float):
     return shapely.union_all([_placed(poly, p, u) for p in poses]).buffer(0)
 
 
-def _check_mech(mech: object) -> None:
-    """:func:`plan_assembly`'s mechanism: a Mechanism, or a view of one (what runs and has parts)."""
+def _check_mech(mech: Any, material: Any, shaft_pin: Any) -> None:
+    """:func:`plan_assembly`'s mechanism (a Mechanism, or a view of one: what runs and has parts), its parts'
+    material polygons and the motor's pin (a joint's name or None)."""
     if not callable(getattr(mech, "run", None)) or not hasattr(mech, "parts"):
         raise InputError("mech", mech, "a Mechanism (a linkage, a cam or a toy)")
+    missing = [p.name for p in mech.parts if not isinstance(material, dict) or p.name not in material]
+    if missing:
+        raise InputError("material", material, f"a dict of every part's material polygon (mm), {missing[0]!r} too")
+    if shaft_pin is not None and not isinstance(shaft_pin, str):
+        raise InputError("shaft_pin", shaft_pin, "the name of the joint the motor drives (or None)")
 
 
 def _check_sizes(unit_mm: Any, thickness: Any, pin_mm: Any, pin_head: Any, ring_mm: Any, samples: Any) -> None:
@@ -159,7 +165,7 @@ def plan_assembly(
     ``ring_mm``: the outer diameter of a spacer ring (default ``pin_mm``): a part between a pin's ends must clear
     the ring on the pin, not only the pin.
     """
-    _check_mech(mech)
+    _check_mech(mech, material, shaft_pin)
     _check_sizes(unit_mm, thickness, pin_mm, pin_head, ring_mm, samples)
     from shapely.geometry import LineString, Point
 
