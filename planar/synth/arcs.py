@@ -43,6 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planar.errors import InputError
+from planar.synth.atlas import DescriptorIndex
 from planar.synth.kernel import coupler_points
 
 __all__ = [
@@ -79,7 +80,7 @@ MIN_CHORD = 0.2
 
 
 @dataclass
-class Arcs:
+class Arcs(DescriptorIndex):
     """Rocking four-bars' arc descriptors (see the module).
 
     ``params`` ``(M, 6)``: input, coupler, rocker, u, v, circuit (ground 1); ``window`` ``(M, 2)``: the input
@@ -94,18 +95,6 @@ class Arcs:
     seed: int
     build_seconds: float = 0.0
     _tree: Any = field(default=None, repr=False)
-
-    def __len__(self) -> int:
-        return len(self.params)
-
-    @property
-    def tree(self) -> Any:
-        """The :class:`scipy.spatial.cKDTree` over the descriptors (built on first use)."""
-        if self._tree is None:
-            from scipy.spatial import cKDTree
-
-            self._tree = cKDTree(np.asarray(self.desc, float), balanced_tree=False, compact_nodes=False)
-        return self._tree
 
     def save(self, path: str | Path) -> None:
         """Write the arcs as one ``.npz`` file (a temporary beside it, then moved into place)."""

@@ -78,8 +78,29 @@ QUICK_SIZE = 20_000
 CHUNK = 20_000
 
 
+class DescriptorIndex:
+    """What a stored set of normalised curves shares: its length and a k-d tree over its descriptors
+    (``desc``, one row per curve), built on first use (the atlas of closed curves and the rocking arcs)."""
+
+    params: NDArray[np.float32]
+    desc: NDArray[np.float32]
+    _tree: Any
+
+    def __len__(self) -> int:
+        return len(self.params)
+
+    @property
+    def tree(self) -> Any:
+        """The :class:`scipy.spatial.cKDTree` over the descriptors (built on first use)."""
+        if self._tree is None:
+            from scipy.spatial import cKDTree
+
+            self._tree = cKDTree(np.asarray(self.desc, float), balanced_tree=False, compact_nodes=False)
+        return self._tree
+
+
 @dataclass
-class Atlas:
+class Atlas(DescriptorIndex):
     """Normalised four-bars and their curve descriptors (see the module).
 
     ``params`` ``(M, 6)``: crank, coupler, rocker, u, v, circuit (ground 1);
@@ -94,18 +115,6 @@ class Atlas:
     seed: int
     build_seconds: float = 0.0
     _tree: Any = field(default=None, repr=False)
-
-    def __len__(self) -> int:
-        return len(self.params)
-
-    @property
-    def tree(self) -> Any:
-        """The :class:`scipy.spatial.cKDTree` over the descriptors (built on first use)."""
-        if self._tree is None:
-            from scipy.spatial import cKDTree
-
-            self._tree = cKDTree(np.asarray(self.desc, float), balanced_tree=False, compact_nodes=False)
-        return self._tree
 
     def save(self, path: str | Path) -> None:
         """Write the atlas as one ``.npz`` file (written to a temporary beside it, then moved into place).
