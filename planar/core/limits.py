@@ -106,9 +106,20 @@ def check_memory(field: str, value: object, n_bytes: float, what: str, fits: str
         )
 
 
+#: share of the memory limit :func:`units_within` keeps back (at least :data:`MARGIN_MIB`), so that the count a
+#: refusal names still fits when the user runs it: resident memory drifts between two processes
+MARGIN_SHARE = 0.02
+MARGIN_MIB = 4.0
+
+
 def units_within(fixed_bytes: float, unit_bytes: float) -> int:
-    """How many units of ``unit_bytes`` each fit in the memory limit beside ``fixed_bytes`` (0 if none)."""
-    room = limit("memory") * 2.0**20 - fixed_bytes
+    """How many units of ``unit_bytes`` each fit in the memory limit beside ``fixed_bytes`` (0 if none).
+
+    A margin of :data:`MARGIN_SHARE` of the limit (at least :data:`MARGIN_MIB` MiB) is kept back, so that a
+    run of the count named passes the same check in a process whose resident memory is a little larger.
+    """
+    cap = limit("memory") * 2.0**20
+    room = cap - max(MARGIN_SHARE * cap, MARGIN_MIB * 2.0**20) - fixed_bytes
     return max(0, int(room // unit_bytes)) if unit_bytes > 0 and math.isfinite(room) else 0
 
 
