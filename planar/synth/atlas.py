@@ -324,6 +324,19 @@ def _stored_rows(path: str) -> int:
     return int(shape[0]) if shape else 0
 
 
+def _unreadable(e: Exception) -> str:
+    """What was wrong with a file that is not an atlas, in words (not the exception's class name)."""
+    import zipfile
+
+    if isinstance(e, zipfile.BadZipFile):
+        return "not a .npz archive"
+    if isinstance(e, KeyError):
+        return "an archive without the atlas arrays"
+    if isinstance(e, OSError) and e.strerror:
+        return e.strerror
+    return " ".join(str(e).split())[:120] or "unreadable"
+
+
 def read_atlas(path: str | Path) -> Atlas:
     """An atlas written by :meth:`Atlas.save`; raises :class:`InputError` naming the file if it is not one."""
     p = str(path)
@@ -336,7 +349,7 @@ def read_atlas(path: str | Path) -> Atlas:
     except FileNotFoundError:
         raise InputError(p, "missing", "an atlas file written by planar synth atlas") from None
     except (KeyError, ValueError, OSError, zipfile.BadZipFile) as e:
-        raise InputError(p, type(e).__name__, "an atlas file written by planar synth atlas") from None
+        raise InputError(p, _unreadable(e), "an atlas file written by planar synth atlas") from None
     check_atlas_memory(p, rows, search=True)  # from the file's header, before its arrays are read
     try:
         with np.load(p) as z:
@@ -347,7 +360,7 @@ def read_atlas(path: str | Path) -> Atlas:
     except FileNotFoundError:
         raise InputError(p, "missing", "an atlas file written by planar synth atlas") from None
     except (KeyError, ValueError, OSError) as e:
-        raise InputError(p, type(e).__name__, "an atlas file written by planar synth atlas") from None
+        raise InputError(p, _unreadable(e), "an atlas file written by planar synth atlas") from None
     _LOADED[p] = a
     return a
 
@@ -368,8 +381,17 @@ def load_atlas(size: int = DEFAULT_SIZE, seed: int = 0, progress: bool = False) 
     try:
         a.save(path)
         _LOADED[str(path)] = a
-    except (OSError, InputError):  # an unwritable cache folder: the atlas is kept in memory only
-        pass
+    except (OSError, InputError) as e:  # an unwritable cache folder: the atlas is kept in memory only
+        if progress:
+            import sys
+
+            why = e.strerror if isinstance(e, OSError) and e.strerror else " ".join(str(e).split())
+            print(
+                f"planar: note: the atlas could not be cached at {path} ({why}); it is kept for this run only "
+                "and built again next time (set PLANAR_CACHE_DIR to a folder that can be written)",
+                file=sys.stderr,
+                flush=True,
+            )
     return a
 
 

@@ -62,6 +62,43 @@ def test_first_build_says_what_it_builds_and_where(tmp_path, monkeypatch, capsys
     assert "building" not in capsys.readouterr().err  # read, not built
 
 
+def test_a_cache_folder_that_is_a_file_is_said_not_claimed(tmp_path, monkeypatch, capsys):
+    """PLANAR_CACHE_DIR naming a regular file: the atlas is built for this run, and the notice says it could
+    not be cached there (it said 'cached at FILE/atlas-...; later runs read it')."""
+    from planar.synth.atlas import load_atlas
+
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    monkeypatch.setenv("PLANAR_CACHE_DIR", str(afile))
+    a = load_atlas(300, seed=5, progress=True)
+    assert len(a.params) == 300
+    err = capsys.readouterr().err
+    assert "could not be cached" in err and str(afile) in err and "for this run only" in err, err
+    assert afile.read_text() == "x"
+
+
+def test_a_request_without_effectors_says_missing_not_none(tmp_path, capsys):
+    """A design request with no [[effector]] tables: the value is 'missing' (it printed Python's None)."""
+    r = tmp_path / "r.toml"
+    r.write_text('name = "x"\n')
+    assert main(["design", str(r), "-o", str(tmp_path / "d.toml")]) == 2
+    err = capsys.readouterr().err
+    assert "effector = 'missing'" in err and "None" not in err, err
+    assert not (tmp_path / "d.toml").exists()
+
+
+def test_a_file_that_is_not_an_atlas_is_named_in_words(tmp_path):
+    """--atlas of a CSV: the message says what is wrong, not an exception class name ('BadZipFile')."""
+    from planar.errors import InputError
+    from planar.synth.atlas import read_atlas
+
+    f = tmp_path / "c.csv"
+    f.write_text("x,y\n0,0\n")
+    with pytest.raises(InputError) as e:
+        read_atlas(f)
+    assert "not a .npz archive" in str(e.value) and "BadZip" not in str(e.value)
+
+
 def test_transmission_margin_against_the_solved_joints():
     """The smallest transmission-angle margin, against the angle at C measured from the solver's joint positions."""
     from planar.linkages import FourBar

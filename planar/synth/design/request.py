@@ -168,7 +168,7 @@ def load_request(path: str | Path) -> list[Effector]:
         raise InputError(f"{p}: {extra[0]}", data[extra[0]], "only [[effector]] tables and a toy name")
     rows = data.get("effector")
     if not isinstance(rows, list) or not rows or not all(isinstance(r, dict) for r in rows):
-        raise InputError(f"{p}: effector", rows, "one or more [[effector]] tables")
+        raise InputError(f"{p}: effector", "missing" if rows is None else rows, "one or more [[effector]] tables")
     out = []
     for i, r in enumerate(rows):
         where = f"{p}: effector[{i}]"
