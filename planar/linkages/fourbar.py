@@ -16,6 +16,7 @@ degenerates), so a fixed side is branch continuity.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -213,9 +214,9 @@ class FourBar(Linkage):
         the toggle (limit) angles where coupler and rocker fall into line:
         ``|B - O4|^2 = a^2 + d^2 - 2 a d cos(theta) = (b +/- c)^2``.
         """
-        g = self.dims
-        lo_c = (g.a**2 + g.d**2 - (g.b - g.c) ** 2) / (2 * g.a * g.d)
-        hi_c = (g.a**2 + g.d**2 - (g.b + g.c) ** 2) / (2 * g.a * g.d)
+        a, b, c, d = self._unit_lengths()
+        lo_c = (a**2 + d**2 - (b - c) ** 2) / (2 * a * d)
+        hi_c = (a**2 + d**2 - (b + c) ** 2) / (2 * a * d)
         lo = float(np.arccos(np.clip(lo_c, -1, 1)))  # |B-O4| >= |b - c| for theta >= lo
         hi = float(np.arccos(np.clip(hi_c, -1, 1)))  # |B-O4| <= b + c for theta <= hi
         if lo > hi:
@@ -242,10 +243,20 @@ class FourBar(Linkage):
 
     def transmission_angle(self, theta: ArrayLike) -> Array:
         """Transmission angle (radians, in ``[0, pi]``) between coupler and rocker at ``C``."""
-        g = self.dims
+        a, b, c, d = self._unit_lengths()
         th = check_finite(f"{self.name}.transmission_angle(theta)", theta)
-        bo2 = g.a**2 + g.d**2 - 2 * g.a * g.d * np.cos(th)
-        return np.arccos(np.clip((g.b**2 + g.c**2 - bo2) / (2 * g.b * g.c), -1.0, 1.0))
+        bo2 = a**2 + d**2 - 2 * a * d * np.cos(th)
+        return np.arccos(np.clip((b**2 + c**2 - bo2) / (2 * b * c), -1.0, 1.0))
+
+    def _unit_lengths(self) -> tuple[float, float, float, float]:
+        """Crank, coupler, rocker and ground lengths times a power of two that brings the longest near 1.
+
+        Exact (a power of two changes only the exponent), so the angles above are the same bits at any
+        scale from 1e-300 to 1e300, where their squares would overflow or underflow float64.
+        """
+        g = self.dims
+        k = math.ldexp(1.0, -math.frexp(max(g.a, g.b, g.c, g.d))[1])
+        return g.a * k, g.b * k, g.c * k, g.d * k
 
     def coupler_curve(self, theta: ArrayLike) -> tuple[Array, NDArray[np.bool_]]:
         """World coupler-point curve ``(N, 2)`` and validity for crank angles ``theta``."""

@@ -235,3 +235,24 @@ def test_lead_in_only_where_a_circuit_is_carried():
     assert cp.grashof == "change-point"
     lead = cp._lead_in(q)
     assert lead.size > 0 and np.all(np.diff(lead) > 0) and lead[-1] < q[0]
+
+
+@pytest.mark.parametrize("dims", [(4.0, 1.0, 4.0, 3.0), (2.0, 1.5, 2.0, 2.2), (1.0, 3.0, 2.5, 2.2)])
+@pytest.mark.parametrize("scale", [1e-300, 1e300, 2.0**-1000, 2.0**1000])
+def test_limits_and_transmission_at_any_scale(dims, scale):
+    """input_range, toggle_angles and transmission_angle of a four-bar scaled to 1e+-300 equal the unit one's
+    (they overflowed: OverflowError, ZeroDivisionError, all-NaN transmission angles), with no warning."""
+    import warnings
+
+    from planar.linkages import FourBar
+
+    th = np.linspace(0, 2 * np.pi, 12)
+    unit = FourBar(*dims)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        big = FourBar(*[x * scale for x in dims])
+        np.testing.assert_allclose(big.transmission_angle(th), unit.transmission_angle(th), rtol=1e-12, atol=1e-14)
+        np.testing.assert_allclose(big.toggle_angles(), unit.toggle_angles(), atol=1e-12)
+        r_big, r_unit = big.input_range(), unit.input_range()
+    assert len(r_big) == len(r_unit)
+    np.testing.assert_allclose(r_big, r_unit, atol=1e-12)
