@@ -160,6 +160,7 @@ def inverse_dynamics_torque(
     from planar.core.model import Mechanism
 
     check_kind("inverse_dynamics_torque(mech)", mech, Mechanism)
+    mech._check_rates_scale("inverse_dynamics_torque(mech)")
     t = check_samples("inverse_dynamics_torque(t)", t)
     if effects is not None and not all(hasattr(effects, a) for a in ("gravity", "loads", "springs", "damping", "density")):
         raise InputError(

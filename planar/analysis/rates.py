@@ -100,6 +100,7 @@ def mechanism_rates(mech: Mechanism, q: ArrayLike, qd: ArrayLike = 1.0, qdd: Arr
     from planar.core.model import Mechanism
 
     check_kind("mechanism_rates(mech)", mech, Mechanism)
+    mech._check_rates_scale("mechanism_rates(mech)")
     qa = check_samples("mechanism_rates(q)", q)
     qdv = np.broadcast_to(check_samples("mechanism_rates(qd)", qd, qa.shape[0]), qa.shape)
     qddv = np.broadcast_to(check_samples("mechanism_rates(qdd)", qdd, qa.shape[0]), qa.shape)
@@ -128,6 +129,7 @@ def transmission_angles(mech: Mechanism, q: ArrayLike) -> dict[str, Array]:
     from planar.linkages import Linkage
 
     check_kind("transmission_angles(mech)", mech, Mechanism)
+    mech._check_rates_scale("transmission_angles(mech)")
     qa = check_samples("transmission_angles(q)", q)
     if not isinstance(mech, Linkage):
         return {}

@@ -846,6 +846,19 @@ class Mechanism:
             check_scale(self.name, self, size_range=False)
             self.__dict__["_placement_checked"] = True
 
+    def _check_rates_scale(self, where: str) -> None:
+        """Once per mechanism: refuse rates, transmission angles and dynamics of a mechanism whose size is
+        outside :data:`planar.core.limits.SIZE_RANGE` (1e-60 to 1e60 model units).
+
+        Its motion solves at any scale, but rates multiply lengths (a cross product of two positions at 1e300
+        overflows float64) and would come back invalid or zero at every sample; ``where`` names the call.
+        """
+        if "_rates_scale_checked" not in self.__dict__:
+            from planar.core.limits import check_scale
+
+            check_scale(where, self)
+            self.__dict__["_rates_scale_checked"] = True
+
     def _check_driver_resolution(self, q: Array) -> None:
         """Refuse driver values so large that float64's spacing there is coarser than the mechanism needs.
 

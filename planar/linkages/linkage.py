@@ -533,6 +533,7 @@ class Linkage(Mechanism):
         Each node kind differentiates its own closure (:meth:`NodeKind.velocity`);
         ``qdot = 1`` gives velocity coefficients ``dX/dq``.
         """
+        self._check_rates_scale(f"{self.name}.node_velocities")
         qa = check_samples(f"{self.name}.node_velocities(q)", q)
         qd = np.broadcast_to(check_samples(f"{self.name}.node_velocities(qdot)", qdot, qa.shape[0]), qa.shape)
         pos, checks = self.solve_nodes(qa)
@@ -565,6 +566,7 @@ class Linkage(Mechanism):
         ``solved``: :meth:`solve_nodes` of ``q`` if the caller has it already.
         """
         where = f"{self.name}.node_accelerations"
+        self._check_rates_scale(where)
         qa = check_samples(f"{where}(q)", q)
         qd = np.broadcast_to(check_samples(f"{where}(qdot)", qdot, qa.shape[0]), qa.shape)
         qdd = np.broadcast_to(check_samples(f"{where}(qddot)", qddot, qa.shape[0]), qa.shape)

@@ -256,3 +256,29 @@ def test_limits_and_transmission_at_any_scale(dims, scale):
         r_big, r_unit = big.input_range(), unit.input_range()
     assert len(r_big) == len(r_unit)
     np.testing.assert_allclose(r_big, r_unit, atol=1e-12)
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e300])
+def test_rates_beyond_the_size_range_are_refused_naming_the_call(scale):
+    """Rates, transmission angles and dynamics of a four-bar scaled to 1e+-300 are refused (they came back NaN,
+    all zero or all invalid, or raised GEOSException), while its motion still solves; at 1e50 they are computed."""
+    from planar import analysis
+
+    th = np.linspace(0, 6, 12)
+    dims = (4.0, 1.0, 4.0, 3.0)
+    fb = FourBar(*[x * scale for x in dims], coupler_point=(5.5 * scale, -2 * scale))
+    calls = {
+        "transmission_angles(mech)": lambda: analysis.transmission_angles(fb, th),
+        "mechanism_rates(mech)": lambda: analysis.mechanism_rates(fb, th),
+        "node_accelerations": lambda: fb.part_rates(th, np.ones(12), np.zeros(12)),
+        "node_velocities": lambda: analysis.point_velocities(fb, th),
+        "inverse_dynamics_torque(mech)": lambda: analysis.inverse_dynamics_torque(fb, np.linspace(0, 1, 12)),
+    }
+    for where, call in calls.items():
+        with pytest.raises(InputError, match="mechanism size") as e:
+            call()
+        assert where in str(e.value)
+    assert fb.solve(th).valid.all()
+    ok = FourBar(*[x * 1e50 for x in dims], coupler_point=(5.5e50, -2e50))
+    unit = FourBar(*dims, coupler_point=(5.5, -2.0))
+    np.testing.assert_allclose(analysis.transmission_angles(ok, th)["C"], analysis.transmission_angles(unit, th)["C"], rtol=1e-12)
