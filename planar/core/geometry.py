@@ -268,9 +268,13 @@ def line_circle(
     wy = c[..., 1] - p[..., 1]
     s0 = wx * ux + wy * uy  # foot of the perpendicular from c
     e = ux * wy - uy * wx  # signed distance of c from the line (left positive)
-    h2 = (r - e) * (r + e)
-    scale = np.maximum(r * r, e * e)
+    # scale-free: r and e times the power of two nearest |r| (exact), so the squares hold from 1e-300 to 1e300
+    _, ex = np.frexp(np.abs(r))
+    k = np.ldexp(1.0, -ex)
+    rk, ek = r * k, e * k
+    h2 = (rk - ek) * (rk + ek)
+    scale = np.maximum(rk * rk, ek * ek)
     valid = (h2 >= -rtol * np.maximum(scale, np.finfo(float).tiny)) & ok_u
-    s = s0 + np.asarray(branch, float) * np.sqrt(np.maximum(h2, 0.0))
+    s = s0 + np.asarray(branch, float) * (np.sqrt(np.maximum(h2, 0.0)) / k)
     pts = np.stack([p[..., 0] + s * ux, p[..., 1] + s * uy], axis=-1)
     return pts, np.asarray(valid), s

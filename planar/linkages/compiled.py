@@ -256,6 +256,10 @@ def _k_rrp(
 ) -> int:
     """Line-circle as :func:`planar.core.geometry.line_circle` (the numpy path's ``chunked._rrp``)."""
     ra, branch, off = par[0], par[1], par[2]
+    # scale-free as line_circle: ra and e times the power of two nearest 1 / ra (exact: the same bits
+    # where nothing overflows), so the squares hold from 1e-300 to 1e300
+    k = math.ldexp(1.0, -math.frexp(abs(ra))[1])
+    rk = ra * k
     fails = 0
     for i in range(L):
         ux = xq[i] - xp[i]
@@ -270,13 +274,13 @@ def _k_rrp(
         wx = xa[i] - bx
         wy = ya[i] - by
         s0 = wx * ex + wy * ey
-        e = ex * wy - ey * wx
-        h2 = (ra - e) * (ra + e)
-        scale = max(ra * ra, e * e)
+        e = (ex * wy - ey * wx) * k
+        h2 = (rk - e) * (rk + e)
+        scale = max(rk * rk, e * e)
         good = (h2 >= -_RTOL * max(scale, _TINY)) & ok_u
         ok[i] = good
         fails += not good
-        h = math.sqrt(max(h2, 0.0))
+        h = math.sqrt(max(h2, 0.0)) / k
         sk = s0 + branch * h
         so = s0 + -branch * h
         kx, ky = bx + sk * ex, by + sk * ey

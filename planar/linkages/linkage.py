@@ -638,7 +638,8 @@ class Linkage(Mechanism):
         P = self._sweep_pos
         a, b = P[p][ok], P[q][ok]
         d = b - a
-        s = ((P[node][ok] - a) * d).sum(-1) / np.hypot(d[:, 0], d[:, 1])
+        u = d / np.hypot(d[:, 0], d[:, 1])[:, None]  # unit first: a product of two 1e300 lengths overflows
+        s = ((P[node][ok] - a) * u).sum(-1)
         return float(s.min()), float(s.max())
 
     def _build_parts_and_joints(self) -> tuple[list[Part], list[Pivot | PinInSlot | Slide]]:

@@ -44,6 +44,9 @@ class SliderCrank(Linkage):
         r = check_positive(f"{name}.crank", crank)
         l = check_positive(f"{name}.rod", rod)
         e = float(check_number(f"{name}.offset", offset))
+        if max(r, l) > 1e100 * min(r, l):  # as freudenstein_angles: no mechanism, and its squares overflow
+            short, long_ = (("crank", "rod"), ("rod", "crank"))[l < r]
+            raise InputError(f"{name}.{long_}", max(r, l), f"a length within 1e100 of the {short}'s ({min(r, l):g})")
         if abs(e) >= r + l:
             raise InputError(
                 f"{name}.offset", offset, f"|offset| < crank + rod = {r + l:g} (else the rod never reaches the guide)"

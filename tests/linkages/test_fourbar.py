@@ -282,3 +282,22 @@ def test_rates_beyond_the_size_range_are_refused_naming_the_call(scale):
     ok = FourBar(*[x * 1e50 for x in dims], coupler_point=(5.5e50, -2e50))
     unit = FourBar(*dims, coupler_point=(5.5, -2.0))
     np.testing.assert_allclose(analysis.transmission_angles(ok, th)["C"], analysis.transmission_angles(unit, th)["C"], rtol=1e-12)
+
+
+@pytest.mark.parametrize("n", [9, 5000])  # the numpy path and the compiled one
+@pytest.mark.parametrize("scale", [1e-300, 2.0**-1000, 1e300, 2.0**1000])
+def test_slider_crank_at_any_scale(n, scale):
+    """A slider-crank scaled to 1e+-300 gives the unit one's motion, scaled (at 1e-300 it was refused as
+    'not a rigid link', the line-circle squares underflowing; at 1e300 every sample was invalid), and a rod
+    1e300 times the crank is refused naming the rod (it named a pivot's anchor = (nan, nan))."""
+    import warnings
+
+    th = np.linspace(0, 6, n)
+    unit = SliderCrank(crank=1.0, rod=3.0, offset=0.5).solve(th)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        big = SliderCrank(crank=scale, rod=3 * scale, offset=0.5 * scale).solve(th)
+    assert big.valid.all()
+    np.testing.assert_allclose(big.points["slider_pin"] / scale, unit.points["slider_pin"], atol=1e-13)
+    with pytest.raises(InputError, match=r"slidercrank\.rod"):
+        SliderCrank(crank=1.0, rod=1e300)
