@@ -207,6 +207,10 @@ MAX_SHEET_MM = 100_000.0
 MAX_MOTOR_MM = 100.0
 MAX_MOTOR_BODY_MM = 250.0
 MAX_KERF_MM = 2.0
+#: the largest pin diameter, sheet thickness, wall, part or label size (mm) a ``[fabrication]`` table may ask
+#: for: a 100 mm pin or wall is past any laser cutter's stock; at 1e300 the holes swallowed the parts and
+#: the refusal named neither the field nor the value
+MAX_HARDWARE_MM = 100.0
 
 
 #: the largest angle (rad, about 159 000 turns) a phase, amplitude or a clock's turns may reach: float64

@@ -74,6 +74,7 @@ def _check_bounds(s: Any) -> None:
     bounds = dict.fromkeys(_MOTOR_FIELDS, (limits.MAX_MOTOR_MM, "a motor dimension"))
     bounds |= {"motor_body_mm": (limits.MAX_MOTOR_BODY_MM, "a motor body length")}
     bounds |= dict.fromkeys(("kerf", "clearance"), (limits.MAX_KERF_MM, "a width"))
+    bounds |= dict.fromkeys(("pin_mm", "thickness_mm", "min_wall", "min_part", "min_label"), (limits.MAX_HARDWARE_MM, "a size"))
     for name, (most, what) in bounds.items():
         if not getattr(s, name) <= most:
             raise InputError(f"fabrication.{name}", getattr(s, name), f"{what} of at most {most:g} mm")

@@ -11,7 +11,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, Strict, StrictBool, model_validator
 
-from planar.core.limits import MAX_KERF_MM, MAX_MOTOR_BODY_MM, MAX_MOTOR_MM, SIZE_RANGE
+from planar.core.limits import MAX_HARDWARE_MM, MAX_KERF_MM, MAX_MOTOR_BODY_MM, MAX_MOTOR_MM, SIZE_RANGE
 
 Vec2 = tuple[float, float]
 # strict types: a number is a TOML number (true is not 1.0, "4" is not 4.0), a flag is true or false
@@ -90,6 +90,8 @@ def _mm_up_to(most: float, what: str) -> Any:
 MotorMm = Annotated[
     float, Strict(), Field(gt=0, allow_inf_nan=False), AfterValidator(_mm_up_to(MAX_MOTOR_MM, "a motor dimension"))
 ]
+#: a pin, sheet thickness, wall, part or label size (mm)
+HardwareMm = Annotated[float, Strict(), Field(gt=0, allow_inf_nan=False), AfterValidator(_mm_up_to(MAX_HARDWARE_MM, "a size"))]
 MotorBodyMm = Annotated[
     float, Strict(), Field(gt=0, allow_inf_nan=False), AfterValidator(_mm_up_to(MAX_MOTOR_BODY_MM, "a motor body length"))
 ]
@@ -628,11 +630,11 @@ class FabricationSpec(_Strict):
 
     unit_mm: Pos = 10.0
     """What one model unit is in millimetres, e.g. ``15.0``."""
-    thickness_mm: Pos = 3.0
+    thickness_mm: HardwareMm = 3.0
     """Sheet thickness (pin lengths, spacers), e.g. ``3.0``."""
     kerf_mm: Annotated[float, Strict(), Field(ge=0, le=MAX_KERF_MM)] = 0.15
     """Beam width 0-2 mm: outlines grow and holes shrink by half of it."""
-    pin_diameter_mm: Pos = 3.0
+    pin_diameter_mm: HardwareMm = 3.0
     """Diameter of every pin (holes and slots are cut at this plus ``clearance_mm``)."""
     clearance_mm: Annotated[float, Strict(), Field(ge=0, le=MAX_KERF_MM)] = 0.1
     """Running clearance added to pivot holes and slots, 0-2 mm."""
@@ -641,11 +643,11 @@ class FabricationSpec(_Strict):
     # manufacturability (planar.fabrication.parts): thinnest material between a cut and the outline, smallest part,
     # smallest engraved text, clearance past each end of a pin's travel in its slot; narrow parts are
     # widened (widen = true) or refused
-    min_wall_mm: Pos = 1.5
+    min_wall_mm: HardwareMm = 1.5
     """Thinnest material between a cut and the outline (narrow parts widened or refused)."""
-    min_part_mm: Pos = 5.0
+    min_part_mm: HardwareMm = 5.0
     """Smallest part accepted (its smaller side)."""
-    min_label_mm: Pos = 1.5
+    min_label_mm: HardwareMm = 1.5
     """Smallest engraved label height; below it the part's number is engraved."""
     slot_end_margin_mm: Annotated[float, Strict(), Field(ge=0, le=50)] = 1.0
     """Slot length past each end of the pin's travel."""
