@@ -255,6 +255,10 @@ def _design(name: str) -> None:
         (lambda tmp: _simulate(densities={"crank": -1}), "densities['crank'] = -1"),
         (lambda tmp: _simulate(densities={"crank": math.nan}), "densities['crank'] = nan"),
         (lambda tmp: _simulate(densities={"nopart": 1.0}), "densities key = 'nopart'"),
+        (  # the one check both take
+            lambda tmp: __import__("planar").analysis.inverse_dynamics_torque(LEG, _TH, densities={"nopart": 1.0}),
+            "densities key = 'nopart'",
+        ),
         (lambda tmp: __import__("planar").analysis.static_foot_loads(-1, [0], [1], [True]), "static_foot_loads(weight) = -1"),
         (lambda tmp: __import__("planar.windup").windup.elemental(2, D_jc=(1e300, 0)), "#2.D_jc = (1e+300, 0.0)"),
         (lambda tmp: LEG.input_values("x"), "fourbar.input_values(q) = 'x'"),

@@ -106,7 +106,8 @@ def check_driver_rates(
     import numpy as np
 
     qa = check_samples(f"{where}(q)", q)
-    out = [np.broadcast_to(check_samples(f"{where}({n})", r, qa.shape[0]), qa.shape) for n, r in zip(names, rates)]
+    named = zip(names[: len(rates)], rates, strict=True)  # a rate without a name is the caller's mistake
+    out = [np.broadcast_to(check_samples(f"{where}({n})", r, qa.shape[0]), qa.shape) for n, r in named]
     return (qa, *out)
 
 
