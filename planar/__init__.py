@@ -185,7 +185,9 @@ def export(
         ``preview`` (.png), ``bom`` (.csv), ``assembly`` (.svg), ``kerf_test``
         (.dxf or .svg), ``plan`` (.json), ``motion`` (.csv), ``steps`` (.svg)
         (paths) and the ``kerf`` (mm) and ``sheet`` ((width, height) mm)
-        overrides.  Each path must end in its format's suffix, and at least
+        overrides.  ``steps`` names the assembly steps' pages, one per layer:
+        ``steps="st.svg"`` writes ``st-1.svg``, ``st-2.svg``, ... beside it and
+        no ``st.svg``.  Each path must end in its format's suffix, and at least
         one output must be given (as ``planar export`` refuses none): for the
         layout alone, use :func:`planar.fabrication.build.build`.
 
@@ -195,19 +197,14 @@ def export(
         The parts, their placement on the sheet and the files written; every
         file goes to a temporary and is renamed only when all succeeded.
     """
-    from planar.app.pipeline import export_scene
+    from planar.app.pipeline import EXPORT_FILES, check_export_outputs, export_scene
 
-    if dxf is None and svg is None and not any(files.get(k) is not None for k in _EXPORT_FILES):
-        raise InputError("dxf, svg, ...", None, f"an output: dxf, svg or one of {', '.join(_EXPORT_FILES)}")
-    unknown = sorted(set(files) - set(_EXPORT_FILES) - {"kerf", "sheet"})
+    unknown = sorted(set(files) - set(EXPORT_FILES) - {"kerf", "sheet"})
     if unknown:
-        raise InputError(", ".join(unknown), files[unknown[0]], f"one of the outputs {', '.join(_EXPORT_FILES)}, kerf or sheet")
+        raise InputError(", ".join(unknown), files[unknown[0]], f"one of the outputs {', '.join(EXPORT_FILES)}, kerf or sheet")
+    check_export_outputs(dxf, svg, files)  # before the scene is built
     scene = _scene(obj, {} if fabrication is None else {"fabrication": fabrication})
     return export_scene(scene, dxf, svg, **files)
-
-
-#: the files :func:`export` writes besides ``dxf`` and ``svg`` (keyword arguments)
-_EXPORT_FILES = ("preview", "bom", "assembly", "kerf_test", "plan", "motion", "steps")
 
 
 def compare(

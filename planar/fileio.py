@@ -254,6 +254,22 @@ def _same_file(a: Path, b: Path) -> bool:
         return False
 
 
+def check_outputs(
+    outputs: Iterable[tuple[str, str | os.PathLike | None, Sequence[str]]], inputs: Iterable[str | os.PathLike] = ()
+) -> None:
+    """:func:`check_output` of each ``(option, path, suffixes)`` (``None``: not asked for), and refuse two outputs
+    naming one file (the second is named: ``svg='x.svg', assembly='x.svg'`` would leave one of the two)."""
+    inputs = tuple(inputs)
+    seen: dict[str, str] = {}
+    for option, path, suffixes in outputs:
+        check_output(option, path, suffixes, inputs)
+        if path is not None:
+            key = os.path.realpath(path)
+            if key in seen:
+                raise InputError(option, str(path), f"a different file from {seen[key]} (both name it)")
+            seen[key] = option
+
+
 def check_output(
     option: str,
     path: str | os.PathLike | None,

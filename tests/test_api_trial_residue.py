@@ -7,6 +7,7 @@ before the fix with ZeroDivisionError, ValueError, TypeError, MemoryError or Att
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -228,3 +229,112 @@ def test_the_message_names_the_python_argument(tmp_path: Path, call, starts: str
         call(tmp_path)
     assert str(e.value).startswith(starts), str(e.value)
     assert not list(tmp_path.iterdir())
+
+
+# ----------------------------------------------------------------------------- the seventh trial (issue 26)
+
+_TH = np.linspace(0.0, 6.0, 12)
+
+
+def _simulate(**kw: object) -> None:
+    import planar
+
+    planar.simulate(LEG, np.linspace(0.0, 1.0, 5), **kw)  # type: ignore[arg-type]
+
+
+def _design(name: str) -> None:
+    from planar.synth.design import Effector, design_toy
+
+    design_toy([Effector("head", "Oz", 30.0)], name=name, physics=False, place=False)
+
+
+@pytest.mark.parametrize(
+    "call,starts",
+    [
+        # bad values accepted until now
+        (lambda tmp: _simulate(densities={"crank": -1}), "densities['crank'] = -1"),
+        (lambda tmp: _simulate(densities={"crank": math.nan}), "densities['crank'] = nan"),
+        (lambda tmp: _simulate(densities={"nopart": 1.0}), "densities key = 'nopart'"),
+        (  # the one check both take
+            lambda tmp: __import__("planar").analysis.inverse_dynamics_torque(LEG, _TH, densities={"nopart": 1.0}),
+            "densities key = 'nopart'",
+        ),
+        (lambda tmp: __import__("planar").analysis.static_foot_loads(-1, [0], [1], [True]), "static_foot_loads(weight) = -1"),
+        (lambda tmp: __import__("planar.windup").windup.elemental(2, D_jc=(1e300, 0)), "#2.D_jc = (1e+300, 0.0)"),
+        (lambda tmp: LEG.input_values("x"), "fourbar.input_values(q) = 'x'"),
+        (lambda tmp: _design("a\x00b"), "name = 'a\\x00b'"),
+        # messages naming the argument the caller wrote (not another function's, not a command-line option)
+        (lambda tmp: plan_frames(1e-300, 1.0), "period_s = 1e-300"),
+        (lambda tmp: LEG.part_rates(_TH, np.ones(3), np.zeros(12)), "fourbar.part_rates(qd) = "),
+        (lambda tmp: __import__("planar").analysis.point_velocities(LEG, _TH, qdot="a"), "point_velocities(qdot) = 'a'"),
+        (lambda tmp: __import__("planar").analysis.node_velocities(LEG, _TH, qdot="a"), "node_velocities(qdot) = 'a'"),
+        (lambda tmp: __import__("planar").synth.load_request(None), "load_request(path) = None"),
+        (lambda tmp: _simulate(mode="magic"), "mode = 'magic'"),
+        (lambda tmp: __import__("planar").simulate(LEG, []), "t = []"),
+        # an export with two outputs naming one file, or none at all
+        (lambda tmp: __import__("planar.app").app.export_mechanism(LEG), "dxf, svg, ... = None"),
+        (
+            lambda tmp: __import__("planar").export(LEG, "x.dxf", svg="x.svg", assembly="./x.svg"),
+            "assembly = './x.svg': expected a different file from svg",
+        ),
+        # numbers float64 cannot square, refused where they enter (they overflowed with a printed warning)
+        (lambda tmp: __import__("planar").synth.burmester(np.array([[0, 0, 0], [1e300, 0.2, 0.2], [2, 0.1, 0.4]])), "poses = "),
+    ],
+)
+def test_the_seventh_trial_call_raises_a_named_input_error(tmp_path: Path, monkeypatch, call, starts: str) -> None:
+    monkeypatch.chdir(tmp_path)  # outputs named relative to it
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no numpy RuntimeWarning on the way to the refusal
+        with pytest.raises(InputError) as e:
+            call(tmp_path)
+    assert str(e.value).startswith(starts), str(e.value)
+    assert not list(tmp_path.iterdir())
+
+
+def test_a_request_that_is_not_toml_is_named_once(tmp_path: Path) -> None:
+    from planar.synth import load_request
+
+    (tmp_path / "targets.csv").write_text("x,y\n0,1\n", encoding="utf-8")
+    with pytest.raises(InputError) as e:
+        load_request(tmp_path / "targets.csv")
+    assert str(e.value).count("targets.csv") == 1 and "not TOML" in str(e.value), str(e.value)
+
+
+def test_a_refusal_without_a_stage_keeps_its_reason() -> None:
+    """design_toy's list of trees the assembly refused dropped a reason naming no stage ("(it would ))")."""
+    from planar.synth.design.pipeline import _reasons
+
+    assert "Mechanism.name = 'x': expected y" in _reasons(["Mechanism.name = 'x': expected y"])
+
+
+def test_instant_centre_beyond_float64_is_invalid_and_quiet() -> None:
+    from planar.analysis import instant_centre
+
+    big = [[1e300, 0.0]], [[1e300, 0.0]], [[0.0, 1e300]], [[0.0, 1e300]]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        centre, omega, ok = instant_centre(*big)
+    assert np.isfinite(centre).all() and np.isfinite(omega).all() and not ok.any()
+    # the same bodies at a size float64 holds: the lines x = 1 and y = 1 meet at (1, 1), omega = 1
+    centre, omega, ok = instant_centre([[1.0, 0.0]], [[1.0, 0.0]], [[0.0, 1.0]], [[0.0, 1.0]])
+    assert ok.all() and np.allclose(centre, [[1.0, 1.0]]) and np.allclose(omega, [1.0])
+
+
+@pytest.mark.parametrize("name", ["a,b", 'say "hi"'])
+def test_a_mechanism_name_a_scene_cannot_hold_still_gets_its_motion_table(tmp_path: Path, name: str) -> None:
+    """contract.md: from Python a name with a comma is accepted; the mechanism's name is in no column."""
+    import csv
+
+    from planar.app.pipeline import write_mechanism_motion
+
+    named = FourBar(4.0, 1.0, 4.0, 3.0, coupler_point=(5.5, -2.0), name=name)
+    write_mechanism_motion(named, tmp_path / "a.csv", driver={"samples_per_cycle": 6})
+    write_mechanism_motion(LEG, tmp_path / "b.csv", driver={"samples_per_cycle": 6})
+    a, b = (list(csv.reader((tmp_path / f).open(encoding="utf-8"))) for f in ("a.csv", "b.csv"))
+    assert a == b and len(a) == 7
+
+
+def test_the_export_docstring_says_where_the_steps_go() -> None:
+    import planar
+
+    assert "st-1.svg" in (planar.export.__doc__ or "") and "no ``st.svg``" in (planar.export.__doc__ or "")

@@ -123,6 +123,30 @@ def mass_properties(part: Any, density: float) -> tuple[float, tuple[float, floa
     return mass, (cx, cy), moment
 
 
+def check_densities(densities: object, mech: Mechanism, where: str = "densities") -> dict[str, float]:
+    """The per-part densities ``densities`` (``{part name: density}`` or ``None``) checked against ``mech``.
+
+    The one check of every function that takes them (:func:`inverse_dynamics_torque`,
+    :func:`planar.physics.simulate`, ...): each key a part of ``mech``, each density a finite number
+    ``>= 0`` (0: a massless part).  An :class:`~planar.errors.InputError` names the entry as the caller
+    wrote it (``densities['crank'] = -1``); returns the densities as floats (``{}`` for ``None``).
+    """
+    from planar.core.fields import check_kind, check_number
+
+    if densities is None:
+        return {}
+    check_kind(where, densities, dict, "a dict of part name to density (or None)")
+    names = [p.name for p in mech.parts]
+    out: dict[str, float] = {}
+    for part, rho in densities.items():  # type: ignore[attr-defined]
+        if part not in names:
+            raise InputError(f"{where} key", part, f"the name of a part of {mech.name!r} (one of {', '.join(names)})")
+        if check_number(f"{where}[{part!r}]", rho) < 0:
+            raise InputError(f"{where}[{part!r}]", rho, "a density >= 0 (0: a massless part)")
+        out[part] = float(rho)
+    return out
+
+
 def part_mass_table(
     mech: Mechanism, effects: Any, densities: dict[str, float] | None = None
 ) -> dict[str, tuple[float, tuple[float, float], float]]:
@@ -166,11 +190,7 @@ def inverse_dynamics_torque(
         raise InputError(
             "inverse_dynamics_torque(effects)", effects, "an Effects (gravity, loads, springs, damping, density) or None"
         )
-    if densities is not None:
-        check_kind("inverse_dynamics_torque(densities)", densities, dict, "a dict of part name to density")
-        for part, rho in densities.items():  # named as the caller wrote it, not as mass_properties takes it
-            if check_number(f"densities[{part!r}]", rho) < 0:
-                raise InputError(f"densities[{part!r}]", rho, "a density >= 0 (0: a massless part)")
+    check_densities(densities, mech)  # named as the caller wrote it, not as mass_properties takes it
     if t_rest is not None:
         check_number("inverse_dynamics_torque(t_rest)", t_rest)
     drv = mech.driver

@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from planar.core.fields import check_finite, check_kind, check_number, check_samples
+from planar.core.fields import check_driver_rates, check_finite, check_kind, check_number, check_samples
 from planar.errors import InputError
 
 if TYPE_CHECKING:
@@ -167,6 +167,7 @@ def node_velocities(link: Linkage, q: ArrayLike, qdot: ArrayLike = 1.0) -> tuple
     placement; rotate them by ``placement[2]`` for the world.
     """
     _check_linkage("node_velocities(link)", link)
+    q, qdot = check_driver_rates("node_velocities", q, qdot)  # named as the caller wrote them
     vel, valid = link.node_velocities(q, qdot)
     ok = np.asarray(valid, bool) & _dyad_mask(link, q)
     for v in vel.values():
@@ -195,6 +196,7 @@ def _dyad_mask(link: Linkage, q: ArrayLike) -> NDArray[np.bool_]:
 def point_velocities(link: Linkage, q: ArrayLike, qdot: ArrayLike = 1.0) -> tuple[dict[str, Array], NDArray[np.bool_]]:
     """World velocities ``(N, 2)`` of the linkage's named points (placement applied)."""
     _check_linkage("point_velocities(link)", link)
+    q, qdot = check_driver_rates("point_velocities", q, qdot)  # named as the caller wrote them
     vel, valid = node_velocities(link, q, qdot)
     ang = link.placement[2]
     c, s = np.cos(ang), np.sin(ang)
@@ -239,15 +241,16 @@ def instant_centre(p1: ArrayLike, v1: ArrayLike, p2: ArrayLike, v2: ArrayLike) -
         raise InputError(
             "instant_centre(p1, v1, p2, v2)", f"arrays of shapes {shapes}", "points and velocities of one shape (..., 2)"
         )
-    n1, n2 = _perp(v1), _perp(v2)  # directions of the normals
-    den = _cross(n1, n2)
-    scale = np.hypot(*n1.T) * np.hypot(*n2.T)
-    ok = np.abs(den) > 1e-12 * np.maximum(scale, np.finfo(float).tiny)
-    s = _cross(p2 - p1, n2) / np.where(ok, den, 1.0)
-    centre = p1 + s[..., None] * n1
-    r1 = p1 - centre
-    omega = np.where(ok, _cross(r1, v1) / np.maximum((r1 * r1).sum(-1), np.finfo(float).tiny), 0.0)
-    ok = ok & np.isfinite(centre).all(-1) & np.isfinite(omega)  # beyond float64: no centre
+    with np.errstate(over="ignore", invalid="ignore"):  # beyond float64: marked invalid below, not printed
+        n1, n2 = _perp(v1), _perp(v2)  # directions of the normals
+        den = _cross(n1, n2)
+        scale = np.hypot(*n1.T) * np.hypot(*n2.T)
+        ok = np.abs(den) > 1e-12 * np.maximum(scale, np.finfo(float).tiny)
+        s = _cross(p2 - p1, n2) / np.where(ok, den, 1.0)
+        centre = p1 + s[..., None] * n1
+        r1 = p1 - centre
+        omega = np.where(ok, _cross(r1, v1) / np.maximum((r1 * r1).sum(-1), np.finfo(float).tiny), 0.0)
+    ok = ok & np.isfinite(centre).all(-1) & np.isfinite(omega) & np.isfinite(den)  # beyond float64: no centre
     return np.where(ok[..., None], centre, 0.0), np.where(ok, omega, 0.0), ok
 
 
@@ -465,7 +468,9 @@ def static_foot_loads(weight: float, com_x: ArrayLike, foot_x: ArrayLike, contac
     ``stable`` is false where the centre of mass is outside the feet's span
     (the balance needs a negative, pulling foot) or no foot touches.
     """
-    weight = check_number("static_foot_loads(weight)", weight)
+    if check_number("static_foot_loads(weight)", weight) < 0:  # a negative weight pulls the feet up
+        raise InputError("static_foot_loads(weight)", weight, "a weight >= 0 (force units)")
+    weight = float(weight)
     fx = np.atleast_2d(check_finite("static_foot_loads(foot_x)", foot_x))
     if fx.ndim != 2:
         raise InputError("static_foot_loads(foot_x)", f"an array of shape {fx.shape}", "foot positions (N, k)")

@@ -11,12 +11,12 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from planar.core import limits as _limits
-from planar.errors import InputError
+from planar.errors import InputError, LimitError
 
 
 def _check_scene(field: str, scene: object) -> None:
@@ -151,7 +151,7 @@ def animation_plan(scene: Scene, out: str | Path, fps: float | None = None, fps_
         )
     except InputError as e:  # the planner names "duration_s" or "period_s": say which key of which scene
         d = scene.spec.driver
-        if e.field == "duration_s":
+        if e.field == "duration_s" or isinstance(e, LimitError):  # too many frames: the cycles (or duration) ask them
             key, value = (
                 ("driver.duration", d.duration)
                 if d.duration is not None
@@ -405,6 +405,21 @@ def table_motion(
 # --------------------------------------------------------------------------- fabrication
 
 
+#: the files :func:`export_scene` writes besides ``dxf`` and ``svg`` (keyword arguments)
+EXPORT_FILES = ("preview", "bom", "assembly", "kerf_test", "plan", "motion", "steps")
+
+
+def check_export_outputs(dxf: object, svg: object, files: Mapping[str, Any]) -> None:
+    """:class:`InputError` unless an export names an output (``dxf``, ``svg`` or one of :data:`EXPORT_FILES` in
+    ``files``): with none, the whole export would run and write nothing (``planar export`` refuses it too)."""
+    if dxf is None and svg is None and not any(files.get(k) is not None for k in EXPORT_FILES):
+        raise InputError(
+            "dxf, svg, ...",
+            None,
+            f"an output: dxf, svg or one of {', '.join(EXPORT_FILES)} (for the layout alone, planar.fabrication.build.build)",
+        )
+
+
 def export_scene(
     scene: Scene,
     dxf: str | Path | None = None,
@@ -422,21 +437,23 @@ def export_scene(
     """Check, layer and nest a scene's parts and write the requested files (see :mod:`planar.app.export`).
 
     ``kerf`` (mm) and ``sheet`` (width, height in mm) default to the scene's
-    ``[fabrication]`` table.  Every file is written to a temporary and
-    renamed only when all succeeded.
+    ``[fabrication]`` table.  ``steps`` names the assembly steps' pages, one
+    per layer: ``steps="st.svg"`` writes ``st-1.svg``, ``st-2.svg``, ... and
+    no ``st.svg``.  Every file is written to a temporary and renamed only
+    when all succeeded.
     """
     from planar.app.export import write_outputs
     from planar.core.fields import check_number, check_point
     from planar.fabrication.build import build
     from planar.fabrication.parts import FabSettings
-    from planar.fileio import check_output
+    from planar.fileio import check_outputs
 
     _check_scene("scene", scene)
     if kerf is not None:
         check_number("kerf", kerf)
     if sheet is not None:
         sheet = check_point("sheet", sheet, "a sheet (width, height) in mm: two finite numbers")
-    for arg, path, ends in (
+    outputs = (
         ("dxf", dxf, (".dxf",)),
         ("svg", svg, (".svg",)),
         ("preview", preview, (".png",)),
@@ -446,8 +463,10 @@ def export_scene(
         ("plan", plan, (".json",)),
         ("motion", motion, (".csv",)),
         ("steps", steps, (".svg",)),
-    ):  # the suffix names the format: DXF bytes never go into x.svg
-        check_output(arg, path, ends, (scene.path,) if Path(str(scene.path)).is_file() else ())
+    )
+    check_export_outputs(dxf, svg, {arg: path for arg, path, _ in outputs[2:]})
+    # the suffix names the format (DXF bytes never go into x.svg), and two outputs never name one file
+    check_outputs(outputs, (scene.path,) if Path(str(scene.path)).is_file() else ())
     spec = scene.spec.fabrication
     w, h = sheet if sheet is not None else spec.sheet_mm
     where = "--sheet" if sheet is not None else f"{scene.path}: fabrication.sheet_mm"
@@ -525,13 +544,25 @@ def export_mechanism(
     """
     from planar.scene.load import scene_from_mechanism
 
+    check_export_outputs(dxf, svg, files)  # before the scene is built
     return export_scene(scene_from_mechanism(mech, fabrication=fabrication), dxf, svg, **files)
 
 
 def write_mechanism_motion(mech: Mechanism, out: str | Path, derivatives: bool = False, **tables: Any) -> Motion:
-    """The motion table (CSV) of a mechanism built in Python, as ``planar motion [--derivatives]`` writes it."""
+    """The motion table (CSV) of a mechanism built in Python, as ``planar motion [--derivatives]`` writes it.
+
+    The mechanism's own name is in no column, so one a scene file could not hold (a comma, a double quote,
+    more than 80 characters; ``FourBar(name="a,b")``) is accepted: the scene behind the table gets it
+    without them, unless ``tables`` names the scene (``name=...``).  Column names holding a comma are
+    quoted (:func:`planar.fileio.write_motion_csv`).
+    """
+    from planar.core.model import Mechanism
     from planar.scene.load import scene_from_mechanism
 
+    if "name" not in tables and isinstance(mech, Mechanism):
+        safe = mech.name.replace(",", " ").replace('"', "'")[:80]
+        if safe != mech.name:
+            tables = {**tables, "name": safe}
     return write_scene_motion(scene_from_mechanism(mech, **tables), out, derivatives=derivatives)
 
 

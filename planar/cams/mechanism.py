@@ -306,6 +306,9 @@ class CamMechanism(Mechanism):
         ``omega = qd (1 - |P'| / r)`` and
         ``alpha = qdd (1 - |P'| / r) - qd^2 (P' . P'') / (|P'| r)``.
         """
+        from planar.core.fields import check_driver_rates
+
+        q, qd, qdd = check_driver_rates(f"{self.name}.part_rates", q, qd, qdd, names=("qd", "qdd"))
         prof = self.profile
         s, s1, s2 = prof.follower_output(q)
         parts, valid, _ = self.linkage.part_rates(s, s1 * qd, s2 * qd * qd + s1 * qdd)

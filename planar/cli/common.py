@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 from collections.abc import Sequence
 
 from planar.errors import InputError
@@ -14,17 +13,9 @@ __all__ = ["outputs", "positive", "sheet"]
 
 def outputs(args: argparse.Namespace, inputs: Sequence[str], *specs: tuple[str, str, tuple[str, ...]]) -> None:
     """Check each output ``(option, attribute, suffixes)`` of ``args`` before any work; refuse two alike."""
-    from planar.fileio import check_output
+    from planar.fileio import check_outputs
 
-    seen: dict[str, str] = {}
-    for option, attr, suffixes in specs:
-        path = getattr(args, attr)
-        check_output(option, path, suffixes, inputs)
-        if path is not None:
-            key = os.path.realpath(path)
-            if key in seen:
-                raise InputError(option, path, f"a different file from {seen[key]} (both name it)")
-            seen[key] = option
+    check_outputs(((option, getattr(args, attr), suffixes) for option, attr, suffixes in specs), inputs)
 
 
 def positive(option: str, value: float | None, integer: bool = False) -> None:

@@ -18,7 +18,16 @@ if TYPE_CHECKING:
     import numpy as np
     from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["check_fields", "check_finite", "check_kind", "check_number", "check_point", "check_positive", "check_samples"]
+__all__ = [
+    "check_driver_rates",
+    "check_fields",
+    "check_finite",
+    "check_kind",
+    "check_number",
+    "check_point",
+    "check_positive",
+    "check_samples",
+]
 
 Vec = tuple[float, float]
 
@@ -86,6 +95,20 @@ def check_samples(field_name: str, value: ArrayLike, n: int | None = None) -> ND
     if n is not None and np.ndim(value) and a.shape[0] != n:
         raise InputError(field_name, f"an array of shape {a.shape}", f"a number or one value per driver value ({n})")
     return a
+
+
+def check_driver_rates(
+    where: str, q: ArrayLike, *rates: ArrayLike, names: tuple[str, ...] = ("qdot", "qddot")
+) -> tuple[Any, ...]:
+    """``q`` and its ``rates`` (a number or one value per driver value each) checked as :func:`check_samples`
+    does, named ``where(q)``, ``where(qdot)``, ``where(qddot)`` (``names``: the rates' argument names); returns
+    them as 1-D float arrays of ``q``'s length (a rate given as a number is repeated)."""
+    import numpy as np
+
+    qa = check_samples(f"{where}(q)", q)
+    named = zip(names[: len(rates)], rates, strict=True)  # a rate without a name is the caller's mistake
+    out = [np.broadcast_to(check_samples(f"{where}({n})", r, qa.shape[0]), qa.shape) for n, r in named]
+    return (qa, *out)
 
 
 def _check_name(field: str, name: object) -> None:

@@ -283,13 +283,14 @@ def check_coordinates(field: str, points: object, mech: object, shown: object = 
     """:class:`InputError` naming ``field`` if a point of ``points`` (model units, ``[[x, y], ...]``) lies so far
     from the origin that float64 resolves it coarser than :data:`RESOLUTION` of ``mech``'s smallest length (the
     rule :func:`check_scale` applies to the placement: a standoff or a polygon vertex at 1e300 is refused, not cut
-    into nonsense).  ``shown``: the value as the user wrote it (default ``points``)."""
+    into nonsense).  ``mech``: the mechanism, or its smallest length (model units) when it is not built yet (a
+    wind-up mechanism's parameters).  ``shown``: the value as the user wrote it (default ``points``)."""
     with _quiet_numpy():
         import numpy as np
 
         pts = np.asarray(points, dtype=float).reshape(-1)
         extent = float(np.abs(pts).max(initial=0.0))
-        smallest = _smallest_length(mech)
+        smallest = float(mech) if isinstance(mech, (int, float)) else _smallest_length(mech)
         if math.isfinite(extent) and float(np.spacing(extent)) <= RESOLUTION * smallest:
             return
         far = smallest * RESOLUTION / float(np.finfo(float).eps)

@@ -151,15 +151,32 @@ def plan_frames(
     # MAX_FRAMES unless PLANAR_MAX_FRAMES raises it
     frames_f = per_cycle * duration_s / period_s  # inf for a duration 1e300 periods long: refused below
     if not frames_f <= limit("frames"):
-        raise LimitError(
-            "duration_s",
-            duration_s,
-            f"an animation of at most {limit('frames')} frames ({frames_f:.3g} asked "
-            f"for at {1000.0 / delay:.3g} frames per second; shorten the duration, "
-            "lower --fps or raise PLANAR_MAX_FRAMES)",
-        )
+        _refuse_frames(period_s, duration_s, delay, per_cycle, frames_f, fps_option)
     frames = max(1, int(round(frames_f)))
     return FramePlan(float(period_s), float(delay), per_cycle, frames)
+
+
+def _refuse_frames(period_s: float, duration_s: float, delay: float, per_cycle: int, frames_f: float, fps_option: str) -> None:
+    """The :class:`LimitError` of an animation of more than ``PLANAR_MAX_FRAMES`` frames, naming its culprit: the
+    duration when it alone, played at the frame rate, takes too many frames; else the period, whose cycles
+    (each of at least ``MIN_FRAMES_ASKED`` frames) are too short and too many."""
+    from planar.core.limits import limit
+
+    most = limit("frames")
+    if duration_s * 1000.0 / delay <= most:  # a short period: each of its many cycles still takes per_cycle frames
+        raise LimitError(
+            "period_s",
+            period_s,
+            f"at most {most} frames in all (PLANAR_MAX_FRAMES): each cycle takes at least {per_cycle} frames, so "
+            f"cycles of {period_s:.3g} s over {duration_s:.3g} s ask {frames_f:.3g} (a period of at least "
+            f"{per_cycle * duration_s / most:.3g} s fits)",
+        )
+    raise LimitError(
+        "duration_s",
+        duration_s,
+        f"an animation of at most {most} frames ({frames_f:.3g} asked for at {1000.0 / delay:.3g} frames per "
+        f"second; shorten the duration, lower {fps_option} or raise PLANAR_MAX_FRAMES)",
+    )
 
 
 def scene_duration(scene: Scene) -> float:

@@ -751,10 +751,10 @@ class Linkage(Mechanism):
 
         Empty for a single-input linkage (its value is the driver value).
         """
+        qa = check_samples(f"{self.name}.input_values(q)", q)  # checked for a single input too
         inputs = [n for n in self.nodes if n.is_input]
         if len(inputs) < 2:
             return {}
-        qa = check_samples(f"{self.name}.input_values(q)", q)
         out: dict[str, Array] = {}
         for n in inputs:
             own = getattr(n, "input_angle", None)  # a geared or driven node's law
@@ -794,6 +794,9 @@ class Linkage(Mechanism):
     def part_rates(self, q: Array, qd: Array, qdd: Array) -> RatesResult:
         """Rates of every link (see :meth:`Mechanism.part_rates`): every node kind's closure differentiated
         twice (:meth:`node_accelerations`), the link frames' rates (:meth:`link_rates`) turned by the placement."""
+        from planar.core.fields import check_driver_rates
+
+        q, qd, qdd = check_driver_rates(f"{self.name}.part_rates", q, qd, qdd, names=("qd", "qdd"))
         pos, vel, acc, valid = self.node_accelerations(q, qd, qdd, solved=self.cached_solve_nodes(q))
         ang = self.placement[2]
         out = {

@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 from planar.core.effects import Effects
 from planar.core.geometry import poses_apply
 from planar.core.model import Mechanism, Motion, joint_residuals
-from planar.errors import InputError, PlanarError
+from planar.errors import InputError
 from planar.physics.cycle import check_cycle
 from planar.physics.failure import _failure_at, _PoseCheck, change_point
 from planar.physics.rebuild import _Rebuild
@@ -60,8 +60,6 @@ def _analytic_pose_velocity(mech: Mechanism, t: Array) -> tuple[dict[str, Array]
 
 
 def _check_mode(mech: Mechanism, mode: str) -> None:
-    if mode not in ("kinematic", "motor"):
-        raise SimulationError(f"{mech.name}: mode {mode!r} is neither 'kinematic' nor 'motor'")
     if mode != "motor":
         return
     if mech.driver.kind != "rotation" or mech.driver.amplitude is not None:
@@ -110,6 +108,7 @@ def _simulated_motion(
 
 def _check_simulate_args(mech: Any, t: Any, effects: Any, settings: Any, mode: Any, densities: Any) -> NDArray[np.float64]:
     """:func:`simulate`'s arguments checked at its entrance (each named); the output times as a 1-D array."""
+    from planar.analysis.dynamics import check_densities
     from planar.core.model import check_finite
     from planar.errors import InputError
 
@@ -124,10 +123,11 @@ def _check_simulate_args(mech: Any, t: Any, effects: Any, settings: Any, mode: A
         raise InputError("effects", type(effects).__name__, "an Effects record, or a scene's effects (or None)")
     if not isinstance(settings, SimSettings):
         raise InputError("settings", type(settings).__name__, "a SimSettings")
-    if not isinstance(mode, str):
+    if not isinstance(mode, str) or mode not in ("kinematic", "motor"):
         raise InputError("mode", mode, "'kinematic' or 'motor'")
-    if densities is not None and not (isinstance(densities, dict) and all(isinstance(k, str) for k in densities)):
-        raise InputError("densities", type(densities).__name__, "a dict of part name -> density (or None)")
+    if times.size < 2:
+        raise InputError("t", t, "at least two output times (s)")
+    check_densities(densities, mech)  # the one check inverse_dynamics_torque makes too
     return times
 
 
@@ -186,8 +186,6 @@ def simulate(
     t = _check_simulate_args(mech, t, effects, settings, mode, densities)
     _check_mechanism(mech)
     _check_mode(mech, mode)
-    if t.size < 2:
-        raise PlanarError("simulate: needs at least two output times")
     _check_memory(mech, t.size, settings.substeps)
     dt_out = float(t[1] - t[0])
     poses_a, vel_a, analytic = _analytic_pose_velocity(mech, t)

@@ -384,6 +384,9 @@ def burmester(poses: Array, max_ratio: float = 10.0, grid: int = 24, min_transmi
     poses = check_finite("poses", poses)
     if poses.ndim != 2 or poses.shape[1] != 3 or not 3 <= len(poses) <= 5:
         raise InputError("poses", poses.shape, "3, 4 or 5 poses (x, y, angle)")
+    from planar.synth.targets import normalisation
+
+    normalisation(poses[:, :2], "poses")  # positions within what the solvers square and multiply (SIZE_RANGE)
     if not 1.0 <= check_number("max_ratio", max_ratio) <= 1e6:
         raise InputError("max_ratio", max_ratio, "a longest-to-shortest link ratio from 1 to 1e6")
     if not 2 <= check_number("grid", grid, integer=True) <= 4096:

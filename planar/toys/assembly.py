@@ -557,6 +557,9 @@ class ToyAssembly(Mechanism):
         do not change; the piece's origin is a point of that body (``v + omega x r``,
         ``a + alpha x r - omega^2 r``, ``r`` from the stage part's origin to the piece's).
         """
+        from planar.core.fields import check_driver_rates
+
+        q, qd, qdd = check_driver_rates(f"{self.name}.part_rates", q, qd, qdd, names=("qd", "qdd"))
         raw, ok, _ = self.toy.part_rates(q, qd, qdd)
         stage_poses = self.stage_poses(q)
         pieces = self.piece_poses(stage_poses)

@@ -290,6 +290,9 @@ class ToyMechanism(Mechanism):
     def part_rates(self, q: Array, qd: Array, qdd: Array) -> RatesResult:
         """Rates of every stage's parts (see :meth:`Mechanism.part_rates`): each stage's input is its parent's
         output (or the motor's at its cam's phase) through the same linear axis maps as the motions."""
+        from planar.core.fields import check_driver_rates
+
+        q, qd, qdd = check_driver_rates(f"{self.name}.part_rates", q, qd, qdd, names=("qd", "qdd"))
         outs: dict[int, tuple[Array, Array, Array]] = {}
         valid = np.ones(q.shape, bool)
         parts: dict[str, PartRates] = {}

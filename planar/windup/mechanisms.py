@@ -138,6 +138,9 @@ class ElementalMechanism(ElementalBuilders, Mechanism):
         """Rates of the three parts (see :meth:`Mechanism.part_rates`): the record's ``rates`` (its forward
         kinematics differentiated twice) through the driver's and follower's pose rules, in the view plane's
         coordinates."""
+        from planar.core.fields import check_driver_rates
+
+        q, qd, qdd = check_driver_rates(f"{self.name}.part_rates", q, qd, qdd, names=("qd", "qdd"))
         u = R.driver_motion_rates(self.motion_in, self.params, self.driver_motion(q), q, qd, qdd)
         out1, out2, ok = self.record.rates(self.params, u[0], u[1], u[2])
         parts = R.stage_part_rates(self.motion_in, self.record.follower_motion, u, out1, out2)

@@ -37,13 +37,31 @@ def check_params(number: int, P: Any) -> None:
             raise InputError(f"#{number}.{f.name}", v, "finite numbers")
         if f.name.endswith(("r", "h", "w1", "w2", "amplitude")) and arr.ndim == 0 and arr <= 0:
             raise InputError(f"#{number}.{f.name}", v, "a positive length")
+    lengths = [float(v) for f in fields(P) if f.name.endswith(("r", "h", "w1", "w2")) and np.ndim(v := getattr(P, f.name)) == 0]
     for fld, label, fn in rec.lengths:
         length = float(fn(P))
         if not length > 1e-12:
             raise InputError(f"#{number}.{fld}", getattr(P, fld), f"a positive {label} (got {length:g})")
+        lengths.append(length)
+    _check_places(number, P, min(lengths, default=1.0))
     ref = rec.forward(P, np.zeros(1) if rec.motions[0] != "OzT" else np.zeros((1, 3)))
     if not ref.valid[0]:
         raise InputError(f"#{number}.params", P, f"a mechanism that assembles at rest ({ref.why})")
+
+
+def _check_places(number: int, P: Any, smallest: float) -> None:
+    """Refuse a position of ``P`` (its vectors but the angles ``D_theta``) that float64 resolves coarser than
+    :data:`planar.core.limits.RESOLUTION` of the smallest length ``smallest``: the check a solve makes of the
+    built mechanism (:func:`planar.core.limits.check_scale`), made where it is built and naming the parameter
+    (``D_jc = (1e300, 0)`` overflowed the forward kinematics at rest)."""
+    from dataclasses import fields
+
+    from planar.core.limits import check_coordinates
+
+    for f in fields(P):
+        v = getattr(P, f.name)
+        if f.name != "D_theta" and np.ndim(v) == 1:
+            check_coordinates(f"#{number}.{f.name}", v, smallest)
 
 
 def standalone_driver(number: int, P: Any, rate: float = 2 * np.pi, phase: float = 0.0) -> Driver:

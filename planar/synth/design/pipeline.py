@@ -258,6 +258,12 @@ def _check_design_args(
     for arg, text in (("name", name), ("source", source)):
         if not isinstance(text, str):
             raise InputError(arg, text, "a string")
+    if not 1 <= len(name) <= 80 or any(ord(c) < 32 or ord(c) == 127 or c in ',"' for c in name):  # a scene's name
+        raise InputError(
+            "name",
+            name,
+            "a toy name of 1 to 80 characters without control characters (newline, tab, NUL), commas or quotes ('\"')",
+        )
     check_count("chain", "max_length", check_number("max_length", max_length, integer=True), "stages in a chain")
     for arg, value in (("max_length", max_length), ("max_trees", max_trees), ("max_fabricated", max_fabricated)):
         if not 1 <= check_number(arg, value, integer=True) <= 1_000_000:
@@ -356,7 +362,8 @@ def _reasons(errs: list[str]) -> str:
     by: dict[str, list[str]] = {}
     for e in errs:
         why, stage = _assembly_reason(e)
-        if stage and stage not in by.setdefault(why, []):
-            by[why].append(stage)
+        stages = by.setdefault(why, [])  # a reason without a stage is kept too (it was dropped: "it would )")
+        if stage and stage not in stages:
+            stages.append(stage)
     parts = [why + (f" ({', '.join(stages)})" if stages else "") for why, stages in sorted(by.items())]
     return " or ".join(parts).replace(" or need ", " or ")

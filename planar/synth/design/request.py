@@ -156,13 +156,17 @@ _MISSING = _Missing()
 
 def load_request(path: str | Path) -> list[Effector]:
     """Read a request file (TOML ``[[effector]]`` tables); bad input is an :class:`InputError` naming the field."""
-    p = str(path)
+    import os
+
     from planar.fileio import read_text
 
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError("load_request(path)", path, "a path to a request file (TOML)")
+    p = str(path)
     try:
         data = tomllib.loads(read_text(p, "request file (TOML)"))
     except tomllib.TOMLDecodeError as e:
-        raise InputError(p, p, f"TOML ({e})") from None
+        raise InputError(p, f"not TOML: {e}", "a request file in TOML ([[effector]] tables)") from None
     extra = sorted(set(data) - {"effector", "name"})
     if extra:
         raise InputError(f"{p}: {extra[0]}", data[extra[0]], "only [[effector]] tables and a toy name")
