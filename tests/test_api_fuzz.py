@@ -828,3 +828,12 @@ def test_api_fuzz_costly_sample(tmp_path: Path) -> None:
     """Two seeded cases of each costly callable (synthesis, physics, export, render: a second or more a call;
     their whole product is hours of CPU)."""
     _ratchet(default_sample(all_cases(), 2, costly=True), tmp_path)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("costly", sorted(COSTLY))
+def test_api_fuzz_costly_everything(costly: str, tmp_path: Path) -> None:
+    """Every case of one costly callable (each parameter with every wrong value, and its methods'): the whole
+    product the seeded sample above leaves out, one test per callable (about 1,800 calls in all, from 11 of
+    ``format_comparison`` to 132 of ``export_scene``; minutes of CPU each, an hour or more in all)."""
+    _ratchet([c for c in all_cases() if _owner(c.target)[0] == costly], tmp_path)

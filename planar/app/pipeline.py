@@ -77,6 +77,8 @@ def gallery_scenes(folder: str | os.PathLike[str]) -> list[Path]:
     code.  Raises :class:`InputError` if ``folder`` is not a directory or holds
     no scene file.
     """
+    if not isinstance(folder, (str, os.PathLike)):
+        raise InputError("scenes folder", folder, "a folder name (a string or a pathlib.Path)")
     p = Path(folder)
     if not p.is_dir():
         raise InputError("scenes folder", str(p), "an existing folder of .toml scene files")
@@ -190,8 +192,10 @@ def render_scene(
     from planar.draw.timing import animation_motion, resample
     from planar.errors import InputError
 
+    if not (isinstance(options, tuple) and len(options) == 2 and all(isinstance(o, str) for o in options)):
+        raise InputError("options", options, "two strings naming out and fps in messages, e.g. ('-o', '--fps')")
     _check_scene("scene", scene)
-    _check_path("out", out)
+    _check_path(options[0], out)
     _check_flag("progress", progress)
     from planar.core.model import Motion as MotionKind
 

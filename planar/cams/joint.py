@@ -36,6 +36,7 @@ class CamContact:
     """
 
     kind: ClassVar[str] = "cam-profile"
+    point_fields: ClassVar[tuple[str, ...]] = ("point",)
     name: str
     a: str
     b: str

@@ -43,7 +43,7 @@ def _cmd_design(args: argparse.Namespace) -> int:
     name = tomllib.loads(read_text(args.request, "request file (TOML)")).get("name") or Path(args.request).stem
     import re
 
-    from planar.scene.load import _NAME
+    from planar.scene.messages import NAME_PATTERN as _NAME
 
     if not isinstance(name, str) or not re.match(_NAME, name) or len(name) > 80:
         raise InputError(

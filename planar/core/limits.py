@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 import numbers
 import os
+from collections.abc import Iterable
 from typing import Any
 
 from planar.errors import InputError, LimitError
@@ -35,11 +36,13 @@ __all__ = [
     "check_coordinates",
     "check_count",
     "check_memory",
+    "check_resolution",
     "check_scale",
     "limit",
     "motion_bytes",
     "pilot_bytes",
     "resident_bytes",
+    "resolution_terms",
     "sample_count",
     "units_within",
 ]
@@ -299,6 +302,63 @@ def check_coordinates(field: str, points: object, mech: object, shown: object = 
         points if shown is None else shown,
         f"coordinates within about {far:.3g} model units of the origin (float64 resolves coarser there than "
         f"{RESOLUTION:g} of the mechanism's smallest length {smallest:.6g})",
+    )
+
+
+#: one number a resolution check weighs: ``(field, value as given, magnitude, is_length)``; a length (> 0) also sets
+#: the smallest length the others are resolved against, a coordinate or signed offset only reaches
+Term = tuple[str, object, float, bool]
+
+
+def resolution_terms(obj: object, where: str) -> list[Term]:
+    """The lengths and coordinates of one kind (a node, a joint, a feature) for :func:`check_resolution`.
+
+    Each kind states them as class attributes: ``length_fields`` (lengths, model units: a radius, a pin's
+    diameter, a slot's width) and ``point_fields`` (points ``(x, y)`` or signed offsets, model units); a field
+    holding ``None`` is skipped.  The field is named ``where.FIELD``.
+    """
+    out: list[Term] = []
+    for names, is_length in ((getattr(type(obj), "length_fields", ()), True), (getattr(type(obj), "point_fields", ()), False)):
+        for name in names:
+            v = getattr(obj, name, None)
+            if v is None:
+                continue
+            flat = v if isinstance(v, (tuple, list)) else (v,)
+            try:
+                mag = max((abs(float(x)) for x in flat), default=0.0)
+            except (TypeError, ValueError):  # not numbers: the kind's own checks name it
+                continue
+            out.append((f"{where}.{name}", v, mag, is_length))
+    return out
+
+
+def check_resolution(terms: Iterable[Term], what: str = "mechanism") -> None:
+    """:class:`InputError` naming the term whose magnitude float64 resolves coarser than :data:`RESOLUTION` of the
+    smallest length among ``terms`` (the rule :func:`check_scale` applies to a scene, for an assembly built in
+    Python).
+
+    A big but consistent linkage passes (every length 1e6: the smallest is 1e6 too); a coordinate or a length
+    so far beyond the smallest length that float64 cannot tell positions apart on that length's scale is
+    refused: ``RRR("B", "A", 1e300, "D", 1.0)``, ``Fixed("O", (1e300, 0))`` in a linkage of 1-unit links, a
+    part's hull circle of radius 1 at x = 1e300.  Terms holding no positive length are not checked (nothing
+    to resolve against).  ``what`` names the assembly in the message ("linkage", "part", ...).
+    """
+    terms = list(terms)
+    lengths = [(t[2], t[0]) for t in terms if t[3] and t[2] > 0.0 and math.isfinite(t[2])]
+    if not lengths or not terms:
+        return
+    smallest, small_field = min(lengths)
+    field, value, mag, _ = max(terms, key=lambda t: t[2])
+    spacing = math.ulp(mag) if math.isfinite(mag) else math.inf
+    if spacing <= RESOLUTION * smallest:
+        return
+    far = math.ldexp(1.0, math.frexp(RESOLUTION * smallest)[1] + 52)  # the largest power of two resolved that finely
+    raise InputError(
+        field,
+        value,
+        f"a value within about {far:.3g} model units of zero: float64 resolves {spacing:.3g} there, coarser than "
+        f"{RESOLUTION:g} of the {what}'s smallest length {smallest:.6g} ({small_field}); scale every length "
+        "together (a big mechanism is fine) or move it nearer the origin",
     )
 
 

@@ -104,6 +104,9 @@ def _check_joint(joint: Any, points: tuple[str, ...], size: str | None) -> None:
         check_point(f"{kind} {joint.name!r}.{f}", getattr(joint, f))
     if size is not None and getattr(joint, size) is not None:
         check_positive(f"{kind} {joint.name!r}.{size}", getattr(joint, size))
+    from planar.core.limits import check_resolution, resolution_terms
+
+    check_resolution(resolution_terms(joint, f"{kind} {joint.name!r}"), f"{kind} joint")
 
 
 def _vec(v: ArrayLike) -> Vec:
@@ -163,6 +166,32 @@ class Part:
         check_number(f"{where}.offset", self.offset)
         if not isinstance(self.features, (tuple, list)) or not all(isinstance(f, (Hole, Slot, ArcSlot)) for f in self.features):
             raise InputError(f"{where}.features", self.features, "a tuple of Hole, Slot or ArcSlot")
+        from planar.core.limits import check_resolution
+
+        check_resolution(self._resolution_terms(where), "part")
+
+    def _resolution_terms(self, where: str) -> list[tuple[str, object, float, bool]]:
+        """The part's lengths (hull radii > 0, its features' sizes) and coordinates (hull centres, polygon points,
+        features, ``offset``), own frame, for :func:`planar.core.limits.check_resolution`; named ``where.FIELD``."""
+        from planar.core.limits import resolution_terms
+
+        terms: list[tuple[str, object, float, bool]] = []
+        h = np.asarray(self.hull, dtype=float).reshape(-1, 3)
+        if len(h):
+            far = int(np.abs(h[:, :2]).max(axis=1).argmax())
+            terms.append((f"{where}.hull[{far}]", self.hull[far], float(np.abs(h[far, :2]).max()), False))
+            r = np.where(h[:, 2] > 0, h[:, 2], np.inf)
+            if np.isfinite(r).any():
+                k = int(r.argmin())
+                terms.append((f"{where}.hull[{k}]", self.hull[k], float(h[k, 2]), True))
+        if self.polygon is not None:
+            poly = np.abs(np.asarray(self.polygon, dtype=float).reshape(-1, 2)).max(axis=1)
+            k = int(poly.argmax())
+            terms.append((f"{where}.polygon[{k}]", self.polygon[k], float(poly[k]), False))
+        terms.append((f"{where}.offset", self.offset, abs(float(self.offset)), False))
+        for i, f in enumerate(self.features):
+            terms += resolution_terms(f, f"{where}.features[{i}]")
+        return terms
 
     @cached_property
     def outline(self) -> shapely.Polygon:
@@ -254,6 +283,8 @@ class Pivot:
     """
 
     kind: ClassVar[str] = "pivot"
+    length_fields: ClassVar[tuple[str, ...]] = ("diameter",)
+    point_fields: ClassVar[tuple[str, ...]] = ("anchor_a", "anchor_b")
     name: str
     a: str
     b: str
@@ -291,6 +322,8 @@ class PinInSlot:
     """
 
     kind: ClassVar[str] = "pin-in-slot"
+    length_fields: ClassVar[tuple[str, ...]] = ("width",)
+    point_fields: ClassVar[tuple[str, ...]] = ("start", "end", "pin")
     name: str
     a: str
     b: str
@@ -333,6 +366,8 @@ class PinInArcSlot:
     """
 
     kind: ClassVar[str] = "pin-in-arc-slot"
+    length_fields: ClassVar[tuple[str, ...]] = ("radius",)
+    point_fields: ClassVar[tuple[str, ...]] = ("centre", "pin")
     name: str
     a: str
     b: str
@@ -369,6 +404,8 @@ class Slide:
     """
 
     kind: ClassVar[str] = "slide"
+    length_fields: ClassVar[tuple[str, ...]] = ("width",)
+    point_fields: ClassVar[tuple[str, ...]] = ("start", "end", "anchor", "axis")
     name: str
     a: str
     b: str
@@ -418,6 +455,8 @@ class CamOnLine:
     """
 
     kind: ClassVar[str] = "cam-on-line"
+    length_fields: ClassVar[tuple[str, ...]] = ("radius",)
+    point_fields: ClassVar[tuple[str, ...]] = ("start", "end", "centre")
     name: str
     a: str
     b: str
@@ -781,6 +820,16 @@ class Mechanism:
         if driver.part not in names:
             raise InputError(f"{name}.driver.part", driver.part, f"one of the parts {names}")
         self.parts = _with_joint_features(self.parts, self.joints)
+        self._check_resolution()
+
+    def _check_resolution(self) -> None:
+        """Refuse a part or joint coordinate float64 resolves coarser than :data:`~planar.core.limits.RESOLUTION` of
+        the mechanism's smallest length (a pin hole, a hull radius, a slot): the whole assembly, as a scene is."""
+        from planar.core.limits import check_resolution, resolution_terms
+
+        terms = [t for p in self.parts for t in p._resolution_terms(f"{self.name}.parts.{p.name}")]
+        terms += [t for j in self.joints for t in resolution_terms(j, f"{self.name}.joints.{j.name}")]
+        check_resolution(terms, "mechanism")
 
     def _check_joints(self, names: list[str]) -> None:
         """Every joint is of a registered kind and joins two existing parts."""

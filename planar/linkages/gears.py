@@ -70,6 +70,7 @@ class Geared(NodeKind):
     """Turns about ``centre`` at ``radius``: ``angle = ratio * angle(mesh) + phase`` (rad); ``ratio < 0``."""
 
     kind: ClassVar[str] = "geared"
+    length_fields: ClassVar[tuple[str, ...]] = ("radius",)
     scene_fields: ClassVar[tuple[str, ...]] = ("centre", "radius", "mesh", "ratio", "phase")
     angle_fields: ClassVar[tuple[str, ...]] = ("phase",)
     is_input: ClassVar[bool] = True
@@ -207,6 +208,7 @@ class Driven(NodeKind):
     """A crank about ``centre`` at ``radius`` with its own law of the clock ``theta`` (see the module note)."""
 
     kind: ClassVar[str] = "driven"
+    length_fields: ClassVar[tuple[str, ...]] = ("radius",)
     scene_fields: ClassVar[tuple[str, ...]] = ("centre", "radius", "cycles", "phase", "amplitude", "mean")
     #: without ``amplitude`` the node turns fully (``phase + cycles theta``)
     required_fields: ClassVar[tuple[str, ...]] = ("centre", "radius")
@@ -308,6 +310,8 @@ class GearMesh:
     """
 
     kind: ClassVar[str] = "gear"
+    length_fields: ClassVar[tuple[str, ...]] = ("radius_a", "radius_b")
+    point_fields: ClassVar[tuple[str, ...]] = ("centre_a", "centre_b")
     name: str
     a: str
     b: str

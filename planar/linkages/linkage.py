@@ -34,7 +34,7 @@ from numpy.typing import ArrayLike, NDArray
 from planar.core.buffers import MIN_BYTES
 from planar.core.buffers import block as new_block
 from planar.core.geometry import poses_apply, poses_compose, poses_invert
-from planar.core.limits import limit
+from planar.core.limits import check_resolution, limit, resolution_terms
 from planar.core.model import (
     Driver,
     FinitePoses,
@@ -122,6 +122,11 @@ class Linkage(Mechanism):
     the linkage's span).  ``points`` maps names to node names.  A driver that
     rocks instead of turning: ``amplitude`` and ``centre`` (rad or units), so
     the input is ``centre + amplitude sin(rate t + phase)``.
+
+    ``ground`` names the ground part (the frame that never moves): a link of that name among ``links``, whose
+    nodes must all stay still (a link carrying the crank's moving end is refused), or, when no link has that
+    name, the part made of the ``Fixed`` nodes, given that name (so any name is accepted: ``ground="frame"``
+    names the frame part ``frame``).  It names a part, not a node.
     """
 
     def __init__(
@@ -158,6 +163,7 @@ class Linkage(Mechanism):
             raise InputError(f"{name}.placement", placement, "(x, y, angle): three numbers")
         self.placement = tuple(float(v) for v in pl)
         self._validate_nodes(name)
+        self._check_node_resolution(name)
         bound: dict[str, NodeKind] = {n.name: n for n in self.nodes}
         for n in self.nodes:
             bound[n.name] = n.bind(f"{name}.nodes.{n.name}", bound)
@@ -213,6 +219,7 @@ class Linkage(Mechanism):
         k_ref = int(np.argmax(sweep_ok))
         self._ref_nodes = {k: v[k_ref] for k, v in self._sweep_pos.items()}
         self._check_rigid(name)
+        self._check_ground_still(name)
         span = self._span()
         self.width = check_positive(f"{name}.width", width) if width is not None else 0.08 * span
         self.pin_diameter = check_positive(f"{name}.pin_diameter", pin_diameter) if pin_diameter is not None else 0.03 * span
@@ -247,6 +254,16 @@ class Linkage(Mechanism):
                     raise InputError(where, r, "a node declared before it")
             n.validate(where)
             seen.add(n.name)
+
+    def _check_node_resolution(self, name: str) -> None:
+        """Refuse a node's length or coordinate (or the placement) that float64 resolves coarser than
+        :data:`~planar.core.limits.RESOLUTION` of the linkage's smallest length, before it is solved: a far
+        ``Fixed`` node or an ``RRR`` link of 1e300 beside 1-unit links would otherwise be solved into noise
+        (or refused for a reason it does not have)."""
+        terms = [t for n in self.nodes for t in resolution_terms(n, f"{name}.nodes.{n.name}")]
+        x, y, _ = self.placement
+        terms.append((f"{name}.placement", self.placement, max(abs(x), abs(y)), False))
+        check_resolution(terms, "linkage")
 
     def _with_ground(self, links: tuple[Link, ...], ground: str) -> tuple[Link, ...]:
         if any(lk.name == ground for lk in links):
@@ -353,6 +370,24 @@ class Linkage(Mechanism):
                         nodes,
                         f"a block that keeps its guide's direction: nodes {nodes[0]!r}-{nodes[1]!r} turn by "
                         f"{dev:.4g} rad against the guide {lk.guide[0]!r}-{lk.guide[1]!r}",
+                    )
+
+    def _check_ground_still(self, name: str) -> None:
+        """Refuse a ``ground`` naming a link that carries a moving node: the ground part never moves, so the
+        motion would hold that node still while the solver moves it (every sample marked valid, the joint open)."""
+        ok = self._sweep_ok
+        tol = 1e-9 * self._span()
+        for lk in self.links:
+            if lk.name != self.ground_name:
+                continue
+            for node in lk.nodes:
+                moved = float(np.ptp(self._sweep_pos[node][ok], axis=0).max(initial=0.0))
+                if moved > tol:
+                    raise InputError(
+                        f"{name}.ground",
+                        self.ground_name,
+                        f"a link whose nodes stay still, or a new name for the part the fixed nodes make: link "
+                        f"{lk.name!r} carries node {node!r}, which moves by {moved:.4g} over the driver's cycle",
                     )
 
     # -- solving ------------------------------------------------------------

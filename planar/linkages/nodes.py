@@ -46,6 +46,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planar.core.geometry import circle_circle, line_circle
+from planar.core.limits import check_resolution, resolution_terms
 from planar.core.model import _check_name, check_fields, check_finite, check_point, check_positive
 from planar.errors import InputError
 
@@ -206,6 +207,10 @@ class NodeKind:
     transmits: ClassVar[bool] = False
     scene_fields: ClassVar[tuple[str, ...]] = ()
     angle_fields: ClassVar[tuple[str, ...]] = ()
+    #: its lengths (model units, > 0: a radius, a link length) and its points or signed offsets (model units),
+    #: for the resolution check (:func:`planar.core.limits.check_resolution`)
+    length_fields: ClassVar[tuple[str, ...]] = ()
+    point_fields: ClassVar[tuple[str, ...]] = ()
     is_input: ClassVar[bool] = False
     name: str
 
@@ -220,6 +225,9 @@ class NodeKind:
         for ref in self.refs():
             _check_name(f"nodes.{self.name}: a node it is placed from", ref)
         self.validate(f"nodes.{self.name}")
+        # its own numbers float64 resolves together (RRR(ra=1e300, rb=1) is refused here; the whole linkage
+        # is checked where it is assembled)
+        check_resolution(resolution_terms(self, f"nodes.{self.name}"), f"{self.kind} node")
 
     def validate(self, where: str) -> None:
         """Raise :class:`InputError` (naming ``where``) for unusable values."""
@@ -297,6 +305,7 @@ class Fixed(NodeKind):
     """A point ``xy`` on the ground."""
 
     kind: ClassVar[str] = "fixed"
+    point_fields: ClassVar[tuple[str, ...]] = ("xy",)
     scene_fields: ClassVar[tuple[str, ...]] = ("at",)
     name: str
     xy: Vec
@@ -322,6 +331,7 @@ class Crank(NodeKind):
     """Turns about node ``centre`` at ``radius``: angle ``q + phase`` (rad, counter-clockwise)."""
 
     kind: ClassVar[str] = "crank"
+    length_fields: ClassVar[tuple[str, ...]] = ("radius",)
     scene_fields: ClassVar[tuple[str, ...]] = ("centre", "radius", "phase")
     angle_fields: ClassVar[tuple[str, ...]] = ("phase",)
     is_input: ClassVar[bool] = True
@@ -364,6 +374,7 @@ class Actuator(NodeKind):
     """Translates with the driver: ``origin + (q + offset) * axis / |axis|`` (model units)."""
 
     kind: ClassVar[str] = "actuator"
+    point_fields: ClassVar[tuple[str, ...]] = ("offset",)
     scene_fields: ClassVar[tuple[str, ...]] = ("origin", "axis", "offset")
     is_input: ClassVar[bool] = True
     name: str
@@ -409,6 +420,7 @@ class RRR(NodeKind):
 
     kind: ClassVar[str] = "rrr"
     transmits: ClassVar[bool] = True
+    length_fields: ClassVar[tuple[str, ...]] = ("ra", "rb")
     scene_fields: ClassVar[tuple[str, ...]] = ("a", "ra", "b", "rb", "branch")
     name: str
     a: str
@@ -486,6 +498,8 @@ class RRP(NodeKind):
     """At ``ra`` from node ``a`` on the line ``p -> q`` shifted left by ``offset``; ``branch`` +1: further along."""
 
     kind: ClassVar[str] = "rrp"
+    length_fields: ClassVar[tuple[str, ...]] = ("ra",)
+    point_fields: ClassVar[tuple[str, ...]] = ("offset",)
     scene_fields: ClassVar[tuple[str, ...]] = ("a", "ra", "p", "q", "branch", "offset")
     name: str
     a: str
@@ -571,6 +585,7 @@ class Rigid(NodeKind):
     """Fixed in the frame of nodes ``a, b``: ``a + u e + v e_perp``, ``e`` the unit vector ``a -> b``."""
 
     kind: ClassVar[str] = "rigid"
+    point_fields: ClassVar[tuple[str, ...]] = ("local",)
     scene_fields: ClassVar[tuple[str, ...]] = ("a", "b", "local")
     name: str
     a: str

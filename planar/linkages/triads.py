@@ -231,6 +231,8 @@ class Triad(NodeKind):
     """One node of a triad: ``ra`` from node ``a``, at ``local`` on the ternary link; ``at``: near it at driver 0."""
 
     kind: ClassVar[str] = "triad"
+    length_fields: ClassVar[tuple[str, ...]] = ("ra",)
+    point_fields: ClassVar[tuple[str, ...]] = ("local", "at")
     scene_fields: ClassVar[tuple[str, ...]] = ("a", "ra", "local", "at", "members")
     #: the keys every triad node gives (``members`` only the first of the three)
     required_fields: ClassVar[tuple[str, ...]] = ("a", "ra", "local", "at")

@@ -106,6 +106,15 @@ def _simulated_motion(
     return Motion(driver=analytic.driver, poses=out, valid=valid, fail_code=code, fail_table=table, points=pts, t=t)
 
 
+def check_effects_settings(effects_field: str, effects: Any, settings_field: str, settings: Any) -> None:
+    """:class:`~planar.errors.InputError` naming the argument unless ``effects`` is an Effects record (or a scene's
+    effects, or None) and ``settings`` a :class:`SimSettings` (None: the caller's default)."""
+    if effects is not None and not all(hasattr(effects, f) for f in ("gravity", "damping", "density", "springs", "loads")):
+        raise InputError(effects_field, type(effects).__name__, "an Effects record, or a scene's effects (or None)")
+    if settings is not None and not isinstance(settings, SimSettings):
+        raise InputError(settings_field, type(settings).__name__, "a SimSettings (or None)")
+
+
 def _check_simulate_args(mech: Any, t: Any, effects: Any, settings: Any, mode: Any, densities: Any) -> NDArray[np.float64]:
     """:func:`simulate`'s arguments checked at its entrance (each named); the output times as a 1-D array."""
     from planar.analysis.dynamics import check_densities
@@ -119,10 +128,9 @@ def _check_simulate_args(mech: Any, t: Any, effects: Any, settings: Any, mode: A
         raise InputError("t", f"an array of shape {times.shape}", "a 1-D array of output times (s)")
     if times.size >= 2 and not bool(np.all(np.diff(times) > 0)):
         raise InputError("t", times, "increasing output times (s), evenly spaced")
-    if effects is not None and not all(hasattr(effects, f) for f in ("gravity", "damping", "density", "springs", "loads")):
-        raise InputError("effects", type(effects).__name__, "an Effects record, or a scene's effects (or None)")
-    if not isinstance(settings, SimSettings):
-        raise InputError("settings", type(settings).__name__, "a SimSettings")
+    check_effects_settings("effects", effects, "settings", settings)
+    if settings is None:
+        raise InputError("settings", settings, "a SimSettings")
     if not isinstance(mode, str) or mode not in ("kinematic", "motor"):
         raise InputError("mode", mode, "'kinematic' or 'motor'")
     if times.size < 2:

@@ -146,6 +146,9 @@ def simulate_toy(
     from planar.errors import InputError
 
     t = check_samples("simulate_toy(t)", t)
+    from planar.physics.run import check_effects_settings
+
+    check_effects_settings("simulate_toy(effects)", effects, "simulate_toy(settings)", settings)
     if len(t) < 2:
         raise InputError("simulate_toy(t)", t, "two or more sample times (s)")
     from planar.analysis.dynamics import gravity_and_damping, plane_gravity

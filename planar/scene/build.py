@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from planar.core.effects import Effects, Load, Spring
 from planar.core.limits import check_coordinates, check_scale
@@ -92,13 +93,15 @@ class Scene:
         check_memory(where, value, float(per_sample) * max(n, 2), "a motion", fits=f"{units_within(0.0, per_sample):,} samples")
         return max(2, n)
 
+    def times(self) -> NDArray[np.float64]:
+        """The times (s) of :meth:`motion`'s samples, without solving it (checked as :meth:`sample_count`)."""
+        step = self.mechanism.driver.period / self.spec.driver.samples_per_cycle
+        return np.arange(self.sample_count(), dtype=np.float64) * step
+
     def motion(self) -> Motion:
         """The analytic motion over the scene's cycles (or duration)."""
-        d = self.spec.driver
-        drv = self.mechanism.driver
-        n = self.sample_count()
-        t = np.arange(n) * (drv.period / d.samples_per_cycle)
-        return self.mechanism.solve(drv.value(t), t=t)
+        t = self.times()
+        return self.mechanism.solve(self.mechanism.driver.value(t), t=t)
 
     @property
     def name(self) -> str:

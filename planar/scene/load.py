@@ -14,7 +14,6 @@ model units (``[fabrication] unit_mm`` says what one unit is in millimetres).
 
 from __future__ import annotations
 
-import re
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
@@ -25,90 +24,15 @@ from pydantic import ValidationError
 from planar.core.model import Mechanism
 from planar.errors import InputError, SceneError
 from planar.scene.build import Scene, build_scene
-from planar.scene.schema import _NAME, SceneSpec, scene_schema
+from planar.scene.messages import child_of as _child
+from planar.scene.messages import expected_text as _expected
+from planar.scene.messages import field_path as _loc
+from planar.scene.schema import SceneSpec, scene_schema
 
 __all__ = ["Scene", "SceneSpec", "build_scene", "load_scene", "parse_scene", "scene_from_mechanism", "scene_schema"]
 
 
 # --------------------------------------------------------------------------- loading
-
-
-def _loc(loc: tuple, data: Any = None) -> str:
-    """The field path of a pydantic error location; a list item with a name (a node, a link) is named by it."""
-    out = ""
-    node = data
-    for i, part in enumerate(loc):
-        child = _child(node, part)
-        if isinstance(part, int):
-            name = child.get("name") if isinstance(child, dict) else None
-            named = isinstance(name, str) and re.fullmatch(r"[A-Za-z0-9_\-]+", name) is not None
-            out += f".{name}" if named else f"[{part}]"
-        elif (
-            i == 1
-            and loc[0] == "mechanism"
-            and part in ("fourbar", "slidercrank", "linkage", "legs", "elemental", "chain", "toy", "catalog", "cam")
-        ):
-            continue  # the discriminated union's tag
-        elif i > 0 and (str(part) in ("float", "int", "str", "bool") or str(part).startswith(("list[", "tuple["))):
-            continue  # which member of a union (a number or a list of numbers) pydantic tried
-        elif not re.fullmatch(r"[A-Za-z0-9_\-]+", str(part)):
-            out += f"[{str(part)!r}]"  # a key with spaces, dots or control characters, shown quoted on one line
-        else:
-            out += ("." if out else "") + str(part)
-        if child is not None:
-            node = child
-    return out
-
-
-def _child(node: Any, part: Any) -> Any:
-    """``node[part]`` of the parsed document, or None (a union member's tag is not in the document)."""
-    if isinstance(part, int) and isinstance(node, list) and -len(node) <= part < len(node):
-        return node[part]
-    if isinstance(part, str) and isinstance(node, dict):
-        return node.get(part)
-    return None
-
-
-#: pydantic's error types said in planar's words: "FIELD = VALUE: expected ..." (ctx holds the bounds)
-_WORDS: dict[str, str] = {
-    "missing": "a value here (it is missing)",
-    "greater_than": "a number greater than {gt}",
-    "greater_than_equal": "a number of at least {ge}",
-    "less_than": "a number less than {lt}",
-    "less_than_equal": "a number of at most {le}",
-    "finite_number": "a finite number",
-    "literal_error": "one of {expected}",
-    "too_long": "at most {max_length} items (it has {actual_length})",
-    "too_short": "at least {min_length} items (it has {actual_length})",
-    "float_type": "a number",
-    "float_parsing": "a number",
-    "int_type": "a whole number (written without a point)",
-    "int_parsing": "a whole number (written without a point)",
-    "int_from_float": "a whole number (written without a point)",
-    "bool_type": "true or false",
-    "bool_parsing": "true or false",
-    "string_type": "text in double quotes",
-    "list_type": "a list [...]",
-    "tuple_type": "a list [...]",
-    "dict_type": "a table",
-    "model_type": "a table",
-    "extra_forbidden": "no such key here (a misspelt or misplaced key)",
-}
-
-
-def _expected(err: Any) -> str:
-    """What a pydantic error says was expected, in planar's words."""
-    kind = err["type"]
-    ctx = err.get("ctx") or {}
-    if kind == "string_pattern_mismatch" and ctx.get("pattern") == _NAME:
-        return "a name without control characters (newline, tab), commas or double quotes"
-    if kind in _WORDS:
-        try:
-            return _WORDS[kind].format(**ctx)
-        except (KeyError, IndexError):
-            pass
-    msg = str(err["msg"]).removeprefix("Value error, ")
-    return msg[:1].lower() + msg[1:]
 
 
 def _format_validation(path: str, e: ValidationError, data: Any = None) -> str:

@@ -7,18 +7,30 @@ model units (``[fabrication] unit_mm`` says what one unit is in millimetres).
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
-from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, Strict, StrictBool, model_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    Strict,
+    StrictBool,
+    ValidationError,
+    model_validator,
+)
 
 from planar.core.limits import MAX_HARDWARE_MM, MAX_KERF_MM, MAX_MOTOR_BODY_MM, MAX_MOTOR_MM, SIZE_RANGE
+from planar.errors import InputError
+from planar.scene.messages import MISSING, NAME_PATTERN, first_problem
 
 Vec2 = tuple[float, float]
 # strict types: a number is a TOML number (true is not 1.0, "4" is not 4.0), a flag is true or false
 Pos = Annotated[float, Strict(), Field(gt=0, allow_inf_nan=False)]
 Real = Annotated[float, Strict(), Field(allow_inf_nan=False)]
 #: a name written into CSV headers, DXF groups and SVG text: no control character, comma or double quote
-_NAME = r'^[^\x00-\x1f\x7f,"]*$'
+_NAME = NAME_PATTERN
 Name = Annotated[str, Strict(), Field(min_length=1, max_length=80, pattern=_NAME)]
 Title = Annotated[str, Strict(), Field(max_length=80, pattern=_NAME)]
 
@@ -112,7 +124,33 @@ def _whole(v: Any) -> Any:
 Branch = Annotated[Literal[1, -1], BeforeValidator(_whole)]
 
 
-class _Strict(BaseModel):
+if TYPE_CHECKING:  # pydantic's model metaclass, named for the type checker only
+    from pydantic._internal._model_construction import ModelMetaclass as _ModelMeta
+else:  # at run time reached through a public object, not pydantic's private module
+    _ModelMeta = type(BaseModel)
+
+
+class _RefusesInPlanarWords(_ModelMeta):
+    """Built from Python (``SceneSpec(mechanism=...)``), a value that does not validate is an
+    :class:`~planar.errors.InputError` naming the field as a scene file writes it and the value, as
+    :func:`planar.scene.parse_scene` names it, not pydantic's ``ValidationError``.  Only the direct call is
+    wrapped: validating a document (``model_validate``, the nested tables) raises pydantic's error, which the
+    loader turns into a :class:`~planar.errors.SceneError` naming the file."""
+
+    def __call__(cls, *args: Any, **data: Any) -> Any:
+        try:
+            return super().__call__(*args, **data)
+        except ValidationError as e:
+            errors = e.errors(include_url=False)
+            field, value, expected = first_problem(errors, data)
+            if errors[0]["type"] == "missing" and not (errors[0]["loc"] and isinstance(errors[0]["loc"][-1], int)):
+                value = MISSING
+            if len(errors) > 1:
+                expected += f" (and {len(errors) - 1} more problem{'s' if len(errors) > 2 else ''})"
+            raise InputError(f"{cls.__name__}.{field}", value, expected) from None
+
+
+class _Strict(BaseModel, metaclass=_RefusesInPlanarWords):
     # a docstring under a field is its description in the JSON schema (``planar schema``)
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False, use_attribute_docstrings=True)
 

@@ -79,6 +79,7 @@ class KeyedShaft:
     """
 
     kind: ClassVar[str] = "keyed-shaft"
+    point_fields: ClassVar[tuple[str, ...]] = ("anchor_a", "anchor_b")
     name: str
     a: str
     b: str

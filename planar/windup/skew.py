@@ -25,6 +25,8 @@ class SkewContact:
     """
 
     kind: ClassVar[str] = "skew-contact"
+    length_fields: ClassVar[tuple[str, ...]] = ("radius",)
+    point_fields: ClassVar[tuple[str, ...]] = ("edge_point", "pin_x", "plane_z")
     name: str
     a: str  # the driver, carrying the edge
     b: str  # the follower, carrying the pin

@@ -519,3 +519,90 @@ def test_bench_accuracy_of_a_fine_scene_is_refused_up_front(tmp_path: Path) -> N
     rc, mib, text = peak(argv, tmp_path, SMALL_MIB)
     _refused(rc, mib, text, written)
     assert "simulated run" in text and _fits(text) > 0, text
+
+
+# --------------------------------------------------------------------------- at the default limit, by a line
+# `toy` and `bench accuracy` spend milliseconds of CPU a sample (128 physics steps each; some 30 simulated runs),
+# so the largest size the default limit accepts (hundreds of thousands of samples) would run for an hour.  Their
+# test at the default limit: far too much is refused up front naming the count that fits, and the peak is
+# measured at three sizes past the one where the physics chunk (65,536 steps) is full, up to about a minute of
+# CPU in all; the peak is linear in the samples there (checked: the middle size lies on the line through the
+# others), its slope is at most the estimate's cost per sample, and the line reaches at most the limit x 1.25 at
+# the count the refusal named.
+
+
+def _peak_line(argv: Callable[[int], list[str]], sizes: tuple[int, int, int], cwd: Path) -> tuple[float, float]:
+    """Intercept (MiB) and slope (MiB a sample) of the peak of ``argv(n)`` at the default limit over ``sizes``;
+    each run succeeds and the middle one lies within 4 MiB of the line through the outer two."""
+    peaks = []
+    for n in sizes:
+        rc, mib, out = peak(argv(n), cwd)
+        assert rc == 0, out
+        peaks.append(mib)
+    (n0, n1, n2), (p0, p1, p2) = sizes, peaks
+    slope = (p2 - p0) / (n2 - n0)
+    print(f"peaks (MiB) {dict(zip(sizes, (round(p, 1) for p in peaks)))}: {slope * 2**20:.0f} B a sample")
+    assert abs(p0 + slope * (n1 - n0) - p1) <= 4.0, f"not linear in the samples: {dict(zip(sizes, peaks))}"
+    return p0 - slope * n0, slope
+
+
+def _estimated_per_sample_mib(scene: Path) -> float:
+    """The simulated run's estimate per sample (MiB): three times the motion's bytes, as planar.physics counts it."""
+    import planar
+    from planar.core.limits import motion_bytes
+    from planar.physics.toy import coupled_mechanism
+    from planar.toys.assembly import toy_assembly
+
+    mech = planar.load_scene(scene).mechanism
+    if mech.stages:  # a toy's run is of its coupled pieces
+        mech = coupled_mechanism(toy_assembly(mech))
+    return 1.5 * motion_bytes(len(mech.parts), len(mech.points), 2.0) / 2**20
+
+
+@pytest.mark.slow
+def test_toy_at_the_default_limit(tmp_path: Path) -> None:
+    """The Horse: 2,000,000 samples are refused where its motion is checked, naming what fits; that many are
+    refused by the coupled run's check, up front (before, the scene's motion of 1.2 million samples was solved
+    first: 1.1 GB, then refused), naming the count the run fits.  Peaks at 800, 2,400 and 7,200 samples (about a
+    minute of CPU; measured 189 MiB at 600 and 199 MiB at 5,000) put that count within 2,048 MiB x 1.25."""
+
+    def argv(n: int) -> list[str]:
+        return ["toy", str(_scene(tmp_path, "horse", n))]
+
+    rc, mib, out = peak(argv(2_000_000), tmp_path)
+    _refused(rc, mib, out, [])
+    assert "samples_per_cycle" in out, out
+    rc, mib, out = peak(argv(_fits(out)), tmp_path)
+    _refused(rc, mib, out, [])
+    assert "simulated run" in out, out
+    fits = _fits(out)
+    base, slope = _peak_line(argv, (800, 2_400, 7_200), tmp_path)
+    assert 0 < slope <= _estimated_per_sample_mib(_scene(tmp_path, "horse", 800)), f"{slope * 2**20:.0f} B a sample"
+    print(f"{fits:,} samples fit: the line reaches {base + slope * fits:.0f} MiB there")
+    assert base + slope * fits <= LIMIT_MIB * 1.25, f"{fits:,} samples: {base:.0f} + {slope * 2**20:.0f} B a sample"
+
+
+@pytest.mark.slow
+def test_bench_accuracy_at_the_default_limit(tmp_path: Path) -> None:
+    """The slider-crank at 2,000,000 samples is refused before its first run, naming what fits (about a million;
+    every setting of the quick grid runs at it: hours).  Peaks at 4,000, 8,000 and 16,000 samples (about a
+    minute of CPU; below about 2,400 the physics chunk is still growing) put that count within 2,048 MiB x 1.25."""
+    src = tmp_path / "scenes"
+    src.mkdir()
+    out_dir = tmp_path / "acc"
+    written = [out_dir / "accuracy.csv", out_dir / "accuracy.png"]
+
+    def argv(n: int) -> list[str]:
+        for p in src.iterdir():
+            p.unlink()
+        _scene(tmp_path, "slider-crank", n).rename(src / "slider-crank.toml")
+        return ["bench", "accuracy", "--quick", "--repeats", "1", "--scenes", str(src), "-o", str(out_dir)]
+
+    rc, mib, out = peak(argv(2_000_000), tmp_path)
+    _refused(rc, mib, out, written)
+    assert "simulated run" in out, out
+    fits = _fits(out)
+    base, slope = _peak_line(argv, (4_000, 8_000, 16_000), tmp_path)
+    assert 0 < slope <= _estimated_per_sample_mib(src / "slider-crank.toml"), f"{slope * 2**20:.0f} B a sample"
+    print(f"{fits:,} samples fit: the line reaches {base + slope * fits:.0f} MiB there")
+    assert base + slope * fits <= LIMIT_MIB * 1.25, f"{fits:,} samples: {base:.0f} + {slope * 2**20:.0f} B a sample"
