@@ -74,12 +74,13 @@ def check_lines(scene: Any, fab: Fabrication, hint: bool = True, option: str = "
     """What the build check found, one line each (empty: it builds), and, when it failed and ``hint``, what would
     make it build: the smallest ``unit_mm`` found at which the same scene builds
     (:func:`planar.fabrication.scale.smallest_unit`; ``option`` names how to ask for it), or that none up to the
-    sheet's size does."""
+    sheet's size does (kept as ``fab.unit_hint``)."""
     from planar.fabrication.scale import smallest_unit
 
     lines = [v.text() for v in fab.violations]
     if lines and hint:
-        lines.append(smallest_unit(scene, fab.settings).text(option))
+        fab.unit_hint = smallest_unit(scene, fab.settings)
+        lines.append(fab.unit_hint.text(option))
     return lines
 
 

@@ -57,6 +57,10 @@ class Fabrication:
     mounts: dict[str, list[tuple[float, float]]] = field(default_factory=dict)
     #: how far the motor and the pins' lower ends hang below the bottom layer (mm): the standoffs clear it
     below_mm: float = 0.0
+    #: when the build check failed: the smallest ``unit_mm`` found at which the same scene builds
+    #: (a :class:`planar.fabrication.scale.ScaleHint`; ``unit_mm`` None: none up to the sheet's size), filled by
+    #: ``planar export`` and :func:`planar.export`
+    unit_hint: Any = None
 
 
 def _shaft_pin(mech: Mechanism, pins) -> Any:
