@@ -168,6 +168,8 @@ def export(
     svg: str | Path | None = None,
     *,
     fabrication: dict[str, Any] | None = None,
+    unit_mm: float | None = None,
+    check: bool = True,
     **files: Any,
 ) -> Fabrication:
     """Lay a scene's or a mechanism's parts out for cutting and write the files, as ``planar export`` does.
@@ -181,6 +183,16 @@ def export(
     fabrication : dict, optional
         For a mechanism only: ``[fabrication]`` keys (``unit_mm``, ``kerf_mm``,
         ``sheet_mm``, ...); a scene carries its own.
+    unit_mm : float, optional
+        Millimetres per model unit, overriding the scene's ``[fabrication] unit_mm`` (and a ``fabrication``
+        dict's), as ``planar export --unit-mm``: positive, the largest part at least ``min_part_mm`` across and
+        fitting the sheet's diagonal.
+    check : bool
+        True (default): when the build check fails (``violations`` not empty), raise
+        :class:`planar.errors.CheckError` after the files are written, as ``planar export`` writes them and
+        exits 3; its ``result`` is the :class:`Fabrication`, its message names the problems and the smallest
+        ``unit_mm`` found at which the same scene builds.  False: return the :class:`Fabrication` whatever
+        the check found (read its ``violations``).
     **files
         ``preview`` (.png), ``bom`` (.csv), ``assembly`` (.svg), ``kerf_test``
         (.dxf or .svg), ``plan`` (.json), ``motion`` (.csv), ``steps`` (.svg)
@@ -194,17 +206,42 @@ def export(
     Returns
     -------
     Fabrication
-        The parts, their placement on the sheet and the files written; every
-        file goes to a temporary and is renamed only when all succeeded.
+        The parts, their placement on the sheet and the files written (``written``); every
+        file goes to a temporary and is renamed only when all succeeded.  ``violations``: what the
+        build check found (empty: every part, pin, spacer and the motor shaft clear through the cycle).
+
+    Raises
+    ------
+    planar.errors.CheckError
+        The build check failed (and ``check`` is true); the files are written.
     """
+    from planar.app.export import check_lines, scene_with_unit
     from planar.app.pipeline import EXPORT_FILES, check_export_outputs, export_scene
+    from planar.errors import CheckError
 
     unknown = sorted(set(files) - set(EXPORT_FILES) - {"kerf", "sheet"})
     if unknown:
         raise InputError(", ".join(unknown), files[unknown[0]], f"one of the outputs {', '.join(EXPORT_FILES)}, kerf or sheet")
+    if not isinstance(check, bool):
+        raise InputError("check", check, "True or False")
     check_export_outputs(dxf, svg, files)  # before the scene is built
     scene = _scene(obj, {} if fabrication is None else {"fabrication": fabrication})
-    return export_scene(scene, dxf, svg, **files)
+    sheet = files.get("sheet")
+    if sheet is not None:  # checked by the export, naming it; the unit's bounds use it when it is two numbers
+        try:
+            sheet = (float(sheet[0]), float(sheet[1]))
+        except (TypeError, ValueError, IndexError, KeyError):
+            sheet = None
+    scene = scene_with_unit(scene, unit_mm, "unit_mm", sheet)
+    fab = export_scene(scene, dxf, svg, **files)
+    if check and fab.violations:
+        lines = check_lines(scene, fab, option="unit_mm=")
+        raise CheckError(
+            f"build check failed: {len(fab.violations)} problem(s), the files are written: " + "; ".join(lines),
+            fab,
+            tuple(lines),
+        )
+    return fab
 
 
 def compare(

@@ -5,12 +5,13 @@ and *what* (the offending value and what was expected).  The CLI prints the
 message on one line and exits with status 2; no traceback is shown.  Every
 class here derives from :class:`PlanarError`; :class:`InputError` and
 :class:`LimitError` are also :class:`ValueError`, so Python callers may catch
-either; so are :class:`AssemblyError` and :class:`SceneError`.
+either; so are :class:`AssemblyError` and :class:`SceneError`.  :class:`CheckError` is not a user
+error but a result that failed its own check (the CLI's exit status 3); it carries the result.
 """
 
 from __future__ import annotations
 
-__all__ = ["AssemblyError", "InputError", "LimitError", "PlanarError", "SceneError", "short_repr"]
+__all__ = ["AssemblyError", "CheckError", "InputError", "LimitError", "PlanarError", "SceneError", "short_repr"]
 
 
 class PlanarError(Exception):
@@ -63,3 +64,17 @@ class AssemblyError(PlanarError, ValueError):
 
 class SceneError(PlanarError, ValueError):
     """A scene file is malformed; the message names the file and field path."""
+
+
+class CheckError(PlanarError):
+    """A result failed its own check (what the command line reports with exit status 3).
+
+    Raised after the result's files are written (to look at), as the command line writes them and exits 3.
+    ``result`` is the result itself (:func:`planar.export`: the :class:`~planar.fabrication.build.Fabrication`,
+    whose ``violations`` list the collisions the build check found); ``problems`` its failures, one line each.
+    """
+
+    def __init__(self, message: str, result: object = None, problems: tuple[str, ...] = ()) -> None:
+        self.result = result
+        self.problems = tuple(problems)
+        super().__init__(message)

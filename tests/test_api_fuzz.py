@@ -353,6 +353,7 @@ EXAMPLES: dict[str, Callable[[Ctx], dict[str, Any]]] = {
         "max_trees": 4,
     },
     "planar.synth.load_request": lambda c: {"path": _request(c)},
+    "planar.synth.read_targets": lambda c: {"path": _svg(c), "points": 5},
     "planar.synth.search_function": lambda c: {
         "phi": np.linspace(0.0, 1.0, 5),
         "psi": np.linspace(0.0, 0.5, 5),
@@ -471,6 +472,15 @@ def _function_constraints() -> Any:
     from planar.synth.function_search import FunctionConstraints
 
     return FunctionConstraints()
+
+
+def _svg(c: Ctx) -> Path:
+    path = c.tmp / "drawn.svg"
+    path.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 100 100"><path d="M 10 10 C 40 0 90 40 60 90 Z"/></svg>',
+        encoding="utf-8",
+    )
+    return path
 
 
 def _request(c: Ctx) -> Path:

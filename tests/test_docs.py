@@ -104,3 +104,16 @@ def test_the_gallery_extension_writes_a_page_per_scene(tmp_path: Path) -> None:
     assert [p.stem for p in pages] == [s.stem for s in scenes] and not (tmp_path / "stale.md").exists()
     horse = (tmp_path / "horse.md").read_text(encoding="utf-8")
     assert horse.startswith("# horse") and "horse.gif)" in horse and "planar render gallery/horse.toml" in horse
+
+
+@pytest.mark.slow
+def test_the_python_how_to_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """docs/how-to/python.md's blocks in order, synthesis included: an SVG drawn, a four-bar found, made a
+    scene with its targets and unit, and cut (at the unit the build check names, when it fails)."""
+    import tomllib
+
+    ns = _run_blocks(DOCS / "how-to" / "python.md", tmp_path, monkeypatch)
+    assert ns["fab"].violations == []  # type: ignore[attr-defined]
+    assert (tmp_path / "bean.dxf").stat().st_size > 0 and (tmp_path / "bean-bom.csv").exists()
+    saved = tomllib.loads((tmp_path / "bean.toml").read_text(encoding="utf-8"))
+    assert saved["fabrication"]["unit_mm"] == 1.0 and len(saved["render"]["targets"]) == 25

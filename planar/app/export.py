@@ -11,12 +11,77 @@ With several sheets, ``parts.dxf`` becomes ``parts-1.dxf``, ``parts-2.dxf``
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 from planar.errors import InputError
 from planar.fabrication.build import Fabrication, build, kerf_test_layout, sheet_paths, summary
 from planar.fabrication.parts import FabSettings
 
-__all__ = ["Fabrication", "build", "kerf_test_layout", "sheet_paths", "summary", "write_outputs"]
+__all__ = [
+    "Fabrication",
+    "build",
+    "check_lines",
+    "kerf_test_layout",
+    "scene_with_unit",
+    "sheet_paths",
+    "summary",
+    "write_outputs",
+]
+
+
+def scene_with_unit(scene: Any, unit_mm: float | None, where: str, sheet: tuple[float, float] | None = None) -> Any:
+    """``scene`` with its ``[fabrication] unit_mm`` replaced by ``unit_mm`` (mm per model unit; ``None``: as it is).
+
+    Checked like the scene's field, and named ``where`` (``--unit-mm`` on the command line, ``unit_mm`` from
+    Python): a positive, finite number whose largest part is at least ``min_part_mm`` across and fits the
+    sheet's diagonal (``sheet`` in mm, the scene's when ``None``), the bounds ``planar export`` puts on the
+    scene's own ``unit_mm``.
+    """
+    import math
+
+    from planar.core.fields import check_number
+    from planar.core.limits import MAX_SHEET_MM
+    from planar.fabrication.scale import scene_at_unit
+
+    if unit_mm is None:
+        return scene
+    u = check_number(where, unit_mm)
+    if not (math.isfinite(u) and u > 0):
+        raise InputError(where, unit_mm, "a positive, finite number of millimetres per model unit")
+    spec = scene.spec.fabrication
+    w, h = sheet if sheet is not None else spec.sheet_mm
+    across = scene.mechanism.size * u  # the largest part's diameter, mm
+    if not (math.isfinite(w) and math.isfinite(h) and min(w, h) > 0 and max(w, h) <= MAX_SHEET_MM):
+        return scene_at_unit(scene, u)  # the sheet itself is refused by the export, naming it
+    if not across <= math.hypot(w, h):
+        raise InputError(
+            where,
+            unit_mm,
+            f"parts that fit the {w:g} x {h:g} mm sheet (the largest part would be {across:.4g} mm across; "
+            f"at most {math.hypot(w, h) / scene.mechanism.size:.4g} on this sheet)",
+        )
+    if not across >= spec.min_part_mm:
+        raise InputError(
+            where,
+            unit_mm,
+            f"a unit whose largest part is at least min_part_mm = {spec.min_part_mm:g} mm across (it would be "
+            f"{across:.4g} mm; at least {spec.min_part_mm / scene.mechanism.size:.4g})",
+        )
+    return scene_at_unit(scene, u)
+
+
+def check_lines(scene: Any, fab: Fabrication, hint: bool = True, option: str = "--unit-mm ") -> list[str]:
+    """What the build check found, one line each (empty: it builds), and, when it failed and ``hint``, what would
+    make it build: the smallest ``unit_mm`` found at which the same scene builds
+    (:func:`planar.fabrication.scale.smallest_unit`; ``option`` names how to ask for it), or that none up to the
+    sheet's size does (kept as ``fab.unit_hint``)."""
+    from planar.fabrication.scale import smallest_unit
+
+    lines = [v.text() for v in fab.violations]
+    if lines and hint:
+        fab.unit_hint = smallest_unit(scene, fab.settings)
+        lines.append(fab.unit_hint.text(option))
+    return lines
 
 
 def _commit(files: dict[Path, bytes]) -> None:

@@ -43,8 +43,10 @@ def _cmd_export(args: argparse.Namespace) -> int:
 
     if args.kerf is not None and not kerf_ok(args.kerf):
         raise InputError("--kerf", args.kerf, KERF_RANGE)
-    scene = load_scene(args.scene)
+    from planar.app.export import check_lines, scene_with_unit
+
     size = sheet(args.sheet) if args.sheet else None
+    scene = scene_with_unit(load_scene(args.scene), args.unit_mm, "--unit-mm", size)
     fab = export_scene(
         scene,
         args.output,
@@ -68,8 +70,8 @@ def _cmd_export(args: argparse.Namespace) -> int:
     print(f"{summary(fab)} -> {', '.join(map(str, rest)) or 'no part file written'}")
     for p in kerf_file:  # the calibration piece alone, none of the parts
         print(f"kerf test piece (a 20 mm square with a 10 mm hole, kerf {fab.settings.kerf:g} mm) -> {p}")
-    for v in fab.violations:  # the build check: the files are written (to look at), the exit status says it fails
-        print(f"build check: {v.text()}")
+    for line in check_lines(scene, fab):  # the files are written (to look at), the exit status says it fails
+        print(f"build check: {line}")
     if fab.violations:
         where = (
             f"; the assembly drawing {args.assembly} rings them red"
@@ -91,6 +93,12 @@ def add_parser(sub: Any) -> None:
     ex.add_argument("--svg", default=None, help="SVG file to write")
     ex.add_argument("--kerf", type=float, default=None, help="beam width in mm (default: the scene's kerf_mm)")
     ex.add_argument("--sheet", default=None, help="sheet size WIDTHxHEIGHT in mm (default: the scene's)")
+    ex.add_argument(
+        "--unit-mm",
+        type=float,
+        default=None,
+        help="millimetres per model unit (default: the scene's [fabrication] unit_mm, 10 if it has none)",
+    )
     ex.add_argument("--preview", default=None, help="PNG preview of each sheet (photo-like)")
     ex.add_argument("--bom", default=None, help="bill of materials (CSV): parts, layers, pins, spacers, tab joints")
     ex.add_argument("--assembly", default=None, help="assembly drawing (SVG): parts in place, layers, letters")

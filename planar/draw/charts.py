@@ -210,16 +210,7 @@ def scene_figure(
         ax.set_gid(f"chart-{chart}")
         ax.grid(True, lw=0.4, alpha=0.5)
         if chart == "curve":
-            for pname, xy in motion.points.items():
-                pts = np.where(motion.valid[:, None], xy, np.nan)
-                closed = np.vstack([pts, pts[:1]]) if drv.amplitude is None else pts
-                (ln,) = ax.plot(closed[:, 0], closed[:, 1], lw=1.4, label=pname)
-                ln.set_gid(f"curve:{pname}")
-                ax.plot(xy[:1, 0], xy[:1, 1], "o", ms=4, color=ln.get_color())
-            ax.set_aspect("equal", adjustable="datalim")
-            ax.set_xlabel("x (model units)")
-            ax.set_ylabel("y")
-            ax.set_title("path of the named points (dot: first sample)", fontsize=9)
+            _curve_panel(ax, scene, motion)
         elif chart == "pressure":
             cm: Any = mech  # a CamMechanism (available_charts offers "pressure" only for one)
             prof = cm.profile
@@ -273,6 +264,37 @@ def scene_figure(
         if len(ax.get_lines()) > 1 or chart == "curve":
             ax.legend(fontsize=7, loc="best", ncols=2 if len(ax.get_lines()) > 6 else 1)
     return fig
+
+
+#: the colour of the targets on the coupler-curve chart (the animation's target dots are pink too)
+TARGET_COLOUR = "#e75480"
+
+
+def _curve_panel(ax: Any, scene: Scene, motion: Motion) -> None:
+    """The path of every named point (world, model units), its first sample dotted, and the scene's
+    ``[render] targets`` (the points a synthesis aimed at) as pink dots, numbered in their order."""
+    closed_loop = scene.mechanism.driver.amplitude is None
+    for pname, xy in motion.points.items():
+        pts = np.where(motion.valid[:, None], xy, np.nan)
+        closed = np.vstack([pts, pts[:1]]) if closed_loop else pts
+        (ln,) = ax.plot(closed[:, 0], closed[:, 1], lw=1.4, label=pname)
+        ln.set_gid(f"curve:{pname}")
+        ax.plot(xy[:1, 0], xy[:1, 1], "o", ms=4, color=ln.get_color())
+    targets = np.asarray(scene.spec.render.targets, float).reshape(-1, 2)
+    what = "dot: first sample"
+    if len(targets):
+        (tl,) = ax.plot(
+            targets[:, 0], targets[:, 1], "o", ms=4.5, mfc="none", mec=TARGET_COLOUR, mew=1.4, label=f"targets ({len(targets)})"
+        )
+        tl.set_gid("targets")
+        if len(targets) <= 30:  # their order (a timed or ordered synthesis passes them in it)
+            for k, (tx, ty) in enumerate(targets, start=1):
+                ax.annotate(str(k), (tx, ty), fontsize=6, color=TARGET_COLOUR, xytext=(3, 3), textcoords="offset points")
+        what += "; rings: the targets"
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x (model units)")
+    ax.set_ylabel("y")
+    ax.set_title(f"path of the named points ({what})", fontsize=9)
 
 
 def _follower_panel(ax: Any, mech: Any, motion: Motion, x: np.ndarray, k: int) -> None:

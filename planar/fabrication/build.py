@@ -57,6 +57,10 @@ class Fabrication:
     mounts: dict[str, list[tuple[float, float]]] = field(default_factory=dict)
     #: how far the motor and the pins' lower ends hang below the bottom layer (mm): the standoffs clear it
     below_mm: float = 0.0
+    #: when the build check failed: the smallest ``unit_mm`` found at which the same scene builds
+    #: (a :class:`planar.fabrication.scale.ScaleHint`; ``unit_mm`` None: none up to the sheet's size), filled by
+    #: ``planar export`` and :func:`planar.export`
+    unit_hint: Any = None
 
 
 def _shaft_pin(mech: Mechanism, pins) -> Any:
@@ -286,16 +290,18 @@ def _tab_notes(cuts: list[PartCut], joins: list[Any], s: FabSettings) -> list[st
     return out
 
 
-def build(scene: Any, settings: FabSettings) -> Fabrication:
+def build(scene: Any, settings: FabSettings, samples: tuple[int, int] = (120, 240)) -> Fabrication:
     """Cut-ready, checked, layered and nested parts of ``scene`` (raises FabricationError/InputError).
 
     An error in a ``[fabrication]`` value or a ``mechanism.`` key read from a scene file starts with the file's
     path as given (``toys/bird.toml: fabrication.pin_diameter_mm = 3.5: ...``), as every scene error does.
+    ``samples``: samples per cycle of the planner's build checks and of the final one (the verdict in
+    ``violations``; :func:`planar.fabrication.plan.settle`).
     """
     where = getattr(scene, "path", None)
     in_file = bool(where) and Path(str(where)).is_file()
     try:
-        return _build(scene, settings)
+        return _build(scene, settings, samples)
     except InputError as e:
         if not (e.field.startswith("fabrication.") and in_file):
             raise
@@ -316,7 +322,7 @@ def kerf_ok(kerf: float) -> bool:
     return kerf == 0 or 1e-3 <= kerf <= 2
 
 
-def _build(scene: Any, settings: FabSettings) -> Fabrication:
+def _build(scene: Any, settings: FabSettings, samples: tuple[int, int] = (120, 240)) -> Fabrication:
     """:func:`build` without the file name on its errors."""
     s = settings
     if not kerf_ok(s.kerf):
@@ -435,7 +441,7 @@ def _build(scene: Any, settings: FabSettings) -> Fabrication:
 
     from planar.fabrication.plan import blocking, settle
 
-    violations = settle(SimpleNamespace(mechanism=mech, assembly=asm, own=material, settings=s))
+    violations = settle(SimpleNamespace(mechanism=mech, assembly=asm, own=material, settings=s), *samples)
     notes.extend(blocking(asm, violations))
     violations = violations + shaft_check(s, asm.pins, _shaft_xy(asm))
     for pc in cuts:

@@ -5,7 +5,8 @@
 * :mod:`.function` — function generation by Freudenstein's equation, and
   :mod:`.function_search` — a search for a valid four-bar on one circuit when it is none;
 * :mod:`.motion` — motion generation by Burmester theory (3, 4, 5 poses);
-* :mod:`.scene_out` — the result as a scene file.
+* :mod:`.scene_out` — the result as a scene file;
+* :mod:`.targets` — the targets read from a file (:func:`read_targets`: an SVG drawing or a CSV table).
 
 Every name in ``__all__`` is imported from its module on first use (:func:`planar.core.lazy.attach`).
 """
@@ -27,5 +28,6 @@ __getattr__, __dir__, __all__ = attach(
         "Design": "planar.synth.design",
         "design_toy": "planar.synth.design",
         "load_request": "planar.synth.design",
+        "read_targets": "planar.synth.targets",
     },
 )

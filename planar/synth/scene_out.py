@@ -39,9 +39,12 @@ def fourbar_scene_text(
     centre: float = 0.0,
     samples_per_cycle: int = 72,
     targets: Sequence[Sequence[float]] = (),
+    unit_mm: float | None = None,
 ) -> str:
     """The scene text of a four-bar (radians); ``amplitude``/``centre`` give a rocking driver; ``targets``
-    ``[x, y]`` each: fixed points ``planar render`` draws (``[render] targets``)."""
+    ``[x, y]`` each: fixed points ``planar render`` and ``planar plot`` draw (``[render] targets``);
+    ``unit_mm``: what one unit of the targets is in millimetres, written as ``[fabrication] unit_mm`` (none:
+    the scene's default, 10; an SVG's user units are millimetres: :func:`planar.synth.targets.target_unit_mm`)."""
     lines = [f"# {c}" for c in comments]
     lines += [
         f"name = {name!r}".replace("'", '"'),
@@ -64,8 +67,21 @@ def fourbar_scene_text(
     ]
     if amplitude is not None:
         lines += [f"amplitude = {_f(amplitude)}", f"centre = {_f(centre)}"]
-    lines += ["", "[render]", 'trails = ["coupler_point"]', *_targets(targets), ""]
+    lines += ["", "[render]", 'trails = ["coupler_point"]', *_targets(targets), *_fabrication(unit_mm), ""]
     return "\n".join(lines)
+
+
+def _fabrication(unit_mm: float | None) -> list[str]:
+    """The ``[fabrication]`` table holding ``unit_mm`` (none for ``None``)."""
+    if unit_mm is None:
+        return []
+    from planar.core.fields import check_number
+
+    if not check_number("unit_mm", unit_mm) > 0:
+        from planar.errors import InputError
+
+        raise InputError("unit_mm", unit_mm, "a positive number of millimetres per unit")
+    return ["", "[fabrication]", f"unit_mm = {_f(unit_mm)}"]
 
 
 def _targets(targets: Sequence[Sequence[float]]) -> list[str]:
@@ -95,9 +111,10 @@ def linkage_scene_text(
     comments: Sequence[str] = (),
     samples_per_cycle: int = 72,
     targets: Sequence[Sequence[float]] = (),
+    unit_mm: float | None = None,
 ) -> str:
     """The scene text of a general linkage (``type = "linkage"``; node tables as the scene schema's; ``targets``
-    as :func:`fourbar_scene_text`'s)."""
+    and ``unit_mm`` as :func:`fourbar_scene_text`'s)."""
     lines = [f"# {c}" for c in comments]
     lines += [
         f'name = "{name}"',
@@ -123,6 +140,7 @@ def linkage_scene_text(
         "[render]",
         "trails = [" + ", ".join(f'"{k}"' for k in points) + "]",
         *_targets(targets),
+        *_fabrication(unit_mm),
         "",
     ]
     return "\n".join(lines)

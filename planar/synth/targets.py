@@ -18,7 +18,29 @@ from numpy.typing import NDArray
 from planar.core.limits import RESOLUTION, SIZE_RANGE
 from planar.errors import InputError
 
-__all__ = ["SIZE_RANGE", "check_theta", "normalisation", "read_path_targets", "read_svg_points", "read_table"]
+__all__ = [
+    "SIZE_RANGE",
+    "SVG_UNIT_MM",
+    "check_theta",
+    "normalisation",
+    "read_path_targets",
+    "read_svg_points",
+    "read_table",
+    "read_targets",
+    "target_unit_mm",
+]
+
+#: millimetres per SVG user unit: a drawing's coordinates are read as millimetres (the ``viewBox`` of a drawing
+#: made in mm, as Inkscape's default document is; a drawing in px is read 1 px = 1 mm: scale it, or export with
+#: ``--unit-mm``)
+SVG_UNIT_MM = 1.0
+
+
+def target_unit_mm(path: str | Path) -> float | None:
+    """What one unit of the targets in ``path`` is in millimetres: :data:`SVG_UNIT_MM` for an SVG drawing,
+    ``None`` for a CSV table (its numbers have no unit: the scene's default ``unit_mm`` applies)."""
+    return SVG_UNIT_MM if str(path).lower().endswith(".svg") else None
+
 
 # SIZE_RANGE (re-exported): the sizes and coordinates planar synthesises at, from planar.core.limits
 
@@ -98,7 +120,7 @@ def _even_by_length(path: Any, n: int, closed: bool) -> Array:
     return np.asarray(path.npoint(np.interp(want, cum, u)), float)
 
 
-def read_svg_points(path: str | Path, n: int) -> Array:
+def read_svg_points(path: str | Path, n: int, option: str = "--points") -> Array:
     """``n`` points spaced evenly by arc length along the first shape of an SVG file (y up).
 
     The SVG is read by svgelements (transforms applied); a closed shape gives
@@ -112,7 +134,7 @@ def read_svg_points(path: str | Path, n: int) -> Array:
 
     p = str(path)
     if n < 3:
-        raise InputError("--points", n, "3 or more points to sample from the SVG path")
+        raise InputError(option, n, "3 or more points to sample from the SVG path")
     try:
         svg = se.SVG.parse(p)
     except FileNotFoundError:
@@ -165,16 +187,16 @@ def _check_finite_attributes(path: str) -> None:
                 raise InputError(f"{path}: <{tag}> {name}", text, "finite numbers (SVG coordinates)")
 
 
-def read_path_targets(path: str | Path, svg_points: int | None = 12) -> tuple[Array, Array | None]:
+def read_path_targets(path: str | Path, svg_points: int | None = None, option: str = "--points") -> tuple[Array, Array | None]:
     """Targets ``(N, 2)`` and crank angles ``(N,)`` or ``None``, from ``x,y[,theta]`` CSV or an SVG path.
 
-    ``svg_points``: points sampled along an SVG (12 when ``None``); given with a CSV it is an error.
-    A CSV column other than ``x``, ``y``, ``theta`` is an error.
+    ``svg_points``: points sampled along an SVG (12 when ``None``); given with a CSV it is an error, naming
+    ``option`` (the command line's ``--points``).  A CSV column other than ``x``, ``y``, ``theta`` is an error.
     """
     if str(path).lower().endswith(".svg"):
-        return read_svg_points(path, 12 if svg_points is None else svg_points), None
+        return read_svg_points(path, 12 if svg_points is None else svg_points, option), None
     if svg_points is not None:
-        raise InputError("--points", svg_points, f"no --points with a CSV target ({path}: every row is a target)")
+        raise InputError(option, svg_points, f"no {option} with a CSV target ({path}: every row is a target)")
     t = read_table(path, ("x", "y"), ("theta",), min_rows=3, strict=True)
     return np.column_stack([t["x"], t["y"]]), t.get("theta")
 
@@ -260,3 +282,42 @@ def check_search_args(
         if not isinstance(value, (bool, np.bool_)):
             raise InputError(name, value, "True or False")
     return t, th
+
+
+#: the most points :func:`read_targets` samples along an SVG (a path is matched at each; ``synth path``'s cap)
+MAX_SVG_POINTS = 500
+
+
+def read_targets(path: str | Path, points: int | None = None) -> tuple[Array, Array | None]:
+    """The targets of a path synthesis from a file, as ``planar synth path FILE`` reads them.
+
+    Parameters
+    ----------
+    path : str or Path
+        An SVG drawing (``.svg``: the first shape with a non-zero length; its user units are read as
+        millimetres, :data:`SVG_UNIT_MM`, and y is turned up: a drawing's ``(x, y)`` is the target
+        ``(x, -y)``) or a CSV table with columns ``x``, ``y`` and optionally ``theta`` (the crank angle at each
+        target, radians).
+    points : int, optional
+        For an SVG: how many points to sample along the shape, evenly by arc length (3 to
+        :data:`MAX_SVG_POINTS`; 12 when ``None``).  None for a CSV (every row is a target).
+
+    Returns
+    -------
+    targets : ndarray, shape (N, 2)
+        The points (the file's units, y up).
+    theta : ndarray, shape (N,), or None
+        The CSV's ``theta`` column (radians), or ``None``.
+
+    Examples
+    --------
+    >>> targets, theta = read_targets("bean.svg", points=25)  # doctest: +SKIP
+    >>> design = planar.synth.synthesise_path(targets, theta)  # doctest: +SKIP
+    """
+    from planar.core.fields import check_number
+
+    if not isinstance(path, (str, Path)):
+        raise InputError("path", path, "a file name (str or Path): an .svg drawing or a CSV table")
+    if points is not None and not 3 <= check_number("points", points, integer=True) <= MAX_SVG_POINTS:
+        raise InputError("points", points, f"3 to {MAX_SVG_POINTS} points sampled along the SVG")
+    return read_path_targets(path, points, option="points")
