@@ -26,6 +26,7 @@ class FourBarLinks:
     circuit: str
 
     def _coupler_and_placement(self) -> tuple[tuple[float, float], tuple[float, float, float]]:
+        """The coupler point (coupler frame, model units) and the placement ``(x, y, angle)`` (model units, rad)."""
         raise NotImplementedError
 
     def lengths_dict(self) -> dict[str, Any]:
