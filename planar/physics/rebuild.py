@@ -327,26 +327,15 @@ class _Rebuild:
 
     def set_state(self, poses: dict[str, Array], vel: dict[str, Array]) -> None:
         """Place every moving body at a pose with a velocity (origin velocity, angular velocity; per s)."""
-        dt = self.dt
         for name, body in self.bodies.items():
-            if body is self.space.static_body:
-                continue
-            x, y, a = poses[name]
-            vx, vy, w = vel[name] * dt
-            cx, cy = self.cog[name]
-            c, s = math.cos(a), math.sin(a)
-            rx, ry = c * cx - s * cy, s * cx + c * cy
-            body.position = (float(x + rx), float(y + ry))
-            body.angle = float(a)
-            body.velocity = (float(vx - w * ry), float(vy + w * rx))
-            body.angular_velocity = float(w)
-        for body, part, xy in self.pins:
-            x, y, a = poses[part]
-            vx, vy, w = vel[part] * dt
-            c, s = math.cos(a), math.sin(a)
-            rx, ry = c * xy[0] - s * xy[1], s * xy[0] + c * xy[1]
-            body.position = (float(x + rx), float(y + ry))
-            body.velocity = (float(vx - w * ry), float(vy + w * rx))
+            if body is not self.space.static_body:
+                xy, v, a, w = _carried(poses[name], vel[name] * self.dt, self.cog[name])
+                body.position = xy  # before the angle, as pymunk turns a body about its centre of mass
+                body.angle = float(a)
+                body.velocity = v
+                body.angular_velocity = float(w)
+        for body, part, xy in self.pins:  # a pin turns freely on its part: no spin of its own
+            body.position, body.velocity, _, _ = _carried(poses[part], vel[part] * self.dt, xy)
             body.angular_velocity = 0.0
 
     def moving(self) -> list[str]:
@@ -429,6 +418,16 @@ def _cam_profile(rb: _Rebuild, j: CamContact, effects: Effects | None) -> list[A
         "(parts sit in layers), and a groove along the analytic profile would only replay the analytic motion; "
         "no comparison is made"
     )
+
+
+def _carried(pose: Array, vel: Array, xy: tuple[float, float]) -> tuple[tuple[float, float], tuple[float, float], float, float]:
+    """World position and velocity of the point ``xy`` (part frame) of a part at ``pose`` (x, y, angle) moving at
+    ``vel`` (origin velocity, angular velocity; per step), with the part's angle and angular velocity."""
+    x, y, a = pose
+    vx, vy, w = vel
+    c, s = math.cos(a), math.sin(a)
+    rx, ry = c * xy[0] - s * xy[1], s * xy[0] + c * xy[1]
+    return (float(x + rx), float(y + ry)), (float(vx - w * ry), float(vy + w * rx)), a, w
 
 
 def _padded(a, b, frac: float = 0.1) -> tuple[tuple[float, float], tuple[float, float]]:

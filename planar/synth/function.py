@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planar.errors import InputError
-from planar.synth.designs import Checked
+from planar.synth.designs import Checked, FourBarLinks
 
 __all__ = ["FunctionDesign", "check_function", "freudenstein_fit", "synthesise_function"]
 
@@ -46,7 +46,7 @@ def spans(phi: Array, psi: Array) -> tuple[float, float]:
 
 
 @dataclass
-class FunctionDesign(Checked):
+class FunctionDesign(Checked, FourBarLinks):
     ground: float
     crank: float
     coupler: float
@@ -68,27 +68,12 @@ class FunctionDesign(Checked):
     def max_error(self) -> float:
         return float(np.max(np.abs(self.output_error)))
 
-    def fourbar(self, **kw: Any):
-        from planar.linkages import FourBar
-
-        return FourBar(
-            self.ground,
-            self.crank,
-            self.coupler,
-            self.rocker,
-            coupler_point=(0.5 * self.coupler, 0.0),
-            circuit=self.circuit,  # type: ignore[arg-type]
-            placement=(0.0, 0.0, self.ground_angle),
-            **kw,
-        )
+    def _coupler_and_placement(self) -> tuple[tuple[float, float], tuple[float, float, float]]:
+        return (0.5 * self.coupler, 0.0), (0.0, 0.0, self.ground_angle)
 
     def to_dict(self) -> dict[str, Any]:
         return {
-            "type": "fourbar",
-            "ground": self.ground,
-            "crank": self.crank,
-            "coupler": self.coupler,
-            "rocker": self.rocker,
+            **self.lengths_dict(),
             "circuit": self.circuit,
             "ground_angle": self.ground_angle,
             "input_offset_rad": self.input_offset,

@@ -56,3 +56,18 @@ def test_heldout_small_run_recovers_and_reports_the_nearest():
     assert mo["summary"]["5"]["recovered"] >= 2 / 3
     text = format_heldout(fn, mo)
     assert "function, 3 pairs, fixed offsets" in text and "motion, 5 poses" in text
+
+
+def test_pylinkage_on_the_first_problems_of_each_size(monkeypatch):
+    """``per_size`` keeps the first problems of each number of targets, in the order drawn (the peer stubbed)."""
+    from planar.bench import synthesis_heldout as H
+
+    seen = []
+    monkeypatch.setattr(H, "_pylinkage_path", lambda T, th, score: seen.append((len(T), th is None)) or (0.5, 0.0, "stub"))
+    rng = np.random.default_rng(9)
+    problems = [{"n": n, "targets": rng.random((n, 2)), "theta": rng.random(n)} for n in (8, 12, 8, 25, 12, 8, 25)]
+    r = H.bench_reachable_pylinkage(problems, score=None, per_size=2)
+    assert [row["targets"] for row in r["rows"]] == [8, 12, 8, 25, 12, 25]
+    assert r["count"] == 2 and [s["untimed"]["problems"] for s in r["summary"].values()] == [2, 2, 2]
+    assert seen == [(n, untimed) for n in (8, 12, 8, 25, 12, 25) for untimed in (True, False)]
+    assert len(H.bench_reachable_pylinkage(problems, score=None)["rows"]) == len(problems)

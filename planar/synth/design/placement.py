@@ -285,8 +285,7 @@ def place_stages(
         toy = build(x)
         if toy is None:
             return math.inf, math.inf, math.inf, None
-        outs, checks = toy.world_motion(q)
-        if not all(np.all(ok) for ok, _, _ in checks) or any(not np.allclose(outs[k], ref[k], rtol=0, atol=1e-9) for k in ref):
+        if not _moves_as(toy, q, ref):
             return math.inf, math.inf, math.inf, None
         try:
             fp, ovl = _layout_score(toy)
@@ -362,10 +361,14 @@ def _disc_cams(
     except InputError:
         return None
     ref, _ = toy.world_motion(q)
-    got, checks = disc.world_motion(q)
-    if not all(np.all(ok) for ok, _, _ in checks) or any(not np.allclose(got[k], ref[k], rtol=0, atol=1e-9) for k in ref):
-        return None
-    return out
+    return out if _moves_as(disc, q, ref) else None
+
+
+def _moves_as(toy: ToyMechanism, q: Array, ref: dict[int, Array]) -> bool:
+    """Whether ``toy`` closes at every motor angle ``q`` (rad) and moves every stage's follower as ``ref`` (world
+    motions at ``q``, per stage) does, to 1e-9."""
+    got, checks = toy.world_motion(q)
+    return all(np.all(ok) for ok, _, _ in checks) and all(np.allclose(got[k], ref[k], rtol=0, atol=1e-9) for k in ref)
 
 
 def _variants(
