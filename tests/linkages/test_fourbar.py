@@ -250,7 +250,7 @@ def test_limits_and_transmission_at_any_scale(dims, scale):
     unit = FourBar(*dims)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        big = FourBar(*[x * scale for x in dims])
+        big = FourBar(*[x * scale for x in dims], coupler_point=(0.5 * scale, 0.0))
         np.testing.assert_allclose(big.transmission_angle(th), unit.transmission_angle(th), rtol=1e-12, atol=1e-14)
         np.testing.assert_allclose(big.toggle_angles(), unit.toggle_angles(), atol=1e-12)
         r_big, r_unit = big.input_range(), unit.input_range()
