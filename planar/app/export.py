@@ -73,13 +73,13 @@ def scene_with_unit(scene: Any, unit_mm: float | None, where: str, sheet: tuple[
 def check_lines(scene: Any, fab: Fabrication, hint: bool = True, option: str = "--unit-mm ") -> list[str]:
     """What the build check found, one line each (empty: it builds), and, when it failed and ``hint``, what would
     make it build: the smallest ``unit_mm`` found at which the same scene builds
-    (:func:`planar.fabrication.scale.smallest_unit`; ``option`` names how to ask for it), or that none up to the
-    sheet's size does (kept as ``fab.unit_hint``)."""
-    from planar.fabrication.scale import smallest_unit
+    (:func:`planar.fabrication.scale.unit_hint`; ``option`` names how to ask for it), or that none up to the
+    sheet's size does, or why it was not searched (kept as ``fab.unit_hint``).  The hint is the last line."""
+    from planar.fabrication.scale import unit_hint
 
     lines = [v.text() for v in fab.violations]
     if lines and hint:
-        fab.unit_hint = smallest_unit(scene, fab.settings)
+        fab.unit_hint = unit_hint(scene, fab)
         lines.append(fab.unit_hint.text(option))
     return lines
 

@@ -70,8 +70,11 @@ def _cmd_export(args: argparse.Namespace) -> int:
     print(f"{summary(fab)} -> {', '.join(map(str, rest)) or 'no part file written'}")
     for p in kerf_file:  # the calibration piece alone, none of the parts
         print(f"kerf test piece (a 20 mm square with a 10 mm hole, kerf {fab.settings.kerf:g} mm) -> {p}")
-    for line in check_lines(scene, fab):  # the files are written (to look at), the exit status says it fails
+    lines = check_lines(scene, fab)  # the files are written (to look at), the exit status says it fails
+    for line in lines[: len(fab.violations)]:
         print(f"build check: {line}")
+    for line in lines[len(fab.violations) :]:  # what would make it build
+        print(f"scale: {line}")
     if fab.violations:
         where = (
             f"; the assembly drawing {args.assembly} rings them red"

@@ -9,6 +9,8 @@ scene's unit upwards by doubling, then bisects between the last unit that failed
 within :data:`TOLERANCE`, rounds that up to two significant digits and runs the full build check there (the
 export's: 240 samples).  The figure it reports is one at which the export passes; nothing is said of the units
 between it and the scene's own (the check is not proved monotonic in the scale, only searched).
+:func:`unit_hint` skips the search where no unit helps (:data:`UNSCALED`) or a build takes long
+(more than :data:`MAX_PARTS` parts), and says so.
 """
 
 from __future__ import annotations
@@ -17,7 +19,17 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["COARSE_SAMPLES", "MAX_BUILDS", "TOLERANCE", "ScaleHint", "scene_at_unit", "smallest_unit"]
+__all__ = [
+    "COARSE_SAMPLES",
+    "MAX_BUILDS",
+    "MAX_PARTS",
+    "TOLERANCE",
+    "UNSCALED",
+    "ScaleHint",
+    "scene_at_unit",
+    "smallest_unit",
+    "unit_hint",
+]
 
 #: samples per cycle of the search's build checks (the pins' paths between samples are swept, so a coarse
 #: cycle still sees most collisions; the unit reported is checked again at the export's full 240)
@@ -26,6 +38,11 @@ COARSE_SAMPLES = 36
 TOLERANCE = 1.03
 #: builds the search may run in all (the doubling, the bisection and the final checks)
 MAX_BUILDS = 14
+#: the most parts (as cut) of a mechanism the search runs for: a synthesised four-bar has 4, a six-bar 6; a
+#: 5-leg walker (30 parts) took 20 s of CPU a build, so the search's 14 builds would take minutes
+MAX_PARTS = 8
+#: problems no unit fixes: the motor shaft's length is set by the layers' count and the sheet's thickness
+UNSCALED = frozenset({"motor shaft too short"})
 
 
 @dataclass(frozen=True)
@@ -41,13 +58,17 @@ class ScaleHint:
     across_mm: float
     top_mm: float
     builds: int
+    #: why the search did not run (``""``: it ran)
+    skipped: str = ""
 
     def text(self, option: str = "--unit-mm ") -> str:
         """One line for a maker; ``option`` names how to export at the unit found (``"unit_mm="`` from Python)."""
+        if self.skipped:
+            return f"no unit_mm searched: {self.skipped}"
         if self.unit_mm is not None:
             return (
-                f"builds at unit_mm = {self.unit_mm:g} (the largest part {self.across_mm:.0f} mm across; "
-                f"export with {option}{self.unit_mm:g})"
+                f"the same scene builds at unit_mm = {self.unit_mm:g} (the largest part {self.across_mm:.0f} mm "
+                f"across; export with {option}{self.unit_mm:g})"
             )
         return (
             f"no unit_mm up to {self.top_mm:.3g} (where the largest part, {self.across_mm:.0f} mm across, fills the "
@@ -62,6 +83,28 @@ def scene_at_unit(scene: Any, unit_mm: float) -> Any:
 
     fab = scene.spec.fabrication.model_copy(update={"unit_mm": float(unit_mm)})
     return build_scene(scene.spec.model_copy(update={"fabrication": fab}), scene.path)
+
+
+def unit_hint(scene: Any, fab: Any) -> ScaleHint:
+    """What would make ``scene`` build, its :class:`~planar.fabrication.build.Fabrication` ``fab`` having failed
+    the check: :func:`smallest_unit`, unless a problem no unit fixes is among its violations (:data:`UNSCALED`)
+    or the mechanism as cut has more than :data:`MAX_PARTS` parts (then the hint says so, with ``builds = 0``)."""
+    size = float(scene.mechanism.size)
+    top = math.hypot(*fab.settings.sheet) / size
+    fixed = sorted({v.what for v in fab.violations} & UNSCALED)
+    if fixed:
+        return ScaleHint(None, top * size, top, 0, f"{fixed[0]} does not change with the unit (see its line)")
+    parts = len(fab.mechanism.parts) if fab.mechanism is not None else len(scene.mechanism.parts)
+    if parts > MAX_PARTS:
+        return ScaleHint(
+            None,
+            top * size,
+            top,
+            0,
+            f"{parts} parts (the search runs for at most {MAX_PARTS}: each build of this many takes long); "
+            "a larger unit_mm moves pins apart",
+        )
+    return smallest_unit(scene, fab.settings)
 
 
 def _nice_up(u: float) -> float:

@@ -47,8 +47,7 @@ def test_a_unit_is_checked_like_the_scene_field(tmp_path) -> None:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("seed", [11, 12])
-def test_the_unit_the_hint_names_builds(tmp_path, seed: int) -> None:
+def test_the_unit_the_hint_names_builds(tmp_path, capsys, seed: int = 11) -> None:
     from planar.cli.main import main
 
     failed = 0
@@ -70,12 +69,15 @@ def test_the_unit_the_hint_names_builds(tmp_path, seed: int) -> None:
         m = re.search(r"builds at unit_mm = ([0-9.e+-]+) \(the largest part (\d+) mm across", str(e.value))
         assert m, str(e.value)
         unit = float(m.group(1))
-        assert unit > 1.0 and e.value.problems[-1].startswith(m.group(0))
+        assert unit > 1.0 and m.group(0) in e.value.problems[-1] and fab.unit_hint.unit_mm == unit
         assert float(m.group(2)) == pytest.approx(scene.mechanism.size * unit, abs=0.51)
         ok = planar.export(scene, tmp_path / f"ok{k}.dxf", unit_mm=unit)  # raises if the figure were false
         assert ok.violations == [] and ok.settings.unit_mm == unit
         rc = main(["export", str(path), "-o", str(tmp_path / f"cli{k}.dxf"), "--unit-mm", str(unit)])
         assert rc == 0
+        assert main(["export", str(path), "-o", str(tmp_path / f"fail{k}.dxf")]) == 3
+        said = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("scale: ")]
+        assert said == [f"scale: {e.value.problems[-1].replace('unit_mm=', '--unit-mm ')}"]
     assert failed == 2  # most of these build at 1 mm a unit (6 of the first 8 of seed 11 do): it takes the first two that do not
 
 
@@ -101,3 +103,38 @@ def test_when_no_unit_builds_the_line_says_so_and_the_search_is_bounded(monkeypa
     assert hint.unit_mm is None and hint.top_mm == pytest.approx(top) and len(tried) == hint.builds <= MAX_BUILDS
     assert max(tried) == pytest.approx(top)  # it went up to the sheet's size
     assert hint.text().startswith(f"no unit_mm up to {top:.3g} ")
+
+
+def test_the_command_line_names_its_option_and_writes_nothing(tmp_path, capsys) -> None:
+    from planar.cli.main import main
+
+    path = tmp_path / "leg.toml"
+    planar.scene_from_mechanism(_crank_rockers(1, 4)[0], fabrication={"unit_mm": 1.0}).save(path)
+    for bad in ("nan", "-1", "0", "1e6"):
+        assert main(["export", str(path), "-o", str(tmp_path / "x.dxf"), f"--unit-mm={bad}"]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("planar: error: --unit-mm = ") and err.count("\n") == 1, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["leg.toml"]
+
+
+def test_no_search_where_no_unit_helps_or_a_build_takes_long() -> None:
+    """A motor shaft too short is not a matter of scale; a mechanism of many parts is not searched (a 5-leg
+    walker's build took 20 s of CPU): each says why, without building."""
+    import types
+
+    from planar.fabrication.check import Violation
+    from planar.fabrication.parts import FabSettings
+    from planar.fabrication.scale import MAX_PARTS, unit_hint
+
+    leg = _crank_rockers(1, 6)[0]
+    scene = planar.scene_from_mechanism(leg, fabrication={"unit_mm": 1.0})
+    shaft = Violation("motor shaft too short", "motor shaft A", "crank", 3, 0, 1, 0.0)
+    fab = types.SimpleNamespace(violations=[shaft], settings=FabSettings(unit_mm=1.0), mechanism=leg)
+    hint = unit_hint(scene, fab)
+    assert hint.builds == 0 and hint.unit_mm is None and "motor shaft too short does not change" in hint.text()
+    many = types.SimpleNamespace(parts=[None] * (MAX_PARTS + 1))
+    crowded = types.SimpleNamespace(
+        violations=[Violation("pins collide", "pin A", "pin B", 1, 0, 1, 0.1)], settings=FabSettings(unit_mm=1.0), mechanism=many
+    )
+    hint = unit_hint(scene, crowded)
+    assert hint.builds == 0 and hint.text().startswith(f"no unit_mm searched: {MAX_PARTS + 1} parts")
