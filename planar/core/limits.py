@@ -65,12 +65,12 @@ def limit(name: str) -> int:
     if text is None or not text.strip():
         return default
     try:
-        value = int(float(text))
-    except (ValueError, OverflowError):
-        raise InputError(var, text, "a positive whole number (an environment variable raising a limit)") from None
-    if value < 1:
+        number = float(text)
+    except ValueError:
+        number = math.nan
+    if not (math.isfinite(number) and number.is_integer() and number >= 1):  # 1.5 is refused, not cut to 1
         raise InputError(var, text, "a positive whole number (an environment variable raising a limit)")
-    return value
+    return int(number)
 
 
 def check_count(name: str, field: str, value: float, what: str, shown: object = None) -> int:

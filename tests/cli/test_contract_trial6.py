@@ -30,3 +30,18 @@ def test_fabsettings_bounds_the_same_fields() -> None:
         with pytest.raises(InputError, match=f"fabrication.{name}"):
             FabSettings(**{name: 1e300})
     FabSettings(pin_mm=100.0, thickness_mm=100.0)  # the bound itself is accepted
+
+
+@pytest.mark.parametrize("var", ["PLANAR_MAX_SAMPLES", "PLANAR_MAX_MEMORY", "PLANAR_MAX_FRAMES", "PLANAR_MAX_CHAIN"])
+@pytest.mark.parametrize("text", ["1.5", "0.0001", "inf", "nan", "-3", "ten"])
+def test_a_limit_variable_that_is_not_a_whole_number_is_refused(monkeypatch, var: str, text: str) -> None:
+    """PLANAR_MAX_SAMPLES=1.5 was cut to 1 (and PLANAR_MAX_MEMORY=1.5 accepted) while 0.0001 was refused."""
+    from planar.core.limits import DEFAULTS, limit
+    from planar.errors import InputError
+
+    name = next(k for k, (v, _) in DEFAULTS.items() if v == var)
+    monkeypatch.setenv(var, text)
+    with pytest.raises(InputError, match=var):
+        limit(name)
+    monkeypatch.setenv(var, "1e6")  # a whole number written in exponent form is one
+    assert limit(name) == 1_000_000
