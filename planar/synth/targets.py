@@ -139,8 +139,9 @@ def read_svg_points(path: str | Path, n: int, option: str = "--points") -> Array
         svg = se.SVG.parse(p)
     except FileNotFoundError:
         raise InputError(p, "missing", "an existing SVG file") from None
-    except Exception as e:  # svgelements raises parser errors of several kinds
-        raise InputError(p, type(e).__name__, "a readable SVG file") from None
+    except Exception as e:  # svgelements raises parser errors of several kinds: say what the parser said
+        why = " ".join(str(e).split())[:160] or type(e).__name__
+        raise InputError(p, f"not readable as SVG ({why})", "a readable SVG file") from None
     _check_finite_attributes(p)
     for el in svg.elements():
         if isinstance(el, se.Shape) and not isinstance(el, se.Group):
@@ -166,6 +167,8 @@ def read_svg_points(path: str | Path, n: int, option: str = "--points") -> Array
 
 #: the SVG attributes that carry coordinates or lengths (svgelements reads ``cx="nan"`` as 0)
 _GEOMETRY = ("cx", "cy", "r", "rx", "ry", "x", "y", "width", "height", "x1", "y1", "x2", "y2", "points", "d", "transform")
+#: the attributes that are lengths: a negative one is an error in SVG (svgelements took its absolute value)
+_SIZES = ("r", "rx", "ry", "width", "height")
 _NON_FINITE = re.compile(r"(?i)(?<![a-z])(nan|inf(inity)?)(?![a-z])")
 
 
@@ -185,6 +188,8 @@ def _check_finite_attributes(path: str) -> None:
             text = el.attrib.get(name)
             if text is not None and _NON_FINITE.search(text):
                 raise InputError(f"{path}: <{tag}> {name}", text, "finite numbers (SVG coordinates)")
+            if text is not None and name in _SIZES and text.strip().startswith("-"):  # SVG: an error, not |r|
+                raise InputError(f"{path}: <{tag}> {name}", text, "a length >= 0 (SVG refuses a negative one)")
 
 
 def read_path_targets(path: str | Path, svg_points: int | None = None, option: str = "--points") -> tuple[Array, Array | None]:

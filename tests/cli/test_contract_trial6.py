@@ -45,3 +45,19 @@ def test_a_limit_variable_that_is_not_a_whole_number_is_refused(monkeypatch, var
         limit(name)
     monkeypatch.setenv(var, "1e6")  # a whole number written in exponent form is one
     assert limit(name) == 1_000_000
+
+
+def test_an_svg_circle_of_negative_radius_is_refused(capsys, tmp_path: Path) -> None:
+    """svgelements took |r|: a drawing SVG calls an error was synthesised as a circle of radius 5."""
+    svg = tmp_path / "neg.svg"
+    svg.write_text('<svg xmlns="http://www.w3.org/2000/svg"><circle cx="0" cy="0" r="-5"/></svg>')
+    out = tmp_path / "s.toml"
+    fails_cleanly(capsys, ["synth", "path", str(svg), "-o", str(out)], "<circle> r", "-5", out=out)
+
+
+def test_an_unparsable_svg_says_what_the_parser_said(capsys, tmp_path: Path) -> None:
+    """It said only 'ParseError' (the exception's class)."""
+    svg = tmp_path / "bad.svg"
+    svg.write_text("not xml <<")
+    out = tmp_path / "s.toml"
+    fails_cleanly(capsys, ["synth", "path", str(svg), "-o", str(out)], "not readable as SVG", "line 1", out=out)
