@@ -369,7 +369,7 @@ def input_swing(row: Array, theta: Array) -> tuple[float, float] | None:
 SEARCH_K, SEARCH_REFINE, SEARCH_NFEV = 64, 16, 200
 #: the final polish (:func:`polish_positions`): iterations per start, and how many of the best refined starts (each
 #: on one swing) it is tried on, best first, until one is within the search's stop
-POLISH_ITERS, POLISH_STARTS = 600, 4
+POLISH_ITERS, POLISH_STARTS = 600, 8
 
 
 def search_arcs(targets: Array, arcs: Arcs, cons: Any = None, stop: float = 1e-9) -> tuple[Any, tuple[float, float] | None]:
