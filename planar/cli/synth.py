@@ -757,8 +757,10 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--rocking",
         action="store_true",
-        help="a four-bar whose input swings between two angles (double-rocker, rocker-crank or triple-rocker) "
-        "tracing the targets as an open arc, from the rocking-arc atlas (untimed targets)",
+        help="only a four-bar whose input swings between two angles (double-rocker, rocker-crank or triple-rocker) "
+        "tracing the targets as an open arc, from the rocking-arc atlas (untimed targets; built on first use). Without "
+        "it, untimed synth path tries that atlas too when the coupler-curve atlas is not within --tolerance, once "
+        "planar synth atlas --rocking has built it",
     )
     p.add_argument(
         "--atlas",
