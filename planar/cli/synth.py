@@ -237,38 +237,50 @@ def _cmd_path(args: argparse.Namespace) -> int:
             ordered=args.ordered,
             min_transmission=min_transmission,
         )
-    why = _unusable(d, "four-bar", cons.region is not None)
+
+    def scene() -> tuple[str, str]:
+        fb = d.fourbar()
+        amp, centre = _rocking(fb, d.theta)
+        if "input_swing_rad" in d.checks:  # a rocking input swings over its found range
+            lo, hi = d.checks["input_swing_rad"]
+            amp, centre = max(0.5 * (hi - lo), 1e-6), 0.5 * (hi + lo)
+        text = fourbar_scene_text(
+            "synth-path",
+            d.ground,
+            d.crank,
+            d.coupler,
+            d.rocker,
+            d.coupler_point,
+            d.circuit,
+            d.placement,
+            comments=[
+                f"planar synth path {args.target}: {len(targets)} targets, {'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
+                "crank angle at each target (rad): " + ", ".join(f"{t:.6g}" for t in d.theta),
+            ],
+            amplitude=amp,
+            centre=centre,
+            targets=targets.tolist(),
+        )
+        return text, f"four-bar ({fb.grashof}, {d.circuit}, the input {d.checks.get('input', 'rocks')})"
+
+    return _path_result(args, d, targets, "four-bar", lambda: _box_word(d, targets, cons, atlas, args), scene)
+
+
+def _path_result(args: argparse.Namespace, d: Any, targets: np.ndarray, kind: str, box: Any, scene: Any) -> int:
+    """The end of ``synth path`` for any design ``d`` of ``kind``: no design (nothing written, exit 3) when it is
+    unusable, else its scene written (``scene()``: the text and the design in a few words) and reported, with
+    each failed check (``box()``: what a ``--pivots`` box costs, in words)."""
+    why = _unusable(d, kind, args.pivots is not None)
     if why is not None:
         return _no_design(args, "synth path", {"targets": len(targets)}, why)
-    failing = _path_failing(d, "four-bar", _box_word(d, targets, cons, atlas, args))
-    fb = d.fourbar()
-    amp, centre = _rocking(fb, d.theta)
-    if "input_swing_rad" in d.checks:  # --rocking: the input swings over its found range
-        lo, hi = d.checks["input_swing_rad"]
-        amp, centre = max(0.5 * (hi - lo), 1e-6), 0.5 * (hi + lo)
-    text = fourbar_scene_text(
-        "synth-path",
-        d.ground,
-        d.crank,
-        d.coupler,
-        d.rocker,
-        d.coupler_point,
-        d.circuit,
-        d.placement,
-        comments=[
-            f"planar synth path {args.target}: {len(targets)} targets, {'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
-            "crank angle at each target (rad): " + ", ".join(f"{t:.6g}" for t in d.theta),
-        ],
-        amplitude=amp,
-        centre=centre,
-        targets=targets.tolist(),
-    )
+    failing = _path_failing(d, kind, box())
+    text, what = scene()
+    found = f"; found by {d.checks['found_by']}" if d.checks.get("found_by") else ""
     report = {"command": "synth path", "targets": len(targets), "target_points": targets.tolist(), **d.to_dict()}
     return _finish_path(
         args,
-        f"four-bar ({fb.grashof}, {d.circuit}), largest distance {d.checks['max_error']:.3g} of the targets' size "
-        f"(RMS {d.checks['rms_error']:.3g}) over {len(targets)} targets "
-        f"in {d.seconds:.2f} s; found by {d.checks['found_by']}",
+        f"{what}, largest distance {d.checks['max_error']:.3g} of the targets' size (RMS {d.checks['rms_error']:.3g}) "
+        f"over {len(targets)} targets in {d.seconds:.2f} s{found}",
         text,
         report,
         d.ok,
@@ -278,17 +290,13 @@ def _cmd_path(args: argparse.Namespace) -> int:
 
 def _rocking_design(args: argparse.Namespace, targets: np.ndarray, theta: Any, cons: Any) -> Any:
     """``--rocking``: a four-bar whose input swings between two angles, from the rocking-arc atlas."""
-    from planar.synth.arcs import synthesise_rocking_path
+    from planar.synth.path import synthesise_rocking_path
 
     if theta is not None:
         raise InputError("--rocking", str(args.target), "untimed targets (x, y only: the swing finds its own input angles)")
     if args.pivots is not None:
         raise InputError("--rocking", args.pivots, "no --pivots box (the rocking search does not keep one)")
-    d = synthesise_rocking_path(targets, args.tolerance, args.ordered, cons.max_ratio, budget=args.budget)
-    if "input_swing_deg" in d.checks:
-        a, b = d.checks["input_swing_deg"]
-        d.checks["found_by"] += f"; the input rocks between {a:.4g} and {b:.4g} deg from the ground line"
-    return d
+    return synthesise_rocking_path(targets, args.tolerance, args.ordered, cons.max_ratio, budget=args.budget)
 
 
 def _box_word(d: Any, targets: np.ndarray, cons: Any, atlas: Any, args: argparse.Namespace) -> str:
@@ -346,62 +354,95 @@ def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | N
         atlas=atlas,
         ordered=args.ordered,
     )
-    why = _unusable(d, f"{topology} six-bar", cons.region is not None)
-    if why is not None:
-        return _no_design(args, "synth path", {"targets": len(targets)}, why)
     box = "every ground pivot was kept in the --pivots box, which may be why (try without it)" if cons.region is not None else ""
-    failing = _path_failing(d, f"{topology} six-bar", box)
-    text = linkage_scene_text(
-        f"synth-sixbar-{d.topology}",
-        d.nodes(),
-        d.links(),
-        {"tracer": "T"},
-        targets=targets.tolist(),
-        comments=[
-            f"planar synth path {args.target} --type sixbar --topology {d.topology}: {len(targets)} targets, "
-            f"{'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
-            "crank angle at each target (rad, from the ground line O2-O4): " + ", ".join(f"{t:.6g}" for t in wrapped(d.theta)),
-        ],
-    )
-    report = {"command": "synth path", "targets": len(targets), "target_points": targets.tolist(), **d.to_dict()}
-    return _finish_path(
-        args,
-        f"{d.topology} six-bar, largest distance {d.checks['max_error']:.3g} of the targets' size "
-        f"(RMS {d.checks['rms_error']:.3g}) over {len(targets)} targets in {d.seconds:.2f} s",
-        text,
-        report,
-        d.ok,
-        failing,
-    )
+
+    def scene() -> tuple[str, str]:
+        text = linkage_scene_text(
+            f"synth-sixbar-{d.topology}",
+            d.nodes(),
+            d.links(),
+            {"tracer": "T"},
+            targets=targets.tolist(),
+            comments=[
+                f"planar synth path {args.target} --type sixbar --topology {d.topology}: {len(targets)} targets, "
+                f"{'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
+                "crank angle at each target (rad, from the ground line O2-O4): "
+                + ", ".join(f"{t:.6g}" for t in wrapped(d.theta)),
+            ],
+        )
+        return text, f"{d.topology} six-bar"
+
+    return _path_result(args, d, targets, f"{topology} six-bar", lambda: box, scene)
 
 
 def _cmd_atlas(args: argparse.Namespace) -> int:
     import os
     import time
 
-    from planar.synth.atlas import atlas_path, build_atlas, check_atlas_memory, read_atlas
+    from planar.synth.atlas import DEFAULT_SIZE, atlas_path, build_atlas, check_atlas_memory, read_atlas
 
-    if args.size < 100:
-        raise InputError("--size", args.size, "at least 100 four-bars")
+    if args.rocking:
+        return _cmd_arcs(args)
+    size = DEFAULT_SIZE if args.size is None else args.size
+    if size < 100:
+        raise InputError("--size", size, "at least 100 four-bars")
     if not 0 <= args.seed < 2**32:
         raise InputError("--seed", args.seed, "a seed from 0 to 2**32 - 1")
-    check_atlas_memory("--size", args.size)  # before any output is checked or any four-bar solved
-    if args.output is not None:  # like every output: an existing folder, no folder made for it
-        from planar.fileio import check_output
-
-        check_output("-o/--output", args.output, (".npz",))
-    path = args.output if args.output is not None else str(atlas_path(args.size, args.seed))
-    if not path.endswith(".npz"):
-        raise InputError("-o/--output", path, "an .npz file")
+    check_atlas_memory("--size", size)  # before any output is checked or any four-bar solved
+    path = _atlas_output(args, str(atlas_path(size, args.seed)))
     if os.path.exists(path) and not args.force:
         a = read_atlas(path)
         print(f"{path}: atlas of {len(a)} four-bars exists (built in {a.build_seconds:.1f} s CPU); --force rebuilds it")
         return 0
     t0 = time.process_time()
-    a = build_atlas(args.size, args.seed, progress=True)
+    a = build_atlas(size, args.seed, progress=True)
     a.save(path)
-    size = os.path.getsize(path)
-    print(f"wrote {path}: {len(a)} four-bars, {size / 1e6:.1f} MB, built in {time.process_time() - t0:.1f} s CPU")
+    size_b = os.path.getsize(path)
+    print(f"wrote {path}: {len(a)} four-bars, {size_b / 1e6:.1f} MB, built in {time.process_time() - t0:.1f} s CPU")
+    return 0
+
+
+def _atlas_output(args: argparse.Namespace, default: str) -> str:
+    """``-o/--output`` of ``synth atlas`` checked (an .npz file in an existing folder), or ``default``."""
+    if args.output is not None:  # like every output: an existing folder, no folder made for it
+        from planar.fileio import check_output
+
+        check_output("-o/--output", args.output, (".npz",))
+    path = args.output if args.output is not None else default
+    if not path.endswith(".npz"):
+        raise InputError("-o/--output", path, "an .npz file")
+    return str(path)
+
+
+#: most four-bars of a rocking-arc atlas ``synth atlas --rocking --size`` builds (four arcs each, 176 bytes an arc:
+#: about 700 MB on disk)
+MAX_ARC_FOURBARS = 1_000_000
+
+
+def _cmd_arcs(args: argparse.Namespace) -> int:
+    """``synth atlas --rocking``: the rocking-arc atlas plain ``synth path`` also tries (and ``--rocking`` uses)."""
+    import os
+    import time
+
+    from planar.synth.arcs import DEFAULT_FOURBARS, WINDOWS, arcs_path, build_arcs, read_arcs
+
+    size = DEFAULT_FOURBARS if args.size is None else args.size
+    if not 100 <= size <= MAX_ARC_FOURBARS:
+        raise InputError("--size", size, f"100 to {MAX_ARC_FOURBARS:,} four-bars (with --rocking)")
+    if not 0 <= args.seed < 2**32:
+        raise InputError("--seed", args.seed, "a seed from 0 to 2**32 - 1")
+    path = _atlas_output(args, str(arcs_path(size, args.seed)))
+    if os.path.exists(path) and not args.force:
+        a = read_arcs(path)
+        print(f"{path}: rocking-arc atlas of {len(a)} arcs exists (built in {a.build_seconds:.1f} s CPU); --force rebuilds it")
+        return 0
+    t0 = time.process_time()
+    a = build_arcs(size, args.seed, progress=True)
+    a.save(path)
+    print(
+        f"wrote {path}: {len(a)} arcs of {size} rocking four-bars ({len(WINDOWS)} windows each), "
+        f"{os.path.getsize(path) / 1e6:.1f} MB, built in {time.process_time() - t0:.1f} s CPU"
+    )
     return 0
 
 
@@ -716,8 +757,10 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--rocking",
         action="store_true",
-        help="a four-bar whose input swings between two angles (double-rocker, rocker-crank or triple-rocker) "
-        "tracing the targets as an open arc, from the rocking-arc atlas (untimed targets)",
+        help="only a four-bar whose input swings between two angles (double-rocker, rocker-crank or triple-rocker) "
+        "tracing the targets as an open arc, from the rocking-arc atlas (untimed targets; built on first use). Without "
+        "it, untimed synth path tries that atlas too when the coupler-curve atlas is not within --tolerance, once "
+        "planar synth atlas --rocking has built it",
     )
     p.add_argument(
         "--atlas",
@@ -728,12 +771,23 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--seed", type=int, default=0, help="random seed of the search (same seed, same result)")
     p.set_defaults(func=_cmd_path)
 
-    a = ss.add_parser("atlas", help="build the coupler-curve atlas untimed path synthesis searches (cached)")
+    a = ss.add_parser(
+        "atlas",
+        help="build the coupler-curve atlas (or --rocking: the rocking-arc atlas) untimed path synthesis searches (cached)",
+    )
     a.add_argument(
         "--size",
         type=int,
-        default=1_000_000,
-        help="four-bars in the atlas (1000000: about 25 s CPU, a 112 MB file, 580 MB of memory while building)",
+        default=None,
+        help="four-bars in the atlas (1000000: about 25 s CPU, a 112 MB file, 580 MB of memory while building; "
+        "with --rocking 250000: about 14 s CPU, a 176 MB file)",
+    )
+    a.add_argument(
+        "--rocking",
+        action="store_true",
+        help="build the rocking-arc atlas instead (four-bars whose input swings between two angles: double-rockers, "
+        "rocker-cranks, triple-rockers): once it is in the cache folder, untimed synth path tries it too when the "
+        "coupler-curve atlas's best is not within --tolerance",
     )
     a.add_argument("--seed", type=int, default=0, help="random seed (same size and seed, same atlas)")
     a.add_argument("-o", "--output", default=None, help="atlas file (.npz) to write (default: the user cache folder)")

@@ -34,6 +34,7 @@ and between which angles.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -347,10 +348,28 @@ def rocking_range(row: Array, theta: Array) -> tuple[float, float] | None:
     return None
 
 
+def input_swing(row: Array, theta: Array) -> tuple[float, float] | None:
+    """The input angles (rad from the ground line, ``lo <= hi``) a four-bar (kernel row ``row``) swings between to
+    pass crank angles ``theta`` in their order on one swing: :func:`rocking_range` when its input rocks; when it
+    turns fully (a crank-rocker tracing part of its closed curve: a cognate of a double-rocker does), the angles'
+    own span when they run one way within one turn (such a crank can be driven back and forth over it); else None."""
+    swing = rocking_range(row, theta)
+    r1, r2, r3, r4 = (abs(float(v)) for v in row[:4])
+    if swing is not None or input_range(np.array([r2 / r1]), np.array([r3 / r1]), np.array([r4 / r1]))[2][0]:
+        return swing
+    step = np.mod(np.diff(np.asarray(theta, float)) + np.pi, 2 * np.pi) - np.pi
+    u = float(theta[0]) + np.concatenate([[0.0], np.cumsum(step)])
+    if not (np.all(step > 0) or np.all(step < 0)) or np.ptp(u) >= 2 * np.pi:
+        return None
+    lo, hi = float(u.min()), float(u.max())
+    return (lo, hi) if hi > lo else None
+
+
 #: lookup and refinement effort: neighbours per query, starts refined, evaluations per start
 SEARCH_K, SEARCH_REFINE, SEARCH_NFEV = 64, 16, 200
-#: evaluations of the best start's last refinement (its crank angles kept, not re-assigned)
-POLISH_NFEV = 1000
+#: the final polish (:func:`polish_positions`): iterations per start, and how many of the best refined starts (each
+#: on one swing) it is tried on, best first, until one is within the search's stop
+POLISH_ITERS, POLISH_STARTS = 600, 8
 
 
 def search_arcs(targets: Array, arcs: Arcs, cons: Any = None, stop: float = 1e-9) -> tuple[Any, tuple[float, float] | None]:
@@ -364,7 +383,6 @@ def search_arcs(targets: Array, arcs: Arcs, cons: Any = None, stop: float = 1e-9
         Constraints,
         PathObjective,
         SearchResult,
-        _refine,
         default_bounds,
         max_distance,
         reassigned_refine,
@@ -381,8 +399,13 @@ def search_arcs(targets: Array, arcs: Arcs, cons: Any = None, stop: float = 1e-9
     stages = {"arcs_s": time.perf_counter() - t0}
     t1 = time.perf_counter()
     f = obj.population(every, np.float64) if len(every) else np.zeros(0)
-    best: tuple[float, Array, Array, tuple[float, float]] | None = None
+    found: list[tuple[float, Array, Array, tuple[float, float]]] = []
     tried: list[Array] = []
+
+    def usable(r: Array, tt: Array) -> tuple[float, float] | None:
+        swing = input_swing(r[:9], tt)
+        return None if swing is None or violation(r[None, :9], cons, obj.scale, 0.0)[0] > 0 else swing
+
     for row in every[np.argsort(f, kind="stable")]:
         if len(tried) >= SEARCH_REFINE:
             break
@@ -390,140 +413,195 @@ def search_arcs(targets: Array, arcs: Arcs, cons: Any = None, stop: float = 1e-9
             continue
         tried.append(row)
         r, tt, _ = reassigned_refine(obj, row, b, SEARCH_NFEV, stop)
-        swing = rocking_range(r[:9], tt)
-        if swing is None or violation(r[None, :9], cons, obj.scale, 0.0)[0] > 0:
-            continue
-        e = max_distance(obj, r, tt)
-        if best is None or e < best[0]:
-            best = (e, r, tt, swing)
-        if e <= stop:
-            break
-    if best is not None and best[0] > stop:  # the best goes on with its own angles (no re-assignment)
-        e0, r0, tt0, _ = best
-        r, tt, _ = _refine(obj, r0, b, max_nfev=POLISH_NFEV, method="lm", theta0=tt0)
-        swing = rocking_range(r[:9], tt)
-        e = max_distance(obj, r, tt)
-        if swing is not None and e < e0 and violation(r[None, :9], cons, obj.scale, 0.0)[0] == 0:
-            best = (e, r, tt, swing)
+        swing = usable(r, tt)
+        if swing is not None:
+            found.append((max_distance(obj, r, tt), r, tt, swing))
+            if found[-1][0] <= stop:
+                break
     stages["refine_s"] = time.perf_counter() - t1
-    if best is None:
+    if not found:
         return None, None
+    found.sort(key=lambda c: c[0])
+    best = found[0]
+    # the best few go on in the joints' positions (a better-conditioned parametrisation) with geodesic acceleration
+    for _, r0, tt0, _ in found[:POLISH_STARTS] if best[0] > stop else []:
+        r, tt = polish_positions(t, r0, tt0, POLISH_ITERS, cons.max_ratio)
+        swing = usable(r, tt)
+        e = max_distance(obj, r, tt) if swing is not None else math.inf
+        if swing is not None and e < best[0]:
+            best = (e, r, tt, swing)
+        if best[0] <= stop:
+            break
+    stages["polish_s"] = time.perf_counter() - t1 - stages["refine_s"]
     e, r, tt, swing = best
     sse = float(np.sum(np.square(_points(r, tt) - t)))
     return SearchResult(r[:9], 1 if r[9] >= 0 else -1, tt, sse, True, len(tried), stages), swing
 
 
+def joint_positions(row: Array, theta: Array) -> tuple[Array, Array]:
+    """A kernel row (9 parameters and the circuit) and its input angles at the targets ``theta`` ``(N,)`` as the
+    joints' positions at the first target's pose, ``O2, B, C, O4, P`` (x, y each: 10 numbers), and the input's
+    turn from there to each later target ``(N - 1,)`` (rad): the variables of :func:`polish_positions`."""
+    r1, r2, r3, r4, u, v, x0, y0, phi = (float(x) for x in row[:9])
+    s = 1.0 if row[9] >= 0 else -1.0
+    o2 = complex(x0, y0)
+    o4 = o2 + r1 * np.exp(1j * phi)
+    b = o2 + r2 * np.exp(1j * (phi + float(theta[0])))
+    d = o4 - b
+    L2 = abs(d) ** 2
+    A = 0.5 * (L2 + r3 * r3 - r4 * r4)
+    e = (A + 1j * s * math.sqrt(max(r3 * r3 * L2 - A * A, 0.0))) * d / L2  # C - B
+    c = b + e
+    p = b + (u + 1j * v) * e / r3
+    q = np.array([o2.real, o2.imag, b.real, b.imag, c.real, c.imag, o4.real, o4.imag, p.real, p.imag])
+    return q, np.asarray(theta[1:], float) - float(theta[0])
+
+
+def positions_points(q: Any, turn: Any, circuit: float) -> tuple[Any, Any]:
+    """Coupler points ``(x, y)`` at the first pose of :func:`joint_positions` and after each ``turn``: written with
+    arithmetic, ``cos``, ``sin`` and ``sqrt`` only, so it runs on complex numbers for the complex-step derivative."""
+    o2x, o2y, bx0, by0, cx0, cy0, o4x, o4y, px0, py0 = q
+    al = np.concatenate([np.zeros(1, dtype=np.result_type(turn, float)), turn])
+    ca, sa = np.cos(al), np.sin(al)
+    rx, ry = bx0 - o2x, by0 - o2y
+    bx, by = o2x + ca * rx - sa * ry, o2y + sa * rx + ca * ry
+    ex0, ey0 = cx0 - bx0, cy0 - by0
+    b2 = ex0 * ex0 + ey0 * ey0  # coupler length squared, rocker's below: the loop-closure lengths
+    c2 = (cx0 - o4x) ** 2 + (cy0 - o4y) ** 2
+    fx, fy = px0 - bx0, py0 - by0
+    a1, a2 = (fx * ex0 + fy * ey0) / b2, (ex0 * fy - ey0 * fx) / b2
+    dx, dy = o4x - bx, o4y - by
+    L2 = dx * dx + dy * dy
+    A = 0.5 * (L2 + b2 - c2)
+    w = circuit * np.sqrt(b2 * L2 - A * A)
+    ex, ey = (A * dx - w * dy) / L2, (A * dy + w * dx) / L2
+    return bx + a1 * ex - a2 * ey, by + a1 * ey + a2 * ex
+
+
+def row_from_positions(q: Array, turn: Array, circuit: float) -> tuple[Array, Array]:
+    """The kernel row (9 parameters and ``circuit``) and the input angles at the targets of :func:`joint_positions`'s
+    variables."""
+    o2, b, c, o4, p = (complex(q[i], q[i + 1]) for i in range(0, 10, 2))
+    g, e = o4 - o2, c - b
+    phi = math.atan2(g.imag, g.real)
+    w = (p - b) / e * abs(e)  # the coupler point in the coupler's frame (x along B -> C)
+    row = np.array([abs(g), abs(b - o2), abs(e), abs(c - o4), w.real, w.imag, o2.real, o2.imag, phi, circuit])
+    th0 = math.atan2((b - o2).imag, (b - o2).real) - phi
+    return row, th0 + np.concatenate([[0.0], np.asarray(turn, float)])
+
+
+def _ratio_excess(q: Any, max_ratio: float) -> Any:
+    """How far the longest of the four links (from the joints' positions ``q``) is over ``max_ratio`` (less a
+    margin) times the shortest, 0 when it is not: piecewise analytic, so it runs on complex numbers too."""
+    from planar.synth.search import GRASHOF_MARGIN
+
+    o2x, o2y, bx, by, cx, cy, o4x, o4y = q[:8]
+    sides = ((o4x - o2x, o4y - o2y), (bx - o2x, by - o2y), (cx - bx, cy - by), (cx - o4x, cy - o4y))
+    L = [np.sqrt(dx * dx + dy * dy) for dx, dy in sides]
+    re = [float(np.real(v)) for v in L]
+    x = L[int(np.argmax(re))] - max_ratio * (1.0 - 2 * GRASHOF_MARGIN) * L[int(np.argmin(re))]
+    return x if float(np.real(x)) > 0 else 0.0 * x
+
+
+def _positions_problem(t: Array, circuit: float, max_ratio: float) -> tuple[Any, Any]:
+    """Residuals ``(2 N + 1,)`` (coupler point minus target, x then y; then the link ratio's excess, weighted as
+    the search weighs a broken constraint) of :func:`polish_positions`'s variables and their Jacobian by complex
+    step (exact to rounding: 11 evaluations, the later targets' turns perturbed at once as each moves its own
+    target only)."""
+    n = len(t)
+    w = 10.0 * math.sqrt(n) if math.isfinite(max_ratio) else 0.0
+
+    def resid(z: Array) -> Array:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            x, y = positions_points(z[:10], z[10:], circuit)
+            r = np.concatenate([x - t[:, 0], y - t[:, 1], [w * _ratio_excess(z, max_ratio) if w else 0.0]])
+        return r if np.isfinite(r).all() else np.full(2 * n + 1, 10.0)  # the loop does not close: far
+
+    def jac(z: Array) -> Array:
+        h = 1e-30
+        Z = np.repeat(z[None, :].astype(complex), 11, axis=0)
+        Z[np.arange(10), np.arange(10)] += 1j * h
+        Z[10, 10:] += 1j * h
+        J = np.zeros((2 * n + 1, len(z)))
+        i = np.arange(1, n)
+        for k in range(11):
+            with np.errstate(invalid="ignore", divide="ignore"):
+                x, y = positions_points(Z[k, :10], Z[k, 10:], circuit)
+            col = np.concatenate([x.imag, y.imag]) / h
+            if k < 10:
+                J[: 2 * n, k] = col
+                J[2 * n, k] = w * np.imag(_ratio_excess(Z[k], max_ratio)) / h if w else 0.0
+            else:
+                J[i, 9 + i], J[n + i, 9 + i] = col[1:n], col[n + 1 :]
+        return np.nan_to_num(J, nan=0.0, posinf=0.0, neginf=0.0)
+
+    return resid, jac
+
+
+#: geodesic acceleration: the finite-difference step along the velocity, and the largest ratio of the
+#: acceleration's to the velocity's size accepted (Transtrum and Sethna's recommended 0.1 and 0.75)
+GEODESIC_H, GEODESIC_ALPHA = 0.1, 0.75
+
+
+def geodesic_lm(resid: Any, jac: Any, z: Array, iters: int) -> tuple[Array, Array]:
+    """Levenberg-Marquardt with geodesic acceleration (Transtrum and Sethna, 2011): each damped Gauss-Newton step
+    (Marquardt's scaling, the largest diagonal of ``J^T J`` seen) gets a second-order correction along the curved
+    valley, from one more residual evaluation; the step is taken only when that correction is small beside it.
+    Returns the variables and residuals it ends at after at most ``iters`` accepted or refused steps."""
+    r = resid(z)
+    f = float(r @ r)
+    J = jac(z)
+    lam = 1e-3
+    D = np.zeros(len(z))
+    for _ in range(iters):
+        if f <= 1e-30 or lam > 1e20:
+            break
+        A, g = J.T @ J, J.T @ r
+        D = np.maximum(D, np.diag(A))
+        M = A + lam * np.diag(np.maximum(D, 1e-300))
+        try:
+            v = -np.linalg.solve(M, g)
+            rh = resid(z + GEODESIC_H * v)
+            acc = -0.5 * np.linalg.solve(M, J.T @ ((2.0 / GEODESIC_H) * ((rh - r) / GEODESIC_H - J @ v)))
+        except np.linalg.LinAlgError:
+            lam *= 10.0
+            continue
+        if 2.0 * math.sqrt(acc @ (D * acc)) > GEODESIC_ALPHA * math.sqrt(v @ (D * v)):
+            lam *= 2.0
+            continue
+        rn = resid(z + v + acc)
+        fn = float(rn @ rn)
+        if fn < f:
+            z, r, f = z + v + acc, rn, fn
+            lam = max(lam / 3.0, 1e-12)
+            J = jac(z)
+        else:
+            lam *= 2.0
+    return z, r
+
+
+def polish_positions(
+    t: Array, row: Array, theta: Array, iters: int = POLISH_ITERS, max_ratio: float = 10.0
+) -> tuple[Array, Array]:
+    """A refined kernel row and its input angles at the targets ``t`` (normalised), polished in the joints'
+    positions (:func:`joint_positions`: the pivots and moving joints at the first target's pose, the input's turn
+    to each later target; the coupler's and rocker's lengths are the loop-closure equations inside
+    :func:`positions_points`) by :func:`geodesic_lm` with an exact Jacobian.
+
+    A rocking four-bar's arc is short and smooth: in the kernel's lengths and angles the four-bars within 1e-5 of
+    it lie along a long, curved, narrow valley (condition numbers 1e6 to 1e9), where Levenberg-Marquardt with a
+    difference Jacobian crawls.  Returns the row and angles (the input as given when nothing better is found)."""
+    circuit = 1.0 if row[9] >= 0 else -1.0
+    q, turn = joint_positions(row, theta)
+    resid, jac = _positions_problem(np.asarray(t, float), circuit, max_ratio)
+    z0 = np.concatenate([q, turn])
+    r0 = resid(z0)
+    z, r = geodesic_lm(resid, jac, z0, iters)
+    if not float(r @ r) < float(r0 @ r0):
+        return row, theta
+    return row_from_positions(z[:10], z[10:], circuit)
+
+
 def _points(row: Array, theta: Array) -> Array:
     x, y, _ = coupler_points(row[None, :9], theta[None, :], np.array([1.0 if row[9] >= 0 else -1.0]))
     return np.column_stack([x[0], y[0]])
-
-
-def synthesise_rocking_path(
-    targets: Array,
-    tolerance: float = 1e-3,
-    ordered: bool = False,
-    max_ratio: float = 10.0,
-    arcs: Arcs | None = None,
-    budget: str = "normal",
-) -> Any:
-    """A four-bar whose input *rocks* (swings between two angles, never turning fully) and whose coupler point
-    passes through ``targets`` ``(N, 2)`` (untimed, in order along its arc), from the rocking-arc atlas.
-
-    ``arcs``: the atlas (default: the cached one of :data:`DEFAULT_FOURBARS` four-bars, or
-    :data:`QUICK_FOURBARS` for ``budget="quick"``, built on first use).  Returns a
-    :class:`planar.synth.path.FourBarDesign` whose ``checks`` hold ``input_swing_rad`` and
-    ``input_swing_deg`` (the input's swing, from the ground line, as ``[from, to]``), ``input_swing_world_deg``
-    (the same from the world's +x axis), ``ok_accuracy`` (largest distance over the targets' size within
-    ``tolerance``), ``ok_swing_assembles`` (planar's solver assembles the whole swing on the design's
-    circuit), ``ok_on_one_swing`` (every target on that swing), ``ok_constraints`` (link ratio) and, with
-    ``ordered``, ``ok_order`` (the targets met in their order as the input swings one way).  When no four-bar
-    keeps the targets on one swing, the design is None-valued in ``checks["error"]`` and ``sse`` is inf.
-    """
-    import math
-
-    from threadpoolctl import threadpool_limits
-
-    from planar.synth.path import FourBarDesign, wrapped
-    from planar.synth.search import Constraints, constraint_failures
-    from planar.synth.targets import normalisation
-
-    t = np.asarray(targets, float)
-    if t.ndim != 2 or t.shape[1] != 2 or len(t) < 3:
-        raise InputError("targets", t.shape, "3 or more (x, y) points")
-    t0 = time.perf_counter()
-    if arcs is None:
-        arcs = load_arcs(QUICK_FOURBARS if budget == "quick" else DEFAULT_FOURBARS, progress=True)
-    c, s = normalisation(t)
-    cons = Constraints(full_turn=False, max_ratio=max_ratio)
-    with threadpool_limits(1):
-        r, swing = search_arcs((t - c) / s, arcs, cons)
-    if r is None or swing is None:
-        d = FourBarDesign(1.0, 1.0, 1.0, 1.0, (0.0, 0.0), "open", (0.0, 0.0, 0.0), np.zeros(len(t)), math.inf, t, False, 0.0)
-        d.checks = {"error": "no four-bar of the rocking-arc atlas keeps the targets on one swing of its input"}
-        d.checks["ok_found"] = False
-        return d
-    p = r.params.copy()
-    p[:6] *= s
-    p[6:8] = p[6:8] * s + c
-    d = FourBarDesign(
-        float(p[0]),
-        float(p[1]),
-        float(p[2]),
-        float(p[3]),
-        (float(p[4]), float(p[5])),
-        "open" if r.circuit > 0 else "crossed",
-        (float(p[6]), float(p[7]), float(p[8])),
-        wrapped(r.theta),
-        math.nan,
-        t,
-        False,
-        time.perf_counter() - t0,
-    )
-    _check_rocking(d, r.theta, swing, tolerance, ordered, s)
-    d.checks["constraint_failures"] = list(constraint_failures(p, cons))
-    d.checks["ok_constraints"] = not d.checks["constraint_failures"]
-    d.checks["stages_s"] = r.stages
-    d.checks["found_by"] = "the rocking-arc atlas lookup and refinement"
-    return d
-
-
-def _check_rocking(d: Any, theta: Array, swing: tuple[float, float], tolerance: float, ordered: bool, size: float) -> None:
-    """Fill ``d.sse`` and ``d.checks`` from planar's solver: at the targets, and over the swing (dense, as a
-    path, against the same angles as a scattered batch: the circuit never switches)."""
-    import math
-
-    fb = d.fourbar()
-    lo, hi = swing
-    th = np.asarray(theta, float)
-    u = lo - 1e-9 + np.mod(th - lo + 1e-9, 2 * np.pi)  # the targets' input angles on the swing (lo itself included)
-    at = fb.solve(u)
-    pts = at.points["coupler_point"]
-    dist = np.hypot(*(pts - d.targets).T)
-    d.sse = float(np.sum(dist**2)) if at.valid.all() else math.inf
-    sweep = np.linspace(lo, hi, 721)
-    path = fb.solve(sweep)
-    perm = np.random.default_rng(0).permutation(len(sweep))
-    batch = fb.solve(sweep[perm])
-    same = bool(path.valid.all() and batch.valid.all()) and bool(
-        np.max(np.abs(batch.points["coupler_point"] - path.points["coupler_point"][perm])) <= 1e-9 * size
-    )
-    du = np.diff(u)
-    phi = d.placement[2]
-    d.checks = {
-        "grashof": fb.grashof,
-        "input_swing_rad": [lo, hi],
-        "input_swing_deg": [math.degrees(lo), math.degrees(hi)],
-        "input_swing_world_deg": [math.degrees(lo + phi), math.degrees(hi + phi)],
-        "ok_valid_at_targets": bool(at.valid.all()),
-        "ok_on_one_swing": bool(np.all((u >= lo - 1e-9) & (u <= hi + 1e-9))),
-        "ok_swing_assembles": same,
-        "max_target_distance": float(dist.max()) if at.valid.all() else math.inf,
-        "worst_target": int(np.argmax(dist)) + 1,
-        "size": size,
-        "max_error": float(dist.max()) / size if at.valid.all() else math.inf,
-        "rms_error": math.sqrt(d.sse / len(th)) / size if math.isfinite(d.sse) else math.inf,
-        "tolerance": tolerance,
-    }
-    d.checks["ok_accuracy"] = bool(d.checks["max_error"] <= tolerance)
-    if ordered:
-        d.checks["ok_order"] = bool(np.all(du > 0) or np.all(du < 0))

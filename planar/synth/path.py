@@ -34,7 +34,7 @@ from planar.synth.designs import Checked, PlacedFourBar
 from planar.synth.search import Constraints, PathObjective, constraint_failures, search_fourbar
 from planar.synth.targets import check_search_args, normalisation
 
-__all__ = ["FourBarDesign", "synthesise_path"]
+__all__ = ["FourBarDesign", "check_path_args", "synthesise_path", "synthesise_rocking_path"]
 
 Array = NDArray[np.float64]
 
@@ -139,17 +139,27 @@ def transmission_margin(fb: Any) -> tuple[float, float]:
 
 
 def _search(
-    t: Array, theta: Array | None, cons: Constraints, budget: str, seed: int, tolerance: float, atlas: Any, ordered: bool
-) -> tuple[Any, str]:
-    """The search on normalised targets ``t``: the atlas first when untimed, the global search when timed or
-    when the atlas's best is not within ``tolerance`` (largest distance, targets' size 1).
+    t: Array,
+    theta: Array | None,
+    cons: Constraints,
+    budget: str,
+    seed: int,
+    tolerance: float,
+    atlas: Any,
+    ordered: bool,
+    arcs: Any = None,
+) -> tuple[Any, str, tuple[float, float] | None]:
+    """The search on normalised targets ``t``: the atlas first when untimed, then the rocking arcs
+    (:func:`_rocking_search`) when they may be tried, the global search when timed or when neither's best is within
+    ``tolerance`` (largest distance, targets' size 1).
 
     Returns the result (its ``stages``: every stage that ran, seconds: ``atlas_load_s``, ``atlas_s``,
-    ``refine_s``, ``timed_s`` and, when the global search ran, ``global_sample_s``, ``global_de_s``,
-    ``global_refine_s``) and a sentence saying which stage produced it."""
+    ``refine_s``, ``timed_s``, ``rocking_s`` and, when the global search ran, ``global_sample_s``, ``global_de_s``,
+    ``global_refine_s``), a sentence saying which stage produced it, and the input's swing (rad from the ground
+    line) when the result's input rocks (None when it turns fully)."""
     import time
 
-    from planar.synth.search import in_order, max_distance, search_atlas, timed_from_atlas
+    from planar.synth.search import max_distance, timed_from_atlas
 
     kw = BUDGETS[budget]
     t0 = time.perf_counter()
@@ -158,45 +168,125 @@ def _search(
 
         atlas = load_atlas(QUICK_SIZE if budget == "quick" else DEFAULT_SIZE, progress=True)
     load = {"atlas_load_s": time.perf_counter() - t0}
-    if theta is not None:
-        # the curve from the atlas, then the timing: exact when the atlas finds the four-bar itself (a cognate
-        # traces the same curve at other crank angles: then the global search runs)
-        timed = timed_from_atlas(t, theta, atlas, cons)
-        e_atlas = (
-            max_distance(PathObjective(t, theta, cons), np.append(timed.params, timed.circuit), theta)
-            if timed is not None
-            else float("inf")
-        )
-        if timed is not None and timed.feasible and _keeps_transmission(timed, cons) and e_atlas <= tolerance:
-            timed.stages = {**load, **timed.stages}
-            return timed, "the atlas lookup and refinement (the global search did not run: within the tolerance)"
-        g = search_fourbar(t, theta, cons, seed=seed, **kw)
-        g.stages = {**load, **(timed.stages if timed is not None else {}), **_prefixed(g.stages)}
-        return g, f"the global search (--budget {budget}; the atlas's best was {e_atlas:.3g} of the size off)"
+    if theta is None:
+        return _untimed(t, cons, budget, seed, tolerance, atlas, ordered, arcs, load)
+    # the curve from the atlas, then the timing: exact when the atlas finds the four-bar itself (a cognate
+    # traces the same curve at other crank angles: then the global search runs)
+    timed = timed_from_atlas(t, theta, atlas, cons)
+    e_atlas = (
+        max_distance(PathObjective(t, theta, cons), np.append(timed.params, timed.circuit), theta)
+        if timed is not None
+        else float("inf")
+    )
+    if timed is not None and timed.feasible and _keeps_transmission(timed, cons) and e_atlas <= tolerance:
+        timed.stages = {**load, **timed.stages}
+        return timed, "the atlas lookup and refinement (the global search did not run: within the tolerance)", None
+    g = search_fourbar(t, theta, cons, seed=seed, **kw)
+    g.stages = {**load, **(timed.stages if timed is not None else {}), **_prefixed(g.stages)}
+    return g, f"the global search (--budget {budget}; the atlas's best was {e_atlas:.3g} of the size off)", None
+
+
+def _untimed(
+    t: Array,
+    cons: Constraints,
+    budget: str,
+    seed: int,
+    tolerance: float,
+    atlas: Any,
+    ordered: bool,
+    arcs: Any,
+    load: dict[str, float],
+) -> tuple[Any, str, tuple[float, float] | None]:
+    """:func:`_search` of untimed targets: the closed-curve atlas, the rocking arcs, then the global search."""
+    from planar.synth.search import in_order, max_distance, search_atlas
+
     r = search_atlas(t, atlas, cons, ordered=ordered)
-    row = np.append(r.params, r.circuit)
     good = r.feasible and (in_order(r.theta) or not ordered) and _keeps_transmission(r, cons)
-    e_atlas = max_distance(PathObjective(t, None, cons), row, r.theta)
+    e_atlas = max_distance(PathObjective(t, None, cons), np.append(r.params, r.circuit), r.theta)
     if good and e_atlas <= tolerance:
         r.stages = {**load, **r.stages}
-        return r, "the atlas lookup and refinement (the global search did not run: within the tolerance)"
-    g = search_fourbar(t, None, cons, seed=seed, **kw)
+        return r, "the atlas lookup and refinement (the global search did not run: within the tolerance)", None
+    stages = {**load, **r.stages}
+    rock, swing, e_rock, rock_word = _rocking_search(t, cons, budget, ordered, arcs, stages)
+    if rock is not None and e_rock <= tolerance:
+        rock.stages = stages
+        why = f"the closed-curve atlas's best was {e_atlas:.3g} of the size off; the global search did not run"
+        return rock, f"{rock_word} ({why})", swing
+    g = search_fourbar(t, None, cons, seed=seed, **BUDGETS[budget])
     g_good = g.feasible and (in_order(g.theta) or not ordered) and _keeps_transmission(g, cons)
     e_global = max_distance(PathObjective(t, None, cons), np.append(g.params, g.circuit), g.theta)
-    stages = {**load, **r.stages, **_prefixed(g.stages)}
-    # the better of the two: usable first, then the smaller largest distance (what the check judges)
+    stages.update(_prefixed(g.stages))
+    # the best of them: usable first, then the smaller largest distance (what the check judges)
+    if rock is not None and (True, -e_rock) > max((g_good, -e_global), (good, -e_atlas)):
+        rock.stages = stages
+        why = f"better than the closed-curve atlas's {e_atlas:.3g} and the global search's {e_global:.3g}"
+        return rock, f"{rock_word} (largest distance {e_rock:.3g} of the size; {why})", swing
+    tried = f"; {rock_word}: {e_rock:.3g}" if rock is not None else f"; {rock_word}" if rock_word else ""
     if (g_good, -e_global) > (good, -e_atlas):
         g.stages = stages
-        return g, (
-            f"the global search (--budget {budget}; largest distance {e_global:.3g} of the size, "
-            f"better than the atlas's {e_atlas:.3g})"
+        return (
+            g,
+            (
+                f"the global search (--budget {budget}; largest distance {e_global:.3g} of the size, "
+                f"better than the atlas's {e_atlas:.3g}{tried})"
+            ),
+            None,
         )
     r.stages = stages
     other = f"found no better: {e_global:.3g}" if g_good else "found none usable (out of order or breaking a constraint)"
-    return r, (
-        f"the atlas lookup and refinement (largest distance {e_atlas:.3g} of the size; the global search, "
-        f"--budget {budget}, ran too and {other})"
+    return (
+        r,
+        (
+            f"the atlas lookup and refinement (largest distance {e_atlas:.3g} of the size; the global search, "
+            f"--budget {budget}, ran too and {other}{tried})"
+        ),
+        None,
     )
+
+
+def _rocking_search(
+    t: Array, cons: Constraints, budget: str, ordered: bool, arcs: Any, stages: dict[str, float]
+) -> tuple[Any, tuple[float, float] | None, float, str]:
+    """The rocking arcs (:func:`planar.synth.arcs.search_arcs`) on normalised untimed targets, when they may be
+    tried: no pivots box, no transmission limit (the rocking search keeps neither), and ``arcs`` given or the
+    cached arc atlas of ``budget`` on disk (it is not built here: ``planar synth atlas --rocking`` builds it).
+
+    Returns the result (None when not tried or nothing keeps the targets on one swing, in order when
+    ``ordered``), its swing, its largest distance (the targets' size 1) and a few words saying what was tried
+    (empty when nothing was); ``stages`` gains ``rocking_s``."""
+    import dataclasses
+    import time
+
+    from planar.synth import arcs as arcs_mod
+    from planar.synth.search import max_distance
+
+    if cons.region is not None or cons.min_transmission > 0:
+        return None, None, math.inf, ""
+    if arcs is None:
+        path = arcs_mod.arcs_path(arcs_mod.QUICK_FOURBARS if budget == "quick" else arcs_mod.DEFAULT_FOURBARS)
+        if not path.exists():
+            return None, None, math.inf, "the rocking-arc atlas is not built (planar synth atlas --rocking builds it)"
+        arcs = arcs_mod.read_arcs(path)
+    t0 = time.perf_counter()
+    rock_cons = dataclasses.replace(cons, full_turn=False)
+    r, swing = arcs_mod.search_arcs(t, arcs, rock_cons)
+    stages["rocking_s"] = time.perf_counter() - t0
+    word = "the rocking-arc atlas lookup and refinement"
+    if r is None or swing is None or (ordered and not _one_way(r.theta, swing)):
+        return None, None, math.inf, word + " found none on one swing" + (" in order" if ordered else "")
+    return r, swing, max_distance(PathObjective(t, None, rock_cons), np.append(r.params, r.circuit), r.theta), word
+
+
+def _one_way(theta: Array, swing: tuple[float, float]) -> bool:
+    """Whether input angles ``theta`` (rad) placed on the ``swing`` run one way (the targets met in order)."""
+    du = np.diff(_on_swing(theta, swing))
+    return bool(np.all(du > 0) or np.all(du < 0))
+
+
+def _on_swing(theta: Array, swing: tuple[float, float]) -> Array:
+    """Input angles ``theta`` (rad) as angles within ``swing`` ``(lo, hi)`` (``lo`` itself included)."""
+    lo = swing[0]
+    return lo - 1e-9 + np.mod(np.asarray(theta, float) - lo + 1e-9, 2 * np.pi)
 
 
 def best_fourbar(
@@ -273,6 +363,7 @@ def synthesise_path(
     atlas: Any = None,
     ordered: bool = False,
     min_transmission: float = 0.0,
+    arcs: Any = None,
 ) -> FourBarDesign:
     """A four-bar whose coupler point passes through (or nearest to) ``targets`` ``(N, 2)``.
 
@@ -280,7 +371,13 @@ def synthesise_path(
     line); ``None`` leaves them free: the targets are looked up in a
     coupler-curve atlas (:mod:`planar.synth.atlas`; ``atlas``, or the cached
     one of the budget: 20,000 curves for ``"quick"``, 1,000,000 otherwise,
-    built on first use) and refined, with the global search as the fallback.
+    built on first use) and refined; when that is not within ``tolerance``
+    the rocking arcs are tried (:mod:`planar.synth.arcs`: four-bars whose input
+    swings between two angles; ``arcs``, or the cached arc atlas of the budget
+    when it is on disk; not with a pivots box or ``min_transmission``), then
+    the global search.  A rocking result's checks are those of
+    :func:`synthesise_rocking_path` and ``checks["input"]`` says ``"rocks"``
+    (``"turns fully"`` otherwise).
     ``budget``: ``"quick"`` (for tests), ``"normal"`` or ``"thorough"``.
     ``tolerance``: the largest accepted distance from a target to the
     coupler point, as a fraction of the targets' size (RMS distance from
@@ -299,48 +396,21 @@ def synthesise_path(
     """
     from threadpoolctl import threadpool_limits
 
-    t, theta = check_search_args(targets, theta, seed, tolerance, {"ordered": ordered})
-    if cons is not None and not isinstance(cons, Constraints):
-        raise InputError("cons", cons, "a synth.search.Constraints (or None)")
+    t, theta, cons = check_path_args(targets, theta, cons, budget, seed, tolerance, ordered, min_transmission)
     if atlas is not None:
         from planar.synth.atlas import Atlas
 
         if not isinstance(atlas, Atlas):
             raise InputError("atlas", atlas, "an Atlas (planar.synth.atlas.load_atlas), or None for the cached one")
-    cons = cons if cons is not None else Constraints()
-    if not 0.0 <= check_number("min_transmission", min_transmission) < math.pi / 2:
-        raise InputError("min_transmission", min_transmission, "an angle from 0 to below pi/2 rad")
-    if np.ptp(t, axis=0).max() <= 0:
-        raise InputError("targets", t[0].tolist(), "targets that are not all the same point")
-    if budget not in BUDGETS:
-        raise InputError("budget", budget, f"one of {', '.join(BUDGETS)}")
+    arcs = _check_arcs(arcs)
     t0 = time.perf_counter()
-    if min_transmission > cons.min_transmission:  # asked for: a constraint of the search, not only a check
-        import dataclasses
-
-        cons = dataclasses.replace(cons, min_transmission=float(min_transmission))
     # searched on the targets moved to their centroid and divided by their size, then mapped back
     c, s = normalisation(t)
     with threadpool_limits(1):
-        r, source = _search((t - c) / s, theta, normalised(cons, c, s), budget, seed, tolerance, atlas, ordered)
-    secs = time.perf_counter() - t0
-    p = r.params.copy()
-    p[:6] *= s
-    p[6:8] = p[6:8] * s + c
-    d = FourBarDesign(
-        float(p[0]),
-        float(p[1]),
-        float(p[2]),
-        float(p[3]),
-        (float(p[4]), float(p[5])),
-        "open" if r.circuit > 0 else "crossed",
-        (float(p[6]), float(p[7]), float(p[8])),
-        wrapped(r.theta),
-        float("nan"),
-        t,
-        theta is not None,
-        secs,
-    )
+        r, source, swing = _search((t - c) / s, theta, normalised(cons, c, s), budget, seed, tolerance, atlas, ordered, arcs)
+    d, p = design_from(r, c, s, t, theta is not None, time.perf_counter() - t0)
+    if swing is not None:  # the input rocks: checked over its swing
+        return _rocking_checked(d, r, p, swing, tolerance, ordered, cons, source, s)
     from planar.synth.kernel import coupler_points
     from planar.synth.search import in_order
 
@@ -363,5 +433,180 @@ def synthesise_path(
     d.checks["ok_transmission"] = bool(margin >= limit)
     d.checks["stages_s"] = r.stages
     d.checks["found_by"] = source
+    d.checks["input"] = "turns fully"
     d.checks["evaluations"] = r.evaluations
     return d
+
+
+def check_path_args(
+    targets: Any,
+    theta: Any,
+    cons: Any,
+    budget: Any,
+    seed: Any,
+    tolerance: Any,
+    ordered: Any,
+    min_transmission: Any = 0.0,
+) -> tuple[Array, Array | None, Constraints]:
+    """The Python entrance of a path synthesis (:func:`synthesise_path`, :func:`synthesise_rocking_path`): the
+    targets, crank angles, seed, tolerance and ``ordered`` (:func:`planar.synth.targets.check_search_args`),
+    ``cons`` a :class:`~planar.synth.search.Constraints` or None, ``min_transmission`` from 0 to below pi/2 rad,
+    targets not all one point, ``budget`` one of :data:`BUDGETS`; :class:`InputError` naming the argument.
+    Returns the targets and angles as arrays and the constraints (``min_transmission`` in them when larger)."""
+    import dataclasses
+
+    t, theta = check_search_args(targets, theta, seed, tolerance, {"ordered": ordered})
+    if cons is not None and not isinstance(cons, Constraints):
+        raise InputError("cons", cons, "a synth.search.Constraints (or None)")
+    cons = cons if cons is not None else Constraints()
+    if not 0.0 <= check_number("min_transmission", min_transmission) < math.pi / 2:
+        raise InputError("min_transmission", min_transmission, "an angle from 0 to below pi/2 rad")
+    if np.ptp(t, axis=0).max() <= 0:
+        raise InputError("targets", t[0].tolist(), "targets that are not all the same point")
+    if not isinstance(budget, str) or budget not in BUDGETS:
+        raise InputError("budget", budget, f"one of {', '.join(BUDGETS)}")
+    if min_transmission > cons.min_transmission:  # asked for: a constraint of the search, not only a check
+        cons = dataclasses.replace(cons, min_transmission=float(min_transmission))
+    return t, theta, cons
+
+
+def _check_arcs(arcs: Any) -> Any:
+    """``arcs``: None or a rocking-arc atlas (:class:`planar.synth.arcs.Arcs`); :class:`InputError` otherwise."""
+    if arcs is not None:
+        from planar.synth.arcs import Arcs
+
+        if not isinstance(arcs, Arcs):
+            raise InputError("arcs", arcs, "an Arcs (planar.synth.arcs.load_arcs), or None for the cached one")
+    return arcs
+
+
+def design_from(r: Any, c: Array, s: float, t: Array, timed: bool, seconds: float) -> tuple[FourBarDesign, Array]:
+    """The design of a search result ``r`` on targets normalised by centroid ``c`` and size ``s``, mapped back onto
+    the targets ``t`` (not yet checked: ``sse`` NaN), and its kernel row in the targets' units."""
+    p = np.asarray(r.params, float).copy()
+    p[:6] *= s
+    p[6:8] = p[6:8] * s + c
+    d = FourBarDesign(
+        float(p[0]),
+        float(p[1]),
+        float(p[2]),
+        float(p[3]),
+        (float(p[4]), float(p[5])),
+        "open" if r.circuit > 0 else "crossed",
+        (float(p[6]), float(p[7]), float(p[8])),
+        wrapped(r.theta),
+        math.nan,
+        t,
+        timed,
+        seconds,
+    )
+    return d, p
+
+
+def synthesise_rocking_path(
+    targets: Array,
+    tolerance: float = DEFAULT_TOLERANCE,
+    ordered: bool = False,
+    max_ratio: float = 10.0,
+    arcs: Any = None,
+    budget: str = "normal",
+) -> FourBarDesign:
+    """A four-bar whose input *rocks* (swings between two angles, never turning fully) and whose coupler point
+    passes through ``targets`` ``(N, 2)`` (untimed, in order along its arc), from the rocking-arc atlas.
+
+    ``arcs``: the atlas (default: the cached one of :data:`planar.synth.arcs.DEFAULT_FOURBARS` four-bars, or
+    :data:`~planar.synth.arcs.QUICK_FOURBARS` for ``budget="quick"``, built on first use).  Returns a
+    :class:`FourBarDesign` whose ``checks`` hold ``input_swing_rad`` and ``input_swing_deg`` (the input's swing,
+    from the ground line, as ``[from, to]``), ``input_swing_world_deg`` (the same from the world's +x axis),
+    ``ok_accuracy`` (largest distance over the targets' size within ``tolerance``), ``ok_swing_assembles``
+    (planar's solver assembles the whole swing on the design's circuit), ``ok_on_one_swing`` (every target on
+    that swing), ``ok_constraints`` (link ratio) and, with ``ordered``, ``ok_order`` (the targets met in their
+    order as the input swings one way).  When no four-bar keeps the targets on one swing, ``checks["error"]``
+    says so and ``sse`` is inf.  Raises :class:`InputError` naming a bad argument (as :func:`synthesise_path`).
+    """
+    from threadpoolctl import threadpool_limits
+
+    from planar.synth.arcs import DEFAULT_FOURBARS, QUICK_FOURBARS, load_arcs, search_arcs
+
+    if not (check_number("max_ratio", max_ratio) > 1 and math.isfinite(max_ratio)):
+        raise InputError("max_ratio", max_ratio, "a finite ratio greater than 1")
+    cons = Constraints(full_turn=False, max_ratio=float(max_ratio))
+    t, _, cons = check_path_args(targets, None, cons, budget, 0, tolerance, ordered)
+    arcs = _check_arcs(arcs)
+    t0 = time.perf_counter()
+    if arcs is None:
+        arcs = load_arcs(QUICK_FOURBARS if budget == "quick" else DEFAULT_FOURBARS, progress=True)
+    c, s = normalisation(t)
+    with threadpool_limits(1):
+        r, swing = search_arcs((t - c) / s, arcs, cons)
+    if r is None or swing is None:
+        d = FourBarDesign(1.0, 1.0, 1.0, 1.0, (0.0, 0.0), "open", (0.0, 0.0, 0.0), np.zeros(len(t)), math.inf, t, False, 0.0)
+        d.checks = {"error": "no four-bar of the rocking-arc atlas keeps the targets on one swing of its input"}
+        d.checks["ok_found"] = False
+        return d
+    d, p = design_from(r, c, s, t, False, time.perf_counter() - t0)
+    return _rocking_checked(d, r, p, swing, tolerance, ordered, cons, "the rocking-arc atlas lookup and refinement", s)
+
+
+def _rocking_checked(
+    d: FourBarDesign,
+    r: Any,
+    p: Array,
+    swing: tuple[float, float],
+    tolerance: float,
+    ordered: bool,
+    cons: Any,
+    source: str,
+    size: float,
+) -> FourBarDesign:
+    """A rocking design ``d`` (kernel row ``p``, search result ``r``, targets' size ``size``) checked over its
+    ``swing``: see :func:`synthesise_rocking_path`."""
+    import dataclasses
+
+    _check_rocking(d, r.theta, swing, tolerance, ordered, size)
+    d.checks["constraint_failures"] = list(constraint_failures(p, dataclasses.replace(cons, full_turn=False)))
+    d.checks["ok_constraints"] = not d.checks["constraint_failures"]
+    d.checks["stages_s"] = r.stages
+    a, b = d.checks["input_swing_deg"]
+    d.checks["found_by"] = f"{source}; the input rocks between {a:.4g} and {b:.4g} deg from the ground line"
+    d.checks["input"] = "rocks"
+    d.checks["evaluations"] = r.evaluations
+    return d
+
+
+def _check_rocking(d: Any, theta: Array, swing: tuple[float, float], tolerance: float, ordered: bool, size: float) -> None:
+    """Fill ``d.sse`` and ``d.checks`` from planar's solver: at the targets, and over the swing (dense, as a
+    path, against the same angles as a scattered batch: the circuit never switches)."""
+    fb = d.fourbar()
+    lo, hi = swing
+    u = _on_swing(theta, swing)  # the targets' input angles on the swing
+    at = fb.solve(u)
+    pts = at.points["coupler_point"]
+    dist = np.hypot(*(pts - d.targets).T)
+    d.sse = float(np.sum(dist**2)) if at.valid.all() else math.inf
+    sweep = np.linspace(lo, hi, 721)
+    path = fb.solve(sweep)
+    perm = np.random.default_rng(0).permutation(len(sweep))
+    batch = fb.solve(sweep[perm])
+    same = bool(path.valid.all() and batch.valid.all()) and bool(
+        np.max(np.abs(batch.points["coupler_point"] - path.points["coupler_point"][perm])) <= 1e-9 * size
+    )
+    phi = d.placement[2]
+    d.checks = {
+        "grashof": fb.grashof,
+        "input_swing_rad": [lo, hi],
+        "input_swing_deg": [math.degrees(lo), math.degrees(hi)],
+        "input_swing_world_deg": [math.degrees(lo + phi), math.degrees(hi + phi)],
+        "ok_valid_at_targets": bool(at.valid.all()),
+        "ok_on_one_swing": bool(np.all((u >= lo - 1e-9) & (u <= hi + 1e-9))),
+        "ok_swing_assembles": same,
+        "max_target_distance": float(dist.max()) if at.valid.all() else math.inf,
+        "worst_target": int(np.argmax(dist)) + 1,
+        "size": size,
+        "max_error": float(dist.max()) / size if at.valid.all() else math.inf,
+        "rms_error": math.sqrt(d.sse / len(u)) / size if math.isfinite(d.sse) else math.inf,
+        "tolerance": tolerance,
+    }
+    d.checks["ok_accuracy"] = bool(d.checks["max_error"] <= tolerance)
+    if ordered:
+        d.checks["ok_order"] = _one_way(theta, swing)

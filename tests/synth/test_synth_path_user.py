@@ -226,5 +226,5 @@ def test_atlas_and_global_results_compared_by_largest_distance(monkeypatch):
     bad = S.SearchResult(far, 1, th, 1e-9, True, 1, {"sample_s": 0.0})
     monkeypatch.setattr(S, "search_atlas", lambda *a, **k: good)
     monkeypatch.setattr(P, "search_fourbar", lambda *a, **k: bad)
-    r, found = P._search(T, None, S.Constraints(), "quick", 0, 1e-9, object(), False)
-    assert r is good and found.startswith("the atlas") and "global_sample_s" in r.stages
+    r, found, swing = P._search(T, None, S.Constraints(), "quick", 0, 1e-9, object(), False)
+    assert r is good and found.startswith("the atlas") and "global_sample_s" in r.stages and swing is None
