@@ -567,9 +567,12 @@ def search_atlas(
     t1 = time.perf_counter()
     done: list[tuple[float, Array, Array]] = []
     tried: list[Array] = []
-    if not _refine_starts(obj, cons, b, every, refine, ordered, stop, done, tried) and not _refine_starts(
-        obj, cons, b, _wide_candidates(atlas, obj), WIDE_REFINE, ordered, stop, done, tried
-    ):
+    wide: list[Array] = []
+    found = _refine_starts(obj, cons, b, every, refine, ordered, stop, done, tried)
+    if not found:
+        wide.append(_wide_candidates(atlas, obj, BATCH_STARTS))
+        found = _refine_starts(obj, cons, b, wide[0][:WIDE_KEEP], WIDE_REFINE, ordered, stop, done, tried)
+    if not found and not _batch_starts(obj, cons, b, wide[0], ordered, stop, done, tried):
         # none reached ``stop``: look up the curves of the best refined four-bars (they pass near every target,
         # so they describe the targets' curve better than the targets' own spline, which is rough across the
         # gaps between sparse targets), and refine their neighbours
@@ -596,10 +599,10 @@ def search_atlas(
 WIDE_K, WIDE_KEEP, WIDE_SAMPLES, WIDE_REFINE = 4000, 256, 32, 16
 
 
-def _wide_candidates(atlas: Any, obj: PathObjective) -> Array:
+def _wide_candidates(atlas: Any, obj: PathObjective, keep: int = WIDE_KEEP) -> Array:
     """Many more of the targets' atlas neighbours (:data:`WIDE_K` per query), ranked by the distance from each
     target to the nearest point of the candidate's coupler curve after a similarity fit on a coarse curve
-    (:func:`align_candidates` at :data:`WIDE_SAMPLES` crank angles): the :data:`WIDE_KEEP` best.
+    (:func:`align_candidates` at :data:`WIDE_SAMPLES` crank angles): the ``keep`` best, best first.
 
     Across the gaps between sparse targets their spline differs from the true curve, so the true curve's own
     neighbours can rank thousands deep among the spline's; the fit to the targets themselves ranks them again."""
@@ -607,8 +610,122 @@ def _wide_candidates(atlas: Any, obj: PathObjective) -> Array:
 
     C = candidates(atlas, obj.targets, WIDE_K)
     A, score = align_candidates(obj, C, samples=WIDE_SAMPLES)
-    keep = np.argsort(score, kind="stable")[:WIDE_KEEP]
-    return A[keep]
+    return A[np.argsort(score, kind="stable")[:keep]]
+
+
+#: the batch stage, when the wide lookup's serial refinements fail: how many of the wide candidates are refined at
+#: once (:func:`batch_lm`), its iterations (the crank angles assigned afresh every :data:`REASSIGN_NFEV`), and how
+#: many of its best results are finished one by one
+BATCH_STARTS, BATCH_ITERS, BATCH_FINISH = 512, 60, 16
+
+
+def _batch_starts(
+    obj: PathObjective,
+    cons: Constraints,
+    b: list[tuple[float, float]],
+    wide: Array,
+    ordered: bool,
+    stop: float | Any,
+    done: list[tuple[float, Array, Array]],
+    tried: list[Array],
+) -> bool:
+    """Levenberg-Marquardt on the :data:`BATCH_STARTS` best wide candidates at once (:func:`batch_lm`, a few
+    hundred starts for the price of a few serial ones), then the :data:`BATCH_FINISH` best of its results finished
+    by :func:`_refined` with their crank angles (appended to ``done``); whether one reached ``stop``.
+
+    Eight targets leave a one-parameter family of four-bars through them and many curves that pass near all
+    eight: the serial refinements of the best-fitting wide candidates stop at local minima 1e-5 to 1e-3 of the
+    size off, while somewhere among the next few hundred a start lies in the basin of an exact four-bar."""
+    if len(wide) == 0:
+        return False
+    C, _ = align_candidates(obj, wide[:BATCH_STARTS])
+    Z, f = batch_lm(obj, C, BATCH_ITERS)
+    lo = np.array([v[0] for v in b])
+    hi = np.array([v[1] for v in b])
+    n0 = len(tried)
+    for j in np.argsort(f, kind="stable"):
+        if len(tried) - n0 >= BATCH_FINISH or not np.isfinite(f[j]):
+            break
+        row = np.append(Z[j, :N_PARAMS], C[j, 9])
+        if all(np.linalg.norm((row - s) / (hi - lo)) > 1e-6 for s in tried[n0:]):
+            tried.append(row)
+            if _refined(obj, cons, b, row, Z[j, N_PARAMS:], REFINE_NFEV, ordered, stop, done):
+                return True
+    return False
+
+
+def _batch_residuals(obj: PathObjective, Z: Array, circ: Array) -> Array:
+    """The refinement's residuals (:func:`_residual_functions`) of many variable vectors ``Z`` ``(K, 9 + N)`` with
+    circuits ``circ`` ``(K,)``: ``(K, 2 N + 1)``."""
+    P = Z[:, :N_PARAMS]
+    x, y, ok = coupler_points(P, np.ascontiguousarray(Z[:, N_PARAMS:]), circ)
+    r = np.concatenate([x - obj.targets[:, 0], y - obj.targets[:, 1]], axis=1)
+    r = np.where(np.concatenate([ok, ok], axis=1), r, obj.scale)
+    v = violation(P, obj.cons, obj.scale, 2 * GRASHOF_MARGIN)
+    return np.concatenate([r, (np.sqrt(obj.penalty) * v)[:, None]], axis=1)
+
+
+def _batch_jacobian(obj: PathObjective, Z: Array, circ: Array, R0: Array) -> Array:
+    """Forward-difference Jacobians ``(K, 2 N + 1, 9 + N)`` of :func:`_batch_residuals` at ``Z`` (residuals ``R0``),
+    structured as in :func:`_residual_functions` (10 kernel rows per start, all starts in one call)."""
+    K, m = Z.shape
+    n = m - N_PARAMS
+    h = 1.49e-8 * np.maximum(1.0, np.abs(Z))
+    E = np.repeat(Z[:, None, :], N_PARAMS + 1, axis=1)
+    i9 = np.arange(N_PARAMS)
+    E[:, i9, i9] += h[:, :N_PARAMS]
+    E[:, -1, N_PARAMS:] += h[:, N_PARAMS:]
+    R = _batch_residuals(obj, E.reshape(-1, m), np.repeat(circ, N_PARAMS + 1)).reshape(K, N_PARAMS + 1, -1)
+    J = np.zeros((K, R.shape[2], m))
+    J[:, :, :N_PARAMS] = np.transpose((R[:, :N_PARAMS] - R0[:, None, :]) / h[:, :N_PARAMS, None], (0, 2, 1))
+    d = (R[:, -1] - R0)[:, : 2 * n]
+    i = np.arange(n)
+    J[:, i, N_PARAMS + i] = d[:, :n] / h[:, N_PARAMS:]
+    J[:, n + i, N_PARAMS + i] = d[:, n:] / h[:, N_PARAMS:]
+    return J
+
+
+def batch_lm(obj: PathObjective, C: Array, iters: int, reassign: int = 10) -> tuple[Array, Array]:
+    """Levenberg-Marquardt from many starts at once: candidate rows ``C`` ``(K, 10)`` on untimed targets, the
+    crank angles at the targets assigned on each start's curve (:func:`assign_theta`) and again every
+    ``reassign`` iterations; ``iters`` iterations, each one kernel call for every start's Jacobian and a batched
+    solve of the damped normal equations (Marquardt's diagonal scaling, the damping per start divided by 3 after
+    a step that lowers its sum of squares, multiplied by 4 after one that does not, up to 4 tries).  Returns the
+    variables ``(K, 9 + N)`` (parameters, then the crank angles) and their sums of squares with penalties ``(K,)``.
+
+    Cheaper per start than :func:`scipy.optimize.least_squares`, since the small algebra of all starts runs in a
+    few numpy calls; it is a screening step: the best results are finished by :func:`_refine`."""
+    K = len(C)
+    circ = np.where(C[:, 9] >= 0, 1.0, -1.0)
+    m = N_PARAMS + len(obj.targets)
+    Z = np.empty((K, m))
+    Z[:, :N_PARAMS] = C[:, :N_PARAMS]
+    eye = np.eye(m)
+    lam = np.full(K, 1e-3)
+    f = np.full(K, np.inf)
+    R = np.zeros((K, 2 * len(obj.targets) + 1))
+    for it in range(iters):
+        if it % reassign == 0:
+            Z[:, N_PARAMS:] = [assign_theta(obj, np.append(z[:N_PARAMS], c)) for z, c in zip(Z, circ, strict=True)]
+            R = _batch_residuals(obj, Z, circ)
+            f = np.sum(R**2, axis=1)
+        J = _batch_jacobian(obj, Z, circ, R)
+        A = np.einsum("kij,kil->kjl", J, J)
+        g = np.einsum("kij,ki->kj", J, R)
+        D = np.einsum("kjj->kj", A) + 1e-12
+        pending = np.isfinite(f)
+        for _ in range(4):
+            step = -np.linalg.solve(A + (lam[:, None] * D)[:, :, None] * eye, g[:, :, None])[:, :, 0]
+            Rn = _batch_residuals(obj, Z + step, circ)
+            fn = np.sum(Rn**2, axis=1)
+            better = pending & np.isfinite(fn) & (fn < f)
+            Z[better] += step[better]
+            R[better], f[better] = Rn[better], fn[better]
+            lam = np.where(better, lam / 3, np.where(pending, lam * 4, lam))
+            pending &= ~better
+            if not pending.any():
+                break
+    return Z, f
 
 
 #: after the targets' own lookup: rounds of looking up the best refined curves, from how many of them, the
