@@ -78,7 +78,7 @@ def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, An
     return 0 if ok else EXIT_CHECK
 
 
-def _path_failing(d: Any, kind: str = "four-bar", box: str = "") -> list[str]:
+def _path_failing(d: Any, kind: str = "four-bar", box: str = "", budget: str = "normal") -> list[str]:
     """One line per failed check of a path design, naming what failed and by how much (``kind`` and ``box``:
     as :func:`_unreachable`'s)."""
     out: list[str] = []
@@ -94,7 +94,7 @@ def _path_failing(d: Any, kind: str = "four-bar", box: str = "") -> list[str]:
                 f"(RMS distance {d.checks['rms_error']:.3g} of the size, sse {d.sse:.6g})"
             )
             if d.checks["max_error"] > FAR_OFF * d.checks["tolerance"]:
-                out.append(_unreachable(d, kind, box))
+                out.append(_unreachable(d, kind, box, budget))
         elif k == "ok_transmission":
             out.append(_transmission_word(d.checks))
         elif k == "ok_order":
@@ -147,7 +147,7 @@ def _sharpest_turn(t: np.ndarray) -> tuple[float, int]:
     return float(np.degrees(turn[k])), (k + 1) % len(t) + 1
 
 
-def _unreachable(d: Any, kind: str = "four-bar", box: str = "") -> str:
+def _unreachable(d: Any, kind: str = "four-bar", box: str = "", budget: str = "normal") -> str:
     """The plain word for a best design far beyond the tolerance: nothing of ``kind`` found traces the curve,
     and the likely reasons (a sharp corner; the ``--pivots`` box, ``box`` saying how the unboxed atlas does)."""
     deg, at = _sharpest_turn(d.targets)
@@ -160,9 +160,10 @@ def _unreachable(d: Any, kind: str = "four-bar", box: str = "") -> str:
         why = box
     else:
         more = ", --type sixbar" if kind == "four-bar" else ""
+        thorough = "" if budget == "thorough" else "--budget thorough, "
         why = (
             f"no {kind} the search found traces this shape closer: it may be a shape no {kind} traces, or one the "
-            f"search missed (try --budget thorough, another --seed{more}, or a larger --tolerance)"
+            f"search missed (try {thorough}another --seed{more}, or a larger --tolerance)"
         )
     return (
         f"no {kind} found traces this curve within --tolerance {d.checks['tolerance']:g}: the best found is "
@@ -273,7 +274,7 @@ def _path_result(args: argparse.Namespace, d: Any, targets: np.ndarray, kind: st
     why = _unusable(d, kind, args.pivots is not None)
     if why is not None:
         return _no_design(args, "synth path", {"targets": len(targets)}, why)
-    failing = _path_failing(d, kind, box())
+    failing = _path_failing(d, kind, box(), args.budget)
     text, what = scene()
     found = f"; found by {d.checks['found_by']}" if d.checks.get("found_by") else ""
     report = {"command": "synth path", "targets": len(targets), "target_points": targets.tolist(), **d.to_dict()}
@@ -295,7 +296,7 @@ def _rocking_design(args: argparse.Namespace, targets: np.ndarray, theta: Any, c
     if theta is not None:
         raise InputError("--rocking", str(args.target), "untimed targets (x, y only: the swing finds its own input angles)")
     if args.pivots is not None:
-        raise InputError("--rocking", args.pivots, "no --pivots box (the rocking search does not keep one)")
+        raise InputError("--pivots", args.pivots, "no --pivots box with --rocking (the rocking search does not keep one)")
     return synthesise_rocking_path(targets, args.tolerance, args.ordered, cons.max_ratio, budget=args.budget)
 
 

@@ -224,14 +224,13 @@ def _untimed(
     tried = f"; {rock_word}: {e_rock:.3g}" if rock is not None else f"; {rock_word}" if rock_word else ""
     if (g_good, -e_global) > (good, -e_atlas):
         g.stages = stages
-        return (
-            g,
-            (
-                f"the global search (--budget {budget}; largest distance {e_global:.3g} of the size, "
-                f"better than the atlas's {e_atlas:.3g}{tried})"
-            ),
-            None,
+        # preferred because the atlas's best was closer but unusable, or because it is closer
+        than = (
+            f"closer than the atlas's {e_atlas:.3g}"
+            if good
+            else f"the atlas's best, {e_atlas:.3g}, was out of order or broke a constraint"
         )
+        return g, f"the global search (--budget {budget}; largest distance {e_global:.3g} of the size, {than}{tried})", None
     r.stages = stages
     other = f"found no better: {e_global:.3g}" if g_good else "found none usable (out of order or breaking a constraint)"
     return (
