@@ -426,8 +426,10 @@ def min_norm_newton(resid: Any, jac: Any, z: Array, r: Array, iters: int = NEWTO
         step = 1.0
         for _ in range(6):
             zn = z + step * dz
-            rn = resid(zn)
-            fn = float(np.sum(rn**2))
+            with np.errstate(over="ignore", invalid="ignore"):  # a step too far overflows: inf, then halved
+                rn = resid(zn)
+                fn = float(np.sum(rn**2))
+            fn = fn if np.isfinite(fn) else np.inf
             if fn < f:
                 break
             step *= 0.5
@@ -704,27 +706,29 @@ def batch_lm(obj: PathObjective, C: Array, iters: int, reassign: int = 10) -> tu
     lam = np.full(K, 1e-3)
     f = np.full(K, np.inf)
     R = np.zeros((K, 2 * len(obj.targets) + 1))
-    for it in range(iters):
-        if it % reassign == 0:
-            Z[:, N_PARAMS:] = [assign_theta(obj, np.append(z[:N_PARAMS], c)) for z, c in zip(Z, circ, strict=True)]
-            R = _batch_residuals(obj, Z, circ)
-            f = np.sum(R**2, axis=1)
-        J = _batch_jacobian(obj, Z, circ, R)
-        A = np.einsum("kij,kil->kjl", J, J)
-        g = np.einsum("kij,ki->kj", J, R)
-        D = np.einsum("kjj->kj", A) + 1e-12
-        pending = np.isfinite(f)
-        for _ in range(4):
-            step = -np.linalg.solve(A + (lam[:, None] * D)[:, :, None] * eye, g[:, :, None])[:, :, 0]
-            Rn = _batch_residuals(obj, Z + step, circ)
-            fn = np.sum(Rn**2, axis=1)
-            better = pending & np.isfinite(fn) & (fn < f)
-            Z[better] += step[better]
-            R[better], f[better] = Rn[better], fn[better]
-            lam = np.where(better, lam / 3, np.where(pending, lam * 4, lam))
-            pending &= ~better
-            if not pending.any():
-                break
+    # a step too far overflows: its sum of squares is inf and the step is not taken (pending, lam raised)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        for it in range(iters):
+            if it % reassign == 0:
+                Z[:, N_PARAMS:] = [assign_theta(obj, np.append(z[:N_PARAMS], c)) for z, c in zip(Z, circ, strict=True)]
+                R = _batch_residuals(obj, Z, circ)
+                f = np.sum(R**2, axis=1)
+            J = _batch_jacobian(obj, Z, circ, R)
+            A = np.einsum("kij,kil->kjl", J, J)
+            g = np.einsum("kij,ki->kj", J, R)
+            D = np.einsum("kjj->kj", A) + 1e-12
+            pending = np.isfinite(f)
+            for _ in range(4):
+                step = -np.linalg.solve(A + (lam[:, None] * D)[:, :, None] * eye, g[:, :, None])[:, :, 0]
+                Rn = _batch_residuals(obj, Z + step, circ)
+                fn = np.sum(Rn**2, axis=1)
+                better = pending & np.isfinite(fn) & (fn < f)
+                Z[better] += step[better]
+                R[better], f[better] = Rn[better], fn[better]
+                lam = np.where(better, lam / 3, np.where(pending, lam * 4, lam))
+                pending &= ~better
+                if not pending.any():
+                    break
     return Z, f
 
 
