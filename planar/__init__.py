@@ -24,7 +24,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from planar.errors import AssemblyError, InputError, LimitError, PlanarError, SceneError
+from planar.errors import AssemblyError, CheckError, InputError, LimitError, PlanarError, SceneError
 
 if TYPE_CHECKING:  # pragma: no cover
     from planar.core.model import Driver, Mechanism, Motion, Part, PinInSlot, Pivot, Slide, joint_residuals
@@ -39,6 +39,7 @@ __all__ = [
     "RRR",
     "Actuator",
     "AssemblyError",
+    "CheckError",
     "Crank",
     "Driver",
     "Fixed",

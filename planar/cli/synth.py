@@ -147,6 +147,12 @@ def _sharpest_turn(t: np.ndarray) -> tuple[float, int]:
     return float(np.degrees(turn[k])), (k + 1) % len(t) + 1
 
 
+def _rad(x: float, deg: bool) -> str:
+    """An angle (rad) as the report prints it: in radians (``--tolerance``'s unit), with degrees beside when the
+    pairs were given in degrees (``--deg``)."""
+    return f"{x:.3g} rad ({math.degrees(x):.3g} deg)" if deg else f"{x:.3g} rad"
+
+
 def _unreachable(d: Any, kind: str = "four-bar", box: str = "", budget: str = "normal") -> str:
     """The plain word for a best design far beyond the tolerance: nothing of ``kind`` found traces the curve,
     and the likely reasons (a sharp corner; the ``--pivots`` box, ``box`` saying how the unboxed atlas does)."""
@@ -191,7 +197,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
     from planar.synth.path import synthesise_path
     from planar.synth.scene_out import fourbar_scene_text
     from planar.synth.search import Constraints
-    from planar.synth.targets import check_theta, normalisation, read_path_targets
+    from planar.synth.targets import check_theta, normalisation, read_path_targets, target_unit_mm
 
     if not (args.max_ratio > 1 and math.isfinite(args.max_ratio)):
         raise InputError("--max-ratio", args.max_ratio, "a finite ratio greater than 1")
@@ -261,6 +267,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
             amplitude=amp,
             centre=centre,
             targets=targets.tolist(),
+            unit_mm=target_unit_mm(args.target),
         )
         return text, f"four-bar ({fb.grashof}, {d.circuit}, the input {d.checks.get('input', 'rocks')})"
 
@@ -337,6 +344,7 @@ def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | N
     from planar.synth.path import wrapped
     from planar.synth.scene_out import linkage_scene_text
     from planar.synth.sixbar import synthesise_sixbar
+    from planar.synth.targets import target_unit_mm
 
     topology = args.topology or "stephenson"
     atlas = None
@@ -364,6 +372,7 @@ def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | N
             d.links(),
             {"tracer": "T"},
             targets=targets.tolist(),
+            unit_mm=target_unit_mm(args.target),
             comments=[
                 f"planar synth path {args.target} --type sixbar --topology {d.topology}: {len(targets)} targets, "
                 f"{'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
@@ -493,6 +502,11 @@ def _cmd_function(args: argparse.Namespace) -> int:
         raise InputError(f"{args.pairs}: input", phi.tolist(), "a different input angle in every row")
     if len(np.unique(psi)) < 2:
         raise InputError(f"{args.pairs}: output", psi.tolist(), "output angles that change")
+    from planar.core.limits import check_angle
+
+    for name, col in (("input", phi), ("output", psi)):  # 1e300 degrees is no angle: refused, not wrapped
+        big = col[int(np.argmax(np.abs(col)))]
+        check_angle(f"{args.pairs}: {name}", float(big), math.pi / 180 if args.deg else 1.0)
     if args.deg:
         phi, psi = np.radians(phi), np.radians(psi)
     from planar.synth.function import spans
@@ -521,7 +535,7 @@ def _cmd_function(args: argparse.Namespace) -> int:
     failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]
     if not d.checks["ok_output_error"]:
         failing[failing.index("output error")] = (
-            f"output angle error {d.max_error:.3g} rad (limit {args.tolerance:g}) on the best valid four-bar"
+            f"output angle error {_rad(d.max_error, args.deg)} (limit {args.tolerance:g} rad) on the best valid four-bar"
             + (f"; {d.note}" if d.note else "")
             + (f"; {hint}" if hint else "")
         )
@@ -556,8 +570,8 @@ def _cmd_function(args: argparse.Namespace) -> int:
     )
     return _finish(
         args,
-        f"four-bar ({d.grashof}, {d.circuit}, {d.method}), max output angle error {d.max_error:.3g} "
-        f"rad, transmission angle >= {d.checks['min_transmission_deg']:.3g} deg{shift}",
+        f"four-bar ({d.grashof}, {d.circuit}, {d.method}), max output angle error {_rad(d.max_error, args.deg)}, "
+        f"transmission angle >= {d.checks['min_transmission_deg']:.3g} deg{shift}",
         text,
         report,
         d.ok,

@@ -61,3 +61,24 @@ def test_an_unparsable_svg_says_what_the_parser_said(capsys, tmp_path: Path) -> 
     svg.write_text("not xml <<")
     out = tmp_path / "s.toml"
     fails_cleanly(capsys, ["synth", "path", str(svg), "-o", str(out)], "not readable as SVG", "line 1", out=out)
+
+
+def test_an_angle_beyond_float64s_resolution_in_function_pairs_is_refused(capsys, tmp_path: Path) -> None:
+    """An output angle of 1e300 degrees was wrapped into noise and synthesised (exit 3)."""
+    pairs = tmp_path / "f.csv"
+    pairs.write_text("input,output\n0,10\n30,1e300\n60,40\n")
+    out = tmp_path / "s.toml"
+    fails_cleanly(capsys, ["synth", "function", str(pairs), "-o", str(out), "--deg"], "f.csv: output", "1e+300", out=out)
+
+
+def test_a_synthesised_scene_from_an_svg_is_in_millimetres(capsys, tmp_path: Path) -> None:
+    """An SVG's user units are millimetres: the scene says unit_mm = 1 (the default 10 made it ten times too big)."""
+    import tomllib
+
+    from planar.cli.main import main
+
+    svg = tmp_path / "c.svg"
+    svg.write_text('<svg xmlns="http://www.w3.org/2000/svg"><ellipse cx="40" cy="30" rx="30" ry="18"/></svg>')
+    out = tmp_path / "s.toml"
+    main(["synth", "path", str(svg), "-o", str(out), "--points", "12", "--budget", "quick"])
+    assert tomllib.loads(out.read_text())["fabrication"]["unit_mm"] == 1.0
