@@ -40,7 +40,10 @@ from planar.errors import InputError
 from planar.linkages.linkage import Link, Linkage
 from planar.linkages.nodes import RRP, RRR, Crank, Fixed, NodeKind, Rigid
 
-__all__ = ["MIRRORS", "Legs", "LegsAssembly", "Slab", "auto_standoffs"]
+__all__ = ["MIRRORS", "STANDOFF_REACH", "Legs", "LegsAssembly", "Slab", "auto_standoffs"]
+
+#: how far from the crank axis a standoff may stand, in spans of the walker's joints (the frame plates reach it)
+STANDOFF_REACH = 3.0
 
 Array = NDArray[np.float64]
 
@@ -161,6 +164,22 @@ class Legs(Linkage):
             width=self.leg.width,
             pin_diameter=self.leg.pin_diameter,
         )
+        self._check_standoffs_near(name)
+
+    def _check_standoffs_near(self, name: str) -> None:
+        """Refuse a standoff farther from the crank axis than :data:`STANDOFF_REACH` times the walker's span: the
+        frame plates would stretch to it (a standoff at 1e7 made a plate 10 km long, refused only as a part too
+        big for the sheet, naming neither the field nor the value)."""
+        cx, cy = self._ref_nodes[self.crank_centre]
+        reach = STANDOFF_REACH * self._span()
+        for i, (x, y) in enumerate(self.standoffs):
+            if math.hypot(x - cx, y - cy) > reach:
+                raise InputError(
+                    f"{name}.standoffs[{i}]",
+                    [x, y],
+                    f"a point within {reach:.4g} model units of the crank axis ({STANDOFF_REACH:g} times the walker's "
+                    "span): the frame plates reach every standoff",
+                )
 
     @staticmethod
     def _crank_of(name: str, nodes: list[NodeKind], links: list[Link]) -> tuple[Crank, Fixed, Link]:

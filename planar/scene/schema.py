@@ -712,7 +712,7 @@ class FabricationSpec(_Strict):
     26; more with an encoder): the mounting standoffs clear it."""
     mounting_hole_mm: MotorMm = 3.2
     """Diameter of the ground plates' mounting holes (on ears), as cut: M3 screws into the standoffs."""
-    link_width_mm: Pos | None = None
+    link_width_mm: HardwareMm | None = None
     """Width of every link of a ``linkage`` scene (mm, the cut and the drawings), at least ``pin_diameter_mm +
     clearance_mm + 2 min_wall_mm``; default 8 % of the linkage's span (the larger side of the box its joints stay
     in over a cycle) times ``unit_mm``."""

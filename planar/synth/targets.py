@@ -206,6 +206,11 @@ def read_path_targets(path: str | Path, svg_points: int | None = None, option: s
     return np.column_stack([t["x"], t["y"]]), t.get("theta")
 
 
+#: how fine float64 must resolve a target coordinate, as a fraction of the targets' size (:data:`RESOLUTION` of a
+#: design's smallest length, its pins, a hundredth of the size)
+TARGET_RESOLUTION = RESOLUTION * 1e-2
+
+
 def normalisation(targets: Array, name: str = "targets") -> tuple[Array, float]:
     """The targets' centroid ``(2,)`` and size ``s`` (RMS distance from the centroid, model units).
 
@@ -231,12 +236,15 @@ def normalisation(targets: Array, name: str = "targets") -> tuple[Array, float]:
             f"size {s:.3g} (RMS distance from the centroid)",
             f"a size between {lo:g} and {hi:g} model units (the solvers multiply four lengths; scale the targets)",
         )
-    if float(np.spacing(big)) > RESOLUTION * s:
+    # the design's pins are a few hundredths of the targets' size: its own check (check_scale) refuses a
+    # placement float64 resolves coarser than 1e-9 of them, so the targets are held to 1e-11 of their size
+    # here, before any search (a 1-unit curve 1e6 from the origin was refused only after 30 s of search)
+    if float(np.spacing(big)) > TARGET_RESOLUTION * s:
         raise InputError(
             name,
             f"a coordinate of {big:.6g} with the targets {s:.3g} across",
             f"targets nearer the origin: float64 resolves {float(np.spacing(big)):.3g} there, coarser than "
-            f"{RESOLUTION:g} of their size (move them toward the origin)",
+            f"{TARGET_RESOLUTION:g} of their size, and the design's pins are smaller still (move them toward the origin)",
         )
     return c, s
 

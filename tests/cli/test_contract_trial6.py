@@ -82,3 +82,39 @@ def test_a_synthesised_scene_from_an_svg_is_in_millimetres(capsys, tmp_path: Pat
     out = tmp_path / "s.toml"
     main(["synth", "path", str(svg), "-o", str(out), "--points", "12", "--budget", "quick"])
     assert tomllib.loads(out.read_text())["fabrication"]["unit_mm"] == 1.0
+
+
+def test_a_link_width_beyond_100_mm_is_refused_naming_the_field(capsys, tmp_path: Path) -> None:
+    """link_width_mm = 1e300 was refused as a gear reaching past its pitch circle ('shorten the crank')."""
+    text = (GALLERY / "geared-five-bar.toml").read_text()
+    scene = tmp_path / "g.toml"
+    if "\n[fabrication]\n" in text:
+        scene.write_text(text.replace("\n[fabrication]\n", "\n[fabrication]\nlink_width_mm = 1e300\n", 1))
+    else:
+        scene.write_text(text + "\n[fabrication]\nlink_width_mm = 1e300\n")
+    out = tmp_path / "p.dxf"
+    fails_cleanly(capsys, ["export", str(scene), "-o", str(out)], "fabrication.link_width_mm", "1e+300", out=out)
+
+
+def test_a_standoff_far_from_the_walker_is_refused_naming_it(capsys, tmp_path: Path) -> None:
+    """A standoff at 1e7 made a frame plate 10 km long, refused only as a part too big for the sheet."""
+    text = (GALLERY / "jansen-walker-4.toml").read_text()
+    assert "standoffs = " in text
+    lines = ["standoffs = [[1e7, -32.0], [0.0, 32.0]]" if ln.startswith("standoffs = ") else ln for ln in text.splitlines()]
+    scene = tmp_path / "w.toml"
+    scene.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "p.dxf"
+    fails_cleanly(capsys, ["export", str(scene), "-o", str(out)], "standoffs[0]", "10000000.0", out=out)
+
+
+def test_targets_far_from_the_origin_are_refused_before_the_search(capsys, tmp_path: Path) -> None:
+    """A 1-unit curve 1e6 from the origin passed the targets' check and was refused after 30 s of search, naming
+    'fourbar: placement' instead of the file."""
+    import numpy as np
+
+    th = np.linspace(0, 6, 12)
+    t = np.c_[np.cos(th), 0.6 * np.sin(th)] + 1e6
+    f = tmp_path / "far.csv"
+    f.write_text("x,y\n" + "\n".join(f"{float(x)!r},{float(y)!r}" for x, y in t) + "\n")
+    out = tmp_path / "s.toml"
+    fails_cleanly(capsys, ["synth", "path", str(f), "-o", str(out), "--budget", "quick"], "far.csv", "nearer the origin", out=out)
