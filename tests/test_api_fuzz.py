@@ -80,7 +80,7 @@ NOT_FUZZED: dict[str, str] = {
     "planar.linkages.node_kind": "a class decorator for authors of a new kind: a malformed kind is a TypeError at import",
 }
 #: the errors themselves: they take any message parts
-for _name in ("PlanarError", "InputError", "LimitError", "AssemblyError", "SceneError"):
+for _name in ("PlanarError", "InputError", "LimitError", "AssemblyError", "SceneError", "CheckError"):
     NOT_FUZZED[f"planar.{_name}"] = "an error class"
 for _name in ("core.UnsupportedError", "cams.CamError", "physics.SimulationError", "fabrication.FabricationError"):
     NOT_FUZZED[f"planar.{_name}"] = "an error class"

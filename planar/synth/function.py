@@ -93,8 +93,8 @@ def _pairs(phi: Array, psi: Array, ground: float) -> tuple[Array, Array]:
     from planar.core.limits import SIZE_RANGE
     from planar.core.model import check_finite, check_positive
 
-    phi = check_finite("pairs: input", phi).ravel()
-    psi = check_finite("pairs: output", psi).ravel()
+    phi = check_finite("phi", phi).ravel()
+    psi = check_finite("psi", psi).ravel()
     if len(phi) != len(psi):
         raise InputError("psi", f"{len(psi)} output angles", f"one output angle per input angle (phi has {len(phi)})")
     if len(phi) < 3:
@@ -235,14 +235,12 @@ def synthesise_function(
     cons = FunctionConstraints() if cons is None else cons
     phi, psi = _pairs(phi, psi, ground)
     if len(np.unique(phi)) < len(phi):
-        raise InputError("pairs", [float(v) for v in phi], "a different input angle in every pair")
+        raise InputError("phi", [float(v) for v in phi], "a different input angle in every pair")
     if len(np.unique(psi)) < 2:
-        raise InputError("pairs", [float(v) for v in psi], "output angles that change")
-    for name, span in zip(("input", "output"), spans(phi, psi)):
+        raise InputError("psi", [float(v) for v in psi], "output angles that change")
+    for name, span in zip(("phi", "psi"), spans(phi, psi)):
         if span > 2 * np.pi:
-            raise InputError(
-                f"pairs: {name}", f"a span of {span:.6g} rad", "a span of at most 2 pi rad (one turn; --deg for degrees)"
-            )
+            raise InputError(name, f"a span of {span:.6g} rad", "a span of at most 2 pi rad (one turn; angles in radians)")
     closed: FunctionDesign | None = None
     note = ""
     if not cons.free_offsets:

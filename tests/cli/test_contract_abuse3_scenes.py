@@ -45,7 +45,7 @@ CASES = [
     # 1. exit 1 (internal error)
     pytest.param(
         WALKER, [(STANDOFFS, "standoffs = [[1e300, -32.0], [0.0, 32.0]]")], _export,
-        ("mechanism.standoffs[0] = [1e+300, -32.0]", "model units of the origin"), id="standoff-1e300",
+        ("standoffs[0] = [1e+300, -32.0]", "model units of the crank axis"), id="standoff-1e300",
     ),
     pytest.param(
         "cam-automaton.toml", [(BIRD, "points = [[0,0],[1e300,0],[0,1e300]]")], _export,
