@@ -31,7 +31,7 @@ each target on the curve (untimed, 7200 per turn):
 
 planar, the documented synthesis and the optimisers alternate for
 ``repeats`` repeats (planar's seed is the repeat number; pylinkage's swarm is
-unseeded); times are wall seconds, median (min-max).  Without ``--quick``,
+unseeded); times are wall seconds, median (min-max).  With ``--full`` (``quick=False``),
 planar's Stephenson and Watt six-bars run once each (seed 0) on the same
 targets.
 """

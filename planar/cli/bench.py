@@ -33,8 +33,12 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         kwargs["n"] = args.n
     if args.repeats is not None:
         kwargs["repeats"] = args.repeats
+    if args.full and args.name != "synthesis":
+        raise InputError("--full", True, "only with 'planar bench synthesis' (whose quick run is the default)")
+    if args.full and args.quick:
+        raise InputError("--full", True, "no --quick with it (one or the other)")
     if args.name == "synthesis":
-        kwargs["quick"] = args.quick
+        kwargs["quick"] = not args.full  # the whole run takes over an hour of CPU: asked for, not the default
     if args.name == "accuracy":
         from planar.fileio import check_output
 
@@ -69,7 +73,14 @@ def add_parser(sub: Any) -> None:
     )
     b.add_argument("-o", "--output", default="planar-bench-accuracy", help="accuracy: folder for the CSV and chart")
     b.add_argument(
-        "--quick", action="store_true", help="accuracy: a small grid on three mechanisms; synthesis: one repeat, small budgets"
+        "--quick",
+        action="store_true",
+        help="accuracy: a small grid on three mechanisms; synthesis: the default already (one repeat, small budgets)",
+    )
+    b.add_argument(
+        "--full",
+        action="store_true",
+        help="synthesis: every problem at the normal budgets, 5 repeats (well over an hour of CPU)",
     )
     b.add_argument(
         "--scenes", default="gallery", help="accuracy: folder of scene files to measure (default: ./gallery, the repository's)"
