@@ -136,7 +136,7 @@ def read_svg_points(path: str | Path, n: int, option: str = "--points") -> Array
     if n < 3:
         raise InputError(option, n, "3 or more points to sample from the SVG path")
     try:
-        svg = se.SVG.parse(p)
+        svg = se.SVG.parse(p, ppi=25.4)  # 25.4 per inch: a length in mm (or in, cm) is read as mm, px as 1
     except FileNotFoundError:
         raise InputError(p, "missing", "an existing SVG file") from None
     except Exception as e:  # svgelements raises parser errors of several kinds: say what the parser said
@@ -307,8 +307,9 @@ def read_targets(path: str | Path, points: int | None = None) -> tuple[Array, Ar
     Parameters
     ----------
     path : str or Path
-        An SVG drawing (``.svg``: the first shape with a non-zero length; its user units are read as
-        millimetres, :data:`SVG_UNIT_MM`, and y is turned up: a drawing's ``(x, y)`` is the target
+        An SVG drawing (``.svg``: the first shape with a non-zero length, in millimetres,
+        :data:`SVG_UNIT_MM`: a page sized in mm, cm or in is converted, and unitless or px user units are
+        read as mm; y is turned up: a drawing's ``(x, y)`` is the target
         ``(x, -y)``) or a CSV table with columns ``x``, ``y`` and optionally ``theta`` (the crank angle at each
         target, radians).
     points : int, optional

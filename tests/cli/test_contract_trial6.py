@@ -118,3 +118,27 @@ def test_targets_far_from_the_origin_are_refused_before_the_search(capsys, tmp_p
     f.write_text("x,y\n" + "\n".join(f"{float(x)!r},{float(y)!r}" for x, y in t) + "\n")
     out = tmp_path / "s.toml"
     fails_cleanly(capsys, ["synth", "path", str(f), "-o", str(out), "--budget", "quick"], "far.csv", "nearer the origin", out=out)
+
+
+@pytest.mark.parametrize(
+    ("size", "box", "circle", "scale"),
+    [
+        ('width="100mm" height="60mm"', "0 0 100 60", 'cx="15" cy="40" r="10"', 1.0),  # Inkscape's mm page
+        ('width="4in" height="2in"', "0 0 4 2", 'cx="1" cy="1" r="0.5"', 25.4),  # inches, converted to mm
+        ('width="100" height="60"', "0 0 100 60", 'cx="15" cy="40" r="10"', 1.0),  # user units read as mm
+    ],
+)
+def test_svg_targets_are_in_millimetres(tmp_path: Path, size: str, box: str, circle: str, scale: float) -> None:
+    """A drawing in mm came back in px at 96 dpi (3.78 times too big) while the scene said unit_mm = 1."""
+    import re
+
+    import numpy as np
+
+    from planar.synth import read_targets
+
+    f = tmp_path / "c.svg"
+    f.write_text(f'<svg xmlns="http://www.w3.org/2000/svg" {size} viewBox="{box}"><circle {circle}/></svg>')
+    got = read_targets(f, 24)
+    pts = got[0] if isinstance(got, tuple) else got
+    cx, cy, r = (float(re.search(rf'{k}="([^"]+)"', circle).group(1)) * scale for k in ("cx", "cy", "r"))
+    np.testing.assert_allclose(np.hypot(pts[:, 0] - cx, pts[:, 1] + cy), r, rtol=1e-5)
