@@ -269,7 +269,10 @@ def _cmd_path(args: argparse.Namespace) -> int:
             targets=targets.tolist(),
             unit_mm=target_unit_mm(args.target),
         )
-        return text, f"four-bar ({fb.grashof}, {d.circuit}, the input {d.checks.get('input', 'rocks')})"
+        motion = d.checks.get("input", "rocks")
+        if motion == "rocks" and fb.grashof in ("crank-rocker", "double-crank"):  # a cognate whose crank could turn
+            motion = "rocks over the targets' span (its crank could turn fully)"
+        return text, f"four-bar ({fb.grashof}, {d.circuit}, the input {motion})"
 
     return _path_result(args, d, targets, "four-bar", lambda: _box_word(d, targets, cons, atlas, args), scene)
 

@@ -262,9 +262,12 @@ def _rocking_search(
     if cons.region is not None or cons.min_transmission > 0:
         return None, None, math.inf, ""
     if arcs is None:
-        path = arcs_mod.arcs_path(arcs_mod.QUICK_FOURBARS if budget == "quick" else arcs_mod.DEFAULT_FOURBARS)
+        size = arcs_mod.QUICK_FOURBARS if budget == "quick" else arcs_mod.DEFAULT_FOURBARS
+        path = arcs_mod.arcs_path(size)
         if not path.exists():
-            return None, None, math.inf, "the rocking-arc atlas is not built (planar synth atlas --rocking builds it)"
+            which = f"--budget {budget}'s rocking-arc atlas ({size:,} four-bars)"
+            build = "planar synth atlas --rocking" + ("" if size == arcs_mod.DEFAULT_FOURBARS else f" --size {size}")
+            return None, None, math.inf, f"{which} is not built ({build} builds it)"
         arcs = arcs_mod.read_arcs(path)
     t0 = time.perf_counter()
     rock_cons = dataclasses.replace(cons, full_turn=False)
