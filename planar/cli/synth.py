@@ -742,8 +742,8 @@ def add_parser(sub: Any) -> None:
         "--budget",
         choices=("quick", "normal", "thorough"),
         default="normal",
-        help="search effort (normal: about 4 s CPU when the atlas finds the curve, 6-8 s when the global search runs too; "
-        "sixbar: about twice that)",
+        help="search effort (normal: about 4 s CPU when the atlas finds the curve; 6-18 s when it misses and the later "
+        "stages and the global search run; sixbar: about twice that)",
     )
     p.add_argument(
         "--max-ratio",
