@@ -242,11 +242,11 @@ def test_geared_ratio_and_mesh_are_checked() -> None:
 @pytest.mark.parametrize(
     "phi,psi,ground,needle",
     [
-        ([0.0, math.nan, 1.0], [0.0, 1.0, 2.0], 1.0, "input"),
-        ([0.0, 0.5, 1.0], [0.0, math.inf, 2.0], 1.0, "output"),
+        ([0.0, math.nan, 1.0], [0.0, 1.0, 2.0], 1.0, "phi"),  # the Python arguments' names
+        ([0.0, 0.5, 1.0], [0.0, math.inf, 2.0], 1.0, "psi"),
         ([0.0, 0.5, 1.0], [0.0, 1.0, 2.0], 1e300, "ground"),
         ([0.0, 0.5, 1.0], [0.0, 1.0, 2.0], "1", "ground"),
-        (["a", 0.5, 1.0], [0.0, 1.0, 2.0], 1.0, "input"),
+        (["a", 0.5, 1.0], [0.0, 1.0, 2.0], 1.0, "phi"),
     ],
 )
 def test_synthesise_function_entrance(phi, psi, ground, needle: str) -> None:
