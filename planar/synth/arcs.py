@@ -44,7 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planar.errors import InputError
-from planar.synth.atlas import DescriptorIndex
+from planar.synth.atlas import DescriptorIndex, unreadable
 from planar.synth.kernel import coupler_points
 
 __all__ = [
@@ -257,7 +257,7 @@ def read_arcs(path: str | Path) -> Arcs:
     except FileNotFoundError:
         raise InputError(p, "missing", "an arc atlas file written by planar") from None
     except (KeyError, ValueError, OSError) as e:
-        raise InputError(p, type(e).__name__, "an arc atlas file written by planar") from None
+        raise InputError(p, unreadable(e, p), "an arc atlas file written by planar") from None
     _LOADED[p] = a
     return a
 

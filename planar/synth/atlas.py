@@ -324,11 +324,12 @@ def _stored_rows(path: str) -> int:
     return int(shape[0]) if shape else 0
 
 
-def _unreadable(e: Exception) -> str:
-    """What was wrong with a file that is not an atlas, in words (not the exception's class name)."""
+def unreadable(e: Exception, path: str | None = None) -> str:
+    """What was wrong with a file that is not an atlas (of curves or of arcs), in words (not the exception's class
+    name); ``path``: the file, to tell one that is no archive at all (numpy's loader then speaks of pickles)."""
     import zipfile
 
-    if isinstance(e, zipfile.BadZipFile):
+    if isinstance(e, zipfile.BadZipFile) or (path is not None and os.path.isfile(path) and not zipfile.is_zipfile(path)):
         return "not a .npz archive"
     if isinstance(e, KeyError):
         return "an archive without the atlas arrays"
@@ -349,7 +350,7 @@ def read_atlas(path: str | Path) -> Atlas:
     except FileNotFoundError:
         raise InputError(p, "missing", "an atlas file written by planar synth atlas") from None
     except (KeyError, ValueError, OSError, zipfile.BadZipFile) as e:
-        raise InputError(p, _unreadable(e), "an atlas file written by planar synth atlas") from None
+        raise InputError(p, unreadable(e), "an atlas file written by planar synth atlas") from None
     check_atlas_memory(p, rows, search=True)  # from the file's header, before its arrays are read
     try:
         with np.load(p) as z:
@@ -360,7 +361,7 @@ def read_atlas(path: str | Path) -> Atlas:
     except FileNotFoundError:
         raise InputError(p, "missing", "an atlas file written by planar synth atlas") from None
     except (KeyError, ValueError, OSError) as e:
-        raise InputError(p, _unreadable(e), "an atlas file written by planar synth atlas") from None
+        raise InputError(p, unreadable(e), "an atlas file written by planar synth atlas") from None
     _LOADED[p] = a
     return a
 

@@ -228,3 +228,15 @@ def test_atlas_and_global_results_compared_by_largest_distance(monkeypatch):
     monkeypatch.setattr(P, "search_fourbar", lambda *a, **k: bad)
     r, found, swing = P._search(T, None, S.Constraints(), "quick", 0, 1e-9, object(), False)
     assert r is good and found.startswith("the atlas") and "global_sample_s" in r.stages and swing is None
+
+
+def test_a_file_that_is_not_an_arc_atlas_is_named_in_words(tmp_path):
+    """The rocking arcs' reader shares the atlas's words (it printed the exception's class, or numpy's pickle text)."""
+    from planar.errors import InputError
+    from planar.synth.arcs import read_arcs
+
+    f = tmp_path / "c.csv"
+    f.write_text("x,y\n0,0\n")
+    with pytest.raises(InputError) as e:
+        read_arcs(f)
+    assert "not a .npz archive" in str(e.value) and "pickle" not in str(e.value)
