@@ -171,6 +171,13 @@ def _unreachable(d: Any, kind: str = "four-bar", box: str = "", budget: str = "n
             f"no {kind} the search found traces this shape closer: it may be a shape no {kind} traces, or one the "
             f"search missed (try {thorough}another --seed{more}, or a larger --tolerance)"
         )
+        n = len(d.targets)
+        if kind == "four-bar" and getattr(d, "timed", False) and n >= 5:
+            why += (
+                f". {n} targets at given crank angles are {2 * n} equations and a four-bar has 9 dimensions: beyond 4 "
+                "such targets, only points of one four-bar's curve at those very angles are met exactly (drop the "
+                "theta column to let the angles free)"
+            )
     return (
         f"no {kind} found traces this curve within --tolerance {d.checks['tolerance']:g}: the best found is "
         f"{d.checks['max_error']:.3g} of the targets' size off at target {d.checks['worst_target']} "
@@ -206,6 +213,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
     if not (args.tolerance > 0 and math.isfinite(args.tolerance)):
         raise InputError("--tolerance", args.tolerance, "a positive fraction of the targets' size")
     min_transmission = _min_transmission_rad(args)
+    _unit_mm(args)  # refused before the search, not after it
     if args.topology is not None and args.type != "sixbar":
         raise InputError("--topology", args.topology, "--topology only with --type sixbar")
     if args.points is not None and not 3 <= args.points <= MAX_TARGETS:
@@ -267,7 +275,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
             amplitude=amp,
             centre=centre,
             targets=targets.tolist(),
-            unit_mm=target_unit_mm(args.target),
+            unit_mm=_unit_mm(args, target_unit_mm(args.target)),
         )
         motion = d.checks.get("input", "rocks")
         if motion == "rocks" and fb.grashof in ("crank-rocker", "double-crank"):  # a cognate whose crank could turn
@@ -287,6 +295,9 @@ def _path_result(args: argparse.Namespace, d: Any, targets: np.ndarray, kind: st
     failing = _path_failing(d, kind, box(), args.budget)
     text, what = scene()
     found = f"; found by {d.checks['found_by']}" if d.checks.get("found_by") else ""
+    if "min_transmission_deg" in d.checks:  # a four-bar's (a six-bar's are in its checks)
+        over = "swing" if d.checks.get("input") == "rocks" else "turn"
+        what += f", transmission angle >= {d.checks['min_transmission_deg']:.3g} deg from a toggle over the {over}"
     report = {"command": "synth path", "targets": len(targets), "target_points": targets.tolist(), **d.to_dict()}
     return _finish_path(
         args,
@@ -307,7 +318,9 @@ def _rocking_design(args: argparse.Namespace, targets: np.ndarray, theta: Any, c
         raise InputError("--rocking", str(args.target), "untimed targets (x, y only: the swing finds its own input angles)")
     if args.pivots is not None:
         raise InputError("--pivots", args.pivots, "no --pivots box with --rocking (the rocking search does not keep one)")
-    return synthesise_rocking_path(targets, args.tolerance, args.ordered, cons.max_ratio, budget=args.budget)
+    return synthesise_rocking_path(
+        targets, args.tolerance, args.ordered, cons.max_ratio, budget=args.budget, min_transmission=_min_transmission_rad(args)
+    )
 
 
 def _box_word(d: Any, targets: np.ndarray, cons: Any, atlas: Any, args: argparse.Namespace) -> str:
@@ -375,7 +388,7 @@ def _sixbar(args: argparse.Namespace, targets: np.ndarray, theta: np.ndarray | N
             d.links(),
             {"tracer": "T"},
             targets=targets.tolist(),
-            unit_mm=target_unit_mm(args.target),
+            unit_mm=_unit_mm(args, target_unit_mm(args.target)),
             comments=[
                 f"planar synth path {args.target} --type sixbar --topology {d.topology}: {len(targets)} targets, "
                 f"{'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
@@ -495,6 +508,7 @@ def _cmd_function(args: argparse.Namespace) -> int:
     if not (math.isfinite(args.ground) and SIZE_RANGE[0] <= args.ground <= SIZE_RANGE[1]):
         raise InputError("--ground", args.ground, f"a ground length from {SIZE_RANGE[0]:g} to {SIZE_RANGE[1]:g} (model units)")
     min_transmission = _min_transmission_rad(args)
+    _unit_mm(args)  # refused before the search, not after it
     if not (args.tolerance > 0 and math.isfinite(args.tolerance)):
         raise InputError("--tolerance", args.tolerance, "a positive angle in radians")
     t = read_table(args.pairs, ("input", "output"), min_rows=3)
@@ -561,6 +575,7 @@ def _cmd_function(args: argparse.Namespace) -> int:
         ],
         amplitude=amp,
         centre=centre,
+        unit_mm=_unit_mm(args),
     )
     report = {"command": "synth function", "pairs": len(phi), **d.to_dict(), **({"hint": hint} if hint else {})}
     shift = (
@@ -624,6 +639,7 @@ def _cmd_motion(args: argparse.Namespace) -> int:
     if not (args.max_ratio > 1 and math.isfinite(args.max_ratio)):
         raise InputError("--max-ratio", args.max_ratio, "a finite ratio greater than 1")
     min_transmission = _min_transmission_rad(args)
+    _unit_mm(args)  # refused before the search, not after it
     t = read_table(args.poses, ("x", "y", "angle"), min_rows=3)
     from planar.core.limits import check_angle
 
@@ -675,6 +691,7 @@ def _cmd_motion(args: argparse.Namespace) -> int:
         ],
         amplitude=amp,
         centre=centre,
+        unit_mm=_unit_mm(args),
     )
     report = {"command": "synth motion", "poses": len(poses), "angle_offset": d.angle_offset, **d.to_dict()}
     return _finish(
@@ -706,7 +723,24 @@ def _min_transmission_parent() -> argparse.ArgumentParser:
         "constraint of the search; motion: chooses among the four-bars through the poses; when the best found does "
         "not keep it, it is written and exits 3 naming the angle and where",
     )
+    parent.add_argument(
+        "--unit-mm",
+        type=float,
+        default=None,
+        help="millimetres one unit of the file's numbers (and of the design) is, written into the scene's [fabrication] "
+        "unit_mm for export (default: 1 for an SVG drawing, whose units are mm; else the scene's default, 10)",
+    )
     return parent
+
+
+def _unit_mm(args: argparse.Namespace, default: float | None = None) -> float | None:
+    """``--unit-mm`` (or ``default`` when not given); :class:`InputError` naming the option unless a positive,
+    finite number of millimetres."""
+    if args.unit_mm is None:
+        return default
+    if not (math.isfinite(args.unit_mm) and 0 < args.unit_mm <= 1e6):
+        raise InputError("--unit-mm", args.unit_mm, "a positive number of millimetres per unit, at most 1e6")
+    return float(args.unit_mm)
 
 
 def _min_transmission_rad(args: argparse.Namespace) -> float:
@@ -775,8 +809,10 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--rocking",
         action="store_true",
-        help="only a four-bar whose input swings between two angles (double-rocker, rocker-crank or triple-rocker) "
-        "tracing the targets as an open arc, from the rocking-arc atlas (untimed targets; built on first use). Without "
+        help="only a four-bar whose input swings between two angles (a double-rocker, rocker-crank or triple-rocker, "
+        "or a cognate whose crank could turn fully, swung over the targets' span) tracing the targets as an open arc, "
+        "from the rocking-arc atlas (untimed targets; built on first use; --min-transmission is checked over the "
+        "swing). Without "
         "it, untimed synth path tries that atlas too when the coupler-curve atlas is not within --tolerance, once "
         "planar synth atlas --rocking has built it",
     )

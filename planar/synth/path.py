@@ -32,7 +32,7 @@ from planar.core.fields import check_number
 from planar.errors import InputError
 from planar.synth.designs import Checked, PlacedFourBar
 from planar.synth.search import Constraints, PathObjective, constraint_failures, search_fourbar
-from planar.synth.targets import check_search_args, normalisation
+from planar.synth.targets import check_search_args, check_theta, normalisation
 
 __all__ = ["FourBarDesign", "check_path_args", "synthesise_path", "synthesise_rocking_path"]
 
@@ -458,6 +458,8 @@ def check_path_args(
     import dataclasses
 
     t, theta = check_search_args(targets, theta, seed, tolerance, {"ordered": ordered})
+    if theta is not None:
+        check_theta(theta, None, False)
     if cons is not None and not isinstance(cons, Constraints):
         raise InputError("cons", cons, "a synth.search.Constraints (or None)")
     cons = cons if cons is not None else Constraints()
@@ -512,6 +514,7 @@ def synthesise_rocking_path(
     max_ratio: float = 10.0,
     arcs: Any = None,
     budget: str = "normal",
+    min_transmission: float = 0.0,
 ) -> FourBarDesign:
     """A four-bar whose input *rocks* (swings between two angles, never turning fully) and whose coupler point
     passes through ``targets`` ``(N, 2)`` (untimed, in order along its arc), from the rocking-arc atlas.
@@ -522,8 +525,11 @@ def synthesise_rocking_path(
     from the ground line, as ``[from, to]``), ``input_swing_world_deg`` (the same from the world's +x axis),
     ``ok_accuracy`` (largest distance over the targets' size within ``tolerance``), ``ok_swing_assembles``
     (planar's solver assembles the whole swing on the design's circuit), ``ok_on_one_swing`` (every target on
-    that swing), ``ok_constraints`` (link ratio) and, with ``ordered``, ``ok_order`` (the targets met in their
-    order as the input swings one way).  When no four-bar keeps the targets on one swing, ``checks["error"]``
+    that swing), ``ok_constraints`` (link ratio), ``ok_transmission`` (over the swing, the transmission angle at
+    least ``min_transmission`` rad from a toggle and never nearer than :data:`TOGGLE_FLOOR_DEG`; the smallest is
+    ``min_transmission_deg``, at the input angle ``min_transmission_at_rad``: a check of the result, not a
+    constraint of the search) and, with ``ordered``, ``ok_order`` (the targets met in their order as the input
+    swings one way).  When no four-bar keeps the targets on one swing, ``checks["error"]``
     says so and ``sse`` is inf.  Raises :class:`InputError` naming a bad argument (as :func:`synthesise_path`).
     """
     from threadpoolctl import threadpool_limits
@@ -533,7 +539,7 @@ def synthesise_rocking_path(
     if not (check_number("max_ratio", max_ratio) > 1 and math.isfinite(max_ratio)):
         raise InputError("max_ratio", max_ratio, "a finite ratio greater than 1")
     cons = Constraints(full_turn=False, max_ratio=float(max_ratio))
-    t, _, cons = check_path_args(targets, None, cons, budget, 0, tolerance, ordered)
+    t, _, cons = check_path_args(targets, None, cons, budget, 0, tolerance, ordered, min_transmission)
     arcs = _check_arcs(arcs)
     t0 = time.perf_counter()
     if arcs is None:
@@ -566,6 +572,7 @@ def _rocking_checked(
     import dataclasses
 
     _check_rocking(d, r.theta, swing, tolerance, ordered, size)
+    _check_swing_transmission(d, swing, cons.min_transmission)
     d.checks["constraint_failures"] = list(constraint_failures(p, dataclasses.replace(cons, full_turn=False)))
     d.checks["ok_constraints"] = not d.checks["constraint_failures"]
     d.checks["stages_s"] = r.stages
@@ -574,6 +581,21 @@ def _rocking_checked(
     d.checks["input"] = "rocks"
     d.checks["evaluations"] = r.evaluations
     return d
+
+
+def _check_swing_transmission(d: Any, swing: tuple[float, float], min_transmission: float) -> None:
+    """Fill the transmission checks of a rocking design ``d`` over its ``swing`` (rad from the ground line): as
+    :func:`synthesise_path`'s over a turn, the limit ``min_transmission`` (rad) and never under
+    :data:`TOGGLE_FLOOR_DEG` (a swing ends short of its toggles, where coupler and rocker line up)."""
+    th = np.linspace(swing[0], swing[1], 721)
+    mu = np.asarray(d.fourbar().transmission_angle(th), float)
+    m = np.minimum(mu, np.pi - mu)
+    k = int(np.argmin(m))
+    limit = max(float(min_transmission), math.radians(TOGGLE_FLOOR_DEG))
+    d.checks["min_transmission_deg"] = math.degrees(float(m[k]))
+    d.checks["min_transmission_at_rad"] = float(th[k])
+    d.checks["transmission_limit_deg"] = math.degrees(limit)
+    d.checks["ok_transmission"] = bool(m[k] >= limit)
 
 
 def _check_rocking(d: Any, theta: Array, swing: tuple[float, float], tolerance: float, ordered: bool, size: float) -> None:

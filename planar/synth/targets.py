@@ -120,6 +120,17 @@ def _even_by_length(path: Any, n: int, closed: bool) -> Array:
     return np.asarray(path.npoint(np.interp(want, cum, u)), float)
 
 
+def _metric_page_factor(svg: Any) -> float:
+    """What undoes svgelements' inch of 25.40000 mm made of ``1 / 0.0393701`` (0.54 ppm long) in a drawing whose
+    ``viewBox`` is mapped onto a page sized in mm or cm: 1 for any other drawing (and once svgelements is exact)."""
+    import svgelements as se
+
+    size = str(svg.values.get("width") or svg.values.get("height") or "").strip().lower()
+    if svg.viewbox is None or not size.endswith(("mm", "cm")):
+        return 1.0
+    return 1.0 / float(se.Length("1mm").value(ppi=25.4))
+
+
 def read_svg_points(path: str | Path, n: int, option: str = "--points") -> Array:
     """``n`` points spaced evenly by arc length along the first shape of an SVG file (y up).
 
@@ -159,7 +170,7 @@ def read_svg_points(path: str | Path, n: int, option: str = "--points") -> Array
                 continue
             d = path_.d()
             closed = d.rstrip().upper().endswith("Z")
-            pts = _even_by_length(path_, n, closed)
+            pts = _even_by_length(path_, n, closed) * _metric_page_factor(svg)
             pts[:, 1] = -pts[:, 1]
             return pts
     raise InputError(p, "no path", "an SVG with a path or shape of non-zero length")
@@ -249,17 +260,18 @@ def normalisation(targets: Array, name: str = "targets") -> tuple[Array, float]:
     return c, s
 
 
-def check_theta(theta: Array, name: str, deg: bool) -> None:
-    """Refuse crank angles (radians) spanning more than a turn, or two targets at the same angle."""
+def check_theta(theta: Array, name: str | None, deg: bool) -> None:
+    """Refuse crank angles (radians) spanning more than a turn, or two targets at the same angle.
+
+    ``name``: the file they were read from (the field is then ``FILE: theta``), or None for the Python
+    argument ``theta``; ``deg``: whether the file's angles were given in degrees (``--deg``)."""
+    field = "theta" if name is None else f"{name}: theta"
     span = float(np.ptp(theta))
     if span > 2 * np.pi * (1 + 1e-12):
         unit = "deg" if deg else "rad"
         shown = np.degrees(span) if deg else span
-        raise InputError(
-            f"{name}: theta",
-            f"values spanning {shown:.6g} {unit}",
-            "crank angles within one turn" + ("" if deg else " (they look like degrees: add --deg)"),
-        )
+        hint = "" if deg else " (they look like degrees: add --deg)" if name is not None else " (degrees? numpy.radians them)"
+        raise InputError(field, f"values spanning {shown:.6g} {unit}", "crank angles within one turn" + hint)
     w = np.mod(theta, 2 * np.pi)
     order = np.argsort(w, kind="stable")
     gap = np.diff(np.append(w[order], w[order[0]] + 2 * np.pi))
@@ -267,7 +279,7 @@ def check_theta(theta: Array, name: str, deg: bool) -> None:
     if gap[k] <= 1e-12 * 2 * np.pi:
         i, j = sorted((int(order[k]), int(order[(k + 1) % len(order)])))
         raise InputError(
-            f"{name}: theta",
+            field,
             f"targets {i + 1} and {j + 1} (in data-row order) at the same crank angle {theta[i]:.6g}",
             "a different crank angle (modulo a turn) at every target",
         )
@@ -308,10 +320,10 @@ def read_targets(path: str | Path, points: int | None = None) -> tuple[Array, Ar
     ----------
     path : str or Path
         An SVG drawing (``.svg``: the first shape with a non-zero length, in millimetres,
-        :data:`SVG_UNIT_MM`: a page sized in mm, cm or in is converted, and unitless or px user units are
+        :data:`planar.synth.targets.SVG_UNIT_MM`: a page sized in mm, cm or in is converted, and unitless or px user units are
         read as mm; y is turned up: a drawing's ``(x, y)`` is the target
         ``(x, -y)``) or a CSV table with columns ``x``, ``y`` and optionally ``theta`` (the crank angle at each
-        target, radians).
+        target, radians: ``numpy.radians`` a table in degrees before passing it on).
     points : int, optional
         For an SVG: how many points to sample along the shape, evenly by arc length (3 to
         :data:`MAX_SVG_POINTS`; 12 when ``None``).  None for a CSV (every row is a target).

@@ -1,0 +1,106 @@
+"""What a new user synthesising a nodding arc, a timed leg and a function generator ran into, held fixed.
+
+Each check is against something computed here, independently of planar's own report: the law of cosines for
+a transmission angle, a drawing's numbers for an SVG read in millimetres, the file planar writes.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from planar.cli.main import main
+from planar.errors import InputError
+from planar.synth.targets import read_targets
+
+ARC = '<path d="M 10 20 A 36.3333 36.3333 0 0 0 50 20" fill="none" stroke="black"/>'
+
+
+@pytest.mark.parametrize(
+    ("page", "scale"),
+    [('width="60mm" height="40mm"', 1.0), ('width="6cm" height="4cm"', 1.0), ('width="120mm" height="80mm"', 2.0)],
+)
+def test_an_svg_page_in_millimetres_reads_its_numbers_exactly(tmp_path, page, scale) -> None:
+    # svgelements makes an inch of 1 / 0.0393701 mm (0.54 ppm long): a page in mm read 10 as 10.0000054
+    plain = tmp_path / "plain.svg"
+    plain.write_text(f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 60 40">{ARC}</svg>')
+    sized = tmp_path / "sized.svg"
+    sized.write_text(f'<svg xmlns="http://www.w3.org/2000/svg" {page} viewBox="0 0 60 40">{ARC}</svg>')
+    a, b = read_targets(plain)[0], read_targets(sized)[0]
+    assert a[0].tolist() == [10.0, -20.0]
+    np.testing.assert_allclose(b, scale * a, rtol=0, atol=1e-12 * scale * 50)
+
+
+def test_the_python_path_synthesis_refuses_crank_angles_in_degrees() -> None:
+    from planar.synth.path import synthesise_path
+
+    t = np.array([[0, 0], [20, -2], [40, 0], [46, 12], [22, 20], [-4, 12]], float)
+    with pytest.raises(InputError, match=r"theta = 'values spanning 300 rad'.*radians"):
+        synthesise_path(t, np.array([0, 60, 120, 180, 240, 300.0]))
+    with pytest.raises(InputError, match=r"targets 2 and 3 .* same crank angle"):
+        synthesise_path(t, np.array([0, 1, 1, 2, 3, 4.0]))
+
+
+def test_a_timed_miss_says_how_many_equations_its_targets_are() -> None:
+    from planar.cli.synth import _unreachable
+
+    d = SimpleNamespace(
+        targets=np.array([[0, 0], [2, -0.2], [4, 0], [4.6, 1.2], [2.2, 2], [-0.4, 1.2]]),
+        timed=True,
+        checks={"tolerance": 1e-3, "max_error": 0.09, "worst_target": 6},
+    )
+    said = _unreachable(d)
+    assert "6 targets at given crank angles are 12 equations" in said and "9 dimensions" in said
+    d.timed = False
+    assert "equations" not in _unreachable(d)
+
+
+def test_synth_writes_the_unit_it_is_given_and_refuses_a_bad_one(tmp_path, capsys) -> None:
+    pairs = tmp_path / "fg.csv"
+    pairs.write_text("input,output\n0,0\n20,8\n40,18\n60,30\n80,45\n")
+    out = tmp_path / "fg.toml"
+    for bad in ("-3", "0", "nan", "inf", "1e9"):
+        assert main(["synth", "function", str(pairs), "--deg", "-o", str(out), "--unit-mm", bad]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "--unit-mm" in err and not out.exists()
+    main(["synth", "function", str(pairs), "--deg", "-o", str(out), "--unit-mm", "2.5"])
+    assert tomllib.loads(out.read_text())["fabrication"] == {"unit_mm": 2.5}
+
+
+@pytest.mark.slow
+def test_a_rocking_design_checks_its_transmission_over_its_swing(tmp_path) -> None:
+    # a double-rocker's arc: the result states the transmission angle's smallest distance from a toggle over
+    # the swing, equal to the law of cosines at 2,001 input angles of that swing; a limit above it fails
+    # ok_transmission (and the result still says where), one below it passes
+    from planar.synth.arcs import QUICK_FOURBARS, build_arcs
+    from planar.synth.kernel import coupler_points
+    from planar.synth.path import synthesise_rocking_path
+
+    arcs = build_arcs(QUICK_FOURBARS, seed=0)
+    p = np.array([1.0, 0.9, 0.35, 0.8, 0.4, 0.3, 0.0, 0.0, 0.0])
+    th = np.linspace(0.55, 1.2, 15)  # within the input's range, 0.467 to 1.297 rad
+    x, y, ok = coupler_points(p[None], th[None], np.array([1.0]))
+    assert ok.all()
+    t = np.column_stack([x[0], y[0]]) * 30.0
+    d = synthesise_rocking_path(t, tolerance=1e-3, ordered=True, arcs=arcs, budget="quick")
+    c = d.checks
+    assert c["ok_accuracy"] and c["input"] == "rocks"
+    lo, hi = c["input_swing_rad"]
+    u = np.linspace(lo, hi, 2001)
+    bo4 = d.crank**2 + d.ground**2 - 2 * d.crank * d.ground * np.cos(u)
+    mu = np.arccos(np.clip((d.coupler**2 + d.rocker**2 - bo4) / (2 * d.coupler * d.rocker), -1, 1))
+    worst = math.degrees(float(np.min(np.minimum(mu, np.pi - mu))))
+    assert abs(c["min_transmission_deg"] - worst) <= 0.05 and c["ok_transmission"] == (worst >= 1.0)
+    strict = synthesise_rocking_path(
+        t, tolerance=1e-3, ordered=True, arcs=arcs, budget="quick", min_transmission=math.radians(worst + 5)
+    )
+    if strict.checks["min_transmission_deg"] < worst + 5:
+        assert not strict.checks["ok_transmission"] and not strict.ok
+    loose = synthesise_rocking_path(
+        t, tolerance=1e-3, ordered=True, arcs=arcs, budget="quick", min_transmission=math.radians(max(worst - 5, 0))
+    )
+    assert loose.checks["ok_transmission"] == (loose.checks["min_transmission_deg"] >= max(worst - 5, 1.0))
