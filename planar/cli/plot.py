@@ -1,4 +1,4 @@
-"""``planar plot SCENE -o fig.png|svg [--what curve,follower,pressure,transmission,velocity,speed,acceleration,torque]``."""
+"""``planar plot SCENE -o fig.png|svg [--what curve,follower,pressure,transmission,angle,velocity,speed,acceleration,torque]``."""
 
 from __future__ import annotations
 
@@ -35,7 +35,8 @@ def add_parser(sub: Any) -> None:
         description="Draw the charts a designer looks at (matplotlib) from the scene's exact "
         "motion and rates: curve (paths of the named points), follower and "
         "pressure (a cam's follower motion and pressure angle), transmission "
-        "(angle at each RRR dyad, linkages only), velocity and acceleration "
+        "(angle at each RRR dyad, linkages only), angle (every moving part's, "
+        "from +x: a rocker's output against the crank), velocity and acceleration "
         "(angular, every moving part), torque (motor torque under [effects], "
         "and the loads alone). Horizontal axis: crank (cam) angle for a turning "
         "input, else time.",
@@ -45,7 +46,7 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--what",
         default=None,
-        help="comma-separated charts: curve,follower,pressure,transmission,velocity,speed,"
+        help="comma-separated charts: curve,follower,pressure,transmission,angle,velocity,speed,"
         "acceleration,torque "
         "(default: every chart that applies)",
     )

@@ -48,7 +48,7 @@ if TYPE_CHECKING:
 __all__ = ["CHARTS", "available_charts", "scene_figure", "write_plot"]
 
 #: every chart :func:`scene_figure` can draw, in drawing order
-CHARTS = ("curve", "follower", "pressure", "transmission", "velocity", "speed", "acceleration", "torque")
+CHARTS = ("curve", "follower", "pressure", "transmission", "angle", "velocity", "speed", "acceleration", "torque")
 #: the transmission angles designers keep to (degrees)
 GOOD_TRANSMISSION = (40.0, 140.0)
 
@@ -66,7 +66,7 @@ def available_charts(scene: Scene) -> list[str]:
         out += ["follower", "pressure"]
     if transmission_angles(scene.mechanism, scene.mechanism.driver.value(np.zeros(1))):
         out.append("transmission")
-    out.append("velocity")
+    out += ["angle", "velocity"]
     if scene.mechanism.points:
         out.append("speed")
     return out + ["acceleration", "torque"]
@@ -236,6 +236,8 @@ def scene_figure(
             ax.set_ylim(0, 180)
             ax.set_ylabel("transmission angle (deg)")
             ax.set_title(f"transmission angle at each dyad (band: {lo:g}-{hi:g}°)", fontsize=9)
+        elif chart == "angle":
+            _angle_panel(ax, motion, moving, x)
         elif chart == "speed":
             for pname in motion.points:
                 sp = np.hypot(col[f"{pname}.vx"], col[f"{pname}.vy"])
@@ -264,6 +266,17 @@ def scene_figure(
         if len(ax.get_lines()) > 1 or chart == "curve":
             ax.legend(fontsize=7, loc="best", ncols=2 if len(ax.get_lines()) > 6 else 1)
     return fig
+
+
+def _angle_panel(ax: Any, motion: Motion, moving: list[str], x: np.ndarray) -> None:
+    """Every moving part's angle (degrees, counter-clockwise from the world's +x axis, unwrapped along the
+    motion: a rocker's output against the crank's input, what a function generator is asked for)."""
+    for p in moving:
+        a = np.degrees(np.unwrap(np.asarray(motion.poses[p])[:, 2]))
+        (ln,) = ax.plot(x, np.where(motion.valid, a, np.nan), lw=1.2, label=p)
+        ln.set_gid(f"angle:{p}")
+    ax.set_ylabel("angle from +x (deg)")
+    ax.set_title("each moving part's angle (counter-clockwise from +x)", fontsize=9)
 
 
 #: the colour of the targets on the coupler-curve chart (the animation's target dots are pink too)

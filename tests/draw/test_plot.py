@@ -29,6 +29,7 @@ def test_figure_lines_hold_the_motion_and_independent_formulas() -> None:
     assert [ax.get_gid() for ax in fig.axes if ax.get_gid()] == [
         "chart-curve",
         "chart-transmission",
+        "chart-angle",
         "chart-velocity",
         "chart-speed",
         "chart-acceleration",
@@ -42,6 +43,12 @@ def test_figure_lines_hold_the_motion_and_independent_formulas() -> None:
     tr = _line(fig, "transmission:C")
     assert np.allclose(tr.get_xdata(), np.degrees(mo.driver))
     assert np.allclose(tr.get_ydata(), np.degrees(sc.mechanism.transmission_angle(mo.driver)), atol=1e-9)
+    # the rocker's angle against Freudenstein's (tangent half-angle) closed form, turned by the placement
+    _, th4, _ = sc.mechanism.angles(mo.driver)
+    turn = np.degrees(sc.mechanism.placement[2])
+    got = _line(fig, "angle:rocker").get_ydata()
+    assert np.allclose(np.mod(got - np.degrees(th4) - turn + 180, 360) - 180, 0, atol=1e-9)
+    assert np.all(np.abs(np.diff(got)) < 90)  # unwrapped: no jump of a turn
     # the coupler's angular velocity against Norton's loop equations
     w3, _, _ = analysis.fourbar_velocities(sc.mechanism, mo.driver, sc.mechanism.driver.rate)
     assert np.allclose(_line(fig, "omega:coupler").get_ydata(), w3, rtol=1e-10, atol=1e-12)
