@@ -522,13 +522,14 @@ def check_sixbar(
         d.checks = {"ok_builds": False, "error": str(e), "ok_constraints": not cf, "constraint_failures": cf}
         return
     th = np.mod(d.theta, 2 * np.pi)
-    order = np.argsort(th, kind="stable")
     turn = np.linspace(0.0, 2 * np.pi, 360, endpoint=False)
-    path = lk.solve(np.sort(np.concatenate([turn, th])))
+    swept = np.sort(np.concatenate([turn, th]))
+    path = lk.solve(swept)  # the turn in steps of at most 1 deg, through every target's crank angle
     full = lk.solve(turn)
-    at = lk.solve(th[order])  # a path through the targets' crank angles, ascending
-    pts = np.empty_like(d.targets)
-    pts[order] = at.points["tracer"]
+    # the targets as the driven linkage meets them: on that path (a solve at the targets' angles alone carried
+    # the second dyad onto its other branch across wide gaps between targets, which no driven linkage does)
+    at = path.take(np.searchsorted(swept, th))
+    pts = at.points["tracer"]
     x, y, _ = sixbar_points(d.params[None], d.theta, d.topology)
     kern = np.column_stack([x[0], y[0]])
     d.sse = float(np.sum((pts - d.targets) ** 2)) if at.valid.all() else float("inf")
