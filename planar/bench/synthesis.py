@@ -479,6 +479,51 @@ def reachable_problem(rng: np.random.Generator, n: int) -> tuple[Array, Array]:
     return np.column_stack([x[0], y[0]]), th
 
 
+def random_drag_link(rng: np.random.Generator) -> tuple[Array, float]:
+    """A random Grashof drag-link (double-crank: the ground shortest, link ratio <= 10, 2 % from a change point)
+    with a random coupler point and placement, drawn as :func:`random_crank_rocker` with the ground and crank
+    exchanged: the kernel's 9 parameters and the circuit."""
+    while True:
+        k, c, r = rng.uniform(0.3, 3.0, 3)
+        g = rng.uniform(0.1, 1.0) * min(k, c, r)
+        L = sorted((g, k, c, r))
+        if L[0] == g and L[0] + L[3] < 0.98 * (L[1] + L[2]) and L[3] <= 9.5 * L[0]:
+            break
+    u, v = c * rng.uniform(-1.0, 2.0), c * rng.uniform(-1.0, 1.0)
+    row = np.array([g, k, c, r, u, v, rng.uniform(), rng.uniform(), rng.uniform(-np.pi, np.pi)])
+    return row, float(rng.choice([-1.0, 1.0]))
+
+
+def _on_curve(row: Array, circ: float, th: Array) -> Array:
+    from planar.synth.kernel import coupler_points
+
+    x, y, _ = coupler_points(row[None, :], th, np.array([circ]))
+    return np.column_stack([x[0], y[0]])
+
+
+def _whole_turn(rng: np.random.Generator, n: int, linkage: Any) -> tuple[Array, Array]:
+    row, circ = linkage(rng)
+    th = np.sort(rng.uniform(0.0, 2 * np.pi, n))
+    return _on_curve(row, circ, th), th
+
+
+def part_curve_problem(rng: np.random.Generator, n: int) -> tuple[Array, Array]:
+    """``n`` targets on PART of the coupler curve of a random crank-rocker or drag-link (either, even odds): sorted
+    random crank angles within an arc of 90 to 300 degrees starting anywhere (an open target set), and the angles."""
+    row, circ = (random_crank_rocker if rng.random() < 0.5 else random_drag_link)(rng)
+    span = np.radians(rng.uniform(90.0, 300.0))
+    th = rng.uniform(-np.pi, np.pi) + np.sort(rng.uniform(0.0, span, n))
+    return _on_curve(row, circ, th), th
+
+
+#: the reachable problems' kinds (:func:`bench_reachable`): each draws ``n`` targets and their crank angles
+REACHABLE_KINDS: dict[str, Any] = {
+    "crank-rocker": reachable_problem,
+    "drag-link": lambda rng, n: _whole_turn(rng, n, random_drag_link),
+    "part-curve": part_curve_problem,
+}
+
+
 def _max_error(targets: Array, row: Array, theta: Array) -> float:
     """Largest distance from a target to the coupler point of ``row`` (9 + circuit) at ``theta``, over the
     targets' size (RMS distance from their centroid)."""

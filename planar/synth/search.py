@@ -933,11 +933,88 @@ TIMED_FROM, TIMED_STOP = 1e-6, 1e-9
 TIMED_DIRECT = 4
 
 
+def _dyad_line(A: Array, rhs: Array) -> tuple[Array, Array] | None:
+    """The solutions of ``A x = rhs`` (``A`` of rank 6 in 7 unknowns): a point and the null direction, by SVD; None
+    when a second singular value is also at rounding level (the targets do not fix the line)."""
+    U, S, Vt = np.linalg.svd(A, full_matrices=False)
+    if S[-2] <= DYAD_RCOND * S[0]:
+        return None
+    return Vt[:-1].T @ ((U[:, :-1].T @ rhs) / S[:-1]), Vt[-1]
+
+
+def _dyad_roots(x0: Array, n: Array) -> list[float]:
+    """Where on the line ``x0 + t n`` of unknowns ``[K, a, b, q]`` (``a, b, q`` complex, as pairs) the product ``q``
+    equals ``a conj(b)``: the real parts of the two roots of that complex quadratic in ``t``."""
+    a0, a1 = complex(x0[1], x0[2]), complex(n[1], n[2])
+    b0, b1 = complex(x0[3], x0[4]), complex(n[3], n[4])
+    q0, q1 = complex(x0[5], x0[6]), complex(n[5], n[6])
+    lead = -a1 * np.conj(b1)
+    if abs(lead) == 0.0:
+        return []
+    return [float(r.real) for r in np.roots([lead, q1 - a1 * np.conj(b0) - a0 * np.conj(b1), q0 - a0 * np.conj(b0)])]
+
+
+#: singular values (relative to the largest) under which the closed-form timed solution is not attempted
+DYAD_RCOND = 1e-10
+
+
+def timed_closed_form(targets: Array, theta: Array) -> Array:
+    """Four-bars whose coupler point passes through ``targets`` ``(N, 2)`` at the crank angles ``theta`` ``(N,)``
+    (radians from the ground line), in closed form from the targets alone (no search): rows of the kernel's 9
+    parameters and the circuit ``(k, 10)``, usually two (a four-bar and another with the same timing), none for
+    fewer than 7 targets or when the targets do not fix them.  Exact for targets a four-bar passes through (to
+    rounding); for others a start for least squares.
+
+    The crank pin is ``B_i = O2 + w e^(i theta_i)`` (complex; ``w`` the crank, turned by the ground line's
+    angle) and the coupler point stays at a distance ``d`` from it: ``|P_i - O2 - w e^(i theta_i)|^2 = d^2``.
+    Expanded, that is linear in ``K = |O2|^2 + |w|^2 - d^2``, ``O2``, ``w`` and ``q = O2 conj(w)`` (7 real
+    unknowns, one equation per target).  Two dyads turning at the crank's rate reach the coupler point (the
+    crank and one of a cognate's), so the system has rank 6; the line of its solutions meets ``q = O2 conj(w)``
+    at both (a quadratic).  With the crank known, the coupler's pose at each target is known (``B_i`` and the
+    direction to ``P_i``), and the rocker pin ``C_i = B_i + c u_i`` (``u_i`` the unit vector from ``B_i`` to
+    ``P_i``, ``c`` complex in the coupler's frame) on a circle about ``O4`` is the same problem again, linear in
+    ``c``, ``O4``, ``|c|^2 + |O4|^2 - r4^2`` and ``c conj(O4)``; its two solutions are the rocker pin and the crank
+    pin itself (``c = 0``, discarded)."""
+    P = np.asarray(targets, float) @ np.array([1.0, 1j])
+    th = np.asarray(theta, float)
+    N = len(P)
+    out: list[list[float]] = []
+    if N < 7:
+        return np.empty((0, N_PARAMS + 1))
+    e = np.exp(-1j * th)
+    Pe = P * e
+    A = np.column_stack([np.ones(N), -2 * P.real, -2 * P.imag, -2 * Pe.real, -2 * Pe.imag, 2 * e.real, -2 * e.imag])
+    line = _dyad_line(A, -(np.abs(P) ** 2))
+    for t in _dyad_roots(*line) if line is not None else []:
+        x = line[0] + t * line[1]  # type: ignore[index]
+        O2, w = complex(x[1], x[2]), complex(x[3], x[4])
+        d2 = abs(O2) ** 2 + abs(w) ** 2 - x[0]
+        if d2 <= 0 or w == 0:
+            continue
+        B = O2 + w * np.exp(1j * th)
+        u = (P - B) / np.maximum(np.abs(P - B), 1e-300)
+        Bu = B * np.conj(u)
+        A2 = np.column_stack([np.ones(N), 2 * Bu.real, 2 * Bu.imag, -2 * B.real, -2 * B.imag, -2 * u.real, 2 * u.imag])
+        line2 = _dyad_line(A2, -(np.abs(B) ** 2))
+        for s in _dyad_roots(*line2) if line2 is not None else []:
+            y = line2[0] + s * line2[1]  # type: ignore[index]
+            c, O4 = complex(y[1], y[2]), complex(y[3], y[4])
+            if abs(c) <= 1e-9 * np.sqrt(d2) or O4 == O2:
+                continue
+            C = B + c * u
+            uv = np.sqrt(d2) * np.conj(c) / abs(c)  # the coupler point in the coupler's frame (x toward C)
+            circ = 1.0 if np.mean((np.conj(O4 - B) * (C - B)).imag) >= 0 else -1.0
+            r4 = float(np.mean(np.abs(C - O4)))
+            out.append([abs(O4 - O2), abs(w), abs(c), r4, uv.real, uv.imag, O2.real, O2.imag, float(np.angle(O4 - O2)), circ])
+    return np.array(out, float).reshape(-1, N_PARAMS + 1)
+
+
 def timed_from_atlas(
     targets: Array, theta: Array, atlas: Any, cons: Constraints | None = None, starts: int = 3
 ) -> SearchResult | None:
-    """Timed targets (normalised) from the atlas: the :data:`TIMED_DIRECT` best direct starts
-    (:func:`timed_starts`) refined with the crank angles fixed at ``theta``; when none is exact, the untimed
+    """Timed targets (normalised) from the atlas: first the closed form (:func:`timed_closed_form`, exact on targets
+    a four-bar passes through, from 7 targets; refined with the crank angles fixed at ``theta`` when not exact), then
+    the :data:`TIMED_DIRECT` best direct starts (:func:`timed_starts`) refined likewise; when none is exact, the untimed
     curve (:func:`search_atlas`, each refined start within :data:`TIMED_FROM` refined again with the angles
     fixed, until one is exact), then least squares with the angles fixed from its best (None when no start
     closes at every crank angle)."""
@@ -960,9 +1037,17 @@ def timed_from_atlas(
         timed.append((e, r, tt))
         return max_distance(obj, r, obj.theta) <= TIMED_STOP and not constraint_failures(r[:N_PARAMS], cons)  # type: ignore[arg-type]
 
-    # first the direct starts: the neighbours placed by the prescribed timing, refined with the angles fixed
-    for row in timed_starts(atlas, obj)[:TIMED_DIRECT]:
-        r, tt, e = _refine(obj, row, b, max_nfev=REFINE_NFEV, method="lm")
+    # first the closed form (exact on targets a four-bar passes through), then the direct starts: the neighbours
+    # placed by the prescribed timing, each refined with the angles fixed
+    def direct() -> Any:
+        yield from timed_closed_form(obj.targets, obj.theta)  # type: ignore[arg-type]
+        yield from timed_starts(atlas, obj)[:TIMED_DIRECT]  # the atlas's lookup only when the closed form fails
+
+    for row in direct():
+        r, tt = row, np.asarray(obj.theta, float)
+        if max_distance(obj, row, tt) > TIMED_STOP:
+            r, tt, _ = _refine(obj, row, b, max_nfev=REFINE_NFEV, method="lm")
+        e = float(obj.population(r[None, :], np.float64)[0])
         if max_distance(obj, r, obj.theta) <= TIMED_STOP and not constraint_failures(r[:N_PARAMS], cons):  # type: ignore[arg-type]
             stages = {"timed_s": time.perf_counter() - t0}
             return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), True, 0, stages)
