@@ -276,29 +276,29 @@ def ordered_theta(d2: Array, th: Array, starts: int = 4) -> tuple[Array, float]:
     if len(loc) == 0:
         return th[np.argmin(d2, axis=1)], float("inf")
     loc = loc[np.argsort(d0[loc], kind="stable")[:starts]]
-    best: tuple[float, Array] = (float("inf"), th[np.argmin(d2, axis=1)])
-    for sign in (1, -1):
-        for s in loc:
-            idx = (s + sign * np.arange(n)) % n  # the turn unrolled from the start, one way round
-            D = d2[:, idx]
-            cost = np.full(n, np.inf)
-            cost[0] = D[0, 0]
-            arg = np.zeros((N, n), dtype=np.intp)
-            k = np.arange(n)
-            for i in range(1, N):
-                run = np.minimum.accumulate(cost)
-                where = np.maximum.accumulate(np.where(cost <= run, k, 0))
-                cost = D[i] + run
-                arg[i] = where
-            j = int(np.argmin(cost))
-            total = float(cost[j])
-            if total < best[0]:
-                path = np.empty(N, dtype=np.intp)
-                for i in range(N - 1, -1, -1):
-                    path[i] = j
-                    j = int(arg[i, j])
-                best = (total, th[idx[path]])
-    return best[1], best[0]
+    k = np.arange(n)
+    # every start both ways round at once (rows: one way from each start, then the other way)
+    idx = (np.concatenate([loc, loc])[:, None] + np.repeat([1, -1], len(loc))[:, None] * k[None, :]) % n
+    D = d2[:, idx]  # (N, V, n): each variant's turn unrolled from its start
+    V = len(idx)
+    cost = np.full((V, n), np.inf)
+    cost[:, 0] = D[0, :, 0]
+    arg = np.zeros((N, V, n), dtype=np.intp)
+    for i in range(1, N):
+        run = np.minimum.accumulate(cost, axis=1)
+        arg[i] = np.maximum.accumulate(np.where(cost <= run, k, 0), axis=1)
+        cost = D[i] + run
+    ends = np.argmin(cost, axis=1)
+    totals = cost[np.arange(V), ends]
+    v = int(np.argmin(totals))  # the first of the best, as one variant after another would keep
+    if not np.isfinite(totals[v]):
+        return th[np.argmin(d2, axis=1)], float("inf")
+    path = np.empty(N, dtype=np.intp)
+    j = int(ends[v])
+    for i in range(N - 1, -1, -1):
+        path[i] = j
+        j = int(arg[i, v, j])
+    return th[idx[v, path]], float(totals[v])
 
 
 def _residual_functions(obj: PathObjective, circuit: float, hi: Array) -> tuple[Any, Any]:
@@ -598,7 +598,7 @@ def search_atlas(
 
 #: the wide lookup, when the targets' nearest entries fail: neighbours per query (8 queries), the best kept by a
 #: cheap similarity fit on a coarse curve (samples) and how many of them are refined
-WIDE_K, WIDE_KEEP, WIDE_SAMPLES, WIDE_REFINE = 4000, 256, 32, 16
+WIDE_K, WIDE_KEEP, WIDE_SAMPLES, WIDE_REFINE = 4000, 256, 32, 4
 
 
 def _wide_candidates(atlas: Any, obj: PathObjective, keep: int = WIDE_KEEP) -> Array:
@@ -687,6 +687,39 @@ def _batch_jacobian(obj: PathObjective, Z: Array, circ: Array, R0: Array) -> Arr
     return J
 
 
+def _structured_normal(J: Array, R: Array) -> tuple[Array, ...]:
+    """The normal equations of Jacobians ``J`` ``(K, 2 N + 1, 9 + N)`` (:func:`_batch_jacobian`) and residuals ``R``,
+    in the blocks their structure leaves: ``A_pp`` ``(K, 9, 9)`` (the parameters), ``A_tp`` ``(K, N, 9)``,
+    the diagonal ``a_tt`` ``(K, N)`` (crank angle ``i`` moves only target ``i``'s residuals), and the gradient's
+    parts ``g_p`` ``(K, 9)``, ``g_t`` ``(K, N)``."""
+    n = J.shape[2] - N_PARAMS
+    i = np.arange(n)
+    Jp = J[:, :, :N_PARAMS]
+    jx, jy = J[:, i, N_PARAMS + i], J[:, n + i, N_PARAMS + i]
+    App = np.matmul(Jp.transpose(0, 2, 1), Jp)
+    Atp = Jp[:, :n, :] * jx[:, :, None] + Jp[:, n : 2 * n, :] * jy[:, :, None]
+    att = jx * jx + jy * jy
+    gp = np.matmul(Jp.transpose(0, 2, 1), R[:, :, None])[:, :, 0]
+    gt = jx * R[:, :n] + jy * R[:, n : 2 * n]
+    return App, Atp, att, gp, gt
+
+
+def _damped_step(normal: tuple[Array, ...], lam: Array) -> Array:
+    """Levenberg-Marquardt steps ``(K, 9 + N)`` of the structured normal equations (:func:`_structured_normal`)
+    damped by ``lam`` ``(K,)`` times their diagonal (Marquardt's scaling): the crank angles eliminated (their block
+    is diagonal), a 9 x 9 Schur complement solved per start, the angles' steps back-substituted.  The same steps as
+    solving the whole ``(9 + N)`` system, at a cost linear in ``N``."""
+    App, Atp, att, gp, gt = normal
+    dp = np.einsum("kjj->kj", App) + 1e-12
+    T = att + lam[:, None] * (att + 1e-12)
+    W = Atp / T[:, :, None]
+    S = App + (lam[:, None] * dp)[:, :, None] * np.eye(N_PARAMS) - np.matmul(W.transpose(0, 2, 1), Atp)
+    rhs = -gp + np.matmul(W.transpose(0, 2, 1), gt[:, :, None])[:, :, 0]
+    sp = np.linalg.solve(S, rhs[:, :, None])[:, :, 0]
+    st = (-gt - np.matmul(Atp, sp[:, :, None])[:, :, 0]) / T
+    return np.concatenate([sp, st], axis=1)
+
+
 def batch_lm(obj: PathObjective, C: Array, iters: int, reassign: int = 10) -> tuple[Array, Array]:
     """Levenberg-Marquardt from many starts at once: candidate rows ``C`` ``(K, 10)`` on untimed targets, the
     crank angles at the targets assigned on each start's curve (:func:`assign_theta`) and again every
@@ -702,7 +735,6 @@ def batch_lm(obj: PathObjective, C: Array, iters: int, reassign: int = 10) -> tu
     m = N_PARAMS + len(obj.targets)
     Z = np.empty((K, m))
     Z[:, :N_PARAMS] = C[:, :N_PARAMS]
-    eye = np.eye(m)
     lam = np.full(K, 1e-3)
     f = np.full(K, np.inf)
     R = np.zeros((K, 2 * len(obj.targets) + 1))
@@ -710,16 +742,13 @@ def batch_lm(obj: PathObjective, C: Array, iters: int, reassign: int = 10) -> tu
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         for it in range(iters):
             if it % reassign == 0:
-                Z[:, N_PARAMS:] = [assign_theta(obj, np.append(z[:N_PARAMS], c)) for z, c in zip(Z, circ, strict=True)]
+                Z[:, N_PARAMS:] = assign_theta_batch(obj, np.column_stack([Z[:, :N_PARAMS], circ]))
                 R = _batch_residuals(obj, Z, circ)
                 f = np.sum(R**2, axis=1)
-            J = _batch_jacobian(obj, Z, circ, R)
-            A = np.einsum("kij,kil->kjl", J, J)
-            g = np.einsum("kij,ki->kj", J, R)
-            D = np.einsum("kjj->kj", A) + 1e-12
+            normal = _structured_normal(_batch_jacobian(obj, Z, circ, R), R)
             pending = np.isfinite(f)
             for _ in range(4):
-                step = -np.linalg.solve(A + (lam[:, None] * D)[:, :, None] * eye, g[:, :, None])[:, :, 0]
+                step = _damped_step(normal, lam)
                 Rn = _batch_residuals(obj, Z + step, circ)
                 fn = np.sum(Rn**2, axis=1)
                 better = pending & np.isfinite(fn) & (fn < f)
@@ -867,12 +896,30 @@ def assign_theta(obj: PathObjective, row: Array, n: int = 256) -> Array:
     that costs at most 10 times the nearest points' squared distance (the targets then run along the curve),
     else each target's nearest point."""
     th, d2 = _curve_d2(obj, row, n)
+    return _assigned(d2, th)
+
+
+def _assigned(d2: Array, th: Array) -> Array:
+    """:func:`assign_theta` from the squared distances ``d2`` ``(N, n)`` of the targets to a curve at ``th``."""
     near = th[np.argmin(d2, axis=1)]
     cost_near = float(np.sum(np.min(d2, axis=1)))
     if not np.isfinite(cost_near):
         return near
     ordered, cost = ordered_theta(d2, th)
     return ordered if cost <= 10.0 * cost_near + 1e-30 else near
+
+
+def assign_theta_batch(obj: PathObjective, rows: Array, n: int = 256) -> Array:
+    """:func:`assign_theta` for candidate rows ``rows`` ``(K, 10)`` (the same angles ``(K, N)``), their curves solved
+    by one kernel call."""
+    th = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    x, y, ok = coupler_points(rows[:, :N_PARAMS], th, np.where(rows[:, 9] >= 0, 1.0, -1.0))
+    out = np.empty((len(rows), len(obj.targets)))
+    for k in range(len(rows)):
+        d2 = (x[k][None, :] - obj.targets[:, 0:1]) ** 2 + (y[k][None, :] - obj.targets[:, 1:2]) ** 2
+        d2[:, ~ok[k]] = np.inf
+        out[k] = _assigned(d2, th)
+    return out
 
 
 def reassigned_refine(
