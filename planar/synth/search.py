@@ -1057,14 +1057,16 @@ def timed_closed_form(targets: Array, theta: Array) -> Array:
 
 
 def timed_from_atlas(
-    targets: Array, theta: Array, atlas: Any, cons: Constraints | None = None, starts: int = 3
+    targets: Array, theta: Array, atlas: Any, cons: Constraints | None = None, starts: int = 3, closed_form: bool = True
 ) -> SearchResult | None:
     """Timed targets (normalised) from the atlas: first the closed form (:func:`timed_closed_form`, exact on targets
     a four-bar passes through, from 7 targets; refined with the crank angles fixed at ``theta`` when not exact), then
     the :data:`TIMED_DIRECT` best direct starts (:func:`timed_starts`) refined likewise; when none is exact, the untimed
     curve (:func:`search_atlas`, each refined start within :data:`TIMED_FROM` refined again with the angles
     fixed, until one is exact), then least squares with the angles fixed from its best (None when no start
-    closes at every crank angle)."""
+    closes at every crank angle).  ``closed_form=False`` leaves the closed form out (the atlas's starts alone).
+    The result's ``stages``: ``closed_form_s`` alone when the closed form gave it, else ``timed_s`` (and the
+    untimed search's when it ran)."""
     import time
 
     cons = cons if cons is not None else Constraints()
@@ -1086,17 +1088,19 @@ def timed_from_atlas(
 
     # first the closed form (exact on targets a four-bar passes through), then the direct starts: the neighbours
     # placed by the prescribed timing, each refined with the angles fixed
+    exact = timed_closed_form(obj.targets, obj.theta) if closed_form else np.empty((0, N_PARAMS + 1))  # type: ignore[arg-type]
+
     def direct() -> Any:
-        yield from timed_closed_form(obj.targets, obj.theta)  # type: ignore[arg-type]
+        yield from exact
         yield from timed_starts(atlas, obj)[:TIMED_DIRECT]  # the atlas's lookup only when the closed form fails
 
-    for row in direct():
+    for k, row in enumerate(direct()):
         r, tt = row, np.asarray(obj.theta, float)
         if max_distance(obj, row, tt) > TIMED_STOP:
             r, tt, _ = _refine(obj, row, b, max_nfev=REFINE_NFEV, method="lm")
         e = float(obj.population(r[None, :], np.float64)[0])
         if max_distance(obj, r, obj.theta) <= TIMED_STOP and not constraint_failures(r[:N_PARAMS], cons):  # type: ignore[arg-type]
-            stages = {"timed_s": time.perf_counter() - t0}
+            stages = {"closed_form_s" if k < len(exact) else "timed_s": time.perf_counter() - t0}
             return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), True, 0, stages)
         timed.append((e, r, tt))
     u = search_atlas(targets, atlas, cons, stop=exact_timed)

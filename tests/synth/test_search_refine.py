@@ -171,10 +171,14 @@ def test_timed_targets_are_placed_by_their_timing_and_refined_exactly():
         direct = timed_starts(atlas, obj)
         placed = candidates(atlas, obj.targets, 64)
         assert obj.population(direct[:1], np.float64)[0] < obj.population(placed, np.float64).min()
-        r = timed_from_atlas(obj.targets, th, atlas)
+        r = timed_from_atlas(obj.targets, th, atlas, closed_form=False)
         assert r is not None and r.feasible
         assert max_distance(obj, np.append(r.params, r.circuit), th) <= 1e-9
         assert set(r.stages) == {"timed_s"}
+        # with the closed form (the default) it is exact before any atlas lookup
+        r = timed_from_atlas(obj.targets, th, atlas)
+        assert r is not None and r.feasible and set(r.stages) == {"closed_form_s"}
+        assert max_distance(obj, np.append(r.params, r.circuit), th) <= 1e-9
 
 
 def _fourbar_points(row, circ, theta):
