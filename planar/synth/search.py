@@ -1053,7 +1053,8 @@ def timed_closed_form(targets: Array, theta: Array) -> Array:
             circ = 1.0 if np.mean((np.conj(O4 - B) * (C - B)).imag) >= 0 else -1.0
             r4 = float(np.mean(np.abs(C - O4)))
             out.append([abs(O4 - O2), abs(w), abs(c), r4, uv.real, uv.imag, O2.real, O2.imag, float(np.angle(O4 - O2)), circ])
-    return np.array(out, float).reshape(-1, N_PARAMS + 1)
+    rows = np.array(out, float).reshape(-1, N_PARAMS + 1)
+    return rows[np.isfinite(rows).all(1) & (rows[:, :4] > 0).all(1)]
 
 
 def timed_from_atlas(
@@ -1099,6 +1100,8 @@ def timed_from_atlas(
         if max_distance(obj, row, tt) > TIMED_STOP:
             r, tt, _ = _refine(obj, row, b, max_nfev=REFINE_NFEV, method="lm")
         e = float(obj.population(r[None, :], np.float64)[0])
+        if not np.isfinite(e):  # a degenerate start (from an ill-conditioned closed form): nothing to keep
+            continue
         if max_distance(obj, r, obj.theta) <= TIMED_STOP and not constraint_failures(r[:N_PARAMS], cons):  # type: ignore[arg-type]
             stages = {"closed_form_s" if k < len(exact) else "timed_s": time.perf_counter() - t0}
             return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), True, 0, stages)

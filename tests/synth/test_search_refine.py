@@ -220,3 +220,21 @@ def test_timed_closed_form_recovers_random_four_bars_exactly(n):
         assert min(gap) <= 1e-9 * max(1.0, float(np.abs(row).max()))
         assert rows[int(np.argmin(gap)), 9] == circ
     assert len(timed_closed_form(T[:6], th[:6])) == 0
+
+
+def test_timed_closed_form_on_targets_no_four_bar_passes_gives_finite_starts_or_none():
+    """Noisy targets, all crank angles equal, a circle traced at the crank's rate (the coupler point on the crank pin):
+    the closed form raises nothing and every row it gives is finite with positive lengths (the circle gives none)."""
+    from planar.synth.search import timed_closed_form
+
+    rng = np.random.default_rng(12)
+    a = np.linspace(0.0, 6.0, 10)
+    cases = [
+        (rng.normal(size=(12, 2)), np.sort(rng.uniform(0.0, 6.0, 12))),
+        (rng.normal(size=(9, 2)), np.zeros(9)),
+        (np.column_stack([np.cos(a), np.sin(a)]), a),
+    ]
+    for T, th in cases:
+        rows = timed_closed_form(T, th)
+        assert np.isfinite(rows).all() and (rows[:, :4] > 0).all()
+    assert len(timed_closed_form(*cases[2])) == 0
