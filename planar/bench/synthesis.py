@@ -278,9 +278,9 @@ def bench_synthesis(
     ``quick``: one repeat, planar's ``quick`` budget, pylinkage's coarser
     orientation grid; ``n`` (``-n``): candidates in the kernel-rate measurement;
     ``problems``: a subset of :data:`PROBLEMS` by name (all by default);
-    ``reachable``: random reachable curves per number of targets in :func:`bench_reachable` (25, or 2 with
-    ``quick``; 0 leaves that benchmark, the targets scaling and :func:`bench_unreachable` out: 7 problems
-    per group, 56 in all, or 1 per group with ``quick``);
+    ``reachable``: random reachable crank-rocker curves per number of targets in :func:`bench_reachable` (25, or 2
+    with ``quick``, which also runs one drag-link and one part-curve a size; 0 leaves that benchmark, the targets
+    scaling and :func:`bench_unreachable` out: 7 problems per group, 56 in all, or 1 per group with ``quick``);
     ``heldout``: function and motion problems per size in :mod:`planar.bench.synthesis_heldout` (50, or 2 with
     ``quick``; 0 leaves them out).
     """
@@ -354,7 +354,8 @@ def bench_synthesis(
     count = (2 if quick else 25) if reachable is None else reachable
     extra: dict[str, Any] = {}
     if count > 0:
-        extra["reachable"] = bench_reachable(count=count, quick=quick)
+        # the other kinds (drag-links, part-curves): one a size in the quick run, as many as the crank-rockers otherwise
+        extra["reachable"] = bench_reachable(count=count, quick=quick, kind_count=1 if quick else None)
         extra["targets_scaling"] = bench_targets_scaling(quick=quick)
         extra["unreachable"] = bench_unreachable(count=1 if quick else 7, quick=quick)
         from planar.bench.synthesis_heldout import bench_reachable_pylinkage, reachable_problems
@@ -479,6 +480,51 @@ def reachable_problem(rng: np.random.Generator, n: int) -> tuple[Array, Array]:
     return np.column_stack([x[0], y[0]]), th
 
 
+def random_drag_link(rng: np.random.Generator) -> tuple[Array, float]:
+    """A random Grashof drag-link (double-crank: the ground shortest, link ratio <= 10, 2 % from a change point)
+    with a random coupler point and placement, drawn as :func:`random_crank_rocker` with the ground and crank
+    exchanged: the kernel's 9 parameters and the circuit."""
+    while True:
+        k, c, r = rng.uniform(0.3, 3.0, 3)
+        g = rng.uniform(0.1, 1.0) * min(k, c, r)
+        L = sorted((g, k, c, r))
+        if L[0] == g and L[0] + L[3] < 0.98 * (L[1] + L[2]) and L[3] <= 9.5 * L[0]:
+            break
+    u, v = c * rng.uniform(-1.0, 2.0), c * rng.uniform(-1.0, 1.0)
+    row = np.array([g, k, c, r, u, v, rng.uniform(), rng.uniform(), rng.uniform(-np.pi, np.pi)])
+    return row, float(rng.choice([-1.0, 1.0]))
+
+
+def _on_curve(row: Array, circ: float, th: Array) -> Array:
+    from planar.synth.kernel import coupler_points
+
+    x, y, _ = coupler_points(row[None, :], th, np.array([circ]))
+    return np.column_stack([x[0], y[0]])
+
+
+def _whole_turn(rng: np.random.Generator, n: int, linkage: Any) -> tuple[Array, Array]:
+    row, circ = linkage(rng)
+    th = np.sort(rng.uniform(0.0, 2 * np.pi, n))
+    return _on_curve(row, circ, th), th
+
+
+def part_curve_problem(rng: np.random.Generator, n: int) -> tuple[Array, Array]:
+    """``n`` targets on PART of the coupler curve of a random crank-rocker or drag-link (either, even odds): sorted
+    random crank angles within an arc of 90 to 300 degrees starting anywhere (an open target set), and the angles."""
+    row, circ = (random_crank_rocker if rng.random() < 0.5 else random_drag_link)(rng)
+    span = np.radians(rng.uniform(90.0, 300.0))
+    th = rng.uniform(-np.pi, np.pi) + np.sort(rng.uniform(0.0, span, n))
+    return _on_curve(row, circ, th), th
+
+
+#: the reachable problems' kinds (:func:`bench_reachable`): each draws ``n`` targets and their crank angles
+REACHABLE_KINDS: dict[str, Any] = {
+    "crank-rocker": reachable_problem,
+    "drag-link": lambda rng, n: _whole_turn(rng, n, random_drag_link),
+    "part-curve": part_curve_problem,
+}
+
+
 def _max_error(targets: Array, row: Array, theta: Array) -> float:
     """Largest distance from a target to the coupler point of ``row`` (9 + circuit) at ``theta``, over the
     targets' size (RMS distance from their centroid)."""
@@ -528,45 +574,42 @@ def scipy_baseline(targets: Array, theta: Array | None, cpu_s: float, seed: int 
 
 
 def bench_reachable(
-    sizes: tuple[int, ...] = (8, 12, 25, 50), count: int = 25, seed: int = 2026, quick: bool = False, noise: float = 0.01
+    sizes: tuple[int, ...] = (8, 12, 25, 50),
+    count: int = 25,
+    seed: int = 2026,
+    quick: bool = False,
+    noise: float = 0.01,
+    kinds: tuple[str, ...] = tuple(REACHABLE_KINDS),
+    kind_count: int | None = None,
 ) -> dict[str, Any]:
-    """Reachable curves of random crank-rockers (:func:`reachable_problem`, seeded ``seed``, never used to tune
-    anything), ``count`` per number of targets in ``sizes``: planar untimed (atlas, after it is loaded) and
-    timed, each by CPU time (``time.process_time``) and largest error over the targets' size; then the same
-    curves with Gaussian noise (``noise`` of their size; unreachable), planar against :func:`scipy_baseline`
-    given the CPU time planar took.  ``quick``: the 20,000-curve atlas."""
+    """Reachable curves of random four-bars never used to tune anything, per kind of :data:`REACHABLE_KINDS`
+    (crank-rockers over the whole turn, drag-links over the whole turn, part-curves: an arc of 90 to 300 degrees of
+    a crank-rocker's or drag-link's turn), ``count`` crank-rockers and ``kind_count`` (``count`` when None) of each
+    other kind per number of targets in ``sizes``, each kind its own random stream (``seed`` and the kind's place):
+    planar untimed (atlas, after it is loaded) and timed, each by CPU time (``time.process_time``) and largest
+    error over the targets' size; then the crank-rockers' curves with Gaussian noise (``noise`` of their size;
+    unreachable), planar against :func:`scipy_baseline` given the CPU time planar took.  ``quick``: the
+    20,000-curve atlas."""
     from threadpoolctl import threadpool_limits
 
     from planar.synth.atlas import DEFAULT_SIZE, QUICK_SIZE, load_atlas
-    from planar.synth.path import synthesise_path
 
+    for k in kinds:
+        if k not in REACHABLE_KINDS:
+            raise PlanarError(f"bench_reachable: unknown kind {k!r} (one of {', '.join(REACHABLE_KINDS)})")
     t0 = time.process_time()
     atlas = load_atlas(QUICK_SIZE if quick else DEFAULT_SIZE)
     atlas.tree  # noqa: B018 (built here, not inside the first timed problem)
     load_s = time.process_time() - t0
-    rng = np.random.default_rng(seed)
     rows: list[dict[str, Any]] = []
     with threadpool_limits(1):
-        for n in sizes:
-            for _ in range(count):
-                T, th = reachable_problem(rng, n)
-                rec: dict[str, Any] = {"targets": n}
-                for mode, theta in (("untimed", None), ("timed", th)):
-                    c0 = time.process_time()
-                    d = synthesise_path(T, theta, budget="quick" if quick else "normal", atlas=atlas)
-                    rec[mode] = {"cpu_s": time.process_time() - c0, "max_error": d.checks["max_error"], "ok": d.ok}
-                noisy = T + noise * float(np.sqrt(np.mean(np.sum((T - T.mean(0)) ** 2, 1)))) * rng.standard_normal(T.shape)
-                c0 = time.process_time()
-                d = synthesise_path(noisy, None, budget="quick" if quick else "normal", atlas=atlas)
-                cpu = time.process_time() - c0
-                base, starts = scipy_baseline(noisy, None, cpu)
-                rec["noisy"] = {
-                    "cpu_s": cpu,
-                    "planar_max_error": d.checks["max_error"],
-                    "scipy_max_error": base,
-                    "scipy_starts": starts,
-                }
-                rows.append(rec)
+        for place, kind in enumerate(kinds):
+            # the crank-rockers keep the stream they always had (``seed`` alone)
+            rng = np.random.default_rng(seed if kind == "crank-rocker" else (seed, place))
+            per = count if kind == "crank-rocker" or kind_count is None else kind_count
+            for n in sizes:
+                for _ in range(per):
+                    rows.append(_reachable_row(rng, kind, n, atlas, quick, noise if kind == "crank-rocker" else None))
     return {
         "atlas_size": len(atlas),
         "atlas_load_cpu_s": load_s,
@@ -576,27 +619,48 @@ def bench_reachable(
     }
 
 
+def _reachable_row(rng: np.random.Generator, kind: str, n: int, atlas: Any, quick: bool, noise: float | None) -> dict[str, Any]:
+    """One problem of :func:`bench_reachable`: untimed and timed, and with ``noise`` (None: not) against scipy."""
+    T, th = REACHABLE_KINDS[kind](rng, n)
+    budget = "quick" if quick else "normal"
+    rec: dict[str, Any] = {"kind": kind, "targets": n}
+    for mode, theta in (("untimed", None), ("timed", th)):
+        c0 = time.process_time()
+        d = synthesise_path(T, theta, budget=budget, atlas=atlas)
+        rec[mode] = {"cpu_s": time.process_time() - c0, "max_error": d.checks["max_error"], "ok": d.ok}
+    if noise is not None:
+        noisy = T + noise * float(np.sqrt(np.mean(np.sum((T - T.mean(0)) ** 2, 1)))) * rng.standard_normal(T.shape)
+        c0 = time.process_time()
+        d = synthesise_path(noisy, None, budget=budget, atlas=atlas)
+        cpu = time.process_time() - c0
+        base, starts = scipy_baseline(noisy, None, cpu)
+        rec["noisy"] = {"cpu_s": cpu, "planar_max_error": d.checks["max_error"], "scipy_max_error": base, "scipy_starts": starts}
+    return rec
+
+
 def _reachable_summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    """Per kind and number of targets (keys ``"<kind> <n>"``): success within 1e-6 of the size, median error and
+    CPU (median, 90th percentile, largest), untimed and timed; for the crank-rockers the noisy comparison."""
     out: dict[str, Any] = {}
-    for n in sorted({r["targets"] for r in rows}):
-        rs = [r for r in rows if r["targets"] == n]
-        u = np.array([r["untimed"]["max_error"] for r in rs])
-        ti = np.array([r["timed"]["max_error"] for r in rs])
-        out[str(n)] = {
-            "problems": len(rs),
-            "untimed_recovered_1e-6": float(np.mean(u <= 1e-6)),
-            "untimed_median_error": float(np.median(u)),
-            "untimed_median_cpu_s": float(np.median([r["untimed"]["cpu_s"] for r in rs])),
-            "untimed_p90_cpu_s": float(np.percentile([r["untimed"]["cpu_s"] for r in rs], 90)),
-            "timed_exact_1e-6": float(np.mean(ti <= 1e-6)),
-            "timed_median_cpu_s": float(np.median([r["timed"]["cpu_s"] for r in rs])),
-            "timed_p90_cpu_s": float(np.percentile([r["timed"]["cpu_s"] for r in rs], 90)),
-            "noisy_planar_as_good_as_scipy": float(
-                np.mean([r["noisy"]["planar_max_error"] <= r["noisy"]["scipy_max_error"] * (1 + 1e-9) for r in rs])
-            ),
-            "noisy_planar_median_error": float(np.median([r["noisy"]["planar_max_error"] for r in rs])),
-            "noisy_scipy_median_error": float(np.median([r["noisy"]["scipy_max_error"] for r in rs])),
-        }
+    for kind in dict.fromkeys(r.get("kind", "crank-rocker") for r in rows):
+        for n in sorted({r["targets"] for r in rows if r.get("kind", "crank-rocker") == kind}):
+            rs = [r for r in rows if r.get("kind", "crank-rocker") == kind and r["targets"] == n]
+            s: dict[str, Any] = {"kind": kind, "targets": n, "problems": len(rs)}
+            for mode in ("untimed", "timed"):
+                e = np.array([r[mode]["max_error"] for r in rs])
+                c = np.array([r[mode]["cpu_s"] for r in rs])
+                s[f"{mode}_recovered_1e-6"] = float(np.mean(e <= 1e-6))
+                s[f"{mode}_median_error"] = float(np.median(e))
+                s[f"{mode}_median_cpu_s"] = float(np.median(c))
+                s[f"{mode}_p90_cpu_s"] = float(np.percentile(c, 90))
+                s[f"{mode}_max_cpu_s"] = float(np.max(c))
+            if all("noisy" in r for r in rs):
+                s["noisy_planar_as_good_as_scipy"] = float(
+                    np.mean([r["noisy"]["planar_max_error"] <= r["noisy"]["scipy_max_error"] * (1 + 1e-9) for r in rs])
+                )
+                s["noisy_planar_median_error"] = float(np.median([r["noisy"]["planar_max_error"] for r in rs]))
+                s["noisy_scipy_median_error"] = float(np.median([r["noisy"]["scipy_max_error"] for r in rs]))
+            out[f"{kind} {n}"] = s
     return out
 
 
@@ -621,18 +685,22 @@ def bench_targets_scaling(
 
 def format_reachable(r: dict[str, Any], scaling: list[dict[str, Any]]) -> str:
     lines = [
-        f"reachable curves of random crank-rockers (atlas of {r['atlas_size']:,}: built in {r['atlas_build_cpu_s']:.1f} s CPU, "
+        f"reachable curves of random four-bars (atlas of {r['atlas_size']:,}: built in {r['atlas_build_cpu_s']:.1f} s CPU, "
         f"loaded in {r['atlas_load_cpu_s']:.1f} s CPU)",
-        "  targets  untimed ok(<=1e-6)  median err  CPU median / 90th pct | timed ok  CPU median / 90th pct | "
+        "  kind          targets  untimed ok(<=1e-6)  median err  CPU median / 90th pct | timed ok  CPU median / max | "
         "noisy: planar >= scipy  median err planar / scipy",
     ]
-    for n, s in r["summary"].items():
-        lines.append(
-            f"  {n:>7}  {s['untimed_recovered_1e-6']:>17.0%}  {s['untimed_median_error']:>10.2g}  "
-            f"{s['untimed_median_cpu_s']:>11.2f} / {s['untimed_p90_cpu_s']:.2f} s | {s['timed_exact_1e-6']:>8.0%}  "
-            f"{s['timed_median_cpu_s']:>11.2f} / {s['timed_p90_cpu_s']:.2f} s | "
+    for s in r["summary"].values():
+        noisy = (
             f"{s['noisy_planar_as_good_as_scipy']:>21.0%}  "
             f"{s['noisy_planar_median_error']:.3g} / {s['noisy_scipy_median_error']:.3g}"
+            if "noisy_planar_as_good_as_scipy" in s
+            else f"{'-':>21}"
+        )
+        lines.append(
+            f"  {s['kind']:<12}  {s['targets']:>7}  {s['untimed_recovered_1e-6']:>17.0%}  {s['untimed_median_error']:>10.2g}  "
+            f"{s['untimed_median_cpu_s']:>11.2f} / {s['untimed_p90_cpu_s']:.2f} s | {s['timed_recovered_1e-6']:>8.0%}  "
+            f"{s['timed_median_cpu_s']:>10.2f} / {s['timed_max_cpu_s']:.2f} s | {noisy}"
         )
     lines.append("  untimed CPU against targets: " + ", ".join(f"{x['targets']}: {x['cpu_s']:.2f} s" for x in scaling))
     return "\n".join(lines)

@@ -154,9 +154,9 @@ def _search(
     ``tolerance`` (largest distance, targets' size 1).
 
     Returns the result (its ``stages``: every stage that ran, seconds: ``atlas_load_s``, ``atlas_s``,
-    ``refine_s``, ``timed_s``, ``rocking_s`` and, when the global search ran, ``global_sample_s``, ``global_de_s``,
-    ``global_refine_s``), a sentence saying which stage produced it, and the input's swing (rad from the ground
-    line) when the result's input rocks (None when it turns fully)."""
+    ``refine_s``, ``timed_s`` or ``closed_form_s`` (timed targets), ``rocking_s`` and, when the global search ran,
+    ``global_sample_s``, ``global_de_s``, ``global_refine_s``), a sentence saying which stage produced it, and the
+    input's swing (rad from the ground line) when the result's input rocks (None when it turns fully)."""
     import time
 
     from planar.synth.search import max_distance, timed_from_atlas
@@ -179,8 +179,13 @@ def _search(
         else float("inf")
     )
     if timed is not None and timed.feasible and _keeps_transmission(timed, cons) and e_atlas <= tolerance:
+        how = (
+            "the closed-form timed solution (no atlas lookup"
+            if "closed_form_s" in timed.stages
+            else "the atlas lookup and refinement ("
+        )
         timed.stages = {**load, **timed.stages}
-        return timed, "the atlas lookup and refinement (the global search did not run: within the tolerance)", None
+        return timed, f"{how}{'; ' if how.endswith('lookup') else ''}the global search did not run: within the tolerance)", None
     g = search_fourbar(t, theta, cons, seed=seed, **kw)
     g.stages = {**load, **(timed.stages if timed is not None else {}), **_prefixed(g.stages)}
     return g, f"the global search (--budget {budget}; the atlas's best was {e_atlas:.3g} of the size off)", None

@@ -276,29 +276,29 @@ def ordered_theta(d2: Array, th: Array, starts: int = 4) -> tuple[Array, float]:
     if len(loc) == 0:
         return th[np.argmin(d2, axis=1)], float("inf")
     loc = loc[np.argsort(d0[loc], kind="stable")[:starts]]
-    best: tuple[float, Array] = (float("inf"), th[np.argmin(d2, axis=1)])
-    for sign in (1, -1):
-        for s in loc:
-            idx = (s + sign * np.arange(n)) % n  # the turn unrolled from the start, one way round
-            D = d2[:, idx]
-            cost = np.full(n, np.inf)
-            cost[0] = D[0, 0]
-            arg = np.zeros((N, n), dtype=np.intp)
-            k = np.arange(n)
-            for i in range(1, N):
-                run = np.minimum.accumulate(cost)
-                where = np.maximum.accumulate(np.where(cost <= run, k, 0))
-                cost = D[i] + run
-                arg[i] = where
-            j = int(np.argmin(cost))
-            total = float(cost[j])
-            if total < best[0]:
-                path = np.empty(N, dtype=np.intp)
-                for i in range(N - 1, -1, -1):
-                    path[i] = j
-                    j = int(arg[i, j])
-                best = (total, th[idx[path]])
-    return best[1], best[0]
+    k = np.arange(n)
+    # every start both ways round at once (rows: one way from each start, then the other way)
+    idx = (np.concatenate([loc, loc])[:, None] + np.repeat([1, -1], len(loc))[:, None] * k[None, :]) % n
+    D = d2[:, idx]  # (N, V, n): each variant's turn unrolled from its start
+    V = len(idx)
+    cost = np.full((V, n), np.inf)
+    cost[:, 0] = D[0, :, 0]
+    arg = np.zeros((N, V, n), dtype=np.intp)
+    for i in range(1, N):
+        run = np.minimum.accumulate(cost, axis=1)
+        arg[i] = np.maximum.accumulate(np.where(cost <= run, k, 0), axis=1)
+        cost = D[i] + run
+    ends = np.argmin(cost, axis=1)
+    totals = cost[np.arange(V), ends]
+    v = int(np.argmin(totals))  # the first of the best, as one variant after another would keep
+    if not np.isfinite(totals[v]):
+        return th[np.argmin(d2, axis=1)], float("inf")
+    path = np.empty(N, dtype=np.intp)
+    j = int(ends[v])
+    for i in range(N - 1, -1, -1):
+        path[i] = j
+        j = int(arg[i, v, j])
+    return th[idx[v, path]], float(totals[v])
 
 
 def _residual_functions(obj: PathObjective, circuit: float, hi: Array) -> tuple[Any, Any]:
@@ -598,7 +598,7 @@ def search_atlas(
 
 #: the wide lookup, when the targets' nearest entries fail: neighbours per query (8 queries), the best kept by a
 #: cheap similarity fit on a coarse curve (samples) and how many of them are refined
-WIDE_K, WIDE_KEEP, WIDE_SAMPLES, WIDE_REFINE = 4000, 256, 32, 16
+WIDE_K, WIDE_KEEP, WIDE_SAMPLES, WIDE_REFINE = 4000, 256, 32, 4
 
 
 def _wide_candidates(atlas: Any, obj: PathObjective, keep: int = WIDE_KEEP) -> Array:
@@ -687,6 +687,39 @@ def _batch_jacobian(obj: PathObjective, Z: Array, circ: Array, R0: Array) -> Arr
     return J
 
 
+def _structured_normal(J: Array, R: Array) -> tuple[Array, ...]:
+    """The normal equations of Jacobians ``J`` ``(K, 2 N + 1, 9 + N)`` (:func:`_batch_jacobian`) and residuals ``R``,
+    in the blocks their structure leaves: ``A_pp`` ``(K, 9, 9)`` (the parameters), ``A_tp`` ``(K, N, 9)``,
+    the diagonal ``a_tt`` ``(K, N)`` (crank angle ``i`` moves only target ``i``'s residuals), and the gradient's
+    parts ``g_p`` ``(K, 9)``, ``g_t`` ``(K, N)``."""
+    n = J.shape[2] - N_PARAMS
+    i = np.arange(n)
+    Jp = J[:, :, :N_PARAMS]
+    jx, jy = J[:, i, N_PARAMS + i], J[:, n + i, N_PARAMS + i]
+    App = np.matmul(Jp.transpose(0, 2, 1), Jp)
+    Atp = Jp[:, :n, :] * jx[:, :, None] + Jp[:, n : 2 * n, :] * jy[:, :, None]
+    att = jx * jx + jy * jy
+    gp = np.matmul(Jp.transpose(0, 2, 1), R[:, :, None])[:, :, 0]
+    gt = jx * R[:, :n] + jy * R[:, n : 2 * n]
+    return App, Atp, att, gp, gt
+
+
+def _damped_step(normal: tuple[Array, ...], lam: Array) -> Array:
+    """Levenberg-Marquardt steps ``(K, 9 + N)`` of the structured normal equations (:func:`_structured_normal`)
+    damped by ``lam`` ``(K,)`` times their diagonal (Marquardt's scaling): the crank angles eliminated (their block
+    is diagonal), a 9 x 9 Schur complement solved per start, the angles' steps back-substituted.  The same steps as
+    solving the whole ``(9 + N)`` system, at a cost linear in ``N``."""
+    App, Atp, att, gp, gt = normal
+    dp = np.einsum("kjj->kj", App) + 1e-12
+    T = att + lam[:, None] * (att + 1e-12)
+    W = Atp / T[:, :, None]
+    S = App + (lam[:, None] * dp)[:, :, None] * np.eye(N_PARAMS) - np.matmul(W.transpose(0, 2, 1), Atp)
+    rhs = -gp + np.matmul(W.transpose(0, 2, 1), gt[:, :, None])[:, :, 0]
+    sp = np.linalg.solve(S, rhs[:, :, None])[:, :, 0]
+    st = (-gt - np.matmul(Atp, sp[:, :, None])[:, :, 0]) / T
+    return np.concatenate([sp, st], axis=1)
+
+
 def batch_lm(obj: PathObjective, C: Array, iters: int, reassign: int = 10) -> tuple[Array, Array]:
     """Levenberg-Marquardt from many starts at once: candidate rows ``C`` ``(K, 10)`` on untimed targets, the
     crank angles at the targets assigned on each start's curve (:func:`assign_theta`) and again every
@@ -702,7 +735,6 @@ def batch_lm(obj: PathObjective, C: Array, iters: int, reassign: int = 10) -> tu
     m = N_PARAMS + len(obj.targets)
     Z = np.empty((K, m))
     Z[:, :N_PARAMS] = C[:, :N_PARAMS]
-    eye = np.eye(m)
     lam = np.full(K, 1e-3)
     f = np.full(K, np.inf)
     R = np.zeros((K, 2 * len(obj.targets) + 1))
@@ -710,16 +742,13 @@ def batch_lm(obj: PathObjective, C: Array, iters: int, reassign: int = 10) -> tu
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         for it in range(iters):
             if it % reassign == 0:
-                Z[:, N_PARAMS:] = [assign_theta(obj, np.append(z[:N_PARAMS], c)) for z, c in zip(Z, circ, strict=True)]
+                Z[:, N_PARAMS:] = assign_theta_batch(obj, np.column_stack([Z[:, :N_PARAMS], circ]))
                 R = _batch_residuals(obj, Z, circ)
                 f = np.sum(R**2, axis=1)
-            J = _batch_jacobian(obj, Z, circ, R)
-            A = np.einsum("kij,kil->kjl", J, J)
-            g = np.einsum("kij,ki->kj", J, R)
-            D = np.einsum("kjj->kj", A) + 1e-12
+            normal = _structured_normal(_batch_jacobian(obj, Z, circ, R), R)
             pending = np.isfinite(f)
             for _ in range(4):
-                step = -np.linalg.solve(A + (lam[:, None] * D)[:, :, None] * eye, g[:, :, None])[:, :, 0]
+                step = _damped_step(normal, lam)
                 Rn = _batch_residuals(obj, Z + step, circ)
                 fn = np.sum(Rn**2, axis=1)
                 better = pending & np.isfinite(fn) & (fn < f)
@@ -867,12 +896,30 @@ def assign_theta(obj: PathObjective, row: Array, n: int = 256) -> Array:
     that costs at most 10 times the nearest points' squared distance (the targets then run along the curve),
     else each target's nearest point."""
     th, d2 = _curve_d2(obj, row, n)
+    return _assigned(d2, th)
+
+
+def _assigned(d2: Array, th: Array) -> Array:
+    """:func:`assign_theta` from the squared distances ``d2`` ``(N, n)`` of the targets to a curve at ``th``."""
     near = th[np.argmin(d2, axis=1)]
     cost_near = float(np.sum(np.min(d2, axis=1)))
     if not np.isfinite(cost_near):
         return near
     ordered, cost = ordered_theta(d2, th)
     return ordered if cost <= 10.0 * cost_near + 1e-30 else near
+
+
+def assign_theta_batch(obj: PathObjective, rows: Array, n: int = 256) -> Array:
+    """:func:`assign_theta` for candidate rows ``rows`` ``(K, 10)`` (the same angles ``(K, N)``), their curves solved
+    by one kernel call."""
+    th = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    x, y, ok = coupler_points(rows[:, :N_PARAMS], th, np.where(rows[:, 9] >= 0, 1.0, -1.0))
+    out = np.empty((len(rows), len(obj.targets)))
+    for k in range(len(rows)):
+        d2 = (x[k][None, :] - obj.targets[:, 0:1]) ** 2 + (y[k][None, :] - obj.targets[:, 1:2]) ** 2
+        d2[:, ~ok[k]] = np.inf
+        out[k] = _assigned(d2, th)
+    return out
 
 
 def reassigned_refine(
@@ -933,14 +980,94 @@ TIMED_FROM, TIMED_STOP = 1e-6, 1e-9
 TIMED_DIRECT = 4
 
 
+def _dyad_line(A: Array, rhs: Array) -> tuple[Array, Array] | None:
+    """The solutions of ``A x = rhs`` (``A`` of rank 6 in 7 unknowns): a point and the null direction, by SVD; None
+    when a second singular value is also at rounding level (the targets do not fix the line)."""
+    U, S, Vt = np.linalg.svd(A, full_matrices=False)
+    if S[-2] <= DYAD_RCOND * S[0]:
+        return None
+    return Vt[:-1].T @ ((U[:, :-1].T @ rhs) / S[:-1]), Vt[-1]
+
+
+def _dyad_roots(x0: Array, n: Array) -> list[float]:
+    """Where on the line ``x0 + t n`` of unknowns ``[K, a, b, q]`` (``a, b, q`` complex, as pairs) the product ``q``
+    equals ``a conj(b)``: the real parts of the two roots of that complex quadratic in ``t``."""
+    a0, a1 = complex(x0[1], x0[2]), complex(n[1], n[2])
+    b0, b1 = complex(x0[3], x0[4]), complex(n[3], n[4])
+    q0, q1 = complex(x0[5], x0[6]), complex(n[5], n[6])
+    lead = -a1 * np.conj(b1)
+    if abs(lead) == 0.0:
+        return []
+    return [float(r.real) for r in np.roots([lead, q1 - a1 * np.conj(b0) - a0 * np.conj(b1), q0 - a0 * np.conj(b0)])]
+
+
+#: singular values (relative to the largest) under which the closed-form timed solution is not attempted
+DYAD_RCOND = 1e-10
+
+
+def timed_closed_form(targets: Array, theta: Array) -> Array:
+    """Four-bars whose coupler point passes through ``targets`` ``(N, 2)`` at the crank angles ``theta`` ``(N,)``
+    (radians from the ground line), in closed form from the targets alone (no search): rows of the kernel's 9
+    parameters and the circuit ``(k, 10)``, usually two (a four-bar and another with the same timing), none for
+    fewer than 7 targets or when the targets do not fix them.  Exact for targets a four-bar passes through (to
+    rounding); for others a start for least squares.
+
+    The crank pin is ``B_i = O2 + w e^(i theta_i)`` (complex; ``w`` the crank, turned by the ground line's
+    angle) and the coupler point stays at a distance ``d`` from it: ``|P_i - O2 - w e^(i theta_i)|^2 = d^2``.
+    Expanded, that is linear in ``K = |O2|^2 + |w|^2 - d^2``, ``O2``, ``w`` and ``q = O2 conj(w)`` (7 real
+    unknowns, one equation per target).  Two dyads turning at the crank's rate reach the coupler point (the
+    crank and one of a cognate's), so the system has rank 6; the line of its solutions meets ``q = O2 conj(w)``
+    at both (a quadratic).  With the crank known, the coupler's pose at each target is known (``B_i`` and the
+    direction to ``P_i``), and the rocker pin ``C_i = B_i + c u_i`` (``u_i`` the unit vector from ``B_i`` to
+    ``P_i``, ``c`` complex in the coupler's frame) on a circle about ``O4`` is the same problem again, linear in
+    ``c``, ``O4``, ``|c|^2 + |O4|^2 - r4^2`` and ``c conj(O4)``; its two solutions are the rocker pin and the crank
+    pin itself (``c = 0``, discarded)."""
+    P = np.asarray(targets, float) @ np.array([1.0, 1j])
+    th = np.asarray(theta, float)
+    N = len(P)
+    out: list[list[float]] = []
+    if N < 7:
+        return np.empty((0, N_PARAMS + 1))
+    e = np.exp(-1j * th)
+    Pe = P * e
+    A = np.column_stack([np.ones(N), -2 * P.real, -2 * P.imag, -2 * Pe.real, -2 * Pe.imag, 2 * e.real, -2 * e.imag])
+    line = _dyad_line(A, -(np.abs(P) ** 2))
+    for t in _dyad_roots(*line) if line is not None else []:
+        x = line[0] + t * line[1]  # type: ignore[index]
+        O2, w = complex(x[1], x[2]), complex(x[3], x[4])
+        d2 = abs(O2) ** 2 + abs(w) ** 2 - x[0]
+        if d2 <= 0 or w == 0:
+            continue
+        B = O2 + w * np.exp(1j * th)
+        u = (P - B) / np.maximum(np.abs(P - B), 1e-300)
+        Bu = B * np.conj(u)
+        A2 = np.column_stack([np.ones(N), 2 * Bu.real, 2 * Bu.imag, -2 * B.real, -2 * B.imag, -2 * u.real, 2 * u.imag])
+        line2 = _dyad_line(A2, -(np.abs(B) ** 2))
+        for s in _dyad_roots(*line2) if line2 is not None else []:
+            y = line2[0] + s * line2[1]  # type: ignore[index]
+            c, O4 = complex(y[1], y[2]), complex(y[3], y[4])
+            if abs(c) <= 1e-9 * np.sqrt(d2) or O4 == O2:
+                continue
+            C = B + c * u
+            uv = np.sqrt(d2) * np.conj(c) / abs(c)  # the coupler point in the coupler's frame (x toward C)
+            circ = 1.0 if np.mean((np.conj(O4 - B) * (C - B)).imag) >= 0 else -1.0
+            r4 = float(np.mean(np.abs(C - O4)))
+            out.append([abs(O4 - O2), abs(w), abs(c), r4, uv.real, uv.imag, O2.real, O2.imag, float(np.angle(O4 - O2)), circ])
+    rows = np.array(out, float).reshape(-1, N_PARAMS + 1)
+    return rows[np.isfinite(rows).all(1) & (rows[:, :4] > 0).all(1)]
+
+
 def timed_from_atlas(
-    targets: Array, theta: Array, atlas: Any, cons: Constraints | None = None, starts: int = 3
+    targets: Array, theta: Array, atlas: Any, cons: Constraints | None = None, starts: int = 3, closed_form: bool = True
 ) -> SearchResult | None:
-    """Timed targets (normalised) from the atlas: the :data:`TIMED_DIRECT` best direct starts
-    (:func:`timed_starts`) refined with the crank angles fixed at ``theta``; when none is exact, the untimed
+    """Timed targets (normalised) from the atlas: first the closed form (:func:`timed_closed_form`, exact on targets
+    a four-bar passes through, from 7 targets; refined with the crank angles fixed at ``theta`` when not exact), then
+    the :data:`TIMED_DIRECT` best direct starts (:func:`timed_starts`) refined likewise; when none is exact, the untimed
     curve (:func:`search_atlas`, each refined start within :data:`TIMED_FROM` refined again with the angles
     fixed, until one is exact), then least squares with the angles fixed from its best (None when no start
-    closes at every crank angle)."""
+    closes at every crank angle).  ``closed_form=False`` leaves the closed form out (the atlas's starts alone).
+    The result's ``stages``: ``closed_form_s`` alone when the closed form gave it, else ``timed_s`` (and the
+    untimed search's when it ran)."""
     import time
 
     cons = cons if cons is not None else Constraints()
@@ -960,11 +1087,23 @@ def timed_from_atlas(
         timed.append((e, r, tt))
         return max_distance(obj, r, obj.theta) <= TIMED_STOP and not constraint_failures(r[:N_PARAMS], cons)  # type: ignore[arg-type]
 
-    # first the direct starts: the neighbours placed by the prescribed timing, refined with the angles fixed
-    for row in timed_starts(atlas, obj)[:TIMED_DIRECT]:
-        r, tt, e = _refine(obj, row, b, max_nfev=REFINE_NFEV, method="lm")
+    # first the closed form (exact on targets a four-bar passes through), then the direct starts: the neighbours
+    # placed by the prescribed timing, each refined with the angles fixed
+    exact = timed_closed_form(obj.targets, obj.theta) if closed_form else np.empty((0, N_PARAMS + 1))  # type: ignore[arg-type]
+
+    def direct() -> Any:
+        yield from exact
+        yield from timed_starts(atlas, obj)[:TIMED_DIRECT]  # the atlas's lookup only when the closed form fails
+
+    for k, row in enumerate(direct()):
+        r, tt = row, np.asarray(obj.theta, float)
+        if max_distance(obj, row, tt) > TIMED_STOP:
+            r, tt, _ = _refine(obj, row, b, max_nfev=REFINE_NFEV, method="lm")
+        e = float(obj.population(r[None, :], np.float64)[0])
+        if not np.isfinite(e):  # a degenerate start (from an ill-conditioned closed form): nothing to keep
+            continue
         if max_distance(obj, r, obj.theta) <= TIMED_STOP and not constraint_failures(r[:N_PARAMS], cons):  # type: ignore[arg-type]
-            stages = {"timed_s": time.perf_counter() - t0}
+            stages = {"closed_form_s" if k < len(exact) else "timed_s": time.perf_counter() - t0}
             return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), True, 0, stages)
         timed.append((e, r, tt))
     u = search_atlas(targets, atlas, cons, stop=exact_timed)

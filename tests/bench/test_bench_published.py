@@ -114,3 +114,32 @@ def test_unreachable_problems_are_seeded_and_noisy_by_their_level():
     X = random_sixbar(np.random.default_rng(2), "watt")
     _, _, margin = sixbar_points(X[None, :], np.linspace(0, 2 * np.pi, 3600, endpoint=False), "watt")
     assert margin.min() > 0
+
+
+def test_reachable_kinds_draw_what_they_name():
+    """The reachable benchmark's kinds: drag-links are double-cranks with the ground shortest and crank-rockers
+    crank-rockers (planar's FourBar says so), both valid over the whole turn on their circuit; a part-curve's crank
+    angles are sorted and span at most 300 degrees; same seed, same targets; an unknown kind is refused naming the
+    kinds."""
+    from planar.bench.synthesis import REACHABLE_KINDS, bench_reachable, random_crank_rocker, random_drag_link
+    from planar.errors import PlanarError
+    from planar.linkages import FourBar
+
+    rng = np.random.default_rng(41)
+    for kind, draw in REACHABLE_KINDS.items():
+        for _ in range(20):
+            T, th = draw(rng, 9)
+            assert T.shape == (9, 2) and np.all(np.diff(th) > 0)
+            assert kind != "part-curve" or th[-1] - th[0] <= np.radians(300.0)
+        a, b = draw(np.random.default_rng(3), 9), draw(np.random.default_rng(3), 9)
+        assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+    for draw, grashof in ((random_drag_link, "double-crank"), (random_crank_rocker, "crank-rocker")):
+        for _ in range(10):
+            row, circ = draw(rng)
+            circuit = "open" if circ > 0 else "crossed"
+            fb = FourBar(*row[:4], coupler_point=(row[4], row[5]), circuit=circuit, placement=tuple(row[6:9]))
+            assert fb.grashof == grashof
+            assert (row[0] == row[:4].min()) == (grashof == "double-crank")
+            assert fb.solve(np.linspace(0.0, 2 * np.pi, 90, endpoint=False)).valid.all()
+    with pytest.raises(PlanarError, match=r"unknown kind 'rocker'.*drag-link"):
+        bench_reachable(kinds=("rocker",))

@@ -171,7 +171,70 @@ def test_timed_targets_are_placed_by_their_timing_and_refined_exactly():
         direct = timed_starts(atlas, obj)
         placed = candidates(atlas, obj.targets, 64)
         assert obj.population(direct[:1], np.float64)[0] < obj.population(placed, np.float64).min()
-        r = timed_from_atlas(obj.targets, th, atlas)
+        r = timed_from_atlas(obj.targets, th, atlas, closed_form=False)
         assert r is not None and r.feasible
         assert max_distance(obj, np.append(r.params, r.circuit), th) <= 1e-9
         assert set(r.stages) == {"timed_s"}
+        # with the closed form (the default) it is exact before any atlas lookup
+        r = timed_from_atlas(obj.targets, th, atlas)
+        assert r is not None and r.feasible and set(r.stages) == {"closed_form_s"}
+        assert max_distance(obj, np.append(r.params, r.circuit), th) <= 1e-9
+
+
+def _fourbar_points(row, circ, theta):
+    """The coupler points of a kernel row by planar's FourBar solver (not the search's kernel)."""
+    from planar.linkages import FourBar
+
+    fb = FourBar(
+        *row[:4],
+        coupler_point=(row[4], row[5]),
+        circuit="open" if circ > 0 else "crossed",
+        placement=(row[6], row[7], row[8]),
+    )
+    at = fb.solve(np.asarray(theta, float))
+    assert at.valid.all()
+    return at.points["coupler_point"]
+
+
+@pytest.mark.parametrize("n", [7, 8, 12, 50])
+def test_timed_closed_form_recovers_random_four_bars_exactly(n):
+    """Targets at prescribed crank angles on random crank-rockers and drag-links (planar's FourBar solver makes them):
+    the closed form gives, with no search, the four-bar itself (its four lengths, coupler point and placement to
+    1e-9) and every row it gives passes through the targets by the same solver; fewer than 7 targets give none."""
+    from planar.bench.synthesis import random_drag_link
+    from planar.synth.search import timed_closed_form
+
+    rng = np.random.default_rng(7000 + n)
+    for draw in (random_crank_rocker, random_drag_link) * 3:
+        row, circ = draw(rng)
+        th = np.sort(rng.uniform(0.0, 2 * np.pi, n))
+        T = _fourbar_points(row, circ, th)
+        rows = timed_closed_form(T, th)
+        assert 1 <= len(rows) <= 2
+        size = float(np.sqrt(np.mean(np.sum((T - T.mean(0)) ** 2, 1))))
+        for r in rows:
+            assert np.max(np.hypot(*(_fourbar_points(r[:9], r[9], th) - T).T)) <= 1e-9 * size
+        gap = [
+            np.max(np.abs(r[:9] - row) * [1, 1, 1, 1, 1, 1, 1, 1, 0]) + abs(np.angle(np.exp(1j * (r[8] - row[8])))) for r in rows
+        ]
+        assert min(gap) <= 1e-9 * max(1.0, float(np.abs(row).max()))
+        assert rows[int(np.argmin(gap)), 9] == circ
+    assert len(timed_closed_form(T[:6], th[:6])) == 0
+
+
+def test_timed_closed_form_on_targets_no_four_bar_passes_gives_finite_starts_or_none():
+    """Noisy targets, all crank angles equal, a circle traced at the crank's rate (the coupler point on the crank pin):
+    the closed form raises nothing and every row it gives is finite with positive lengths (the circle gives none)."""
+    from planar.synth.search import timed_closed_form
+
+    rng = np.random.default_rng(12)
+    a = np.linspace(0.0, 6.0, 10)
+    cases = [
+        (rng.normal(size=(12, 2)), np.sort(rng.uniform(0.0, 6.0, 12))),
+        (rng.normal(size=(9, 2)), np.zeros(9)),
+        (np.column_stack([np.cos(a), np.sin(a)]), a),
+    ]
+    for T, th in cases:
+        rows = timed_closed_form(T, th)
+        assert np.isfinite(rows).all() and (rows[:, :4] > 0).all()
+    assert len(timed_closed_form(*cases[2])) == 0
