@@ -58,8 +58,9 @@ __all__ = [
 
 Array = NDArray[np.float64]
 
-#: the seed of the held-out problems (never used to tune anything)
-SEED = 90817
+#: the seed of the held-out problems, never used to tune anything (90817 measured the search before the algebraic
+#: solve of free offsets; this one, after it)
+SEED = 20261130
 #: pairs per function problem and poses per motion problem
 FUNCTION_SIZES = (3, 4, 5, 7, 10)
 MOTION_SIZES = (3, 4, 5)

@@ -18,6 +18,14 @@ same margin).  The error is the true output angle on the candidate's circuit
 (the :mod:`.kernel`'s rocker pin) minus the request, not Freudenstein's
 equation residual.
 
+Free offsets with 5 or more pairs are first solved algebraically: expanded,
+Freudenstein's equation is linear and homogeneous in seven products of the
+unknowns (:func:`_linear_unknowns`), so its null space (a line from 6 pairs,
+a plane and a cubic at 5) gives every four-bar that meets the pairs exactly;
+Gauss-Newton on the five unknowns polishes them.  A valid one within
+:data:`ALGEBRAIC_EXACT` is the design (the one with the largest transmission
+margin when several are); otherwise they join the seeds.
+
 Seeds: Freudenstein's linear least squares at a grid of offsets (free) or at
 the given ones (fixed), and a scrambled Sobol sample of the lengths (and
 offsets), each on both circuits, evaluated at once; the best valid ones (and
@@ -44,6 +52,8 @@ MARGIN_FLOOR = 1e-4
 SCREEN = 24
 #: weight of a constraint's violation (rad) against output-angle error (rad) in the refinement
 WEIGHT = 10.0
+#: free offsets: Gauss-Newton steps polishing the algebraic solutions of Freudenstein's equation
+NEWTON_STEPS = 12
 
 
 @dataclass(frozen=True)
@@ -147,6 +157,88 @@ def _closed_form_seeds(phi: Array, psi: Array, A: Array, B: Array) -> Array:
     b2 = a * a + c * c + 1.0 - 2.0 * a * c * K[:, 2]
     real = b2 > 0
     return np.column_stack([a, np.sqrt(np.where(real, b2, 1.0)), c, A - turn, B - turn])[real]
+
+
+def _freudenstein_newton(phi: Array, psi: Array, Z: Array, iterations: int = NEWTON_STEPS) -> tuple[Array, Array]:
+    """Gauss-Newton, all starts at once, on Freudenstein's equation with free offsets: rows ``Z = (K1, K2, K3, A,
+    B)``, residuals ``K1 cos(psi + B) - K2 cos(phi + A) + K3 - cos(phi + A - psi - B)``, their exact Jacobian, a
+    step kept only where it lowers the residual.  Returns the rows and their residuals' norms."""
+
+    def res(Z: Array) -> tuple[Array, Array, Array]:
+        th, ps = phi[None, :] + Z[:, 3:4], psi[None, :] + Z[:, 4:5]
+        return Z[:, 0:1] * np.cos(ps) - Z[:, 1:2] * np.cos(th) + Z[:, 2:3] - np.cos(th - ps), th, ps
+
+    r, th, ps = res(Z)
+    cost = np.einsum("pn,pn->p", r, r)
+    for _ in range(iterations):
+        s = np.sin(th - ps)
+        J = np.stack(
+            [np.cos(ps), -np.cos(th), np.ones_like(th), Z[:, 1:2] * np.sin(th) + s, -Z[:, 0:1] * np.sin(ps) - s], axis=-1
+        )
+        step = np.stack([np.linalg.lstsq(Ji, -ri, rcond=None)[0] for Ji, ri in zip(J, r)]) if len(Z) else Z
+        rn, thn, psn = res(Z + step)
+        cn = np.einsum("pn,pn->p", rn, rn)
+        better = cn < cost
+        if not better.any():
+            break
+        Z = np.where(better[:, None], Z + step, Z)
+        r, th, ps = (np.where(better[:, None], new, old) for new, old in ((rn, r), (thn, th), (psn, ps)))
+        cost = np.where(better, cn, cost)
+    return Z, np.sqrt(cost)
+
+
+def _linear_unknowns(phi: Array, psi: Array) -> Array:
+    """Candidate vectors ``u = (K1 cos B, K1 sin B, K2 cos A, K2 sin A, K3, cos(A - B), sin(A - B))`` (rows).
+
+    Expanded, Freudenstein's equation with free offsets is linear and homogeneous in ``u``:
+    ``u1 cos psi - u2 sin psi - u3 cos phi + u4 sin phi + u5 - u6 cos(phi - psi) + u7 sin(phi - psi) = 0``.
+    With 6 or more pairs the exact ``u`` spans the null space of that system (its last right singular vector;
+    the least-squares one when no four-bar meets the pairs).  With 5 pairs the null space is a plane
+    ``alpha v1 + beta v2``; ``u`` must also be consistent (``(u3 + i u4)(u1 - i u2)(u6 - i u7)`` real, since
+    ``A - B`` is the angle of ``u6 + i u7``): a homogeneous cubic in ``(alpha, beta)``, up to three roots.
+    Fewer pairs: none (the search's grid and random seeds find those)."""
+    n = len(phi)
+    if n < 5:
+        return np.zeros((0, 7))
+    d = phi - psi
+    M = np.column_stack([np.cos(psi), -np.sin(psi), -np.cos(phi), np.sin(phi), np.ones(n), -np.cos(d), np.sin(d)])
+    V = np.linalg.svd(M / np.linalg.norm(M, axis=1, keepdims=True), full_matrices=n < 7)[2]  # 7 x 7 (never n x n)
+    if n > 5:
+        return V[-1:]
+    v1, v2 = V[-2], V[-1]
+
+    def imag(U: Array) -> Array:
+        return np.imag((U[:, 2] + 1j * U[:, 3]) * (U[:, 0] - 1j * U[:, 1]) * (U[:, 5] - 1j * U[:, 6]))
+
+    # u = alpha v1 + beta v2: with beta = 1 a cubic in alpha (fitted exactly at 4 points), and beta = 0 checked
+    a = np.array([-1.0, -1 / 3, 1 / 3, 1.0])
+    roots = np.roots(np.polyfit(a, imag(a[:, None] * v1 + v2), 3))
+    alphas = roots[np.abs(roots.imag) <= 1e-8 * np.maximum(1.0, np.abs(roots))].real
+    rows = [al * v1 + v2 for al in alphas]
+    if abs(imag(v1[None, :])[0]) <= 1e-12:
+        rows.append(v1)
+    return np.array(rows).reshape(-1, 7)
+
+
+def _algebraic_seeds(phi: Array, psi: Array) -> Array:
+    """Free offsets, 5 or more pairs: the four-bars of :func:`_linear_unknowns`, polished by
+    :func:`_freudenstein_newton`, as rows ``a, b, c, A, B`` (real ones, ``K1`` and ``K2`` of one sign).  Where a
+    four-bar meets the pairs exactly it is among them, to rounding."""
+    U = _linear_unknowns(phi, psi)
+    U = np.vstack([U, -U])  # u and -u: one of them has K1 and K2 of one sign
+    U = U / np.maximum(np.hypot(U[:, 5], U[:, 6]), 1e-300)[:, None]  # cos^2 + sin^2 = 1
+    B, A = np.arctan2(U[:, 1], U[:, 0]), np.arctan2(U[:, 3], U[:, 2])
+    K1, K2 = np.hypot(U[:, 0], U[:, 1]), np.hypot(U[:, 2], U[:, 3])
+    flip = np.cos(A - B - np.arctan2(U[:, 6], U[:, 5])) < 0  # A - B off by pi: K2 is negative
+    K2 = np.where(flip, -K2, K2)
+    A = np.where(flip, A + np.pi, A)
+    Z, _ = _freudenstein_newton(phi, psi, np.column_stack([K1, K2, U[:, 4], A, B]))
+    Z = Z[(Z[:, 0] * Z[:, 1] > 0) & np.isfinite(Z).all(1)]
+    turn = np.where(Z[:, 0] < 0, np.pi, 0.0)  # negative K1, K2: the frame turned by pi
+    a, c = 1.0 / np.abs(Z[:, 0]), 1.0 / np.abs(Z[:, 1])
+    b2 = a * a + c * c + 1.0 - 2.0 * a * c * Z[:, 2]
+    real = b2 > 0
+    return np.column_stack([a, np.sqrt(np.where(real, b2, 1.0)), c, _wrap(Z[:, 3] - turn), _wrap(Z[:, 4] - turn)])[real]
 
 
 def _seeds(phi: Array, psi: Array, cons: FunctionConstraints, n_random: int, grid: int, seed: int) -> Array:
@@ -277,7 +369,11 @@ def search_function(
         raise InputError("seed", seed, "a whole number >= 0")
     order = np.argsort(phi, kind="stable")  # seeds judged at most SCREEN pairs, spread over the arc
     sub = order[np.unique(np.round(np.linspace(0, len(phi) - 1, min(len(phi), SCREEN))).astype(int))]
-    X = _seeds(phi[sub], psi[sub], cons, n_random, grid, seed)
+    alg = _algebraic_seeds(phi, psi) if cons.free_offsets else np.zeros((0, 5))
+    exact = _exact_choice(alg, phi, psi, cons)
+    if exact is not None:
+        return exact
+    X = np.vstack([alg, _seeds(phi[sub], psi[sub], cons, n_random, grid, seed)])
     X = np.vstack([X, X])
     circ = np.repeat([1.0, -1.0], len(X) // 2)
     e, ok = output_errors(X, circ, phi[sub], psi[sub])
@@ -307,6 +403,31 @@ def search_function(
     if cons.free_offsets:
         x[3:] = _wrap(x[3:])
     return SearchResult(x, int(allC[i]), err_i, margin_i, len(X), len(picks), "", counts)
+
+
+#: an algebraic solution (free offsets, 5 or more pairs) this close (rad) at every pair, and valid, is the design
+#: without the search
+ALGEBRAIC_EXACT = 1e-9
+
+
+def _exact_choice(X: Array, phi: Array, psi: Array, cons: FunctionConstraints) -> SearchResult | None:
+    """Of the candidates ``X`` (rows ``a, b, c, A, B``) on either circuit, the valid one within
+    :data:`ALGEBRAIC_EXACT` at every pair with the largest transmission margin (polished), or None."""
+    if not len(X):
+        return None
+    X2, circ = np.vstack([X, X]), np.repeat([1.0, -1.0], len(X))
+    e, ok = output_errors(X2, circ, phi, psi)
+    err = np.where(ok.all(1), np.abs(e).max(1), np.inf)
+    good = (violations(X2, phi, cons).sum(1) == 0) & (err <= ALGEBRAIC_EXACT)
+    if not good.any():
+        return None
+    margin = arc_margin(X2[:, 0], X2[:, 1], X2[:, 2], phi.min() + X2[:, 3], phi.max() + X2[:, 3])
+    i = int(np.flatnonzero(good)[np.argmax(margin[good])])
+    x, err_i, margin_i = X2[i].copy(), float(err[i]), float(margin[i])
+    if err_i > POLISH_ABOVE:
+        x, err_i, margin_i = _polish(x, int(circ[i]), phi, psi, cons, err_i, margin_i)
+    x[3:] = _wrap(x[3:])
+    return SearchResult(x, int(circ[i]), err_i, margin_i, len(X2), 0, "", _counts(X2, circ, phi, cons))
 
 
 #: the chosen candidate is refined further (:data:`POLISH_NFEV` evaluations) when its largest error (rad) is above this

@@ -107,6 +107,63 @@ def test_known_fourbar_recovered_with_free_offsets_and_root_finder_agrees():
     assert np.abs(_wrap(_loop_closure_outputs(d) - want) - d.output_error).max() < 1e-9
 
 
+def _random_pairs(rng, n):
+    """``n`` (input, output) pairs of a random four-bar (FourBar's own solve) on an arc its crank moves over."""
+    while True:
+        a, b, c = np.exp(rng.uniform(-1.0, 1.0, 3))
+        if max(a, b, c, 1.0) >= 0.99 * (a + b + c + 1.0 - max(a, b, c, 1.0)):
+            continue  # it cannot close
+        fb = FourBar(1.0, a, b, c, circuit=str(rng.choice(["open", "crossed"])))
+        rng_ = fb.input_range()
+        if not rng_:
+            continue
+        lo, hi = rng_[0]
+        if hi - lo > 6.28:
+            lo, hi = lo, lo + rng.uniform(1.0, 5.0)
+        pad = 0.1 * (hi - lo)
+        phi = np.sort(rng.uniform(lo + pad, hi - pad, n))
+        _, psi, ok = fb.angles(phi)
+        if ok.all() and np.min(np.diff(phi)) > 1e-3 and np.abs(np.diff(np.unwrap(psi))).max() < 2.8:
+            return (a, b, c), phi, psi
+
+
+@pytest.mark.parametrize("n", [5, 6, 9])
+def test_free_offsets_five_or_more_pairs_exact(n):
+    """Free offsets from 5 pairs: the algebraic solve meets every pair to rounding, in a few ms; from 6 pairs the
+    four-bar is the one the pairs came from (the null space is a line)."""
+    import time
+
+    rng = np.random.default_rng(100 + n)
+    cpu = []
+    for _ in range(8):
+        (a, b, c), phi, psi = _random_pairs(rng, n)
+        A, B = rng.uniform(-np.pi, np.pi, 2)
+        t0 = time.process_time()
+        d, why = synthesise_function(phi - A, psi - B, ground=2.0, cons=FunctionConstraints(free_offsets=True, max_ratio=30))
+        cpu.append(time.process_time() - t0)
+        assert d is not None and d.ok, (why, d and d.checks)
+        assert d.max_error < 1e-9
+        if n >= 6:
+            assert np.allclose([d.crank, d.coupler, d.rocker], [2 * a, 2 * b, 2 * c], rtol=1e-6)
+    assert np.median(cpu) < 0.05
+
+
+def test_linear_unknowns_hold_the_true_four_bar():
+    """The null space's candidates include the four-bar the 5 pairs came from (its seven products)."""
+    from planar.synth.function_search import _linear_unknowns
+
+    rng = np.random.default_rng(7)
+    for _ in range(12):
+        (a, b, c), phi, psi = _random_pairs(rng, 5)
+        A, B = rng.uniform(-np.pi, np.pi, 2)
+        K1, K2, K3 = 1 / a, 1 / c, (a * a - b * b + c * c + 1) / (2 * a * c)
+        u = np.array([K1 * np.cos(B), K1 * np.sin(B), K2 * np.cos(A), K2 * np.sin(A), K3, np.cos(A - B), np.sin(A - B)])
+        U = _linear_unknowns(phi - A, psi - B)
+        U = U / np.hypot(U[:, 5], U[:, 6])[:, None]
+        assert 1 <= len(U) <= 3
+        assert min(np.abs(U - u).max(1).min(), np.abs(U + u).max(1).min()) < 1e-6
+
+
 def test_cli_finds_valid_linkage_where_closed_form_is_not_one(tmp_path, capsys):
     # y = tan x on [0, pi/4], 5 Chebyshev points, 120 deg in, 90 deg out, both zeros on the ground line:
     # the closed form's four-bar cannot reach every pair on its circuit (it exited 3 before this change)
