@@ -187,7 +187,15 @@ def _search(
         timed.stages = {**load, **timed.stages}
         return timed, f"{how}{'; ' if how.endswith('lookup') else ''}the global search did not run: within the tolerance)", None
     g = search_fourbar(t, theta, cons, seed=seed, **kw)
-    g.stages = {**load, **(timed.stages if timed is not None else {}), **_prefixed(g.stages)}
+    stages = {**load, **(timed.stages if timed is not None else {}), **_prefixed(g.stages)}
+    e_global = max_distance(PathObjective(t, theta, cons), np.append(g.params, g.circuit), theta)
+    good = timed is not None and timed.feasible and _keeps_transmission(timed, cons)
+    g_good = g.feasible and _keeps_transmission(g, cons)
+    if timed is not None and (good, -e_atlas) > (g_good, -e_global):  # the atlas's is usable and closer: kept
+        timed.stages = stages
+        other = f"found no better: {e_global:.3g}" if g_good else "found none usable"
+        return timed, f"the atlas lookup and refinement (the global search, --budget {budget}, ran too and {other})", None
+    g.stages = stages
     return g, f"the global search (--budget {budget}; the atlas's best was {e_atlas:.3g} of the size off)", None
 
 
