@@ -556,6 +556,14 @@ def _cmd_function(args: argparse.Namespace) -> int:
             + (f"; {d.note}" if d.note else "")
             + (f"; {hint}" if hint else "")
         )
+    if not d.checks["ok_transmission"]:
+        c = d.checks
+        failing[failing.index("transmission")] = (
+            f"the transmission angle falls to {c['min_transmission_deg']:.3g} deg from a toggle over the input's arc "
+            f"({'the floor, 1 deg' if args.min_transmission < 1 else f'limit {args.min_transmission:g} deg, --min-transmission'})"
+            ": coupler and rocker "
+            "fold nearly flat there, so the linkage may lock or flip"
+        )
     offs = (
         f"crank angle from the ground line = input {_plus(d.input_offset)} rad, "
         f"rocker angle = output {_plus(d.output_offset)} rad"

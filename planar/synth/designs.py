@@ -4,6 +4,11 @@ from __future__ import annotations
 
 from typing import Any
 
+#: transmission angle (degrees) nearer than this to a toggle (0 or 180) fails every synthesis's check whatever
+#: ``min_transmission`` asks: coupler and rocker fold almost flat there and the coupler point jumps (a
+#: design at 0.4 deg moved its coupler point by 20 units between two of a scene's 72 samples)
+TOGGLE_FLOOR_DEG = 1.0
+
 
 class Checked:
     """A design whose ``checks`` hold ``ok_...`` verdicts (and figures under other keys)."""

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planar.errors import InputError
-from planar.synth.designs import Checked, FourBarLinks
+from planar.synth.designs import TOGGLE_FLOOR_DEG, Checked, FourBarLinks
 
 __all__ = ["FunctionDesign", "check_function", "freudenstein_fit", "synthesise_function"]
 
@@ -200,14 +200,16 @@ def check_function(d: FunctionDesign, cons: Any, tolerance: float, dense: int = 
         margin_turn = float(np.minimum(mu, np.pi - mu).min())
     lengths = np.array([d.ground, d.crank, d.coupler, d.rocker])
     ratio = float(lengths.max() / lengths.min())
+    limit = max(float(cons.min_transmission), np.radians(TOGGLE_FLOOR_DEG))  # never nearer a toggle than the floor
     full = fb.input_range() == [(0.0, 2 * np.pi)]
     d.checks = {
         "ok_assembles_over_arc": bool(m.valid.all()),
         "ok_output_error": bool(np.isfinite(d.max_error) and d.max_error <= tolerance),
         "ok_link_ratio": ratio <= cons.max_ratio * (1 + 1e-9),
-        "ok_transmission": min(margin, margin_turn if cons.full_turn else margin) >= cons.min_transmission - 1e-9,
+        "ok_transmission": min(margin, margin_turn if cons.full_turn else margin) >= limit - 1e-9,
         "input_arc_deg": float(np.degrees(th.max() - th.min())),
         "min_transmission_deg": float(np.degrees(margin)),
+        "transmission_limit_deg": float(np.degrees(limit)),
         "link_ratio": ratio,
         "crank_turns_fully": bool(full),
     }

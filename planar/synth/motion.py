@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planar.errors import InputError, PlanarError
-from planar.synth.designs import Checked, PlacedFourBar
+from planar.synth.designs import TOGGLE_FLOOR_DEG, Checked, PlacedFourBar
 
 __all__ = ["MotionDesign", "burmester", "burmester_points", "circle_point_curve", "dyad_rows"]
 
@@ -239,9 +239,6 @@ def crank_order(
     return np.where(full, turn_ok, arc_ok), full, lo, hi
 
 
-#: a design whose transmission angle comes nearer than this to a toggle (0 or 180 deg) fails its check whatever
-#: ``min_transmission`` asks (as path synthesis's floor)
-TOGGLE_FLOOR_DEG = 1.0
 #: the selection prefers a transmission angle farther from a toggle up to this, then the smaller link ratio
 GOOD_TRANSMISSION_DEG = 30.0
 

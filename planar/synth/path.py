@@ -30,7 +30,7 @@ from numpy.typing import NDArray
 
 from planar.core.fields import check_number
 from planar.errors import InputError
-from planar.synth.designs import Checked, PlacedFourBar
+from planar.synth.designs import TOGGLE_FLOOR_DEG, Checked, PlacedFourBar
 from planar.synth.search import Constraints, PathObjective, constraint_failures, search_fourbar
 from planar.synth.targets import check_search_args, check_theta, normalisation
 
@@ -38,10 +38,6 @@ __all__ = ["FourBarDesign", "check_path_args", "synthesise_path", "synthesise_ro
 
 Array = NDArray[np.float64]
 
-#: transmission angle (degrees) nearer than this to a toggle (0 or 180) fails the check whatever
-#: ``min_transmission`` asks: coupler and rocker fold almost flat there and the coupler point jumps (a
-#: design at 0.4 deg moved its coupler point by 20 units between two of a scene's 72 samples)
-TOGGLE_FLOOR_DEG = 1.0
 #: default largest distance to a target, as a fraction of the targets' size (RMS distance from the centroid)
 DEFAULT_TOLERANCE = 1e-3
 

@@ -120,3 +120,20 @@ def test_a_timed_miss_keeps_the_closer_of_the_atlas_and_the_global_search() -> N
     said = d.checks["found_by"]
     other = [float(v) for v in re.findall(r"(?:no better: |best was )([0-9.e+-]+)", said)]
     assert other and d.checks["max_error"] <= min(other) * (1 + 1e-3), said
+
+
+@pytest.mark.slow
+def test_a_function_generator_near_a_toggle_fails_the_floor() -> None:
+    # the new user's five pairs: the design's transmission angle came within 0.063 deg of a toggle over the
+    # input's arc and ok_transmission said True (the floor of 1 deg, in the help, was not applied)
+    from planar.synth.function import synthesise_function
+
+    d, _ = synthesise_function(np.radians([0, 20, 40, 60, 80.0]), np.radians([0, 8, 18, 30, 45.0]))
+    assert d is not None
+    th = np.linspace(0, np.radians(80), 4001) + d.input_offset
+    bo4 = d.crank**2 + d.ground**2 - 2 * d.crank * d.ground * np.cos(th)
+    mu = np.arccos(np.clip((d.coupler**2 + d.rocker**2 - bo4) / (2 * d.coupler * d.rocker), -1, 1))
+    worst = math.degrees(float(np.min(np.minimum(mu, np.pi - mu))))
+    assert abs(d.checks["min_transmission_deg"] - worst) <= 0.01
+    assert d.checks["ok_transmission"] == (worst >= 1.0) and d.checks["transmission_limit_deg"] == 1.0
+    assert d.ok == all(v for k, v in d.checks.items() if k.startswith("ok_"))
