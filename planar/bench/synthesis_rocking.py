@@ -155,7 +155,7 @@ def bench_rocking(
                 rng = np.random.default_rng([seed, n, KINDS.index(kind)])
                 rows = [_one(rocking_problem(rng, kind, n)["targets"], arcs, budget) for _ in range(counts[kind])]
                 groups.append({"kind": kind, "targets": n, "problems": rows, **_summary(rows)})
-    return {"seed": seed, "quick": quick, "atlas_fourbars": len(arcs), "atlas_load_cpu_s": load, "groups": groups}
+    return {"seed": seed, "quick": quick, "atlas_arcs": len(arcs), "atlas_load_cpu_s": load, "groups": groups}
 
 
 def _summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
@@ -178,7 +178,7 @@ def _summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
 def format_rocking(result: dict[str, Any]) -> str:
     """The result of :func:`bench_rocking` as a table."""
     lines = [
-        f"rocking inputs: seed {result['seed']}, arc atlas of {result['atlas_fourbars']:,} arcs "
+        f"rocking inputs: seed {result['seed']}, arc atlas of {result['atlas_arcs']:,} arcs "
         f"(loaded in {result['atlas_load_cpu_s']:.1f} s CPU); untimed, ordered; largest distance over the targets' size",
         f"{'four-bars':<15}{'targets':>8}{'problems':>9}{'<=1e-6':>8}{'<=1e-4':>8}{'<=1e-3':>8}"
         f"{'median':>10}{'CPU med':>9}{'CPU p90':>9}  one swing",
