@@ -461,7 +461,8 @@ def positions_points(q: Any, turn: Any, circuit: float) -> tuple[Any, Any]:
     """Coupler points ``(x, y)`` at the first pose of :func:`joint_positions` and after each ``turn``: written with
     arithmetic, ``cos``, ``sin`` and ``sqrt`` only, so it runs on complex numbers for the complex-step derivative."""
     o2x, o2y, bx0, by0, cx0, cy0, o4x, o4y, px0, py0 = q
-    al = np.concatenate([np.zeros(1, dtype=np.result_type(turn, float)), turn])
+    turn = np.asarray(turn)
+    al = np.concatenate([np.zeros(turn.shape[:-1] + (1,), dtype=np.result_type(turn, float)), turn], axis=-1)
     ca, sa = np.cos(al), np.sin(al)
     rx, ry = bx0 - o2x, by0 - o2y
     bx, by = o2x + ca * rx - sa * ry, o2y + sa * rx + ca * ry
@@ -524,15 +525,13 @@ def _positions_problem(t: Array, circuit: float, max_ratio: float) -> tuple[Any,
         Z[10, 10:] += 1j * h
         J = np.zeros((2 * n + 1, len(z)))
         i = np.arange(1, n)
-        for k in range(11):
-            with np.errstate(invalid="ignore", divide="ignore"):
-                x, y = positions_points(Z[k, :10], Z[k, 10:], circuit)
-            col = np.concatenate([x.imag, y.imag]) / h
-            if k < 10:
-                J[: 2 * n, k] = col
-                J[2 * n, k] = w * np.imag(_ratio_excess(Z[k], max_ratio)) / h if w else 0.0
-            else:
-                J[i, 9 + i], J[n + i, 9 + i] = col[1:n], col[n + 1 :]
+        with np.errstate(invalid="ignore", divide="ignore"):  # the 11 perturbed evaluations as one batch
+            x, y = positions_points(tuple(Z[:, j : j + 1] for j in range(10)), Z[:, 10:], circuit)
+        cols = np.concatenate([x.imag, y.imag], axis=1) / h  # (11, 2 n)
+        J[: 2 * n, :10] = cols[:10].T
+        J[i, 9 + i], J[n + i, 9 + i] = cols[10, 1:n], cols[10, n + 1 :]
+        if w and float(np.real(_ratio_excess(z, max_ratio))) > 0:  # else its derivative is 0
+            J[2 * n, :10] = [w * np.imag(_ratio_excess(Z[k], max_ratio)) / h for k in range(10)]
         return np.nan_to_num(J, nan=0.0, posinf=0.0, neginf=0.0)
 
     return resid, jac
