@@ -280,7 +280,8 @@ def bench_synthesis(
     ``problems``: a subset of :data:`PROBLEMS` by name (all by default);
     ``reachable``: random reachable crank-rocker curves per number of targets in :func:`bench_reachable` (25, or 2
     with ``quick``, which also runs one drag-link and one part-curve a size; 0 leaves that benchmark, the targets
-    scaling and :func:`bench_unreachable` out: 7 problems per group, 56 in all, or 1 per group with ``quick``);
+    scaling, :func:`bench_unreachable` (7 problems per group, 56 in all, or 1 per group with ``quick``) and
+    :func:`planar.bench.synthesis_rocking.bench_rocking` (the rocking inputs' arcs) out);
     ``heldout``: function and motion problems per size in :mod:`planar.bench.synthesis_heldout` (50, or 2 with
     ``quick``; 0 leaves them out).
     """
@@ -362,6 +363,9 @@ def bench_synthesis(
 
         peer_problems = reachable_problems(reachable_problem, count=count)
         extra["reachable_pylinkage"] = bench_reachable_pylinkage(peer_problems, _from_pylinkage)
+        from planar.bench.synthesis_rocking import bench_rocking
+
+        extra["rocking"] = bench_rocking(quick=quick)  # double- and triple-rockers' arcs, untimed and ordered
     per = (2 if quick else 50) if heldout is None else heldout
     if per > 0:
         from planar.bench.synthesis_heldout import bench_function_heldout, bench_motion_heldout
@@ -445,6 +449,10 @@ def format_synthesis(r: dict[str, Any]) -> str:
         from planar.bench.synthesis_heldout import format_reachable_pylinkage
 
         lines.append(format_reachable_pylinkage(r["reachable_pylinkage"]))
+    if "rocking" in r:
+        from planar.bench.synthesis_rocking import format_rocking
+
+        lines.append(format_rocking(r["rocking"]))
     if "function_heldout" in r:
         from planar.bench.synthesis_heldout import format_heldout
 
