@@ -45,6 +45,7 @@ from numpy.typing import NDArray
 
 from planar.errors import InputError
 from planar.synth.atlas import DescriptorIndex, unreadable
+from planar.synth.designs import TOGGLE_FLOOR_DEG
 from planar.synth.kernel import coupler_points
 
 __all__ = [
@@ -372,10 +373,36 @@ SEARCH_K, SEARCH_REFINE, SEARCH_NFEV = 64, 16, 200
 POLISH_ITERS, POLISH_STARTS = 600, 8
 
 
-def search_arcs(targets: Array, arcs: Arcs, cons: Any = None, stop: float = 1e-9) -> tuple[Any, tuple[float, float] | None]:
+def on_swing(theta: Array, swing: tuple[float, float]) -> Array:
+    """Input angles ``theta`` (rad) as angles within ``swing`` ``(lo, hi)`` (``lo`` itself included)."""
+    lo = swing[0]
+    return lo - 1e-9 + np.mod(np.asarray(theta, float) - lo + 1e-9, 2 * np.pi)
+
+
+def one_way(theta: Array, swing: tuple[float, float]) -> bool:
+    """Whether input angles ``theta`` (rad) placed on the ``swing`` run one way (the targets met in order)."""
+    du = np.diff(on_swing(theta, swing))
+    return bool(np.all(du > 0) or np.all(du < 0))
+
+
+def swing_transmission(row: Array, swing: tuple[float, float], n: int = 181) -> float:
+    """The smallest distance (rad) of the transmission angle of kernel row ``row`` from a toggle (0 or pi) over
+    ``swing`` (input angles, rad from the ground line), on ``n`` angles: law of cosines in the diagonal B-O4."""
+    r1, r2, r3, r4 = (abs(float(v)) for v in row[:4])
+    th = np.linspace(swing[0], swing[1], n)
+    c = (r3 * r3 + r4 * r4 - (r1 * r1 + r2 * r2 - 2 * r1 * r2 * np.cos(th))) / (2 * r3 * r4)
+    mu = np.arccos(np.clip(c, -1.0, 1.0))
+    return float(np.min(np.minimum(mu, np.pi - mu)))
+
+
+def search_arcs(
+    targets: Array, arcs: Arcs, cons: Any = None, stop: float = 1e-9, ordered: bool = False
+) -> tuple[Any, tuple[float, float] | None]:
     """Untimed targets (normalised: centroid 0, size 1) from the rocking arcs, refined: the best result (as
-    :class:`planar.synth.search.SearchResult`) whose targets lie on one swing of its input, and that swing's input
-    range (:func:`rocking_range`; None when no result keeps the targets on one swing).  ``cons``: the path's
+    :class:`planar.synth.search.SearchResult`) whose targets lie on one swing of its input (``ordered``: met in
+    their order as it swings one way), whose transmission angle keeps over that swing ``cons.min_transmission``
+    and the floor :data:`planar.synth.designs.TOGGLE_FLOOR_DEG` from a toggle, and that swing's input range
+    (:func:`rocking_range`; None when no result does).  ``cons``: the path's
     :class:`~planar.synth.search.Constraints` with the full turn not required (its link ratio is kept)."""
     import dataclasses
 
@@ -402,9 +429,13 @@ def search_arcs(targets: Array, arcs: Arcs, cons: Any = None, stop: float = 1e-9
     found: list[tuple[float, Array, Array, tuple[float, float]]] = []
     tried: list[Array] = []
 
+    floor = max(float(cons.min_transmission), math.radians(TOGGLE_FLOOR_DEG))
+
     def usable(r: Array, tt: Array) -> tuple[float, float] | None:
         swing = input_swing(r[:9], tt)
-        return None if swing is None or violation(r[None, :9], cons, obj.scale, 0.0)[0] > 0 else swing
+        if swing is None or violation(r[None, :9], cons, obj.scale, 0.0)[0] > 0 or (ordered and not one_way(tt, swing)):
+            return None
+        return swing if swing_transmission(r, swing) >= floor else None
 
     for row in every[np.argsort(f, kind="stable")]:
         if len(tried) >= SEARCH_REFINE:

@@ -280,24 +280,12 @@ def _rocking_search(
         arcs = arcs_mod.read_arcs(path)
     t0 = time.perf_counter()
     rock_cons = dataclasses.replace(cons, full_turn=False)
-    r, swing = arcs_mod.search_arcs(t, arcs, rock_cons)
+    r, swing = arcs_mod.search_arcs(t, arcs, rock_cons, ordered=ordered)
     stages["rocking_s"] = time.perf_counter() - t0
     word = "the rocking-arc atlas lookup and refinement"
-    if r is None or swing is None or (ordered and not _one_way(r.theta, swing)):
+    if r is None or swing is None or (ordered and not arcs_mod.one_way(r.theta, swing)):
         return None, None, math.inf, word + " found none on one swing" + (" in order" if ordered else "")
     return r, swing, max_distance(PathObjective(t, None, rock_cons), np.append(r.params, r.circuit), r.theta), word
-
-
-def _one_way(theta: Array, swing: tuple[float, float]) -> bool:
-    """Whether input angles ``theta`` (rad) placed on the ``swing`` run one way (the targets met in order)."""
-    du = np.diff(_on_swing(theta, swing))
-    return bool(np.all(du > 0) or np.all(du < 0))
-
-
-def _on_swing(theta: Array, swing: tuple[float, float]) -> Array:
-    """Input angles ``theta`` (rad) as angles within ``swing`` ``(lo, hi)`` (``lo`` itself included)."""
-    lo = swing[0]
-    return lo - 1e-9 + np.mod(np.asarray(theta, float) - lo + 1e-9, 2 * np.pi)
 
 
 def best_fourbar(
@@ -555,7 +543,7 @@ def synthesise_rocking_path(
         arcs = load_arcs(QUICK_FOURBARS if budget == "quick" else DEFAULT_FOURBARS, progress=True)
     c, s = normalisation(t)
     with threadpool_limits(1):
-        r, swing = search_arcs((t - c) / s, arcs, cons)
+        r, swing = search_arcs((t - c) / s, arcs, cons, ordered=ordered)
     if r is None or swing is None:
         d = FourBarDesign(1.0, 1.0, 1.0, 1.0, (0.0, 0.0), "open", (0.0, 0.0, 0.0), np.zeros(len(t)), math.inf, t, False, 0.0)
         d.checks = {"error": "no four-bar of the rocking-arc atlas keeps the targets on one swing of its input"}
@@ -612,7 +600,9 @@ def _check_rocking(d: Any, theta: Array, swing: tuple[float, float], tolerance: 
     path, against the same angles as a scattered batch: the circuit never switches)."""
     fb = d.fourbar()
     lo, hi = swing
-    u = _on_swing(theta, swing)  # the targets' input angles on the swing
+    from planar.synth.arcs import on_swing, one_way
+
+    u = on_swing(theta, swing)  # the targets' input angles on the swing
     at = fb.solve(u)
     pts = at.points["coupler_point"]
     dist = np.hypot(*(pts - d.targets).T)
@@ -642,4 +632,4 @@ def _check_rocking(d: Any, theta: Array, swing: tuple[float, float], tolerance: 
     }
     d.checks["ok_accuracy"] = bool(d.checks["max_error"] <= tolerance)
     if ordered:
-        d.checks["ok_order"] = _one_way(theta, swing)
+        d.checks["ok_order"] = one_way(theta, swing)

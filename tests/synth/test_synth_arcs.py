@@ -76,11 +76,10 @@ def test_double_rockers_recovered_from_targets_on_their_arc():
         assert d.checks["ok_swing_assembles"] and d.checks["ok_on_one_swing"]
         errors.append(d.checks["max_error"])
         if d.checks["max_error"] <= 1e-3:
-            # every check passes, or only the transmission angle's: a four-bar through the targets may swing
-            # within a hair of its own toggle (seen: 0.0026 deg), and the result says so rather than passing
+            # every check passes: the transmission angle's too (a triple-rocker swinging 0.0026 deg from its own
+            # toggle was once returned for one of these: the search now keeps only results clear of the floor)
             failed = [k for k, v in d.checks.items() if k.startswith("ok_") and not v]
-            assert failed in ([], ["ok_transmission"]) and d.checks["ok_order"], failed
-            assert d.ok == (d.checks["min_transmission_deg"] >= 1.0)
+            assert d.ok and d.checks["ok_order"] and d.checks["min_transmission_deg"] >= 1.0, failed
             a, b = d.checks["input_swing_rad"]
             # the swing is within one turn; a crank that turns fully is kept only as a double-rocker's cognate
             # tracing the same arc, driven back and forth over it (its whole swing checked above)

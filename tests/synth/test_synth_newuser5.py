@@ -137,3 +137,24 @@ def test_a_function_generator_near_a_toggle_fails_the_floor() -> None:
     assert abs(d.checks["min_transmission_deg"] - worst) <= 0.01
     assert d.checks["ok_transmission"] == (worst >= 1.0) and d.checks["transmission_limit_deg"] == 1.0
     assert d.ok == all(v for k, v in d.checks.items() if k.startswith("ok_"))
+
+
+def test_the_rocking_search_measures_transmission_as_planars_four_bar_does() -> None:
+    # the search keeps only results whose transmission angle clears the floor over their swing: its measure
+    # (law of cosines on the kernel's row) against planar's FourBar.transmission_angle on the same angles
+    from planar.linkages.fourbar import FourBar
+    from planar.synth.arcs import swing_transmission
+
+    rng = np.random.default_rng(7)
+    done = 0
+    while done < 20:
+        r1, r2, r3, r4 = np.exp(rng.uniform(np.log(0.2), np.log(2.0), 4))
+        if 2 * max(r1, r2, r3, r4) >= r1 + r2 + r3 + r4:  # cannot close
+            continue
+        done += 1
+        lo = rng.uniform(-np.pi, np.pi)
+        swing = (lo, lo + rng.uniform(0.1, 2.0))
+        fb = FourBar(crank=r2, coupler=r3, rocker=r4, ground=r1)
+        mu = fb.transmission_angle(np.linspace(*swing, 181))
+        want = float(np.min(np.minimum(mu, np.pi - mu)))
+        assert swing_transmission(np.array([r1, r2, r3, r4, 0, 0, 0, 0, 0]), swing) == pytest.approx(want, abs=1e-12)
