@@ -598,7 +598,7 @@ def search_atlas(
 
 #: the wide lookup, when the targets' nearest entries fail: neighbours per query (8 queries), the best kept by a
 #: cheap similarity fit on a coarse curve (samples) and how many of them are refined
-WIDE_K, WIDE_KEEP, WIDE_SAMPLES, WIDE_REFINE = 4000, 256, 32, 4
+WIDE_K, WIDE_KEEP, WIDE_SAMPLES, WIDE_REFINE = 4000, 256, 32, 16
 
 
 def _wide_candidates(atlas: Any, obj: PathObjective, keep: int = WIDE_KEEP) -> Array:
