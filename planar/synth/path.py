@@ -158,17 +158,27 @@ def _search(
     from planar.synth.search import max_distance, timed_from_atlas
 
     kw = BUDGETS[budget]
-    t0 = time.perf_counter()
-    if atlas is None:
-        from planar.synth.atlas import DEFAULT_SIZE, QUICK_SIZE, load_atlas
+    load: dict[str, float] = {}
+    given = atlas
 
-        atlas = load_atlas(QUICK_SIZE if budget == "quick" else DEFAULT_SIZE, progress=True)
-    load = {"atlas_load_s": time.perf_counter() - t0}
+    def loaded() -> Any:
+        # the atlas of the budget, loaded (or built) on first need: timed targets the closed form solves need none
+        nonlocal atlas
+        if atlas is None:
+            from planar.synth.atlas import DEFAULT_SIZE, QUICK_SIZE, load_atlas
+
+            t0 = time.perf_counter()
+            atlas = load_atlas(QUICK_SIZE if budget == "quick" else DEFAULT_SIZE, progress=True)
+            load["atlas_load_s"] = time.perf_counter() - t0
+        elif atlas is given:
+            load.setdefault("atlas_load_s", 0.0)
+        return atlas
+
     if theta is None:
-        return _untimed(t, cons, budget, seed, tolerance, atlas, ordered, arcs, load)
-    # the curve from the atlas, then the timing: exact when the atlas finds the four-bar itself (a cognate
-    # traces the same curve at other crank angles: then the global search runs)
-    timed = timed_from_atlas(t, theta, atlas, cons)
+        return _untimed(t, cons, budget, seed, tolerance, loaded(), ordered, arcs, load)
+    # the closed form, then the curve from the atlas and the timing: exact when the atlas finds the four-bar itself
+    # (a cognate traces the same curve at other crank angles: then the global search runs)
+    timed = timed_from_atlas(t, theta, loaded, cons)
     e_atlas = (
         max_distance(PathObjective(t, theta, cons), np.append(timed.params, timed.circuit), theta)
         if timed is not None

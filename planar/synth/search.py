@@ -598,7 +598,7 @@ def search_atlas(
 
 #: the wide lookup, when the targets' nearest entries fail: neighbours per query (8 queries), the best kept by a
 #: cheap similarity fit on a coarse curve (samples) and how many of them are refined
-WIDE_K, WIDE_KEEP, WIDE_SAMPLES, WIDE_REFINE = 4000, 256, 32, 4
+WIDE_K, WIDE_KEEP, WIDE_SAMPLES, WIDE_REFINE = 4000, 256, 32, 16
 
 
 def _wide_candidates(atlas: Any, obj: PathObjective, keep: int = WIDE_KEEP) -> Array:
@@ -1065,9 +1065,10 @@ def timed_from_atlas(
     the :data:`TIMED_DIRECT` best direct starts (:func:`timed_starts`) refined likewise; when none is exact, the untimed
     curve (:func:`search_atlas`, each refined start within :data:`TIMED_FROM` refined again with the angles
     fixed, until one is exact), then least squares with the angles fixed from its best (None when no start
-    closes at every crank angle).  ``closed_form=False`` leaves the closed form out (the atlas's starts alone).
-    The result's ``stages``: ``closed_form_s`` alone when the closed form gave it, else ``timed_s`` (and the
-    untimed search's when it ran)."""
+    closes at every crank angle).  ``atlas``: an atlas, or a function of no arguments returning one (called only
+    when the closed form gives nothing exact, so a loader need not run).  ``closed_form=False`` leaves the closed
+    form out (the atlas's starts alone).  The result's ``stages``: ``closed_form_s`` alone when the closed form gave
+    it, else ``timed_s`` (and the untimed search's when it ran)."""
     import time
 
     cons = cons if cons is not None else Constraints()
@@ -1093,7 +1094,10 @@ def timed_from_atlas(
 
     def direct() -> Any:
         yield from exact
-        yield from timed_starts(atlas, obj)[:TIMED_DIRECT]  # the atlas's lookup only when the closed form fails
+        yield from timed_starts(the_atlas(), obj)[:TIMED_DIRECT]  # the atlas's lookup only when the closed form fails
+
+    def the_atlas() -> Any:
+        return atlas() if callable(atlas) else atlas
 
     for k, row in enumerate(direct()):
         r, tt = row, np.asarray(obj.theta, float)
@@ -1106,7 +1110,7 @@ def timed_from_atlas(
             stages = {"closed_form_s" if k < len(exact) else "timed_s": time.perf_counter() - t0}
             return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), True, 0, stages)
         timed.append((e, r, tt))
-    u = search_atlas(targets, atlas, cons, stop=exact_timed)
+    u = search_atlas(targets, the_atlas(), cons, stop=exact_timed)
     r0, tt0, e0 = _refine(obj, np.append(u.params, u.circuit), b, max_nfev=REFINE_NFEV, method="lm")
     timed.append((e0, r0, tt0))
     e, r, tt = min(timed, key=lambda d: d[0])

@@ -143,3 +143,19 @@ def test_reachable_kinds_draw_what_they_name():
             assert fb.solve(np.linspace(0.0, 2 * np.pi, 90, endpoint=False)).valid.all()
     with pytest.raises(PlanarError, match=r"unknown kind 'rocker'.*drag-link"):
         bench_reachable(kinds=("rocker",))
+
+
+@pytest.mark.slow
+def test_bench_reachable_reports_every_kind():
+    """One problem of each kind at 8 targets (quick atlas): the summary and the text name each kind with its
+    untimed and timed figures; the timed problems are exact (the closed form), the noisy comparison only for the
+    crank-rockers."""
+    from planar.bench.synthesis import REACHABLE_KINDS, bench_reachable, format_reachable
+
+    r = bench_reachable(sizes=(8,), count=1, quick=True, kind_count=1)
+    assert [(s["kind"], s["targets"], s["problems"]) for s in r["summary"].values()] == [(k, 8, 1) for k in REACHABLE_KINDS]
+    for s in r["summary"].values():
+        assert s["timed_recovered_1e-6"] == 1.0 and s["timed_max_cpu_s"] >= s["timed_median_cpu_s"] > 0
+        assert ("noisy_planar_as_good_as_scipy" in s) == (s["kind"] == "crank-rocker")
+    text = format_reachable(r, [])
+    assert all(f"  {k:<12}        8" in text for k in REACHABLE_KINDS)

@@ -238,3 +238,19 @@ def test_timed_closed_form_on_targets_no_four_bar_passes_gives_finite_starts_or_
         rows = timed_closed_form(T, th)
         assert np.isfinite(rows).all() and (rows[:, :4] > 0).all()
     assert len(timed_closed_form(*cases[2])) == 0
+
+
+def test_timed_synthesis_the_closed_form_solves_needs_no_atlas(tmp_path, monkeypatch):
+    """Timed targets (9, a random drag-link's curve) with no atlas given and an empty cache folder: the closed form
+    gives the four-bar, so no atlas is loaded or built (the folder stays empty, no ``atlas_load_s``), and the design
+    passes planar's own checks; it says it came from the closed form."""
+    from planar.bench.synthesis import REACHABLE_KINDS
+    from planar.synth.path import synthesise_path
+
+    monkeypatch.setenv("PLANAR_CACHE_DIR", str(tmp_path / "cache"))
+    T, th = REACHABLE_KINDS["drag-link"](np.random.default_rng(77), 9)
+    d = synthesise_path(T * 40.0 + 7.0, th)
+    assert d.ok and d.checks["max_error"] <= 1e-9
+    assert "closed_form_s" in d.checks["stages_s"] and "atlas_load_s" not in d.checks["stages_s"]
+    assert d.checks["found_by"].startswith("the closed-form timed solution")
+    assert not (tmp_path / "cache").exists()
