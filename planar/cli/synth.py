@@ -584,6 +584,7 @@ def _cmd_function(args: argparse.Namespace) -> int:
         amplitude=amp,
         centre=centre,
         unit_mm=_unit_mm(args),
+        trails=(),  # the coupler point of a function generator traces nothing anyone asked for
     )
     report = {"command": "synth function", "pairs": len(phi), **d.to_dict(), **({"hint": hint} if hint else {})}
     shift = (

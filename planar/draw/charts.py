@@ -257,7 +257,7 @@ def scene_figure(
             (ln2,) = ax.plot(x, col["torque.loads"], lw=1.0, ls="--", label="loads alone")
             ln2.set_gid("torque.loads")
             ax.axhline(0.0, color="k", lw=0.5)
-            ax.set_ylabel("torque (force x unit)")
+            ax.set_ylabel("torque (model force x length units)")
             if good.any():
                 k = int(np.nanargmax(np.abs(col["torque"])))
                 ax.set_title(f"motor torque: peak {abs(col['torque'][k]):.4g} at {x[k]:.4g}{xunit}", fontsize=9)

@@ -40,8 +40,10 @@ def fourbar_scene_text(
     samples_per_cycle: int = 72,
     targets: Sequence[Sequence[float]] = (),
     unit_mm: float | None = None,
+    trails: Sequence[str] = ("coupler_point",),
 ) -> str:
-    """The scene text of a four-bar (radians); ``amplitude``/``centre`` give a rocking driver; ``targets``
+    """The scene text of a four-bar (radians); ``amplitude``/``centre`` give a rocking driver; ``trails``: the named
+    points whose paths are drawn (none for a function generator, whose coupler point means nothing); ``targets``
     ``[x, y]`` each: fixed points ``planar render`` and ``planar plot`` draw (``[render] targets``);
     ``unit_mm``: what one unit of the targets is in millimetres, written as ``[fabrication] unit_mm`` (none:
     the scene's default, 10; an SVG's user units are millimetres: :func:`planar.synth.targets.target_unit_mm`)."""
@@ -67,7 +69,8 @@ def fourbar_scene_text(
     ]
     if amplitude is not None:
         lines += [f"amplitude = {_f(amplitude)}", f"centre = {_f(centre)}"]
-    lines += ["", "[render]", 'trails = ["coupler_point"]', *_targets(targets), *_fabrication(unit_mm), ""]
+    drawn = ", ".join(f'"{t}"' for t in trails)
+    lines += ["", "[render]", f"trails = [{drawn}]", *_targets(targets), *_fabrication(unit_mm), ""]
     return "\n".join(lines)
 
 

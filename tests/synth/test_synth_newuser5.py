@@ -68,7 +68,9 @@ def test_synth_writes_the_unit_it_is_given_and_refuses_a_bad_one(tmp_path, capsy
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and "--unit-mm" in err and not out.exists()
     main(["synth", "function", str(pairs), "--deg", "-o", str(out), "--unit-mm", "2.5"])
-    assert tomllib.loads(out.read_text())["fabrication"] == {"unit_mm": 2.5}
+    scene = tomllib.loads(out.read_text())
+    assert scene["fabrication"] == {"unit_mm": 2.5}
+    assert scene["render"]["trails"] == []  # a function generator's coupler point traces nothing asked for
 
 
 @pytest.mark.slow
