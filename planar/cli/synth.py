@@ -270,7 +270,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
             d.placement,
             comments=[
                 f"planar synth path {args.target}: {len(targets)} targets, {'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
-                "crank angle at each target (rad): " + ", ".join(f"{t:.6g}" for t in d.theta),
+                "crank angle at each target (rad): " + ", ".join(repr(float(t)) for t in d.theta),
             ],
             amplitude=amp,
             centre=centre,
@@ -552,9 +552,8 @@ def _cmd_function(args: argparse.Namespace) -> int:
     failing = [k[3:].replace("_", " ") for k, v in d.checks.items() if k.startswith("ok_") and not v]
     if not d.checks["ok_output_error"]:
         failing[failing.index("output error")] = (
-            f"output angle error {_rad(d.max_error, args.deg)} (limit {args.tolerance:g} rad) on the best valid four-bar"
-            + (f"; {d.note}" if d.note else "")
-            + (f"; {hint}" if hint else "")
+            f"output angle error {_rad(d.max_error, args.deg)} (limit {args.tolerance:g} rad) on the best four-bar "
+            "that moves over the inputs' arc on one circuit" + (f"; {d.note}" if d.note else "") + (f"; {hint}" if hint else "")
         )
     if not d.checks["ok_transmission"]:
         c = d.checks
@@ -696,7 +695,7 @@ def _cmd_motion(args: argparse.Namespace) -> int:
         d.placement,
         comments=[
             f"planar synth motion {args.poses}: {len(poses)} poses; the body's angle is the coupler's + {d.angle_offset:.9g} rad",
-            "crank angle at each pose (rad): " + ", ".join(f"{v:.6g}" for v in d.theta),
+            "crank angle at each pose (rad): " + ", ".join(repr(float(v)) for v in d.theta),
         ],
         amplitude=amp,
         centre=centre,

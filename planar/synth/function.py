@@ -17,6 +17,7 @@ solved output angle minus the requested one) is reported.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -200,13 +201,13 @@ def check_function(d: FunctionDesign, cons: Any, tolerance: float, dense: int = 
         margin_turn = float(np.minimum(mu, np.pi - mu).min())
     lengths = np.array([d.ground, d.crank, d.coupler, d.rocker])
     ratio = float(lengths.max() / lengths.min())
-    limit = max(float(cons.min_transmission), np.radians(TOGGLE_FLOOR_DEG))  # never nearer a toggle than the floor
+    limit = max(float(cons.min_transmission), math.radians(TOGGLE_FLOOR_DEG))  # never nearer a toggle than the floor
     full = fb.input_range() == [(0.0, 2 * np.pi)]
     d.checks = {
         "ok_assembles_over_arc": bool(m.valid.all()),
         "ok_output_error": bool(np.isfinite(d.max_error) and d.max_error <= tolerance),
         "ok_link_ratio": ratio <= cons.max_ratio * (1 + 1e-9),
-        "ok_transmission": min(margin, margin_turn if cons.full_turn else margin) >= limit - 1e-9,
+        "ok_transmission": bool(min(margin, margin_turn if cons.full_turn else margin) >= limit - 1e-9),
         "input_arc_deg": float(np.degrees(th.max() - th.min())),
         "min_transmission_deg": float(np.degrees(margin)),
         "transmission_limit_deg": float(np.degrees(limit)),

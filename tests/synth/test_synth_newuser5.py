@@ -139,6 +139,7 @@ def test_a_function_generator_near_a_toggle_fails_the_floor() -> None:
     assert abs(d.checks["min_transmission_deg"] - worst) <= 0.01
     assert d.checks["ok_transmission"] == (worst >= 1.0) and d.checks["transmission_limit_deg"] == 1.0
     assert d.ok == all(v for k, v in d.checks.items() if k.startswith("ok_"))
+    assert all(type(v) is bool for k, v in d.checks.items() if k.startswith("ok_"))  # JSON true/false, not 1.0
 
 
 def test_the_rocking_search_measures_transmission_as_planars_four_bar_does() -> None:
