@@ -121,13 +121,14 @@ def check_design(d: FourBarDesign, kernel_points: Array | None = None) -> None:
         d.checks["ok_kernel_matches_solve"] = bool(gap <= 1e-6 * scale)
 
 
-def transmission_margin(fb: Any) -> tuple[float, float]:
+def transmission_margin(fb: Any, theta: Array | None = None) -> tuple[float, float]:
     """``(margin, theta)``: the smallest distance (radians) of the transmission angle from a toggle (0 or pi)
-    over the crank's whole turn, and the crank angle (radians from the ground line) where it is.
+    at the crank angles ``theta`` (radians from the ground line; default: the whole turn), and the angle where
+    it is.
 
-    The angle depends on the crank only through the diagonal ``B-O4``, longest at ``theta = pi`` and
-    shortest at ``0``, so its extremes over a turn are there; a grid of 721 angles is checked as well."""
-    th = np.concatenate([[0.0, np.pi], np.linspace(0.0, 2 * np.pi, 721, endpoint=False)])
+    Over a turn the angle depends on the crank only through the diagonal ``B-O4``, longest at ``theta = pi``
+    and shortest at ``0``, so its extremes are there; a grid of 721 angles is checked as well."""
+    th = np.concatenate([[0.0, np.pi], np.linspace(0.0, 2 * np.pi, 721, endpoint=False)]) if theta is None else theta
     mu = np.asarray(fb.transmission_angle(th), float)
     m = np.minimum(mu, np.pi - mu)
     k = int(np.argmin(m))
@@ -434,12 +435,7 @@ def synthesise_path(
     d.checks["tolerance"] = tolerance
     if ordered:
         d.checks["ok_order"] = in_order(d.theta)
-    margin, where = transmission_margin(d.fourbar())
-    limit = max(float(cons.min_transmission), math.radians(TOGGLE_FLOOR_DEG))
-    d.checks["min_transmission_deg"] = math.degrees(margin)
-    d.checks["min_transmission_at_rad"] = where
-    d.checks["transmission_limit_deg"] = math.degrees(limit)
-    d.checks["ok_transmission"] = bool(margin >= limit)
+    _check_transmission(d, None, cons.min_transmission)
     d.checks["stages_s"] = r.stages
     d.checks["found_by"] = source
     d.checks["input"] = "turns fully"
@@ -579,7 +575,7 @@ def _rocking_checked(
     import dataclasses
 
     _check_rocking(d, r.theta, swing, tolerance, ordered, size)
-    _check_swing_transmission(d, swing, cons.min_transmission)
+    _check_transmission(d, np.linspace(swing[0], swing[1], 721), cons.min_transmission)
     d.checks["constraint_failures"] = list(constraint_failures(p, dataclasses.replace(cons, full_turn=False)))
     d.checks["ok_constraints"] = not d.checks["constraint_failures"]
     d.checks["stages_s"] = r.stages
@@ -590,19 +586,16 @@ def _rocking_checked(
     return d
 
 
-def _check_swing_transmission(d: Any, swing: tuple[float, float], min_transmission: float) -> None:
-    """Fill the transmission checks of a rocking design ``d`` over its ``swing`` (rad from the ground line): as
-    :func:`synthesise_path`'s over a turn, the limit ``min_transmission`` (rad) and never under
-    :data:`TOGGLE_FLOOR_DEG` (a swing ends short of its toggles, where coupler and rocker line up)."""
-    th = np.linspace(swing[0], swing[1], 721)
-    mu = np.asarray(d.fourbar().transmission_angle(th), float)
-    m = np.minimum(mu, np.pi - mu)
-    k = int(np.argmin(m))
+def _check_transmission(d: Any, theta: Array | None, min_transmission: float) -> None:
+    """Fill the transmission checks of design ``d`` at input angles ``theta`` (rad from the ground line; None:
+    the whole turn; a rocking design: its swing, which ends short of its toggles): the limit ``min_transmission``
+    (rad), never under :data:`TOGGLE_FLOOR_DEG` (:func:`transmission_margin`, planar's own four-bar)."""
+    margin, where = transmission_margin(d.fourbar(), theta)
     limit = max(float(min_transmission), math.radians(TOGGLE_FLOOR_DEG))
-    d.checks["min_transmission_deg"] = math.degrees(float(m[k]))
-    d.checks["min_transmission_at_rad"] = float(th[k])
+    d.checks["min_transmission_deg"] = math.degrees(margin)
+    d.checks["min_transmission_at_rad"] = where
     d.checks["transmission_limit_deg"] = math.degrees(limit)
-    d.checks["ok_transmission"] = bool(m[k] >= limit)
+    d.checks["ok_transmission"] = bool(margin >= limit)
 
 
 def _check_rocking(d: Any, theta: Array, swing: tuple[float, float], tolerance: float, ordered: bool, size: float) -> None:
