@@ -463,44 +463,42 @@ def format_synthesis(r: dict[str, Any]) -> str:
 # --- reachable curves: random four-bars the search was not tuned on (issue: synthesis that finds the mechanism) ---
 
 
-def random_crank_rocker(rng: np.random.Generator) -> tuple[Array, float]:
-    """A random Grashof crank-rocker (crank shortest, link ratio <= 10) with a random coupler point and placement:
-    the kernel's 9 parameters and the circuit.  Lengths uniform (not the atlas's log-uniform), coupler point
-    uniform in a box twice the coupler's length, placement anywhere in the unit square, any rotation."""
+def _random_grashof(rng: np.random.Generator, shortest: str) -> tuple[Array, float]:
+    """A random Grashof four-bar whose ``shortest`` link (``"crank"`` or ``"ground"``) is shortest (link ratio <= 10,
+    2 % from a change point), a random coupler point and placement: the kernel's 9 parameters and the circuit.
+    Three lengths uniform in 0.3 to 3, the shortest 0.1 to 1 times their least; coupler point uniform in a box
+    twice the coupler's length, placement anywhere in the unit square, any rotation."""
     while True:
-        g, c, r = rng.uniform(0.3, 3.0, 3)
-        k = rng.uniform(0.1, 1.0) * min(g, c, r)
+        a, c, r = rng.uniform(0.3, 3.0, 3)
+        short = rng.uniform(0.1, 1.0) * min(a, c, r)
+        g, k = (a, short) if shortest == "crank" else (short, a)
         L = sorted((g, k, c, r))
-        if L[0] == k and L[0] + L[3] < 0.98 * (L[1] + L[2]) and L[3] <= 9.5 * L[0]:
+        if L[0] == short and L[0] + L[3] < 0.98 * (L[1] + L[2]) and L[3] <= 9.5 * L[0]:
             break
     u, v = c * rng.uniform(-1.0, 2.0), c * rng.uniform(-1.0, 1.0)
     row = np.array([g, k, c, r, u, v, rng.uniform(), rng.uniform(), rng.uniform(-np.pi, np.pi)])
     return row, float(rng.choice([-1.0, 1.0]))
 
 
+def random_crank_rocker(rng: np.random.Generator) -> tuple[Array, float]:
+    """A random Grashof crank-rocker (crank shortest, link ratio <= 10) with a random coupler point and placement:
+    the kernel's 9 parameters and the circuit.  Lengths uniform (not the atlas's log-uniform): see
+    :func:`_random_grashof`."""
+    return _random_grashof(rng, "crank")
+
+
 def reachable_problem(rng: np.random.Generator, n: int) -> tuple[Array, Array]:
     """``n`` targets on the coupler curve of :func:`random_crank_rocker` at sorted random crank angles, and the angles."""
-    from planar.synth.kernel import coupler_points
-
     row, circ = random_crank_rocker(rng)
     th = np.sort(rng.uniform(0.0, 2 * np.pi, n))
-    x, y, _ = coupler_points(row[None, :], th, np.array([circ]))
-    return np.column_stack([x[0], y[0]]), th
+    return _on_curve(row, circ, th), th
 
 
 def random_drag_link(rng: np.random.Generator) -> tuple[Array, float]:
     """A random Grashof drag-link (double-crank: the ground shortest, link ratio <= 10, 2 % from a change point)
     with a random coupler point and placement, drawn as :func:`random_crank_rocker` with the ground and crank
     exchanged: the kernel's 9 parameters and the circuit."""
-    while True:
-        k, c, r = rng.uniform(0.3, 3.0, 3)
-        g = rng.uniform(0.1, 1.0) * min(k, c, r)
-        L = sorted((g, k, c, r))
-        if L[0] == g and L[0] + L[3] < 0.98 * (L[1] + L[2]) and L[3] <= 9.5 * L[0]:
-            break
-    u, v = c * rng.uniform(-1.0, 2.0), c * rng.uniform(-1.0, 1.0)
-    row = np.array([g, k, c, r, u, v, rng.uniform(), rng.uniform(), rng.uniform(-np.pi, np.pi)])
-    return row, float(rng.choice([-1.0, 1.0]))
+    return _random_grashof(rng, "ground")
 
 
 def _on_curve(row: Array, circ: float, th: Array) -> Array:
