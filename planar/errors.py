@@ -11,6 +11,8 @@ error but a result that failed its own check (the CLI's exit status 3); it carri
 
 from __future__ import annotations
 
+import os
+
 __all__ = ["AssemblyError", "CheckError", "InputError", "LimitError", "PlanarError", "SceneError", "short_repr"]
 
 
@@ -37,7 +39,12 @@ def short_repr(value: object, limit: int = 80) -> str:
     except Exception:  # pragma: no cover - numpy is a dependency; repr below still works
         pass
     text = repr(value).replace("\n", " ")
-    return text if len(text) <= limit else text[: limit - 3] + "..."
+    if isinstance(value, str | os.PathLike):
+        limit = max(limit, 240)  # a file name is what the reader needs: keep paths whole up to a long limit
+    if len(text) <= limit:
+        return text
+    tail = limit // 2  # the end of a long value (a path's file name) is kept, the middle elided
+    return text[: limit - 3 - tail] + "..." + text[-tail:]
 
 
 class InputError(PlanarError, ValueError):

@@ -66,6 +66,14 @@ def test_array_summaries_show_plain_numbers_and_count_nan() -> None:
     assert text == "<array of shape (4, 3), from -0.2 to 3.0, with 1 NaN, 1 inf>", text
 
 
+def test_a_long_value_keeps_its_end_and_a_path_stays_whole() -> None:
+    path = Path("/tmp") / ("deep-" * 30) / "leg.gif"
+    assert short_repr(path).endswith("leg.gif')") and "..." not in short_repr(path)
+    text = short_repr("x" * 300 + "the end")
+    assert text.endswith("the end'") and "..." in text and len(text) <= 240
+    assert short_repr(list(range(100))).endswith("98, 99]") and len(short_repr(list(range(100)))) == 80
+
+
 def test_an_output_under_a_file_says_it_is_a_file(tmp_path: Path) -> None:
     from planar.fileio import atomic_write
 

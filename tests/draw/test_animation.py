@@ -188,11 +188,13 @@ def test_translucent_parts_show_what_is_under_them(tmp_path):
 
 
 def test_wrong_suffix_is_refused_and_nothing_written(tmp_path, capsys):
-    out = tmp_path / "x.csv"
+    deep = tmp_path / ("a-long-folder-name-" * 6)  # CI's temporary paths are long: the file name must still show
+    deep.mkdir()
+    out = deep / "x.csv"
     assert main(["render", str(_scene(tmp_path)), "-o", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "x.csv" in err[0] and ".gif" in err[0]
-    assert not out.exists() and list(tmp_path.iterdir()) == [tmp_path / "leg.toml"]
+    assert not out.exists() and sorted(tmp_path.iterdir()) == [deep, tmp_path / "leg.toml"] and not any(deep.iterdir())
 
 
 def test_video_without_the_extra_is_one_clear_line(tmp_path, monkeypatch, capsys):
