@@ -44,6 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planar.errors import InputError
+from planar.synth.algebraic import search_algebraic
 from planar.synth.atlas import DescriptorIndex, unreadable
 from planar.synth.designs import TOGGLE_FLOOR_DEG
 from planar.synth.kernel import coupler_points
@@ -395,6 +396,20 @@ def swing_transmission(row: Array, swing: tuple[float, float], n: int = 181) -> 
     return float(np.min(np.minimum(mu, np.pi - mu)))
 
 
+def usable_swing(r: Array, theta: Array, cons: Any, scale: float, ordered: bool) -> tuple[float, float] | None:
+    """The swing (:func:`input_swing`) of a refined row ``r`` (9 parameters and the circuit) passing crank angles
+    ``theta``, when it is usable as a rocking result: it keeps ``cons`` (the full turn not asked), meets the targets
+    one way when ``ordered``, and its transmission angle over the swing keeps ``cons.min_transmission`` and the floor
+    :data:`planar.synth.designs.TOGGLE_FLOOR_DEG`; else None."""
+    from planar.synth.search import violation
+
+    swing = input_swing(r[:9], theta)
+    if swing is None or violation(r[None, :9], cons, scale, 0.0)[0] > 0 or (ordered and not one_way(theta, swing)):
+        return None
+    floor = max(float(cons.min_transmission), math.radians(TOGGLE_FLOOR_DEG))
+    return swing if swing_transmission(r, swing) >= floor else None
+
+
 def search_arcs(
     targets: Array, arcs: Arcs, cons: Any = None, stop: float = 1e-9, ordered: bool = False
 ) -> tuple[Any, tuple[float, float] | None]:
@@ -413,7 +428,6 @@ def search_arcs(
         default_bounds,
         max_distance,
         reassigned_refine,
-        violation,
     )
 
     cons = dataclasses.replace(cons if cons is not None else Constraints(), full_turn=False)
@@ -421,6 +435,11 @@ def search_arcs(
     obj = PathObjective(t, None, cons, 256)
     b = default_bounds(t, cons, False)
     b[8] = (-3 * np.pi, 3 * np.pi)
+    # the four-bar of the targets' own sextic first (exact from 15 targets on a long enough arc): no lookup
+    alg, _ = search_algebraic(t, cons, ordered, stop)
+    swing = usable_swing(np.append(alg.params, alg.circuit), alg.theta, cons, obj.scale, ordered) if alg else None
+    if alg is not None and swing is not None:
+        return alg, swing
     t0 = time.perf_counter()
     every = arc_candidates(arcs, t, SEARCH_K)
     stages = {"arcs_s": time.perf_counter() - t0}
@@ -429,13 +448,8 @@ def search_arcs(
     found: list[tuple[float, Array, Array, tuple[float, float]]] = []
     tried: list[Array] = []
 
-    floor = max(float(cons.min_transmission), math.radians(TOGGLE_FLOOR_DEG))
-
     def usable(r: Array, tt: Array) -> tuple[float, float] | None:
-        swing = input_swing(r[:9], tt)
-        if swing is None or violation(r[None, :9], cons, obj.scale, 0.0)[0] > 0 or (ordered and not one_way(tt, swing)):
-            return None
-        return swing if swing_transmission(r, swing) >= floor else None
+        return usable_swing(r, tt, cons, obj.scale, ordered)
 
     for row in every[np.argsort(f, kind="stable")]:
         if len(tried) >= SEARCH_REFINE:

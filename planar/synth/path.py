@@ -176,7 +176,7 @@ def _search(
         return atlas
 
     if theta is None:
-        return _untimed(t, cons, budget, seed, tolerance, loaded(), ordered, arcs, load)
+        return _untimed(t, cons, budget, seed, tolerance, loaded, ordered, arcs, load)
     # the closed form, then the curve from the atlas and the timing: exact when the atlas finds the four-bar itself
     # (a cognate traces the same curve at other crank angles: then the global search runs)
     timed = timed_from_atlas(t, theta, loaded, cons)
@@ -212,15 +212,22 @@ def _untimed(
     budget: str,
     seed: int,
     tolerance: float,
-    atlas: Any,
+    loaded: Any,
     ordered: bool,
     arcs: Any,
     load: dict[str, float],
 ) -> tuple[Any, str, tuple[float, float] | None]:
-    """:func:`_search` of untimed targets: the closed-curve atlas, the rocking arcs, then the global search."""
+    """:func:`_search` of untimed targets: the targets' sextic, the closed-curve atlas (``loaded()`` loads it), the
+    rocking arcs, then the global search."""
+    from planar.synth.algebraic import search_algebraic
     from planar.synth.search import in_order, max_distance, search_atlas
 
-    r = search_atlas(t, atlas, cons, ordered=ordered)
+    # from 15 targets on one four-bar's curve its equation gives the four-bar: no atlas is loaded
+    rocking = cons.region is None and cons.min_transmission == 0
+    alg, swing = search_algebraic(t, cons, ordered, stop=min(1e-9, tolerance), rocking=rocking)
+    if alg is not None:
+        return alg, "the targets' own curve equation (its singular foci; no atlas lookup: within the tolerance)", swing
+    r = search_atlas(t, loaded(), cons, ordered=ordered)
     good = r.feasible and (in_order(r.theta) or not ordered) and _keeps_transmission(r, cons)
     e_atlas = max_distance(PathObjective(t, None, cons), np.append(r.params, r.circuit), r.theta)
     if good and e_atlas <= tolerance:
