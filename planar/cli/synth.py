@@ -96,7 +96,9 @@ def _path_failing(d: Any, kind: str = "four-bar", box: str = "", budget: str = "
             if d.checks["max_error"] > FAR_OFF * d.checks["tolerance"]:
                 out.append(_unreachable(d, kind, box, budget))
         elif k == "ok_transmission":
-            out.append(_transmission_word(d.checks))
+            c = d.checks
+            where = f"at crank angle {c['min_transmission_at_rad']:.4g} rad from the ground line"
+            out.append(_transmission_word(c["min_transmission_deg"], where, c["transmission_limit_deg"]))
         elif k == "ok_order":
             out.append("the branch does not pass the targets in their order (--ordered)")
         elif k == "ok_valid_over_turn" and d.checks.get("failures"):
@@ -106,16 +108,15 @@ def _path_failing(d: Any, kind: str = "four-bar", box: str = "", budget: str = "
     return out
 
 
-def _transmission_word(c: dict[str, Any]) -> str:
-    """The failed transmission check in words: a near-toggle (under the 1 deg floor) or under the asked limit."""
+def _transmission_word(deg: float, where: str, asked: float) -> str:
+    """A failed transmission check in words: the smallest angle ``deg`` (deg from a toggle), ``where`` it falls
+    (e.g. ``"at crank angle 1.2 rad from the ground line"``), the limit (``--min-transmission`` ``asked``, deg, or
+    the 1 deg floor) and what it means: a near-toggle under the floor, else a rocker driven poorly."""
     from planar.synth.path import TOGGLE_FLOOR_DEG
 
-    head = (
-        f"the transmission angle falls to {c['min_transmission_deg']:.3g} deg from a toggle at crank angle "
-        f"{c['min_transmission_at_rad']:.4g} rad from the ground line (limit {c['transmission_limit_deg']:g} deg, "
-        "--min-transmission)"
-    )
-    if c["min_transmission_deg"] < TOGGLE_FLOOR_DEG:
+    limit = f"limit {asked:g} deg, --min-transmission" if asked > TOGGLE_FLOOR_DEG else f"the floor, {TOGGLE_FLOOR_DEG:g} deg"
+    head = f"the transmission angle falls to {deg:.3g} deg from a toggle {where} ({limit})"
+    if deg < TOGGLE_FLOOR_DEG:
         return head + (
             ": coupler and rocker fold nearly flat there, so the coupler point moves far for a small crank step "
             "and the linkage may lock or flip"
@@ -556,12 +557,8 @@ def _cmd_function(args: argparse.Namespace) -> int:
             "that moves over the inputs' arc on one circuit" + (f"; {d.note}" if d.note else "") + (f"; {hint}" if hint else "")
         )
     if not d.checks["ok_transmission"]:
-        c = d.checks
-        failing[failing.index("transmission")] = (
-            f"the transmission angle falls to {c['min_transmission_deg']:.3g} deg from a toggle over the input's arc "
-            f"({'the floor, 1 deg' if args.min_transmission < 1 else f'limit {args.min_transmission:g} deg, --min-transmission'})"
-            ": coupler and rocker "
-            "fold nearly flat there, so the linkage may lock or flip"
+        failing[failing.index("transmission")] = _transmission_word(
+            d.checks["min_transmission_deg"], "over the input's arc", args.min_transmission
         )
     offs = (
         f"crank angle from the ground line = input {_plus(d.input_offset)} rad, "
@@ -680,9 +677,8 @@ def _cmd_motion(args: argparse.Namespace) -> int:
             f"{d.checks['max_position_error']:.3g} off in position and {d.checks['max_angle_error_rad']:.3g} rad in angle"
         )
     if not d.checks["ok_transmission"]:
-        failing[failing.index("transmission")] = (
-            f"transmission angle {d.checks['min_transmission_deg']:.3g} deg from a toggle (limit "
-            f"{args.min_transmission:g}, --min-transmission) at {d.checks['min_transmission_at']}"
+        failing[failing.index("transmission")] = _transmission_word(
+            d.checks["min_transmission_deg"], f"at {d.checks['min_transmission_at']}", args.min_transmission
         )
     text = fourbar_scene_text(
         "synth-motion",

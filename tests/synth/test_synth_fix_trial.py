@@ -182,11 +182,11 @@ def test_transmission_constraint_of_the_search_against_a_dense_sweep():
 def test_transmission_failure_worded_by_what_it_is():
     from planar.cli.synth import _transmission_word
 
-    c = {"min_transmission_at_rad": 3.1, "transmission_limit_deg": 30.0}
-    soft = _transmission_word({**c, "min_transmission_deg": 10.4})
+    soft = _transmission_word(10.4, "at crank angle 3.1 rad from the ground line", 30.0)
     assert "falls to 10.4 deg" in soft and "drives it poorly" in soft and "jumps" not in soft and "flip" not in soft
-    hard = _transmission_word({**c, "min_transmission_deg": 0.42})
-    assert "fold nearly flat" in hard and "lock or flip" in hard
+    assert "limit 30 deg, --min-transmission" in soft
+    hard = _transmission_word(0.42, "over the input's arc", 0.0)
+    assert "fold nearly flat" in hard and "lock or flip" in hard and "the floor, 1 deg" in hard
 
 
 @pytest.mark.slow
