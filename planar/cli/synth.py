@@ -95,6 +95,12 @@ def _path_failing(d: Any, kind: str = "four-bar", box: str = "", budget: str = "
             )
             if d.checks["max_error"] > FAR_OFF * d.checks["tolerance"]:
                 out.append(_unreachable(d, kind, box, budget))
+            elif d.checks["rms_error"] <= NOISE_RMS:  # a near miss: the likeliest reason in the same line
+                out[-1] += (
+                    f"; if the targets are measured, measured points carry noise a {kind} cannot follow: misses like these "
+                    f"(RMS {d.checks['rms_error']:.2g} of the size) may be the noise, and a --tolerance a few times it "
+                    "accepts the fit"
+                )
         elif k == "ok_transmission":
             c = d.checks
             where = f"at crank angle {c['min_transmission_at_rad']:.4g} rad from the ground line"
@@ -123,6 +129,9 @@ def _transmission_word(deg: float, where: str, asked: float) -> str:
         )
     return head + ": the coupler pushes the rocker mostly along its length there, so it drives it poorly (stiff, loads the pins)"
 
+
+#: a best design whose RMS distance is at most this (a fraction of the targets' size) may be off by measurement noise
+NOISE_RMS = 0.05
 
 #: a best design more than this many times the tolerance off is reported as no four-bar tracing the curve
 FAR_OFF = 10.0
@@ -168,9 +177,16 @@ def _unreachable(d: Any, kind: str = "four-bar", box: str = "", budget: str = "n
     else:
         more = ", --type sixbar" if kind == "four-bar" else ""
         thorough = "" if budget == "thorough" else "--budget thorough, "
+        rms = d.checks.get("rms_error", math.inf)
+        noise = (
+            f"measured points carry noise a {kind} cannot follow (if that is why, the RMS distance, {rms:.2g} of the size, "
+            "is about the noise: a --tolerance a few times it accepts the fit); or "
+            if rms <= NOISE_RMS
+            else ""
+        )
         why = (
-            f"no {kind} the search found traces this shape closer: it may be a shape no {kind} traces, or one the "
-            f"search missed (try {thorough}another --seed{more}, or a larger --tolerance)"
+            f"no {kind} the search found traces this shape closer: {noise}it may be a shape no {kind} traces, or one "
+            f"the search missed (try {thorough}another --seed{more}, or a larger --tolerance)"
         )
         n = len(d.targets)
         if kind == "four-bar" and getattr(d, "timed", False) and n >= 5:
@@ -217,6 +233,8 @@ def _cmd_path(args: argparse.Namespace) -> int:
     _unit_mm(args)  # refused before the search, not after it
     if args.topology is not None and args.type != "sixbar":
         raise InputError("--topology", args.topology, "--topology only with --type sixbar")
+    if args.input_rocks and not args.rocking:
+        raise InputError("--input-rocks", True, "--rocking with it (it asks the rocking search for a rocking input link)")
     if args.points is not None and not 3 <= args.points <= MAX_TARGETS:
         raise InputError("--points", args.points, f"3 to {MAX_TARGETS} points sampled along the SVG (a path is matched at each)")
     targets, theta = read_path_targets(args.target, args.points)
@@ -320,7 +338,13 @@ def _rocking_design(args: argparse.Namespace, targets: np.ndarray, theta: Any, c
     if args.pivots is not None:
         raise InputError("--pivots", args.pivots, "no --pivots box with --rocking (the rocking search does not keep one)")
     return synthesise_rocking_path(
-        targets, args.tolerance, args.ordered, cons.max_ratio, budget=args.budget, min_transmission=_min_transmission_rad(args)
+        targets,
+        args.tolerance,
+        args.ordered,
+        cons.max_ratio,
+        budget=args.budget,
+        min_transmission=_min_transmission_rad(args),
+        input_rocks=args.input_rocks,
     )
 
 
@@ -780,8 +804,10 @@ def add_parser(sub: Any) -> None:
         "--budget",
         choices=("quick", "normal", "thorough"),
         default="normal",
-        help="search effort (normal: about 4 s CPU when the atlas finds the curve; 6-18 s when it misses and the later "
-        "stages and the global search run; sixbar: about twice that)",
+        help="search effort of the atlas and the global search (normal, untimed: 15 or more targets on a four-bar's "
+        "curve need neither, under 2 s of CPU in all; fewer, about 3 s when the atlas's nearest curves find it, most "
+        "of it loading the atlas, up to about 20 s when the later stages and the global search run, as with noisy "
+        "or drawn targets; sixbar: about twice that)",
     )
     p.add_argument(
         "--max-ratio",
@@ -819,6 +845,12 @@ def add_parser(sub: Any) -> None:
         "swing). Without "
         "it, untimed synth path tries that atlas too when the coupler-curve atlas is not within --tolerance, once "
         "planar synth atlas --rocking has built it",
+    )
+    p.add_argument(
+        "--input-rocks",
+        action="store_true",
+        help="with --rocking: only a four-bar whose input link itself cannot turn fully (a double- or triple-rocker), "
+        "not a cognate whose crank could turn fully swung back and forth over the targets' span",
     )
     p.add_argument(
         "--atlas",

@@ -31,6 +31,7 @@ using algebraic curves" (J. Mech. Trans. Autom. Des. 108, 1986) for synthesis th
 from __future__ import annotations
 
 import itertools
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -207,56 +208,53 @@ def _wide_bounds(t: Array) -> list[tuple[float, float]]:
     return b + [(-3 * np.pi, 3 * np.pi), (-1.0, 1.0)]
 
 
-def search_algebraic(
-    targets: Array, cons: Any, ordered: bool = False, stop: float = 1e-9, rocking: bool = True
-) -> tuple[Any, tuple[float, float] | None]:
-    """Untimed ``targets`` (normalised: centroid 0, size 1) from their sextic alone (no atlas): the first of the
-    :func:`algebraic_starts` (best first, :func:`rank_starts`) whose refinement (crank angles free, from each
-    target's nearest point) is within ``stop`` (largest distance) and usable.
+#: a caller's preference of a refined exact result (kernel row with circuit, crank angles at the targets): ``None``
+#: when it is not usable, else ``(rank, extra)``, rank 0 the best (the search stops at the first of rank 0)
+Choice = Callable[[Array, Array], "tuple[int, Any] | None"]
 
-    Usable: keeping ``cons`` (a :class:`planar.synth.search.Constraints`: with its full turn, pivots box and
-    transmission angle) and the targets' order when ``ordered``; or, when ``rocking`` and the input does not turn
-    fully, usable as a rocking result (:func:`planar.synth.arcs.usable_swing`).  Returns the result (a
-    :class:`planar.synth.search.SearchResult`, its ``stages`` holding ``algebraic_s``) and the input's swing (None
-    when it turns fully), or ``(None, None)`` when none is (fewer than :data:`MIN_TARGETS` targets, targets on no
-    one four-bar's curve or too short an arc of it to fix the sextic, or a four-bar that breaks a constraint)."""
+
+def search_algebraic(targets: Array, cons: Any, choose: Choice, stop: float = 1e-9) -> tuple[Any, Any]:
+    """Untimed ``targets`` (normalised: centroid 0, size 1) from their sextic alone (no atlas): the refinements
+    (crank angles free, from each target's nearest point) of the best :data:`SEARCH_REFINE` of the
+    :func:`algebraic_starts` (:func:`rank_starts`) that are within ``stop`` (largest distance), the one ``choose``
+    ranks best.
+
+    ``cons`` (a :class:`planar.synth.search.Constraints`) is kept by the refinement except its full turn (a rocking
+    input may be the answer: ``choose`` judges that, the order and anything else).  Returns the result (a
+    :class:`planar.synth.search.SearchResult`, its ``stages`` holding ``algebraic_s``) and ``choose``'s extra, or
+    ``(None, None)`` when none is usable (fewer than :data:`MIN_TARGETS` targets, targets on no one four-bar's
+    curve or too short an arc of it to fix the sextic, or no four-bar ``choose`` accepts)."""
     import dataclasses
     import time
 
-    from planar.synth.arcs import usable_swing
-    from planar.synth.search import (
-        PathObjective,
-        SearchResult,
-        _refine,
-        in_order,
-        max_distance,
-        reassigned_refine,
-        violation,
-    )
+    from planar.synth.search import PathObjective, SearchResult, _refine, max_distance, reassigned_refine
 
     t0 = time.perf_counter()
     t = np.asarray(targets, float)
     rows = algebraic_starts(t)
     if len(rows) == 0:
         return None, None
-    free = dataclasses.replace(cons, full_turn=False)  # refined without the full turn: a rocker may be the answer
+    free = dataclasses.replace(cons, full_turn=False)
     obj = PathObjective(t, None, free, 256)
     b = _wide_bounds(t)
     order, theta, _ = rank_starts(t, rows)
+    best: tuple[int, Array, Array, Any] | None = None
     for k in order[:SEARCH_REFINE]:
         r, tt, _ = _refine(obj, rows[k], b, max_nfev=SEARCH_NFEV, method="lm", theta0=theta[k])
         if not max_distance(obj, r, tt) <= stop:
             r, tt, _ = reassigned_refine(obj, rows[k], b, SEARCH_NFEV, stop)
             if not max_distance(obj, r, tt) <= stop:
                 continue
-        sse = float(np.sum(np.square(obj.targets - _points(r, tt))))
-        result = SearchResult(r[:9], 1 if r[9] >= 0 else -1, tt, sse, True, 1, {"algebraic_s": time.perf_counter() - t0})
-        if violation(r[None, :9], cons, obj.scale, 0.0)[0] <= 0 and (in_order(tt) or not ordered):
-            return result, None
-        swing = usable_swing(r, tt, free, obj.scale, ordered) if rocking else None
-        if swing is not None:
-            return result, swing
-    return None, None
+        choice = choose(r, tt)
+        if choice is not None and (best is None or choice[0] < best[0]):
+            best = (choice[0], r, tt, choice[1])
+            if choice[0] == 0:
+                break
+    if best is None:
+        return None, None
+    _, r, tt, extra = best
+    sse = float(np.sum(np.square(obj.targets - _points(r, tt))))
+    return SearchResult(r[:9], 1 if r[9] >= 0 else -1, tt, sse, True, 1, {"algebraic_s": time.perf_counter() - t0}), extra
 
 
 def _points(row: Array, theta: Array) -> Array:

@@ -44,7 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planar.errors import InputError
-from planar.synth.algebraic import search_algebraic
+from planar.synth.algebraic import MIN_TARGETS, search_algebraic
 from planar.synth.atlas import DescriptorIndex, unreadable
 from planar.synth.designs import TOGGLE_FLOOR_DEG
 from planar.synth.kernel import coupler_points
@@ -396,14 +396,17 @@ def swing_transmission(row: Array, swing: tuple[float, float], n: int = 181) -> 
     return float(np.min(np.minimum(mu, np.pi - mu)))
 
 
-def usable_swing(r: Array, theta: Array, cons: Any, scale: float, ordered: bool) -> tuple[float, float] | None:
+def usable_swing(
+    r: Array, theta: Array, cons: Any, scale: float, ordered: bool, input_rocks: bool = False
+) -> tuple[float, float] | None:
     """The swing (:func:`input_swing`) of a refined row ``r`` (9 parameters and the circuit) passing crank angles
     ``theta``, when it is usable as a rocking result: it keeps ``cons`` (the full turn not asked), meets the targets
     one way when ``ordered``, and its transmission angle over the swing keeps ``cons.min_transmission`` and the floor
-    :data:`planar.synth.designs.TOGGLE_FLOOR_DEG`; else None."""
+    :data:`planar.synth.designs.TOGGLE_FLOOR_DEG`; with ``input_rocks``, its input link itself cannot turn fully
+    (:func:`rocking_range`: not a cognate whose crank is swung over the targets' span); else None."""
     from planar.synth.search import violation
 
-    swing = input_swing(r[:9], theta)
+    swing = rocking_range(r[:9], theta) if input_rocks else input_swing(r[:9], theta)
     if swing is None or violation(r[None, :9], cons, scale, 0.0)[0] > 0 or (ordered and not one_way(theta, swing)):
         return None
     floor = max(float(cons.min_transmission), math.radians(TOGGLE_FLOOR_DEG))
@@ -411,14 +414,15 @@ def usable_swing(r: Array, theta: Array, cons: Any, scale: float, ordered: bool)
 
 
 def search_arcs(
-    targets: Array, arcs: Arcs, cons: Any = None, stop: float = 1e-9, ordered: bool = False
+    targets: Array, arcs: Arcs, cons: Any = None, stop: float = 1e-9, ordered: bool = False, input_rocks: bool = False
 ) -> tuple[Any, tuple[float, float] | None]:
     """Untimed targets (normalised: centroid 0, size 1) from the rocking arcs, refined: the best result (as
     :class:`planar.synth.search.SearchResult`) whose targets lie on one swing of its input (``ordered``: met in
     their order as it swings one way), whose transmission angle keeps over that swing ``cons.min_transmission``
     and the floor :data:`planar.synth.designs.TOGGLE_FLOOR_DEG` from a toggle, and that swing's input range
     (:func:`rocking_range`; None when no result does).  ``cons``: the path's
-    :class:`~planar.synth.search.Constraints` with the full turn not required (its link ratio is kept)."""
+    :class:`~planar.synth.search.Constraints` with the full turn not required (its link ratio is kept).
+    ``input_rocks``: only a four-bar whose input link itself cannot turn fully (see :func:`usable_swing`)."""
     import dataclasses
 
     from planar.synth.search import (
@@ -435,22 +439,27 @@ def search_arcs(
     obj = PathObjective(t, None, cons, 256)
     b = default_bounds(t, cons, False)
     b[8] = (-3 * np.pi, 3 * np.pi)
+
+    def usable(r: Array, tt: Array) -> tuple[float, float] | None:
+        return usable_swing(r, tt, cons, obj.scale, ordered, input_rocks)
+
     # the four-bar of the targets' own sextic first (exact from 15 targets on a long enough arc): no lookup
-    alg, _ = search_algebraic(t, cons, ordered, stop)
-    swing = usable_swing(np.append(alg.params, alg.circuit), alg.theta, cons, obj.scale, ordered) if alg else None
-    if alg is not None and swing is not None:
+    def choose(r: Array, tt: Array) -> tuple[int, Any] | None:  # an input link that rocks first
+        swing = usable(r, tt)
+        return None if swing is None else (0 if rocking_range(r[:9], tt) is not None else 1, swing)
+
+    t_alg = time.perf_counter()
+    alg, swing = search_algebraic(t, cons, choose, stop)
+    if alg is not None:
         return alg, swing
     t0 = time.perf_counter()
     every = arc_candidates(arcs, t, SEARCH_K)
-    stages = {"arcs_s": time.perf_counter() - t0}
+    stages = {"algebraic_s": t0 - t_alg} if len(t) >= MIN_TARGETS else {}
+    stages["arcs_s"] = time.perf_counter() - t0
     t1 = time.perf_counter()
     f = obj.population(every, np.float64) if len(every) else np.zeros(0)
     found: list[tuple[float, Array, Array, tuple[float, float]]] = []
     tried: list[Array] = []
-
-    def usable(r: Array, tt: Array) -> tuple[float, float] | None:
-        return usable_swing(r, tt, cons, obj.scale, ordered)
-
     for row in every[np.argsort(f, kind="stable")]:
         if len(tried) >= SEARCH_REFINE:
             break

@@ -206,6 +206,16 @@ def _search(
     return g, f"the global search (--budget {budget}; the atlas's best was {e_atlas:.3g} of the size off)", None
 
 
+#: ``found_by`` of a result the targets' own curve equation gave (:func:`planar.synth.algebraic.search_algebraic`)
+EQUATION_SOURCE = "the targets' own curve equation (its singular foci; no atlas lookup: within the tolerance)"
+#: ``found_by`` when that equation's four-bars pass through every target but meet them out of the given order
+EQUATION_ORDER_SOURCE = (
+    "the targets' own curve equation: a four-bar passes through every target, but meets them in another order than "
+    "listed, as every four-bar tracing this curve does (with --ordered list them in their order along the curve, "
+    "or drop --ordered); no atlas lookup"
+)
+
+
 def _untimed(
     t: Array,
     cons: Constraints,
@@ -217,16 +227,70 @@ def _untimed(
     arcs: Any,
     load: dict[str, float],
 ) -> tuple[Any, str, tuple[float, float] | None]:
-    """:func:`_search` of untimed targets: the targets' sextic, the closed-curve atlas (``loaded()`` loads it), the
-    rocking arcs, then the global search."""
+    """:func:`_search` of untimed targets: from :data:`planar.synth.algebraic.MIN_TARGETS` targets their own curve
+    equation (:func:`_from_equation`: no atlas is loaded when it gives the four-bar), then :func:`_searched`."""
+    import time
+
+    from planar.synth.algebraic import MIN_TARGETS
+
+    if len(t) < MIN_TARGETS:
+        return _searched(t, cons, budget, seed, tolerance, loaded, ordered, arcs, load)
+    t0 = time.perf_counter()
+    alg, how, swing = _from_equation(t, cons, ordered, tolerance)
+    load["algebraic_s"] = time.perf_counter() - t0
+    if alg is not None:
+        alg.stages = dict(load)
+        return alg, how, swing
+    r, source, swing = _searched(t, cons, budget, seed, tolerance, loaded, ordered, arcs, load)
+    return r, source + "; the targets' own curve equation gave no four-bar through them (see the curve equation docs)", swing
+
+
+def _from_equation(t: Array, cons: Constraints, ordered: bool, tolerance: float) -> tuple[Any, str, Any]:
+    """The four-bar of the targets' own curve equation (:func:`planar.synth.algebraic.search_algebraic`): a crank
+    keeping ``cons`` and the order first, then a rocking input (when the rocking search may be tried: no pivots box,
+    no transmission limit), then, with ``ordered``, one through every target in another order (every four-bar
+    tracing that curve meets them so: no search would do better).  Returns the result (None when none), the
+    sentence saying how it was found, and its input's swing (None when it turns fully)."""
+    import dataclasses
+
     from planar.synth.algebraic import search_algebraic
+    from planar.synth.arcs import usable_swing
+    from planar.synth.search import in_order, violation
+
+    rocking = cons.region is None and cons.min_transmission == 0
+
+    def choose(r: Array, tt: Array) -> tuple[int, Any] | None:
+        keeps = violation(r[None, :9], cons, 1.0, 0.0)[0] <= 0
+        if keeps and (in_order(tt) or not ordered):
+            return 0, None
+        swing = usable_swing(r, tt, dataclasses.replace(cons, full_turn=False), 1.0, ordered) if rocking else None
+        if swing is not None:
+            return 1, swing
+        return (2, "order") if keeps else None
+
+    alg, extra = search_algebraic(t, cons, choose, stop=min(1e-9, tolerance))
+    if alg is None:
+        return None, "", None
+    if extra == "order":
+        return alg, EQUATION_ORDER_SOURCE, None
+    return alg, EQUATION_SOURCE, extra
+
+
+def _searched(
+    t: Array,
+    cons: Constraints,
+    budget: str,
+    seed: int,
+    tolerance: float,
+    loaded: Any,
+    ordered: bool,
+    arcs: Any,
+    load: dict[str, float],
+) -> tuple[Any, str, tuple[float, float] | None]:
+    """:func:`_untimed` by search: the closed-curve atlas (``loaded()`` loads it), the rocking arcs, then the global
+    search."""
     from planar.synth.search import in_order, max_distance, search_atlas
 
-    # from 15 targets on one four-bar's curve its equation gives the four-bar: no atlas is loaded
-    rocking = cons.region is None and cons.min_transmission == 0
-    alg, swing = search_algebraic(t, cons, ordered, stop=min(1e-9, tolerance), rocking=rocking)
-    if alg is not None:
-        return alg, "the targets' own curve equation (its singular foci; no atlas lookup: within the tolerance)", swing
     r = search_atlas(t, loaded(), cons, ordered=ordered)
     good = r.feasible and (in_order(r.theta) or not ordered) and _keeps_transmission(r, cons)
     e_atlas = max_distance(PathObjective(t, None, cons), np.append(r.params, r.circuit), r.theta)
@@ -525,6 +589,7 @@ def synthesise_rocking_path(
     arcs: Any = None,
     budget: str = "normal",
     min_transmission: float = 0.0,
+    input_rocks: bool = False,
 ) -> FourBarDesign:
     """A four-bar whose input *rocks* (swings between two angles, never turning fully) and whose coupler point
     passes through ``targets`` ``(N, 2)`` (untimed, in order along its arc), from the rocking-arc atlas.
@@ -539,8 +604,11 @@ def synthesise_rocking_path(
     least ``min_transmission`` rad from a toggle and never nearer than :data:`TOGGLE_FLOOR_DEG`; the smallest is
     ``min_transmission_deg``, at the input angle ``min_transmission_at_rad``: a check of the result, not a
     constraint of the search) and, with ``ordered``, ``ok_order`` (the targets met in their order as the input
-    swings one way).  When no four-bar keeps the targets on one swing, ``checks["error"]``
-    says so and ``sse`` is inf.  Raises :class:`InputError` naming a bad argument (as :func:`synthesise_path`).
+    swings one way).  ``input_rocks``: only a four-bar whose input link itself cannot turn fully (a double- or
+    triple-rocker; by default a cognate whose crank could turn fully, swung over the targets' span, is accepted
+    too); ``checks["input_link"]`` says which the result is (``"rocks"`` or ``"could turn fully"``).  When no
+    four-bar keeps the targets on one swing, ``checks["error"]`` says so and ``sse`` is inf.  Raises
+    :class:`InputError` naming a bad argument (as :func:`synthesise_path`).
     """
     from threadpoolctl import threadpool_limits
 
@@ -556,14 +624,16 @@ def synthesise_rocking_path(
         arcs = load_arcs(QUICK_FOURBARS if budget == "quick" else DEFAULT_FOURBARS, progress=True)
     c, s = normalisation(t)
     with threadpool_limits(1):
-        r, swing = search_arcs((t - c) / s, arcs, cons, ordered=ordered)
+        r, swing = search_arcs((t - c) / s, arcs, cons, ordered=ordered, input_rocks=bool(input_rocks))
     if r is None or swing is None:
         d = FourBarDesign(1.0, 1.0, 1.0, 1.0, (0.0, 0.0), "open", (0.0, 0.0, 0.0), np.zeros(len(t)), math.inf, t, False, 0.0)
-        d.checks = {"error": "no four-bar of the rocking-arc atlas keeps the targets on one swing of its input"}
+        which = "whose input link cannot turn fully " if input_rocks else ""
+        d.checks = {"error": f"no four-bar {which}the rocking search found keeps the targets on one swing of its input"}
         d.checks["ok_found"] = False
         return d
     d, p = design_from(r, c, s, t, False, time.perf_counter() - t0)
-    return _rocking_checked(d, r, p, swing, tolerance, ordered, cons, "the rocking-arc atlas lookup and refinement", s)
+    source = "the rocking-arc atlas lookup and refinement" if "arcs_s" in r.stages else EQUATION_SOURCE
+    return _rocking_checked(d, r, p, swing, tolerance, ordered, cons, source, s)
 
 
 def _rocking_checked(
@@ -581,6 +651,8 @@ def _rocking_checked(
     ``swing``: see :func:`synthesise_rocking_path`."""
     import dataclasses
 
+    from planar.synth.arcs import rocking_range
+
     _check_rocking(d, r.theta, swing, tolerance, ordered, size)
     _check_transmission(d, np.linspace(swing[0], swing[1], 721), cons.min_transmission)
     d.checks["constraint_failures"] = list(constraint_failures(p, dataclasses.replace(cons, full_turn=False)))
@@ -589,6 +661,12 @@ def _rocking_checked(
     a, b = d.checks["input_swing_deg"]
     d.checks["found_by"] = f"{source}; the input rocks between {a:.4g} and {b:.4g} deg from the ground line"
     d.checks["input"] = "rocks"
+    d.checks["input_link"] = "rocks" if rocking_range(p, r.theta) is not None else "could turn fully"
+    if d.checks["input_link"] != "rocks":
+        d.checks["found_by"] += (
+            "; its input link could turn fully (a crank swung back and forth over the targets' span: --input-rocks asks "
+            "for one that cannot)"
+        )
     d.checks["evaluations"] = r.evaluations
     return d
 
