@@ -202,6 +202,23 @@ def _unreachable(d: Any, kind: str = "four-bar", box: str = "", budget: str = "n
     )
 
 
+def _angles_comment(d: Any) -> str:
+    """The scene comment listing the crank angle at each target (rad from the ground line, full precision): on a
+    rocking input's swing, as the swing's own angles (the line printed gives the swing in the same terms), else in
+    ``[0, 2 pi)``."""
+    import numpy as np
+
+    theta = np.asarray(d.theta, float)
+    where = "in [0, 2 pi)"
+    if "input_swing_rad" in d.checks:
+        from planar.synth.arcs import on_swing
+
+        lo, hi = d.checks["input_swing_rad"]
+        theta = on_swing(theta, (lo, hi))
+        where = f"on the input's swing, {lo!r} to {hi!r}"
+    return f"crank angle at each target (rad from the ground line, {where}): " + ", ".join(repr(float(t)) for t in theta)
+
+
 def _unusable(d: Any, kind: str, region: bool) -> str | None:
     """Why a design is no valid linkage at all (a constraint broken, or it misses a target's crank angle)."""
     if d.checks.get("constraint_failures"):
@@ -289,7 +306,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
             d.placement,
             comments=[
                 f"planar synth path {args.target}: {len(targets)} targets, {'timed' if d.timed else 'untimed'}, sse {d.sse:.6g}",
-                "crank angle at each target (rad): " + ", ".join(repr(float(t)) for t in d.theta),
+                _angles_comment(d),
             ],
             amplitude=amp,
             centre=centre,
