@@ -156,7 +156,7 @@ def test_min_transmission_checked_like_function(tmp_path, capsys):
     assert (rc == 0 and rep["checks"]["min_transmission_deg"] >= own + 0.5) or (rc == 3 and not rep["checks"]["ok_transmission"])
     rc = main(["synth", "motion", str(path), "-o", str(out), "--min-transmission", "89"])
     err = capsys.readouterr()
-    assert rc == 3 and "check failed: transmission angle" in err.err + err.out and "crank angle" in err.err + err.out
+    assert rc == 3 and "check failed: the transmission angle falls to" in err.err + err.out and "crank angle" in err.err + err.out
     rc = main(["synth", "motion", str(path), "-o", str(out), "--min-transmission", f"{own - 0.5:.4f}", "--json"])
     rep = json.loads(capsys.readouterr().out)
     assert rc == 0 and rep["checks"]["ok_transmission"] and "between poses" in rep["checks"]["min_transmission_at"]
