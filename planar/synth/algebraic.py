@@ -23,6 +23,15 @@ with a common root, and their resultant is
 
 On exact targets the four-bar comes out exact (to the conditioning of the fit); on noisy or sparse targets (fewer
 than 15, where the fit leaves a family of sextics) the four-bars are starts, refined like the atlas's.
+
+The foci can also be unknowns (:func:`refine_foci`): the resultant at each target, divided by its gradient with
+respect to the target (:func:`foci_residuals`, Sampson's first-order distance to the curve), depends on the three
+foci and ``(s**2, k1, k2)`` only (nine reals, a four-bar's nine dimensions, no crank angle).  For given foci the
+dyads are fitted by a few Gauss-Newton steps from the linear solution (:func:`fitted_dyads`), leaving a least-squares
+problem in the six coordinates of the foci (variable projection, Kaufman's Jacobian).  From a nearby four-bar
+(:func:`foci_of_row` gives its foci) it reaches the targets' curve more often than the four-bar refined with its
+crank angles: :func:`search_algebraic` uses it when a short arc leaves the sextic nearly undetermined, and
+:func:`search_foci` runs it from any starts (an atlas's nearest four-bars).
 Reference: Wampler, "Isotropic coordinates, circularity and Bezout numbers: planar kinematics from a new
 perspective" (ASME DETC 1996) for the isotropic loop equations; Blechschmidt and Uicker, "Linkage synthesis
 using algebraic curves" (J. Mech. Trans. Autom. Des. 108, 1986) for synthesis through the curve's equation.
@@ -49,6 +58,7 @@ __all__ = [
     "refine_foci",
     "row_of_foci",
     "search_algebraic",
+    "search_foci",
     "singular_foci",
 ]
 
@@ -262,7 +272,7 @@ def search_algebraic(targets: Array, cons: Any, choose: Choice, stop: float = 1e
         return None, None
     obj = PathObjective(t, None, dataclasses.replace(cons, full_turn=False), 256)
     order, theta, _ = rank_starts(t, rows)
-    best: tuple[int, Array, Array, Any] | None = None
+    best: Best | None = None
     for k in order[:SEARCH_REFINE]:
         best = _better(best, finish_start(obj, rows[k], theta[k], stop), choose)
         if best is not None and best[0] == 0:
@@ -273,27 +283,78 @@ def search_algebraic(targets: Array, cons: Any, choose: Choice, stop: float = 1e
             break
     if best is None:
         return None, None
-    _, r, tt, extra = best
+    _, _, r, tt, extra = best
     sse = float(np.sum(np.square(obj.targets - _points(r, tt))))
     return SearchResult(r[:9], 1 if r[9] >= 0 else -1, tt, sse, True, 1, {"algebraic_s": time.perf_counter() - t0}), extra
 
 
-def _better(best: tuple[int, Array, Array, Any] | None, found: tuple[Array, Array] | None, choose: Choice) -> Any:
-    """``best`` (rank, row, crank angles, extra) or the refined ``found`` (row, crank angles) when ``choose`` ranks
-    it better."""
+#: a refined four-bar as the searches here keep it: ``choose``'s rank, its largest distance, row, crank angles, extra
+Best = tuple[int, float, Array, Array, Any]
+
+
+def _better(best: Best | None, found: tuple[Array, Array, float] | None, choose: Choice) -> Best | None:
+    """``best`` or the refined ``found`` (row, crank angles, largest distance) when ``choose`` ranks it better (a
+    lower rank, then a smaller distance)."""
     if found is None:
         return best
-    choice = choose(*found)
-    if choice is not None and (best is None or choice[0] < best[0]):
-        return (choice[0], found[0], found[1], choice[1])
+    choice = choose(found[0], found[1])
+    if choice is not None and (best is None or (choice[0], found[2]) < best[:2]):
+        return (choice[0], found[2], found[0], found[1], choice[1])
     return best
 
 
-def finish_foci(obj: Any, start: Array, stop: float, choose: Choice) -> tuple[int, Array, Array, Any] | None:
+#: how many of a lookup's candidates :func:`search_foci` refines by their foci, and the largest distance (targets'
+#: size 1) of a near result the atlas searches keep for their own finish when none is within their stop
+FOCI_CANDIDATES, FOCI_ACCEPT = 16, 1e-6
+
+
+def search_foci(
+    targets: Array,
+    starts: Array,
+    cons: Any,
+    choose: Choice,
+    stop: float = 1e-9,
+    count: int = FOCI_CANDIDATES,
+    accept: float | None = None,
+) -> tuple[Any, Any]:
+    """Untimed ``targets`` (normalised: centroid 0, size 1; 6 or more) from the first ``count`` of ``starts`` (kernel
+    rows with circuit, best first: an atlas's nearest four-bars) by their curve's foci: each start's foci refined on
+    the targets (:func:`refine_foci`, no crank angle) and, when they fit, their four-bars refined with the crank
+    angles free (:func:`finish_foci`); the first ``choose`` ranks 0 within ``stop`` (largest distance), else the best
+    it accepts (lower rank, then smaller distance) within ``accept`` (default ``stop``; a larger one keeps near
+    results, e.g. for a caller's better-conditioned finish).
+
+    Fewer than 15 targets leave a family of sextics, so no foci come from the targets alone; an atlas start's foci,
+    refined, are on the targets' curve more often than the start refined directly.  ``cons`` as
+    :func:`search_algebraic`.  Returns the result (a :class:`planar.synth.search.SearchResult`, its ``stages``
+    holding ``foci_s``) and ``choose``'s extra, or ``(None, None)``."""
+    import dataclasses
+    import time
+
+    from planar.synth.search import PathObjective, SearchResult
+
+    t0 = time.perf_counter()
+    t = np.asarray(targets, float)
+    obj = PathObjective(t, None, dataclasses.replace(cons, full_turn=False), 256)
+    best: Best | None = None
+    for row in np.asarray(starts, float)[:count] if len(t) >= 6 else []:
+        found = finish_foci(obj, row, stop, choose, accept)
+        if found is not None and (best is None or found[:2] < best[:2]):
+            best = found
+            if best[0] == 0 and best[1] <= stop:
+                break
+    if best is None:
+        return None, None
+    _, _, r, tt, extra = best
+    sse = float(np.sum(np.square(obj.targets - _points(r, tt))))
+    return SearchResult(r[:9], 1 if r[9] >= 0 else -1, tt, sse, True, 1, {"foci_s": time.perf_counter() - t0}), extra
+
+
+def finish_foci(obj: Any, start: Array, stop: float, choose: Choice, accept: float | None = None) -> Best | None:
     """A start (kernel row and circuit) near the untimed targets of ``obj`` (a
     :class:`planar.synth.search.PathObjective`, normalised targets), its foci refined (:func:`refine_foci`) and,
     when their largest residual is at most :data:`FOCI_FAR`, the :data:`FOCI_REFINE` best of their four-bars
-    finished by :func:`finish_start`: the best ``choose`` accepts (rank, row, crank angles, extra), or None."""
+    finished by :func:`finish_start` (within ``accept``, default ``stop``): the best ``choose`` accepts, or None."""
     rows, far = refine_foci(obj.targets, start)
     if not far <= FOCI_FAR or len(rows) == 0:
         return None
@@ -302,26 +363,30 @@ def finish_foci(obj: Any, start: Array, stop: float, choose: Choice) -> tuple[in
     for k in order[:FOCI_REFINE]:
         if not np.isfinite(dist[k]):
             break
-        best = _better(best, finish_start(obj, rows[k], theta[k], stop), choose)
-        if best is not None and best[0] == 0:
+        best = _better(best, finish_start(obj, rows[k], theta[k], stop, accept), choose)
+        if best is not None and best[0] == 0 and best[1] <= stop:
             break
     return best
 
 
-def finish_start(obj: Any, row: Array, theta: Array, stop: float) -> tuple[Array, Array] | None:
+def finish_start(
+    obj: Any, row: Array, theta: Array, stop: float, accept: float | None = None
+) -> tuple[Array, Array, float] | None:
     """One start (kernel row and circuit; crank angles ``theta`` at the targets of ``obj``, rad) refined on the
     targets (crank angles free, :data:`WIDE_BOX`) by Levenberg-Marquardt, then with its angles re-assigned
-    (:func:`planar.synth.search.reassigned_refine`) if not within ``stop``: the refined row and crank angles when
-    within ``stop`` (largest distance), else None."""
+    (:func:`planar.synth.search.reassigned_refine`) if not within ``stop``: the refined row, crank angles and largest
+    distance when within ``accept`` (default ``stop``), else None."""
     from planar.synth.search import _refine, max_distance, reassigned_refine
 
     b = _wide_bounds(obj.targets)
     r, tt, _ = _refine(obj, row, b, max_nfev=SEARCH_NFEV, method="lm", theta0=theta)
-    if not max_distance(obj, r, tt) <= stop:
-        r, tt, _ = reassigned_refine(obj, row, b, SEARCH_NFEV, stop)
-        if not max_distance(obj, r, tt) <= stop:
-            return None
-    return r, tt
+    e = max_distance(obj, r, tt)
+    if not e <= stop:
+        r2, tt2, _ = reassigned_refine(obj, row, b, SEARCH_NFEV, stop)
+        e2 = max_distance(obj, r2, tt2)
+        if e2 < e or not np.isfinite(e):
+            r, tt, e = r2, tt2, e2
+    return (r, tt, e) if e <= max(stop, accept if accept is not None else stop) else None
 
 
 def _points(row: Array, theta: Array) -> Array:
@@ -390,7 +455,7 @@ def foci_residuals(targets: Array, x: Array) -> Array:
 
 #: least-squares evaluations of :func:`refine_foci` (each solving the dyads, :func:`fitted_dyads`), and the
 #: Gauss-Newton iterations of :func:`fitted_dyads`
-FOCI_NFEV, DYAD_ITERS = 400, 6
+FOCI_NFEV, DYAD_ITERS = 100, 6
 
 
 def _foci_vector(row: Array) -> Array:
