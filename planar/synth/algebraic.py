@@ -30,8 +30,10 @@ foci and ``(s**2, k1, k2)`` only (nine reals, a four-bar's nine dimensions, no c
 dyads are fitted by a few Gauss-Newton steps from the linear solution (:func:`fitted_dyads`), leaving a least-squares
 problem in the six coordinates of the foci (variable projection, Kaufman's Jacobian).  From a nearby four-bar
 (:func:`foci_of_row` gives its foci) it reaches the targets' curve more often than the four-bar refined with its
-crank angles: :func:`search_algebraic` uses it when a short arc leaves the sextic nearly undetermined, and
-:func:`search_foci` runs it from any starts (an atlas's nearest four-bars).
+crank angles: :func:`search_algebraic` uses it when a short arc leaves the sextic nearly undetermined.  From an
+atlas's starts below 15 targets it recovered more than the same starts refined directly (12 targets, 30 problems
+per kind: double-rockers 10 -> 63 %, part-curves 23 -> 60 %), but no more than the atlas search's later stages
+already do, at more CPU, so the atlas search does not use it (see docs/explanation/curve-equation.md).
 Reference: Wampler, "Isotropic coordinates, circularity and Bezout numbers: planar kinematics from a new
 perspective" (ASME DETC 1996) for the isotropic loop equations; Blechschmidt and Uicker, "Linkage synthesis
 using algebraic curves" (J. Mech. Trans. Autom. Des. 108, 1986) for synthesis through the curve's equation.
@@ -58,7 +60,6 @@ __all__ = [
     "refine_foci",
     "row_of_foci",
     "search_algebraic",
-    "search_foci",
     "singular_foci",
 ]
 
@@ -247,11 +248,15 @@ Choice = Callable[[Array, Array], "tuple[int, Any] | None"]
 FOCI_STARTS, FOCI_FAR, FOCI_REFINE = 4, 1e-4, 2
 
 
-def search_algebraic(targets: Array, cons: Any, choose: Choice, stop: float = 1e-9) -> tuple[Any, Any]:
+def search_algebraic(
+    targets: Array, cons: Any, choose: Choice, stop: float = 1e-9, accept: float | None = None
+) -> tuple[Any, Any]:
     """Untimed ``targets`` (normalised: centroid 0, size 1) from their sextic alone (no atlas): the refinements
     (crank angles free, from each target's nearest point) of the best :data:`SEARCH_REFINE` of the
     :func:`algebraic_starts` (:func:`rank_starts`) that are within ``stop`` (largest distance), the one ``choose``
-    ranks best.  When none is usable (a short arc leaves the sextic nearly undetermined, so its foci are off), the
+    ranks best (lower rank, then smaller distance); with ``accept`` (a largest distance above ``stop``: noisy or
+    measured targets) the best within it when none is within ``stop``.  When none is usable (a short arc leaves the
+    sextic nearly undetermined, so its foci are off), the
     foci of the :data:`FOCI_STARTS` best starts are refined on the targets (:func:`refine_foci`) and their four-bars
     refined the same way.
 
@@ -274,12 +279,12 @@ def search_algebraic(targets: Array, cons: Any, choose: Choice, stop: float = 1e
     order, theta, _ = rank_starts(t, rows)
     best: Best | None = None
     for k in order[:SEARCH_REFINE]:
-        best = _better(best, finish_start(obj, rows[k], theta[k], stop), choose)
-        if best is not None and best[0] == 0:
+        best = _better(best, finish_start(obj, rows[k], theta[k], stop, accept), choose)
+        if best is not None and best[0] == 0 and best[1] <= stop:
             break
-    for k in order[:FOCI_STARTS] if best is None else []:
-        best = finish_foci(obj, rows[k], stop, choose)
-        if best is not None:
+    for k in order[:FOCI_STARTS] if best is None or best[1] > stop else []:
+        best = _kept(best, finish_foci(obj, rows[k], stop, choose, accept))
+        if best is not None and best[1] <= stop:
             break
     if best is None:
         return None, None
@@ -292,6 +297,13 @@ def search_algebraic(targets: Array, cons: Any, choose: Choice, stop: float = 1e
 Best = tuple[int, float, Array, Array, Any]
 
 
+def _kept(best: Best | None, other: Best | None) -> Best | None:
+    """The better of two kept results (lower rank, then smaller distance; either may be None)."""
+    if best is None or (other is not None and other[:2] < best[:2]):
+        return other
+    return best
+
+
 def _better(best: Best | None, found: tuple[Array, Array, float] | None, choose: Choice) -> Best | None:
     """``best`` or the refined ``found`` (row, crank angles, largest distance) when ``choose`` ranks it better (a
     lower rank, then a smaller distance)."""
@@ -301,54 +313,6 @@ def _better(best: Best | None, found: tuple[Array, Array, float] | None, choose:
     if choice is not None and (best is None or (choice[0], found[2]) < best[:2]):
         return (choice[0], found[2], found[0], found[1], choice[1])
     return best
-
-
-#: how many of a lookup's candidates :func:`search_foci` refines by their foci, the least-squares evaluations of each
-#: (:func:`refine_foci`; measured at 12 targets on 30 double-rockers: 400 recovered 63 %, 100 33 %), and the largest
-#: distance (targets' size 1) of a near result a caller may keep for its own finish
-FOCI_CANDIDATES, FOCI_SEARCH_NFEV, FOCI_ACCEPT = 16, 400, 1e-6
-
-
-def search_foci(
-    targets: Array,
-    starts: Array,
-    cons: Any,
-    choose: Choice,
-    stop: float = 1e-9,
-    count: int = FOCI_CANDIDATES,
-    accept: float | None = None,
-) -> tuple[Any, Any]:
-    """Untimed ``targets`` (normalised: centroid 0, size 1; 6 or more) from the first ``count`` of ``starts`` (kernel
-    rows with circuit, best first: an atlas's nearest four-bars) by their curve's foci: each start's foci refined on
-    the targets (:func:`refine_foci`, no crank angle) and, when they fit, their four-bars refined with the crank
-    angles free (:func:`finish_foci`); the first ``choose`` ranks 0 within ``stop`` (largest distance), else the best
-    it accepts (lower rank, then smaller distance) within ``accept`` (default ``stop``; a larger one keeps near
-    results, e.g. for a caller's better-conditioned finish).
-
-    Fewer than 15 targets leave a family of sextics, so no foci come from the targets alone; an atlas start's foci,
-    refined, are on the targets' curve more often than the start refined directly.  ``cons`` as
-    :func:`search_algebraic`.  Returns the result (a :class:`planar.synth.search.SearchResult`, its ``stages``
-    holding ``foci_s``) and ``choose``'s extra, or ``(None, None)``."""
-    import dataclasses
-    import time
-
-    from planar.synth.search import PathObjective, SearchResult
-
-    t0 = time.perf_counter()
-    t = np.asarray(targets, float)
-    obj = PathObjective(t, None, dataclasses.replace(cons, full_turn=False), 256)
-    best: Best | None = None
-    for row in np.asarray(starts, float)[:count] if len(t) >= 6 else []:
-        found = finish_foci(obj, row, stop, choose, accept, FOCI_SEARCH_NFEV)
-        if found is not None and (best is None or found[:2] < best[:2]):
-            best = found
-            if best[0] == 0 and best[1] <= stop:
-                break
-    if best is None:
-        return None, None
-    _, _, r, tt, extra = best
-    sse = float(np.sum(np.square(obj.targets - _points(r, tt))))
-    return SearchResult(r[:9], 1 if r[9] >= 0 else -1, tt, sse, True, 1, {"foci_s": time.perf_counter() - t0}), extra
 
 
 def finish_foci(

@@ -268,7 +268,7 @@ def _from_equation(t: Array, cons: Constraints, ordered: bool, tolerance: float)
             return 1, swing
         return (2, "order") if keeps else None
 
-    alg, extra = search_algebraic(t, cons, choose, stop=min(1e-9, tolerance))
+    alg, extra = search_algebraic(t, cons, choose, stop=min(1e-9, tolerance), accept=tolerance)
     if alg is None:
         return None, "", None
     if extra == "order":

@@ -99,3 +99,30 @@ def test_rocking_prefers_an_input_that_rocks_and_input_rocks_insists():
             if "algebraic_s" in d.checks["stages_s"] and "arcs_s" not in d.checks["stages_s"]:
                 assert "curve equation" in d.checks["found_by"] and "rocking-arc atlas" not in d.checks["found_by"]
     assert rocks >= 6, rocks
+
+
+@pytest.mark.slow
+def test_slightly_noisy_targets_within_the_tolerance_need_no_atlas():
+    """Digitised points (noise 1e-5 of the size) with --tolerance 1e-4: the equation's four-bar, refined, is within
+    it, and no atlas is loaded; its distances are the noise's size, checked by this module's own loop closure."""
+    from planar.synth.path import synthesise_path
+
+    p = _crank_rocker_points(30, 11)
+    size = float(np.sqrt(np.mean(np.sum((p - p.mean(0)) ** 2, 1))))
+    q = p + 1e-5 * size * np.random.default_rng(1).standard_normal(p.shape)
+    d = synthesise_path(q, None, tolerance=1e-4)
+    assert d.ok and "curve equation" in d.checks["found_by"] and set(d.checks["stages_s"]) == {"algebraic_s"}
+    assert 1e-6 < d.checks["max_error"] <= 1e-4
+    # the found four-bar's distance from the noise-free curve: within the tolerance too
+    x0, y0, phi = d.placement
+    th = np.linspace(0, 2 * np.pi, 200_001)
+    b = complex(x0, y0) + d.crank * np.exp(1j * (phi + th))
+    o4 = complex(x0, y0) + d.ground * np.exp(1j * phi)
+    dd = o4 - b
+    L = np.abs(dd)
+    a = (d.coupler**2 - d.rocker**2 + L**2) / (2 * L)
+    sign = 1.0 if d.circuit == "open" else -1.0
+    c = b + dd / L * (a + 1j * sign * np.sqrt(d.coupler**2 - a**2))
+    curve = b + (c - b) / d.coupler * complex(*d.coupler_point)
+    truth = p[:, 0] + 1j * p[:, 1]
+    assert np.max(np.min(np.abs(truth[:, None] - curve[None, :]), axis=1)) < 1e-4 * size
