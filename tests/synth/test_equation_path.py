@@ -78,10 +78,10 @@ def test_rocking_prefers_an_input_that_rocks_and_input_rocks_insists():
     cognates does (here: the double-rocker itself), said by the equation, not by the atlas; input_rocks gives the
     same or fails, never a crank."""
     from planar.bench.synthesis_rocking import rocking_problem
-    from planar.synth.arcs import QUICK_FOURBARS, load_arcs, rocking_range
+    from planar.synth.arcs import QUICK_FOURBARS, build_arcs, rocking_range
     from planar.synth.path import synthesise_rocking_path
 
-    arcs = load_arcs(QUICK_FOURBARS)
+    arcs = build_arcs(QUICK_FOURBARS)  # in memory: the cache folder's atlas is another test's business
     rng = np.random.default_rng(4242)
     rocks = 0
     for _ in range(8):
