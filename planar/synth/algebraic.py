@@ -48,6 +48,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from planar.synth.kernel import row_points
+
 __all__ = [
     "MIN_TARGETS",
     "algebraic_starts",
@@ -289,7 +291,7 @@ def search_algebraic(
     if best is None:
         return None, None
     _, _, r, tt, extra = best
-    sse = float(np.sum(np.square(obj.targets - _points(r, tt))))
+    sse = float(np.sum(np.square(obj.targets - row_points(r, tt))))
     return SearchResult(r[:9], 1 if r[9] >= 0 else -1, tt, sse, True, 1, {"algebraic_s": time.perf_counter() - t0}), extra
 
 
@@ -355,14 +357,6 @@ def finish_start(
         if e2 < e or not np.isfinite(e):
             r, tt, e = r2, tt2, e2
     return (r, tt, e) if e <= max(stop, accept if accept is not None else stop) else None
-
-
-def _points(row: Array, theta: Array) -> Array:
-    """The coupler points ``(N, 2)`` of row ``row`` (9 parameters and the circuit) at crank angles ``theta``."""
-    from planar.synth.kernel import coupler_points
-
-    x, y, _ = coupler_points(row[None, :9], np.asarray(theta, float)[None, :], np.array([1.0 if row[9] >= 0 else -1.0]))
-    return np.column_stack([x[0], y[0]])
 
 
 def foci_of_row(row: Array) -> tuple[complex, complex, complex, float, float, float]:

@@ -47,7 +47,7 @@ from planar.errors import InputError
 from planar.synth.algebraic import MIN_TARGETS, search_algebraic
 from planar.synth.atlas import DescriptorIndex, unreadable
 from planar.synth.designs import TOGGLE_FLOOR_DEG
-from planar.synth.kernel import coupler_points
+from planar.synth.kernel import coupler_points, row_points
 
 __all__ = [
     "ARC_POINTS",
@@ -488,7 +488,7 @@ def search_arcs(
             break
     stages["polish_s"] = time.perf_counter() - t1 - stages["refine_s"]
     e, r, tt, swing = best
-    sse = float(np.sum(np.square(_points(r, tt) - t)))
+    sse = float(np.sum(np.square(row_points(r, tt) - t)))
     return SearchResult(r[:9], 1 if r[9] >= 0 else -1, tt, sse, True, len(tried), stages), swing
 
 
@@ -653,8 +653,3 @@ def polish_positions(
     if not float(r @ r) < float(r0 @ r0):
         return row, theta
     return row_from_positions(z[:10], z[10:], circuit)
-
-
-def _points(row: Array, theta: Array) -> Array:
-    x, y, _ = coupler_points(row[None, :9], theta[None, :], np.array([1.0 if row[9] >= 0 else -1.0]))
-    return np.column_stack([x[0], y[0]])

@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from planar.linkages.chunked import threads_default
 
-__all__ = ["N_PARAMS", "PARAM_NAMES", "coupler_points"]
+__all__ = ["N_PARAMS", "PARAM_NAMES", "coupler_points", "row_points"]
 
 Array = NDArray[np.float64]
 Mask = NDArray[np.bool_]
@@ -129,3 +129,12 @@ def coupler_points(
         with ThreadPoolExecutor(workers) as pool:  # numpy releases the GIL inside each operation
             list(pool.map(run, starts))
     return xs, ys, ok
+
+
+def row_points(row: Array, theta: Array) -> Array:
+    """The coupler points ``(N, 2)`` (world units) of one candidate ``row`` (the 9 parameters and a tenth column whose
+    sign is the circuit) at its own crank angles ``theta`` ``(N,)`` (radians from the ground line)."""
+    x, y, _ = coupler_points(
+        np.asarray(row, float)[None, :N_PARAMS], np.asarray(theta, float)[None, :], np.array([1.0 if row[9] >= 0 else -1.0])
+    )
+    return np.column_stack([x[0], y[0]])
