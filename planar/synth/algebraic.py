@@ -48,7 +48,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from planar.synth.kernel import row_points
+from planar.synth.kernel import coupler_points, row_points
 
 __all__ = [
     "MIN_TARGETS",
@@ -213,8 +213,6 @@ def rank_starts(targets: Array, rows: Array, samples: int = RANK_SAMPLES) -> tup
     """Rows ``(K, 10)`` ranked by the largest distance from a target to the nearest of ``samples`` points of the
     row's coupler curve over a turn: the order (best first), each row's crank angle nearest each target ``(K, N)``
     (rad) and that distance ``(K,)`` (inf when the curve has no point)."""
-    from planar.synth.kernel import coupler_points
-
     t = np.asarray(targets, float)
     th = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
     x, y, ok = coupler_points(rows[:, :9], th, np.where(rows[:, 9] >= 0, 1.0, -1.0))
@@ -309,23 +307,18 @@ def _kept(best: Best | None, other: Best | None) -> Best | None:
 def _better(best: Best | None, found: tuple[Array, Array, float] | None, choose: Choice) -> Best | None:
     """``best`` or the refined ``found`` (row, crank angles, largest distance) when ``choose`` ranks it better (a
     lower rank, then a smaller distance)."""
-    if found is None:
+    choice = None if found is None else choose(found[0], found[1])
+    if found is None or choice is None:
         return best
-    choice = choose(found[0], found[1])
-    if choice is not None and (best is None or (choice[0], found[2]) < best[:2]):
-        return (choice[0], found[2], found[0], found[1], choice[1])
-    return best
+    return _kept(best, (choice[0], found[2], found[0], found[1], choice[1]))
 
 
-def finish_foci(
-    obj: Any, start: Array, stop: float, choose: Choice, accept: float | None = None, nfev: int | None = None
-) -> Best | None:
+def finish_foci(obj: Any, start: Array, stop: float, choose: Choice, accept: float | None = None) -> Best | None:
     """A start (kernel row and circuit) near the untimed targets of ``obj`` (a
     :class:`planar.synth.search.PathObjective`, normalised targets), its foci refined (:func:`refine_foci`) and,
     when their largest residual is at most :data:`FOCI_FAR`, the :data:`FOCI_REFINE` best of their four-bars
-    finished by :func:`finish_start` (within ``accept``, default ``stop``): the best ``choose`` accepts, or None.
-    ``nfev``: :func:`refine_foci`'s evaluations (default :data:`FOCI_NFEV`)."""
-    rows, far = refine_foci(obj.targets, start, FOCI_NFEV if nfev is None else nfev)
+    finished by :func:`finish_start` (within ``accept``, default ``stop``): the best ``choose`` accepts, or None."""
+    rows, far = refine_foci(obj.targets, start)
     if not far <= FOCI_FAR or len(rows) == 0:
         return None
     order, theta, dist = rank_starts(obj.targets, rows)
