@@ -16,18 +16,23 @@ def _csv(path, pts: np.ndarray) -> str:
     return str(path)
 
 
+def _loop(o2: complex, ground: float, phi: float, crank: float, coupler: float, rocker: float, uv: complex, th, circuit=1.0):
+    """Coupler points (complex) at crank angles ``th`` (rad from the ground line at angle ``phi``) by this module's own
+    loop closure: the rocker pin where the circles about the crank pin and the rocker's pivot meet, left of crank
+    pin -> pivot for circuit +1; ``uv`` the coupler point from the crank pin, x toward the rocker pin."""
+    b = o2 + crank * np.exp(1j * (phi + np.asarray(th)))
+    d = o2 + ground * np.exp(1j * phi) - b
+    L = np.abs(d)
+    a = (coupler**2 - rocker**2 + L**2) / (2 * L)
+    c = b + d / L * (a + 1j * circuit * np.sqrt(coupler**2 - a**2))
+    return b + (c - b) / coupler * uv
+
+
 def _crank_rocker_points(n: int, seed: int) -> np.ndarray:
     """``n`` points, at sorted random crank angles, of a crank-rocker (ground 3.9, crank 1.2, coupler 3.5, rocker 3)
-    by this module's own loop closure (two circles' intersection)."""
-    rng = np.random.default_rng(seed)
-    th = np.sort(rng.uniform(0, 2 * np.pi, n))
-    o2, o4 = 0j, 3.9 + 0j
-    b = o2 + 1.2 * np.exp(1j * th)
-    d = o4 - b
-    L = np.abs(d)
-    a = (3.5**2 - 3.0**2 + L**2) / (2 * L)
-    c = b + d / L * (a + 1j * np.sqrt(3.5**2 - a**2))
-    p = b + (c - b) / 3.5 * (1.5 + 1.0j)
+    by :func:`_loop`."""
+    th = np.sort(np.random.default_rng(seed).uniform(0, 2 * np.pi, n))
+    p = _loop(0j, 3.9, 0.0, 1.2, 3.5, 3.0, 1.5 + 1.0j, th)
     return np.column_stack([p.real, p.imag])
 
 
@@ -115,14 +120,8 @@ def test_slightly_noisy_targets_within_the_tolerance_need_no_atlas():
     assert 1e-6 < d.checks["max_error"] <= 1e-4
     # the found four-bar's distance from the noise-free curve: within the tolerance too
     x0, y0, phi = d.placement
+    circuit = 1.0 if d.circuit == "open" else -1.0
     th = np.linspace(0, 2 * np.pi, 200_001)
-    b = complex(x0, y0) + d.crank * np.exp(1j * (phi + th))
-    o4 = complex(x0, y0) + d.ground * np.exp(1j * phi)
-    dd = o4 - b
-    L = np.abs(dd)
-    a = (d.coupler**2 - d.rocker**2 + L**2) / (2 * L)
-    sign = 1.0 if d.circuit == "open" else -1.0
-    c = b + dd / L * (a + 1j * sign * np.sqrt(d.coupler**2 - a**2))
-    curve = b + (c - b) / d.coupler * complex(*d.coupler_point)
+    curve = _loop(complex(x0, y0), d.ground, phi, d.crank, d.coupler, d.rocker, complex(*d.coupler_point), th, circuit)
     truth = p[:, 0] + 1j * p[:, 1]
     assert np.max(np.min(np.abs(truth[:, None] - curve[None, :]), axis=1)) < 1e-4 * size
