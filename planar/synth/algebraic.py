@@ -230,12 +230,10 @@ def rank_starts(targets: Array, rows: Array, samples: int = RANK_SAMPLES) -> tup
 
 
 def _wide_bounds(t: Array) -> list[tuple[float, float]]:
-    """:data:`WIDE_BOX` bounds for the refinement (the circuit column last, as :func:`default_bounds`)."""
-    L = float(max(np.hypot(*np.ptp(t, axis=0)), 1e-9))
-    c = t.mean(0)
-    b = [(L / WIDE_BOX, WIDE_BOX * L)] * 4 + [(-WIDE_BOX * L, WIDE_BOX * L)] * 2
-    b += [(c[0] - WIDE_BOX * L, c[0] + WIDE_BOX * L), (c[1] - WIDE_BOX * L, c[1] + WIDE_BOX * L)]
-    return b + [(-3 * np.pi, 3 * np.pi), (-1.0, 1.0)]
+    """:data:`WIDE_BOX` bounds for the refinement (:func:`planar.synth.search.default_bounds`, no region)."""
+    from planar.synth.search import Constraints, default_bounds
+
+    return default_bounds(t, Constraints(), False, reach=WIDE_BOX, shortest=WIDE_BOX, turn=3 * np.pi)
 
 
 #: a caller's preference of a refined exact result (kernel row with circuit, crank angles at the targets): ``None``

@@ -437,8 +437,7 @@ def search_arcs(
     cons = dataclasses.replace(cons if cons is not None else Constraints(), full_turn=False)
     t = np.asarray(targets, float)
     obj = PathObjective(t, None, cons, 256)
-    b = default_bounds(t, cons, False)
-    b[8] = (-3 * np.pi, 3 * np.pi)
+    b = default_bounds(t, cons, False, turn=3 * np.pi)
 
     def usable(r: Array, tt: Array) -> tuple[float, float] | None:
         return usable_swing(r, tt, cons, obj.scale, ordered, input_rocks)

@@ -58,6 +58,8 @@ REFINE_NFEV = 200
 
 #: relative margin kept from a change-point (s + l = p + q) and from equal shortest links
 GRASHOF_MARGIN = 1e-3
+#: the largest |cos| of a transmission angle the penalty counts (a candidate beyond it cannot assemble anyway)
+CMU_CAP = 1e6
 
 
 @dataclass(frozen=True)
@@ -99,8 +101,10 @@ def violation(X: Array, cons: Constraints, scale: float, margin: float = GRASHOF
         cos_lim = np.cos(cons.min_transmission)
         r3, r4 = X[:, 2], X[:, 3]
         for diag in (np.abs(r1 - r2), r1 + r2):
-            cmu = (r3 * r3 + r4 * r4 - diag * diag) / np.maximum(2 * r3 * r4, 1e-300)
-            v += np.maximum(0.0, np.abs(cmu) - cos_lim) * scale
+            with np.errstate(over="ignore", invalid="ignore"):
+                cmu = (r3 * r3 + r4 * r4 - diag * diag) / np.maximum(2 * r3 * r4, 1e-300)
+            # a runaway candidate (a link near 0 or huge) gets a large finite penalty, not an overflow
+            v += np.maximum(0.0, np.minimum(np.abs(np.nan_to_num(cmu, nan=CMU_CAP)), CMU_CAP) - cos_lim) * scale
     return v / scale
 
 
@@ -223,19 +227,28 @@ class SearchResult:
     stages: dict[str, float]
 
 
-def default_bounds(targets: Array, cons: Constraints, theta_given: bool) -> list[tuple[float, float]]:
-    """Search bounds from the targets' extent ``L`` and centre: lengths ``[L/50, 4 L]``, coupler point
-    ``+-4 L``, crank pivot within ``4 L`` of the centre (or the region), ground angle any."""
+def default_bounds(
+    targets: Array,
+    cons: Constraints,
+    theta_given: bool,
+    reach: float = 4.0,
+    shortest: float = 50.0,
+    turn: float = np.pi,
+) -> list[tuple[float, float]]:
+    """Search bounds from the targets' extent ``L`` and centre: lengths ``[L / shortest, reach L]``, coupler point
+    ``+-reach L``, crank pivot within ``reach L`` of the centre (or in ``cons.region``), ground angle within
+    ``+-turn`` (radians), then the circuit column.  The defaults bound the global search; the refinement of a
+    start (a four-bar tracing a short arc can have links far longer than the arc) uses wider ones."""
     t = np.asarray(targets, float)
     L = float(max(np.hypot(*np.ptp(t, axis=0)), 1e-9))
     c = t.mean(0)
-    b = [(L / 50, 4 * L)] * 4 + [(-4 * L, 4 * L)] * 2
+    b = [(L / shortest, reach * L)] * 4 + [(-reach * L, reach * L)] * 2
     if cons.region is not None:
         x0, y0, x1, y1 = cons.region
         b += [(x0, x1), (y0, y1)]
     else:
-        b += [(c[0] - 4 * L, c[0] + 4 * L), (c[1] - 4 * L, c[1] + 4 * L)]
-    b += [(-np.pi, np.pi), (-1.0, 1.0)]
+        b += [(c[0] - reach * L, c[0] + reach * L), (c[1] - reach * L, c[1] + reach * L)]
+    b += [(-turn, turn), (-1.0, 1.0)]
     return b
 
 
@@ -560,8 +573,7 @@ def search_atlas(
     cons = cons if cons is not None else Constraints()
     t = np.asarray(targets, float)
     obj = PathObjective(t, None, cons, samples)
-    b = default_bounds(t, cons, False)
-    b[8] = (-3 * np.pi, 3 * np.pi)  # the ground line's angle: no wall at +-pi for a candidate placed near it
+    b = default_bounds(t, cons, False, turn=3 * np.pi)  # the ground line's angle: no wall at +-pi near a candidate
     stages: dict[str, float] = {}
     t0 = time.perf_counter()
     every = candidates(atlas, t, neighbours)
@@ -1075,8 +1087,7 @@ def timed_from_atlas(
     t0 = time.perf_counter()
     obj = PathObjective(np.asarray(targets, float), np.asarray(theta, float), cons)
     free = PathObjective(obj.targets, None, cons)
-    b = default_bounds(obj.targets, cons, True)
-    b[8] = (-3 * np.pi, 3 * np.pi)
+    b = default_bounds(obj.targets, cons, True, turn=3 * np.pi)
     timed: list[tuple[float, Array, Array]] = []
 
     def exact_timed(row: Array, th: Array) -> bool:
