@@ -31,7 +31,8 @@ from numpy.typing import NDArray
 from planar.core.fields import check_number
 from planar.errors import InputError
 from planar.synth.designs import TOGGLE_FLOOR_DEG, Checked, PlacedFourBar
-from planar.synth.search import Constraints, PathObjective, constraint_failures, search_fourbar
+from planar.synth.path_search import BUDGETS, EQUATION_SOURCE, PathSearch
+from planar.synth.search import Constraints, PathObjective, constraint_failures
 from planar.synth.targets import check_search_args, check_theta, normalisation
 
 __all__ = ["FourBarDesign", "check_path_args", "synthesise_path", "synthesise_rocking_path"]
@@ -135,241 +136,6 @@ def transmission_margin(fb: Any, theta: Array | None = None) -> tuple[float, flo
     return float(m[k]), float(th[k])
 
 
-def _search(
-    t: Array,
-    theta: Array | None,
-    cons: Constraints,
-    budget: str,
-    seed: int,
-    tolerance: float,
-    atlas: Any,
-    ordered: bool,
-    arcs: Any = None,
-) -> tuple[Any, str, tuple[float, float] | None]:
-    """The search on normalised targets ``t``: the atlas first when untimed, then the rocking arcs
-    (:func:`_rocking_search`) when they may be tried, the global search when timed or when neither's best is within
-    ``tolerance`` (largest distance, targets' size 1).
-
-    Returns the result (its ``stages``: every stage that ran, seconds: ``atlas_load_s``, ``atlas_s``,
-    ``refine_s``, ``timed_s`` or ``closed_form_s`` (timed targets), ``rocking_s`` and, when the global search ran,
-    ``global_sample_s``, ``global_de_s``, ``global_refine_s``), a sentence saying which stage produced it, and the
-    input's swing (rad from the ground line) when the result's input rocks (None when it turns fully)."""
-    import time
-
-    from planar.synth.search import max_distance, timed_from_atlas
-
-    kw = BUDGETS[budget]
-    load: dict[str, float] = {}
-    given = atlas
-
-    def loaded() -> Any:
-        # the atlas of the budget, loaded (or built) on first need: timed targets the closed form solves need none
-        nonlocal atlas
-        if atlas is None:
-            from planar.synth.atlas import DEFAULT_SIZE, QUICK_SIZE, load_atlas
-
-            t0 = time.perf_counter()
-            atlas = load_atlas(QUICK_SIZE if budget == "quick" else DEFAULT_SIZE, progress=True)
-            load["atlas_load_s"] = time.perf_counter() - t0
-        elif atlas is given:
-            load.setdefault("atlas_load_s", 0.0)
-        return atlas
-
-    if theta is None:
-        return _untimed(t, cons, budget, seed, tolerance, loaded, ordered, arcs, load)
-    # the closed form, then the curve from the atlas and the timing: exact when the atlas finds the four-bar itself
-    # (a cognate traces the same curve at other crank angles: then the global search runs)
-    timed = timed_from_atlas(t, theta, loaded, cons)
-    e_atlas = (
-        max_distance(PathObjective(t, theta, cons), np.append(timed.params, timed.circuit), theta)
-        if timed is not None
-        else float("inf")
-    )
-    if timed is not None and timed.feasible and _keeps_transmission(timed, cons) and e_atlas <= tolerance:
-        how = (
-            "the closed-form timed solution (no atlas lookup"
-            if "closed_form_s" in timed.stages
-            else "the atlas lookup and refinement ("
-        )
-        timed.stages = {**load, **timed.stages}
-        return timed, f"{how}{'; ' if how.endswith('lookup') else ''}the global search did not run: within the tolerance)", None
-    g = search_fourbar(t, theta, cons, seed=seed, **kw)
-    stages = {**load, **(timed.stages if timed is not None else {}), **_prefixed(g.stages)}
-    e_global = max_distance(PathObjective(t, theta, cons), np.append(g.params, g.circuit), theta)
-    good = timed is not None and timed.feasible and _keeps_transmission(timed, cons)
-    g_good = g.feasible and _keeps_transmission(g, cons)
-    if timed is not None and (good, -e_atlas) > (g_good, -e_global):  # the atlas's is usable and closer: kept
-        timed.stages = stages
-        other = f"found no better: {e_global:.3g}" if g_good else "found none usable"
-        return timed, f"the atlas lookup and refinement (the global search, --budget {budget}, ran too and {other})", None
-    g.stages = stages
-    return g, f"the global search (--budget {budget}; the atlas's best was {e_atlas:.3g} of the size off)", None
-
-
-#: ``found_by`` of a result the targets' own curve equation gave (:func:`planar.synth.algebraic.search_algebraic`)
-EQUATION_SOURCE = "the targets' own curve equation (its singular foci; no atlas lookup: within the tolerance)"
-#: ``found_by`` when that equation's four-bars pass through every target but meet them out of the given order
-EQUATION_ORDER_SOURCE = (
-    "the targets' own curve equation: a four-bar passes through every target, but meets them in another order than "
-    "listed, as every four-bar tracing this curve does (with --ordered list them in their order along the curve, "
-    "or drop --ordered); no atlas lookup"
-)
-
-
-def _untimed(
-    t: Array,
-    cons: Constraints,
-    budget: str,
-    seed: int,
-    tolerance: float,
-    loaded: Any,
-    ordered: bool,
-    arcs: Any,
-    load: dict[str, float],
-) -> tuple[Any, str, tuple[float, float] | None]:
-    """:func:`_search` of untimed targets: from :data:`planar.synth.algebraic.MIN_TARGETS` targets their own curve
-    equation (:func:`_from_equation`: no atlas is loaded when it gives the four-bar), then :func:`_searched`."""
-    import time
-
-    from planar.synth.algebraic import MIN_TARGETS
-
-    if len(t) < MIN_TARGETS:
-        return _searched(t, cons, budget, seed, tolerance, loaded, ordered, arcs, load)
-    t0 = time.perf_counter()
-    alg, how, swing = _from_equation(t, cons, ordered, tolerance)
-    load["algebraic_s"] = time.perf_counter() - t0
-    if alg is not None:
-        alg.stages = dict(load)
-        return alg, how, swing
-    r, source, swing = _searched(t, cons, budget, seed, tolerance, loaded, ordered, arcs, load)
-    return r, source + "; the targets' own curve equation gave no four-bar through them (see the curve equation docs)", swing
-
-
-def _from_equation(t: Array, cons: Constraints, ordered: bool, tolerance: float) -> tuple[Any, str, Any]:
-    """The four-bar of the targets' own curve equation (:func:`planar.synth.algebraic.search_algebraic`): a crank
-    keeping ``cons`` and the order first, then a rocking input (when the rocking search may be tried: no pivots box,
-    no transmission limit), then, with ``ordered``, one through every target in another order (every four-bar
-    tracing that curve meets them so: no search would do better).  Returns the result (None when none), the
-    sentence saying how it was found, and its input's swing (None when it turns fully)."""
-    import dataclasses
-
-    from planar.synth.algebraic import search_algebraic
-    from planar.synth.arcs import usable_swing
-    from planar.synth.search import in_order, violation
-
-    rocking = cons.region is None and cons.min_transmission == 0
-
-    def choose(r: Array, tt: Array) -> tuple[int, Any] | None:
-        keeps = violation(r[None, :9], cons, 1.0, 0.0)[0] <= 0
-        if keeps and (in_order(tt) or not ordered):
-            return 0, None
-        swing = usable_swing(r, tt, dataclasses.replace(cons, full_turn=False), 1.0, ordered) if rocking else None
-        if swing is not None:
-            return 1, swing
-        return (2, "order") if keeps else None
-
-    alg, extra = search_algebraic(t, cons, choose, stop=min(1e-9, tolerance), accept=tolerance)
-    if alg is None:
-        return None, "", None
-    if extra == "order":
-        return alg, EQUATION_ORDER_SOURCE, None
-    return alg, EQUATION_SOURCE, extra
-
-
-def _searched(
-    t: Array,
-    cons: Constraints,
-    budget: str,
-    seed: int,
-    tolerance: float,
-    loaded: Any,
-    ordered: bool,
-    arcs: Any,
-    load: dict[str, float],
-) -> tuple[Any, str, tuple[float, float] | None]:
-    """:func:`_untimed` by search: the closed-curve atlas (``loaded()`` loads it), the rocking arcs, then the global
-    search."""
-    from planar.synth.search import in_order, max_distance, search_atlas
-
-    r = search_atlas(t, loaded(), cons, ordered=ordered)
-    good = r.feasible and (in_order(r.theta) or not ordered) and _keeps_transmission(r, cons)
-    e_atlas = max_distance(PathObjective(t, None, cons), np.append(r.params, r.circuit), r.theta)
-    if good and e_atlas <= tolerance:
-        r.stages = {**load, **r.stages}
-        return r, "the atlas lookup and refinement (the global search did not run: within the tolerance)", None
-    stages = {**load, **r.stages}
-    rock, swing, e_rock, rock_word = _rocking_search(t, cons, budget, ordered, arcs, stages)
-    if rock is not None and e_rock <= tolerance:
-        rock.stages = stages
-        why = f"the closed-curve atlas's best was {e_atlas:.3g} of the size off; the global search did not run"
-        return rock, f"{rock_word} ({why})", swing
-    g = search_fourbar(t, None, cons, seed=seed, **BUDGETS[budget])
-    g_good = g.feasible and (in_order(g.theta) or not ordered) and _keeps_transmission(g, cons)
-    e_global = max_distance(PathObjective(t, None, cons), np.append(g.params, g.circuit), g.theta)
-    stages.update(_prefixed(g.stages))
-    # the best of them: usable first, then the smaller largest distance (what the check judges)
-    if rock is not None and (True, -e_rock) > max((g_good, -e_global), (good, -e_atlas)):
-        rock.stages = stages
-        why = f"better than the closed-curve atlas's {e_atlas:.3g} and the global search's {e_global:.3g}"
-        return rock, f"{rock_word} (largest distance {e_rock:.3g} of the size; {why})", swing
-    tried = f"; {rock_word}: {e_rock:.3g}" if rock is not None else f"; {rock_word}" if rock_word else ""
-    if (g_good, -e_global) > (good, -e_atlas):
-        g.stages = stages
-        # preferred because the atlas's best was closer but unusable, or because it is closer
-        than = (
-            f"closer than the atlas's {e_atlas:.3g}"
-            if good
-            else f"the atlas's best, {e_atlas:.3g}, was out of order or broke a constraint"
-        )
-        return g, f"the global search (--budget {budget}; largest distance {e_global:.3g} of the size, {than}{tried})", None
-    r.stages = stages
-    other = f"found no better: {e_global:.3g}" if g_good else "found none usable (out of order or breaking a constraint)"
-    return (
-        r,
-        (
-            f"the atlas lookup and refinement (largest distance {e_atlas:.3g} of the size; the global search, "
-            f"--budget {budget}, ran too and {other}{tried})"
-        ),
-        None,
-    )
-
-
-def _rocking_search(
-    t: Array, cons: Constraints, budget: str, ordered: bool, arcs: Any, stages: dict[str, float]
-) -> tuple[Any, tuple[float, float] | None, float, str]:
-    """The rocking arcs (:func:`planar.synth.arcs.search_arcs`) on normalised untimed targets, when they may be
-    tried: no pivots box, no transmission limit (the rocking search keeps neither), and ``arcs`` given or the
-    cached arc atlas of ``budget`` on disk (it is not built here: ``planar synth atlas --rocking`` builds it).
-
-    Returns the result (None when not tried or nothing keeps the targets on one swing, in order when
-    ``ordered``), its swing, its largest distance (the targets' size 1) and a few words saying what was tried
-    (empty when nothing was); ``stages`` gains ``rocking_s``."""
-    import dataclasses
-    import time
-
-    from planar.synth import arcs as arcs_mod
-    from planar.synth.search import max_distance
-
-    if cons.region is not None or cons.min_transmission > 0:
-        return None, None, math.inf, ""
-    if arcs is None:
-        size = arcs_mod.QUICK_FOURBARS if budget == "quick" else arcs_mod.DEFAULT_FOURBARS
-        path = arcs_mod.arcs_path(size)
-        if not path.exists():
-            which = f"--budget {budget}'s rocking-arc atlas ({size:,} four-bars)"
-            build = "planar synth atlas --rocking" + ("" if size == arcs_mod.DEFAULT_FOURBARS else f" --size {size}")
-            return None, None, math.inf, f"{which} is not built ({build} builds it)"
-        arcs = arcs_mod.read_arcs(path)
-    t0 = time.perf_counter()
-    rock_cons = dataclasses.replace(cons, full_turn=False)
-    r, swing = arcs_mod.search_arcs(t, arcs, rock_cons, ordered=ordered)
-    stages["rocking_s"] = time.perf_counter() - t0
-    word = "the rocking-arc atlas lookup and refinement"
-    if r is None or swing is None or (ordered and not arcs_mod.one_way(r.theta, swing)):
-        return None, None, math.inf, word + " found none on one swing" + (" in order" if ordered else "")
-    return r, swing, max_distance(PathObjective(t, None, rock_cons), np.append(r.params, r.circuit), r.theta), word
-
-
 def best_fourbar(
     t: Array,
     theta: Array | None,
@@ -387,7 +153,7 @@ def best_fourbar(
     if not isinstance(budget, str) or budget not in BUDGETS:
         raise InputError("budget", budget, f"one of {', '.join(BUDGETS)}")
     with threadpool_limits(1):
-        return _search(t, theta, cons, budget, seed, tolerance, atlas, ordered)[0]
+        return PathSearch(t, cons, budget, seed, tolerance, atlas, ordered).run(theta)[0]
 
 
 def unboxed_error(targets: Array, cons: Constraints, atlas: Any = None, budget: str = "normal") -> float:
@@ -411,27 +177,6 @@ def unboxed_error(targets: Array, cons: Constraints, atlas: Any = None, budget: 
     with threadpool_limits(1):
         r = search_atlas(tn, atlas, free)
     return max_distance(PathObjective(tn, None, free), np.append(r.params, r.circuit), r.theta)
-
-
-def _keeps_transmission(r: Any, cons: Constraints) -> bool:
-    """Whether a search result keeps ``cons.min_transmission`` over the turn (True when none is asked)."""
-    from planar.synth.search import violation
-
-    only = Constraints(full_turn=False, max_ratio=np.inf, min_transmission=cons.min_transmission)
-    return bool(violation(np.asarray(r.params, float)[None, :], only, 1.0, 0.0)[0] <= 1e-12)
-
-
-def _prefixed(stages: dict[str, float]) -> dict[str, float]:
-    """The global search's stages named as such (``global_sample_s``, ``global_de_s``, ``global_refine_s``)."""
-    return {f"global_{k}": v for k, v in stages.items()}
-
-
-#: effort of the global search (random sample, differential evolution, least-squares starts) per budget
-BUDGETS: dict[str, dict[str, Any]] = {
-    "quick": {"n_sample": 20_000, "maxiter": 60, "popsize": 15, "refine": 3},
-    "normal": {"n_sample": 100_000, "maxiter": 200, "popsize": 30, "refine": 8},
-    "thorough": {"n_sample": 500_000, "maxiter": 600, "popsize": 40, "refine": 16},
-}
 
 
 def synthesise_path(
@@ -488,7 +233,8 @@ def synthesise_path(
     # searched on the targets moved to their centroid and divided by their size, then mapped back
     c, s = normalisation(t)
     with threadpool_limits(1):
-        r, source, swing = _search((t - c) / s, theta, normalised(cons, c, s), budget, seed, tolerance, atlas, ordered, arcs)
+        search = PathSearch((t - c) / s, normalised(cons, c, s), budget, seed, tolerance, atlas, ordered, arcs)
+        r, source, swing = search.run(theta)
     d, p = design_from(r, c, s, t, theta is not None, time.perf_counter() - t0)
     if swing is not None:  # the input rocks: checked over its swing
         return _rocking_checked(d, r, p, swing, tolerance, ordered, cons, source, s)

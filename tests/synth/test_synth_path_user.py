@@ -213,8 +213,9 @@ def test_min_transmission_fails_the_check_naming_the_angle(tmp_path, capsys):
 
 def test_atlas_and_global_results_compared_by_largest_distance(monkeypatch):
     """The global search's result with the smaller sum of squares but the larger largest distance loses."""
-    import planar.synth.path as P
+    import planar.synth.path_search as P
     import planar.synth.search as S
+    from planar.synth.path_search import PathSearch
 
     row = np.array([1.0, 0.3, 1.1, 0.9, 0.5, 0.4, 0.0, 0.0, 0.0])
     th = np.linspace(0, 2 * np.pi, 12, endpoint=False)
@@ -226,7 +227,7 @@ def test_atlas_and_global_results_compared_by_largest_distance(monkeypatch):
     bad = S.SearchResult(far, 1, th, 1e-9, True, 1, {"sample_s": 0.0})
     monkeypatch.setattr(S, "search_atlas", lambda *a, **k: good)
     monkeypatch.setattr(P, "search_fourbar", lambda *a, **k: bad)
-    r, found, swing = P._search(T, None, S.Constraints(), "quick", 0, 1e-9, object(), False)
+    r, found, swing = PathSearch(T, S.Constraints(), "quick", 0, 1e-9, object(), False).run(None)
     assert r is good and found.startswith("the atlas") and "global_sample_s" in r.stages and swing is None
 
 
