@@ -58,7 +58,7 @@ REFINE_NFEV = 200
 
 #: relative margin kept from a change-point (s + l = p + q) and from equal shortest links
 GRASHOF_MARGIN = 1e-3
-#: the largest |cos| of a transmission angle the penalty counts (a candidate beyond it cannot assemble anyway)
+#: the largest absolute cosine of a transmission angle the penalty counts (a candidate beyond it cannot assemble anyway)
 CMU_CAP = 1e6
 
 
@@ -565,10 +565,17 @@ def search_atlas(
     distance to a target is at most ``stop`` (model units of the normalised targets; or, a function of a row and
     its crank angles at the targets, once it returns True).  ``ordered``: a result whose branch passes the targets
     out of order (:func:`in_order`) is kept only if no other is found.
+
+    When none reaches ``stop``, the later stages run in turn until one does: one round of looking up the best
+    refined curves (:func:`_requery`), the wide lookup (:func:`_wide_candidates`), the batch of starts
+    (:func:`_batch_starts`), :data:`REQUERY_ROUNDS` more rounds of looking up, and the two best refined for longer.
+    The first round of looking up came before the wide lookup after measuring (seed 20261204, never used to tune:
+    drag-links' whole curves at 8 targets 56 -> 58 of 60 within 1e-6, median CPU 1.58 -> 0.93 s; crank-rockers and
+    12 targets the same or faster; docs/explanation/coupler-curve-atlas.md).
     """
     import time
 
-    from planar.synth.atlas import candidates, curve_candidates
+    from planar.synth.atlas import candidates
 
     cons = cons if cons is not None else Constraints()
     t = np.asarray(targets, float)
@@ -583,17 +590,16 @@ def search_atlas(
     tried: list[Array] = []
     wide: list[Array] = []
     found = _refine_starts(obj, cons, b, every, refine, ordered, stop, done, tried)
+    # none reached ``stop``: the curves of the best refined four-bars looked up (they pass near every target, so
+    # they describe the targets' curve better than the targets' own spline, rough across the gaps between sparse
+    # targets): one round before the wide lookup, more after the batch stage
+    found = found or _requery(obj, atlas, cons, b, ordered, stop, done, tried)
     if not found:
         wide.append(_wide_candidates(atlas, obj, BATCH_STARTS))
         found = _refine_starts(obj, cons, b, wide[0][:WIDE_KEEP], WIDE_REFINE, ordered, stop, done, tried)
     if not found and not _batch_starts(obj, cons, b, wide[0], ordered, stop, done, tried):
-        # none reached ``stop``: look up the curves of the best refined four-bars (they pass near every target,
-        # so they describe the targets' curve better than the targets' own spline, which is rough across the
-        # gaps between sparse targets), and refine their neighbours
         for _ in range(REQUERY_ROUNDS):
-            top = sorted(done, key=lambda d: d[0])[:REQUERY_FROM]
-            near = [curve_candidates(atlas, _curve(r), REQUERY_K) for _, r, _ in top]
-            if near and _refine_starts(obj, cons, b, np.concatenate(near), REQUERY_REFINE, ordered, stop, done, tried):
+            if _requery(obj, atlas, cons, b, ordered, stop, done, tried):
                 break
         else:
             # the two best go on (Levenberg-Marquardt can crawl along a valley; on 8 targets, underdetermined,
@@ -773,9 +779,30 @@ def batch_lm(obj: PathObjective, C: Array, iters: int, reassign: int = 10) -> tu
     return Z, f
 
 
-#: after the targets' own lookup: rounds of looking up the best refined curves, from how many of them, the
-#: neighbours of each (in both normalisations) and how many of those are refined per round
+#: after the batch stage: rounds of looking up the best refined curves (:func:`_requery`; one round also runs before
+#: the wide lookup), from how many of them, the neighbours of each (in both normalisations) and how many of those are
+#: refined per round
 REQUERY_ROUNDS, REQUERY_FROM, REQUERY_K, REQUERY_REFINE = 4, 3, 16, 8
+
+
+def _requery(
+    obj: PathObjective,
+    atlas: Any,
+    cons: Constraints,
+    b: list[tuple[float, float]],
+    ordered: bool,
+    stop: float | Any,
+    done: list[tuple[float, Array, Array]],
+    tried: list[Array],
+) -> bool:
+    """One round of looking up the curves of the :data:`REQUERY_FROM` best refined four-bars in ``done``
+    (:func:`planar.synth.atlas.curve_candidates`, :data:`REQUERY_K` neighbours each) and refining the
+    :data:`REQUERY_REFINE` best of those not ``tried`` (:func:`_refine_starts`); whether one reached ``stop``."""
+    from planar.synth.atlas import curve_candidates
+
+    top = sorted(done, key=lambda d: d[0])[:REQUERY_FROM]
+    near = [curve_candidates(atlas, _curve(r), REQUERY_K) for _, r, _ in top]
+    return bool(near) and _refine_starts(obj, cons, b, np.concatenate(near), REQUERY_REFINE, ordered, stop, done, tried)
 
 
 def _curve(row: Array, n: int = 128) -> NDArray[np.complex128]:
