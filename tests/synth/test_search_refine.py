@@ -254,3 +254,30 @@ def test_timed_synthesis_the_closed_form_solves_needs_no_atlas(tmp_path, monkeyp
     assert "closed_form_s" in d.checks["stages_s"] and "atlas_load_s" not in d.checks["stages_s"]
     assert d.checks["found_by"].startswith("the closed-form timed solution")
     assert not (tmp_path / "cache").exists()
+
+
+def test_the_transmission_penalty_of_a_runaway_candidate_is_large_and_finite():
+    """A candidate with a link near 0 (or huge) gets a finite penalty, without an overflow warning (CI's slow set
+    warned of one in the refinement's residuals)."""
+    import warnings
+
+    from planar.synth.search import Constraints, violation
+
+    X = np.array([[1.0, 0.3, 1e-200, 1e-200, 0, 0, 0, 0, 0], [1.0, 0.3, 1e200, 1.0, 0, 0, 0, 0, 0]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        v = violation(X, Constraints(full_turn=False, max_ratio=np.inf, min_transmission=0.5), 1.0, 0.0)
+    assert np.all(np.isfinite(v)) and np.all(v > 1e5)
+
+
+def test_wide_bounds_are_the_default_bounds_widened():
+    """The refinement's wide box is :func:`default_bounds` with a longer reach, and the same centre."""
+    from planar.synth.algebraic import WIDE_BOX, _wide_bounds
+    from planar.synth.search import Constraints, default_bounds
+
+    t = np.array([[0.0, 0.0], [2.0, 0.0], [1.0, 1.0]])
+    L = np.hypot(2.0, 1.0)
+    wide, narrow = _wide_bounds(t), default_bounds(t, Constraints(), False)
+    assert wide[0] == (L / WIDE_BOX, WIDE_BOX * L) and narrow[0] == (L / 50, 4 * L)
+    assert np.isclose(sum(wide[6]) / 2, 1.0) and np.isclose(sum(narrow[6]) / 2, 1.0)
+    assert wide[8] == (-3 * np.pi, 3 * np.pi) and narrow[8] == (-np.pi, np.pi) and len(wide) == len(narrow) == 10
