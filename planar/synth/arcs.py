@@ -304,20 +304,17 @@ def arc_candidates(arcs: Arcs, targets: Array, k: int = 64) -> Array:
     """Rocking four-bars whose arcs are near the targets ``(N, 2)`` (in order along the arc), placed onto them:
     rows of the kernel's 9 parameters and the circuit (as :func:`planar.synth.atlas.candidates`), ``4 k`` of them
     (the targets' description both ways along and mirrored), nearest first within each query."""
-    from planar.synth.atlas import _mirror
+    from planar.synth.atlas import _mirror, views
 
     t = np.asarray(targets, float)
-    z = t[:, 0] + 1j * t[:, 1]
     out: list[Array] = []
-    for mirrored in (False, True):
-        zm = np.conj(z) if mirrored else z
-        for seq in (zm, zm[::-1]):
-            d, fr = describe_open(smooth_open(seq)[None, :])
-            if not np.isfinite(d).all():
-                continue
-            _, idx = arcs.tree.query(d[0], k=min(k, len(arcs)))
-            rows = _place(arcs, np.atleast_1d(idx), fr[0])
-            out.append(_mirror(rows) if mirrored else rows)
+    for mirrored, seq in views(t[:, 0] + 1j * t[:, 1]):
+        d, fr = describe_open(smooth_open(seq)[None, :])
+        if not np.isfinite(d).all():
+            continue
+        _, idx = arcs.tree.query(d[0], k=min(k, len(arcs)))
+        rows = _place(arcs, np.atleast_1d(idx), fr[0])
+        out.append(_mirror(rows) if mirrored else rows)
     return np.concatenate(out) if out else np.empty((0, 10))
 
 

@@ -437,13 +437,15 @@ def smooth_closed(z: NDArray[np.complex128], n: int = CURVE_SAMPLES) -> NDArray[
     return np.asarray(q[:, 0] + 1j * q[:, 1])
 
 
-def curve_candidates(atlas: Atlas, z: NDArray[np.complex128], k: int = 32) -> Array:
-    """Four-bars whose curves are near the closed curve ``z`` (complex points in the crank's order, e.g. a
-    refined four-bar's coupler curve), placed onto it: ``2 k`` rows as :func:`candidates` (both normalisations,
-    not reversed or mirrored: an atlas curve runs the way its crank turns, as ``z`` does)."""
-    d, fr = describe(np.asarray(z, complex)[None, :])
-    if not np.isfinite(d).all():
-        return np.empty((0, 10))
+def views(z: NDArray[np.complex128]) -> list[tuple[bool, NDArray[np.complex128]]]:
+    """The four ways a query looks up points ``z`` (complex, in order): as given and reversed, plain and mirrored
+    (conjugated), as ``(mirrored, points)``; rows found for a mirrored view are mirrored back (:func:`_mirror`)."""
+    return [(m, seq) for m in (False, True) for seq in ((np.conj(z), np.conj(z)[::-1]) if m else (z, z[::-1]))]
+
+
+def _both_normalisations(atlas: Atlas, d: Array, fr: Array, k: int) -> list[Array]:
+    """The ``k`` nearest entries to a description ``d`` ``(1, D)`` (frame ``fr`` ``(1, 4)``) and to its other
+    normalisation (turned half a turn, :func:`_flip`), each placed onto the query."""
     out = []
     for flipped in (False, True):
         q = _flip(d) if flipped else d
@@ -452,7 +454,17 @@ def curve_candidates(atlas: Atlas, z: NDArray[np.complex128], k: int = 32) -> Ar
             wf[3] += np.pi
         _, idx = atlas.tree.query(q[0], k=min(k, len(atlas)))
         out.append(_place(atlas, np.atleast_1d(idx), wf))
-    return np.concatenate(out)
+    return out
+
+
+def curve_candidates(atlas: Atlas, z: NDArray[np.complex128], k: int = 32) -> Array:
+    """Four-bars whose curves are near the closed curve ``z`` (complex points in the crank's order, e.g. a
+    refined four-bar's coupler curve), placed onto it: ``2 k`` rows as :func:`candidates` (both normalisations,
+    not reversed or mirrored: an atlas curve runs the way its crank turns, as ``z`` does)."""
+    d, fr = describe(np.asarray(z, complex)[None, :])
+    if not np.isfinite(d).all():
+        return np.empty((0, 10))
+    return np.concatenate(_both_normalisations(atlas, d, fr, k))
 
 
 def candidates(atlas: Atlas, targets: Array, k: int = 32) -> Array:
@@ -462,22 +474,11 @@ def candidates(atlas: Atlas, targets: Array, k: int = 32) -> Array:
     in both normalisations (see the module): ``8 k`` rows, nearest first within each query.
     """
     t = np.asarray(targets, float)
-    z = t[:, 0] + 1j * t[:, 1]
     out: list[Array] = []
-    for mirrored in (False, True):
-        zm = np.conj(z) if mirrored else z
-        for seq in (zm, zm[::-1]):
-            d, fr = describe(smooth_closed(seq)[None, :])
-            if not np.isfinite(d).all():
-                continue
-            for flipped in (False, True):
-                q = _flip(d) if flipped else d
-                wf = fr[0].copy()
-                if flipped:
-                    wf[3] += np.pi
-                _, idx = atlas.tree.query(q[0], k=min(k, len(atlas)))
-                rows = _place(atlas, np.atleast_1d(idx), wf)
-                out.append(_mirror(rows) if mirrored else rows)
+    for mirrored, seq in views(t[:, 0] + 1j * t[:, 1]):
+        d, fr = describe(smooth_closed(seq)[None, :])
+        if np.isfinite(d).all():
+            out.extend(_mirror(rows) if mirrored else rows for rows in _both_normalisations(atlas, d, fr, k))
     if not out:
         return np.empty((0, 10))
     return np.concatenate(out)
