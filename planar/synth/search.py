@@ -471,41 +471,15 @@ def search_fourbar(
     cons = cons if cons is not None else Constraints()
     import time
 
-    from scipy.optimize import differential_evolution
-
     targets = np.asarray(targets, float)
     th = None if theta is None else np.asarray(theta, float)
     obj = PathObjective(targets, th, cons, samples)
     b = bounds if bounds is not None else default_bounds(targets, cons, th is not None)
     lo = np.array([v[0] for v in b])
     hi = np.array([v[1] for v in b])
-    rng = np.random.default_rng(seed)
     stages: dict[str, float] = {}
-    t0 = time.perf_counter()
-    X = lo + (hi - lo) * rng.random((n_sample, len(b)))
-    f = obj.population(X)
-    stages["sample_s"] = time.perf_counter() - t0
-    evals = n_sample
-    npop = popsize * len(b)
-    order = np.argsort(f, kind="stable")
-    init = X[order[:npop]]
-    t1 = time.perf_counter()
-    de = differential_evolution(
-        obj,
-        b,
-        init=init,
-        maxiter=maxiter,
-        tol=0.0,
-        atol=0.0,
-        seed=seed,
-        vectorized=True,
-        updating="deferred",
-        polish=False,
-        mutation=(0.5, 1.0),
-        recombination=0.9,
-    )
-    stages["de_s"] = time.perf_counter() - t1
-    evals += (int(de.nit) + 1) * len(init)  # scipy counts vectorised calls, not candidates
+    X, order, de = sampled_evolution(obj, obj.population, b, n_sample, popsize, maxiter, seed, stages)
+    evals = n_sample + (int(de.nit) + 1) * min(n_sample, popsize * len(b))  # scipy counts calls, not candidates
     # refine the DE best and the best distinct candidates of the sample and the final population
     # half the starts from DE's final population (its basin), half from the sample's best (other basins)
     starts: list[Array] = []
@@ -529,6 +503,50 @@ def search_fourbar(
     e, r, tt = best
     feasible = not constraint_failures(r[:N_PARAMS], cons)
     return SearchResult(r[:N_PARAMS], 1 if r[9] >= 0 else -1, tt, float(e), feasible, evals, stages)
+
+
+def sampled_evolution(
+    objective: Any,
+    sample_cost: Any,
+    b: list[tuple[float, float]],
+    n_sample: int,
+    popsize: int,
+    maxiter: int,
+    seed: int,
+    stages: dict[str, float] | None = None,
+) -> tuple[Array, NDArray[np.intp], Any]:
+    """The global search's first two steps: ``n_sample`` uniform random rows within the bounds ``b`` (seeded
+    ``seed``), their costs (``sample_cost`` of the rows ``(n_sample, len(b))``), then
+    :func:`scipy.optimize.differential_evolution` of the vectorised ``objective`` (columns are candidates) started
+    from the ``popsize * len(b)`` cheapest, ``maxiter`` generations, no polish.  Returns the sample, its order
+    (cheapest first) and scipy's result; ``stages`` gains ``sample_s`` and ``de_s`` (seconds)."""
+    import time
+
+    from scipy.optimize import differential_evolution
+
+    lo = np.array([v[0] for v in b])
+    hi = np.array([v[1] for v in b])
+    t0 = time.perf_counter()
+    X = lo + (hi - lo) * np.random.default_rng(seed).random((n_sample, len(b)))
+    order = np.argsort(sample_cost(X), kind="stable")
+    t1 = time.perf_counter()
+    de = differential_evolution(
+        objective,
+        b,
+        init=X[order[: popsize * len(b)]],
+        maxiter=maxiter,
+        tol=0.0,
+        atol=0.0,
+        seed=seed,
+        vectorized=True,
+        updating="deferred",
+        polish=False,
+        mutation=(0.5, 1.0),
+        recombination=0.9,
+    )
+    if stages is not None:
+        stages["sample_s"], stages["de_s"] = t1 - t0, time.perf_counter() - t1
+    return X, order, de
 
 
 def max_distance(obj: PathObjective, row: Array, theta: Array) -> float:

@@ -376,9 +376,7 @@ def synthesise_sixbar(
     ``budget``: ``"quick"``, ``"normal"``, ``"thorough"`` or ``(random samples, DE generations, DE
     population per variable, refinement starts)``.
     """
-    from scipy.optimize import differential_evolution
-
-    from planar.synth.search import default_bounds
+    from planar.synth.search import default_bounds, sampled_evolution
     from planar.synth.targets import check_search_args
 
     t, theta = check_search_args(targets, theta, seed, tolerance, {"ordered": ordered})
@@ -413,25 +411,7 @@ def synthesise_sixbar(
     b = fb[:9] + o6 + [(L / 50, 4 * L)] * 2 + [(-4 * L, 4 * L)] * 2 + [(-1.0, 1.0)] * 2
     lo = np.array([v[0] for v in b])
     hi = np.array([v[1] for v in b])
-    rng = np.random.default_rng(seed)
-    X = lo + (hi - lo) * rng.random((n_sample, len(b)))
-    f = obj(X.T)
-    order = np.argsort(f, kind="stable")
-    init = X[order[: popsize * len(b)]]
-    de = differential_evolution(
-        obj,
-        b,
-        init=init,
-        maxiter=maxiter,
-        tol=0.0,
-        atol=0.0,
-        seed=seed,
-        vectorized=True,
-        updating="deferred",
-        polish=False,
-        mutation=(0.5, 1.0),
-        recombination=0.9,
-    )
+    X, order, de = sampled_evolution(obj, lambda rows: obj(rows.T), b, n_sample, popsize, maxiter, seed)
     pool = np.vstack([de.x[None], de.population[np.argsort(de.population_energies)], X[order[: 4 * refine]]])
     pool = np.clip(pool, lo, hi)
     starts: list[tuple[Array, Array | None]] = []
