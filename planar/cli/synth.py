@@ -75,6 +75,8 @@ def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, An
         print(f"wrote {args.output}: {what}")
         for f in failing:
             print(f"check failed: {f}")
+        for c in report.get("checks", {}).get("cautions", []):
+            print(f"caution: {c}")
     return 0 if ok else EXIT_CHECK
 
 
@@ -338,7 +340,7 @@ def _path_result(args: argparse.Namespace, d: Any, targets: np.ndarray, kind: st
     return _finish_path(
         args,
         f"{what}, largest distance {d.checks['max_error']:.3g} of the targets' size (RMS {d.checks['rms_error']:.3g}) "
-        f"over {len(targets)} targets in {d.seconds:.2f} s{found}",
+        f"over {len(targets)} targets in {d.seconds:.2f} s (wall){found}",
         text,
         report,
         d.ok,
@@ -822,9 +824,10 @@ def add_parser(sub: Any) -> None:
         choices=("quick", "normal", "thorough"),
         default="normal",
         help="search effort of the atlas and the global search (normal, untimed: 15 or more targets on a four-bar's "
-        "curve need neither, under 2 s of CPU in all; fewer, about 3 s when the atlas's nearest curves find it, most "
-        "of it loading the atlas, up to about 20 s when the later stages and the global search run, as with noisy "
-        "or drawn targets; sixbar: about twice that)",
+        "curve need neither, under 2 s of CPU in all; fewer on a whole curve, about 3 s when the atlas's nearest "
+        "curves find it, most of it loading the atlas; on an arc of a curve, or when the later stages run, 5 to 15 "
+        "s; up to about 20 s when the global search runs too, as with noisy or drawn targets; sixbar: about twice "
+        "that)",
     )
     p.add_argument(
         "--max-ratio",

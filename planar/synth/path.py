@@ -215,6 +215,9 @@ def synthesise_path(
     crank angle where it is smallest are ``min_transmission_deg`` and
     ``min_transmission_at_rad``).  Raises
     :class:`InputError` for fewer than 3 targets or mismatched lengths.
+    Untimed, ``checks["cautions"]`` says in words what the targets leave open (:func:`untimed_cautions`: fewer
+    than 10 targets do not fix the curve; targets on less than 270 degrees of the crank's turn fix it weakly
+    beyond them); the command line prints each as a ``caution:`` line.
 
     Small dense algebra (the least-squares steps) runs on one BLAS thread
     (threadpoolctl): on two threads under load each small SVD was 200 times
@@ -257,7 +260,42 @@ def synthesise_path(
     d.checks["found_by"] = source
     d.checks["input"] = "turns fully"
     d.checks["evaluations"] = r.evaluations
+    if theta is None:
+        d.checks["cautions"] = untimed_cautions(len(t), d.theta)
     return d
+
+
+#: untimed targets fewer than this do not fix a four-bar's curve (9 dimensions, one condition per target: 8 leave a
+#: one-parameter family through them, 9 a finite number of four-bars)
+FIXED_FROM = 10
+#: crank angles (degrees) the untimed targets of a result whose crank turns fully must span for no caution
+SPAN_DEG = 270.0
+
+
+def untimed_cautions(n: int, theta: Array | None) -> list[str]:
+    """What an untimed result through ``n`` targets (at crank angles ``theta``, rad, of a crank that turns fully;
+    None for an input that rocks) does not settle, in words: the curve when fewer than :data:`FIXED_FROM` targets,
+    the curve beyond the targets when they span less than :data:`SPAN_DEG` of the crank's turn.  Empty when
+    neither."""
+    out = []
+    if n < FIXED_FROM:
+        family = "a one-parameter family" if n == 8 else "a finite number" if n == 9 else f"a {9 - n}-parameter family"
+        out.append(
+            f"{n} untimed targets do not fix the curve: {family} of four-bars pass through them, so between and beyond "
+            f"the targets this curve is one of several (give {FIXED_FROM} or more targets spread along the curve, or "
+            "their crank angles, to pin it down)"
+        )
+    if theta is None:
+        return out
+    th = np.sort(np.asarray(theta, float) % (2 * np.pi))
+    gaps = np.diff(np.append(th, th[0] + 2 * np.pi))
+    span = float(np.degrees(2 * np.pi - gaps.max())) if len(th) > 1 else 0.0
+    if span < SPAN_DEG:
+        out.append(
+            f"the targets lie on {span:.0f} deg of the crank's turn: beyond them the curve is weakly fixed (four-bars "
+            "whose curves differ there pass as close to the targets); add targets there to pin it down"
+        )
+    return out
 
 
 def check_path_args(
@@ -414,6 +452,7 @@ def _rocking_checked(
             "for one that cannot)"
         )
     d.checks["evaluations"] = r.evaluations
+    d.checks["cautions"] = untimed_cautions(len(d.targets), None)  # the swing is the arc: no span to judge
     return d
 
 

@@ -147,11 +147,11 @@ class PathSearch:
             other = f"found no better: {e_global:.3g}" if g_good else "found none usable"
             return (
                 timed,
-                f"the atlas lookup and refinement (the global search, --budget {self.budget}, ran too and {other})",
+                f"the atlas lookup and refinement (the global search, budget {self.budget}, ran too and {other})",
                 None,
             )
         g.stages = stages
-        return g, f"the global search (--budget {self.budget}; the atlas's best was {e_atlas:.3g} of the size off)", None
+        return g, f"the global search (budget {self.budget}; the atlas's best was {e_atlas:.3g} of the size off)", None
 
     def untimed(self) -> Found:
         """Untimed targets: from :data:`planar.synth.algebraic.MIN_TARGETS` targets their own curve equation
@@ -236,13 +236,13 @@ class PathSearch:
             )
             return (
                 g,
-                f"the global search (--budget {self.budget}; largest distance {e_global:.3g} of the size, {than}{tried})",
+                f"the global search (budget {self.budget}; largest distance {e_global:.3g} of the size, {than}{tried})",
                 None,
             )
         r.stages = stages
         other = f"found no better: {e_global:.3g}" if g_good else "found none usable (out of order or breaking a constraint)"
         head = f"the atlas lookup and refinement (largest distance {e_atlas:.3g} of the size; the global search, "
-        return r, f"{head}--budget {self.budget}, ran too and {other}{tried})", None
+        return r, f"{head}budget {self.budget}, ran too and {other}{tried})", None
 
     def rocking(self, stages: dict[str, float]) -> tuple[Any, tuple[float, float] | None, float, str]:
         """The rocking arcs (:func:`planar.synth.arcs.search_arcs`), when they may be tried: no pivots box, no

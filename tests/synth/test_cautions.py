@@ -1,0 +1,79 @@
+"""Untimed path synthesis says what few targets, or targets on a short arc, leave open (a new user's trial: a
+four-bar exact at 8 targets whose curve was 1.4 % of the size away from theirs between the targets)."""
+
+import numpy as np
+
+from planar.synth.kernel import coupler_points
+from planar.synth.path import FIXED_FROM, untimed_cautions
+
+ROW = np.array([1.0, 0.3, 1.1, 0.9, 0.5, 0.4, 0.2, 0.1, 0.3])
+
+
+def _points(row, th):
+    x, y, ok = coupler_points(np.asarray(row, float)[None, :], np.asarray(th, float), np.array([1.0]))
+    assert ok.all()
+    return np.column_stack([x[0], y[0]])
+
+
+def test_cautions_name_too_few_targets_and_a_short_arc():
+    whole = np.linspace(0, 2 * np.pi, 12, endpoint=False)
+    assert untimed_cautions(12, whole) == []
+    few = untimed_cautions(8, whole[:8] * 1.5)
+    assert len(few) == 1 and "8 untimed targets do not fix the curve: a one-parameter family" in few[0]
+    assert "a finite number" in untimed_cautions(9, whole)[0] and "a 3-parameter family" in untimed_cautions(6, whole)[0]
+    arc = untimed_cautions(12, np.linspace(1.0, 1.0 + np.radians(100), 12))
+    assert len(arc) == 1 and "on 100 deg of the crank's turn" in arc[0]
+    assert untimed_cautions(8, None) == few and untimed_cautions(FIXED_FROM, None) == []
+
+
+def test_eight_targets_are_passed_exactly_by_another_four_bar_with_another_curve():
+    """What the caution claims, shown: from the four-bar through 8 targets, a step along the null direction of the
+    16 x 17 system (9 dimensions, 8 crank angles) and Gauss-Newton back give a second four-bar through all 8 to
+    rounding whose curve leaves the first's between the targets."""
+    th = np.sort(np.random.default_rng(4).uniform(0, 2 * np.pi, 8))
+    T = _points(ROW, th)
+
+    def resid(z):
+        return (_points(z[:9], z[9:]) - T).ravel()
+
+    def jac(z):
+        h = 1e-7
+        return np.column_stack([(resid(z + h * e) - resid(z - h * e)) / (2 * h) for e in np.eye(len(z))])
+
+    z0 = np.concatenate([ROW, th])
+    v = np.linalg.svd(jac(z0))[2][-1]  # the family's tangent
+    z = z0 + 0.05 * v / np.linalg.norm(v[:9])
+    for _ in range(30):
+        z = z - np.linalg.lstsq(jac(z), resid(z), rcond=None)[0]
+    assert np.abs(resid(z)).max() < 1e-12
+    assert np.abs(z[:9] - ROW).max() > 1e-3  # another four-bar
+    dense = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
+    mine, other = _points(ROW, dense), _points(z[:9], dense)
+    gap = np.sqrt(((other[:, None, :] - mine[None, :, :]) ** 2).sum(-1)).min(1).max()
+    size = np.sqrt(np.mean(np.sum((T - T.mean(0)) ** 2, 1)))
+    assert gap > 1e-3 * size  # its curve is another between the targets
+
+
+def test_synthesis_reports_the_cautions(tmp_path):
+    from planar.synth.atlas import build_atlas
+    from planar.synth.path import synthesise_path
+
+    atlas = build_atlas(5000, seed=0)
+    few = synthesise_path(_points(ROW, np.linspace(0, 2 * np.pi, 8, endpoint=False)), atlas=atlas, budget="quick")
+    assert any("8 untimed targets do not fix the curve" in c for c in few.checks["cautions"])
+    many = synthesise_path(_points(ROW, np.linspace(0, 2 * np.pi, 16, endpoint=False)), atlas=atlas, budget="quick")
+    assert many.checks["max_error"] < 1e-6 and many.checks["cautions"] == []
+    timed = synthesise_path(_points(ROW, th := np.linspace(0, 6, 8)), th, atlas=atlas, budget="quick")
+    assert "cautions" not in timed.checks  # crank angles given: the timing fixes the four-bar
+
+
+def test_the_command_line_prints_each_caution(tmp_path, capsys):
+    from planar.cli.main import main
+
+    f = tmp_path / "t.csv"
+    np.savetxt(f, _points(ROW, np.linspace(0, 2 * np.pi, 8, endpoint=False)), delimiter=",", header="x,y", comments="")
+    rc = main(["synth", "path", str(f), "-o", str(tmp_path / "s.toml"), "--budget", "quick", "--ordered"])
+    out = capsys.readouterr().out.splitlines()
+    cautions = [line for line in out if line.startswith("caution: ")]
+    assert rc == 0 and len(cautions) == 1 and "8 untimed targets do not fix the curve" in cautions[0], out
+    assert " s (wall); found by " in out[0]
