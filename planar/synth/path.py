@@ -260,8 +260,8 @@ def synthesise_path(
     d.checks["found_by"] = source
     d.checks["input"] = "turns fully"
     d.checks["evaluations"] = r.evaluations
-    if theta is None:
-        d.checks["cautions"] = untimed_cautions(len(t), d.theta)
+    if theta is None:  # what targets met leave open (targets not met are said to be so)
+        d.checks["cautions"] = untimed_cautions(len(t), d.theta) if d.checks["ok_accuracy"] else []
     return d
 
 
@@ -452,7 +452,8 @@ def _rocking_checked(
             "for one that cannot)"
         )
     d.checks["evaluations"] = r.evaluations
-    d.checks["cautions"] = untimed_cautions(len(d.targets), None)  # the swing is the arc: no span to judge
+    # the swing is the arc: no span to judge; targets not met are said to be so
+    d.checks["cautions"] = untimed_cautions(len(d.targets), None) if d.checks.get("ok_accuracy") else []
     return d
 
 

@@ -159,7 +159,7 @@ class PathSearch:
         from planar.synth.algebraic import MIN_TARGETS
 
         if len(self.t) < MIN_TARGETS:
-            return self.searched()
+            return self.off_toggle(*self.searched())
         t0 = time.perf_counter()
         alg, how, swing = self.from_equation()
         self.stages["algebraic_s"] = time.perf_counter() - t0
@@ -168,7 +168,35 @@ class PathSearch:
             return alg, how, swing
         r, source, swing = self.searched()
         gave = "; the targets' own curve equation gave no four-bar through them (see the curve equation docs)"
-        return r, source + gave, swing
+        return self.off_toggle(r, source + gave, swing)
+
+    def off_toggle(self, r: Any, source: str, swing: tuple[float, float] | None) -> Found:
+        """An untimed result not within the tolerance whose crank turns fully but brings the linkage within
+        :data:`planar.synth.designs.TOGGLE_FLOOR_DEG` of a toggle (a linkage that nearly folds: no answer, though
+        the nearest) is searched again keeping that floor (:func:`planar.synth.search.search_atlas` with it as
+        ``min_transmission``); the new result is kept when it keeps the floor, the order and the constraints."""
+        from planar.synth.designs import TOGGLE_FLOOR_DEG
+        from planar.synth.search import search_atlas
+
+        floor = math.radians(TOGGLE_FLOOR_DEG)
+        if swing is not None or self.cons.min_transmission >= floor or self._distance(r, None) <= self.tolerance:
+            return r, source, swing
+        floored = dataclasses.replace(self.cons, min_transmission=floor)
+        if keeps_transmission(r, floored):
+            return r, source, swing
+        t0 = time.perf_counter()
+        again = search_atlas(self.t, self.loaded_atlas(), floored, ordered=self.ordered)
+        stages = {**r.stages, "floor_s": time.perf_counter() - t0}
+        e = self._distance(again, None)
+        if not (again.feasible and keeps_transmission(again, floored) and self._usable(again)):
+            r.stages = stages
+            return r, source + f"; searched again {TOGGLE_FLOOR_DEG:g} deg from a toggle, none found usable", swing
+        again.stages = stages
+        why = (
+            f"the atlas lookup and refinement kept {TOGGLE_FLOOR_DEG:g} deg from a toggle (largest distance {e:.3g} of "
+            f"the size; the nearest without it nearly folds: {source})"
+        )
+        return again, why, swing
 
     def from_equation(self) -> Found:
         """The four-bar of the targets' own curve equation (:func:`planar.synth.algebraic.search_algebraic`): a crank

@@ -77,3 +77,34 @@ def test_the_command_line_prints_each_caution(tmp_path, capsys):
     cautions = [line for line in out if line.startswith("caution: ")]
     assert rc == 0 and len(cautions) == 1 and "8 untimed targets do not fix the curve" in cautions[0], out
     assert " s (wall); found by " in out[0]
+
+
+def test_unmet_targets_get_a_linkage_that_does_not_nearly_fold(monkeypatch):
+    """A trial's hand-drawn figure: the nearest four-bar found had a transmission angle of 0.36 deg (two links
+    equal to 1e-8), below the 1 deg floor; the search runs again keeping the floor and that design is kept."""
+    import planar.synth.path_search as P
+    import planar.synth.search as S
+    from planar.synth.path import transmission_margin
+
+    T = _points(ROW, np.linspace(0, 2 * np.pi, 9, endpoint=False))
+    folding = np.array([1.0, 0.3, 0.7, 0.6000001, 0.5, 0.4, 0.2, 0.1, 0.3])  # 1 + 0.3 = 0.7 + 0.6: a change point
+    calls = []
+
+    def fake(t, atlas, cons=None, **k):
+        calls.append(cons.min_transmission)
+        row = folding if cons.min_transmission == 0 else ROW * np.array([1, 1, 1, 1, 1.05, 1, 1, 1, 1])
+        return S.SearchResult(row, 1, np.linspace(0, 2 * np.pi, 9, endpoint=False), 1.0, True, 1, {"atlas_s": 0.0})
+
+    monkeypatch.setattr(S, "search_atlas", fake)
+    monkeypatch.setattr(P.PathSearch, "rocking", lambda self, stages: (None, None, np.inf, ""))
+    monkeypatch.setattr(P, "search_fourbar", lambda *a, **k: fake(None, None, S.Constraints()))
+    search = P.PathSearch(T, S.Constraints(), "quick", 0, 1e-3, object(), True)
+    r, found, swing = search.run(None)
+    assert swing is None and calls[-1] == np.radians(1.0) and "kept 1 deg from a toggle" in found and "floor_s" in r.stages
+    assert np.degrees(transmission_margin(_fb(r.params))[0]) > 1.0 > np.degrees(transmission_margin(_fb(folding))[0])
+
+
+def _fb(row):
+    from planar.linkages import FourBar
+
+    return FourBar(ground=row[0], crank=row[1], coupler=row[2], rocker=row[3])
