@@ -210,7 +210,7 @@ def scene_figure(
         ax.set_gid(f"chart-{chart}")
         ax.grid(True, lw=0.4, alpha=0.5)
         if chart == "curve":
-            _curve_panel(ax, scene, motion)
+            _curve_panel(ax, scene, _curve_motion(scene, motion, samples_per_cycle))
         elif chart == "pressure":
             cm: Any = mech  # a CamMechanism (available_charts offers "pressure" only for one)
             prof = cm.profile
@@ -281,6 +281,31 @@ def _angle_panel(ax: Any, motion: Motion, moving: list[str], x: np.ndarray) -> N
 
 #: the colour of the targets on the coupler-curve chart (the animation's target dots are pink too)
 TARGET_COLOUR = "#e75480"
+
+
+#: the curve chart re-solves the motion finer when a named point's longest step between samples is more than this many
+#: times its median step (a point that sweeps fast near a toggle: straight chords would cut across its curve), up to
+#: :data:`CURVE_MAX_SAMPLES` samples per cycle
+CURVE_CHORD_RATIO, CURVE_MAX_SAMPLES = 4.0, 20_000
+
+
+def _curve_motion(scene: Scene, motion: Motion, samples_per_cycle: int | None) -> Motion:
+    """The motion the curve chart draws: ``motion`` itself, or, when no ``samples_per_cycle`` was asked and a named
+    point's longest step is over :data:`CURVE_CHORD_RATIO` times its median step, the motion re-solved with that
+    many times the samples (at most :data:`CURVE_MAX_SAMPLES` per cycle)."""
+    if samples_per_cycle is not None or not motion.points:
+        return motion
+    ratio = 1.0
+    for xy in motion.points.values():
+        ok = motion.valid[1:] & motion.valid[:-1]
+        step = np.hypot(*np.diff(xy, axis=0).T)[ok]
+        med = float(np.median(step)) if len(step) else 0.0
+        if med > 0:
+            ratio = max(ratio, float(step.max()) / med)
+    spc = scene.spec.driver.samples_per_cycle
+    if ratio <= CURVE_CHORD_RATIO or spc >= CURVE_MAX_SAMPLES:
+        return motion
+    return _motion(scene, int(min(CURVE_MAX_SAMPLES, spc * np.ceil(ratio))))
 
 
 def _curve_panel(ax: Any, scene: Scene, motion: Motion) -> None:

@@ -21,3 +21,30 @@ def test_the_curve_chart_rings_each_target_where_the_scene_puts_it() -> None:
     assert "targets (7)" in [t.get_text() for t in ax.get_legend().get_texts()]
     plain = scene_figure(planar.scene_from_mechanism(leg), "curve")
     assert not [ln for ln in plain.axes[0].get_lines() if ln.get_gid() == "targets"]
+
+
+def test_the_curve_chart_is_solved_finer_where_a_point_sweeps_fast() -> None:
+    """A trial's nearly folding four-bar (coupler and rocker equal to 1e-7: the coupler point swept a third of its
+    figure in 1.5 deg of crank) was drawn from the scene's 72 samples as straight chords cutting across the curve;
+    the curve chart re-solves it finer, and its drawn path then stays near the curve solved at 20,000 samples."""
+    from planar.draw.charts import CURVE_CHORD_RATIO
+
+    leg = planar.FourBar(ground=1.6217, crank=1.6399, coupler=2.93428, rocker=2.9342771, coupler_point=(0.702, -1.755))
+    scene = planar.scene_from_mechanism(leg)
+    n = scene.spec.driver.samples_per_cycle
+    (line,) = [ln for ln in scene_figure(scene, "curve").axes[0].get_lines() if ln.get_gid() == "curve:coupler_point"]
+    drawn = np.column_stack(line.get_data())
+    fine = leg.solve(np.linspace(0.0, 2 * np.pi, 20_000, endpoint=False)).points["coupler_point"]
+    coarse = leg.solve(np.linspace(0.0, 2 * np.pi, n, endpoint=False)).points["coupler_point"]
+
+    def off(pts):  # the largest distance from the midpoint of a drawn chord to the fine curve
+        mid = 0.5 * (pts[1:] + pts[:-1])
+        return np.sqrt(((mid[:, None, :] - fine[None, :, :]) ** 2).sum(-1)).min(1).max()
+
+    size = np.ptp(fine, axis=0).max()
+    assert len(drawn) > CURVE_CHORD_RATIO * n and off(drawn) < 0.01 * size < off(np.vstack([coarse, coarse[:1]]))
+    # a point moving at an even pace keeps the scene's own samples
+    even = planar.FourBar(ground=4.0, crank=1.0, coupler=3.5, rocker=3.0, coupler_point=(1.5, 1.0))
+    es = planar.scene_from_mechanism(even)
+    (line,) = [ln for ln in scene_figure(es, "curve").axes[0].get_lines() if ln.get_gid() == "curve:coupler_point"]
+    assert len(line.get_xdata()) == es.spec.driver.samples_per_cycle + 1
