@@ -138,3 +138,32 @@ def test_no_search_where_no_unit_helps_or_a_build_takes_long() -> None:
     )
     hint = unit_hint(scene, crowded)
     assert hint.builds == 0 and hint.text().startswith(f"no unit_mm searched: {MAX_PARTS + 1} parts")
+
+
+@pytest.mark.slow
+def test_parts_widened_to_the_least_wall_name_the_unit_that_scales_them(tmp_path, capsys) -> None:
+    """A trial's synthesised crank-rocker from a CSV in arbitrary units kept the default 10 mm a unit: every part
+    was widened to the 1.5 mm wall and the mechanism filled 2 % of the sheet, with nothing saying why; a ``size:``
+    line names the unit and the longest part (checked against the DXF a maker gets, read with ezdxf), and none is
+    printed where no part was widened."""
+    import ezdxf
+
+    from planar.cli.main import main
+
+    leg = planar.FourBar(ground=4.0, crank=1.0, coupler=3.5, rocker=3.0, coupler_point=(1.5, 1.0))
+    small, big = tmp_path / "small.toml", tmp_path / "big.toml"
+    planar.scene_from_mechanism(leg, fabrication={"unit_mm": 10.0}).save(small)
+    planar.scene_from_mechanism(leg, fabrication={"unit_mm": 40.0}).save(big)
+    assert main(["export", str(small), "-o", str(tmp_path / "s.dxf")]) == 0
+    said = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("size: ")]
+    assert len(said) == 1 and "at unit_mm 10 " in said[0] and "--unit-mm N cuts the mechanism N/10 times" in said[0]
+    longest = float(re.search(r"the longest part is ([0-9.]+) mm", said[0]).group(1))
+    box = ezdxf.readfile(tmp_path / "s.dxf").modelspace()
+    spans = []
+    for e in box.query("LWPOLYLINE"):
+        pts = np.array([p[:2] for p in e.get_points()])
+        spans.append(np.ptp(pts, axis=0).max())
+    parts = [v for v in spans if v < 200.0]  # not the 300 x 200 mm sheet's outline
+    assert abs(max(parts) - longest) < 1.0  # the longest outline in the file, to the kerf and arcs' bulges
+    assert main(["export", str(big), "-o", str(tmp_path / "b.dxf")]) == 0
+    assert not [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("size: ")]
