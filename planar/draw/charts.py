@@ -283,29 +283,20 @@ def _angle_panel(ax: Any, motion: Motion, moving: list[str], x: np.ndarray) -> N
 TARGET_COLOUR = "#e75480"
 
 
-#: the curve chart re-solves the motion finer when a named point's longest step between samples is more than this many
-#: times its median step (a point that sweeps fast near a toggle: straight chords would cut across its curve), up to
-#: :data:`CURVE_MAX_SAMPLES` samples per cycle
-CURVE_CHORD_RATIO, CURVE_MAX_SAMPLES = 4.0, 20_000
-
-
 def _curve_motion(scene: Scene, motion: Motion, samples_per_cycle: int | None) -> Motion:
     """The motion the curve chart draws: ``motion`` itself, or, when no ``samples_per_cycle`` was asked and a named
-    point's longest step is over :data:`CURVE_CHORD_RATIO` times its median step, the motion re-solved with that
-    many times the samples (at most :data:`CURVE_MAX_SAMPLES` per cycle)."""
+    point sweeps fast (:func:`planar.draw.timing.chord_ratio` over :data:`planar.draw.timing.CHORD_RATIO`), the
+    motion re-solved with that many times the samples (at most
+    :data:`planar.draw.timing.MAX_SAMPLES_PER_CYCLE` a cycle)."""
+    from planar.draw.timing import CHORD_RATIO, MAX_SAMPLES_PER_CYCLE, chord_ratio
+
     if samples_per_cycle is not None or not motion.points:
         return motion
-    ratio = 1.0
-    for xy in motion.points.values():
-        ok = motion.valid[1:] & motion.valid[:-1]
-        step = np.hypot(*np.diff(xy, axis=0).T)[ok]
-        med = float(np.median(step)) if len(step) else 0.0
-        if med > 0:
-            ratio = max(ratio, float(step.max()) / med)
+    ratio = chord_ratio(motion)
     spc = scene.spec.driver.samples_per_cycle
-    if ratio <= CURVE_CHORD_RATIO or spc >= CURVE_MAX_SAMPLES:
+    if ratio <= CHORD_RATIO or spc >= MAX_SAMPLES_PER_CYCLE:
         return motion
-    return _motion(scene, int(min(CURVE_MAX_SAMPLES, spc * np.ceil(ratio))))
+    return _motion(scene, int(min(MAX_SAMPLES_PER_CYCLE, spc * np.ceil(ratio))))
 
 
 def _curve_panel(ax: Any, scene: Scene, motion: Motion) -> None:

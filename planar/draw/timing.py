@@ -200,9 +200,40 @@ def animation_motion(scene: Scene, plan: FramePlan) -> tuple[Motion, Motion]:
     check_kind("animation_motion(plan)", plan, FramePlan)
     drv = scene.mechanism.driver
     m = max(1, math.ceil(scene.spec.driver.samples_per_cycle / plan.frames_per_cycle))
-    t = np.arange(plan.frames * m, dtype=np.float64) * (plan.period_s / (plan.frames_per_cycle * m))
-    fine = scene.mechanism.solve(drv.value(t), t=t)
+
+    def solved(m: int) -> Motion:
+        t = np.arange(plan.frames * m, dtype=np.float64) * (plan.period_s / (plan.frames_per_cycle * m))
+        return scene.mechanism.solve(drv.value(t), t=t)
+
+    fine = solved(m)
+    ratio = chord_ratio(fine)
+    if ratio > CHORD_RATIO:  # a point sweeping fast (near a toggle): its trail would cut across its curve
+        finer = min(m * math.ceil(ratio), max(m, MAX_SAMPLES_PER_CYCLE // plan.frames_per_cycle))
+        finer = min(finer, max(m, MAX_FINE_SAMPLES // plan.frames))
+        if finer > m:
+            m, fine = finer, solved(finer)
     return fine.take(np.arange(plan.frames) * m), fine
+
+
+#: a motion is drawn from a finer grid when a named point's longest step between samples is more than this many times
+#: its median step (:func:`chord_ratio`), up to :data:`MAX_SAMPLES_PER_CYCLE` a cycle and :data:`MAX_FINE_SAMPLES` in
+#: all (memory bounded whatever the animation's length)
+CHORD_RATIO, MAX_SAMPLES_PER_CYCLE, MAX_FINE_SAMPLES = 4.0, 20_000, 400_000
+
+
+def chord_ratio(motion: Motion) -> float:
+    """The largest ratio over the named points of ``motion`` of the longest step between consecutive valid samples
+    to the median step (1 when no point moves): over :data:`CHORD_RATIO`, straight chords between the samples cut
+    across the point's curve where it sweeps fast (a linkage near a toggle)."""
+    ratio = 1.0
+    ok = np.asarray(motion.valid[1:] & motion.valid[:-1], bool)
+    for xy in motion.points.values():
+        step = np.hypot(*np.diff(np.asarray(xy, float), axis=0).T)[ok]
+        step = step[np.isfinite(step)]
+        med = float(np.median(step)) if len(step) else 0.0
+        if med > 0:
+            ratio = max(ratio, float(step.max()) / med)
+    return ratio
 
 
 def resample(motion: Motion, t: np.ndarray) -> Motion:
