@@ -123,7 +123,7 @@ def _transmission_word(deg: float, where: str, asked: float) -> str:
     from planar.synth.path import TOGGLE_FLOOR_DEG
 
     limit = f"limit {asked:g} deg, --min-transmission" if asked > TOGGLE_FLOOR_DEG else f"the floor, {TOGGLE_FLOOR_DEG:g} deg"
-    head = f"the transmission angle falls to {deg:.3g} deg from a toggle {where} ({limit})"
+    head = f"the transmission angle falls to {deg:.4g} deg from a toggle {where} ({limit})"
     if deg < TOGGLE_FLOOR_DEG:
         return head + (
             ": coupler and rocker fold nearly flat there, so the coupler point moves far for a small crank step "
@@ -335,7 +335,7 @@ def _path_result(args: argparse.Namespace, d: Any, targets: np.ndarray, kind: st
     found = f"; found by {d.checks['found_by']}" if d.checks.get("found_by") else ""
     if "min_transmission_deg" in d.checks:  # a four-bar's (a six-bar's are in its checks)
         over = "swing" if d.checks.get("input") == "rocks" else "turn"
-        what += f", transmission angle >= {d.checks['min_transmission_deg']:.3g} deg from a toggle over the {over}"
+        what += f", transmission angle >= {d.checks['min_transmission_deg']:.4g} deg from a toggle over the {over}"
     report = {"command": "synth path", "targets": len(targets), "target_points": targets.tolist(), **d.to_dict()}
     return _finish_path(
         args,
@@ -765,7 +765,7 @@ def _min_transmission_parent() -> argparse.ArgumentParser:
         "--min-transmission",
         type=float,
         default=0.0,
-        help="keep the transmission angle (between coupler and rocker) at least this far from 0 and 180 (a toggle) "
+        help="keep the transmission angle (between the coupler and the output link) at least this far from 0 and 180 (a toggle) "
         "over the motion (path: the crank's whole turn), degrees (0; never accepted nearer than 1 deg). path: a "
         "constraint of the search; motion: chooses among the four-bars through the poses; when the best found does "
         "not keep it, it is written and exits 3 naming the angle and where",

@@ -260,9 +260,28 @@ def synthesise_path(
     d.checks["found_by"] = source
     d.checks["input"] = "turns fully"
     d.checks["evaluations"] = r.evaluations
-    if theta is None:  # what targets met leave open (targets not met are said to be so)
-        d.checks["cautions"] = untimed_cautions(len(t), d.theta) if d.checks["ok_accuracy"] else []
+    # what targets met leave open (targets not met are said to be so), and a linkage that comes near a toggle
+    met = theta is None and d.checks["ok_accuracy"]
+    d.checks["cautions"] = (untimed_cautions(len(t), d.theta) if met else []) + transmission_cautions(d, cons)
     return d
+
+
+#: a design whose transmission angle comes nearer a toggle than this (degrees), with no ``min_transmission`` asked,
+#: is cautioned (it passes the 1 degree floor, but such a linkage binds or jerks there; 40 is common advice)
+LOW_TRANSMISSION_DEG = 10.0
+
+
+def transmission_cautions(d: Any, cons: Constraints) -> list[str]:
+    """A caution, in words, when ``d``'s transmission angle comes within :data:`LOW_TRANSMISSION_DEG` of a toggle
+    and no ``min_transmission`` was asked (empty otherwise, and when the check already failed)."""
+    deg = d.checks.get("min_transmission_deg")
+    if deg is None or cons.min_transmission > 0 or not d.checks.get("ok_transmission", True) or deg >= LOW_TRANSMISSION_DEG:
+        return []
+    return [
+        f"the transmission angle comes within {deg:.3g} deg of a toggle (crank at {d.checks['min_transmission_at_rad']:.3g}"
+        " rad): a linkage this near folding binds or jerks there; --min-transmission N (min_transmission=, radians, "
+        "from Python) asks the search to keep N deg (40 is common advice)"
+    ]
 
 
 #: untimed targets fewer than this do not fix a four-bar's curve (9 dimensions, one condition per target: 8 leave a
@@ -453,7 +472,8 @@ def _rocking_checked(
         )
     d.checks["evaluations"] = r.evaluations
     # the swing is the arc: no span to judge; targets not met are said to be so
-    d.checks["cautions"] = untimed_cautions(len(d.targets), None) if d.checks.get("ok_accuracy") else []
+    met = untimed_cautions(len(d.targets), None) if d.checks.get("ok_accuracy") else []
+    d.checks["cautions"] = met + transmission_cautions(d, cons)
     return d
 
 

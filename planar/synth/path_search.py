@@ -192,9 +192,10 @@ class PathSearch:
             r.stages = stages
             return r, source + f"; searched again {TOGGLE_FLOOR_DEG:g} deg from a toggle, none found usable", swing
         again.stages = stages
+        e_before = self._distance(r, None)
         why = (
             f"the atlas lookup and refinement kept {TOGGLE_FLOOR_DEG:g} deg from a toggle (largest distance {e:.3g} of "
-            f"the size; the nearest without it nearly folds: {source})"
+            f"the size); without that floor the nearest found, {e_before:.3g} of the size off, nearly folds"
         )
         return again, why, swing
 

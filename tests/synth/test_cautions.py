@@ -64,7 +64,7 @@ def test_synthesis_reports_the_cautions(tmp_path):
     many = synthesise_path(_points(ROW, np.linspace(0, 2 * np.pi, 16, endpoint=False)), atlas=atlas, budget="quick")
     assert many.checks["max_error"] < 1e-6 and many.checks["cautions"] == []
     timed = synthesise_path(_points(ROW, th := np.linspace(0, 6, 8)), th, atlas=atlas, budget="quick")
-    assert "cautions" not in timed.checks  # crank angles given: the timing fixes the four-bar
+    assert not any("untimed" in c for c in timed.checks["cautions"])  # crank angles given: the timing fixes it
 
 
 def test_the_command_line_prints_each_caution(tmp_path, capsys):
@@ -108,3 +108,18 @@ def _fb(row):
     from planar.linkages import FourBar
 
     return FourBar(ground=row[0], crank=row[1], coupler=row[2], rocker=row[3])
+
+
+def test_a_linkage_near_a_toggle_is_cautioned_unless_a_limit_was_asked():
+    """A re-trial's hand-drawn Z came back with a transmission angle 2.97 deg from a toggle and nothing said so."""
+    from types import SimpleNamespace
+
+    from planar.synth.path import transmission_cautions
+    from planar.synth.search import Constraints
+
+    near = SimpleNamespace(checks={"min_transmission_deg": 2.97, "min_transmission_at_rad": 0.0, "ok_transmission": True})
+    (said,) = transmission_cautions(near, Constraints())
+    assert "within 2.97 deg of a toggle" in said and "--min-transmission" in said
+    assert transmission_cautions(near, Constraints(min_transmission=0.5)) == []  # asked: the check judges it
+    far = SimpleNamespace(checks={"min_transmission_deg": 35.0, "min_transmission_at_rad": 0.0, "ok_transmission": True})
+    assert transmission_cautions(far, Constraints()) == []
