@@ -28,7 +28,7 @@ _EXPORT_OUTPUTS = (
 
 def _cmd_export(args: argparse.Namespace) -> int:
     from planar.app.pipeline import export_scene
-    from planar.fabrication.build import summary
+    from planar.fabrication.build import size_note, summary
     from planar.scene.load import load_scene
 
     if all(getattr(args, attr) is None for _, attr, _ in _EXPORT_OUTPUTS):
@@ -63,7 +63,7 @@ def _cmd_export(args: argparse.Namespace) -> int:
     )
     for note in fab.notes:
         print(f"note: {note}")
-    small = _small_note(fab)
+    small = size_note(fab)
     if small:
         print(f"size: {small}")
     for w in fab.warnings:  # a toy's motion the cut parts will not make (the design exits 3 for it; cut anyway)
@@ -117,25 +117,3 @@ def add_parser(sub: Any) -> None:
         "--steps", default=None, help="assembly steps (SVG pages steps-1.svg, ...): layer by layer, which pin goes where"
     )
     ex.set_defaults(func=_cmd_export)
-
-
-def _small_note(fab: Any) -> str:
-    """When parts were widened to the least wall: how long the longest part is at the scene's ``unit_mm`` and how
-    to cut it larger, in words (empty otherwise).  A scene from a CSV of targets in arbitrary units keeps the
-    default 10 mm per unit, which can leave the parts a few millimetres wide."""
-    widened = sum(" widened from " in n for n in fab.notes)
-    if not widened:
-        return ""
-    import numpy as np
-
-    longest = 0.0
-    for p in fab.layout.parts:
-        xy = np.array([v[:2] for v in p.outer.vertices]) if hasattr(p.outer, "vertices") else None
-        if xy is not None and len(xy):
-            longest = max(longest, float(np.ptp(xy, axis=0).max()))
-    u = fab.layout.unit_mm
-    return (
-        f"{widened} part(s) were widened to the least wall; at unit_mm {u:g} (millimetres per model unit, the scene's "
-        f"[fabrication] unit_mm) the longest part is {longest:.1f} mm: export --unit-mm N cuts the mechanism N/{u:g} "
-        "times as large"
-    )

@@ -290,7 +290,7 @@ def _curve_motion(scene: Scene, motion: Motion, samples_per_cycle: int | None) -
     :data:`planar.draw.timing.MAX_SAMPLES_PER_CYCLE` a cycle)."""
     from planar.draw.timing import CHORD_RATIO, MAX_SAMPLES_PER_CYCLE, chord_ratio
 
-    if samples_per_cycle is not None or not motion.points:
+    if samples_per_cycle is not None:
         return motion
     ratio = chord_ratio(motion)
     spc = scene.spec.driver.samples_per_cycle

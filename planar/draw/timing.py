@@ -208,8 +208,8 @@ def animation_motion(scene: Scene, plan: FramePlan) -> tuple[Motion, Motion]:
     fine = solved(m)
     ratio = chord_ratio(fine)
     if ratio > CHORD_RATIO:  # a point sweeping fast (near a toggle): its trail would cut across its curve
-        finer = min(m * math.ceil(ratio), max(m, MAX_SAMPLES_PER_CYCLE // plan.frames_per_cycle))
-        finer = min(finer, max(m, MAX_FINE_SAMPLES // plan.frames))
+        cap = min(MAX_SAMPLES_PER_CYCLE // plan.frames_per_cycle, MAX_FINE_SAMPLES // plan.frames)
+        finer = min(m * math.ceil(ratio), cap)
         if finer > m:
             m, fine = finer, solved(finer)
     return fine.take(np.arange(plan.frames) * m), fine

@@ -567,6 +567,27 @@ def kerf_test_layout(settings: FabSettings) -> Layout:
     return nest([pc], settings.sheet, settings.spacing, settings.margin, settings.kerf, settings.unit_mm)
 
 
+def size_note(fab: Fabrication) -> str:
+    """When parts were widened to the least wall: how long the longest part is at the scene's ``unit_mm`` and how
+    to cut it larger, in words (empty otherwise).  A scene from a CSV of targets in arbitrary units keeps the
+    default 10 mm per unit, which can leave the parts a few millimetres wide."""
+    import numpy as np
+
+    from planar.fabrication.sheet import Contour
+
+    widened = sum(p.widened for p in fab.layout.parts)
+    if not widened:
+        return ""
+    outlines = [np.array(p.outer.vertices)[:, :2] for p in fab.layout.parts if isinstance(p.outer, Contour)]
+    longest = max((float(np.ptp(xy, axis=0).max()) for xy in outlines if len(xy)), default=0.0)
+    u = fab.layout.unit_mm
+    return (
+        f"{widened} part(s) were widened to the least wall; at unit_mm {u:g} (millimetres per model unit, the scene's "
+        f"[fabrication] unit_mm) the longest part is {longest:.1f} mm: export --unit-mm N cuts the mechanism N/{u:g} "
+        "times as large"
+    )
+
+
 def summary(fab: Fabrication) -> str:
     """One line: parts (and the spacer rings cut beside them), sheets, utilisation, layers, pins."""
     lay, asm = fab.layout, fab.assembly

@@ -659,6 +659,7 @@ def part_cuts(
             f"min_wall_mm {s.min_wall:g} (a larger unit_mm, a smaller pin_diameter_mm or a smaller min_wall_mm)"
         )
     nominal_outer, notes = _outer(part, s, feats, 0.0)
+    widened = bool(notes)  # the outline's only note is its widening
     outer = nominal_outer if k2 == 0 else _outer(part, s, feats, k2)[0]
     if tabs is not None:
         nominal_outer, outer = _with_tabs(part.name, cut_polygon(nominal_outer), tabs, k2)
@@ -698,6 +699,7 @@ def part_cuts(
         engrave = engrave + letter_marks(material, [h for h in holes if h[1] > 0], max(s.min_label, 1.5))
     nominal = [(f.a, f.r) for f in feats if f.kind == "hole"]
     pc = PartCut(part.name, outer, [f.cut(k2) for f in feats], engrave, text, height, nominal_holes=nominal, notes=notes)
+    pc.widened = widened
     pc.mounting_at = [f.a for f in feats if f.what == "mounting hole"]
     return pc
 

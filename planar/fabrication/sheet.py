@@ -90,6 +90,8 @@ class PartCut:
     nominal_holes: list[tuple[tuple[float, float], float]] = field(default_factory=list)
     #: what the checks changed or found (widened, label shortened, ...), one line each
     notes: list[str] = field(default_factory=list)
+    #: whether the outline was widened so every cut keeps the least wall (one of ``notes`` says from what)
+    widened: bool = False
     #: assembly layer (0 = bottom) or None for a part standing in another plane
     layer: int | None = None
     #: where the part lies from its own frame: ``(angle, dx, dy)``, a point p goes to R(angle) p + (dx, dy)

@@ -440,7 +440,8 @@ def smooth_closed(z: NDArray[np.complex128], n: int = CURVE_SAMPLES) -> NDArray[
 def views(z: NDArray[np.complex128]) -> list[tuple[bool, NDArray[np.complex128]]]:
     """The four ways a query looks up points ``z`` (complex, in order): as given and reversed, plain and mirrored
     (conjugated), as ``(mirrored, points)``; rows found for a mirrored view are mirrored back (:func:`_mirror`)."""
-    return [(m, seq) for m in (False, True) for seq in ((np.conj(z), np.conj(z)[::-1]) if m else (z, z[::-1]))]
+    zc = np.conj(z)
+    return [(False, z), (False, z[::-1]), (True, zc), (True, zc[::-1])]
 
 
 def _both_normalisations(atlas: Atlas, d: Array, fr: Array, k: int) -> list[Array]:

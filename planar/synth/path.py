@@ -215,9 +215,10 @@ def synthesise_path(
     crank angle where it is smallest are ``min_transmission_deg`` and
     ``min_transmission_at_rad``).  Raises
     :class:`InputError` for fewer than 3 targets or mismatched lengths.
-    Untimed, ``checks["cautions"]`` says in words what the targets leave open (:func:`untimed_cautions`: fewer
+    ``checks["cautions"]`` says in words what untimed targets met leave open (:func:`untimed_cautions`: fewer
     than 10 targets do not fix the curve; targets on less than 270 degrees of the crank's turn fix it weakly
-    beyond them); the command line prints each as a ``caution:`` line.
+    beyond them) and when the transmission angle comes within 10 degrees of a toggle with no ``min_transmission``
+    asked (:func:`transmission_cautions`); the command line prints each as a ``caution:`` line.
 
     Small dense algebra (the least-squares steps) runs on one BLAS thread
     (threadpoolctl): on two threads under load each small SVD was 200 times

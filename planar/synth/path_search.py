@@ -179,23 +179,23 @@ class PathSearch:
         from planar.synth.search import search_atlas
 
         floor = math.radians(TOGGLE_FLOOR_DEG)
-        if swing is not None or self.cons.min_transmission >= floor or self._distance(r, None) <= self.tolerance:
-            return r, source, swing
         floored = dataclasses.replace(self.cons, min_transmission=floor)
-        if keeps_transmission(r, floored):
+        if swing is not None or self.cons.min_transmission >= floor or keeps_transmission(r, floored):
+            return r, source, swing
+        e_before = self._distance(r, None)
+        if e_before <= self.tolerance:
             return r, source, swing
         t0 = time.perf_counter()
         again = search_atlas(self.t, self.loaded_atlas(), floored, ordered=self.ordered)
         stages = {**r.stages, "floor_s": time.perf_counter() - t0}
-        e = self._distance(again, None)
-        if not (again.feasible and keeps_transmission(again, floored) and self._usable(again)):
+        if not (keeps_transmission(again, floored) and self._usable(again)):
             r.stages = stages
             return r, source + f"; searched again {TOGGLE_FLOOR_DEG:g} deg from a toggle, none found usable", swing
         again.stages = stages
-        e_before = self._distance(r, None)
         why = (
-            f"the atlas lookup and refinement kept {TOGGLE_FLOOR_DEG:g} deg from a toggle (largest distance {e:.3g} of "
-            f"the size); without that floor the nearest found, {e_before:.3g} of the size off, nearly folds"
+            f"the atlas lookup and refinement kept {TOGGLE_FLOOR_DEG:g} deg from a toggle (largest distance "
+            f"{self._distance(again, None):.3g} of the size); without that floor the nearest found, {e_before:.3g} of "
+            "the size off, nearly folds"
         )
         return again, why, swing
 
