@@ -22,7 +22,7 @@ same way (a natural cubic spline through them in their order, by chord
 length), also reversed and mirrored, finds the nearest entries with
 :class:`scipy.spatial.cKDTree`, places each on the targets by the similarity
 the two descriptions differ by, and the best are refined by least squares with
-the input angle at each target free (:func:`planar.synth.search.reassigned_refine`).
+the input angle at each target free (:func:`planar.synth.search.refined_start`).
 
 The interface to the path search is :func:`arc_candidates` (targets in, rows of
 the kernel's 9 parameters and the circuit out, as
@@ -48,6 +48,7 @@ from planar.synth.algebraic import MIN_TARGETS, search_algebraic
 from planar.synth.atlas import DescriptorIndex, unreadable
 from planar.synth.designs import TOGGLE_FLOOR_DEG
 from planar.synth.kernel import coupler_points, row_points
+from planar.synth.positions import polish_positions
 
 __all__ = [
     "ARC_POINTS",
@@ -364,11 +365,17 @@ def input_swing(row: Array, theta: Array) -> tuple[float, float] | None:
     return (lo, hi) if hi > lo else None
 
 
-#: lookup and refinement effort: neighbours per query, starts refined, evaluations per start
-SEARCH_K, SEARCH_REFINE, SEARCH_NFEV = 64, 16, 200
-#: the final polish (:func:`polish_positions`): iterations per start, and how many of the best refined starts (each
-#: on one swing) it is tried on, best first, until one is within the search's stop
+#: lookup and refinement effort: neighbours per query, and starts refined
+#: (:func:`planar.synth.search.refined_start`)
+SEARCH_K, SEARCH_REFINE = 64, 32
+#: the final polish (:func:`planar.synth.positions.polish_positions`): iterations per start, and how many of the best
+#: refined starts (each on one swing) it is tried on, best first, until one is within the search's stop or
+#: :data:`BASIN`
 POLISH_ITERS, POLISH_STARTS = 600, 8
+#: a start this near (largest distance over the targets' size) ends the trying of further starts: only it is
+#: polished on.  On a short arc the last digits come slowly (the nearest four-bars lie in a narrow valley), so a
+#: search whose stop is far below this would try every start before polishing the one already found
+BASIN = 1e-7
 
 
 def on_swing(theta: Array, swing: tuple[float, float]) -> Array:
@@ -428,7 +435,7 @@ def search_arcs(
         SearchResult,
         default_bounds,
         max_distance,
-        reassigned_refine,
+        refined_start,
     )
 
     cons = dataclasses.replace(cons if cons is not None else Constraints(), full_turn=False)
@@ -462,190 +469,27 @@ def search_arcs(
         if any(np.allclose(row, s, rtol=1e-6, atol=1e-9) for s in tried):
             continue
         tried.append(row)
-        r, tt, _ = reassigned_refine(obj, row, b, SEARCH_NFEV, stop)
+        r, tt = refined_start(obj, row, b, stop, cons.max_ratio)
         swing = usable(r, tt)
         if swing is not None:
             found.append((max_distance(obj, r, tt), r, tt, swing))
-            if found[-1][0] <= stop:
+            if found[-1][0] <= max(stop, BASIN):
                 break
     stages["refine_s"] = time.perf_counter() - t1
     if not found:
         return None, None
     found.sort(key=lambda c: c[0])
     best = found[0]
-    # the best few go on in the joints' positions (a better-conditioned parametrisation) with geodesic acceleration
-    for _, r0, tt0, _ in found[:POLISH_STARTS] if best[0] > stop else []:
+    # the best few go on for longer (only the best when it is within BASIN)
+    for _, r0, tt0, _ in found[: 1 if best[0] <= BASIN else POLISH_STARTS] if best[0] > stop else []:
         r, tt = polish_positions(t, r0, tt0, POLISH_ITERS, cons.max_ratio)
         swing = usable(r, tt)
         e = max_distance(obj, r, tt) if swing is not None else math.inf
         if swing is not None and e < best[0]:
             best = (e, r, tt, swing)
-        if best[0] <= stop:
+        if best[0] <= max(stop, BASIN):
             break
     stages["polish_s"] = time.perf_counter() - t1 - stages["refine_s"]
     e, r, tt, swing = best
     sse = float(np.sum(np.square(row_points(r, tt) - t)))
     return SearchResult(r[:9], 1 if r[9] >= 0 else -1, tt, sse, True, len(tried), stages), swing
-
-
-def joint_positions(row: Array, theta: Array) -> tuple[Array, Array]:
-    """A kernel row (9 parameters and the circuit) and its input angles at the targets ``theta`` ``(N,)`` as the
-    joints' positions at the first target's pose, ``O2, B, C, O4, P`` (x, y each: 10 numbers), and the input's
-    turn from there to each later target ``(N - 1,)`` (rad): the variables of :func:`polish_positions`."""
-    r1, r2, r3, r4, u, v, x0, y0, phi = (float(x) for x in row[:9])
-    s = 1.0 if row[9] >= 0 else -1.0
-    o2 = complex(x0, y0)
-    o4 = o2 + r1 * np.exp(1j * phi)
-    b = o2 + r2 * np.exp(1j * (phi + float(theta[0])))
-    d = o4 - b
-    L2 = abs(d) ** 2
-    A = 0.5 * (L2 + r3 * r3 - r4 * r4)
-    e = (A + 1j * s * math.sqrt(max(r3 * r3 * L2 - A * A, 0.0))) * d / L2  # C - B
-    c = b + e
-    p = b + (u + 1j * v) * e / r3
-    q = np.array([o2.real, o2.imag, b.real, b.imag, c.real, c.imag, o4.real, o4.imag, p.real, p.imag])
-    return q, np.asarray(theta[1:], float) - float(theta[0])
-
-
-def positions_points(q: Any, turn: Any, circuit: float) -> tuple[Any, Any]:
-    """Coupler points ``(x, y)`` at the first pose of :func:`joint_positions` and after each ``turn``: written with
-    arithmetic, ``cos``, ``sin`` and ``sqrt`` only, so it runs on complex numbers for the complex-step derivative."""
-    o2x, o2y, bx0, by0, cx0, cy0, o4x, o4y, px0, py0 = q
-    turn = np.asarray(turn)
-    al = np.concatenate([np.zeros(turn.shape[:-1] + (1,), dtype=np.result_type(turn, float)), turn], axis=-1)
-    ca, sa = np.cos(al), np.sin(al)
-    rx, ry = bx0 - o2x, by0 - o2y
-    bx, by = o2x + ca * rx - sa * ry, o2y + sa * rx + ca * ry
-    ex0, ey0 = cx0 - bx0, cy0 - by0
-    b2 = ex0 * ex0 + ey0 * ey0  # coupler length squared, rocker's below: the loop-closure lengths
-    c2 = (cx0 - o4x) ** 2 + (cy0 - o4y) ** 2
-    fx, fy = px0 - bx0, py0 - by0
-    a1, a2 = (fx * ex0 + fy * ey0) / b2, (ex0 * fy - ey0 * fx) / b2
-    dx, dy = o4x - bx, o4y - by
-    L2 = dx * dx + dy * dy
-    A = 0.5 * (L2 + b2 - c2)
-    w = circuit * np.sqrt(b2 * L2 - A * A)
-    ex, ey = (A * dx - w * dy) / L2, (A * dy + w * dx) / L2
-    return bx + a1 * ex - a2 * ey, by + a1 * ey + a2 * ex
-
-
-def row_from_positions(q: Array, turn: Array, circuit: float) -> tuple[Array, Array]:
-    """The kernel row (9 parameters and ``circuit``) and the input angles at the targets of :func:`joint_positions`'s
-    variables."""
-    o2, b, c, o4, p = (complex(q[i], q[i + 1]) for i in range(0, 10, 2))
-    g, e = o4 - o2, c - b
-    phi = math.atan2(g.imag, g.real)
-    w = (p - b) / e * abs(e)  # the coupler point in the coupler's frame (x along B -> C)
-    row = np.array([abs(g), abs(b - o2), abs(e), abs(c - o4), w.real, w.imag, o2.real, o2.imag, phi, circuit])
-    th0 = math.atan2((b - o2).imag, (b - o2).real) - phi
-    return row, th0 + np.concatenate([[0.0], np.asarray(turn, float)])
-
-
-def _ratio_excess(q: Any, max_ratio: float) -> Any:
-    """How far the longest of the four links (from the joints' positions ``q``) is over ``max_ratio`` (less a
-    margin) times the shortest, 0 when it is not: piecewise analytic, so it runs on complex numbers too."""
-    from planar.synth.search import GRASHOF_MARGIN
-
-    o2x, o2y, bx, by, cx, cy, o4x, o4y = q[:8]
-    sides = ((o4x - o2x, o4y - o2y), (bx - o2x, by - o2y), (cx - bx, cy - by), (cx - o4x, cy - o4y))
-    L = [np.sqrt(dx * dx + dy * dy) for dx, dy in sides]
-    re = [float(np.real(v)) for v in L]
-    x = L[int(np.argmax(re))] - max_ratio * (1.0 - 2 * GRASHOF_MARGIN) * L[int(np.argmin(re))]
-    return x if float(np.real(x)) > 0 else 0.0 * x
-
-
-def _positions_problem(t: Array, circuit: float, max_ratio: float) -> tuple[Any, Any]:
-    """Residuals ``(2 N + 1,)`` (coupler point minus target, x then y; then the link ratio's excess, weighted as
-    the search weighs a broken constraint) of :func:`polish_positions`'s variables and their Jacobian by complex
-    step (exact to rounding: 11 evaluations, the later targets' turns perturbed at once as each moves its own
-    target only)."""
-    n = len(t)
-    w = 10.0 * math.sqrt(n) if math.isfinite(max_ratio) else 0.0
-
-    def resid(z: Array) -> Array:
-        with np.errstate(invalid="ignore", divide="ignore"):
-            x, y = positions_points(z[:10], z[10:], circuit)
-            r = np.concatenate([x - t[:, 0], y - t[:, 1], [w * _ratio_excess(z, max_ratio) if w else 0.0]])
-        return r if np.isfinite(r).all() else np.full(2 * n + 1, 10.0)  # the loop does not close: far
-
-    def jac(z: Array) -> Array:
-        h = 1e-30
-        Z = np.repeat(z[None, :].astype(complex), 11, axis=0)
-        Z[np.arange(10), np.arange(10)] += 1j * h
-        Z[10, 10:] += 1j * h
-        J = np.zeros((2 * n + 1, len(z)))
-        i = np.arange(1, n)
-        with np.errstate(invalid="ignore", divide="ignore"):  # the 11 perturbed evaluations as one batch
-            x, y = positions_points(tuple(Z[:, j : j + 1] for j in range(10)), Z[:, 10:], circuit)
-        cols = np.concatenate([x.imag, y.imag], axis=1) / h  # (11, 2 n)
-        J[: 2 * n, :10] = cols[:10].T
-        J[i, 9 + i], J[n + i, 9 + i] = cols[10, 1:n], cols[10, n + 1 :]
-        if w and float(np.real(_ratio_excess(z, max_ratio))) > 0:  # else its derivative is 0
-            J[2 * n, :10] = [w * np.imag(_ratio_excess(Z[k], max_ratio)) / h for k in range(10)]
-        return np.nan_to_num(J, nan=0.0, posinf=0.0, neginf=0.0)
-
-    return resid, jac
-
-
-#: geodesic acceleration: the finite-difference step along the velocity, and the largest ratio of the
-#: acceleration's to the velocity's size accepted (Transtrum and Sethna's recommended 0.1 and 0.75)
-GEODESIC_H, GEODESIC_ALPHA = 0.1, 0.75
-
-
-def geodesic_lm(resid: Any, jac: Any, z: Array, iters: int) -> tuple[Array, Array]:
-    """Levenberg-Marquardt with geodesic acceleration (Transtrum and Sethna, 2011): each damped Gauss-Newton step
-    (Marquardt's scaling, the largest diagonal of ``J^T J`` seen) gets a second-order correction along the curved
-    valley, from one more residual evaluation; the step is taken only when that correction is small beside it.
-    Returns the variables and residuals it ends at after at most ``iters`` accepted or refused steps."""
-    r = resid(z)
-    f = float(r @ r)
-    J = jac(z)
-    lam = 1e-3
-    D = np.zeros(len(z))
-    for _ in range(iters):
-        if f <= 1e-30 or lam > 1e20:
-            break
-        A, g = J.T @ J, J.T @ r
-        D = np.maximum(D, np.diag(A))
-        M = A + lam * np.diag(np.maximum(D, 1e-300))
-        try:
-            v = -np.linalg.solve(M, g)
-            rh = resid(z + GEODESIC_H * v)
-            acc = -0.5 * np.linalg.solve(M, J.T @ ((2.0 / GEODESIC_H) * ((rh - r) / GEODESIC_H - J @ v)))
-        except np.linalg.LinAlgError:
-            lam *= 10.0
-            continue
-        if 2.0 * math.sqrt(acc @ (D * acc)) > GEODESIC_ALPHA * math.sqrt(v @ (D * v)):
-            lam *= 2.0
-            continue
-        rn = resid(z + v + acc)
-        fn = float(rn @ rn)
-        if fn < f:
-            z, r, f = z + v + acc, rn, fn
-            lam = max(lam / 3.0, 1e-12)
-            J = jac(z)
-        else:
-            lam *= 2.0
-    return z, r
-
-
-def polish_positions(
-    t: Array, row: Array, theta: Array, iters: int = POLISH_ITERS, max_ratio: float = 10.0
-) -> tuple[Array, Array]:
-    """A refined kernel row and its input angles at the targets ``t`` (normalised), polished in the joints'
-    positions (:func:`joint_positions`: the pivots and moving joints at the first target's pose, the input's turn
-    to each later target; the coupler's and rocker's lengths are the loop-closure equations inside
-    :func:`positions_points`) by :func:`geodesic_lm` with an exact Jacobian.
-
-    A rocking four-bar's arc is short and smooth: in the kernel's lengths and angles the four-bars within 1e-5 of
-    it lie along a long, curved, narrow valley (condition numbers 1e6 to 1e9), where Levenberg-Marquardt with a
-    difference Jacobian crawls.  Returns the row and angles (the input as given when nothing better is found)."""
-    circuit = 1.0 if row[9] >= 0 else -1.0
-    q, turn = joint_positions(row, theta)
-    resid, jac = _positions_problem(np.asarray(t, float), circuit, max_ratio)
-    z0 = np.concatenate([q, turn])
-    r0 = resid(z0)
-    z, r = geodesic_lm(resid, jac, z0, iters)
-    if not float(r @ r) < float(r0 @ r0):
-        return row, theta
-    return row_from_positions(z[:10], z[10:], circuit)

@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from planar.linkages.chunked import threads_default
 
-__all__ = ["N_PARAMS", "PARAM_NAMES", "coupler_points", "row_points"]
+__all__ = ["GRASHOF_MARGIN", "N_PARAMS", "PARAM_NAMES", "coupler_points", "row_points"]
 
 Array = NDArray[np.float64]
 Mask = NDArray[np.bool_]
@@ -33,6 +33,9 @@ Mask = NDArray[np.bool_]
 #: the columns of a candidate row
 PARAM_NAMES = ("ground", "crank", "coupler", "rocker", "u", "v", "x0", "y0", "phi")
 N_PARAMS = len(PARAM_NAMES)
+
+#: relative margin kept from a change-point (s + l = p + q) and from equal shortest links
+GRASHOF_MARGIN = 1e-3
 
 #: candidates per block (512 x 64 doubles: 256 kB per array, within the cache)
 BLOCK = 512

@@ -33,9 +33,9 @@ from numpy.typing import NDArray
 
 from planar.errors import InputError
 from planar.synth.designs import Checked
-from planar.synth.kernel import coupler_points
+from planar.synth.kernel import GRASHOF_MARGIN, coupler_points
 from planar.synth.path import DEFAULT_TOLERANCE, normalised
-from planar.synth.search import GRASHOF_MARGIN, Constraints, in_order, violation
+from planar.synth.search import Constraints, in_order, violation
 from planar.synth.targets import normalisation
 
 __all__ = ["TOPOLOGIES", "SixBarDesign", "sixbar_points", "synthesise_sixbar"]

@@ -98,7 +98,7 @@ def test_rocking_refuses_timed_targets(tmp_path, capsys):
 def test_geodesic_lm_follows_rosenbrocks_curved_valley():
     # Rosenbrock's function as least squares (r = 10 (y - x^2), 1 - x): a long curved valley to its one minimum
     # (1, 1), known in closed form; from the classical start (-1.2, 1) the damped steps must reach it
-    from planar.synth.arcs import geodesic_lm
+    from planar.synth.positions import geodesic_lm
 
     def resid(z):
         return np.array([10.0 * (z[1] - z[0] ** 2), 1.0 - z[0]])
@@ -115,8 +115,8 @@ def test_joint_positions_trace_the_same_points_and_map_back():
     # Jacobian against scipy's finite differences, and the map back to a kernel row
     from scipy.optimize import approx_fprime
 
-    from planar.synth.arcs import _positions_problem, joint_positions, positions_points, row_from_positions
     from planar.synth.path import FourBarDesign
+    from planar.synth.positions import _positions_problem, joint_positions, positions_points, row_from_positions
 
     rng = np.random.default_rng(5)
     for _ in range(4):
@@ -142,7 +142,8 @@ def test_polish_reaches_a_double_rocker_its_search_left_in_the_valley():
     # a random double-rocker (not tuned on) with its joints moved by 1e-3 of the targets' size: the polish in the
     # joints' positions comes back to the targets to 1e-9 on one swing (Levenberg-Marquardt on the kernel's lengths
     # with a difference Jacobian stopped near 1e-7 from 1e-4 in our runs)
-    from planar.synth.arcs import input_swing, polish_positions
+    from planar.synth.arcs import input_swing
+    from planar.synth.positions import polish_positions
     from planar.synth.targets import normalisation
 
     rng = np.random.default_rng(20261201)
@@ -214,3 +215,40 @@ def test_plain_path_tries_the_rocking_arcs_once_built(tmp_path, capsys):
 def test_rocking_atlas_size_checked(tmp_path, capsys):
     assert main(["synth", "atlas", "--rocking", "--size", "50", "-o", str(tmp_path / "a.npz")]) == 2
     assert "--size" in capsys.readouterr().err and not (tmp_path / "a.npz").exists()
+
+
+def test_refined_start_takes_short_arcs_past_where_the_lengths_stall():
+    # from the true four-bars of random double-rockers' 12-target arcs, their shape numbers changed by 3 %, the
+    # start's steps in the joints' positions reach within 1e-6 of the size where as many evaluations in the
+    # kernel's lengths and angles alone stall (the same ten starts)
+    from planar.bench.synthesis_rocking import rocking_problem
+    from planar.synth.path import normalisation
+    from planar.synth.search import (
+        START_NFEV,
+        Constraints,
+        PathObjective,
+        default_bounds,
+        max_distance,
+        reassigned_refine,
+        refined_start,
+    )
+
+    rng = np.random.default_rng(31)
+    cons = Constraints(full_turn=False, max_ratio=10.0)
+    steps = lengths_only = 0
+    for _ in range(10):
+        p = rocking_problem(rng, "double", 12)
+        c, s = normalisation(p["targets"])
+        t = (p["targets"] - c) / s
+        row = np.append(p["fourbar"], p["circuit"]).astype(float)
+        row[:6] /= s
+        row[6:8] = (row[6:8] - c) / s
+        start = row.copy()
+        start[1:6] *= np.exp(rng.normal(0.0, 0.03, 5))
+        obj = PathObjective(t, None, cons, 256)
+        b = default_bounds(t, cons, False, turn=3 * np.pi)
+        r, tt = refined_start(obj, start, b, 1e-9, 10.0)
+        steps += max_distance(obj, r, tt) <= 1e-6
+        r2, tt2, _ = reassigned_refine(obj, start, b, START_NFEV, 1e-9)
+        lengths_only += max_distance(obj, r2, tt2) <= 1e-6
+    assert steps >= 6 and steps >= lengths_only + 2, (steps, lengths_only)
