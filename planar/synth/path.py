@@ -261,10 +261,17 @@ def synthesise_path(
     d.checks["found_by"] = source
     d.checks["input"] = "turns fully"
     d.checks["evaluations"] = r.evaluations
-    # what targets met leave open (targets not met are said to be so), and a linkage that comes near a toggle
-    met = theta is None and d.checks["ok_accuracy"]
-    d.checks["cautions"] = (untimed_cautions(len(t), d.theta) if met else []) + transmission_cautions(d, cons)
+    d.checks["cautions"] = design_cautions(d, cons, theta is None, d.theta)
     return d
+
+
+def design_cautions(d: Any, cons: Constraints, untimed: bool, theta: Array | None) -> list[str]:
+    """``checks["cautions"]`` of a checked design ``d``: what ``untimed`` targets it meets leave open
+    (:func:`untimed_cautions`; the crank angles ``theta`` at them, rad, when its crank turns fully, None when its
+    input rocks: the swing is the arc, no span to judge; targets not met are said to be so by the accuracy check),
+    and a linkage that comes near a toggle (:func:`transmission_cautions`)."""
+    met = untimed and bool(d.checks.get("ok_accuracy"))
+    return (untimed_cautions(len(d.targets), theta) if met else []) + transmission_cautions(d, cons)
 
 
 #: a design whose transmission angle comes nearer a toggle than this (degrees), with no ``min_transmission`` asked,
@@ -472,9 +479,7 @@ def _rocking_checked(
             "for one that cannot)"
         )
     d.checks["evaluations"] = r.evaluations
-    # the swing is the arc: no span to judge; targets not met are said to be so
-    met = untimed_cautions(len(d.targets), None) if d.checks.get("ok_accuracy") else []
-    d.checks["cautions"] = met + transmission_cautions(d, cons)
+    d.checks["cautions"] = design_cautions(d, cons, True, None)
     return d
 
 
