@@ -99,7 +99,8 @@ def _path_failing(d: Any, kind: str = "four-bar", box: str = "", budget: str = "
                 out.append(_unreachable(d, kind, box, budget))
             elif d.checks["rms_error"] <= NOISE_RMS:  # a near miss: the likeliest reason in the same line
                 out[-1] += (
-                    f"; if the targets are measured, measured points carry noise a {kind} cannot follow: misses like these "
+                    f"; points measured with noise, or a shape drawn by hand, depart from every {kind}'s curve a little: "
+                    "misses like these "
                     f"(RMS {d.checks['rms_error']:.2g} of the size) may be the noise, and a --tolerance a few times it "
                     "accepts the fit"
                 )
@@ -181,8 +182,9 @@ def _unreachable(d: Any, kind: str = "four-bar", box: str = "", budget: str = "n
         thorough = "" if budget == "thorough" else "--budget thorough, "
         rms = d.checks.get("rms_error", math.inf)
         noise = (
-            f"measured points carry noise a {kind} cannot follow (if that is why, the RMS distance, {rms:.2g} of the size, "
-            "is about the noise: a --tolerance a few times it accepts the fit); or "
+            f"points measured with noise, or a shape drawn by hand, depart from every {kind}'s curve a little (if that is "
+            f"why, the RMS distance, {rms:.2g} of the size, is about that departure: a --tolerance a few times it accepts "
+            "the fit); or "
             if rms <= NOISE_RMS
             else ""
         )
@@ -233,6 +235,14 @@ def _unusable(d: Any, kind: str, region: bool) -> str | None:
     return None
 
 
+def _closed_svg(target: str) -> bool:
+    """Whether the targets are a closed SVG shape (:func:`planar.synth.targets.svg_closed`): a rocking input traces
+    it only as an arc, back and forth, so only inputs that turn fully are searched."""
+    from planar.synth.targets import svg_closed
+
+    return str(target).lower().endswith(".svg") and svg_closed(target)
+
+
 def _cmd_path(args: argparse.Namespace) -> int:
     import numpy as np
 
@@ -276,6 +286,8 @@ def _cmd_path(args: argparse.Namespace) -> int:
         from planar.synth.atlas import read_atlas
 
         atlas = read_atlas(args.atlas)
+    if args.full_turn and args.rocking:
+        raise InputError("--full-turn", True, "no --full-turn with --rocking (it asks for an input that rocks)")
     if args.rocking:
         d = _rocking_design(args, targets, theta, cons)
     else:
@@ -289,6 +301,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
             atlas=atlas,
             ordered=args.ordered,
             min_transmission=min_transmission,
+            full_turn=bool(args.full_turn or _closed_svg(args.target)),
         )
 
     def scene() -> tuple[str, str]:
@@ -865,6 +878,12 @@ def add_parser(sub: Any) -> None:
         "swing). Without "
         "it, untimed synth path tries that atlas too when the coupler-curve atlas is not within --tolerance, once "
         "planar synth atlas --rocking has built it",
+    )
+    p.add_argument(
+        "--full-turn",
+        action="store_true",
+        help="only a four-bar whose input turns fully: untimed, the rocking arcs are not tried (a closed SVG shape, "
+        "which a rocking input traces only as an arc, asks for this itself)",
     )
     p.add_argument(
         "--input-rocks",

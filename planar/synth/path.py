@@ -190,6 +190,7 @@ def synthesise_path(
     ordered: bool = False,
     min_transmission: float = 0.0,
     arcs: Any = None,
+    full_turn: bool = False,
 ) -> FourBarDesign:
     """A four-bar whose coupler point passes through (or nearest to) ``targets`` ``(N, 2)``.
 
@@ -200,8 +201,9 @@ def synthesise_path(
     built on first use) and refined; when that is not within ``tolerance``
     the rocking arcs are tried (:mod:`planar.synth.arcs`: four-bars whose input
     swings between two angles; ``arcs``, or the cached arc atlas of the budget
-    when it is on disk; not with a pivots box or ``min_transmission``), then
-    the global search.  A rocking result's checks are those of
+    when it is on disk; not with a pivots box, ``min_transmission`` or
+    ``full_turn``: only an input that turns fully, as for a closed drawn
+    shape, which a rocking input traces only as an arc), then the global search.  A rocking result's checks are those of
     :func:`synthesise_rocking_path` and ``checks["input"]`` says ``"rocks"``
     (``"turns fully"`` otherwise).
     ``budget``: ``"quick"`` (for tests), ``"normal"`` or ``"thorough"``.
@@ -226,7 +228,9 @@ def synthesise_path(
     """
     from threadpoolctl import threadpool_limits
 
-    t, theta, cons = check_path_args(targets, theta, cons, budget, seed, tolerance, ordered, min_transmission)
+    t, theta, cons = check_path_args(
+        targets, theta, cons, budget, seed, tolerance, ordered, min_transmission, {"full_turn": full_turn}
+    )
     if atlas is not None:
         from planar.synth.atlas import Atlas
 
@@ -237,7 +241,9 @@ def synthesise_path(
     # searched on the targets moved to their centroid and divided by their size, then mapped back
     c, s = normalisation(t)
     with threadpool_limits(1):
-        search = PathSearch((t - c) / s, normalised(cons, c, s), budget, seed, tolerance, atlas, ordered, arcs)
+        search = PathSearch(
+            (t - c) / s, normalised(cons, c, s), budget, seed, tolerance, atlas, ordered, arcs, full_turn=bool(full_turn)
+        )
         r, source, swing = search.run(theta)
     d, p = design_from(r, c, s, t, theta is not None, time.perf_counter() - t0)
     if swing is not None:  # the input rocks: checked over its swing
@@ -334,15 +340,17 @@ def check_path_args(
     tolerance: Any,
     ordered: Any,
     min_transmission: Any = 0.0,
+    flags: dict[str, Any] | None = None,
 ) -> tuple[Array, Array | None, Constraints]:
     """The Python entrance of a path synthesis (:func:`synthesise_path`, :func:`synthesise_rocking_path`): the
-    targets, crank angles, seed, tolerance and ``ordered`` (:func:`planar.synth.targets.check_search_args`),
+    targets, crank angles, seed, tolerance, ``ordered`` and the other ``flags`` by name (each True or False:
+    :func:`planar.synth.targets.check_search_args`),
     ``cons`` a :class:`~planar.synth.search.Constraints` or None, ``min_transmission`` from 0 to below pi/2 rad,
     targets not all one point, ``budget`` one of :data:`BUDGETS`; :class:`InputError` naming the argument.
     Returns the targets and angles as arrays and the constraints (``min_transmission`` in them when larger)."""
     import dataclasses
 
-    t, theta = check_search_args(targets, theta, seed, tolerance, {"ordered": ordered})
+    t, theta = check_search_args(targets, theta, seed, tolerance, {"ordered": ordered, **(flags or {})})
     if theta is not None:
         check_theta(theta, None, False)
     if cons is not None and not isinstance(cons, Constraints):
@@ -428,14 +436,16 @@ def synthesise_rocking_path(
     if not (check_number("max_ratio", max_ratio) > 1 and math.isfinite(max_ratio)):
         raise InputError("max_ratio", max_ratio, "a finite ratio greater than 1")
     cons = Constraints(full_turn=False, max_ratio=float(max_ratio))
-    t, _, cons = check_path_args(targets, None, cons, budget, 0, tolerance, ordered, min_transmission)
+    t, _, cons = check_path_args(
+        targets, None, cons, budget, 0, tolerance, ordered, min_transmission, {"input_rocks": input_rocks}
+    )
     arcs = _check_arcs(arcs)
     t0 = time.perf_counter()
     if arcs is None:
         arcs = load_arcs(QUICK_FOURBARS if budget == "quick" else DEFAULT_FOURBARS, progress=True)
     c, s = normalisation(t)
     with threadpool_limits(1):
-        r, swing = search_arcs((t - c) / s, arcs, cons, ordered=ordered, input_rocks=bool(input_rocks))
+        r, swing = search_arcs((t - c) / s, arcs, cons, ordered=ordered, input_rocks=input_rocks)
     if r is None or swing is None:
         d = FourBarDesign(1.0, 1.0, 1.0, 1.0, (0.0, 0.0), "open", (0.0, 0.0, 0.0), np.zeros(len(t)), math.inf, t, False, 0.0)
         which = "whose input link cannot turn fully " if input_rocks else ""

@@ -71,7 +71,8 @@ class PathSearch:
     ``budget``: a key of :data:`BUDGETS`; ``tolerance``: the largest distance (the targets' size 1) that ends the
     search; ``atlas``: the closed-curve atlas (None: the cached one of the budget, loaded on first need);
     ``ordered``: the branch must pass the targets in their order; ``arcs``: the rocking-arc atlas (None: the cached
-    one of the budget when it is on disk).  :meth:`run` returns the result (a
+    one of the budget when it is on disk); ``full_turn``: only an input that turns fully (the rocking arcs are not
+    tried).  :meth:`run` returns the result (a
     :class:`planar.synth.search.SearchResult` whose ``stages`` hold every stage's seconds: ``atlas_load_s``,
     ``algebraic_s``, ``atlas_s``, ``refine_s``, ``timed_s`` or ``closed_form_s``, ``rocking_s``, and
     ``global_sample_s``, ``global_de_s``, ``global_refine_s`` when the global search ran), the sentence saying which
@@ -86,6 +87,7 @@ class PathSearch:
     ordered: bool = False
     arcs: Any = None
     stages: dict[str, float] = field(default_factory=dict)
+    full_turn: bool = False
 
     def __post_init__(self) -> None:
         self._given = self.atlas
@@ -274,8 +276,8 @@ class PathSearch:
         return r, f"{head}budget {self.budget}, ran too and {other}{tried})", None
 
     def rocking(self, stages: dict[str, float]) -> tuple[Any, tuple[float, float] | None, float, str]:
-        """The rocking arcs (:func:`planar.synth.arcs.search_arcs`), when they may be tried: no pivots box, no
-        transmission limit (the rocking search keeps neither), and the arcs given or the cached arc atlas of the
+        """The rocking arcs (:func:`planar.synth.arcs.search_arcs`), when they may be tried: not ``full_turn``, no
+        pivots box, no transmission limit (the rocking search keeps neither), and the arcs given or the cached arc atlas of the
         budget on disk (it is not built here: ``planar synth atlas --rocking`` builds it).
 
         Returns the result (None when not tried or nothing keeps the targets on one swing, in order when
@@ -284,6 +286,8 @@ class PathSearch:
         from planar.synth import arcs as arcs_mod
 
         cons, budget, arcs = self.cons, self.budget, self.arcs
+        if self.full_turn:
+            return None, None, math.inf, "the rocking arcs not tried (the input must turn fully)"
         if cons.region is not None or cons.min_transmission > 0:
             return None, None, math.inf, ""
         if arcs is None:

@@ -27,6 +27,7 @@ __all__ = [
     "read_svg_points",
     "read_table",
     "read_targets",
+    "svg_closed",
     "target_unit_mm",
 ]
 
@@ -141,11 +142,27 @@ def read_svg_points(path: str | Path, n: int, option: str = "--points") -> Array
     a point ``(x, y)`` of the drawing (after every transform, the
     ``viewBox``'s included) is the target ``(x, -y)``.
     """
+    if n < 3:
+        raise InputError(option, n, "3 or more points to sample from the SVG path")
+    path_, closed, factor = _first_shape(path)
+    pts = _even_by_length(path_, n, closed) * factor
+    pts[:, 1] = -pts[:, 1]
+    return pts
+
+
+def svg_closed(path: str | Path) -> bool:
+    """Whether the first shape of an SVG file (the one :func:`read_svg_points` samples) is closed: a path ending
+    in ``Z``, or a closed shape (circle, ellipse, rectangle, polygon).  A rocking input traces such a shape only as
+    an arc, back and forth: ``planar synth path`` then searches only inputs that turn fully."""
+    return _first_shape(path)[1]
+
+
+def _first_shape(path: str | Path) -> tuple[Any, bool, float]:
+    """The first shape of non-zero length of an SVG file as an svgelements path, whether it is closed, and the
+    page's factor to millimetres (:func:`_metric_page_factor`); :class:`InputError` naming the file otherwise."""
     import svgelements as se
 
     p = str(path)
-    if n < 3:
-        raise InputError(option, n, "3 or more points to sample from the SVG path")
     try:
         svg = se.SVG.parse(p, ppi=25.4)  # 25.4 per inch: a length in mm (or in, cm) is read as mm, px as 1
     except FileNotFoundError:
@@ -168,11 +185,7 @@ def read_svg_points(path: str | Path, n: int, option: str = "--points") -> Array
                     )
             if len(path_) == 0 or path_.length() <= 0:
                 continue
-            d = path_.d()
-            closed = d.rstrip().upper().endswith("Z")
-            pts = _even_by_length(path_, n, closed) * _metric_page_factor(svg)
-            pts[:, 1] = -pts[:, 1]
-            return pts
+            return path_, path_.d().rstrip().upper().endswith("Z"), _metric_page_factor(svg)
     raise InputError(p, "no path", "an SVG with a path or shape of non-zero length")
 
 

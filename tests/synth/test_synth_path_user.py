@@ -148,7 +148,7 @@ def test_far_off_says_plainly_no_four_bar_and_why_near_miss_does_not():
     from planar.cli.synth import _path_failing
 
     near = _path_failing(_fake(0.0011))
-    assert len(near) == 1 and "no four-bar" not in near[0] and "measured points carry noise" in near[0]
+    assert len(near) == 1 and "no four-bar" not in near[0] and "points measured with noise, or a shape drawn by hand" in near[0]
     far = _path_failing(_fake(0.2))
     assert len(far) == 2 and far[1].startswith("no four-bar found traces this curve within --tolerance 0.001")
     assert "0.2 of the targets' size off at target 3" in far[1] and "90 deg at target" in far[1] and "corner" in far[1]
