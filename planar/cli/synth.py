@@ -303,6 +303,12 @@ def _cmd_path(args: argparse.Namespace) -> int:
             min_transmission=min_transmission,
             full_turn=bool(args.full_turn or _closed_svg(args.target)),
         )
+    if str(args.target).lower().endswith(".svg") and "error" not in d.checks:
+        from planar.synth.drawing import drawing_cautions, drawing_gaps
+
+        gaps = drawing_gaps(d, args.target)
+        d.checks.update(gaps)
+        d.checks["cautions"] = [*d.checks.get("cautions", []), *drawing_cautions(gaps, args.tolerance)]
 
     def scene() -> tuple[str, str]:
         fb = d.fourbar()

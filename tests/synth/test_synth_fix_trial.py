@@ -197,6 +197,11 @@ def test_path_min_transmission_selects_a_design_that_keeps_it(tmp_path, capsys):
     main([*argv, "--min-transmission", "30"])
     rep = json.loads(capsys.readouterr().out)
     assert rep["checks"]["ok_transmission"] and rep["checks"]["min_transmission_deg"] >= 30.0, rep["checks"]
+    # the bean is closed: the drawing against the path both ways, said in a caution when beyond the tolerance
+    c = rep["checks"]
+    assert np.isfinite(c["drawing_max_distance"]) and np.isfinite(c["path_max_distance"])
+    said = any("between the targets the drawing lies up to" in x for x in c["cautions"])
+    assert said == (c["drawing_max_distance"] > c["tolerance"])
     # by the law of cosines over a dense turn, from the written lengths
     g, a, b, r = (rep[k] for k in ("ground", "crank", "coupler", "rocker"))
     th = np.linspace(0, 2 * np.pi, 100_001)

@@ -1,0 +1,66 @@
+"""The drawing against the coupler path (:mod:`planar.synth.drawing`): both ways, from an SVG written here, the
+distances checked by brute force on the same points."""
+
+from types import SimpleNamespace
+
+import numpy as np
+
+from planar.linkages import FourBar
+from planar.synth.drawing import drawing_cautions, drawing_gaps
+from planar.synth.targets import read_svg_points
+
+
+def _design(fb, size, swing=None):
+    checks = {"size": size}
+    if swing is not None:
+        checks["input_swing_rad"] = list(swing)
+    return SimpleNamespace(checks=checks, fourbar=lambda: fb)
+
+
+def _svg(path, pts, closed):
+    tag = "polygon" if closed else "polyline"
+    xy = " ".join(f"{x:.9f},{-y:.9f}" for x, y in pts)  # SVG's y down: read back as (x, -y)
+    path.write_text(f'<svg xmlns="http://www.w3.org/2000/svg"><{tag} points="{xy}" fill="none"/></svg>')
+
+
+def test_a_drawing_of_the_curve_itself_is_on_the_path_and_a_bump_is_measured(tmp_path):
+    fb = FourBar(4.0, 1.0, 3.5, 3.0, coupler_point=(2.0, 1.5))
+    th = np.linspace(0.0, 2 * np.pi, 720, endpoint=False)
+    curve = fb.solve(th).points["coupler_point"]
+    size = 2.0
+    f = tmp_path / "c.svg"
+    _svg(f, curve, True)
+    gaps = drawing_gaps(_design(fb, size), f)
+    assert gaps["drawing_max_distance"] < 1e-3 and gaps["path_max_distance"] < 1e-3
+    assert drawing_cautions(gaps, 1e-2) == []
+    # one vertex pushed out along the curve's normal by h: the drawing's farthest point is that vertex
+    h = 0.2
+    bumped = curve.copy()
+    k = 100
+    tangent = curve[k + 1] - curve[k - 1]
+    normal = np.array([-tangent[1], tangent[0]]) / np.hypot(*tangent)
+    bumped[k] += h * normal
+    _svg(f, bumped, True)
+    gaps = drawing_gaps(_design(fb, size), f)
+    # brute force: the drawing's own samples against the path at 40,000 angles
+    drawn = read_svg_points(f, 1000)
+    dense = fb.solve(np.linspace(0.0, 2 * np.pi, 40000, endpoint=False)).points["coupler_point"]
+    brute = max(float(np.min(np.hypot(*(dense - p).T))) for p in drawn)
+    assert abs(gaps["drawing_max_distance"] - brute / size) < 1e-4
+    assert 0.8 * h / size < gaps["drawing_max_distance"] <= h / size + 1e-4
+    (line,) = drawing_cautions(gaps, 1e-2)
+    assert "between the targets the drawing lies up to" in line
+
+
+def test_a_closed_drawing_traced_only_as_an_arc_and_an_open_one_is_not_asked_the_way_back(tmp_path):
+    fb = FourBar(4.0, 1.0, 3.5, 3.0, coupler_point=(2.0, 1.5))
+    curve = fb.solve(np.linspace(0.0, 2 * np.pi, 720, endpoint=False)).points["coupler_point"]
+    f = tmp_path / "c.svg"
+    _svg(f, curve, True)
+    # the same crank swung over half its turn: the other half of the closed drawing is far from that path
+    half = drawing_gaps(_design(fb, 2.0, (0.0, np.pi)), f)
+    assert half["drawing_max_distance"] > 0.1 and half["path_max_distance"] < 1e-3
+    # the half as an open drawing: on the path both ways, and no way back is asked of an open drawing
+    _svg(f, curve[:361], False)
+    open_half = drawing_gaps(_design(fb, 2.0, (0.0, np.pi)), f)
+    assert open_half["drawing_max_distance"] < 1e-3 and "path_max_distance" not in open_half
