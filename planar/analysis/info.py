@@ -414,6 +414,14 @@ def info(mech: Mechanism, samples: int = SAMPLES) -> Info:
     )
 
 
+def _like_the_range(toggles: list[float], valid_range: list[tuple[float, float]]) -> list[float]:
+    """The toggle angles (degrees in ``[0, 360)``) as the valid range's ends name them (a range from -102.6 to
+    102.6 deg has its toggles at -102.6 and 102.6 deg, not 257.4 and 102.6), in the range's order."""
+    ends = [e for iv in valid_range for e in iv]
+    out = [next((e for e in ends if abs((e - a + 180.0) % 360.0 - 180.0) < 1e-6), a) for a in toggles]
+    return sorted(out)
+
+
 def format_info(r: Info) -> str:
     """``r`` as the text ``planar info`` prints."""
     lines = [
@@ -428,7 +436,8 @@ def format_info(r: Info) -> str:
     elif r.turns_fully:
         lines.append(f"turns fully: {', '.join(r.turns_fully)}")
     if r.toggle_angles:
-        lines.append("toggle (limit) driver angles: " + ", ".join(f"{a:.4f} deg" for a in r.toggle_angles))
+        shown = _like_the_range(r.toggle_angles, r.valid_range)
+        lines.append("toggle (limit) driver angles: " + ", ".join(f"{a:.4f} deg" for a in shown))
     lines.append("valid range: " + (", ".join(f"{a:.4g} to {b:.4g} deg" for a, b in r.valid_range) or "none"))
     for o in r.outputs:
         what = {"turns": "turns fully", "rocks": f"rocks {o.swing:.6g} deg", "slides": f"slides, stroke {o.swing:.6g}"}

@@ -191,3 +191,17 @@ def test_double_rocker_under_a_full_turn_reports_the_rocker_swing(seed):
     text = str(rep)
     assert "turns fully: coupler (the coupler" in text and "relative to the crank, the rocker and the ground" in text
     assert "output rocker: rocks up to" in text
+
+
+def test_the_text_names_toggles_as_the_valid_range_does():
+    # a trial read "toggle (limit) driver angles: 102.6356 deg, 257.3644 deg" beside "valid range: -102.6 to
+    # 102.6 deg": the same two angles in two conventions
+    from planar.analysis.info import format_info
+
+    r = info(FourBar(ground=4.0, crank=3.0, coupler=3.0, rocker=2.5))  # s + l = 6.5 > p + q = 6: non-Grashof
+    text = format_info(r)
+    ((lo, hi),) = r.valid_range
+    assert lo < 0 < hi
+    toggles = next(x for x in text.splitlines() if x.startswith("toggle (limit)"))
+    assert toggles == f"toggle (limit) driver angles: {lo:.4f} deg, {hi:.4f} deg"
+    assert sorted(a % 360 for a in (lo, hi)) == pytest.approx(r.toggle_angles, abs=1e-9)
