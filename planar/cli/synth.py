@@ -287,7 +287,11 @@ def _cmd_path(args: argparse.Namespace) -> int:
 
         atlas = read_atlas(args.atlas)
     if args.full_turn and args.rocking:
-        raise InputError("--full-turn", True, "no --full-turn with --rocking (it asks for an input that rocks)")
+        raise InputError(
+            "--full-turn",
+            "given with --rocking",
+            "one of them (--rocking asks for an input that rocks, --full-turn for one that turns fully)",
+        )
     if args.rocking:
         d = _rocking_design(args, targets, theta, cons)
     else:
@@ -308,7 +312,8 @@ def _cmd_path(args: argparse.Namespace) -> int:
 
         gaps = drawing_gaps(d, args.target)
         d.checks.update(gaps)
-        d.checks["cautions"] = [*d.checks.get("cautions", []), *drawing_cautions(gaps, args.tolerance)]
+        rocks = d.checks.get("input") == "rocks"
+        d.checks["cautions"] = [*d.checks.get("cautions", []), *drawing_cautions(gaps, args.tolerance, rocks)]
 
     def scene() -> tuple[str, str]:
         fb = d.fourbar()

@@ -30,9 +30,10 @@ def drawing_gaps(design: Any, svg: str | Path) -> dict[str, float]:
     :func:`planar.synth.targets.read_svg_points` samples it) and ``design``'s coupler path, over the targets'
     size (``design.checks["size"]``).
 
-    Returns ``drawing_max_distance`` (the farthest point of the drawing from the path) and, for a closed drawing,
-    ``path_max_distance`` (the farthest point of the path from the drawing: a loop or detour the drawing lacks);
-    both ``inf`` when the path does not assemble.  The path is the crank's whole turn, or the swing
+    Returns ``drawing_max_distance`` (the farthest point of the drawing from the path), ``path_max_distance`` (the
+    farthest point of the path from the drawing: a loop or detour a closed drawing lacks, or the way back of a
+    crank whose drawing is an open arc) and ``drawing_closed`` (1.0 for a closed drawing, else 0.0); the distances
+    are ``inf`` when the path does not assemble.  The path is the crank's whole turn, or the swing
     ``checks["input_swing_rad"]`` of an input that rocks, at :data:`PATH_SAMPLES` angles joined by straight
     segments (on the trial's egg, 4,000 angles moved the figures by under 1e-5 of the size against 40,000)."""
     import shapely
@@ -46,24 +47,29 @@ def drawing_gaps(design: Any, svg: str | Path) -> dict[str, float]:
     th = np.linspace(lo, hi, PATH_SAMPLES, endpoint=swing is not None)
     motion = design.fourbar().solve(th)
     size = float(design.checks["size"])
-    out = {"drawing_max_distance": float("inf")}
-    if closed:
-        out["path_max_distance"] = float("inf")
+    out = {"drawing_max_distance": float("inf"), "path_max_distance": float("inf"), "drawing_closed": float(closed)}
     if not motion.valid.all():
         return out
     path = np.asarray(motion.points["coupler_point"], float)
     line = shapely.LinearRing(path) if swing is None else shapely.LineString(path)
     out["drawing_max_distance"] = float(np.max(shapely.distance(shapely.points(drawn), line))) / size
-    if closed:
-        ring = shapely.LinearRing(drawn)
-        out["path_max_distance"] = float(np.max(shapely.distance(shapely.points(path), ring))) / size
+    drawing = shapely.LinearRing(drawn) if closed else shapely.LineString(drawn)
+    out["path_max_distance"] = float(np.max(shapely.distance(shapely.points(path), drawing))) / size
     return out
 
 
-def drawing_cautions(gaps: dict[str, float], tolerance: float) -> list[str]:
-    """``caution:`` lines for the figures of :func:`drawing_gaps` beyond ``tolerance`` (a fraction of the
-    targets' size): the targets are met, the drawing between them is not."""
+def drawing_cautions(gaps: dict[str, float], tolerance: float, rocks: bool) -> list[str]:
+    """``caution:`` lines for the figures of :func:`drawing_gaps` (``rocks``: the design's input swings rather than
+    turns) beyond ``tolerance`` (a fraction of the targets' size): the check at the targets does not see between
+    them, nor where the path goes that the drawing does not."""
     out = []
+    closed = bool(gaps.get("drawing_closed", 0.0))
+    if closed and rocks:
+        out.append(
+            "the drawing is closed and the input rocks: the coupler point runs along part of it and back the same way, "
+            "so the rest of the drawing is not traced (plain synth path searches a closed drawing for an input that "
+            "turns fully)"
+        )
     far = gaps.get("drawing_max_distance", 0.0)
     if far > tolerance:
         out.append(
@@ -72,9 +78,15 @@ def drawing_cautions(gaps: dict[str, float], tolerance: float) -> list[str]:
             "to more of the drawing, and planar plot --what curve draws the path through the targets"
         )
     off = gaps.get("path_max_distance", 0.0)
-    if off > tolerance:
+    if off > tolerance and closed:
         out.append(
             f"the coupler path leaves the closed drawing by up to {off:.3g} of the targets' size: a loop or detour the "
             "drawing does not have"
+        )
+    elif off > tolerance and not rocks:
+        out.append(
+            f"the crank turns fully, so after the drawn arc the coupler point comes back another way, up to {off:.3g} of "
+            "the targets' size from the drawing (planar render shows it; --rocking asks for an input that swings along "
+            "the arc only)"
         )
     return out

@@ -195,9 +195,10 @@ class PathSearch:
             return r, source + f"; searched again {TOGGLE_FLOOR_DEG:g} deg from a toggle, none found usable", swing
         again.stages = stages
         why = (
-            f"the atlas lookup and refinement kept {TOGGLE_FLOOR_DEG:g} deg from a toggle (largest distance "
-            f"{self._distance(again, None):.3g} of the size); without that floor the nearest found, {e_before:.3g} of "
-            "the size off, nearly folds"
+            f"the atlas lookup and refinement searched again keeping the transmission angle at least "
+            f"{TOGGLE_FLOOR_DEG:g} deg from a toggle (largest distance {self._distance(again, None):.3g} of the size): "
+            f"the nearest found without that floor, {e_before:.3g} of the size off, nearly folds and is not offered "
+            f"(that first search: {source})"
         )
         return again, why, swing
 

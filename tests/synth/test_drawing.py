@@ -32,7 +32,7 @@ def test_a_drawing_of_the_curve_itself_is_on_the_path_and_a_bump_is_measured(tmp
     _svg(f, curve, True)
     gaps = drawing_gaps(_design(fb, size), f)
     assert gaps["drawing_max_distance"] < 1e-3 and gaps["path_max_distance"] < 1e-3
-    assert drawing_cautions(gaps, 1e-2) == []
+    assert drawing_cautions(gaps, 1e-2, rocks=False) == []
     # one vertex pushed out along the curve's normal by h: the drawing's farthest point is that vertex
     h = 0.2
     bumped = curve.copy()
@@ -48,7 +48,7 @@ def test_a_drawing_of_the_curve_itself_is_on_the_path_and_a_bump_is_measured(tmp
     brute = max(float(np.min(np.hypot(*(dense - p).T))) for p in drawn)
     assert abs(gaps["drawing_max_distance"] - brute / size) < 1e-4
     assert 0.8 * h / size < gaps["drawing_max_distance"] <= h / size + 1e-4
-    (line,) = drawing_cautions(gaps, 1e-2)
+    (line,) = drawing_cautions(gaps, 1e-2, rocks=False)
     assert "between the targets the drawing lies up to" in line
 
 
@@ -60,7 +60,14 @@ def test_a_closed_drawing_traced_only_as_an_arc_and_an_open_one_is_not_asked_the
     # the same crank swung over half its turn: the other half of the closed drawing is far from that path
     half = drawing_gaps(_design(fb, 2.0, (0.0, np.pi)), f)
     assert half["drawing_max_distance"] > 0.1 and half["path_max_distance"] < 1e-3
-    # the half as an open drawing: on the path both ways, and no way back is asked of an open drawing
+    lines = drawing_cautions(half, 1e-2, rocks=True)
+    assert len(lines) == 2 and "the drawing is closed and the input rocks" in lines[0]
+    # the half as an open drawing: on the swing's path both ways; the crank's whole turn comes back another way
     _svg(f, curve[:361], False)
     open_half = drawing_gaps(_design(fb, 2.0, (0.0, np.pi)), f)
-    assert open_half["drawing_max_distance"] < 1e-3 and "path_max_distance" not in open_half
+    assert open_half["drawing_max_distance"] < 1e-3 and open_half["path_max_distance"] < 1e-3
+    assert drawing_cautions(open_half, 1e-2, rocks=True) == []
+    whole = drawing_gaps(_design(fb, 2.0), f)
+    assert whole["drawing_max_distance"] < 1e-3 and whole["path_max_distance"] > 0.1
+    (back,) = drawing_cautions(whole, 1e-2, rocks=False)
+    assert "comes back another way" in back
