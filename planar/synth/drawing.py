@@ -35,13 +35,13 @@ def drawing_gaps(design: Any, svg: str | Path) -> dict[str, float]:
     crank whose drawing is an open arc) and ``drawing_closed`` (1.0 for a closed drawing, else 0.0); the distances
     are ``inf`` when the path does not assemble.  The path is the crank's whole turn, or the swing
     ``checks["input_swing_rad"]`` of an input that rocks, at :data:`PATH_SAMPLES` angles joined by straight
-    segments (on the trial's egg, 4,000 angles moved the figures by under 1e-5 of the size against 40,000)."""
+    segments (on the trial's egg, a crank's and a rocking result, 4,000 angles gave figures within 9e-6 of the size
+    of 40,000's)."""
     import shapely
 
-    from planar.synth.targets import read_svg_points, svg_closed
+    from planar.synth.targets import read_svg_shape
 
-    drawn = read_svg_points(svg, DRAWING_SAMPLES)
-    closed = svg_closed(svg)
+    drawn, closed = read_svg_shape(svg, DRAWING_SAMPLES)
     swing = design.checks.get("input_swing_rad")
     lo, hi = (float(swing[0]), float(swing[1])) if swing is not None else (0.0, 2 * np.pi)
     th = np.linspace(lo, hi, PATH_SAMPLES, endpoint=swing is not None)

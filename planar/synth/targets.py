@@ -25,6 +25,7 @@ __all__ = [
     "normalisation",
     "read_path_targets",
     "read_svg_points",
+    "read_svg_shape",
     "read_table",
     "read_targets",
     "svg_closed",
@@ -142,12 +143,18 @@ def read_svg_points(path: str | Path, n: int, option: str = "--points") -> Array
     a point ``(x, y)`` of the drawing (after every transform, the
     ``viewBox``'s included) is the target ``(x, -y)``.
     """
+    return read_svg_shape(path, n, option)[0]
+
+
+def read_svg_shape(path: str | Path, n: int, option: str = "--points") -> tuple[Array, bool]:
+    """:func:`read_svg_points`'s points and whether the shape is closed (:func:`svg_closed`), from one reading of
+    the file."""
     if n < 3:
         raise InputError(option, n, "3 or more points to sample from the SVG path")
     path_, closed, factor = _first_shape(path)
     pts = _even_by_length(path_, n, closed) * factor
     pts[:, 1] = -pts[:, 1]
-    return pts
+    return pts, closed
 
 
 def svg_closed(path: str | Path) -> bool:
