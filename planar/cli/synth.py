@@ -207,20 +207,20 @@ def _unreachable(d: Any, kind: str = "four-bar", box: str = "", budget: str = "n
 
 
 def _angles_comment(d: Any) -> str:
-    """The scene comment listing the crank angle at each target (rad from the ground line, full precision): on a
-    rocking input's swing, as the swing's own angles (the line printed gives the swing in the same terms), else in
-    ``[0, 2 pi)``."""
+    """The scene comment listing the input angle at each target (rad from the ground line, full precision): on a
+    rocking input's swing, as the swing's own angles (the line printed gives the swing in the same terms; "input
+    angle", as the input does not turn as a crank), else in ``[0, 2 pi)`` ("crank angle")."""
     import numpy as np
 
     theta = np.asarray(d.theta, float)
-    where = "in [0, 2 pi)"
+    where, word = "in [0, 2 pi)", "crank"
     if "input_swing_rad" in d.checks:
         from planar.synth.arcs import on_swing
 
         lo, hi = d.checks["input_swing_rad"]
         theta = on_swing(theta, (lo, hi))
-        where = f"on the input's swing, {lo!r} to {hi!r}"
-    return f"crank angle at each target (rad from the ground line, {where}): " + ", ".join(repr(float(t)) for t in theta)
+        where, word = f"on the input's swing, {lo!r} to {hi!r}", "input"
+    return f"{word} angle at each target (rad from the ground line, {where}): " + ", ".join(repr(float(t)) for t in theta)
 
 
 def _unusable(d: Any, kind: str, region: bool) -> str | None:

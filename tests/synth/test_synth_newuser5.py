@@ -161,3 +161,18 @@ def test_the_rocking_search_measures_transmission_as_planars_four_bar_does() -> 
         mu = fb.transmission_angle(np.linspace(*swing, 181))
         want = float(np.min(np.minimum(mu, np.pi - mu)))
         assert swing_transmission(np.array([r1, r2, r3, r4, 0, 0, 0, 0, 0]), swing) == pytest.approx(want, abs=1e-12)
+
+
+def test_the_scene_comment_calls_a_rocking_input_an_input_not_a_crank() -> None:
+    # a re-trial read "crank angle at each target" in the scene of a double-rocker, whose input never turns as a
+    # crank; the angles themselves are the swing's own (lo <= angle <= hi), a full turn's in [0, 2 pi)
+    from planar.cli.synth import _angles_comment
+
+    rocks = SimpleNamespace(theta=[6.0, 0.2], checks={"input_swing_rad": (-0.4, 0.3)})
+    line = _angles_comment(rocks)
+    assert line.startswith("input angle at each target") and "crank" not in line
+    shown = [float(v) for v in line.split(": ")[1].split(", ")]
+    assert np.allclose(shown, [6.0 - 2 * np.pi, 0.2]) and all(-0.4 <= v <= 0.3 for v in shown)
+    turns = SimpleNamespace(theta=[-0.5, 7.0], checks={})
+    line = _angles_comment(turns)
+    assert line.startswith("crank angle at each target")
