@@ -368,6 +368,9 @@ def input_swing(row: Array, theta: Array) -> tuple[float, float] | None:
 #: lookup and refinement effort: neighbours per query, and starts refined
 #: (:func:`planar.synth.search.refined_start`)
 SEARCH_K, SEARCH_REFINE = 64, 32
+#: the rounds of :func:`search_arcs`: neighbours per query, and how many starts may have been refined by the round's
+#: end (its own and the rounds' before); a round runs only when none before it ended within :data:`BASIN`
+ROUNDS = ((SEARCH_K, SEARCH_REFINE), (256, 128))
 #: the final polish (:func:`planar.synth.positions.polish_positions`): iterations per start, and how many of the best
 #: refined starts (each on one swing) it is tried on, best first, until one is within the search's stop or
 #: :data:`BASIN`
@@ -376,6 +379,11 @@ POLISH_ITERS, POLISH_STARTS = 600, 8
 #: polished on.  On a short arc the last digits come slowly (the nearest four-bars lie in a narrow valley), so a
 #: search whose stop is far below this would try every start before polishing the one already found
 BASIN = 1e-7
+#: when the rounds end with nothing usable or nothing within ``GUARD_AFTER`` (the targets' size 1), the first
+#: round's starts are refined again keeping the transmission angle at the targets ``TOGGLE_GUARD_DEG`` beyond the
+#: floor a result must keep (:func:`planar.synth.positions.polish_positions`'s ``floor``): on some arcs most starts
+#: otherwise end at a toggle, where the arc turns back and fits the targets loosely, and are not usable
+GUARD_AFTER, TOGGLE_GUARD_DEG = 1e-4, 0.2
 
 
 def on_swing(theta: Array, swing: tuple[float, float]) -> Array:
@@ -417,6 +425,54 @@ def usable_swing(
     return swing if swing_transmission(r, swing) >= floor else None
 
 
+#: a rocking start's outcome: largest distance (the targets' size 1), refined row, input angles at the targets, swing
+Found = tuple[float, Array, Array, tuple[float, float]]
+
+
+def _tried_starts(obj: Any, every: Array, limit: int, tried: list[Array], refine: Any, usable: Any, stop: float) -> list[Found]:
+    """The looked-up rows ``every`` refined (``refine(row) -> (row, angles)``) best first by ``obj``'s score at
+    sampled angles, skipping rows already in ``tried`` (appended to as they are tried), until ``tried`` holds
+    ``limit`` rows or one on a usable swing (``usable(row, angles)``) is within ``stop`` or :data:`BASIN`."""
+    from planar.synth.search import max_distance
+
+    f = obj.population(every, np.float64) if len(every) else np.zeros(0)
+    found: list[Found] = []
+    for row in every[np.argsort(f, kind="stable")]:
+        if len(tried) >= limit:
+            break
+        if tried and np.any(np.all(np.abs(row - np.asarray(tried)) <= 1e-9 + 1e-6 * np.abs(np.asarray(tried)), axis=1)):
+            continue
+        tried.append(row)
+        r, tt = refine(row)
+        swing = usable(r, tt)
+        if swing is not None:
+            found.append((max_distance(obj, r, tt), r, tt, swing))
+            if found[-1][0] <= max(stop, BASIN):
+                break
+    return found
+
+
+def _polished(obj: Any, found: list[Found], stop: float, usable: Any, max_ratio: float, floor: float) -> Found | None:
+    """The best of ``found`` after the best few (only the best when it is within :data:`BASIN`; none when within
+    ``stop``) go on in the joints' positions (:func:`planar.synth.positions.polish_positions`), until one is within
+    ``stop`` or :data:`BASIN`; None when ``found`` is empty."""
+    from planar.synth.search import max_distance
+
+    if not found:
+        return None
+    found = sorted(found, key=lambda c: c[0])
+    best = found[0]
+    for _, r0, tt0, _ in found[: 1 if best[0] <= BASIN else POLISH_STARTS] if best[0] > stop else []:
+        r, tt = polish_positions(obj.targets, r0, tt0, POLISH_ITERS, max_ratio, floor)
+        swing = usable(r, tt)
+        e = max_distance(obj, r, tt) if swing is not None else math.inf
+        if swing is not None and e < best[0]:
+            best = (e, r, tt, swing)
+        if best[0] <= max(stop, BASIN):
+            break
+    return best
+
+
 def search_arcs(
     targets: Array, arcs: Arcs, cons: Any = None, stop: float = 1e-9, ordered: bool = False, input_rocks: bool = False
 ) -> tuple[Any, tuple[float, float] | None]:
@@ -426,7 +482,13 @@ def search_arcs(
     and the floor :data:`planar.synth.designs.TOGGLE_FLOOR_DEG` from a toggle, and that swing's input range
     (:func:`rocking_range`; None when no result does).  ``cons``: the path's
     :class:`~planar.synth.search.Constraints` with the full turn not required (its link ratio is kept).
-    ``input_rocks``: only a four-bar whose input link itself cannot turn fully (see :func:`usable_swing`)."""
+    ``input_rocks``: only a four-bar whose input link itself cannot turn fully (see :func:`usable_swing`).
+
+    Past the targets' own curve equation, the search runs in :data:`ROUNDS`: each looks up more neighbours, refines
+    the starts not yet tried best first (:func:`_tried_starts`) and polishes the best few (:func:`_polished`); a
+    round runs only when none before it ended within :data:`BASIN`.  When they end with nothing usable or nothing
+    within :data:`GUARD_AFTER`, the first round's starts are refined once more keeping the transmission angle at
+    the targets :data:`TOGGLE_GUARD_DEG` beyond the floor (docs/explanation/coupler-curve-atlas.md)."""
     import dataclasses
 
     from planar.synth.search import (
@@ -434,7 +496,6 @@ def search_arcs(
         PathObjective,
         SearchResult,
         default_bounds,
-        max_distance,
         refined_start,
     )
 
@@ -456,40 +517,37 @@ def search_arcs(
     if alg is not None:
         return alg, swing
     t0 = time.perf_counter()
-    every = arc_candidates(arcs, t, SEARCH_K)
     stages = {"algebraic_s": t0 - t_alg} if len(t) >= MIN_TARGETS else {}
-    stages["arcs_s"] = time.perf_counter() - t0
-    t1 = time.perf_counter()
-    f = obj.population(every, np.float64) if len(every) else np.zeros(0)
-    found: list[tuple[float, Array, Array, tuple[float, float]]] = []
+    guard = max(float(cons.min_transmission), math.radians(TOGGLE_FLOOR_DEG)) + math.radians(TOGGLE_GUARD_DEG)
     tried: list[Array] = []
-    for row in every[np.argsort(f, kind="stable")]:
-        if len(tried) >= SEARCH_REFINE:
+    best: Found | None = None
+
+    def one_round(k: int, limit: int, tried: list[Array], floor: float) -> None:
+        nonlocal best
+        t1 = time.perf_counter()
+        every = arc_candidates(arcs, t, k)
+        t2 = time.perf_counter()
+        found = _tried_starts(
+            obj, every, limit, tried, lambda row: refined_start(obj, row, b, stop, cons.max_ratio, floor), usable, stop
+        )
+        t3 = time.perf_counter()
+        polished = _polished(obj, found, stop, usable, cons.max_ratio, floor)
+        for key, s in (("arcs_s", t2 - t1), ("refine_s", t3 - t2), ("polish_s", time.perf_counter() - t3)):
+            stages[key] = stages.get(key, 0.0) + s
+        if polished is not None and (best is None or polished[0] < best[0]):
+            best = polished
+
+    for k, limit in ROUNDS:
+        one_round(k, limit, tried, 0.0)
+        if best is not None and best[0] <= max(stop, BASIN):
             break
-        if any(np.allclose(row, s, rtol=1e-6, atol=1e-9) for s in tried):
-            continue
-        tried.append(row)
-        r, tt = refined_start(obj, row, b, stop, cons.max_ratio)
-        swing = usable(r, tt)
-        if swing is not None:
-            found.append((max_distance(obj, r, tt), r, tt, swing))
-            if found[-1][0] <= max(stop, BASIN):
-                break
-    stages["refine_s"] = time.perf_counter() - t1
-    if not found:
+    else:
+        if best is None or best[0] > GUARD_AFTER:  # the first round's starts again, kept off the toggles
+            guarded: list[Array] = []
+            one_round(*ROUNDS[0], guarded, guard)
+            tried += guarded
+    if best is None:
         return None, None
-    found.sort(key=lambda c: c[0])
-    best = found[0]
-    # the best few go on for longer (only the best when it is within BASIN)
-    for _, r0, tt0, _ in found[: 1 if best[0] <= BASIN else POLISH_STARTS] if best[0] > stop else []:
-        r, tt = polish_positions(t, r0, tt0, POLISH_ITERS, cons.max_ratio)
-        swing = usable(r, tt)
-        e = max_distance(obj, r, tt) if swing is not None else math.inf
-        if swing is not None and e < best[0]:
-            best = (e, r, tt, swing)
-        if best[0] <= max(stop, BASIN):
-            break
-    stages["polish_s"] = time.perf_counter() - t1 - stages["refine_s"]
-    e, r, tt, swing = best
+    _, r, tt, swing = best
     sse = float(np.sum(np.square(row_points(r, tt) - t)))
     return SearchResult(r[:9], 1 if r[9] >= 0 else -1, tt, sse, True, len(tried), stages), swing

@@ -6,7 +6,8 @@ turn from there to each later target; the coupler's and rocker's lengths are the
 :func:`positions_points`, written with arithmetic, ``cos``, ``sin`` and ``sqrt`` only so that a complex step gives
 the exact Jacobian.  :func:`polish_positions` runs Levenberg-Marquardt with geodesic acceleration
 (:func:`geodesic_lm`) on them; :func:`planar.synth.search.refined_start` runs it on every atlas start, the rocking
-arcs' and the closed curves' alike.
+arcs' and the closed curves' alike.  With a ``floor``, a penalty on :func:`positions_sin2` (the transmission angle's
+squared sine at each target) keeps the refinement off the toggles.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ __all__ = [
     "joint_positions",
     "polish_positions",
     "positions_points",
+    "positions_sin2",
     "row_from_positions",
 ]
 
@@ -31,6 +33,9 @@ Array = NDArray[np.float64]
 
 #: the default iterations of :func:`polish_positions`
 POLISH_ITERS = 600
+#: the weight of a target's transmission angle below the floor (:func:`_positions_problem`): a toggle (squared sine
+#: 0) a floor of 1.2 deg below costs as much as a target 0.004 of the size off
+TOGGLE_WEIGHT = 10.0
 
 
 def joint_positions(row: Array, theta: Array) -> tuple[Array, Array]:
@@ -55,6 +60,20 @@ def joint_positions(row: Array, theta: Array) -> tuple[Array, Array]:
 def positions_points(q: Any, turn: Any, circuit: float) -> tuple[Any, Any]:
     """Coupler points ``(x, y)`` at the first pose of :func:`joint_positions` and after each ``turn``: written with
     arithmetic, ``cos``, ``sin`` and ``sqrt`` only, so it runs on complex numbers for the complex-step derivative."""
+    x, y, _ = _poses(q, turn, circuit)
+    return x, y
+
+
+def positions_sin2(q: Any, turn: Any) -> Any:
+    """The squared sine of the transmission angle (between coupler and rocker, at C) at the first pose of
+    :func:`joint_positions` and after each ``turn``: 0 at a toggle.  By the law of sines in the triangle B, C, O4 it
+    is ``(b^2 L^2 - A^2) / (b^2 c^2)``, ``b`` the coupler, ``c`` the rocker, ``L`` the diagonal B-O4 and
+    ``A = (L^2 + b^2 - c^2) / 2``; arithmetic only, so it runs on complex numbers too."""
+    return _poses(q, turn, 1.0)[2]
+
+
+def _poses(q: Any, turn: Any, circuit: float) -> tuple[Any, Any, Any]:
+    """:func:`positions_points`'s coupler points and :func:`positions_sin2`'s squared sines, from one evaluation."""
     o2x, o2y, bx0, by0, cx0, cy0, o4x, o4y, px0, py0 = q
     turn = np.asarray(turn)
     al = np.concatenate([np.zeros(turn.shape[:-1] + (1,), dtype=np.result_type(turn, float)), turn], axis=-1)
@@ -69,9 +88,10 @@ def positions_points(q: Any, turn: Any, circuit: float) -> tuple[Any, Any]:
     dx, dy = o4x - bx, o4y - by
     L2 = dx * dx + dy * dy
     A = 0.5 * (L2 + b2 - c2)
-    w = circuit * np.sqrt(b2 * L2 - A * A)
+    w2 = b2 * L2 - A * A
+    w = circuit * np.sqrt(w2)
     ex, ey = (A * dx - w * dy) / L2, (A * dy + w * dx) / L2
-    return bx + a1 * ex - a2 * ey, by + a1 * ey + a2 * ex
+    return bx + a1 * ex - a2 * ey, by + a1 * ey + a2 * ex, w2 / (b2 * c2)
 
 
 def row_from_positions(q: Array, turn: Array, circuit: float) -> tuple[Array, Array]:
@@ -97,30 +117,44 @@ def _ratio_excess(q: Any, max_ratio: float) -> Any:
     return x if float(np.real(x)) > 0 else 0.0 * x
 
 
-def _positions_problem(t: Array, circuit: float, max_ratio: float) -> tuple[Any, Any]:
-    """Residuals ``(2 N + 1,)`` (coupler point minus target, x then y; then the link ratio's excess, weighted as
-    the search weighs a broken constraint) of :func:`polish_positions`'s variables and their Jacobian by complex
-    step (exact to rounding: 11 evaluations, the later targets' turns perturbed at once as each moves its own
-    target only)."""
+def _positions_problem(t: Array, circuit: float, max_ratio: float, floor: float = 0.0) -> tuple[Any, Any]:
+    """Residuals (coupler point minus target, x then y; then the link ratio's excess, weighted as the search weighs a
+    broken constraint; then, when ``floor`` (rad) is above 0, one per target: how far the squared sine of the
+    transmission angle there is below ``sin(floor)^2``, weighted by :data:`TOGGLE_WEIGHT`) of
+    :func:`polish_positions`'s variables and their Jacobian by complex step (exact to rounding: 11 evaluations, the
+    later targets' turns perturbed at once as each moves its own target only)."""
     n = len(t)
     w = 10.0 * math.sqrt(n) if math.isfinite(max_ratio) else 0.0
+    s2 = math.sin(floor) ** 2
+    m = 2 * n + 1 + (n if floor > 0 else 0)
+
+    def barrier(sin2: Any) -> Any:  # below the floor only: piecewise analytic, complex steps pass
+        x = s2 - sin2
+        return TOGGLE_WEIGHT * np.where(np.real(x) > 0, x, 0.0 * x)
 
     def resid(z: Array) -> Array:
         with np.errstate(invalid="ignore", divide="ignore"):
-            x, y = positions_points(z[:10], z[10:], circuit)
-            r = np.concatenate([x - t[:, 0], y - t[:, 1], [w * _ratio_excess(z, max_ratio) if w else 0.0]])
-        return r if np.isfinite(r).all() else np.full(2 * n + 1, 10.0)  # the loop does not close: far
+            x, y, sin2 = _poses(z[:10], z[10:], circuit)
+            parts = [x - t[:, 0], y - t[:, 1], [w * _ratio_excess(z, max_ratio) if w else 0.0]]
+            if floor > 0:
+                parts.append(barrier(sin2))
+            r = np.concatenate(parts)
+        return r if np.isfinite(r).all() else np.full(m, 10.0)  # the loop does not close: far
 
     def jac(z: Array) -> Array:
         h = 1e-30
         Z = np.repeat(z[None, :].astype(complex), 11, axis=0)
         Z[np.arange(10), np.arange(10)] += 1j * h
         Z[10, 10:] += 1j * h
-        J = np.zeros((2 * n + 1, len(z)))
+        J = np.zeros((m, len(z)))
         i = np.arange(1, n)
         with np.errstate(invalid="ignore", divide="ignore"):  # the 11 perturbed evaluations as one batch
-            x, y = positions_points(tuple(Z[:, j : j + 1] for j in range(10)), Z[:, 10:], circuit)
-        cols = np.concatenate([x.imag, y.imag], axis=1) / h  # (11, 2 n)
+            x, y, sin2 = _poses(tuple(Z[:, j : j + 1] for j in range(10)), Z[:, 10:], circuit)
+            cols = np.concatenate([x.imag, y.imag], axis=1) / h  # (11, 2 n)
+            if floor > 0:
+                g = barrier(sin2).imag / h
+                J[2 * n + 1 :, :10] = g[:10].T
+                J[2 * n + 1 + i, 9 + i] = g[10, 1:]
         J[: 2 * n, :10] = cols[:10].T
         J[i, 9 + i], J[n + i, 9 + i] = cols[10, 1:n], cols[10, n + 1 :]
         if w and float(np.real(_ratio_excess(z, max_ratio))) > 0:  # else its derivative is 0
@@ -173,7 +207,7 @@ def geodesic_lm(resid: Any, jac: Any, z: Array, iters: int) -> tuple[Array, Arra
 
 
 def polish_positions(
-    t: Array, row: Array, theta: Array, iters: int = POLISH_ITERS, max_ratio: float = 10.0
+    t: Array, row: Array, theta: Array, iters: int = POLISH_ITERS, max_ratio: float = 10.0, floor: float = 0.0
 ) -> tuple[Array, Array]:
     """A refined kernel row and its input angles at the targets ``t`` (normalised), polished in the joints'
     positions (:func:`joint_positions`: the pivots and moving joints at the first target's pose, the input's turn
@@ -182,10 +216,13 @@ def polish_positions(
 
     A rocking four-bar's arc is short and smooth: in the kernel's lengths and angles the four-bars within 1e-5 of
     it lie along a long, curved, narrow valley (condition numbers 1e6 to 1e9), where Levenberg-Marquardt with a
-    difference Jacobian crawls.  Returns the row and angles (the input as given when nothing better is found)."""
+    difference Jacobian crawls.  ``floor`` (rad, 0 for none): the transmission angle at the targets is kept this far
+    from a toggle by a penalty (the rocking search's: its refinements otherwise end at a toggle, where the arc
+    turns back and fits the targets loosely).  Returns the row and angles (the input as given when nothing better is
+    found)."""
     circuit = 1.0 if row[9] >= 0 else -1.0
     q, turn = joint_positions(row, theta)
-    resid, jac = _positions_problem(np.asarray(t, float), circuit, max_ratio)
+    resid, jac = _positions_problem(np.asarray(t, float), circuit, max_ratio, floor)
     z0 = np.concatenate([q, turn])
     r0 = resid(z0)
     z, r = geodesic_lm(resid, jac, z0, iters)

@@ -1068,14 +1068,15 @@ START_NFEV, START_ITERS = 10, 120
 
 
 def refined_start(
-    obj: PathObjective, row: Array, b: list[tuple[float, float]], stop: float | Any, max_ratio: float
+    obj: PathObjective, row: Array, b: list[tuple[float, float]], stop: float | Any, max_ratio: float, floor: float = 0.0
 ) -> tuple[Array, Array]:
     """One atlas start ``row`` (9 parameters and the circuit) refined on the untimed targets of ``obj``:
     :data:`START_NFEV` evaluations of Levenberg-Marquardt in the kernel's lengths and angles from angles assigned on
     its curve (:func:`reassigned_refine`: they carry an atlas entry's placement onto the targets), then, unless that
     reaches ``stop`` (a largest distance, or a function of the row and its angles as :func:`search_atlas` takes),
-    :data:`START_ITERS` iterations in the joints' positions (:func:`planar.synth.positions.polish_positions`), kept
-    when nearer.  Returns the row and its input angles at the targets.
+    :data:`START_ITERS` iterations in the joints' positions (:func:`planar.synth.positions.polish_positions`, keeping
+    the transmission angle at the targets ``floor`` rad from a toggle when above 0), kept when nearer.  Returns the
+    row and its input angles at the targets.
 
     Measured on development problems (seeds 777 to 779, 1 BLAS thread, CPU medians), against 200 evaluations in
     the lengths and angles per start: double- and triple-rockers at 8 and 12 targets (with 32 starts instead of
@@ -1086,7 +1087,7 @@ def refined_start(
     r, tt, _ = reassigned_refine(obj, row, b, START_NFEV, stop)
     if _reached(obj, r, tt, stop):
         return r, tt
-    r2, tt2 = polish_positions(obj.targets, r, tt, START_ITERS, max_ratio)
+    r2, tt2 = polish_positions(obj.targets, r, tt, START_ITERS, max_ratio, floor)
     return (r2, tt2) if max_distance(obj, r2, tt2) < max_distance(obj, r, tt) else (r, tt)
 
 

@@ -252,3 +252,126 @@ def test_refined_start_takes_short_arcs_past_where_the_lengths_stall():
         r2, tt2, _ = reassigned_refine(obj, start, b, START_NFEV, 1e-9)
         lengths_only += max_distance(obj, r2, tt2) <= 1e-6
     assert steps >= 6 and steps >= lengths_only + 2, (steps, lengths_only)
+
+
+def test_rocking_rounds_skip_the_starts_already_tried_and_stop_at_the_basin():
+    # the rocking search's later round looks up more neighbours, which include the earlier round's: each row is
+    # refined once, the round stops at its limit of starts in all, and a start within BASIN ends it at once
+    from planar.synth.arcs import BASIN, _tried_starts
+    from planar.synth.kernel import coupler_points
+    from planar.synth.search import Constraints, PathObjective
+
+    rng = np.random.default_rng(3)
+    L, lo, hi = _double_rocker(rng)
+    true = np.array([1.0, *L, 0.3, 0.2, 0.0, 0.0, 0.1, 1.0])
+    th = np.linspace(lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo), 9)
+    x, y, _ = coupler_points(true[None, :9], th[None], np.array([1.0]))
+    obj = PathObjective(np.column_stack([x[0], y[0]]), None, Constraints(full_turn=False), 64)
+    rows = true + rng.normal(0.0, 0.05, (12, 10))
+    rows[:, 9] = 1.0
+    every = np.concatenate([rows, rows[:5]])  # the later round's lookup repeats rows
+    seen: list[np.ndarray] = []
+
+    def refine(row):
+        seen.append(row)
+        return row, th
+
+    tried = [rows[0].copy(), rows[1].copy()]
+    found = _tried_starts(obj, every, 8, tried, refine, lambda r, tt: None, 1e-9)
+    assert found == [] and len(tried) == 8 and len(seen) == 6
+    assert not any(np.array_equal(s, rows[0]) or np.array_equal(s, rows[1]) for s in seen)
+    assert len({s.tobytes() for s in seen}) == 6
+
+    # every start refined onto the true four-bar (on a usable swing): the first ends the round
+    seen.clear()
+
+    def onto_true(row):
+        seen.append(row)
+        return true, th
+
+    found = _tried_starts(obj, every, 20, [], onto_true, lambda r, tt: (lo, hi), 1e-9)
+    assert len(seen) == 1 and len(found) == 1 and found[0][0] <= BASIN and np.array_equal(found[0][1], true)
+
+
+def test_the_positions_transmission_term_is_the_law_of_cosines_and_its_floor_a_barrier():
+    # positions_sin2 against the law of cosines in the diagonal B-O4 (a hand formula, not planar's), on random
+    # double-rockers across their input's range, toggles at its ends included; the floor's residuals are 0 above
+    # the floor and TOGGLE_WEIGHT (sin(floor)^2 - sin(mu)^2) below it, their complex-step Jacobian scipy's
+    from scipy.optimize import approx_fprime
+
+    from planar.synth.positions import TOGGLE_WEIGHT, _positions_problem, joint_positions, positions_sin2
+
+    rng = np.random.default_rng(11)
+    for _ in range(5):
+        L, lo, hi = _double_rocker(rng)
+        row = np.array([1.0, *L, 0.3, -0.2, *rng.uniform(-1, 1, 2), rng.uniform(-3, 3), rng.choice([1.0, -1.0])])
+        th = np.linspace(lo + 1e-9, hi - 1e-9, 7)
+        q, turn = joint_positions(row, th)
+        bo4 = L[0] ** 2 + 1.0 - 2.0 * L[0] * np.cos(th)
+        mu = np.arccos(np.clip((L[1] ** 2 + L[2] ** 2 - bo4) / (2 * L[1] * L[2]), -1, 1))
+        assert np.allclose(positions_sin2(q, turn), np.sin(mu) ** 2, atol=1e-7)
+        assert min(np.sin(mu[0]) ** 2, np.sin(mu[-1]) ** 2) < 1e-6  # the range's ends are toggles
+        floor = np.radians(5.0)
+        z = np.concatenate([q, turn])
+        x, y, _ = coupler_points(row[None, :9], th[None], row[9:])
+        t = np.column_stack([x[0], y[0]])
+        resid, jac = _positions_problem(t, row[9], 10.0, floor)
+        tail = resid(z)[2 * len(t) + 1 :]
+        want = TOGGLE_WEIGHT * np.maximum(np.sin(floor) ** 2 - np.sin(mu) ** 2, 0.0)
+        assert np.allclose(tail, want, atol=1e-7) and tail[0] > 0 and tail[-1] > 0
+        # the Jacobian where the floor (80 deg: active) bites, off the toggles
+        resid, jac = _positions_problem(t, row[9], 10.0, np.radians(80.0))
+        zm = np.concatenate(joint_positions(row, 0.5 * (lo + hi) + np.linspace(-0.2, 0.2, 7) * (hi - lo)))
+        J = jac(zm)
+        Jn = np.array([approx_fprime(zm, lambda v, k=k, f=resid: f(v)[k], 1e-7) for k in range(len(resid(zm)))])
+        assert np.abs(J[2 * len(t) + 1 :]).max() > 0
+        assert np.abs(J - Jn).max() < 1e-4 * max(1.0, np.abs(J).max())
+
+
+def test_the_toggle_guard_round_runs_only_when_the_rounds_end_far(monkeypatch):
+    # the guard round (the first round's starts again, the transmission angle kept off the toggles) runs after the
+    # rounds end with nothing within GUARD_AFTER, and not when a start is within BASIN; it is the last round, with
+    # at most the first round's starts, at the floor plus TOGGLE_GUARD_DEG
+    import planar.synth.search as search_mod
+    from planar.synth import arcs as arcs_mod
+    from planar.synth.kernel import coupler_points
+    from planar.synth.search import Constraints
+
+    arcs = build_arcs(arcs_mod.QUICK_FOURBARS, seed=0)
+    rng = np.random.default_rng(8)
+    L, lo, hi = _double_rocker(rng)
+    true = np.array([1.0, *L, 0.3, 0.2, 0.0, 0.0, 0.1, 1.0])
+    th = np.linspace(lo + 0.2 * (hi - lo), hi - 0.2 * (hi - lo), 9)
+    x, y, _ = coupler_points(true[None, :9], th[None], np.array([1.0]))
+    t = np.column_stack([x[0], y[0]])
+    t = (t - t.mean(axis=0)) / np.ptp(t, axis=0).max()
+    floors: list[float] = []
+    real = search_mod.refined_start
+
+    def unrefined(obj, row, b, stop, max_ratio, floor=0.0):  # the rounds stay far: only the guard refines
+        floors.append(floor)
+        return real(obj, row, b, stop, max_ratio, floor) if floor > 0 else (row, search_mod.assign_theta(obj, row))
+
+    polish = arcs_mod.polish_positions
+
+    def unpolished(t, row, theta, iters, max_ratio, floor=0.0):
+        return polish(t, row, theta, iters, max_ratio, floor) if floor > 0 else (row, theta)
+
+    monkeypatch.setattr(search_mod, "refined_start", unrefined)
+    monkeypatch.setattr(arcs_mod, "polish_positions", unpolished)
+    arcs_mod.search_arcs(t, arcs, Constraints(full_turn=False), ordered=True)
+    first = next(i for i, f in enumerate(floors) if f > 0)
+    assert first > 0 and set(floors[:first]) == {0.0} and len(set(floors[first:])) == 1
+    assert np.isclose(floors[first], np.radians(1.0 + arcs_mod.TOGGLE_GUARD_DEG), rtol=1e-12)
+    assert len(floors) - first <= arcs_mod.ROUNDS[0][1]
+
+    # a start within BASIN in the first round: no guard round
+    floors.clear()
+
+    def exact(obj, row, b, stop, max_ratio, floor=0.0):
+        floors.append(floor)
+        return true, th
+
+    monkeypatch.setattr(search_mod, "refined_start", exact)
+    _, swing = arcs_mod.search_arcs(np.column_stack([x[0], y[0]]), arcs, Constraints(full_turn=False), ordered=True, stop=1e-9)
+    assert floors == [0.0] and swing is not None
