@@ -195,8 +195,9 @@ class FourBarSpec(_Strict):
     """The named point ``coupler_point`` in the coupler's frame: origin at the crank pin B, x toward the
     rocker pin C, e.g. ``[5.5, -2.0]``."""
     circuit: Literal["open", "crossed"] = "open"
-    """Assembly: ``"open"`` (C left of the diagonal B -> O4, declared with the crank at 90 degrees) or
-    ``"crossed"``."""
+    """Assembly: ``"open"`` (C left of the directed diagonal B -> O4 at every crank angle) or ``"crossed"`` (C to
+    its right); a change-point four-bar, whose two circuits meet, is declared with the crank at 90 degrees and
+    carried on by continuity."""
     placement: tuple[Real, Real, Real] = (0.0, 0.0, 0.0)
     """``[x, y, angle]`` of the whole linkage in the world (angle in the scene's angle unit), e.g.
     ``[0.0, 0.0, 0.0]``."""

@@ -313,10 +313,11 @@ def untimed_cautions(n: int, theta: Array | None) -> list[str]:
     out = []
     if n < FIXED_FROM:
         family = "a one-parameter family" if n == 8 else "a finite number" if n == 9 else f"a {9 - n}-parameter family"
+        timing = "" if theta is None else ", or their crank angles,"  # a rocking search takes no angles
         out.append(
-            f"{n} untimed targets do not fix the curve: {family} of four-bars pass through them, so between and beyond "
-            f"the targets this curve is one of several (give {FIXED_FROM} or more targets spread along the curve, or "
-            "their crank angles, to pin it down)"
+            f"{n} untimed targets do not fix the curve: through {n} points {family} of four-bars pass, so between and "
+            f"beyond the targets this curve is one of several (give {FIXED_FROM} or more targets spread along the "
+            f"{'arc' if theta is None else 'curve'}{timing} to pin it down)"
         )
     if theta is None:
         return out
@@ -480,7 +481,7 @@ def _rocking_checked(
     d.checks["ok_constraints"] = not d.checks["constraint_failures"]
     d.checks["stages_s"] = r.stages
     a, b = d.checks["input_swing_deg"]
-    d.checks["found_by"] = f"{source}; the input rocks between {a:.4g} and {b:.4g} deg from the ground line"
+    d.checks["found_by"] = f"{source}; the input rocks between {a:.2f} and {b:.2f} deg from the ground line"
     d.checks["input"] = "rocks"
     d.checks["input_link"] = "rocks" if rocking_range(p, r.theta) is not None else "could turn fully"
     if d.checks["input_link"] != "rocks":

@@ -176,3 +176,21 @@ def test_the_scene_comment_calls_a_rocking_input_an_input_not_a_crank() -> None:
     turns = SimpleNamespace(theta=[-0.5, 7.0], checks={})
     line = _angles_comment(turns)
     assert line.startswith("crank angle at each target")
+
+
+def test_a_miss_against_the_link_ratio_limit_says_so() -> None:
+    # a trial's 9 drawn points came back 0.004 of the size off with its longest link 9.98 times its shortest and
+    # nothing said the search had stopped against --max-ratio; the accuracy line now says so, and only then
+    from planar.cli.synth import _path_failing
+
+    def design(links):
+        checks = {"ok_accuracy": False, "max_error": 0.004, "tolerance": 1e-3, "size": 12.3, "rms_error": 0.0028}
+        return SimpleNamespace(
+            checks=checks, sse=0.01, targets=np.zeros((9, 2)), **dict(zip(("ground", "crank", "coupler", "rocker"), links))
+        )
+
+    at = _path_failing(design([32.85, 33.0, 3.3075, 25.0]), max_ratio=10.0)
+    assert len(at) == 1 and "--max-ratio 10" in at[0] and f"{33.0 / 3.3075:.3g} times its shortest" in at[0]
+    below = _path_failing(design([32.85, 33.0, 6.0, 25.0]), max_ratio=10.0)
+    assert len(below) == 1 and "max-ratio" not in below[0]
+    assert "max-ratio" not in _path_failing(design([32.85, 33.0, 3.3075, 25.0]))[0]  # no limit given
