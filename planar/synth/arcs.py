@@ -369,8 +369,11 @@ def input_swing(row: Array, theta: Array) -> tuple[float, float] | None:
 #: (:func:`planar.synth.search.refined_start`)
 SEARCH_K, SEARCH_REFINE = 64, 32
 #: the rounds of :func:`search_arcs`: neighbours per query, and how many starts may have been refined by the round's
-#: end (its own and the rounds' before); a round runs only when none before it ended within :data:`BASIN`
+#: end (its own and the rounds' before); a later round runs only when the best so far is a near miss: beyond
+#: :data:`BASIN` but within ``NEAR_MISS`` (the targets' size 1).  Drawn or noisy targets, which no four-bar meets,
+#: stop after the first round
 ROUNDS = ((SEARCH_K, SEARCH_REFINE), (256, 128))
+NEAR_MISS = 1e-3
 #: the final polish (:func:`planar.synth.positions.polish_positions`): iterations per start, and how many of the best
 #: refined starts (each on one swing) it is tried on, best first, until one is within the search's stop or
 #: :data:`BASIN`
@@ -379,11 +382,12 @@ POLISH_ITERS, POLISH_STARTS = 600, 8
 #: polished on.  On a short arc the last digits come slowly (the nearest four-bars lie in a narrow valley), so a
 #: search whose stop is far below this would try every start before polishing the one already found
 BASIN = 1e-7
-#: when the rounds end with nothing usable or nothing within ``GUARD_AFTER`` (the targets' size 1), the first
-#: round's starts are refined again keeping the transmission angle at the targets ``TOGGLE_GUARD_DEG`` beyond the
-#: floor a result must keep (:func:`planar.synth.positions.polish_positions`'s ``floor``): on some arcs most starts
-#: otherwise end at a toggle, where the arc turns back and fits the targets loosely, and are not usable
-GUARD_AFTER, TOGGLE_GUARD_DEG = 1e-4, 0.2
+#: when the rounds end with nothing usable or nothing within ``GUARD_AFTER`` (the targets' size 1), and most of
+#: their starts ended unusable, the ``GUARD_STARTS`` best of the first round's starts are refined again keeping the
+#: transmission angle at the targets ``TOGGLE_GUARD_DEG`` beyond the floor a result must keep
+#: (:func:`planar.synth.positions.polish_positions`'s ``floor``): on some arcs most starts otherwise end at a toggle,
+#: where the arc turns back and fits the targets loosely, and are not usable
+GUARD_AFTER, TOGGLE_GUARD_DEG, GUARD_STARTS = 1e-4, 0.2, 8
 
 
 def on_swing(theta: Array, swing: tuple[float, float]) -> Array:
@@ -486,9 +490,10 @@ def search_arcs(
 
     Past the targets' own curve equation, the search runs in :data:`ROUNDS`: each looks up more neighbours, refines
     the starts not yet tried best first (:func:`_tried_starts`) and polishes the best few (:func:`_polished`); a
-    round runs only when none before it ended within :data:`BASIN`.  When they end with nothing usable or nothing
-    within :data:`GUARD_AFTER`, the first round's starts are refined once more keeping the transmission angle at
-    the targets :data:`TOGGLE_GUARD_DEG` beyond the floor (docs/explanation/coupler-curve-atlas.md)."""
+    later round runs only when the best so far is a near miss (beyond :data:`BASIN`, within :data:`NEAR_MISS`).  When
+    they end with nothing usable or nothing within :data:`GUARD_AFTER`, and most of their starts were unusable, the
+    :data:`GUARD_STARTS` best starts are refined once more keeping the transmission angle at the targets
+    :data:`TOGGLE_GUARD_DEG` beyond the floor (docs/explanation/coupler-curve-atlas.md)."""
     import dataclasses
 
     from planar.synth.search import (
@@ -522,7 +527,8 @@ def search_arcs(
     tried: list[Array] = []
     best: Found | None = None
 
-    def one_round(k: int, limit: int, tried: list[Array], floor: float) -> None:
+    def one_round(k: int, limit: int, tried: list[Array], floor: float) -> int:
+        """One round; returns how many of its starts ended on a usable swing."""
         nonlocal best
         t1 = time.perf_counter()
         every = arc_candidates(arcs, t, k)
@@ -536,16 +542,18 @@ def search_arcs(
             stages[key] = stages.get(key, 0.0) + s
         if polished is not None and (best is None or polished[0] < best[0]):
             best = polished
+        return len(found)
 
-    for k, limit in ROUNDS:
-        one_round(k, limit, tried, 0.0)
-        if best is not None and best[0] <= max(stop, BASIN):
-            break
-    else:
-        if best is None or best[0] > GUARD_AFTER:  # the first round's starts again, kept off the toggles
-            guarded: list[Array] = []
-            one_round(*ROUNDS[0], guarded, guard)
-            tried += guarded
+    usable_starts = 0
+    for i, (k, limit) in enumerate(ROUNDS):
+        if i and (best is None or best[0] <= max(stop, BASIN) or best[0] > NEAR_MISS):
+            break  # found, or not near enough for more starts to be worth their time (drawn or noisy targets)
+        usable_starts += one_round(k, limit, tried, 0.0)
+    far = best is None or best[0] > GUARD_AFTER
+    if far and 2 * usable_starts < len(tried):  # most starts ended unusable, at a toggle: again, kept off them
+        guarded: list[Array] = []
+        one_round(ROUNDS[0][0], GUARD_STARTS, guarded, guard)
+        tried += guarded
     if best is None:
         return None, None
     _, r, tt, swing = best

@@ -330,8 +330,9 @@ def test_the_positions_transmission_term_is_the_law_of_cosines_and_its_floor_a_b
 
 def test_the_toggle_guard_round_runs_only_when_the_rounds_end_far(monkeypatch):
     # the guard round (the first round's starts again, the transmission angle kept off the toggles) runs after the
-    # rounds end with nothing within GUARD_AFTER, and not when a start is within BASIN; it is the last round, with
-    # at most the first round's starts, at the floor plus TOGGLE_GUARD_DEG
+    # rounds end with nothing within GUARD_AFTER and most starts unusable, and not when a start is within BASIN; it
+    # is the last round, with at most the first round's starts, at the floor plus TOGGLE_GUARD_DEG; with nothing
+    # usable after the first round the second (a near miss's) does not run
     import planar.synth.search as search_mod
     from planar.synth import arcs as arcs_mod
     from planar.synth.kernel import coupler_points
@@ -357,13 +358,19 @@ def test_the_toggle_guard_round_runs_only_when_the_rounds_end_far(monkeypatch):
     def unpolished(t, row, theta, iters, max_ratio, floor=0.0):
         return polish(t, row, theta, iters, max_ratio, floor) if floor > 0 else (row, theta)
 
+    swing_of = arcs_mod.usable_swing
+
+    def toggling(*a, **k):  # every unguarded start ends at a toggle (unusable), as on the arc that showed it
+        return swing_of(*a, **k) if floors and floors[-1] > 0 else None
+
     monkeypatch.setattr(search_mod, "refined_start", unrefined)
     monkeypatch.setattr(arcs_mod, "polish_positions", unpolished)
+    monkeypatch.setattr(arcs_mod, "usable_swing", toggling)
     arcs_mod.search_arcs(t, arcs, Constraints(full_turn=False), ordered=True)
     first = next(i for i, f in enumerate(floors) if f > 0)
     assert first > 0 and set(floors[:first]) == {0.0} and len(set(floors[first:])) == 1
     assert np.isclose(floors[first], np.radians(1.0 + arcs_mod.TOGGLE_GUARD_DEG), rtol=1e-12)
-    assert len(floors) - first <= arcs_mod.ROUNDS[0][1]
+    assert first == arcs_mod.ROUNDS[0][1] and len(floors) - first <= arcs_mod.GUARD_STARTS  # nothing usable: no round 2
 
     # a start within BASIN in the first round: no guard round
     floors.clear()
@@ -373,5 +380,6 @@ def test_the_toggle_guard_round_runs_only_when_the_rounds_end_far(monkeypatch):
         return true, th
 
     monkeypatch.setattr(search_mod, "refined_start", exact)
+    monkeypatch.setattr(arcs_mod, "usable_swing", swing_of)
     _, swing = arcs_mod.search_arcs(np.column_stack([x[0], y[0]]), arcs, Constraints(full_turn=False), ordered=True, stop=1e-9)
     assert floors == [0.0] and swing is not None
