@@ -77,6 +77,14 @@ def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, An
             print(f"check failed: {f}")
         for c in report.get("checks", {}).get("cautions", []):
             print(f"caution: {c}")
+        if "[fabrication]" not in text:  # a trial's CSV in millimetres would have been cut ten times too large
+            from planar.scene.schema import FabricationSpec
+
+            mm = FabricationSpec.model_fields["unit_mm"].default
+            print(
+                f"note: no --unit-mm: the scene is cut at planar's default of {mm:g} mm a unit (--unit-mm N says what "
+                "one unit of your numbers is in millimetres, e.g. --unit-mm 1 for millimetres)"
+            )
     return 0 if ok else EXIT_CHECK
 
 

@@ -291,10 +291,12 @@ def transmission_cautions(d: Any, cons: Constraints) -> list[str]:
     deg = d.checks.get("min_transmission_deg")
     if deg is None or cons.min_transmission > 0 or not d.checks.get("ok_transmission", True) or deg >= LOW_TRANSMISSION_DEG:
         return []
+    link = "input" if d.checks.get("input") == "rocks" else "crank"  # a rocking input is no crank (a trial's point)
     return [
-        f"the transmission angle comes within {deg:.3g} deg of a toggle (crank at {d.checks['min_transmission_at_rad']:.3g}"
-        " rad): a linkage this near folding binds or jerks there; --min-transmission N (min_transmission=, radians, "
-        "from Python) asks the search to keep N deg (40 is common advice)"
+        f"the transmission angle comes within {deg:.3g} deg of a toggle ({link} at "
+        f"{d.checks['min_transmission_at_rad']:.3g} rad from the ground line): a linkage this near folding binds or "
+        "jerks there; --min-transmission N (min_transmission=, radians, from Python) asks the search to keep N deg "
+        "(40 is common advice)"
     ]
 
 

@@ -67,7 +67,14 @@ def test_synth_writes_the_unit_it_is_given_and_refuses_a_bad_one(tmp_path, capsy
         assert main(["synth", "function", str(pairs), "--deg", "-o", str(out), "--unit-mm", bad]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and "--unit-mm" in err and not out.exists()
+    # without --unit-mm the scene keeps the default and the output says so (a trial's CSV in millimetres would
+    # have been cut ten times too large, nothing saying so); with it, no note
+    main(["synth", "function", str(pairs), "--deg", "-o", str(out)])
+    notes = [x for x in capsys.readouterr().out.splitlines() if x.startswith("note: ")]
+    assert "fabrication" not in tomllib.loads(out.read_text())
+    assert len(notes) == 1 and "10 mm a unit" in notes[0] and "--unit-mm 1" in notes[0]
     main(["synth", "function", str(pairs), "--deg", "-o", str(out), "--unit-mm", "2.5"])
+    assert "note: " not in capsys.readouterr().out
     scene = tomllib.loads(out.read_text())
     assert scene["fabrication"] == {"unit_mm": 2.5}
     assert scene["render"]["trails"] == []  # a function generator's coupler point traces nothing asked for
