@@ -141,6 +141,9 @@ class Info:
     time_ratio: float | None
     stages: list[str] = field(default_factory=list)
     chains: dict[str, list[list[str]]] = field(default_factory=dict)
+    #: the driver angles (degrees, in the valid range's terms) a rocking rotary driver swings between; None when it
+    #: turns fully or slides
+    driven_swing: tuple[float, float] | None = None
 
     def as_dict(self) -> dict[str, Any]:
         """A JSON-ready dict of every field."""
@@ -411,7 +414,16 @@ def info(mech: Mechanism, samples: int = SAMPLES) -> Info:
         time_ratio=ratios[0].time_ratio if ratios else None,
         stages=[f"{s.cam}: {' -> '.join(s.key)} ({s.mech.name})" for s in mech.stages] if cams else [],
         chains={cam: [list(c) for c in chains] for cam, chains in cams.items()} if isinstance(cams, dict) else {},
+        driven_swing=_driven_swing(d),
     )
+
+
+def _driven_swing(d: Any) -> tuple[float, float] | None:
+    """The driver angles (degrees) a rocking rotary driver ``d`` swings between: ``centre -+ amplitude``."""
+    if d.kind != "rotation" or d.amplitude is None:
+        return None
+    c, a = math.degrees(d.centre), math.degrees(abs(d.amplitude))
+    return (c - a, c + a)
 
 
 def _like_the_range(toggles: list[float], valid_range: list[tuple[float, float]]) -> list[float]:
@@ -420,6 +432,17 @@ def _like_the_range(toggles: list[float], valid_range: list[tuple[float, float]]
     ends = [e for iv in valid_range for e in iv]
     out = [next((e for e in ends if abs((e - a + 180.0) % 360.0 - 180.0) < 1e-6), a) for a in toggles]
     return sorted(out)
+
+
+def _within_the_range(swing: tuple[float, float], valid_range: list[tuple[float, float]]) -> tuple[float, float]:
+    """A driven swing (degrees) turned by whole turns into the valid range interval holding it, so both are said in
+    the same terms (as given when none holds it)."""
+    lo, hi = swing
+    for a, b in valid_range:
+        k = math.floor((lo - a) / 360.0 + 1e-12)
+        if a - 1e-9 <= lo - 360.0 * k and hi - 360.0 * k <= b + 1e-9:
+            return lo - 360.0 * k, hi - 360.0 * k
+    return lo, hi
 
 
 def format_info(r: Info) -> str:
@@ -439,6 +462,9 @@ def format_info(r: Info) -> str:
         shown = _like_the_range(r.toggle_angles, r.valid_range)
         lines.append("toggle (limit) driver angles: " + ", ".join(f"{a:.4f} deg" for a in shown))
     lines.append("valid range: " + (", ".join(f"{a:.4g} to {b:.4g} deg" for a, b in r.valid_range) or "none"))
+    if r.driven_swing is not None:  # a trial read only the whole valid range of a scene whose driver rocks
+        lo, hi = _within_the_range(r.driven_swing, r.valid_range)
+        lines.append(f"driven swing (the scene's driver rocks): {lo:.4g} to {hi:.4g} deg")
     for o in r.outputs:
         what = {"turns": "turns fully", "rocks": f"rocks {o.swing:.6g} deg", "slides": f"slides, stroke {o.swing:.6g}"}
         line = f"output {o.part}: {what[o.motion]}"

@@ -205,3 +205,19 @@ def test_the_text_names_toggles_as_the_valid_range_does():
     toggles = next(x for x in text.splitlines() if x.startswith("toggle (limit)"))
     assert toggles == f"toggle (limit) driver angles: {lo:.4f} deg, {hi:.4f} deg"
     assert sorted(a % 360 for a in (lo, hi)) == pytest.approx(r.toggle_angles, abs=1e-9)
+
+
+def test_the_text_gives_a_rocking_drivers_swing_in_the_valid_ranges_terms():
+    # a trial read "valid range: -53.3 to 53.3 deg" for a scene whose driver rocks from -32.4 to 42.1 deg, and
+    # nothing of that swing; the swing is centre -+ amplitude, said within the valid range (here shifted by a turn)
+    from planar.analysis.info import format_info
+
+    fb = FourBar(ground=4.0, crank=3.0, coupler=3.0, rocker=2.5, amplitude=0.5, centre=2 * math.pi + 0.2)
+    r = info(fb)
+    ((lo, hi),) = r.valid_range
+    assert r.driven_swing == pytest.approx((math.degrees(2 * math.pi - 0.3), math.degrees(2 * math.pi + 0.7)))
+    line = next(x for x in format_info(r).splitlines() if x.startswith("driven swing"))
+    a, b = (float(v) for v in line.split(": ")[1].removesuffix(" deg").split(" to "))
+    assert (a, b) == pytest.approx((math.degrees(-0.3), math.degrees(0.7)), abs=0.01) and lo <= a < b <= hi
+    assert info(FourBar(ground=4.0, crank=1.0, coupler=3.5, rocker=3.0)).driven_swing is None  # turns fully
+    assert "driven swing" not in format_info(info(FourBar(ground=4.0, crank=1.0, coupler=3.5, rocker=3.0)))
