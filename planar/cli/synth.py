@@ -382,7 +382,7 @@ def _path_result(args: argparse.Namespace, d: Any, targets: np.ndarray, kind: st
     why = _unusable(d, kind, args.pivots is not None)
     if why is not None:
         return _no_design(args, "synth path", {"targets": len(targets)}, why)
-    failing = _path_failing(d, kind, box(), args.budget, getattr(args, "max_ratio", math.inf))
+    failing = _path_failing(d, kind, box(), args.budget, args.max_ratio)
     text, what = scene()
     found = f"; found by {d.checks['found_by']}" if d.checks.get("found_by") else ""
     if "min_transmission_deg" in d.checks:  # a four-bar's (a six-bar's are in its checks)

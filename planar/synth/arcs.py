@@ -444,8 +444,10 @@ def _tried_starts(obj: Any, every: Array, limit: int, tried: list[Array], refine
     for row in every[np.argsort(f, kind="stable")]:
         if len(tried) >= limit:
             break
-        if tried and np.any(np.all(np.abs(row - np.asarray(tried)) <= 1e-9 + 1e-6 * np.abs(np.asarray(tried)), axis=1)):
-            continue
+        if tried:  # np.allclose(row, s, rtol=1e-6, atol=1e-9) against every row tried, at once
+            seen = np.asarray(tried)
+            if np.any(np.all(np.abs(row - seen) <= 1e-9 + 1e-6 * np.abs(seen), axis=1)):
+                continue
         tried.append(row)
         r, tt = refine(row)
         swing = usable(r, tt)
