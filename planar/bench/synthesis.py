@@ -579,6 +579,20 @@ def scipy_baseline(targets: Array, theta: Array | None, cpu_s: float, seed: int 
     return best, starts
 
 
+def loaded_atlases(quick: bool) -> dict[str, Any]:
+    """The closed-curve atlas and the curve-window atlas of the budget, loaded (built on first use) and their k-d
+    trees built, so no timed problem pays for either: keyword arguments of
+    :func:`planar.synth.path.synthesise_path`."""
+    from planar.synth import windows
+    from planar.synth.atlas import DEFAULT_SIZE, QUICK_SIZE, load_atlas
+
+    atlas = load_atlas(QUICK_SIZE if quick else DEFAULT_SIZE)
+    w = windows.load_windows(windows.QUICK_FOURBARS if quick else windows.DEFAULT_FOURBARS)
+    atlas.tree  # noqa: B018 (built here, not inside the first timed problem)
+    w.tree  # noqa: B018
+    return {"atlas": atlas, "windows": w}
+
+
 def bench_reachable(
     sizes: tuple[int, ...] = (8, 12, 25, 50),
     count: int = 25,
@@ -598,14 +612,12 @@ def bench_reachable(
     20,000-curve atlas."""
     from threadpoolctl import threadpool_limits
 
-    from planar.synth.atlas import DEFAULT_SIZE, QUICK_SIZE, load_atlas
-
     for k in kinds:
         if k not in REACHABLE_KINDS:
             raise PlanarError(f"bench_reachable: unknown kind {k!r} (one of {', '.join(REACHABLE_KINDS)})")
     t0 = time.process_time()
-    atlas = load_atlas(QUICK_SIZE if quick else DEFAULT_SIZE)
-    atlas.tree  # noqa: B018 (built here, not inside the first timed problem)
+    atlases = loaded_atlases(quick)
+    atlas = atlases["atlas"]
     load_s = time.process_time() - t0
     rows: list[dict[str, Any]] = []
     with threadpool_limits(1):
@@ -615,7 +627,7 @@ def bench_reachable(
             per = count if kind == "crank-rocker" or kind_count is None else kind_count
             for n in sizes:
                 for _ in range(per):
-                    rows.append(_reachable_row(rng, kind, n, atlas, quick, noise if kind == "crank-rocker" else None))
+                    rows.append(_reachable_row(rng, kind, n, atlases, quick, noise if kind == "crank-rocker" else None))
     return {
         "atlas_size": len(atlas),
         "atlas_load_cpu_s": load_s,
@@ -625,19 +637,21 @@ def bench_reachable(
     }
 
 
-def _reachable_row(rng: np.random.Generator, kind: str, n: int, atlas: Any, quick: bool, noise: float | None) -> dict[str, Any]:
+def _reachable_row(
+    rng: np.random.Generator, kind: str, n: int, atlases: dict[str, Any], quick: bool, noise: float | None
+) -> dict[str, Any]:
     """One problem of :func:`bench_reachable`: untimed and timed, and with ``noise`` (None: not) against scipy."""
     T, th = REACHABLE_KINDS[kind](rng, n)
     budget = "quick" if quick else "normal"
     rec: dict[str, Any] = {"kind": kind, "targets": n}
     for mode, theta in (("untimed", None), ("timed", th)):
         c0 = time.process_time()
-        d = synthesise_path(T, theta, budget=budget, atlas=atlas)
+        d = synthesise_path(T, theta, budget=budget, **atlases)
         rec[mode] = {"cpu_s": time.process_time() - c0, "max_error": d.checks["max_error"], "ok": d.ok}
     if noise is not None:
         noisy = T + noise * float(np.sqrt(np.mean(np.sum((T - T.mean(0)) ** 2, 1)))) * rng.standard_normal(T.shape)
         c0 = time.process_time()
-        d = synthesise_path(noisy, None, budget=budget, atlas=atlas)
+        d = synthesise_path(noisy, None, budget=budget, **atlases)
         cpu = time.process_time() - c0
         base, starts = scipy_baseline(noisy, None, cpu)
         rec["noisy"] = {"cpu_s": cpu, "planar_max_error": d.checks["max_error"], "scipy_max_error": base, "scipy_starts": starts}
@@ -674,17 +688,15 @@ def bench_targets_scaling(
     sizes: tuple[int, ...] = (8, 16, 32, 64, 128), seed: int = 7, quick: bool = False
 ) -> list[dict[str, Any]]:
     """CPU time of untimed path synthesis against the number of targets (one reachable curve each, atlas loaded)."""
-    from planar.synth.atlas import DEFAULT_SIZE, QUICK_SIZE, load_atlas
     from planar.synth.path import synthesise_path
 
-    atlas = load_atlas(QUICK_SIZE if quick else DEFAULT_SIZE)
-    atlas.tree  # noqa: B018
+    atlases = loaded_atlases(quick)
     rng = np.random.default_rng(seed)
     out = []
     for n in sizes:
         T, _ = reachable_problem(rng, n)
         c0 = time.process_time()
-        d = synthesise_path(T, None, budget="quick" if quick else "normal", atlas=atlas)
+        d = synthesise_path(T, None, budget="quick" if quick else "normal", **atlases)
         out.append({"targets": n, "cpu_s": time.process_time() - c0, "max_error": d.checks["max_error"]})
     return out
 
@@ -772,11 +784,9 @@ def bench_unreachable(count: int = 7, seed: int = 4711, quick: bool = False) -> 
     baseline's (relative 1e-9)."""
     from threadpoolctl import threadpool_limits
 
-    from planar.synth.atlas import DEFAULT_SIZE, QUICK_SIZE, load_atlas
     from planar.synth.path import synthesise_path
 
-    atlas = load_atlas(QUICK_SIZE if quick else DEFAULT_SIZE)
-    atlas.tree  # noqa: B018 (built here, not inside the first timed problem)
+    atlases = loaded_atlases(quick)
     rows: list[dict[str, Any]] = []
     with threadpool_limits(1):
         for g, (what, n, kind) in enumerate(UNREACHABLE_GROUPS):
@@ -784,7 +794,7 @@ def bench_unreachable(count: int = 7, seed: int = 4711, quick: bool = False) -> 
             for _ in range(count):
                 T = unreachable_problem(rng, n, kind)
                 c0 = time.process_time()
-                d = synthesise_path(T, None, budget="quick" if quick else "normal", atlas=atlas)
+                d = synthesise_path(T, None, budget="quick" if quick else "normal", **atlases)
                 cpu = time.process_time() - c0
                 base, starts = scipy_baseline(T, None, cpu)
                 e = float(d.checks["max_error"])

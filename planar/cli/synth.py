@@ -503,7 +503,7 @@ def _cmd_atlas(args: argparse.Namespace) -> int:
 
     from planar.synth.atlas import DEFAULT_SIZE, atlas_path, build_atlas, check_atlas_memory, read_atlas
 
-    if args.rocking:
+    if args.rocking or args.windows:
         return _cmd_arcs(args)
     size = DEFAULT_SIZE if args.size is None else args.size
     if size < 100:
@@ -542,27 +542,40 @@ MAX_ARC_FOURBARS = 1_000_000
 
 
 def _cmd_arcs(args: argparse.Namespace) -> int:
-    """``synth atlas --rocking``: the rocking-arc atlas plain ``synth path`` also tries (and ``--rocking`` uses)."""
+    """``synth atlas --rocking``: the rocking-arc atlas plain ``synth path`` also tries (and ``--rocking`` uses);
+    ``synth atlas --windows``: the curve-window atlas (:mod:`planar.synth.windows`) ``synth path`` looks part of a
+    closed curve up in (built on first need otherwise)."""
     import os
     import time
 
-    from planar.synth.arcs import DEFAULT_FOURBARS, WINDOWS, arcs_path, build_arcs, read_arcs
+    from planar.synth import arcs, windows
 
-    size = DEFAULT_FOURBARS if args.size is None else args.size
+    if args.windows:
+        flag, what, default, per = "--windows", "curve-window atlas", windows.DEFAULT_FOURBARS, len(windows.SPANS_DEG)
+        where, build = windows.windows_path, windows.build_windows
+
+        def read(path: str) -> Any:
+            return arcs.read_arcs(path, windows.KIND, per)
+
+        whose = "full-turn four-bars"
+    else:
+        flag, what, default, per = "--rocking", "rocking-arc atlas", arcs.DEFAULT_FOURBARS, len(arcs.WINDOWS)
+        where, build, read, whose = arcs.arcs_path, arcs.build_arcs, arcs.read_arcs, "rocking four-bars"
+    size = default if args.size is None else args.size
     if not 100 <= size <= MAX_ARC_FOURBARS:
-        raise InputError("--size", size, f"100 to {MAX_ARC_FOURBARS:,} four-bars (with --rocking)")
+        raise InputError("--size", size, f"100 to {MAX_ARC_FOURBARS:,} four-bars (with {flag})")
     if not 0 <= args.seed < 2**32:
         raise InputError("--seed", args.seed, "a seed from 0 to 2**32 - 1")
-    path = _atlas_output(args, str(arcs_path(size, args.seed)))
+    path = _atlas_output(args, str(where(size, args.seed)))
     if os.path.exists(path) and not args.force:
-        a = read_arcs(path)
-        print(f"{path}: rocking-arc atlas of {len(a)} arcs exists (built in {a.build_seconds:.1f} s CPU); --force rebuilds it")
+        a = read(path)
+        print(f"{path}: {what} of {len(a)} arcs exists (built in {a.build_seconds:.1f} s CPU); --force rebuilds it")
         return 0
     t0 = time.process_time()
-    a = build_arcs(size, args.seed, progress=True)
+    a = build(size, args.seed, progress=True)
     a.save(path)
     print(
-        f"wrote {path}: {len(a)} arcs of {size} rocking four-bars ({len(WINDOWS)} windows each), "
+        f"wrote {path}: {len(a)} arcs of {size} {whose} ({per} windows each), "
         f"{os.path.getsize(path) / 1e6:.1f} MB, built in {time.process_time() - t0:.1f} s CPU"
     )
     return 0
@@ -941,21 +954,30 @@ def add_parser(sub: Any) -> None:
 
     a = ss.add_parser(
         "atlas",
-        help="build the coupler-curve atlas (or --rocking: the rocking-arc atlas) untimed path synthesis searches (cached)",
+        help="build the coupler-curve atlas (or --rocking: the rocking-arc atlas; --windows: the curve-window atlas) "
+        "untimed path synthesis searches (cached)",
     )
     a.add_argument(
         "--size",
         type=int,
         default=None,
         help="four-bars in the atlas (1000000: about 25 s CPU, a 112 MB file, 580 MB of memory while building; "
-        "with --rocking 250000: about 14 s CPU, a 176 MB file)",
+        "with --rocking or --windows 250000: about 14 s CPU, a 176 MB file)",
     )
-    a.add_argument(
+    kind = a.add_mutually_exclusive_group()
+    kind.add_argument(
         "--rocking",
         action="store_true",
         help="build the rocking-arc atlas instead (four-bars whose input swings between two angles: double-rockers, "
         "rocker-cranks, triple-rockers): once it is in the cache folder, untimed synth path tries it too when the "
         "coupler-curve atlas's best is not within --tolerance",
+    )
+    kind.add_argument(
+        "--windows",
+        action="store_true",
+        help="build the curve-window atlas instead (parts of full-turn four-bars' coupler curves: 90 to 300 degree "
+        "windows of the crank's turn), which untimed synth path looks targets on part of a curve up in; otherwise "
+        "built on first need (250000 four-bars: about 14 s CPU, a 176 MB file)",
     )
     a.add_argument("--seed", type=int, default=0, help="random seed (same size and seed, same atlas)")
     a.add_argument("-o", "--output", default=None, help="atlas file (.npz) to write (default: the user cache folder)")

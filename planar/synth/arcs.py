@@ -89,7 +89,9 @@ class Arcs(DescriptorIndex):
 
     ``params`` ``(M, 6)``: input, coupler, rocker, u, v, circuit (ground 1); ``window`` ``(M, 2)``: the input
     angles (rad from the ground line) the arc runs between; ``frame`` ``(M, 4)``: centroid x, y, size and
-    rotation of the stored description; ``desc`` ``(M, 2 ARC_POINTS)``.
+    rotation of the stored description; ``desc`` ``(M, 2 ARC_POINTS)``.  ``kind``: ``"rocking"`` (this module's
+    arcs) or ``"windows"`` (windows of full-turn four-bars' curves, :mod:`planar.synth.windows`), ``per`` arcs
+    stored per four-bar; a file of one kind is not read as the other.
     """
 
     params: NDArray[np.float32]
@@ -98,6 +100,8 @@ class Arcs(DescriptorIndex):
     desc: NDArray[np.float32]
     seed: int
     build_seconds: float = 0.0
+    kind: str = "rocking"
+    per: int = len(WINDOWS)
     _tree: Any = field(default=None, repr=False)
 
     def save(self, path: str | Path) -> None:
@@ -106,7 +110,7 @@ class Arcs(DescriptorIndex):
 
         p = Path(path)
         p.parent.mkdir(parents=True, exist_ok=True)
-        meta = np.array([VERSION, ARC_POINTS, ARC_SAMPLES, len(WINDOWS), self.seed], dtype=np.int64)
+        meta = np.array([VERSION, ARC_POINTS, ARC_SAMPLES, self.per, self.seed], dtype=np.int64)
         with atomic_write(p) as fh:
             np.savez(
                 fh,
@@ -116,6 +120,7 @@ class Arcs(DescriptorIndex):
                 desc=self.desc,
                 meta=meta,
                 seconds=np.float64(self.build_seconds),
+                kind=np.array(self.kind),
             )
 
 
@@ -246,21 +251,26 @@ def arcs_path(fourbars: int = DEFAULT_FOURBARS, seed: int = 0) -> Path:
 _LOADED: dict[str, Arcs] = {}
 
 
-def read_arcs(path: str | Path) -> Arcs:
-    """Arcs written by :meth:`Arcs.save`; :class:`InputError` naming the file if it is not one."""
+def read_arcs(path: str | Path, kind: str = "rocking", per: int = len(WINDOWS)) -> Arcs:
+    """Arcs of ``kind`` (``per`` of them a four-bar) written by :meth:`Arcs.save`; :class:`InputError` naming the
+    file if it is not one (a file without a kind holds rocking arcs)."""
     p = str(path)
     if p in _LOADED:
         return _LOADED[p]
+    what = "an arc atlas" if kind == "rocking" else "a curve-window atlas"
     try:
         with np.load(p) as z:
             meta = z["meta"]
-            if meta[:4].tolist() != [VERSION, ARC_POINTS, ARC_SAMPLES, len(WINDOWS)]:
-                raise InputError(p, f"arc atlas format {meta[:4].tolist()}", "an arc atlas of this planar (rebuild it)")
-            a = Arcs(z["params"], z["window"], z["frame"], z["desc"], int(meta[4]), float(z["seconds"]))
+            stored = str(z["kind"]) if "kind" in z.files else "rocking"
+            if meta[:4].tolist() != [VERSION, ARC_POINTS, ARC_SAMPLES, per] or stored != kind:
+                raise InputError(p, f"{stored} atlas format {meta[:4].tolist()}", f"{what} of this planar (rebuild it)")
+            a = Arcs(z["params"], z["window"], z["frame"], z["desc"], int(meta[4]), float(z["seconds"]), kind, per)
+    except InputError:
+        raise
     except FileNotFoundError:
-        raise InputError(p, "missing", "an arc atlas file written by planar") from None
+        raise InputError(p, "missing", f"{what} file written by planar") from None
     except (KeyError, ValueError, OSError) as e:
-        raise InputError(p, unreadable(e, p), "an arc atlas file written by planar") from None
+        raise InputError(p, unreadable(e, p), f"{what} file written by planar") from None
     _LOADED[p] = a
     return a
 

@@ -191,6 +191,7 @@ def synthesise_path(
     min_transmission: float = 0.0,
     arcs: Any = None,
     full_turn: bool = False,
+    windows: Any = None,
 ) -> FourBarDesign:
     """A four-bar whose coupler point passes through (or nearest to) ``targets`` ``(N, 2)``.
 
@@ -198,7 +199,10 @@ def synthesise_path(
     line); ``None`` leaves them free: the targets are looked up in a
     coupler-curve atlas (:mod:`planar.synth.atlas`; ``atlas``, or the cached
     one of the budget: 20,000 curves for ``"quick"``, 1,000,000 otherwise,
-    built on first use) and refined; when that is not within ``tolerance``
+    built on first use) and refined, and when its first starts fail, as part
+    of a closed curve in the curve-window atlas (:mod:`planar.synth.windows`;
+    ``windows``, or the cached one of the budget: 5,000 four-bars for
+    ``"quick"``, 250,000 otherwise, built on first need); when that is not within ``tolerance``
     the rocking arcs are tried (:mod:`planar.synth.arcs`: four-bars whose input
     swings between two angles; ``arcs``, or the cached arc atlas of the budget
     when it is on disk; not with a pivots box, ``min_transmission`` or
@@ -237,12 +241,22 @@ def synthesise_path(
         if not isinstance(atlas, Atlas):
             raise InputError("atlas", atlas, "an Atlas (planar.synth.atlas.load_atlas), or None for the cached one")
     arcs = _check_arcs(arcs)
+    windows = _check_arcs(windows, "windows", "windows")
     t0 = time.perf_counter()
     # searched on the targets moved to their centroid and divided by their size, then mapped back
     c, s = normalisation(t)
     with threadpool_limits(1):
         search = PathSearch(
-            (t - c) / s, normalised(cons, c, s), budget, seed, tolerance, atlas, ordered, arcs, full_turn=bool(full_turn)
+            (t - c) / s,
+            normalised(cons, c, s),
+            budget,
+            seed,
+            tolerance,
+            atlas,
+            ordered,
+            arcs,
+            full_turn=bool(full_turn),
+            windows=windows,
         )
         r, source, swing = search.run(theta)
     d, p = design_from(r, c, s, t, theta is not None, time.perf_counter() - t0)
@@ -370,13 +384,16 @@ def check_path_args(
     return t, theta, cons
 
 
-def _check_arcs(arcs: Any) -> Any:
-    """``arcs``: None or a rocking-arc atlas (:class:`planar.synth.arcs.Arcs`); :class:`InputError` otherwise."""
+def _check_arcs(arcs: Any, name: str = "arcs", kind: str = "rocking") -> Any:
+    """``arcs`` (the argument ``name``): None or an arc atlas of ``kind`` (:class:`planar.synth.arcs.Arcs`:
+    ``"rocking"`` from :func:`planar.synth.arcs.load_arcs`, ``"windows"`` from
+    :func:`planar.synth.windows.load_windows`); :class:`InputError` otherwise."""
     if arcs is not None:
         from planar.synth.arcs import Arcs
 
-        if not isinstance(arcs, Arcs):
-            raise InputError("arcs", arcs, "an Arcs (planar.synth.arcs.load_arcs), or None for the cached one")
+        loader = "planar.synth.arcs.load_arcs" if kind == "rocking" else "planar.synth.windows.load_windows"
+        if not isinstance(arcs, Arcs) or arcs.kind != kind:
+            raise InputError(name, arcs, f"an Arcs of kind {kind!r} ({loader}), or None for the cached one")
     return arcs
 
 

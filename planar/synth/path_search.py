@@ -72,9 +72,11 @@ class PathSearch:
     search; ``atlas``: the closed-curve atlas (None: the cached one of the budget, loaded on first need);
     ``ordered``: the branch must pass the targets in their order; ``arcs``: the rocking-arc atlas (None: the cached
     one of the budget when it is on disk); ``full_turn``: only an input that turns fully (the rocking arcs are not
-    tried).  :meth:`run` returns the result (a
+    tried); ``windows``: the curve-window atlas (None: the cached one of the budget, loaded on first need).
+    :meth:`run` returns the result (a
     :class:`planar.synth.search.SearchResult` whose ``stages`` hold every stage's seconds: ``atlas_load_s``,
-    ``algebraic_s``, ``atlas_s``, ``refine_s``, ``timed_s`` or ``closed_form_s``, ``rocking_s``, and
+    ``algebraic_s``, ``atlas_s``, ``windows_load_s``, ``windows_s``, ``refine_s``, ``timed_s`` or ``closed_form_s``,
+    ``rocking_s``, and
     ``global_sample_s``, ``global_de_s``, ``global_refine_s`` when the global search ran), the sentence saying which
     stage produced it, and the input's swing when it rocks."""
 
@@ -88,6 +90,7 @@ class PathSearch:
     arcs: Any = None
     stages: dict[str, float] = field(default_factory=dict)
     full_turn: bool = False
+    windows: Any = None
 
     def __post_init__(self) -> None:
         self._given = self.atlas
@@ -107,6 +110,17 @@ class PathSearch:
         elif self.atlas is self._given:
             self.stages.setdefault("atlas_load_s", 0.0)
         return self.atlas
+
+    def loaded_windows(self) -> Any:
+        """The curve-window atlas (:mod:`planar.synth.windows`), loaded (or built) on first need: only when the closed
+        curve's first starts fail."""
+        if self.windows is None:
+            from planar.synth.windows import DEFAULT_FOURBARS, QUICK_FOURBARS, load_windows
+
+            t0 = time.perf_counter()
+            self.windows = load_windows(QUICK_FOURBARS if self.budget == "quick" else DEFAULT_FOURBARS, progress=True)
+            self.stages["windows_load_s"] = time.perf_counter() - t0
+        return self.windows
 
     def _distance(self, r: Any, theta: Array | None, cons: Constraints | None = None) -> float:
         """Largest distance from a target to the coupler point of result ``r`` (at ``theta``, or at its own angles)."""
@@ -188,7 +202,7 @@ class PathSearch:
         if e_before <= self.tolerance:
             return r, source, swing
         t0 = time.perf_counter()
-        again = search_atlas(self.t, self.loaded_atlas(), floored, ordered=self.ordered)
+        again = search_atlas(self.t, self.loaded_atlas(), floored, ordered=self.ordered, windows=self.loaded_windows)
         stages = {**r.stages, "floor_s": time.perf_counter() - t0}
         if not (keeps_transmission(again, floored) and self._usable(again)):
             r.stages = stages
@@ -237,7 +251,7 @@ class PathSearch:
         distance, what the check judges)."""
         from planar.synth.search import search_atlas
 
-        r = search_atlas(self.t, self.loaded_atlas(), self.cons, ordered=self.ordered)
+        r = search_atlas(self.t, self.loaded_atlas(), self.cons, ordered=self.ordered, windows=self.loaded_windows)
         good = self._usable(r)
         e_atlas = self._distance(r, None)
         if good and e_atlas <= self.tolerance:

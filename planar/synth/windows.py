@@ -1,0 +1,145 @@
+"""Part of a closed curve: an atlas of the open windows of full-turn four-bars' coupler curves.
+
+Targets on part of a crank-rocker's or drag-link's coupler curve (an arc of the
+crank's turn, an open target set) are described badly as a closed curve: the
+periodic spline through them (:func:`planar.synth.atlas.smooth_closed`) closes
+the gap with a curve the four-bar does not trace, and the closed-curve atlas's
+neighbours of that description are far from the true four-bar.  This atlas
+describes such targets as what they are, an open arc.
+
+Each entry is one four-bar whose crank turns fully (sampled as the closed-curve
+atlas's, :func:`planar.synth.atlas._sample_linkages`: crank or ground shortest,
+Grashof, longest / shortest at most 10, the coupler point within about two
+coupler lengths, either circuit) and one *window* of its crank's turn: a span
+of :data:`SPANS_DEG` starting at a random crank angle.  The coupler point is
+solved at :data:`~planar.synth.arcs.ARC_SAMPLES` crank angles over the window
+and described as the rocking arcs are (:func:`planar.synth.arcs.describe_open`:
+resampled by arc length, normalised for position, scale and the chord's
+direction), so the rocking-arc storage, lookup and placement serve it
+(:class:`planar.synth.arcs.Arcs`; ``window`` holds the crank angles the arc runs
+between).  :func:`window_candidates` gives rows for the closed-curve search's
+refinement (:func:`planar.synth.search.search_atlas`), as
+:func:`planar.synth.atlas.candidates` does.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planar.errors import InputError
+from planar.synth.arcs import ARC_POINTS, ARC_SAMPLES, MIN_CHORD, Arcs, describe_open, read_arcs
+from planar.synth.kernel import coupler_points
+
+__all__ = [
+    "DEFAULT_FOURBARS",
+    "QUICK_FOURBARS",
+    "SPANS_DEG",
+    "build_windows",
+    "load_windows",
+    "window_candidates",
+    "windows_path",
+]
+
+Array = NDArray[np.float64]
+
+#: format version of the files on disk (a change rebuilds them)
+VERSION = 1
+#: the spans (degrees of the crank's turn) of the windows stored per four-bar, each from its own random start
+SPANS_DEG = (75.0, 130.0, 190.0, 260.0)
+#: the kind stored in the files (:class:`planar.synth.arcs.Arcs`), so neither atlas is read as the other
+KIND = "windows"
+#: four-bars of the default window atlas (each gives ``len(SPANS_DEG)`` entries) and of the quick budget's
+DEFAULT_FOURBARS = 250_000
+QUICK_FOURBARS = 5_000
+#: four-bars per chunk of the build
+CHUNK = 10_000
+
+
+def _chunk(seed: int, index: int, n: int) -> tuple[Array, Array, Array, Array]:
+    """One chunk of the build: params, windows, frames and descriptors of its good entries."""
+    from planar.synth.atlas import _sample_linkages
+
+    rng = np.random.default_rng([seed, 11, index])
+    p = _sample_linkages(rng, n)
+    start = rng.uniform(0.0, 2 * np.pi, (n, len(SPANS_DEG)))
+    X = np.column_stack([np.ones(n), p[:, :5], np.zeros((n, 3))])
+    f = np.linspace(0.0, 1.0, ARC_SAMPLES)
+    P, W, F, D = [], [], [], []
+    for j, span in enumerate(np.radians(SPANS_DEG)):
+        a0 = start[:, j]
+        th = a0[:, None] + span * f[None, :]
+        x, y, ok = coupler_points(X, th, p[:, 5], threads=1)
+        desc, frame = describe_open(x + 1j * y)
+        chord = np.abs((x[:, -1] - x[:, 0]) + 1j * (y[:, -1] - y[:, 0]))
+        good = ok.all(1) & np.isfinite(desc).all(1) & (frame[:, 2] > 1e-9) & (chord > MIN_CHORD * frame[:, 2])
+        P.append(p[good])
+        W.append(np.column_stack([a0, a0 + span])[good])
+        F.append(frame[good])
+        D.append(desc[good])
+    return np.concatenate(P), np.concatenate(W), np.concatenate(F), np.concatenate(D)
+
+
+def build_windows(fourbars: int = DEFAULT_FOURBARS, seed: int = 0, progress: bool = False) -> Arcs:
+    """The windows of ``fourbars`` full-turn four-bars, one per span of :data:`SPANS_DEG` (deterministic for both
+    arguments; a window of too short a chord is left out, so the entries are a little fewer than
+    ``fourbars * len(SPANS_DEG)``).  Builds in about 13 s of CPU for the default size."""
+    if fourbars < 100:
+        raise InputError("window atlas size", fourbars, "at least 100 four-bars")
+    t0 = time.process_time()
+    parts: list[tuple[Array, ...]] = []
+    bar = None
+    if progress:
+        from planar.core.progress import progress_bar
+
+        bar = progress_bar(fourbars, "curve windows", "four-bar", unit_scale=True)
+    for index, have in enumerate(range(0, fourbars, CHUNK)):
+        n = min(CHUNK, fourbars - have)
+        parts.append(tuple(a.astype(np.float32) for a in _chunk(seed, index, n)))
+        if bar is not None:
+            bar.update(n)
+    if bar is not None:
+        bar.close()
+    p, w, f, d = (np.concatenate([q[i] for q in parts]) for i in range(4))
+    return Arcs(p, w, f, d, seed, time.process_time() - t0, KIND, len(SPANS_DEG))
+
+
+def windows_path(fourbars: int = DEFAULT_FOURBARS, seed: int = 0) -> Path:
+    """The cache file of the windows of ``fourbars`` four-bars and ``seed`` (beside the closed-curve atlas)."""
+    from planar.synth.atlas import cache_dir
+
+    return cache_dir() / f"windows-v{VERSION}-{ARC_POINTS}-{fourbars}-{seed}.npz"
+
+
+def load_windows(fourbars: int = DEFAULT_FOURBARS, seed: int = 0, progress: bool = False) -> Arcs:
+    """The cached window atlas of ``fourbars`` four-bars, built and cached first if missing (one line on standard
+    error says so when ``progress``; kept in memory only when the cache folder cannot be written)."""
+    path = windows_path(fourbars, seed)
+    if path.exists():
+        return read_arcs(path, KIND, len(SPANS_DEG))
+    if progress:
+        print(
+            f"planar: building the curve-window atlas once ({fourbars:,} four-bars, {len(SPANS_DEG)} windows each, "
+            f"about {fourbars * len(SPANS_DEG) * 176 / 1e6:.0f} MB), cached at {path} (PLANAR_CACHE_DIR chooses the place)",
+            file=sys.stderr,
+            flush=True,
+        )
+    a = build_windows(fourbars, seed, progress)
+    with contextlib.suppress(OSError, InputError):  # an unwritable cache folder: kept in memory only
+        a.save(path)
+    return a
+
+
+def window_candidates(windows: Arcs, targets: Array, k: int = 64) -> Array:
+    """Full-turn four-bars a window of whose curve is near the targets ``(N, 2)`` (in order along part of the
+    curve), placed onto them: ``4 k`` rows of the kernel's 9 parameters and the circuit (as
+    :func:`planar.synth.atlas.candidates`; the targets' description both ways along and mirrored), nearest first
+    within each query."""
+    from planar.synth.arcs import arc_candidates
+
+    return arc_candidates(windows, targets, k)
