@@ -117,7 +117,7 @@ def _path_failing(
             out[-1] += _ratio_limit(d, max_ratio)
         elif k == "ok_transmission":
             c = d.checks
-            where = f"at crank angle {c['min_transmission_at_rad']:.4g} rad from the ground line"
+            where = f"at crank angle {math.degrees(c['min_transmission_at_rad']):.4g} deg from the ground line"
             out.append(_transmission_word(c["min_transmission_deg"], where, c["transmission_limit_deg"]))
         elif k == "ok_order":
             out.append("the branch does not pass the targets in their order (--ordered)")
@@ -890,9 +890,10 @@ def add_parser(sub: Any) -> None:
         default="normal",
         help="search effort of the atlas and the global search (normal, untimed: 15 or more targets on a four-bar's "
         "curve need neither, under 2 s of CPU in all; fewer on a whole curve, about 3 s when the atlas's nearest "
-        "curves find it, most of it loading the atlas; on an arc of a curve, or when the later stages run, 5 to 15 "
-        "s; up to about 20 s when the global search runs too, as with noisy or drawn targets; sixbar: about twice "
-        "that)",
+        "curves find it, most of it loading the atlas; on an arc of a curve about 3 s more to read the curve-window "
+        "atlas; when the later stages run, 5 to 15 s; up to about 20 s when the global search runs too, as with "
+        "noisy or drawn targets; sixbar: about twice that; a first run also builds the atlases it needs, once: "
+        "about 25 and 14 s)",
     )
     p.add_argument(
         "--max-ratio",
@@ -975,7 +976,7 @@ def add_parser(sub: Any) -> None:
     kind.add_argument(
         "--windows",
         action="store_true",
-        help="build the curve-window atlas instead (parts of full-turn four-bars' coupler curves: 90 to 300 degree "
+        help="build the curve-window atlas instead (parts of full-turn four-bars' coupler curves: 75 to 260 degree "
         "windows of the crank's turn), which untimed synth path looks targets on part of a curve up in; otherwise "
         "built on first need (250000 four-bars: about 14 s CPU, a 176 MB file)",
     )

@@ -308,9 +308,9 @@ def transmission_cautions(d: Any, cons: Constraints) -> list[str]:
     link = "input" if d.checks.get("input") == "rocks" else "crank"  # a rocking input is no crank (a trial's point)
     return [
         f"the transmission angle comes within {deg:.3g} deg of a toggle ({link} at "
-        f"{d.checks['min_transmission_at_rad']:.3g} rad from the ground line): a linkage this near folding binds or "
-        "jerks there; --min-transmission N (min_transmission=, radians, from Python) asks the search to keep N deg "
-        "(40 is common advice)"
+        f"{math.degrees(d.checks['min_transmission_at_rad']):.4g} deg from the ground line): a linkage this near "
+        "folding binds or jerks there; --min-transmission N (min_transmission=, radians, from Python) asks the search "
+        "to keep N deg (20 to 40 is common advice)"
     ]
 
 

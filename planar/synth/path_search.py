@@ -58,6 +58,11 @@ def keeps_transmission(r: Any, cons: Constraints) -> bool:
     return bool(violation(np.asarray(r.params, float)[None, :], only, 1.0, 0.0)[0] <= 1e-12)
 
 
+def _windows_word(r: Any) -> str:
+    """Words saying the curve-window atlas was looked up too for search result ``r`` (empty when it was not)."""
+    return "the curve-window atlas looked up too, as for part of a curve; " if "windows_s" in r.stages else ""
+
+
 def _prefixed(stages: dict[str, float]) -> dict[str, float]:
     """The global search's stages named as such (``global_sample_s``, ``global_de_s``, ``global_refine_s``)."""
     return {f"global_{k}": v for k, v in stages.items()}
@@ -121,6 +126,24 @@ class PathSearch:
             self.windows = load_windows(QUICK_FOURBARS if self.budget == "quick" else DEFAULT_FOURBARS, progress=True)
             self.stages["windows_load_s"] = time.perf_counter() - t0
         return self.windows
+
+    def _search_atlas(self, cons: Constraints) -> Any:
+        """:func:`planar.synth.search.search_atlas` on the targets with ``cons``, the curve-window atlas loaded if its
+        stage runs; its stages each count a second once (``windows_s`` without the loading, ``windows_load_s``)."""
+        from planar.synth.search import search_atlas
+
+        before = self.stages.get("windows_load_s", 0.0)
+        r = search_atlas(self.t, self.loaded_atlas(), cons, ordered=self.ordered, windows=self.window_candidates)
+        if "windows_s" in r.stages:
+            r.stages["windows_s"] -= self.stages.get("windows_load_s", 0.0) - before
+        return r
+
+    def window_candidates(self, t: Array, k: int) -> Array:
+        """Candidate rows for targets ``t`` from the curve-window atlas (:func:`planar.synth.windows.window_candidates`,
+        ``k`` neighbours a view), the atlas loaded on this first need (:meth:`loaded_windows`)."""
+        from planar.synth.windows import window_candidates
+
+        return window_candidates(self.loaded_windows(), t, k)
 
     def _distance(self, r: Any, theta: Array | None, cons: Constraints | None = None) -> float:
         """Largest distance from a target to the coupler point of result ``r`` (at ``theta``, or at its own angles)."""
@@ -192,7 +215,6 @@ class PathSearch:
         the nearest) is searched again keeping that floor (:func:`planar.synth.search.search_atlas` with it as
         ``min_transmission``); the new result is kept when it keeps the floor, the order and the constraints."""
         from planar.synth.designs import TOGGLE_FLOOR_DEG
-        from planar.synth.search import search_atlas
 
         floor = math.radians(TOGGLE_FLOOR_DEG)
         floored = dataclasses.replace(self.cons, min_transmission=floor)
@@ -202,7 +224,7 @@ class PathSearch:
         if e_before <= self.tolerance:
             return r, source, swing
         t0 = time.perf_counter()
-        again = search_atlas(self.t, self.loaded_atlas(), floored, ordered=self.ordered, windows=self.loaded_windows)
+        again = self._search_atlas(floored)
         stages = {**r.stages, "floor_s": time.perf_counter() - t0}
         if not (keeps_transmission(again, floored) and self._usable(again)):
             r.stages = stages
@@ -249,14 +271,14 @@ class PathSearch:
         """Untimed targets by search: the closed-curve atlas, the rocking arcs (:meth:`rocking`), then the global
         search; the best of them when none is within the tolerance (usable first, then the smaller largest
         distance, what the check judges)."""
-        from planar.synth.search import search_atlas
 
-        r = search_atlas(self.t, self.loaded_atlas(), self.cons, ordered=self.ordered, windows=self.loaded_windows)
+        r = self._search_atlas(self.cons)
         good = self._usable(r)
         e_atlas = self._distance(r, None)
         if good and e_atlas <= self.tolerance:
             r.stages = {**self.stages, **r.stages}
-            return r, "the atlas lookup and refinement (the global search did not run: within the tolerance)", None
+            how = f"the atlas lookup and refinement ({_windows_word(r)}the global search did not run: within the tolerance)"
+            return r, how, None
         stages = {**self.stages, **r.stages}
         rock, swing, e_rock, rock_word = self.rocking(stages)
         if rock is not None and e_rock <= self.tolerance:
@@ -309,7 +331,7 @@ class PathSearch:
             size = arcs_mod.QUICK_FOURBARS if budget == "quick" else arcs_mod.DEFAULT_FOURBARS
             path = arcs_mod.arcs_path(size)
             if not path.exists():
-                which = f"--budget {budget}'s rocking-arc atlas ({size:,} four-bars)"
+                which = f"the rocking-arc atlas of --budget {budget} ({size:,} four-bars)"
                 build = "planar synth atlas --rocking" + ("" if size == arcs_mod.DEFAULT_FOURBARS else f" --size {size}")
                 return None, None, math.inf, f"{which} is not built ({build} builds it)"
             arcs = arcs_mod.read_arcs(path)

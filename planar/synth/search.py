@@ -28,6 +28,7 @@ screened in float32, refined and checked in float64.  Same inputs and
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -573,7 +574,7 @@ def search_atlas(
     stop: float | Any = 1e-9,
     samples: int = 128,
     ordered: bool = False,
-    windows: Any = None,
+    windows: Callable[[Array, int], Array] | None = None,
 ) -> SearchResult:
     """Untimed targets (normalised: centroid 0, size 1) from an atlas (:mod:`planar.synth.atlas`), refined.
 
@@ -582,8 +583,9 @@ def search_atlas(
     by least squares (crank angles at the targets free), best first, stopping early once the largest
     distance to a target is at most ``stop`` (model units of the normalised targets; or, a function of a row and
     its crank angles at the targets, once it returns True).  ``ordered``: a result whose branch passes the targets
-    out of order (:func:`in_order`) is kept only if no other is found.  ``windows``: the curve-window atlas
-    (:mod:`planar.synth.windows`), or a function returning it (called only when needed), or None.
+    out of order (:func:`in_order`) is kept only if no other is found.  ``windows``: None, or a function of the
+    targets and a number of neighbours giving candidate rows from the curve-window atlas
+    (:func:`planar.synth.windows.window_candidates` on an atlas, loaded when first called).
 
     When the first starts fail, the targets are looked up as part of a closed curve too: the ``refine`` best of
     their ``4 neighbours`` nearest windows (:func:`planar.synth.windows.window_candidates`) are refined.  The
@@ -616,11 +618,8 @@ def search_atlas(
     wide: list[Array] = []
     found = _refine_starts(obj, cons, b, every, refine, ordered, stop, done, tried)
     if not found and windows is not None:  # part of a closed curve: its windows' neighbours (the spline closed it)
-        from planar.synth.windows import window_candidates
-
         t2 = time.perf_counter()
-        near = window_candidates(windows() if callable(windows) else windows, t, neighbours)
-        found = _refine_starts(obj, cons, b, near, refine, ordered, stop, done, tried)
+        found = _refine_starts(obj, cons, b, windows(t, neighbours), refine, ordered, stop, done, tried)
         stages["windows_s"] = time.perf_counter() - t2
     # none reached ``stop``: the curves of the best refined four-bars looked up (they pass near every target, so
     # they describe the targets' curve better than the targets' own spline, rough across the gaps between sparse
@@ -635,7 +634,7 @@ def search_atlas(
                 break
         else:
             _longer(obj, cons, b, ordered, stop, done)
-    stages["refine_s"] = time.perf_counter() - t1
+    stages["refine_s"] = time.perf_counter() - t1 - stages.get("windows_s", 0.0)  # each second in one stage
     best = min(done, key=lambda d: d[0])
     e, r, tt = best
     feasible = not constraint_failures(r[:N_PARAMS], cons)

@@ -133,7 +133,7 @@ def test_a_linkage_near_a_toggle_is_cautioned_unless_a_limit_was_asked():
     far = SimpleNamespace(checks={"min_transmission_deg": 35.0, "min_transmission_at_rad": 0.0, "ok_transmission": True})
     assert transmission_cautions(far, Constraints()) == []
     # where: the crank's angle, or a rocking input's (a trial read "crank at" of an input that only swings)
-    assert "(crank at 0 rad from the ground line)" in said
+    assert "(crank at 0 deg from the ground line)" in said
     rocks = SimpleNamespace(checks={**near.checks, "input": "rocks"})
     (said,) = transmission_cautions(rocks, Constraints())
-    assert "(input at 0 rad from the ground line)" in said and "crank" not in said
+    assert "(input at 0 deg from the ground line)" in said and "crank" not in said

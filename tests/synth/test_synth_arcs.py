@@ -200,7 +200,7 @@ def test_plain_path_tries_the_rocking_arcs_once_built(tmp_path, capsys):
     main(cmd)
     first = json.loads(capsys.readouterr().out)
     said = first["checks"]["found_by"]
-    assert "rocking-arc atlas (5,000 four-bars) is not built" in said, said
+    assert "rocking-arc atlas of --budget quick (5,000 four-bars) is not built" in said, said
     assert f"planar synth atlas --rocking --size {QUICK_FOURBARS} builds it" in said, said  # the atlas this budget reads
     assert main(["synth", "atlas", "--rocking", "--size", str(QUICK_FOURBARS)]) == 0
     assert "rocking four-bars" in capsys.readouterr().out and arcs_path(QUICK_FOURBARS).exists()

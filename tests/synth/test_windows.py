@@ -107,7 +107,7 @@ def test_part_curves_recovered_through_their_windows():
         c = t.mean(0)
         s = float(np.sqrt(np.mean(np.sum((t - c) ** 2, 1))))
         tn = (t - c) / s
-        r = search_atlas(tn, atlas, ordered=True, windows=windows)
+        r = search_atlas(tn, atlas, ordered=True, windows=lambda q, k: win.window_candidates(windows, q, k))
         obj = PathObjective(tn, None, Constraints(), 128)
         with_w.append(max_distance(obj, np.append(r.params, r.circuit), r.theta))
         r0 = search_atlas(tn, atlas, ordered=True)
