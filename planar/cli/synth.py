@@ -89,10 +89,16 @@ def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, An
 
 
 def _path_failing(
-    d: Any, kind: str = "four-bar", box: str = "", budget: str = "normal", max_ratio: float = math.inf
+    d: Any,
+    kind: str = "four-bar",
+    box: str = "",
+    budget: str = "normal",
+    max_ratio: float = math.inf,
+    asked: tuple[str, ...] = (),
 ) -> list[str]:
     """One line per failed check of a path design, naming what failed and by how much (``kind`` and ``box``:
-    as :func:`_unreachable`'s; ``max_ratio``: ``--max-ratio``, named when a missing four-bar sits at it)."""
+    as :func:`_unreachable`'s; ``max_ratio``: ``--max-ratio``, named when a missing four-bar sits at it; ``asked``:
+    the options given that keep four-bars out of the search, named beside the noise as a reason for a near miss)."""
     out: list[str] = []
     for k, v in d.checks.items():
         if not k.startswith("ok_") or v:
@@ -114,6 +120,8 @@ def _path_failing(
                     f"(RMS {d.checks['rms_error']:.2g} of the size) may be the noise, and a --tolerance a few times it "
                     "accepts the fit"
                 )
+                if asked:
+                    out[-1] += f"; or {' and '.join(asked)} keep the nearer {kind}s out: without them it may come closer"
             out[-1] += _ratio_limit(d, max_ratio)
         elif k == "ok_transmission":
             c = d.checks
@@ -336,12 +344,14 @@ def _cmd_path(args: argparse.Namespace) -> int:
             full_turn=bool(args.full_turn or _closed_svg(args.target)),
         )
     if str(args.target).lower().endswith(".svg") and "error" not in d.checks:
-        from planar.synth.drawing import drawing_cautions, drawing_gaps
+        from planar.synth.drawing import BETWEEN_CAUTION, drawing_cautions, drawing_gaps
 
         gaps = drawing_gaps(d, args.target)
         d.checks.update(gaps)
         rocks = d.checks.get("input") == "rocks"
-        d.checks["cautions"] = [*d.checks.get("cautions", []), *drawing_cautions(gaps, args.tolerance, rocks)]
+        # the drawing itself, not a smooth curve through its sampled points, is what the path is measured against
+        kept = [c for c in d.checks.get("cautions", []) if not c.startswith(BETWEEN_CAUTION)]
+        d.checks["cautions"] = [*kept, *drawing_cautions(gaps, args.tolerance, rocks)]
 
     def scene() -> tuple[str, str]:
         fb = d.fourbar()
@@ -382,7 +392,16 @@ def _path_result(args: argparse.Namespace, d: Any, targets: np.ndarray, kind: st
     why = _unusable(d, kind, args.pivots is not None)
     if why is not None:
         return _no_design(args, "synth path", {"targets": len(targets)}, why)
-    failing = _path_failing(d, kind, box(), args.budget, args.max_ratio)
+    asked = tuple(
+        flag
+        for flag, on in (
+            ("--min-transmission", args.min_transmission > 0),
+            ("--full-turn", bool(args.full_turn)),
+            ("--pivots", args.pivots is not None),
+        )
+        if on
+    )
+    failing = _path_failing(d, kind, box(), args.budget, args.max_ratio, asked)
     text, what = scene()
     found = f"; found by {d.checks['found_by']}" if d.checks.get("found_by") else ""
     if "min_transmission_deg" in d.checks:  # a four-bar's (a six-bar's are in its checks)

@@ -289,9 +289,14 @@ def design_cautions(d: Any, cons: Constraints, untimed: bool, theta: Array | Non
     """``checks["cautions"]`` of a checked design ``d``: what ``untimed`` targets it meets leave open
     (:func:`untimed_cautions`; the crank angles ``theta`` at them, rad, when its crank turns fully, None when its
     input rocks: the swing is the arc, no span to judge; targets not met are said to be so by the accuracy check),
-    and a linkage that comes near a toggle (:func:`transmission_cautions`)."""
+    a coupler path that strays between two untimed targets (:func:`planar.synth.drawing.between_targets`, whose
+    figures join ``d.checks``) and a linkage that comes near a toggle (:func:`transmission_cautions`)."""
+    from planar.synth.drawing import between_caution, between_targets
+
     met = untimed and bool(d.checks.get("ok_accuracy"))
-    return (untimed_cautions(len(d.targets), theta) if met else []) + transmission_cautions(d, cons)
+    between = between_targets(d) if untimed else {}
+    d.checks.update(between)
+    return (untimed_cautions(len(d.targets), theta) if met else []) + between_caution(between) + transmission_cautions(d, cons)
 
 
 #: a design whose transmission angle comes nearer a toggle than this (degrees), with no ``min_transmission`` asked,

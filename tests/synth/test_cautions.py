@@ -137,3 +137,19 @@ def test_a_linkage_near_a_toggle_is_cautioned_unless_a_limit_was_asked():
     rocks = SimpleNamespace(checks={**near.checks, "input": "rocks"})
     (said,) = transmission_cautions(rocks, Constraints())
     assert "(input at 0 deg from the ground line)" in said and "crank" not in said
+
+
+def test_a_near_miss_names_the_options_that_keep_four_bars_out():
+    # a trial's point: with --min-transmission and --full-turn the near miss came from them, and the line blamed noise
+    # alone
+    from types import SimpleNamespace
+
+    from planar.cli.synth import _path_failing
+
+    checks = {"ok_accuracy": False, "max_error": 0.0075, "tolerance": 0.005, "size": 2.5, "rms_error": 0.0038}
+    d = SimpleNamespace(checks=checks, sse=7.9e-4)
+    (plain,) = _path_failing(d)
+    assert "may be the noise" in plain and "keep the nearer" not in plain
+    (asked,) = _path_failing(d, asked=("--min-transmission", "--full-turn"))
+    said = "; or --min-transmission and --full-turn keep the nearer four-bars out: without them it may come closer"
+    assert asked.endswith(said)
