@@ -69,6 +69,16 @@ def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, An
     if not ok:  # what failed, as the text output's "check failed" lines
         report["reason"] = "; ".join(failing) or "a check failed (see checks)"
     report["output"] = str(args.output)
+    notes = []
+    if "[fabrication]" not in text:  # a trial's CSV in millimetres would have been cut ten times too large
+        from planar.scene.schema import FabricationSpec
+
+        mm = FabricationSpec.model_fields["unit_mm"].default
+        notes.append(
+            f"no --unit-mm: the scene is cut at planar's default of {mm:g} mm a unit (--unit-mm N says what "
+            "one unit of your numbers is in millimetres, e.g. --unit-mm 1 for millimetres)"
+        )
+    report["notes"] = notes  # with --json too (a re-trial found the note in neither the JSON nor the text)
     if args.json:
         print(json.dumps(report, indent=2, default=float))
     else:
@@ -77,14 +87,8 @@ def _finish(args: argparse.Namespace, what: str, text: str, report: dict[str, An
             print(f"check failed: {f}")
         for c in report.get("checks", {}).get("cautions", []):
             print(f"caution: {c}")
-        if "[fabrication]" not in text:  # a trial's CSV in millimetres would have been cut ten times too large
-            from planar.scene.schema import FabricationSpec
-
-            mm = FabricationSpec.model_fields["unit_mm"].default
-            print(
-                f"note: no --unit-mm: the scene is cut at planar's default of {mm:g} mm a unit (--unit-mm N says what "
-                "one unit of your numbers is in millimetres, e.g. --unit-mm 1 for millimetres)"
-            )
+        for n in notes:
+            print(f"note: {n}")
     return 0 if ok else EXIT_CHECK
 
 
@@ -909,10 +913,10 @@ def add_parser(sub: Any) -> None:
         default="normal",
         help="search effort of the atlas and the global search (normal, untimed: 15 or more targets on a four-bar's "
         "curve need neither, under 2 s of CPU in all; fewer on a whole curve, about 3 s when the atlas's nearest "
-        "curves find it, most of it loading the atlas; on an arc of a curve about 3 s more to read the curve-window "
-        "atlas; when the later stages run, 5 to 15 s; up to about 20 s when the global search runs too, as with "
-        "noisy or drawn targets; sixbar: about twice that; a first run also builds the atlases it needs, once: "
-        "about 25 and 14 s)",
+        "curves find it, most of it loading the atlas; on an arc of a curve about 3 to 7 s more (reading the "
+        "curve-window atlas, its lookup); when the later stages run, 5 to 15 s; up to about 20 s when the global "
+        "search runs too, as with noisy or drawn targets; sixbar: about twice that; a first run also builds the "
+        "atlases it needs, once: about 25 and 14 s, peaking near 1.2 GB of memory)",
     )
     p.add_argument(
         "--max-ratio",

@@ -342,15 +342,35 @@ def untimed_cautions(n: int, theta: Array | None) -> list[str]:
         )
     if theta is None:
         return out
-    th = np.sort(np.asarray(theta, float) % (2 * np.pi))
-    gaps = np.diff(np.append(th, th[0] + 2 * np.pi))
-    span = float(np.degrees(2 * np.pi - gaps.max())) if len(th) > 1 else 0.0
+    span, clockwise = crank_span(np.asarray(theta, float))
     if span < SPAN_DEG:
         out.append(
             f"the targets lie on {span:.0f} deg of the crank's turn: beyond them the curve is weakly fixed (four-bars "
             "whose curves differ there pass as close to the targets); add targets there to pin it down"
         )
+    if clockwise:
+        out.append(
+            "the crank meets the targets in their order turning clockwise; the scene's driver turns it "
+            "counter-clockwise, so the animation meets them last to first"
+        )
     return out
+
+
+def crank_span(theta: Array) -> tuple[float, bool]:
+    """The degrees of the crank's turn the targets at crank angles ``theta`` (rad, in the targets' order) lie on, and
+    whether the crank meets them in their order turning clockwise: passed in their order one way round within one
+    turn, the angle the crank turns from the first to the last; else the smallest arc holding them all (and False)."""
+    th = np.asarray(theta, float)
+    if len(th) < 2:
+        return 0.0, False
+    fwd = np.mod(np.diff(th), 2 * np.pi)
+    back = np.mod(-np.diff(th), 2 * np.pi)
+    if fwd.sum() < 2 * np.pi:
+        return float(np.degrees(fwd.sum())), False
+    if back.sum() < 2 * np.pi:
+        return float(np.degrees(back.sum())), True
+    s = np.sort(np.mod(th, 2 * np.pi))
+    return float(np.degrees(2 * np.pi - np.diff(np.append(s, s[0] + 2 * np.pi)).max())), False
 
 
 def check_path_args(

@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planar.errors import InputError
-from planar.synth.arcs import ARC_POINTS, ARC_SAMPLES, MIN_CHORD, Arcs, describe_open, read_arcs
+from planar.synth.arcs import ARC_POINTS, ARC_SAMPLES, MIN_CHORD, Arcs, build_line, describe_open, read_arcs
 from planar.synth.kernel import coupler_points
 
 __all__ = [
@@ -123,12 +123,7 @@ def load_windows(fourbars: int = DEFAULT_FOURBARS, seed: int = 0, progress: bool
     if path.exists():
         return read_arcs(path, KIND, len(SPANS_DEG))
     if progress:
-        print(
-            f"planar: building the curve-window atlas once ({fourbars:,} four-bars, {len(SPANS_DEG)} windows each, "
-            f"about {fourbars * len(SPANS_DEG) * 176 / 1e6:.0f} MB), cached at {path} (PLANAR_CACHE_DIR chooses the place)",
-            file=sys.stderr,
-            flush=True,
-        )
+        print(build_line("curve-window atlas", fourbars, len(SPANS_DEG), path), file=sys.stderr, flush=True)
     a = build_windows(fourbars, seed, progress)
     with contextlib.suppress(OSError, InputError):  # an unwritable cache folder: kept in memory only
         a.save(path)

@@ -2,6 +2,7 @@
 four-bar exact at 8 targets whose curve was 1.4 % of the size away from theirs between the targets)."""
 
 import numpy as np
+import pytest
 
 from planar.synth.kernel import coupler_points
 from planar.synth.path import FIXED_FROM, untimed_cautions
@@ -153,3 +154,19 @@ def test_a_near_miss_names_the_options_that_keep_four_bars_out():
     (asked,) = _path_failing(d, asked=("--min-transmission", "--full-turn"))
     said = "; or --min-transmission and --full-turn keep the nearer four-bars out: without them it may come closer"
     assert asked.endswith(said)
+
+
+def test_the_span_is_the_one_the_crank_turns_through_the_targets_in_order():
+    # a re-trial's point: crank angles 62, then 196 down to 105 deg are met in order turning clockwise through 318
+    # deg, where the smallest arc holding them is 134 deg; the caution gives the turn, and says which way it goes
+    from planar.synth.path import crank_span
+
+    theta = np.radians([62.0, 350.0, 300.0, 250.0, 196.0, 160.0, 130.0, 105.0])
+    assert crank_span(theta) == pytest.approx((317.0, True))
+    assert crank_span(theta[::-1]) == pytest.approx((317.0, False))
+    s = np.radians([10.0, 200.0, 50.0, 120.0])  # out of order: the smallest arc holding them
+    assert crank_span(s) == pytest.approx((190.0, False))
+    said = untimed_cautions(12, theta)
+    assert any("clockwise" in c and "last to first" in c for c in said) and not any("deg of the crank" in c for c in said)
+    short = untimed_cautions(12, np.radians([100.0, 80.0, 60.0, 40.0, 20.0, 0.0]))
+    assert any("on 100 deg of the crank's turn" in c for c in short) and any("clockwise" in c for c in short)

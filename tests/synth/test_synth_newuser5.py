@@ -6,6 +6,7 @@ a transmission angle, a drawing's numbers for an SVG read in millimetres, the fi
 
 from __future__ import annotations
 
+import json
 import math
 import tomllib
 from types import SimpleNamespace
@@ -73,6 +74,8 @@ def test_synth_writes_the_unit_it_is_given_and_refuses_a_bad_one(tmp_path, capsy
     notes = [x for x in capsys.readouterr().out.splitlines() if x.startswith("note: ")]
     assert "fabrication" not in tomllib.loads(out.read_text())
     assert len(notes) == 1 and "10 mm a unit" in notes[0] and "--unit-mm 1" in notes[0]
+    main(["synth", "function", str(pairs), "--deg", "-o", str(out), "--json"])  # in the JSON too (a re-trial's point)
+    assert json.loads(capsys.readouterr().out)["notes"] == [notes[0].removeprefix("note: ")]
     main(["synth", "function", str(pairs), "--deg", "-o", str(out), "--unit-mm", "2.5"])
     assert "note: " not in capsys.readouterr().out
     scene = tomllib.loads(out.read_text())
