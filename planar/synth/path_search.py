@@ -133,7 +133,10 @@ class PathSearch:
         from planar.synth.search import search_atlas
 
         before = self.stages.get("windows_load_s", 0.0)
-        r = search_atlas(self.t, self.loaded_atlas(), cons, ordered=self.ordered, windows=self.window_candidates)
+        from planar.synth.search import BASIN
+
+        basin = min(BASIN, self.tolerance / 10)  # a near result ends the search well within the tolerance
+        r = search_atlas(self.t, self.loaded_atlas(), cons, ordered=self.ordered, windows=self.window_candidates, basin=basin)
         if "windows_s" in r.stages:
             r.stages["windows_s"] -= self.stages.get("windows_load_s", 0.0) - before
         return r
