@@ -310,3 +310,33 @@ def test_a_result_that_ends_the_search_is_the_one_it_returns():
     assert _record(obj, cons, row, th, obj.penalty, True, 1e-9, done)
     e, best, _ = min(done, key=lambda d: d[0])
     assert best is row and e < 1e-20
+
+
+def test_a_result_within_the_basin_is_finished_and_ends_the_search():
+    # a random crank-rocker's own dimensions moved by about 1e-8: within the basin, so it is finished in the joints'
+    # positions (to rounding level) and the search ends; a stop at or above the basin, a stop given as a function,
+    # or a result out of order when order is asked leave the search to go on
+    from planar.synth.kernel import coupler_points
+    from planar.synth.search import BASIN, Constraints, PathObjective, _basin, max_distance
+
+    rng = np.random.default_rng(20261220)
+    row, circ = random_crank_rocker(rng)
+    th = np.sort(rng.uniform(0, 2 * np.pi, 10))
+    x, y, _ = coupler_points(row[None, :], th[None, :], np.array([circ]))
+    t = np.column_stack([x[0], y[0]])
+    c, s = normalisation(t)
+    tn = (t - c) / s
+    kernel = np.append(row, circ).astype(float)
+    kernel[:6] /= s  # the lengths and the coupler point in the normalised frame, the placement moved with it
+    kernel[6:8] = (kernel[6:8] - c) / s
+    near = kernel + np.append(1e-8 * rng.standard_normal(9), 0.0)
+    obj = PathObjective(tn, None, Constraints(), 128)
+    e0 = max_distance(obj, near, th)
+    assert 1e-10 < e0 < BASIN
+    done = [(float(np.sum(e0**2)), near, th)]
+    assert _basin(obj, Constraints(), True, 1e-9, done, BASIN)
+    assert len(done) == 2 and max_distance(obj, done[1][1], done[1][2]) < 1e-11
+    assert not _basin(obj, Constraints(), True, BASIN, done[:1], BASIN)  # the stop is no stricter
+    assert not _basin(obj, Constraints(), True, lambda r, tt: False, done[:1], BASIN)  # a function stop
+    backwards = [(done[0][0], near, th[::-1])]
+    assert not _basin(obj, Constraints(), True, 1e-9, backwards, BASIN)  # out of the asked order
