@@ -55,8 +55,8 @@ def test_a_loop_between_two_targets_is_found_and_measured_as_a_dense_check_does(
     spline = CubicSpline(s, t, bc_type="natural")
     curve = spline(np.linspace(0.0, s[-1], 40_000))
     step = np.mod(theta[1] - theta[0], 2 * np.pi)
-    path = np.asarray(LOOPED.solve(theta[0] + step * np.linspace(0, 1, 3000)).points["coupler_point"], float)
-    far = np.sqrt(((path[:, None, :] - curve[None, ::4, :]) ** 2).sum(-1)).min(1).max() / d.checks["size"]
+    path = np.asarray(LOOPED.solve(theta[0] + step * np.linspace(0, 1, 1500)).points["coupler_point"], float)
+    far = np.sqrt(((path[:, None, :] - curve[None, ::8, :]) ** 2).sum(-1)).min(1).max() / d.checks["size"]
     ratio = (
         np.linalg.norm(np.diff(path, axis=0), axis=1).sum()
         / np.linalg.norm(np.diff(spline(np.linspace(s[0], s[1], 3000)), axis=0), axis=1).sum()
