@@ -192,17 +192,16 @@ def _sample_rocking(rng: np.random.Generator, n: int) -> Array:
     return np.concatenate(out)[:n]
 
 
-def _chunk(seed: int, index: int, n: int) -> tuple[Array, Array, Array, Array]:
-    rng = np.random.default_rng([seed, 7, index])
-    p = _sample_rocking(rng, n)
-    lo, hi, _ = input_range(p[:, 0], p[:, 1], p[:, 2])
-    pad = 0.01 * (hi - lo)
-    lo, hi = lo + pad, hi - pad
+def described_windows(p: Array, windows: list[tuple[Array, Array]]) -> tuple[Array, Array, Array, Array]:
+    """Four-bars ``p`` ``(n, 6)`` (input, coupler, rocker, u, v, circuit; ground 1) described over each window
+    ``(a0, a1)`` of input angles (rad, ``(n,)`` each) at :data:`ARC_SAMPLES` angles (:func:`describe_open`):
+    the params, windows, frames and descriptors of the arcs that assemble throughout and have a chord of at least
+    :data:`MIN_CHORD` of their size, every window's in turn."""
+    n = len(p)
     X = np.column_stack([np.ones(n), p[:, :5], np.zeros((n, 3))])
     f = np.linspace(0.0, 1.0, ARC_SAMPLES)
     P, W, F, D = [], [], [], []
-    for w0, w1 in WINDOWS:
-        a0, a1 = lo + w0 * (hi - lo), lo + w1 * (hi - lo)
+    for a0, a1 in windows:
         th = a0[:, None] + (a1 - a0)[:, None] * f[None, :]
         x, y, ok = coupler_points(X, th, p[:, 5], threads=1)
         desc, frame = describe_open(x + 1j * y)
@@ -215,30 +214,45 @@ def _chunk(seed: int, index: int, n: int) -> tuple[Array, Array, Array, Array]:
     return np.concatenate(P), np.concatenate(W), np.concatenate(F), np.concatenate(D)
 
 
-def build_arcs(fourbars: int = DEFAULT_FOURBARS, seed: int = 0, progress: bool = False) -> Arcs:
-    """The arcs of ``fourbars`` rocking four-bars, :data:`WINDOWS` each (deterministic for both arguments; an arc
-    too short a chord is left out, so the entries are a little fewer than ``fourbars * len(WINDOWS)``)."""
-    if fourbars < 100:
-        raise InputError("arc atlas size", fourbars, "at least 100 four-bars")
+def _chunk(seed: int, index: int, n: int) -> tuple[Array, Array, Array, Array]:
+    rng = np.random.default_rng([seed, 7, index])
+    p = _sample_rocking(rng, n)
+    lo, hi, _ = input_range(p[:, 0], p[:, 1], p[:, 2])
+    pad = 0.01 * (hi - lo)
+    lo, hi = lo + pad, hi - pad
+    return described_windows(p, [(lo + w0 * (hi - lo), lo + w1 * (hi - lo)) for w0, w1 in WINDOWS])
+
+
+def built(
+    chunk: Any, fourbars: int, seed: int, label: str, progress: bool, kind: str = "rocking", per: int = len(WINDOWS)
+) -> Arcs:
+    """The arcs (of ``kind``, ``per`` a four-bar) of ``fourbars`` four-bars from ``chunk(seed, index, n)`` in chunks
+    of :data:`CHUNK`, stored as float32, with the CPU seconds taken; a progress bar named ``label`` when
+    ``progress``."""
     t0 = time.process_time()
-    parts: list[tuple[Array, Array, Array, Array]] = []
-    have, index = 0, 0
+    parts: list[tuple[Array, ...]] = []
     bar = None
     if progress:
         from planar.core.progress import progress_bar
 
-        bar = progress_bar(fourbars, "rocking arcs", "four-bar", unit_scale=True)
-    while have < fourbars:
+        bar = progress_bar(fourbars, label, "four-bar", unit_scale=True)
+    for index, have in enumerate(range(0, fourbars, CHUNK)):
         n = min(CHUNK, fourbars - have)
-        parts.append(tuple(a.astype(np.float32) for a in _chunk(seed, index, n)))  # type: ignore[arg-type]
-        have += n
-        index += 1
+        parts.append(tuple(a.astype(np.float32) for a in chunk(seed, index, n)))
         if bar is not None:
             bar.update(n)
     if bar is not None:
         bar.close()
     p, w, f, d = (np.concatenate([q[i] for q in parts]) for i in range(4))
-    return Arcs(p, w, f, d, seed, time.process_time() - t0)
+    return Arcs(p, w, f, d, seed, time.process_time() - t0, kind, per)
+
+
+def build_arcs(fourbars: int = DEFAULT_FOURBARS, seed: int = 0, progress: bool = False) -> Arcs:
+    """The arcs of ``fourbars`` rocking four-bars, :data:`WINDOWS` each (deterministic for both arguments; an arc
+    too short a chord is left out, so the entries are a little fewer than ``fourbars * len(WINDOWS)``)."""
+    if fourbars < 100:
+        raise InputError("arc atlas size", fourbars, "at least 100 four-bars")
+    return built(_chunk, fourbars, seed, "rocking arcs", progress)
 
 
 def arcs_path(fourbars: int = DEFAULT_FOURBARS, seed: int = 0) -> Path:

@@ -125,16 +125,14 @@ def _steps(design: Any) -> Array | None:
     within one turn for a crank that turns fully, along the swing for an input that rocks; None when the targets
     are not passed in their order (the path between them then is not one stretch of the motion)."""
     from planar.synth.arcs import on_swing
+    from planar.synth.search import turn_steps
 
     th = np.asarray(design.theta, float)
     swing = design.checks.get("input_swing_rad")
-    if swing is not None:
-        d = np.diff(on_swing(th, (float(swing[0]), float(swing[1]))))
-        return d if (np.all(d > 0) or np.all(d < 0)) else None
-    fwd = np.mod(np.diff(th), 2 * np.pi)
-    back = -np.mod(-np.diff(th), 2 * np.pi)
-    span = 2 * np.pi * (1 - 1e-9)
-    return fwd if fwd.sum() < span else back if -back.sum() < span else None
+    if swing is None:
+        return turn_steps(th)
+    d = np.diff(on_swing(th, (float(swing[0]), float(swing[1]))))
+    return d if (np.all(d > 0) or np.all(d < 0)) else None
 
 
 def _lengths(p: Array) -> Array:

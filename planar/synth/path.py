@@ -360,15 +360,14 @@ def crank_span(theta: Array) -> tuple[float, bool]:
     """The degrees of the crank's turn the targets at crank angles ``theta`` (rad, in the targets' order) lie on, and
     whether the crank meets them in their order turning clockwise: passed in their order one way round within one
     turn, the angle the crank turns from the first to the last; else the smallest arc holding them all (and False)."""
+    from planar.synth.search import turn_steps
+
     th = np.asarray(theta, float)
     if len(th) < 2:
         return 0.0, False
-    fwd = np.mod(np.diff(th), 2 * np.pi)
-    back = np.mod(-np.diff(th), 2 * np.pi)
-    if fwd.sum() < 2 * np.pi:
-        return float(np.degrees(fwd.sum())), False
-    if back.sum() < 2 * np.pi:
-        return float(np.degrees(back.sum())), True
+    steps = turn_steps(th)
+    if steps is not None:
+        return float(np.degrees(abs(steps.sum()))), bool(steps.sum() < 0)
     s = np.sort(np.mod(th, 2 * np.pi))
     return float(np.degrees(2 * np.pi - np.diff(np.append(s, s[0] + 2 * np.pi)).max())), False
 

@@ -130,11 +130,9 @@ class PathSearch:
     def _search_atlas(self, cons: Constraints) -> Any:
         """:func:`planar.synth.search.search_atlas` on the targets with ``cons``, the curve-window atlas loaded if its
         stage runs; its stages each count a second once (``windows_s`` without the loading, ``windows_load_s``)."""
-        from planar.synth.search import search_atlas
+        from planar.synth.search import BASIN, search_atlas
 
         before = self.stages.get("windows_load_s", 0.0)
-        from planar.synth.search import BASIN
-
         basin = min(BASIN, self.tolerance / 10)  # a near result ends the search well within the tolerance
         r = search_atlas(self.t, self.loaded_atlas(), cons, ordered=self.ordered, windows=self.window_candidates, basin=basin)
         if "windows_s" in r.stages:

@@ -557,12 +557,23 @@ def max_distance(obj: PathObjective, row: Array, theta: Array) -> float:
     return float(np.max(np.hypot(x[0] - obj.targets[:, 0], y[0] - obj.targets[:, 1])))
 
 
+def turn_steps(theta: Array) -> Array | None:
+    """The signed steps (radians) of crank angles ``theta`` (one per target, in the targets' order) when they run one
+    way round within one turn: each in ``[0, 2 pi)`` counter-clockwise, else each in ``(-2 pi, 0]`` clockwise;
+    None when they run neither way (the branch does not pass the targets in their order)."""
+    d = np.diff(np.asarray(theta, float))
+    span = 2 * np.pi * (1 - 1e-9)
+    fwd = np.mod(d, 2 * np.pi)
+    if fwd.sum() < span:
+        return fwd
+    back = -np.mod(-d, 2 * np.pi)
+    return back if -back.sum() < span else None
+
+
 def in_order(theta: Array) -> bool:
     """Whether crank angles ``theta`` (radians, one per target in the targets' order) run one way round
-    within one turn: the branch passes the targets in their order."""
-    d = np.diff(np.asarray(theta, float)) % (2 * np.pi)
-    span = 2 * np.pi * (1 - 1e-9)
-    return bool(d.sum() < span or (-np.diff(np.asarray(theta, float)) % (2 * np.pi)).sum() < span)
+    within one turn: the branch passes the targets in their order (:func:`turn_steps`)."""
+    return turn_steps(theta) is not None
 
 
 #: a refined start this near (largest distance over the targets' size), in order when asked and keeping the

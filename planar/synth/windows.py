@@ -26,15 +26,13 @@ from __future__ import annotations
 
 import contextlib
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
 from planar.errors import InputError
-from planar.synth.arcs import ARC_POINTS, ARC_SAMPLES, MIN_CHORD, Arcs, build_line, describe_open, read_arcs
-from planar.synth.kernel import coupler_points
+from planar.synth.arcs import ARC_POINTS, Arcs, build_line, built, described_windows, read_arcs
 
 __all__ = [
     "DEFAULT_FOURBARS",
@@ -57,8 +55,6 @@ KIND = "windows"
 #: four-bars of the default window atlas (each gives ``len(SPANS_DEG)`` entries) and of the quick budget's
 DEFAULT_FOURBARS = 250_000
 QUICK_FOURBARS = 5_000
-#: four-bars per chunk of the build
-CHUNK = 10_000
 
 
 def _chunk(seed: int, index: int, n: int) -> tuple[Array, Array, Array, Array]:
@@ -68,21 +64,8 @@ def _chunk(seed: int, index: int, n: int) -> tuple[Array, Array, Array, Array]:
     rng = np.random.default_rng([seed, 11, index])
     p = _sample_linkages(rng, n)
     start = rng.uniform(0.0, 2 * np.pi, (n, len(SPANS_DEG)))
-    X = np.column_stack([np.ones(n), p[:, :5], np.zeros((n, 3))])
-    f = np.linspace(0.0, 1.0, ARC_SAMPLES)
-    P, W, F, D = [], [], [], []
-    for j, span in enumerate(np.radians(SPANS_DEG)):
-        a0 = start[:, j]
-        th = a0[:, None] + span * f[None, :]
-        x, y, ok = coupler_points(X, th, p[:, 5], threads=1)
-        desc, frame = describe_open(x + 1j * y)
-        chord = np.abs((x[:, -1] - x[:, 0]) + 1j * (y[:, -1] - y[:, 0]))
-        good = ok.all(1) & np.isfinite(desc).all(1) & (frame[:, 2] > 1e-9) & (chord > MIN_CHORD * frame[:, 2])
-        P.append(p[good])
-        W.append(np.column_stack([a0, a0 + span])[good])
-        F.append(frame[good])
-        D.append(desc[good])
-    return np.concatenate(P), np.concatenate(W), np.concatenate(F), np.concatenate(D)
+    spans = np.radians(SPANS_DEG)
+    return described_windows(p, [(start[:, j], start[:, j] + span) for j, span in enumerate(spans)])
 
 
 def build_windows(fourbars: int = DEFAULT_FOURBARS, seed: int = 0, progress: bool = False) -> Arcs:
@@ -91,22 +74,7 @@ def build_windows(fourbars: int = DEFAULT_FOURBARS, seed: int = 0, progress: boo
     ``fourbars * len(SPANS_DEG)``).  Builds in about 13 s of CPU for the default size."""
     if fourbars < 100:
         raise InputError("window atlas size", fourbars, "at least 100 four-bars")
-    t0 = time.process_time()
-    parts: list[tuple[Array, ...]] = []
-    bar = None
-    if progress:
-        from planar.core.progress import progress_bar
-
-        bar = progress_bar(fourbars, "curve windows", "four-bar", unit_scale=True)
-    for index, have in enumerate(range(0, fourbars, CHUNK)):
-        n = min(CHUNK, fourbars - have)
-        parts.append(tuple(a.astype(np.float32) for a in _chunk(seed, index, n)))
-        if bar is not None:
-            bar.update(n)
-    if bar is not None:
-        bar.close()
-    p, w, f, d = (np.concatenate([q[i] for q in parts]) for i in range(4))
-    return Arcs(p, w, f, d, seed, time.process_time() - t0, KIND, len(SPANS_DEG))
+    return built(_chunk, fourbars, seed, "curve windows", progress, KIND, len(SPANS_DEG))
 
 
 def windows_path(fourbars: int = DEFAULT_FOURBARS, seed: int = 0) -> Path:
