@@ -292,14 +292,20 @@ def read_arcs(path: str | Path, kind: str = "rocking", per: int = len(WINDOWS)) 
 def load_arcs(fourbars: int = DEFAULT_FOURBARS, seed: int = 0, progress: bool = False) -> Arcs:
     """The cached arcs of ``fourbars`` four-bars, built and cached first if missing (kept in memory only when the
     cache folder cannot be written)."""
-    path = arcs_path(fourbars, seed)
+    return cached(arcs_path(fourbars, seed), "rocking-arc atlas", fourbars, "rocking", len(WINDOWS), progress, build_arcs, seed)
+
+
+def cached(path: Path, what: str, fourbars: int, kind: str, per: int, progress: bool, build: Any, seed: int) -> Arcs:
+    """The arc atlas of ``kind`` (``per`` arcs a four-bar) cached at ``path``, read (:func:`read_arcs`), or built
+    first by ``build(fourbars, seed, progress)`` and saved there, one line (:func:`build_line`, naming it ``what``)
+    on standard error saying so when ``progress``; kept in memory only when the cache folder cannot be written."""
     if path.exists():
-        return read_arcs(path)
+        return read_arcs(path, kind, per)
     if progress:
         import sys
 
-        print(build_line("rocking-arc atlas", fourbars, len(WINDOWS), path), file=sys.stderr, flush=True)
-    a = build_arcs(fourbars, seed, progress)
+        print(build_line(what, fourbars, per, path), file=sys.stderr, flush=True)
+    a: Arcs = build(fourbars, seed, progress)
     try:
         a.save(path)
         _LOADED[str(path)] = a

@@ -24,15 +24,13 @@ refinement (:func:`planar.synth.search.search_atlas`), as
 
 from __future__ import annotations
 
-import contextlib
-import sys
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
 from planar.errors import InputError
-from planar.synth.arcs import ARC_POINTS, Arcs, build_line, built, described_windows, read_arcs
+from planar.synth.arcs import ARC_POINTS, Arcs, built, cached, described_windows
 
 __all__ = [
     "DEFAULT_FOURBARS",
@@ -88,14 +86,7 @@ def load_windows(fourbars: int = DEFAULT_FOURBARS, seed: int = 0, progress: bool
     """The cached window atlas of ``fourbars`` four-bars, built and cached first if missing (one line on standard
     error says so when ``progress``; kept in memory only when the cache folder cannot be written)."""
     path = windows_path(fourbars, seed)
-    if path.exists():
-        return read_arcs(path, KIND, len(SPANS_DEG))
-    if progress:
-        print(build_line("curve-window atlas", fourbars, len(SPANS_DEG), path), file=sys.stderr, flush=True)
-    a = build_windows(fourbars, seed, progress)
-    with contextlib.suppress(OSError, InputError):  # an unwritable cache folder: kept in memory only
-        a.save(path)
-    return a
+    return cached(path, "curve-window atlas", fourbars, KIND, len(SPANS_DEG), progress, build_windows, seed)
 
 
 def window_candidates(windows: Arcs, targets: Array, k: int = 64) -> Array:
