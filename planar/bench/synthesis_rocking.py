@@ -17,8 +17,9 @@ The problems are made from known random four-bars whose input link cannot turn f
   :data:`SUBRANGE` in from its upper end (targets usually cover part of a swing, rarely all of it).
 
 Every problem's targets therefore lie, in order, on one swing of a rocking four-bar on one circuit.  Each is
-given untimed and ordered to :func:`planar.synth.path.synthesise_rocking_path` (the rocking-arc atlas loaded
-once before the first problem: its load is not in the problems' CPU) with a tolerance of 1e-3 of the targets'
+given untimed and ordered to :func:`planar.synth.path.synthesise_rocking_path` (the rocking-arc atlas and the
+curve-window atlas loaded once before the first problem: their load is not in the problems' CPU) with a tolerance
+of 1e-3 of the targets'
 size; measured: the largest distance over the targets' size (planar's solver), whether the result keeps the
 targets on one swing of its input, in order, its whole swing assembling on one circuit, and the CPU time of
 the call (``time.process_time``, one BLAS thread).
@@ -114,11 +115,11 @@ def _counts(count: int | dict[str, int] | None, quick: bool) -> dict[str, int]:
     return {k: int(count) for k in KINDS}
 
 
-def _one(t: Array, arcs: Any, budget: str) -> dict[str, Any]:
+def _one(t: Array, arcs: Any, windows: Any, budget: str) -> dict[str, Any]:
     from planar.synth.path import synthesise_rocking_path
 
     c0 = time.process_time()
-    d = synthesise_rocking_path(t, tolerance=1e-3, ordered=True, arcs=arcs, budget=budget)
+    d = synthesise_rocking_path(t, tolerance=1e-3, ordered=True, arcs=arcs, budget=budget, windows=windows)
     cpu = time.process_time() - c0
     ch = d.checks
     kept = bool(ch.get("ok_on_one_swing") and ch.get("ok_order") and ch.get("ok_swing_assembles"))
@@ -136,24 +137,27 @@ def bench_rocking(
     ``count``: problems per kind and size (an int for both, or ``{"double": n, "triple": m}``; default
     :data:`COUNT`, :data:`QUICK_COUNT` with ``quick``); ``seed``: the problems' seed (problem ``i`` of a kind and
     size is the same whatever the other counts); ``quick``: the quick arc atlas (``budget="quick"``) and the quick
-    counts.  Returns the atlas's load CPU (s), and per kind and size the problems' largest distances over their
+    counts.  Returns the atlases' load CPU (s), and per kind and size the problems' largest distances over their
     size, CPU times (s), whether each kept its targets on one swing in order, and a summary."""
     from threadpoolctl import threadpool_limits
 
+    from planar.synth import windows as w
     from planar.synth.arcs import DEFAULT_FOURBARS, QUICK_FOURBARS, load_arcs
 
     counts = _counts(count, quick)
     budget = "quick" if quick else "normal"
     c0 = time.process_time()
     arcs = load_arcs(QUICK_FOURBARS if quick else DEFAULT_FOURBARS, progress=True)
-    arcs.tree  # noqa: B018 - the k-d tree is built on first use: here, not in the first problem
+    windows = w.load_windows(w.QUICK_FOURBARS if quick else w.DEFAULT_FOURBARS, progress=True)
+    arcs.tree  # noqa: B018 - the k-d trees are built on first use: here, not in the first problem
+    windows.tree  # noqa: B018
     load = time.process_time() - c0
     groups = []
     with threadpool_limits(1):
         for kind in KINDS:
             for n in sizes:
                 rng = np.random.default_rng([seed, n, KINDS.index(kind)])
-                rows = [_one(rocking_problem(rng, kind, n)["targets"], arcs, budget) for _ in range(counts[kind])]
+                rows = [_one(rocking_problem(rng, kind, n)["targets"], arcs, windows, budget) for _ in range(counts[kind])]
                 groups.append({"kind": kind, "targets": n, "problems": rows, **_summary(rows)})
     return {"seed": seed, "quick": quick, "atlas_arcs": len(arcs), "atlas_load_cpu_s": load, "groups": groups}
 
@@ -185,7 +189,8 @@ def format_rocking(result: dict[str, Any]) -> str:
     """The result of :func:`bench_rocking` as a table."""
     lines = [
         f"rocking inputs: seed {result['seed']}, arc atlas of {result['atlas_arcs']:,} arcs "
-        f"(loaded in {result['atlas_load_cpu_s']:.1f} s CPU); untimed, ordered; largest distance over the targets' size",
+        f"and the curve-window atlas (loaded in {result['atlas_load_cpu_s']:.1f} s CPU); untimed, ordered; largest "
+        "distance over the targets' size",
         f"{'four-bars':<15}{'targets':>8}{'problems':>9}{'<=1e-6':>8}{'<=1e-4':>8}{'<=1e-3':>8}"
         f"{'median':>10}{'CPU med':>9}{'CPU p90':>9}  on one swing, in order",
     ]

@@ -420,15 +420,21 @@ NEAR_MISS = 1e-3
 #: :data:`BASIN`
 POLISH_ITERS, POLISH_STARTS = 600, 8
 #: a start this near (largest distance over the targets' size) ends the trying of further starts: only it is
-#: polished on.  On a short arc the last digits come slowly (the nearest four-bars lie in a narrow valley), so a
-#: search whose stop is far below this would try every start before polishing the one already found
-BASIN = 1e-7
+#: polished on, and no later round runs.  On a short arc the last digits come slowly (the nearest four-bars lie in a
+#: narrow valley), so a search whose stop is far below this would try every start before polishing the one already
+#: found.  The same as the closed-curve search's (:data:`planar.synth.search.BASIN`); a caller passes a smaller one
+#: for a tolerance under ten times it
+BASIN = 1e-6
 #: when the rounds end with nothing usable or nothing within ``GUARD_AFTER`` (the targets' size 1), and most of
 #: their starts ended unusable, the ``GUARD_STARTS`` best of the first round's starts are refined again keeping the
 #: transmission angle at the targets ``TOGGLE_GUARD_DEG`` beyond the floor a result must keep
 #: (:func:`planar.synth.positions.polish_positions`'s ``floor``): on some arcs most starts otherwise end at a toggle,
 #: where the arc turns back and fits the targets loosely, and are not usable
 GUARD_AFTER, TOGGLE_GUARD_DEG, GUARD_STARTS = 1e-4, 0.2, 8
+#: the curve-window round of :func:`search_arcs` (after the first round, when it left nothing within the basin):
+#: neighbours per query in the curve-window atlas (:mod:`planar.synth.windows`: parts of the curves of four-bars whose
+#: crank turns fully, as one of a double-rocker's two cognates does) and how many of them are refined
+WINDOWS_K, WINDOWS_REFINE = 16, 16
 
 
 def on_swing(theta: Array, swing: tuple[float, float]) -> Array:
@@ -474,10 +480,12 @@ def usable_swing(
 Found = tuple[float, Array, Array, tuple[float, float]]
 
 
-def _tried_starts(obj: Any, every: Array, limit: int, tried: list[Array], refine: Any, usable: Any, stop: float) -> list[Found]:
+def _tried_starts(
+    obj: Any, every: Array, limit: int, tried: list[Array], refine: Any, usable: Any, stop: float, basin: float = BASIN
+) -> list[Found]:
     """The looked-up rows ``every`` refined (``refine(row) -> (row, angles)``) best first by ``obj``'s score at
     sampled angles, skipping rows already in ``tried`` (appended to as they are tried), until ``tried`` holds
-    ``limit`` rows or one on a usable swing (``usable(row, angles)``) is within ``stop`` or :data:`BASIN`."""
+    ``limit`` rows or one on a usable swing (``usable(row, angles)``) is within ``stop`` or ``basin``."""
     from planar.synth.search import max_distance
 
     f = obj.population(every, np.float64) if len(every) else np.zeros(0)
@@ -494,34 +502,109 @@ def _tried_starts(obj: Any, every: Array, limit: int, tried: list[Array], refine
         swing = usable(r, tt)
         if swing is not None:
             found.append((max_distance(obj, r, tt), r, tt, swing))
-            if found[-1][0] <= max(stop, BASIN):
+            if found[-1][0] <= max(stop, basin):
                 break
     return found
 
 
-def _polished(obj: Any, found: list[Found], stop: float, usable: Any, max_ratio: float, floor: float) -> Found | None:
-    """The best of ``found`` after the best few (only the best when it is within :data:`BASIN`; none when within
+def _polished(
+    obj: Any, found: list[Found], stop: float, usable: Any, max_ratio: float, floor: float, basin: float = BASIN
+) -> Found | None:
+    """The best of ``found`` after the best few (only the best when it is within ``basin``; none when within
     ``stop``) go on in the joints' positions (:func:`planar.synth.positions.polish_positions`), until one is within
-    ``stop`` or :data:`BASIN`; None when ``found`` is empty."""
+    ``stop`` or ``basin``; None when ``found`` is empty."""
     from planar.synth.search import max_distance
 
     if not found:
         return None
     found = sorted(found, key=lambda c: c[0])
     best = found[0]
-    for _, r0, tt0, _ in found[: 1 if best[0] <= BASIN else POLISH_STARTS] if best[0] > stop else []:
+    for _, r0, tt0, _ in found[: 1 if best[0] <= basin else POLISH_STARTS] if best[0] > stop else []:
         r, tt = polish_positions(obj.targets, r0, tt0, POLISH_ITERS, max_ratio, floor)
         swing = usable(r, tt)
         e = max_distance(obj, r, tt) if swing is not None else math.inf
         if swing is not None and e < best[0]:
             best = (e, r, tt, swing)
-        if best[0] <= max(stop, BASIN):
+        if best[0] <= max(stop, basin):
             break
     return best
 
 
+@dataclass
+class _Rounds:
+    """The state of :func:`search_arcs`'s rounds: the objective (normalised targets), the refinement's bounds, the
+    search's stop and basin, the usable-swing test, the link-ratio limit, the stages' seconds, the starts tried and
+    the best found so far."""
+
+    obj: Any
+    bounds: Any
+    stop: float
+    basin: float
+    usable: Any
+    max_ratio: float
+    stages: dict[str, float]
+    tried: list[Array] = field(default_factory=list)
+    best: Found | None = None
+
+    def short(self) -> bool:
+        """Whether nothing found so far is within the stop or the basin."""
+        return self.best is None or self.best[0] > max(self.stop, self.basin)
+
+    def near_miss(self) -> bool:
+        """Whether the best so far is worth more starts: beyond the stop and the basin, within :data:`NEAR_MISS`
+        (drawn or noisy targets, which no four-bar meets, are not)."""
+        return self.best is not None and max(self.stop, self.basin) < self.best[0] <= NEAR_MISS
+
+    def run(self, every: Array, limit: int, tried: list[Array], floor: float, stage: str | None = None) -> int:
+        """One round on the looked-up rows ``every``: the untried refined best first until ``tried`` holds ``limit``
+        (:func:`_tried_starts`), the best few polished (:func:`_polished`), keeping transmission ``floor`` (rad) at
+        the targets; its seconds go to ``stage``, or to ``refine_s`` and ``polish_s``.  Returns how many of its
+        starts ended on a usable swing."""
+        from planar.synth.search import refined_start
+
+        def refine(row: Array) -> tuple[Array, Array]:
+            return refined_start(self.obj, row, self.bounds, self.stop, self.max_ratio, floor)
+
+        t1 = time.perf_counter()
+        found = _tried_starts(self.obj, every, limit, tried, refine, self.usable, self.stop, self.basin)
+        t2 = time.perf_counter()
+        polished = _polished(self.obj, found, self.stop, self.usable, self.max_ratio, floor, self.basin)
+        t3 = time.perf_counter()
+        for key, sec in ((stage, t3 - t1),) if stage else (("refine_s", t2 - t1), ("polish_s", t3 - t2)):
+            self.stages[key] = self.stages.get(key, 0.0) + sec
+        if polished is not None and (self.best is None or polished[0] < self.best[0]):
+            self.best = polished
+        return len(found)
+
+    def lookup(self, arcs: Arcs, k: int) -> Array:
+        """``k`` neighbours a view in the rocking arcs, their seconds in ``arcs_s``."""
+        t1 = time.perf_counter()
+        every = arc_candidates(arcs, self.obj.targets, k)
+        self.stages["arcs_s"] = self.stages.get("arcs_s", 0.0) + time.perf_counter() - t1
+        return every
+
+    def windows_round(self, windows: Any) -> int:
+        """The curve-window round (:data:`WINDOWS_K`, :data:`WINDOWS_REFINE`): the atlas (``windows``, or a function
+        of no arguments returning it) loaded here, its seconds in ``windows_load_s``, the round's in ``windows_s``
+        (its lookup is :func:`arc_candidates`'s, as :func:`planar.synth.windows.window_candidates`)."""
+        t1 = time.perf_counter()
+        atlas = windows() if callable(windows) else windows
+        t2 = time.perf_counter()
+        self.stages["windows_load_s"] = t2 - t1
+        every = arc_candidates(atlas, self.obj.targets, WINDOWS_K)
+        self.stages["windows_s"] = time.perf_counter() - t2
+        return self.run(every, len(self.tried) + WINDOWS_REFINE, self.tried, 0.0, "windows_s")
+
+
 def search_arcs(
-    targets: Array, arcs: Arcs, cons: Any = None, stop: float = 1e-9, ordered: bool = False, input_rocks: bool = False
+    targets: Array,
+    arcs: Arcs,
+    cons: Any = None,
+    stop: float = 1e-9,
+    ordered: bool = False,
+    input_rocks: bool = False,
+    windows: Any = None,
+    basin: float = BASIN,
 ) -> tuple[Any, tuple[float, float] | None]:
     """Untimed targets (normalised: centroid 0, size 1) from the rocking arcs, refined: the best result (as
     :class:`planar.synth.search.SearchResult`) whose targets lie on one swing of its input (``ordered``: met in
@@ -530,27 +613,26 @@ def search_arcs(
     (:func:`rocking_range`; None when no result does).  ``cons``: the path's
     :class:`~planar.synth.search.Constraints` with the full turn not required (its link ratio is kept).
     ``input_rocks``: only a four-bar whose input link itself cannot turn fully (see :func:`usable_swing`).
+    ``windows``: None, or the curve-window atlas (:mod:`planar.synth.windows`) or a function of no arguments
+    returning it (called only when its round runs).  ``basin``: a result within it ends the search (see
+    :data:`BASIN`).
 
-    Past the targets' own curve equation, the search runs in :data:`ROUNDS`: each looks up more neighbours, refines
-    the starts not yet tried best first (:func:`_tried_starts`) and polishes the best few (:func:`_polished`); a
-    later round runs only when the best so far is a near miss (beyond :data:`BASIN`, within :data:`NEAR_MISS`).  When
-    they end with nothing usable or nothing within :data:`GUARD_AFTER`, and most of their starts were unusable, the
-    :data:`GUARD_STARTS` best starts are refined once more keeping the transmission angle at the targets
-    :data:`TOGGLE_GUARD_DEG` beyond the floor (docs/explanation/coupler-curve-atlas.md)."""
+    Past the targets' own curve equation, the search runs in rounds: each looks up neighbours, refines the starts
+    not yet tried best first (:func:`_tried_starts`) and polishes the best few (:func:`_polished`); a later round
+    runs only when nothing found so far is within ``basin``.  The first looks up the rocking arcs (``ROUNDS[0]``);
+    then, with ``windows`` and without ``input_rocks`` (its four-bars' cranks turn fully), the curve windows
+    (:data:`WINDOWS_K`, :data:`WINDOWS_REFINE`); then, only after a near miss (beyond ``basin``, within
+    :data:`NEAR_MISS`), the rocking arcs again, more of them (``ROUNDS[1]``).  When they end with nothing usable
+    or nothing within :data:`GUARD_AFTER`, and most of their starts were unusable, the :data:`GUARD_STARTS` best
+    starts are refined once more keeping the transmission angle at the targets :data:`TOGGLE_GUARD_DEG` beyond the
+    floor (docs/explanation/coupler-curve-atlas.md)."""
     import dataclasses
 
-    from planar.synth.search import (
-        Constraints,
-        PathObjective,
-        SearchResult,
-        default_bounds,
-        refined_start,
-    )
+    from planar.synth.search import Constraints, PathObjective, SearchResult, default_bounds
 
     cons = dataclasses.replace(cons if cons is not None else Constraints(), full_turn=False)
     t = np.asarray(targets, float)
     obj = PathObjective(t, None, cons, 256)
-    b = default_bounds(t, cons, False, turn=3 * np.pi)
 
     def usable(r: Array, tt: Array) -> tuple[float, float] | None:
         return usable_swing(r, tt, cons, obj.scale, ordered, input_rocks)
@@ -564,41 +646,24 @@ def search_arcs(
     alg, swing = search_algebraic(t, cons, choose, stop)
     if alg is not None:
         return alg, swing
-    t0 = time.perf_counter()
-    stages = {"algebraic_s": t0 - t_alg} if len(t) >= MIN_TARGETS else {}
-    guard = max(float(cons.min_transmission), math.radians(TOGGLE_FLOOR_DEG)) + math.radians(TOGGLE_GUARD_DEG)
-    tried: list[Array] = []
-    best: Found | None = None
-
-    def one_round(k: int, limit: int, tried: list[Array], floor: float) -> int:
-        """One round; returns how many of its starts ended on a usable swing."""
-        nonlocal best
-        t1 = time.perf_counter()
-        every = arc_candidates(arcs, t, k)
-        t2 = time.perf_counter()
-        found = _tried_starts(
-            obj, every, limit, tried, lambda row: refined_start(obj, row, b, stop, cons.max_ratio, floor), usable, stop
-        )
-        t3 = time.perf_counter()
-        polished = _polished(obj, found, stop, usable, cons.max_ratio, floor)
-        for key, s in (("arcs_s", t2 - t1), ("refine_s", t3 - t2), ("polish_s", time.perf_counter() - t3)):
-            stages[key] = stages.get(key, 0.0) + s
-        if polished is not None and (best is None or polished[0] < best[0]):
-            best = polished
-        return len(found)
-
-    usable_starts = 0
-    for i, (k, limit) in enumerate(ROUNDS):
-        if i and (best is None or best[0] <= max(stop, BASIN) or best[0] > NEAR_MISS):
-            break  # found, or not near enough for more starts to be worth their time (drawn or noisy targets)
-        usable_starts += one_round(k, limit, tried, 0.0)
-    far = best is None or best[0] > GUARD_AFTER
-    if far and 2 * usable_starts < len(tried):  # most starts ended unusable, at a toggle: again, kept off them
+    stages = {"algebraic_s": time.perf_counter() - t_alg} if len(t) >= MIN_TARGETS else {}
+    b = default_bounds(t, cons, False, turn=3 * np.pi)
+    rounds = _Rounds(obj, b, stop, basin, usable, cons.max_ratio, stages)
+    usable_starts = rounds.run(rounds.lookup(arcs, ROUNDS[0][0]), ROUNDS[0][1], rounds.tried, 0.0)
+    if windows is not None and not input_rocks and rounds.short():
+        usable_starts += rounds.windows_round(windows)
+    for k, limit in ROUNDS[1:]:
+        if rounds.near_miss():  # else found, or not near enough for more starts to be worth their time
+            usable_starts += rounds.run(rounds.lookup(arcs, k), limit, rounds.tried, 0.0)
+    best = rounds.best
+    if (best is None or best[0] > GUARD_AFTER) and 2 * usable_starts < len(rounds.tried):
+        # most starts ended unusable, at a toggle: again, kept off them
+        guard = max(float(cons.min_transmission), math.radians(TOGGLE_FLOOR_DEG)) + math.radians(TOGGLE_GUARD_DEG)
         guarded: list[Array] = []
-        one_round(ROUNDS[0][0], GUARD_STARTS, guarded, guard)
-        tried += guarded
-    if best is None:
+        rounds.run(rounds.lookup(arcs, ROUNDS[0][0]), GUARD_STARTS, guarded, guard)
+        rounds.tried += guarded
+    if rounds.best is None:
         return None, None
-    _, r, tt, swing = best
+    _, r, tt, swing = rounds.best
     sse = float(np.sum(np.square(row_points(r, tt) - t)))
-    return SearchResult(r[:9], 1 if r[9] >= 0 else -1, tt, sse, True, len(tried), stages), swing
+    return SearchResult(r[:9], 1 if r[9] >= 0 else -1, tt, sse, True, len(rounds.tried), stages), swing

@@ -453,12 +453,16 @@ def synthesise_rocking_path(
     budget: str = "normal",
     min_transmission: float = 0.0,
     input_rocks: bool = False,
+    windows: Any = None,
 ) -> FourBarDesign:
     """A four-bar whose input *rocks* (swings between two angles, never turning fully) and whose coupler point
     passes through ``targets`` ``(N, 2)`` (untimed, in order along its arc), from the rocking-arc atlas.
 
     ``arcs``: the atlas (default: the cached one of :data:`planar.synth.arcs.DEFAULT_FOURBARS` four-bars, or
-    :data:`~planar.synth.arcs.QUICK_FOURBARS` for ``budget="quick"``, built on first use).  Returns a
+    :data:`~planar.synth.arcs.QUICK_FOURBARS` for ``budget="quick"``, built on first use).  ``windows``: the
+    curve-window atlas (:mod:`planar.synth.windows`), looked up when the rocking arcs' first starts leave a near miss
+    (default: the cached one of the budget, read or built on that first need; not with ``input_rocks``: its
+    four-bars' cranks turn fully).  Returns a
     :class:`FourBarDesign` whose ``checks`` hold ``input_swing_rad`` and ``input_swing_deg`` (the input's swing,
     from the ground line, as ``[from, to]``), ``input_swing_world_deg`` (the same from the world's +x axis),
     ``ok_accuracy`` (largest distance over the targets' size within ``tolerance``), ``ok_swing_assembles``
@@ -475,6 +479,7 @@ def synthesise_rocking_path(
     """
     from threadpoolctl import threadpool_limits
 
+    from planar.synth.arcs import BASIN as ARCS_BASIN
     from planar.synth.arcs import DEFAULT_FOURBARS, QUICK_FOURBARS, load_arcs, search_arcs
 
     if not (check_number("max_ratio", max_ratio) > 1 and math.isfinite(max_ratio)):
@@ -484,12 +489,24 @@ def synthesise_rocking_path(
         targets, None, cons, budget, 0, tolerance, ordered, min_transmission, {"input_rocks": input_rocks}
     )
     arcs = _check_arcs(arcs)
+    windows = _check_arcs(windows, "windows", "windows")
     t0 = time.perf_counter()
     if arcs is None:
         arcs = load_arcs(QUICK_FOURBARS if budget == "quick" else DEFAULT_FOURBARS, progress=True)
+
+    def the_windows() -> Any:  # read (or built) only when the search's curve-window round runs
+        from planar.synth import windows as w
+
+        if windows is not None:
+            return windows
+        return w.load_windows(w.QUICK_FOURBARS if budget == "quick" else w.DEFAULT_FOURBARS, progress=True)
+
     c, s = normalisation(t)
+    basin = min(ARCS_BASIN, tolerance / 10)  # a near result ends the search well within the tolerance
     with threadpool_limits(1):
-        r, swing = search_arcs((t - c) / s, arcs, cons, ordered=ordered, input_rocks=input_rocks)
+        r, swing = search_arcs(
+            (t - c) / s, arcs, cons, ordered=ordered, input_rocks=input_rocks, windows=the_windows, basin=basin
+        )
     if r is None or swing is None:
         d = FourBarDesign(1.0, 1.0, 1.0, 1.0, (0.0, 0.0), "open", (0.0, 0.0, 0.0), np.zeros(len(t)), math.inf, t, False, 0.0)
         which = "whose input link cannot turn fully " if input_rocks else ""
@@ -498,6 +515,8 @@ def synthesise_rocking_path(
         return d
     d, p = design_from(r, c, s, t, False, time.perf_counter() - t0)
     source = "the rocking-arc atlas lookup and refinement" if "arcs_s" in r.stages else EQUATION_SOURCE
+    if "windows_s" in r.stages:
+        source += " (the curve-window atlas looked up too: parts of the curves of four-bars whose crank turns fully)"
     return _rocking_checked(d, r, p, swing, tolerance, ordered, cons, source, s)
 
 

@@ -338,7 +338,8 @@ class PathSearch:
             arcs = arcs_mod.read_arcs(path)
         t0 = time.perf_counter()
         rock_cons = dataclasses.replace(cons, full_turn=False)
-        r, swing = arcs_mod.search_arcs(self.t, arcs, rock_cons, ordered=self.ordered)
+        basin = min(arcs_mod.BASIN, self.tolerance / 10)
+        r, swing = arcs_mod.search_arcs(self.t, arcs, rock_cons, ordered=self.ordered, basin=basin)
         stages["rocking_s"] = time.perf_counter() - t0
         word = "the rocking-arc atlas lookup and refinement"
         if r is None or swing is None or (self.ordered and not arcs_mod.one_way(r.theta, swing)):

@@ -383,3 +383,105 @@ def test_the_toggle_guard_round_runs_only_when_the_rounds_end_far(monkeypatch):
     monkeypatch.setattr(arcs_mod, "usable_swing", swing_of)
     _, swing = arcs_mod.search_arcs(np.column_stack([x[0], y[0]]), arcs, Constraints(full_turn=False), ordered=True, stop=1e-9)
     assert floors == [0.0] and swing is not None
+
+
+def _crank_cognate(row: np.ndarray, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The Roberts cognate (Cayley's diagram, by hand) of a four-bar (kernel row: 9 parameters, circuit) that shares its
+    input pivot ``A0`` and whose input link turns with the coupler: with the coupler point ``P = A + lam (B - A)``,
+    ``P = A0 + lam (B - A) + (A - A0)`` puts the new input link along ``lam (B - A)`` and the new coupler along the old
+    input link; the new ground pivot is ``C0 = A0 + lam (B0 - A0)``.  Returns its kernel row and its input angles
+    (rad from its ground line) where the original is at ``theta``."""
+    g, a, b, c, u, v, x0, y0, phi0 = row[:9]
+    lam = complex(u, v) / b
+    k = abs(lam)
+    w = k * a / lam  # the coupler point from the new coupler's input pin, x toward its other pin
+    cog = np.array([k * g, k * b, k * a, k * c, w.real, w.imag, x0, y0, phi0 + np.angle(lam)])
+    A = complex(x0, y0) + a * np.exp(1j * (theta + phi0))
+    x, y, _ = coupler_points(row[None, :9], theta[None], row[9:10])
+    coupler_dir = np.angle(((x[0] + 1j * y[0]) - A) / lam)  # the world angle of B - A
+    return cog, coupler_dir - phi0
+
+
+def test_a_double_rockers_arc_is_found_in_the_curve_windows_through_its_crank_cognate():
+    # a Grashof double-rocker's coupler turns fully, so its cognate whose input link turns with the coupler
+    # (Cayley's diagram, built by hand above, not by planar's sextic) is a crank-rocker tracing the same arc:
+    # checked point by point; then a curve-window atlas holding only that cognate's window, looked up by the
+    # rocking search's curve-window round, recovers the arc exactly with an input that turns fully
+    from planar.synth.arcs import BASIN, Arcs, _Rounds, described_windows, input_swing, usable_swing
+    from planar.synth.search import Constraints, PathObjective, default_bounds
+
+    rng = np.random.default_rng(20261245)
+    L, lo, hi = _double_rocker(rng)
+    true = np.array([1.0, *L, 0.4 * L[1], 0.5 * L[1], 0.2, -0.1, 0.3, 1.0])
+    th = np.linspace(lo + 0.3 * (hi - lo), hi - 0.3 * (hi - lo), 12)
+    x, y, ok = coupler_points(true[None, :9], th[None], np.array([1.0]))
+    assert ok.all()
+    t = np.column_stack([x[0], y[0]])
+    cog, th2 = _crank_cognate(true, th)
+    assert not input_range(cog[1:2] / cog[0], cog[2:3] / cog[0], cog[3:4] / cog[0])[2][0]  # its input turns fully
+    traced = []
+    for circuit in (1.0, -1.0):
+        xc, yc, okc = coupler_points(cog[None], th2[None], np.array([circuit]))
+        traced.append(np.abs(xc[0] + 1j * yc[0] - (x[0] + 1j * y[0])).max() if okc.all() else np.inf)
+    circuit = 1.0 if traced[0] <= traced[1] else -1.0
+    assert min(traced) < 1e-12 * np.ptp(t, axis=0).max()
+
+    c = t.mean(axis=0)
+    s = float(np.sqrt(np.mean(np.sum((t - c) ** 2, axis=1))))
+    tn = (t - c) / s
+    p6 = np.append(cog[1:6] / cog[0], circuit)[None]
+    u = np.unwrap(th2)
+    P, W, F, D = described_windows(p6, [(np.array([u.min() - 0.1]), np.array([u.max() + 0.1]))])
+    assert len(P) == 1
+    f32 = np.float32
+    atlas = Arcs(P.astype(f32), W.astype(f32), F.astype(f32), D.astype(f32), seed=0, kind="windows", per=1)
+    cons = Constraints(full_turn=False)
+    obj = PathObjective(tn, None, cons, 256)
+    stages: dict[str, float] = {}
+    loads = []
+
+    def usable(r, tt):
+        return usable_swing(r, tt, cons, obj.scale, True)
+
+    def loader():
+        loads.append(1)
+        return atlas
+
+    rounds = _Rounds(obj, default_bounds(tn, cons, False, turn=3 * np.pi), 1e-9, BASIN, usable, 10.0, stages)
+    assert rounds.windows_round(loader) >= 1 and loads == [1]
+    e, r, tt, swing = rounds.best
+    # within the basin (on a 29-degree arc a family of four-bars lies within 1e-8 of the targets: the refinement
+    # from the true four-bar itself, its dimensions changed by 1e-7, ends 2e-8 to 9e-7 away, wandering along it)
+    assert e <= BASIN and set(stages) == {"windows_load_s", "windows_s"}
+    assert rocking_range(r[:9], tt) is None and input_swing(r[:9], tt) == swing  # a crank, swung over the targets
+
+
+def test_the_curve_window_round_runs_when_the_first_round_leaves_nothing_within_the_basin(monkeypatch):
+    # the rounds' order: the rocking arcs, then (windows given, no input_rocks, nothing within the basin) the curve
+    # windows, then (a near miss) more rocking arcs
+    from planar.synth import arcs as arcs_mod
+    from planar.synth.search import Constraints
+
+    rng = np.random.default_rng(20261246)
+    L, lo, hi = _double_rocker(rng)
+    true = np.array([1.0, *L, 0.3, 0.2, 0.0, 0.0, 0.1])
+    th = np.linspace(lo + 0.2 * (hi - lo), hi - 0.2 * (hi - lo), 12)
+    x, y, _ = coupler_points(true[None], th[None], np.array([1.0]))
+    t = np.column_stack([x[0], y[0]])
+    t = (t - t.mean(axis=0)) / np.sqrt(np.mean(np.sum((t - t.mean(axis=0)) ** 2, axis=1)))
+    arcs = build_arcs(arcs_mod.QUICK_FOURBARS, seed=0)
+    calls: list[str] = []
+    monkeypatch.setattr(arcs_mod._Rounds, "run", lambda self, every, limit, tried, floor, stage=None: calls.append("run") or 0)
+    monkeypatch.setattr(arcs_mod._Rounds, "windows_round", lambda self, w: calls.append("windows") or 0)
+    for short, near, windows, rocks, want in (
+        (True, True, "w", False, ["run", "windows", "run"]),
+        (True, False, "w", False, ["run", "windows"]),  # nothing usable, or far: no second round of arcs
+        (True, True, None, False, ["run", "run"]),
+        (True, True, "w", True, ["run", "run"]),
+        (False, False, "w", False, ["run"]),
+    ):
+        calls.clear()
+        monkeypatch.setattr(arcs_mod._Rounds, "short", lambda self, short=short: short)
+        monkeypatch.setattr(arcs_mod._Rounds, "near_miss", lambda self, near=near: near)
+        r, swing = arcs_mod.search_arcs(t, arcs, Constraints(full_turn=False), windows=windows, input_rocks=rocks)
+        assert calls == want and r is None and swing is None
