@@ -37,6 +37,12 @@ def _region(text: str | None) -> tuple[float, float, float, float] | None:
     return x0, y0, x1, y1
 
 
+def grashof_words(kind: str) -> str:
+    """A four-bar's Grashof class (:func:`planar.linkages.fourbar.grashof_class`) as the printed line says it: the
+    non-Grashof kind is named for what it is, a triple-rocker (a trial's point: the others name their motion)."""
+    return "triple-rocker, non-Grashof" if kind == "non-Grashof" else kind
+
+
 def _rocking(fb: Any, theta: np.ndarray) -> tuple[float | None, float]:
     """``(amplitude, centre)`` of a rocking driver over the crank angles ``theta``, or ``(None, 0)`` for a full turn."""
     import numpy as np
@@ -384,7 +390,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
         motion = d.checks.get("input", "rocks")
         if motion == "rocks" and fb.grashof in ("crank-rocker", "double-crank"):  # a cognate whose crank could turn
             motion = "rocks over the targets' span (its crank could turn fully)"
-        return text, f"four-bar ({fb.grashof}, {d.circuit}, the input {motion})"
+        return text, f"four-bar ({grashof_words(fb.grashof)}, {d.circuit}, the input {motion})"
 
     return _path_result(args, d, targets, "four-bar", lambda: _box_word(d, targets, cons, atlas, args), scene)
 
@@ -724,7 +730,7 @@ def _cmd_function(args: argparse.Namespace) -> int:
     )
     return _finish(
         args,
-        f"four-bar ({d.grashof}, {d.circuit}, {d.method}), max output angle error {_rad(d.max_error, args.deg)}, "
+        f"four-bar ({grashof_words(d.grashof)}, {d.circuit}, {d.method}), max output angle error {_rad(d.max_error, args.deg)}, "
         f"transmission angle >= {d.checks['min_transmission_deg']:.3g} deg{shift}",
         text,
         report,
@@ -831,7 +837,8 @@ def _cmd_motion(args: argparse.Namespace) -> int:
     report = {"command": "synth motion", "poses": len(poses), "angle_offset": d.angle_offset, **d.to_dict()}
     return _finish(
         args,
-        f"four-bar ({d.grashof}, {d.circuit}) through {len(poses)} poses, position error {d.checks['max_position_error']:.3g}"
+        f"four-bar ({grashof_words(d.grashof)}, {d.circuit}) through {len(poses)} poses, position error "
+        f"{d.checks['max_position_error']:.3g}"
         f", transmission angle >= {d.checks['min_transmission_deg']:.3g} deg ({d.checks['min_transmission_at']})",
         text,
         report,

@@ -545,6 +545,8 @@ class _Rounds:
     stages: dict[str, float]
     tried: list[Array] = field(default_factory=list)
     best: Found | None = None
+    #: the round the best came from: ``"windows"`` for the curve-window round, else empty
+    best_from: str = ""
 
     def short(self) -> bool:
         """Whether nothing found so far is within the stop or the basin."""
@@ -573,7 +575,7 @@ class _Rounds:
         for key, sec in ((stage, t3 - t1),) if stage else (("refine_s", t2 - t1), ("polish_s", t3 - t2)):
             self.stages[key] = self.stages.get(key, 0.0) + sec
         if polished is not None and (self.best is None or polished[0] < self.best[0]):
-            self.best = polished
+            self.best, self.best_from = polished, "windows" if stage == "windows_s" else ""
         return len(found)
 
     def lookup(self, arcs: Arcs, k: int) -> Array:
@@ -666,4 +668,5 @@ def search_arcs(
         return None, None
     _, r, tt, swing = rounds.best
     sse = float(np.sum(np.square(row_points(r, tt) - t)))
-    return SearchResult(r[:9], 1 if r[9] >= 0 else -1, tt, sse, True, len(rounds.tried), stages), swing
+    result = SearchResult(r[:9], 1 if r[9] >= 0 else -1, tt, sse, True, len(rounds.tried), stages, rounds.best_from)
+    return result, swing

@@ -103,6 +103,12 @@ def drawing_cautions(gaps: dict[str, float], tolerance: float, rocks: bool) -> l
             "the targets' size from the drawing (planar render shows it; --rocking asks for an input that swings along "
             "the arc only)"
         )
+    elif off > tolerance:  # an input that swings over the targets' span: the path should follow the open drawing
+        out.append(
+            f"between the targets the coupler path leaves the drawing by up to {off:.3g} of their size ({off / tolerance:.3g} "
+            "times the tolerance): a loop or detour the drawing does not have (planar render shows it; more --points "
+            "hold the search to more of the drawing)"
+        )
     return out
 
 

@@ -225,6 +225,8 @@ class SearchResult:
     feasible: bool
     evaluations: int
     stages: dict[str, float]
+    #: which lookup the result's start came from, when a search tells (``"windows"``: the curve-window atlas)
+    source: str = ""
 
 
 def default_bounds(

@@ -170,3 +170,20 @@ def test_the_span_is_the_one_the_crank_turns_through_the_targets_in_order():
     assert any("clockwise" in c and "last to first" in c for c in said) and not any("deg of the crank" in c for c in said)
     short = untimed_cautions(12, np.radians([100.0, 80.0, 60.0, 40.0, 20.0, 0.0]))
     assert any("on 100 deg of the crank's turn" in c for c in short) and any("clockwise" in c for c in short)
+
+
+def test_a_four_bar_far_larger_than_its_targets_is_cautioned():
+    # a trial's drawn corner (35 by 30 mm) came back with a 5,036 mm ground link and no word; the caution names the
+    # longest link and its ratio to the targets' extent (the bounding box's diagonal, by hand here)
+    from types import SimpleNamespace
+
+    from planar.synth.path import LARGE_DESIGN, size_cautions
+
+    t = np.array([[5.0, 35.0], [40.0, 35.0], [40.0, 5.0]])
+    extent = float(np.hypot(35.0, 30.0))
+    big = SimpleNamespace(targets=t, ground=5036.0, crank=515.0, coupler=800.0, rocker=900.0)
+    (line,) = size_cautions(big)
+    assert "its ground (5036)" in line and f"{5036.0 / extent:.3g} times" in line
+    small = SimpleNamespace(targets=t, ground=LARGE_DESIGN * extent * 0.99, crank=10.0, coupler=20.0, rocker=30.0)
+    assert size_cautions(small) == []
+    assert "its rocker" in size_cautions(SimpleNamespace(targets=t, ground=1.0, crank=1.0, coupler=1.0, rocker=2e4))[0]

@@ -71,3 +71,28 @@ def test_a_closed_drawing_traced_only_as_an_arc_and_an_open_one_is_not_asked_the
     assert whole["drawing_max_distance"] < 1e-3 and whole["path_max_distance"] > 0.1
     (back,) = drawing_cautions(whole, 1e-2, rocks=False)
     assert "comes back another way" in back
+
+
+def test_a_swinging_input_whose_path_leaves_an_open_drawing_is_cautioned(tmp_path):
+    # a trial's drawn corner came back (--input-rocks) exact at its targets with a loop 4.6 of the size off the
+    # drawing between two of them, and said nothing: the path's distance from an open drawing, for an input that
+    # swings over the targets' span, now gets its own line.  Here the drawing is the straight chord of the crank's
+    # half-turn arc, so the path's farthest point from it is the arc's sagitta, checked by brute force
+    fb = FourBar(4.0, 1.0, 3.5, 3.0, coupler_point=(2.0, 1.5))
+    arc = fb.solve(np.linspace(0.0, np.pi, 4000)).points["coupler_point"]
+    f = tmp_path / "chord.svg"
+    _svg(f, np.array([arc[0], arc[-1]]), False)
+    size = 2.0
+    gaps = drawing_gaps(_design(fb, size, (0.0, np.pi)), f)
+    a, b = arc[0], arc[-1]
+    u = (b - a) / np.hypot(*(b - a))
+    rel = arc - a
+    along = np.clip(rel @ u, 0.0, np.hypot(*(b - a)))
+    brute = float(np.max(np.hypot(*(rel - along[:, None] * u).T))) / size
+    assert brute > 0.05 and abs(gaps["path_max_distance"] - brute) < 1e-3 * brute
+    lines = drawing_cautions(gaps, 1e-3, rocks=True)
+    assert any("the coupler path leaves the drawing by up to" in line for line in lines)
+    (leaves,) = [line for line in lines if "leaves the drawing" in line]
+    assert f"{gaps['path_max_distance']:.3g}" in leaves
+    # within the tolerance: no such line
+    assert not any("leaves the drawing" in line for line in drawing_cautions(gaps, 2 * brute, rocks=True))

@@ -452,7 +452,7 @@ def test_a_double_rockers_arc_is_found_in_the_curve_windows_through_its_crank_co
     e, r, tt, swing = rounds.best
     # within the basin (on a 29-degree arc a family of four-bars lies within 1e-8 of the targets: the refinement
     # from the true four-bar itself, its dimensions changed by 1e-7, ends 2e-8 to 9e-7 away, wandering along it)
-    assert e <= BASIN and set(stages) == {"windows_load_s", "windows_s"}
+    assert e <= BASIN and set(stages) == {"windows_load_s", "windows_s"} and rounds.best_from == "windows"
     assert rocking_range(r[:9], tt) is None and input_swing(r[:9], tt) == swing  # a crank, swung over the targets
 
 
@@ -485,3 +485,14 @@ def test_the_curve_window_round_runs_when_the_first_round_leaves_nothing_within_
         monkeypatch.setattr(arcs_mod._Rounds, "near_miss", lambda self, near=near: near)
         r, swing = arcs_mod.search_arcs(t, arcs, Constraints(full_turn=False), windows=windows, input_rocks=rocks)
         assert calls == want and r is None and swing is None
+
+
+def test_a_triple_rocker_is_named_so_on_the_printed_line(tmp_path, capsys):
+    # a trial's point: double-rockers were named, triple-rockers printed only "non-Grashof"
+    t = _triple_rocker_arc(np.random.default_rng(20261202), 12)
+    f = tmp_path / "arc.csv"
+    f.write_text("x,y\n" + "\n".join(f"{a!r},{b!r}" for a, b in t.tolist()) + "\n")
+    out = tmp_path / "o.toml"
+    assert main(["synth", "path", str(f), "--rocking", "--ordered", "--budget", "quick", "-o", str(out)]) == 0
+    said = capsys.readouterr().out
+    assert "four-bar (triple-rocker, non-Grashof, " in said, said
