@@ -958,7 +958,7 @@ def add_parser(sub: Any) -> None:
         help="only a four-bar whose input swings between two angles (a double-rocker, rocker-crank or triple-rocker, "
         "or a cognate whose crank could turn fully, swung over the targets' span) tracing the targets as an open arc, "
         "from the rocking-arc atlas, and when its first starts leave nothing within 1e-6 of the size, the "
-        "curve-window atlas (parts of full-turn four-bars' curves; unless --input-rocks) too (untimed targets; each "
+        "curve-window atlas (parts of full-turn four-bars' curves) too (untimed targets; each "
         "built on first use; --min-transmission is checked over the swing). Without "
         "it, untimed synth path tries that atlas too when the coupler-curve atlas is not within --tolerance, once "
         "planar synth atlas --rocking has built it",

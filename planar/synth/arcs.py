@@ -565,7 +565,7 @@ class _Rounds:
         from planar.synth.search import refined_start
 
         def refine(row: Array) -> tuple[Array, Array]:
-            return refined_start(self.obj, row, self.bounds, self.stop, self.max_ratio, floor)
+            return self.rocking_input(*refined_start(self.obj, row, self.bounds, self.stop, self.max_ratio, floor))
 
         t1 = time.perf_counter()
         found = _tried_starts(self.obj, every, limit, tried, refine, self.usable, self.stop, self.basin)
@@ -577,6 +577,20 @@ class _Rounds:
         if polished is not None and (self.best is None or polished[0] < self.best[0]):
             self.best, self.best_from = polished, "windows" if stage == "windows_s" else ""
         return len(found)
+
+    def rocking_input(self, r: Array, tt: Array) -> tuple[Array, Array]:
+        """A refined row ``r`` (input angles ``tt``), or, when its input turns fully, its cognate on the same input
+        pivot whose input link turns with ``r``'s coupler (:func:`planar.synth.cognates.input_cognate`: the same
+        curve) if that input rocks and the cognate is usable: an input link that rocks is preferred, and with
+        ``input_rocks`` no other is usable."""
+        from planar.synth.cognates import input_cognate
+
+        if rocking_range(r[:9], tt) is not None:
+            return r, tt
+        cog = input_cognate(r, tt)
+        if cog is None or rocking_range(cog[0][:9], cog[1]) is None or self.usable(*cog) is None:
+            return r, tt
+        return cog
 
     def lookup(self, arcs: Arcs, k: int) -> Array:
         """``k`` neighbours a view in the rocking arcs, their seconds in ``arcs_s``."""
@@ -622,8 +636,9 @@ def search_arcs(
     Past the targets' own curve equation, the search runs in rounds: each looks up neighbours, refines the starts
     not yet tried best first (:func:`_tried_starts`) and polishes the best few (:func:`_polished`); a later round
     runs only when nothing found so far is within ``basin``.  The first looks up the rocking arcs (``ROUNDS[0]``);
-    then, with ``windows`` and without ``input_rocks`` (its four-bars' cranks turn fully), the curve windows
-    (:data:`WINDOWS_K`, :data:`WINDOWS_REFINE`); then, only after a near miss (beyond ``basin``, within
+    then, with ``windows``, the curve windows (:data:`WINDOWS_K`, :data:`WINDOWS_REFINE`; their four-bars' cranks
+    turn fully, and a refined one's cognate whose input rocks replaces it: :meth:`_Rounds.rocking_input`, as for
+    every refined start); then, only after a near miss (beyond ``basin``, within
     :data:`NEAR_MISS`), the rocking arcs again, more of them (``ROUNDS[1]``).  When they end with nothing usable
     or nothing within :data:`GUARD_AFTER`, and most of their starts were unusable, the :data:`GUARD_STARTS` best
     starts are refined once more keeping the transmission angle at the targets :data:`TOGGLE_GUARD_DEG` beyond the
@@ -652,7 +667,7 @@ def search_arcs(
     b = default_bounds(t, cons, False, turn=3 * np.pi)
     rounds = _Rounds(obj, b, stop, basin, usable, cons.max_ratio, stages)
     usable_starts = rounds.run(rounds.lookup(arcs, ROUNDS[0][0]), ROUNDS[0][1], rounds.tried, 0.0)
-    if windows is not None and not input_rocks and rounds.short():
+    if windows is not None and rounds.short():
         usable_starts += rounds.windows_round(windows)
     for k, limit in ROUNDS[1:]:
         if rounds.near_miss():  # else found, or not near enough for more starts to be worth their time

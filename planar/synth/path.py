@@ -484,7 +484,8 @@ def synthesise_rocking_path(
     :data:`~planar.synth.arcs.QUICK_FOURBARS` for ``budget="quick"``, built on first use).  ``windows``: the
     curve-window atlas (:mod:`planar.synth.windows`), looked up when the rocking arcs' first starts leave nothing
     within :data:`planar.synth.arcs.BASIN` (default: the cached one of the budget, read or built on that first
-    need; not with ``input_rocks``: its four-bars' cranks turn fully).  Returns a
+    need).  A refined four-bar whose input turns fully is replaced by its cognate on the same input pivot when that
+    one's input rocks (:func:`planar.synth.cognates.input_cognate`: the same curve).  Returns a
     :class:`FourBarDesign` whose ``checks`` hold ``input_swing_rad`` and ``input_swing_deg`` (the input's swing,
     from the ground line, as ``[from, to]``), ``input_swing_world_deg`` (the same from the world's +x axis),
     ``ok_accuracy`` (largest distance over the targets' size within ``tolerance``), ``ok_swing_assembles``

@@ -385,29 +385,65 @@ def test_the_toggle_guard_round_runs_only_when_the_rounds_end_far(monkeypatch):
     assert floors == [0.0] and swing is not None
 
 
-def _crank_cognate(row: np.ndarray, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The Roberts cognate (Cayley's diagram, by hand) of a four-bar (kernel row: 9 parameters, circuit) that shares its
-    input pivot ``A0`` and whose input link turns with the coupler: with the coupler point ``P = A + lam (B - A)``,
-    ``P = A0 + lam (B - A) + (A - A0)`` puts the new input link along ``lam (B - A)`` and the new coupler along the old
-    input link; the new ground pivot is ``C0 = A0 + lam (B0 - A0)``.  Returns its kernel row and its input angles
-    (rad from its ground line) where the original is at ``theta``."""
-    g, a, b, c, u, v, x0, y0, phi0 = row[:9]
-    lam = complex(u, v) / b
-    k = abs(lam)
-    w = k * a / lam  # the coupler point from the new coupler's input pin, x toward its other pin
-    cog = np.array([k * g, k * b, k * a, k * c, w.real, w.imag, x0, y0, phi0 + np.angle(lam)])
-    A = complex(x0, y0) + a * np.exp(1j * (theta + phi0))
-    x, y, _ = coupler_points(row[None, :9], theta[None], row[9:10])
-    coupler_dir = np.angle(((x[0] + 1j * y[0]) - A) / lam)  # the world angle of B - A
-    return cog, coupler_dir - phi0
+def _by_circles(row: np.ndarray, theta: np.ndarray) -> list[np.ndarray]:
+    """The coupler points of a four-bar (kernel row) at input angles ``theta`` on both assemblies, by hand: the
+    rocker's pin where the coupler's circle about the input's pin meets the rocker's circle about its pivot."""
+    g, a, b, c, u, v, x0, y0, phi = row[:9]
+    a0 = complex(x0, y0)
+    b0 = a0 + g * np.exp(1j * phi)
+    pin = a0 + a * np.exp(1j * (theta + phi))
+    d = b0 - pin
+    dist = np.abs(d)
+    x = (b * b - c * c + dist**2) / (2 * dist)
+    h = np.sqrt(np.maximum(b * b - x * x, 0.0))
+    return [pin + complex(u, v) * ((x + s * 1j * h) * d / dist) / b for s in (1.0, -1.0)]
+
+
+def test_the_input_cognate_traces_the_same_curve_and_gives_the_four_bar_back():
+    # Cayley's diagram (planar.synth.cognates) against the geometry by hand: the cognate's coupler point, by circle
+    # intersection on one of its assemblies, is the four-bar's at every angle; its other ground pivot is
+    # A0 + lam (B0 - A0) (the Roberts-Chebyshev triangle); its lengths are the four-bar's times |lam| with input
+    # and coupler exchanged; the construction applied twice gives the four-bar back.  A Grashof double-rocker's
+    # cognate has an input that turns fully; a crank-rocker's and a drag-link's are checked too
+    from planar.synth.cognates import input_cognate
+
+    rng = np.random.default_rng(20261251)
+    rows = []
+    for _ in range(4):
+        L, lo, hi = _double_rocker(rng)
+        rows.append((np.array([1.0, *L, *rng.uniform(-1, 1, 2), *rng.uniform(-1, 1, 2), rng.uniform(-3, 3), 1.0]), lo, hi))
+    crank_rocker = np.array([1.0, 0.3, 1.1, 0.9, 0.5, 0.4, 0.2, 0.1, 0.3, -1.0])
+    rows.append((crank_rocker, 0.5, 1.0))  # 29 degrees of its crank's turn
+    rows.append((np.array([0.3, 1.0, 1.1, 0.9, -0.2, 0.6, 0.0, 0.5, -1.0, 1.0]), 0.0, 2 * np.pi))  # drag-link
+    # over most of a crank-rocker's turn its cognate (whose input turns with the rocking coupler) reaches its own
+    # toggles and changes assembly: no one circuit traces the points, and the function says so
+    assert input_cognate(crank_rocker, np.linspace(0.3, 6.0, 40)) is None
+    for k, (row, lo, hi) in enumerate(rows):
+        th = np.linspace(lo + 0.05 * (hi - lo), hi - 0.05 * (hi - lo), 40)
+        x, y, ok = coupler_points(row[None, :9], th[None], row[9:10])
+        assert ok.all()
+        p = x[0] + 1j * y[0]
+        assert min(np.abs(q - p).max() for q in _by_circles(row, th)) < 1e-12  # the hand geometry itself
+        cog, th2 = input_cognate(row, th)
+        assert min(np.abs(q - p).max() for q in _by_circles(cog, th2)) < 1e-11
+        lam = complex(row[4], row[5]) / row[2]
+        b0 = complex(row[6], row[7]) + row[0] * np.exp(1j * row[8])
+        c0 = complex(cog[6], cog[7]) + cog[0] * np.exp(1j * cog[8])
+        assert abs(c0 - (complex(row[6], row[7]) + lam * (b0 - complex(row[6], row[7])))) < 1e-12
+        assert np.allclose(cog[:4], abs(lam) * row[[0, 2, 1, 3]], rtol=1e-12)
+        back, th3 = input_cognate(cog, th2)
+        assert np.allclose(back[:9], row[:9], rtol=1e-12, atol=1e-12) and back[9] == row[9]
+        assert np.allclose(np.exp(1j * th3), np.exp(1j * th), atol=1e-12)
+        turns = not input_range(cog[1:2] / cog[0], cog[2:3] / cog[0], cog[3:4] / cog[0])[2][0]
+        assert turns == (k != 4)  # the double-rockers' and the drag-link's turn fully, the crank-rocker's rocks
 
 
 def test_a_double_rockers_arc_is_found_in_the_curve_windows_through_its_crank_cognate():
-    # a Grashof double-rocker's coupler turns fully, so its cognate whose input link turns with the coupler
-    # (Cayley's diagram, built by hand above, not by planar's sextic) is a crank-rocker tracing the same arc:
-    # checked point by point; then a curve-window atlas holding only that cognate's window, looked up by the
-    # rocking search's curve-window round, recovers the arc exactly with an input that turns fully
-    from planar.synth.arcs import BASIN, Arcs, _Rounds, described_windows, input_swing, usable_swing
+    # a curve-window atlas holding only the window of a double-rocker's cognate whose input turns fully (a
+    # crank-rocker tracing the same arc), looked up by the rocking search's curve-window round, recovers the arc
+    # within the basin; the refined crank's own cognate, an input that rocks, is what the round keeps
+    from planar.synth.arcs import BASIN, Arcs, _Rounds, described_windows, usable_swing
+    from planar.synth.cognates import input_cognate
     from planar.synth.search import Constraints, PathObjective, default_bounds
 
     rng = np.random.default_rng(20261245)
@@ -417,19 +453,13 @@ def test_a_double_rockers_arc_is_found_in_the_curve_windows_through_its_crank_co
     x, y, ok = coupler_points(true[None, :9], th[None], np.array([1.0]))
     assert ok.all()
     t = np.column_stack([x[0], y[0]])
-    cog, th2 = _crank_cognate(true, th)
+    cog, th2 = input_cognate(true, th)
     assert not input_range(cog[1:2] / cog[0], cog[2:3] / cog[0], cog[3:4] / cog[0])[2][0]  # its input turns fully
-    traced = []
-    for circuit in (1.0, -1.0):
-        xc, yc, okc = coupler_points(cog[None], th2[None], np.array([circuit]))
-        traced.append(np.abs(xc[0] + 1j * yc[0] - (x[0] + 1j * y[0])).max() if okc.all() else np.inf)
-    circuit = 1.0 if traced[0] <= traced[1] else -1.0
-    assert min(traced) < 1e-12 * np.ptp(t, axis=0).max()
 
     c = t.mean(axis=0)
     s = float(np.sqrt(np.mean(np.sum((t - c) ** 2, axis=1))))
     tn = (t - c) / s
-    p6 = np.append(cog[1:6] / cog[0], circuit)[None]
+    p6 = np.append(cog[1:6] / cog[0], cog[9])[None]
     u = np.unwrap(th2)
     P, W, F, D = described_windows(p6, [(np.array([u.min() - 0.1]), np.array([u.max() + 0.1]))])
     assert len(P) == 1
@@ -453,12 +483,12 @@ def test_a_double_rockers_arc_is_found_in_the_curve_windows_through_its_crank_co
     # within the basin (on a 29-degree arc a family of four-bars lies within 1e-8 of the targets: the refinement
     # from the true four-bar itself, its dimensions changed by 1e-7, ends 2e-8 to 9e-7 away, wandering along it)
     assert e <= BASIN and set(stages) == {"windows_load_s", "windows_s"} and rounds.best_from == "windows"
-    assert rocking_range(r[:9], tt) is None and input_swing(r[:9], tt) == swing  # a crank, swung over the targets
+    assert rocking_range(r[:9], tt) == swing  # an input that rocks: the refined crank's cognate
 
 
 def test_the_curve_window_round_runs_when_the_first_round_leaves_nothing_within_the_basin(monkeypatch):
-    # the rounds' order: the rocking arcs, then (windows given, no input_rocks, nothing within the basin) the curve
-    # windows, then (a near miss) more rocking arcs
+    # the rounds' order: the rocking arcs, then (windows given, nothing within the basin) the curve windows, with
+    # input_rocks too (a refined crank's cognate whose input rocks replaces it), then (a near miss) more rocking arcs
     from planar.synth import arcs as arcs_mod
     from planar.synth.search import Constraints
 
@@ -477,7 +507,7 @@ def test_the_curve_window_round_runs_when_the_first_round_leaves_nothing_within_
         (True, True, "w", False, ["run", "windows", "run"]),
         (True, False, "w", False, ["run", "windows"]),  # nothing usable, or far: no second round of arcs
         (True, True, None, False, ["run", "run"]),
-        (True, True, "w", True, ["run", "run"]),
+        (True, True, "w", True, ["run", "windows", "run"]),  # a crank's rocking cognate is usable with input_rocks
         (False, False, "w", False, ["run"]),
     ):
         calls.clear()
