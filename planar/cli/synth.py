@@ -235,8 +235,8 @@ def _unreachable(d: Any, kind: str = "four-bar", box: str = "", budget: str = "n
             else ""
         )
         why = (
-            f"no {kind} the search found traces this shape closer: {noise}it may be a shape no {kind} traces, or one "
-            f"the search missed (try {thorough}another --seed{more}, or a larger --tolerance)"
+            f"{noise}it may be a shape no {kind} traces, or one the search missed (try {thorough}another "
+            f"--seed{more}, or a larger --tolerance)"
         )
         n = len(d.targets)
         if kind == "four-bar" and getattr(d, "timed", False) and n >= 5:
@@ -861,7 +861,8 @@ def _min_transmission_parent() -> argparse.ArgumentParser:
         type=float,
         default=0.0,
         help="keep the transmission angle (between the coupler and the output link) at least this far from 0 and 180 (a toggle) "
-        "over the motion (path: the crank's whole turn), degrees (0; never accepted nearer than 1 deg). path: a "
+        "over the motion (path: the crank's whole turn, or with --rocking the input's swing), degrees (0; never "
+        "accepted nearer than 1 deg). path: a "
         "constraint of the search; motion: chooses among the four-bars through the poses; when the best found does "
         "not keep it, it is written and exits 3 naming the angle and where",
     )
@@ -972,7 +973,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--input-rocks",
         action="store_true",
-        help="with --rocking: only a four-bar whose input link itself cannot turn fully (a double- or triple-rocker), "
+        help="with --rocking: only a four-bar whose input link itself cannot turn fully (a double-rocker, rocker-crank "
+        "or triple-rocker), "
         "not a cognate whose crank could turn fully swung back and forth over the targets' span",
     )
     p.add_argument(

@@ -545,6 +545,13 @@ def synthesise_rocking_path(
     return _rocking_checked(d, r, p, swing, tolerance, ordered, cons, source, s)
 
 
+def first_turn(swing: tuple[float, float]) -> tuple[float, float]:
+    """A swing ``(lo, hi)`` (rad) moved by whole turns so that it starts in [-pi, pi) (a trial read "between 335.36
+    and 554.89 deg" where -24.64 and 194.89 was meant); the same angles of the input."""
+    turns = math.floor((swing[0] + math.pi) / (2 * math.pi))
+    return swing[0] - 2 * math.pi * turns, swing[1] - 2 * math.pi * turns
+
+
 def _rocking_checked(
     d: FourBarDesign,
     r: Any,
@@ -557,7 +564,8 @@ def _rocking_checked(
     size: float,
 ) -> FourBarDesign:
     """A rocking design ``d`` (kernel row ``p``, search result ``r``, targets' size ``size``) checked over its
-    ``swing``: see :func:`synthesise_rocking_path`."""
+    ``swing`` (:func:`first_turn`): see :func:`synthesise_rocking_path`."""
+    swing = first_turn(swing)
     import dataclasses
 
     from planar.synth.arcs import rocking_range

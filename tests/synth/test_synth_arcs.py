@@ -526,3 +526,13 @@ def test_a_triple_rocker_is_named_so_on_the_printed_line(tmp_path, capsys):
     assert main(["synth", "path", str(f), "--rocking", "--ordered", "--budget", "quick", "-o", str(out)]) == 0
     said = capsys.readouterr().out
     assert "four-bar (triple-rocker, non-Grashof, " in said, said
+
+
+def test_a_swing_is_said_from_its_first_turn():
+    from planar.synth.path import first_turn
+
+    lo, hi = first_turn((np.radians(335.36), np.radians(554.89)))
+    assert np.allclose(np.degrees([lo, hi]), [-24.64, 194.89], atol=1e-9)
+    for a in (-7.0, -np.pi, 0.3, np.pi, 12.0):
+        lo, hi = first_turn((a, a + 1.0))
+        assert -np.pi <= lo < np.pi and np.isclose(hi - lo, 1.0) and np.isclose(np.exp(1j * lo), np.exp(1j * a))
