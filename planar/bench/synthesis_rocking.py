@@ -141,14 +141,14 @@ def bench_rocking(
     size, CPU times (s), whether each kept its targets on one swing in order, and a summary."""
     from threadpoolctl import threadpool_limits
 
-    from planar.synth import windows as w
     from planar.synth.arcs import DEFAULT_FOURBARS, QUICK_FOURBARS, load_arcs
+    from planar.synth.windows import load_budget_windows
 
     counts = _counts(count, quick)
     budget = "quick" if quick else "normal"
     c0 = time.process_time()
     arcs = load_arcs(QUICK_FOURBARS if quick else DEFAULT_FOURBARS, progress=True)
-    windows = w.load_windows(w.QUICK_FOURBARS if quick else w.DEFAULT_FOURBARS, progress=True)
+    windows = load_budget_windows(budget)
     arcs.tree  # noqa: B018 - the k-d trees are built on first use: here, not in the first problem
     windows.tree  # noqa: B018
     load = time.process_time() - c0

@@ -32,7 +32,7 @@ from planar.core.fields import check_number
 from planar.errors import InputError
 from planar.synth.designs import TOGGLE_FLOOR_DEG, Checked, PlacedFourBar
 from planar.synth.path_search import BUDGETS, EQUATION_SOURCE, PathSearch
-from planar.synth.search import Constraints, PathObjective, constraint_failures
+from planar.synth.search import Constraints, PathObjective, basin_for, constraint_failures
 from planar.synth.targets import check_search_args, check_theta, normalisation
 
 __all__ = ["FourBarDesign", "check_path_args", "synthesise_path", "synthesise_rocking_path"]
@@ -518,14 +518,12 @@ def synthesise_rocking_path(
         arcs = load_arcs(QUICK_FOURBARS if budget == "quick" else DEFAULT_FOURBARS, progress=True)
 
     def the_windows() -> Any:  # read (or built) only when the search's curve-window round runs
-        from planar.synth import windows as w
+        from planar.synth.windows import load_budget_windows
 
-        if windows is not None:
-            return windows
-        return w.load_windows(w.QUICK_FOURBARS if budget == "quick" else w.DEFAULT_FOURBARS, progress=True)
+        return windows if windows is not None else load_budget_windows(budget)
 
     c, s = normalisation(t)
-    basin = min(ARCS_BASIN, tolerance / 10)  # a near result ends the search well within the tolerance
+    basin = basin_for(tolerance, ARCS_BASIN)
     with threadpool_limits(1):
         r, swing = search_arcs(
             (t - c) / s, arcs, cons, ordered=ordered, input_rocks=input_rocks, windows=the_windows, basin=basin
@@ -565,10 +563,11 @@ def _rocking_checked(
 ) -> FourBarDesign:
     """A rocking design ``d`` (kernel row ``p``, search result ``r``, targets' size ``size``) checked over its
     ``swing`` (:func:`first_turn`): see :func:`synthesise_rocking_path`."""
-    swing = first_turn(swing)
     import dataclasses
 
     from planar.synth.arcs import rocking_range
+
+    swing = first_turn(swing)
 
     _check_rocking(d, r.theta, swing, tolerance, ordered, size)
     _check_transmission(d, np.linspace(swing[0], swing[1], 721), cons.min_transmission)

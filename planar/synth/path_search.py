@@ -120,20 +120,20 @@ class PathSearch:
         """The curve-window atlas (:mod:`planar.synth.windows`), loaded (or built) on first need: only when the closed
         curve's first starts fail."""
         if self.windows is None:
-            from planar.synth.windows import DEFAULT_FOURBARS, QUICK_FOURBARS, load_windows
+            from planar.synth.windows import load_budget_windows
 
             t0 = time.perf_counter()
-            self.windows = load_windows(QUICK_FOURBARS if self.budget == "quick" else DEFAULT_FOURBARS, progress=True)
+            self.windows = load_budget_windows(self.budget)
             self.stages["windows_load_s"] = time.perf_counter() - t0
         return self.windows
 
     def _search_atlas(self, cons: Constraints) -> Any:
         """:func:`planar.synth.search.search_atlas` on the targets with ``cons``, the curve-window atlas loaded if its
         stage runs; its stages each count a second once (``windows_s`` without the loading, ``windows_load_s``)."""
-        from planar.synth.search import BASIN, search_atlas
+        from planar.synth.search import basin_for, search_atlas
 
         before = self.stages.get("windows_load_s", 0.0)
-        basin = min(BASIN, self.tolerance / 10)  # a near result ends the search well within the tolerance
+        basin = basin_for(self.tolerance)
         r = search_atlas(self.t, self.loaded_atlas(), cons, ordered=self.ordered, windows=self.window_candidates, basin=basin)
         if "windows_s" in r.stages:
             r.stages["windows_s"] -= self.stages.get("windows_load_s", 0.0) - before
@@ -338,7 +338,9 @@ class PathSearch:
             arcs = arcs_mod.read_arcs(path)
         t0 = time.perf_counter()
         rock_cons = dataclasses.replace(cons, full_turn=False)
-        basin = min(arcs_mod.BASIN, self.tolerance / 10)
+        from planar.synth.search import basin_for
+
+        basin = basin_for(self.tolerance, arcs_mod.BASIN)
         r, swing = arcs_mod.search_arcs(self.t, arcs, rock_cons, ordered=self.ordered, basin=basin)
         stages["rocking_s"] = time.perf_counter() - t0
         word = "the rocking-arc atlas lookup and refinement"

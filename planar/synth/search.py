@@ -587,6 +587,13 @@ def in_order(theta: Array) -> bool:
 BASIN = 1e-6
 
 
+def basin_for(tolerance: float, basin: float = BASIN) -> float:
+    """The basin a search answering to ``tolerance`` (a largest distance over the targets' size) uses: ``basin``
+    (:data:`BASIN`, or the rocking search's :data:`planar.synth.arcs.BASIN`), or a tenth of the tolerance when that is
+    smaller, so a near result ends the search well within the tolerance."""
+    return min(basin, tolerance / 10)
+
+
 def search_atlas(
     targets: Array,
     atlas: Any,

@@ -89,6 +89,13 @@ def load_windows(fourbars: int = DEFAULT_FOURBARS, seed: int = 0, progress: bool
     return cached(path, "curve-window atlas", fourbars, KIND, len(SPANS_DEG), progress, build_windows, seed)
 
 
+def load_budget_windows(budget: str, progress: bool = True) -> Arcs:
+    """:func:`load_windows` of a search ``budget``'s size (a budget its caller has checked:
+    :func:`planar.synth.path.check_path_args`): :data:`QUICK_FOURBARS` for ``"quick"``, else
+    :data:`DEFAULT_FOURBARS`."""
+    return load_windows(QUICK_FOURBARS if budget == "quick" else DEFAULT_FOURBARS, progress=progress)
+
+
 def window_candidates(windows: Arcs, targets: Array, k: int = 64) -> Array:
     """Full-turn four-bars a window of whose curve is near the targets ``(N, 2)`` (in order along part of the
     curve), placed onto them: ``4 k`` rows of the kernel's 9 parameters and the circuit (as
