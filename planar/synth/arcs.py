@@ -21,8 +21,8 @@ last, along +x): ``2 ARC_POINTS`` numbers.  A query describes the targets the
 same way (a natural cubic spline through them in their order, by chord
 length), also reversed and mirrored, finds the nearest entries with
 :class:`scipy.spatial.cKDTree`, places each on the targets by the similarity
-the two descriptions differ by, and the best are refined by least squares with
-the input angle at each target free (:func:`planar.synth.search.refined_start`).
+the two descriptions differ by, and the best are refined in the joints'
+positions with the input angle at each target free (:func:`arc_start`).
 
 The interface to the path search is :func:`arc_candidates` (targets in, rows of
 the kernel's 9 parameters and the circuit out, as
@@ -406,9 +406,11 @@ def input_swing(row: Array, theta: Array) -> tuple[float, float] | None:
     return (lo, hi) if hi > lo else None
 
 
-#: lookup and refinement effort: neighbours per query, and starts refined
-#: (:func:`planar.synth.search.refined_start`)
+#: lookup and refinement effort: neighbours per query, and starts refined (:func:`arc_start`)
 SEARCH_K, SEARCH_REFINE = 64, 32
+#: a looked-up start's refinement (:func:`arc_start`): at most this many iterations in the joints' positions, ended
+#: sooner after this many refused steps in a row (:func:`planar.synth.positions.geodesic_lm`'s ``patience``)
+ARC_START_ITERS, ARC_START_PATIENCE = 300, 15
 #: the rounds of :func:`search_arcs`: neighbours per query, and how many starts may have been refined by the round's
 #: end (its own and the rounds' before); a later round runs only when the best so far is a near miss: beyond
 #: :data:`BASIN` but within ``NEAR_MISS`` (the targets' size 1).  Drawn or noisy targets, which no four-bar meets,
@@ -476,6 +478,27 @@ def usable_swing(
     return swing if swing_transmission(r, swing) >= floor else None
 
 
+def arc_start(obj: Any, row: Array, max_ratio: float, floor: float = 0.0) -> tuple[Array, Array]:
+    """A looked-up start ``row`` (9 parameters and the circuit, placed on the targets of ``obj``) refined: the input
+    angles assigned on its curve (:func:`planar.synth.search.assign_theta`), then at most :data:`ARC_START_ITERS`
+    iterations in the joints' positions (:func:`planar.synth.positions.polish_positions`, keeping the link ratio
+    ``max_ratio`` and the transmission angle at the targets ``floor`` rad from a toggle when above 0), ended after
+    :data:`ARC_START_PATIENCE` refused steps in a row.  Returns the
+    row and its input angles at the targets (the start's own when nothing nearer is found).
+
+    The closed-curve search's start (:func:`planar.synth.search.refined_start`) first takes 10 evaluations of
+    least squares in the kernel's lengths and angles.  On a rocking arc those angles come from a curve sampled
+    every 1.4 degrees of input over a swing of a few tens of degrees, so the placed start is 0.03 to 0.5 of the
+    size off, and the lengths' steps often leave the range where the loop closes.  Measured on the 14 rocking
+    problems at 12 targets the search had missed (five seeds), each started from its true four-bar's own arc over
+    the targets' window, placed as a lookup places it: the closed-curve search's start came within 1e-6 in 4, this one
+    in all 14 (docs/explanation/coupler-curve-atlas.md)."""
+    from planar.synth.search import assign_theta
+
+    theta = assign_theta(obj, row)
+    return polish_positions(obj.targets, row, theta, ARC_START_ITERS, max_ratio, floor, ARC_START_PATIENCE)
+
+
 #: a rocking start's outcome: largest distance (the targets' size 1), refined row, input angles at the targets, swing
 Found = tuple[float, Array, Array, tuple[float, float]]
 
@@ -532,12 +555,10 @@ def _polished(
 
 @dataclass
 class _Rounds:
-    """The state of :func:`search_arcs`'s rounds: the objective (normalised targets), the refinement's bounds, the
-    search's stop and basin, the usable-swing test, the link-ratio limit, the stages' seconds, the starts tried and
-    the best found so far."""
+    """The state of :func:`search_arcs`'s rounds: the objective (normalised targets), the search's stop and basin,
+    the usable-swing test, the link-ratio limit, the stages' seconds, the starts tried and the best found so far."""
 
     obj: Any
-    bounds: Any
     stop: float
     basin: float
     usable: Any
@@ -562,10 +583,9 @@ class _Rounds:
         (:func:`_tried_starts`), the best few polished (:func:`_polished`), keeping transmission ``floor`` (rad) at
         the targets; its seconds go to ``stage``, or to ``refine_s`` and ``polish_s``.  Returns how many of its
         starts ended on a usable swing."""
-        from planar.synth.search import refined_start
 
         def refine(row: Array) -> tuple[Array, Array]:
-            return self.rocking_input(*refined_start(self.obj, row, self.bounds, self.stop, self.max_ratio, floor))
+            return self.rocking_input(*arc_start(self.obj, row, self.max_ratio, floor))
 
         t1 = time.perf_counter()
         found = _tried_starts(self.obj, every, limit, tried, refine, self.usable, self.stop, self.basin)
@@ -645,7 +665,7 @@ def search_arcs(
     floor (docs/explanation/coupler-curve-atlas.md)."""
     import dataclasses
 
-    from planar.synth.search import Constraints, PathObjective, SearchResult, default_bounds
+    from planar.synth.search import Constraints, PathObjective, SearchResult
 
     cons = dataclasses.replace(cons if cons is not None else Constraints(), full_turn=False)
     t = np.asarray(targets, float)
@@ -664,8 +684,7 @@ def search_arcs(
     if alg is not None:
         return alg, swing
     stages = {"algebraic_s": time.perf_counter() - t_alg} if len(t) >= MIN_TARGETS else {}
-    b = default_bounds(t, cons, False, turn=3 * np.pi)
-    rounds = _Rounds(obj, b, stop, basin, usable, cons.max_ratio, stages)
+    rounds = _Rounds(obj, stop, basin, usable, cons.max_ratio, stages)
     usable_starts = rounds.run(rounds.lookup(arcs, ROUNDS[0][0]), ROUNDS[0][1], rounds.tried, 0.0)
     if windows is not None and rounds.short():
         usable_starts += rounds.windows_round(windows)

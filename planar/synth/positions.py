@@ -170,19 +170,24 @@ def _positions_problem(t: Array, circuit: float, max_ratio: float, floor: float 
 GEODESIC_H, GEODESIC_ALPHA = 0.1, 0.75
 
 
-def geodesic_lm(resid: Any, jac: Any, z: Array, iters: int) -> tuple[Array, Array]:
+def geodesic_lm(resid: Any, jac: Any, z: Array, iters: int, patience: int | None = None) -> tuple[Array, Array]:
     """Levenberg-Marquardt with geodesic acceleration (Transtrum and Sethna, 2011): each damped Gauss-Newton step
     (Marquardt's scaling, the largest diagonal of ``J^T J`` seen) gets a second-order correction along the curved
     valley, from one more residual evaluation; the step is taken only when that correction is small beside it.
-    Returns the variables and residuals it ends at after at most ``iters`` accepted or refused steps."""
+    Returns the variables and residuals it ends at after at most ``iters`` accepted or refused steps, or, with
+    ``patience``, once that many steps in a row were refused (the damping grown ``2^patience`` times or more: at a
+    minimum whose residual is not 0, which targets no four-bar meets end at, every later step is refused until the
+    damping passes 1e20, 80 steps or more)."""
     r = resid(z)
     f = float(r @ r)
     J = jac(z)
     lam = 1e-3
     D = np.zeros(len(z))
+    refused = 0
     for _ in range(iters):
-        if f <= 1e-30 or lam > 1e20:
+        if f <= 1e-30 or lam > 1e20 or (patience is not None and refused >= patience):
             break
+        refused += 1  # until this step is taken
         A, g = J.T @ J, J.T @ r
         D = np.maximum(D, np.diag(A))
         M = A + lam * np.diag(np.maximum(D, 1e-300))
@@ -202,13 +207,20 @@ def geodesic_lm(resid: Any, jac: Any, z: Array, iters: int) -> tuple[Array, Arra
             z, r, f = z + v + acc, rn, fn
             lam = max(lam / 3.0, 1e-12)
             J = jac(z)
+            refused = 0
         else:
             lam *= 2.0
     return z, r
 
 
 def polish_positions(
-    t: Array, row: Array, theta: Array, iters: int = POLISH_ITERS, max_ratio: float = 10.0, floor: float = 0.0
+    t: Array,
+    row: Array,
+    theta: Array,
+    iters: int = POLISH_ITERS,
+    max_ratio: float = 10.0,
+    floor: float = 0.0,
+    patience: int | None = None,
 ) -> tuple[Array, Array]:
     """A refined kernel row and its input angles at the targets ``t`` (normalised), polished in the joints'
     positions (:func:`joint_positions`: the pivots and moving joints at the first target's pose, the input's turn
@@ -219,14 +231,14 @@ def polish_positions(
     it lie along a long, curved, narrow valley (condition numbers 1e6 to 1e9), where Levenberg-Marquardt with a
     difference Jacobian crawls.  ``floor`` (rad, 0 for none): the transmission angle at the targets is kept this far
     from a toggle by a penalty (the rocking search's: its refinements otherwise end at a toggle, where the arc
-    turns back and fits the targets loosely).  Returns the row and angles (the input as given when nothing better is
-    found)."""
+    turns back and fits the targets loosely).  ``patience``: :func:`geodesic_lm`'s (None: only ``iters`` ends it).
+    Returns the row and angles (the input as given when nothing better is found)."""
     circuit = 1.0 if row[9] >= 0 else -1.0
     q, turn = joint_positions(row, theta)
     resid, jac = _positions_problem(np.asarray(t, float), circuit, max_ratio, floor)
     z0 = np.concatenate([q, turn])
     r0 = resid(z0)
-    z, r = geodesic_lm(resid, jac, z0, iters)
+    z, r = geodesic_lm(resid, jac, z0, iters, patience)
     if not float(r @ r) < float(r0 @ r0):
         return row, theta
     return row_from_positions(z[:10], z[10:], circuit)
