@@ -418,8 +418,8 @@ def test_the_toggle_guard_round_runs_only_when_the_rounds_end_far(monkeypatch):
 
     polish = arcs_mod.polish_positions
 
-    def unpolished(t, row, theta, iters, max_ratio, floor=0.0):
-        return polish(t, row, theta, iters, max_ratio, floor) if floor > 0 else (row, theta)
+    def unpolished(t, row, theta, iters, max_ratio, floor=0.0, patience=None):
+        return polish(t, row, theta, iters, max_ratio, floor, patience) if floor > 0 else (row, theta)
 
     swing_of = arcs_mod.usable_swing
 
@@ -507,7 +507,7 @@ def test_a_double_rockers_arc_is_found_in_the_curve_windows_through_its_crank_co
     # within the basin; the refined crank's own cognate, an input that rocks, is what the round keeps
     from planar.synth.arcs import BASIN, Arcs, _Rounds, described_windows, usable_swing
     from planar.synth.cognates import input_cognate
-    from planar.synth.search import Constraints, PathObjective, default_bounds
+    from planar.synth.search import Constraints, PathObjective
 
     rng = np.random.default_rng(20261245)
     L, lo, hi = _double_rocker(rng)
@@ -540,7 +540,7 @@ def test_a_double_rockers_arc_is_found_in_the_curve_windows_through_its_crank_co
         loads.append(1)
         return atlas
 
-    rounds = _Rounds(obj, default_bounds(tn, cons, False, turn=3 * np.pi), 1e-9, BASIN, usable, 10.0, stages)
+    rounds = _Rounds(obj, 1e-9, BASIN, usable, 10.0, stages)
     assert rounds.windows_round(loader) >= 1 and loads == [1]
     e, r, tt, swing = rounds.best
     # within the basin (on a 29-degree arc a family of four-bars lies within 1e-8 of the targets: the refinement
