@@ -417,9 +417,9 @@ ARC_START_ITERS, ARC_START_PATIENCE = 300, 15
 #: stop after the first round
 ROUNDS = ((SEARCH_K, SEARCH_REFINE), (256, 128))
 NEAR_MISS = 1e-3
-#: the final polish (:func:`planar.synth.positions.polish_positions`): iterations per start, and how many of the best
-#: refined starts (each on one swing) it is tried on, best first, until one is within the search's stop or
-#: :data:`BASIN`
+#: the final polish (:func:`planar.synth.positions.polish_positions`): iterations per start (ended, as a start's, after
+#: :data:`ARC_START_PATIENCE` refused steps in a row), and how many of the best refined starts (each on one swing) it
+#: is tried on, best first, until one is within the search's stop or :data:`BASIN`
 POLISH_ITERS, POLISH_STARTS = 600, 8
 #: a start this near (largest distance over the targets' size) ends the trying of further starts: only it is
 #: polished on, and no later round runs.  On a short arc the last digits come slowly (the nearest four-bars lie in a
@@ -543,7 +543,7 @@ def _polished(
     found = sorted(found, key=lambda c: c[0])
     best = found[0]
     for _, r0, tt0, _ in found[: 1 if best[0] <= basin else POLISH_STARTS] if best[0] > stop else []:
-        r, tt = polish_positions(obj.targets, r0, tt0, POLISH_ITERS, max_ratio, floor)
+        r, tt = polish_positions(obj.targets, r0, tt0, POLISH_ITERS, max_ratio, floor, ARC_START_PATIENCE)
         swing = usable(r, tt)
         e = max_distance(obj, r, tt) if swing is not None else math.inf
         if swing is not None and e < best[0]:

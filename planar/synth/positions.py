@@ -5,8 +5,9 @@ The variables (:func:`joint_positions`) are the pivots and moving joints at the 
 turn from there to each later target; the coupler's and rocker's lengths are the loop-closure equations inside
 :func:`positions_points`, written with arithmetic, ``cos``, ``sin`` and ``sqrt`` only so that a complex step gives
 the exact Jacobian.  :func:`polish_positions` runs Levenberg-Marquardt with geodesic acceleration
-(:func:`geodesic_lm`) on them; :func:`planar.synth.search.refined_start` runs it on every atlas start, the rocking
-arcs' and the closed curves' alike.  With a ``floor``, a penalty on :func:`positions_sin2` (the transmission angle's
+(:func:`geodesic_lm`) on them; :func:`planar.synth.search.refined_start` runs it on every closed-curve atlas start
+after a few evaluations in the kernel's lengths, :func:`planar.synth.arcs.arc_start` on every rocking start from its
+first step.  With a ``floor``, a penalty on :func:`positions_sin2` (the transmission angle's
 squared sine at each target) keeps the refinement off the toggles.
 """
 

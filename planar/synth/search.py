@@ -1157,7 +1157,8 @@ def refined_start(
     16) 63 -> 73 of 80 within 1e-6 at medians 0.51-1.49 -> 0.48-1.18 s; drag-links' whole curves at 8 targets
     46 -> 47 of 50, 12 targets 20 -> 20 of 20, medians 0.22-0.76 -> 0.16-0.22 s; part-curves at 8 targets 17 -> 18
     of 20, median 3.64 -> 0.51 s; crank-rockers at 8 targets 58 -> 57 of 60, medians 0.19-0.26 -> 0.11-0.13 s
-    (docs/explanation/coupler-curve-atlas.md)."""
+    (docs/explanation/coupler-curve-atlas.md).  The rocking search's starts have since gone to the joints' positions
+    from the first step (:func:`planar.synth.arcs.arc_start`)."""
     r, tt, _ = reassigned_refine(obj, row, b, START_NFEV, stop)
     if _reached(obj, r, tt, stop):
         return r, tt
