@@ -483,16 +483,16 @@ def arc_start(obj: Any, row: Array, max_ratio: float, floor: float = 0.0) -> tup
     angles assigned on its curve (:func:`planar.synth.search.assign_theta`), then at most :data:`ARC_START_ITERS`
     iterations in the joints' positions (:func:`planar.synth.positions.polish_positions`, keeping the link ratio
     ``max_ratio`` and the transmission angle at the targets ``floor`` rad from a toggle when above 0), ended after
-    :data:`ARC_START_PATIENCE` refused steps in a row.  Returns the
-    row and its input angles at the targets (the start's own when nothing nearer is found).
+    :data:`ARC_START_PATIENCE` refused steps in a row.  Returns the row and its input angles at the targets (the
+    start's own when nothing nearer is found).
 
     The closed-curve search's start (:func:`planar.synth.search.refined_start`) first takes 10 evaluations of
     least squares in the kernel's lengths and angles.  On a rocking arc those angles come from a curve sampled
     every 1.4 degrees of input over a swing of a few tens of degrees, so the placed start is 0.03 to 0.5 of the
     size off, and the lengths' steps often leave the range where the loop closes.  Measured on the 14 rocking
     problems at 12 targets the search had missed (five seeds), each started from its true four-bar's own arc over
-    the targets' window, placed as a lookup places it: the closed-curve search's start came within 1e-6 in 4, this one
-    in all 14 (docs/explanation/coupler-curve-atlas.md)."""
+    the targets' window, placed as a lookup places it: the closed-curve search's start came within 1e-6 in 4, this
+    one in all 14 (docs/explanation/coupler-curve-atlas.md)."""
     from planar.synth.search import assign_theta
 
     theta = assign_theta(obj, row)

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from planar.synth.search import Constraints, PathObjective, search_fourbar
+from planar.synth.search import Constraints, PathObjective, basin_for, search_fourbar
 
 __all__ = ["BUDGETS", "EQUATION_ORDER_SOURCE", "EQUATION_SOURCE", "PathSearch"]
 
@@ -130,7 +130,7 @@ class PathSearch:
     def _search_atlas(self, cons: Constraints) -> Any:
         """:func:`planar.synth.search.search_atlas` on the targets with ``cons``, the curve-window atlas loaded if its
         stage runs; its stages each count a second once (``windows_s`` without the loading, ``windows_load_s``)."""
-        from planar.synth.search import basin_for, search_atlas
+        from planar.synth.search import search_atlas
 
         before = self.stages.get("windows_load_s", 0.0)
         basin = basin_for(self.tolerance)
@@ -338,8 +338,6 @@ class PathSearch:
             arcs = arcs_mod.read_arcs(path)
         t0 = time.perf_counter()
         rock_cons = dataclasses.replace(cons, full_turn=False)
-        from planar.synth.search import basin_for
-
         basin = basin_for(self.tolerance, arcs_mod.BASIN)
         r, swing = arcs_mod.search_arcs(self.t, arcs, rock_cons, ordered=self.ordered, basin=basin)
         stages["rocking_s"] = time.perf_counter() - t0
