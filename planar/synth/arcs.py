@@ -437,6 +437,14 @@ GUARD_AFTER, TOGGLE_GUARD_DEG, GUARD_STARTS = 1e-4, 0.2, 8
 #: neighbours per query in the curve-window atlas (:mod:`planar.synth.windows`: parts of the curves of four-bars whose
 #: crank turns fully, as one of a double-rocker's two cognates does) and how many of them are refined
 WINDOWS_K, WINDOWS_REFINE = 16, 16
+#: the requery rounds of :func:`search_arcs` (after the other rounds when the best is a near miss; the second only
+#: when the first made it nearer): the best refined four-bar's arc from its first target to its last, at
+#: :data:`ARC_SAMPLES` input angles, looked up in the rocking arcs, ``REQUERY_K`` neighbours a view, and up to
+#: ``REQUERY_REFINE`` of them refined (all of them: the best 64 by the objective of a wider lookup rescued fewer
+#: misses); at most ``REQUERY_ROUNDS`` rounds.  That arc passes within a near miss of every target, so it describes
+#: their curve better than the spline through 12 uneven targets does, as the closed-curve search's requery
+#: (:func:`planar.synth.search._requery`) does (docs/explanation/coupler-curve-atlas.md)
+REQUERY_K, REQUERY_REFINE, REQUERY_ROUNDS = 16, 64, 2
 
 
 def on_swing(theta: Array, swing: tuple[float, float]) -> Array:
@@ -619,6 +627,18 @@ class _Rounds:
         self.stages["arcs_s"] = self.stages.get("arcs_s", 0.0) + time.perf_counter() - t1
         return every
 
+    def requery_round(self, arcs: Arcs) -> int:
+        """One requery round (:data:`REQUERY_K`, :data:`REQUERY_REFINE`): the best so far's arc between its first and
+        last target's input angles looked up (:func:`arc_candidates`) and refined; its seconds in ``requery_s``."""
+        assert self.best is not None
+        _, r, tt, swing = self.best
+        u = on_swing(tt, swing)
+        x, y, _ = coupler_points(r[None, :9], np.linspace(u[0], u[-1], ARC_SAMPLES)[None], np.array([r[9]]))
+        t1 = time.perf_counter()
+        every = arc_candidates(arcs, np.column_stack([x[0], y[0]]), REQUERY_K)
+        self.stages["requery_s"] = self.stages.get("requery_s", 0.0) + time.perf_counter() - t1
+        return self.run(every, len(self.tried) + REQUERY_REFINE, self.tried, 0.0, "requery_s")
+
     def windows_round(self, windows: Any) -> int:
         """The curve-window round (:data:`WINDOWS_K`, :data:`WINDOWS_REFINE`): the atlas (``windows``, or a function
         of no arguments returning it) loaded here, its seconds in ``windows_load_s``, the round's in ``windows_s``
@@ -659,7 +679,9 @@ def search_arcs(
     then, with ``windows``, the curve windows (:data:`WINDOWS_K`, :data:`WINDOWS_REFINE`; their four-bars' cranks
     turn fully, and a refined one's cognate whose input rocks replaces it: :meth:`_Rounds.rocking_input`, as for
     every refined start); then, only after a near miss (beyond ``basin``, within
-    :data:`NEAR_MISS`), the rocking arcs again, more of them (``ROUNDS[1]``).  When they end with nothing usable
+    :data:`NEAR_MISS`), the rocking arcs again, more of them (``ROUNDS[1]``); then, while the best is a near miss
+    (after a requery, only if it came nearer), the best's own arc over the targets looked up (:data:`REQUERY_K`,
+    :meth:`_Rounds.requery_round`).  When they end with nothing usable
     or nothing within :data:`GUARD_AFTER`, and most of their starts were unusable, the :data:`GUARD_STARTS` best
     starts are refined once more keeping the transmission angle at the targets :data:`TOGGLE_GUARD_DEG` beyond the
     floor (docs/explanation/coupler-curve-atlas.md)."""
@@ -691,6 +713,13 @@ def search_arcs(
     for k, limit in ROUNDS[1:]:
         if rounds.near_miss():  # else found, or not near enough for more starts to be worth their time
             usable_starts += rounds.run(rounds.lookup(arcs, k), limit, rounds.tried, 0.0)
+    for _ in range(REQUERY_ROUNDS):
+        before = rounds.best
+        if not rounds.near_miss():
+            break
+        usable_starts += rounds.requery_round(arcs)
+        if rounds.best is before:  # no nearer: looking up the same arc again finds the same neighbours
+            break
     best = rounds.best
     if (best is None or best[0] > GUARD_AFTER) and 2 * usable_starts < len(rounds.tried):
         # most starts ended unusable, at a toggle: again, kept off them
