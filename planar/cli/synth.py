@@ -139,11 +139,25 @@ def _path_failing(
             out.append(_transmission_word(c["min_transmission_deg"], where, c["transmission_limit_deg"]))
         elif k == "ok_order":
             out.append("the branch does not pass the targets in their order (--ordered)")
+        elif k == "ok_follows_drawing":
+            out.append(_stray_word(d.checks["drawing_stray"]))
         elif k == "ok_valid_over_turn" and d.checks.get("failures"):
             out += d.checks["failures"]
         else:
             out.append(k[3:].replace("_", " "))
     return out
+
+
+def _stray_word(stray: float) -> str:
+    """A failed drawing check in words: how far (``stray``, over the targets' size) the coupler path and the drawing
+    part between the targets, against the limit (:data:`planar.synth.drawing.DETOUR`), and what to do."""
+    from planar.synth.drawing import DETOUR
+
+    return (
+        f"the coupler path does not trace the drawing: between the targets the two stray up to {stray:.3g} of the "
+        f"targets' size apart (limit {DETOUR:g}; the check at the targets does not see between them): more --points "
+        "hold the search to more of the drawing, and planar render shows the path"
+    )
 
 
 def _ratio_limit(d: Any, max_ratio: float) -> str:
@@ -275,6 +289,8 @@ def _unusable(d: Any, kind: str, region: bool) -> str | None:
         what = f"no {kind} keeping the constraints" + (" (every ground pivot in the --pivots box)" if region else "")
         return f"{what} reaches the targets; the best found: " + "; ".join(d.checks["constraint_failures"])
     if not math.isfinite(d.sse):
+        if d.checks.get("rocking_error"):  # the rocking search's own words: what it asked of every four-bar
+            return str(d.checks["rocking_error"])
         return f"no {kind} found that can be assembled at every target's crank angle" + (
             f" ({d.checks['error']})" if d.checks.get("error") else ""
         )
@@ -354,7 +370,7 @@ def _cmd_path(args: argparse.Namespace) -> int:
             full_turn=bool(args.full_turn or _closed_svg(args.target)),
         )
     if str(args.target).lower().endswith(".svg") and "error" not in d.checks:
-        from planar.synth.drawing import BETWEEN_CAUTION, drawing_cautions, drawing_gaps
+        from planar.synth.drawing import BETWEEN_CAUTION, DETOUR, drawing_cautions, drawing_gaps, drawing_stray
 
         gaps = drawing_gaps(d, args.target)
         d.checks.update(gaps)
@@ -362,6 +378,10 @@ def _cmd_path(args: argparse.Namespace) -> int:
         # the drawing itself, not a smooth curve through its sampled points, is what the path is measured against
         kept = [c for c in d.checks.get("cautions", []) if not c.startswith(BETWEEN_CAUTION)]
         d.checks["cautions"] = [*kept, *drawing_cautions(gaps, args.tolerance, rocks)]
+        stray = drawing_stray(gaps, rocks)
+        if stray is not None:  # the path should follow the drawing all along: far off it, the design fails
+            d.checks["drawing_stray"] = stray
+            d.checks["ok_follows_drawing"] = stray <= DETOUR
 
     def scene() -> tuple[str, str]:
         fb = d.fourbar()

@@ -31,6 +31,7 @@ __all__ = [
     "between_targets",
     "drawing_cautions",
     "drawing_gaps",
+    "drawing_stray",
 ]
 
 Array = NDArray[np.float64]
@@ -110,6 +111,22 @@ def drawing_cautions(gaps: dict[str, float], tolerance: float, rocks: bool) -> l
             "hold the search to more of the drawing)"
         )
     return out
+
+
+def drawing_stray(gaps: dict[str, float], rocks: bool) -> float | None:
+    """How far (over the targets' size) a design's coupler path and the drawing it was asked to trace stray from each
+    other where the path should follow the drawing all along, from :func:`drawing_gaps`'s figures (``rocks``: the
+    design's input swings rather than turns); None where it need not: a closed drawing traced by an input that
+    rocks (along part of it and back) is measured by neither figure, an open drawing traced by a crank that turns
+    fully (which comes back another way) only by the drawing's distance from the path.  Beyond :data:`DETOUR` the
+    design does not trace the drawing: ``synth path`` fails it (``checks.ok_follows_drawing``, exit 3), as a check
+    at the targets cannot see (a trial's nodding-beak arc came back within the tolerance at every target, its
+    path 0.496 of the size off the drawing between two of them)."""
+    closed = bool(gaps.get("drawing_closed", 0.0))
+    if closed and rocks:
+        return None
+    far = float(gaps.get("drawing_max_distance", 0.0))
+    return far if not closed and not rocks else max(far, float(gaps.get("path_max_distance", 0.0)))
 
 
 #: a stretch of coupler path between two targets straying farther than ``DETOUR`` (over the targets' size) from the
