@@ -466,6 +466,25 @@ def design_from(r: Any, c: Array, s: float, t: Array, timed: bool, seconds: floa
     return d, p
 
 
+def _rocking_asked(ordered: bool, min_transmission: float, input_rocks: bool) -> str:
+    """What every result of the rocking search must be, in words, for when none is: its input link rocking
+    (``input_rocks``), the targets on one swing (in order when ``ordered``), and the transmission angle over that
+    swing ``min_transmission`` (rad) or :data:`TOGGLE_FLOOR_DEG` from a toggle, whichever is more; each with the
+    option that asks for it, so the one to relax can be seen (a trial's beak arc found nothing with
+    ``--min-transmission 20`` and ``--input-rocks``, where the line named only the swing)."""
+    asked = ["whose input link cannot turn fully (--input-rocks)"] if input_rocks else []
+    asked.append("with the targets on one swing of its input" + (", met in their order (--ordered)" if ordered else ""))
+    deg = math.degrees(float(min_transmission))
+    if deg > TOGGLE_FLOOR_DEG:
+        asked.append(f"keeping the transmission angle {deg:.4g} deg from a toggle over that swing (--min-transmission)")
+    else:
+        asked.append(f"keeping the transmission angle {TOGGLE_FLOOR_DEG:g} deg from a toggle over that swing (the floor)")
+    return (
+        "the rocking search found no four-bar " + ", ".join(asked[:-1]) + " and " + asked[-1] + ": relaxing one of "
+        "them, or more --points along the arc, may let one through"
+    )
+
+
 def synthesise_rocking_path(
     targets: Array,
     tolerance: float = DEFAULT_TOLERANCE,
@@ -492,12 +511,13 @@ def synthesise_rocking_path(
     (planar's solver assembles the whole swing on the design's circuit), ``ok_on_one_swing`` (every target on
     that swing), ``ok_constraints`` (link ratio), ``ok_transmission`` (over the swing, the transmission angle at
     least ``min_transmission`` rad from a toggle and never nearer than :data:`TOGGLE_FLOOR_DEG`; the smallest is
-    ``min_transmission_deg``, at the input angle ``min_transmission_at_rad``: a check of the result, not a
-    constraint of the search) and, with ``ordered``, ``ok_order`` (the targets met in their order as the input
+    ``min_transmission_deg``, at the input angle ``min_transmission_at_rad``; the search returns only four-bars
+    that keep it) and, with ``ordered``, ``ok_order`` (the targets met in their order as the input
     swings one way).  ``input_rocks``: only a four-bar whose input link itself cannot turn fully (a double- or
     triple-rocker; by default a cognate whose crank could turn fully, swung over the targets' span, is accepted
     too); ``checks["input_link"]`` says which the result is (``"rocks"`` or ``"could turn fully"``).  When no
-    four-bar keeps the targets on one swing, ``checks["error"]`` says so and ``sse`` is inf.  Raises
+    four-bar is all that (on one swing, in order, its transmission angle kept, its input rocking), ``checks["error"]``
+    says what was asked and ``sse`` is inf.  Raises
     :class:`InputError` naming a bad argument (as :func:`synthesise_path`).
     """
     from threadpoolctl import threadpool_limits
@@ -530,9 +550,8 @@ def synthesise_rocking_path(
         )
     if r is None or swing is None:
         d = FourBarDesign(1.0, 1.0, 1.0, 1.0, (0.0, 0.0), "open", (0.0, 0.0, 0.0), np.zeros(len(t)), math.inf, t, False, 0.0)
-        which = "whose input link cannot turn fully " if input_rocks else ""
-        d.checks = {"error": f"no four-bar {which}the rocking search found keeps the targets on one swing of its input"}
-        d.checks["ok_found"] = False
+        said = _rocking_asked(ordered, cons.min_transmission, input_rocks)
+        d.checks = {"error": said, "rocking_error": said, "ok_found": False}
         return d
     d, p = design_from(r, c, s, t, False, time.perf_counter() - t0)
     source = "the rocking-arc atlas lookup and refinement" if "arcs_s" in r.stages else EQUATION_SOURCE

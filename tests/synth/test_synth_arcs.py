@@ -644,3 +644,26 @@ def test_a_swing_is_said_from_its_first_turn():
     for a in (-7.0, -np.pi, 0.3, np.pi, 12.0):
         lo, hi = first_turn((a, a + 1.0))
         assert -np.pi <= lo < np.pi and np.isclose(hi - lo, 1.0) and np.isclose(np.exp(1j * lo), np.exp(1j * a))
+
+
+def test_when_nothing_is_found_the_rocking_search_says_what_it_asked_with_each_option():
+    # a trial's beak arc with --input-rocks and --min-transmission 20 found nothing, and the line named only the
+    # swing: it now names every requirement with the option asking for it.  89 deg from a toggle over a swing is
+    # more than any four-bar keeps (the transmission angle turns as the input swings), so nothing is found
+    from planar.synth.path import synthesise_rocking_path
+    from planar.synth.windows import build_windows
+
+    rng = np.random.default_rng(20261290)
+    L, lo, hi = _double_rocker(rng)
+    p = np.array([1.0, *L, 0.3, 0.2, 0.0, 0.0, 0.1])
+    th = np.linspace(lo + 0.2 * (hi - lo), hi - 0.2 * (hi - lo), 9)
+    x, y, _ = coupler_points(p[None], th[None], np.array([1.0]))
+    t = np.column_stack([x[0], y[0]])
+    arcs, windows = build_arcs(500, seed=0), build_windows(500, seed=0)
+    d = synthesise_rocking_path(t, 1e-3, True, arcs=arcs, windows=windows, min_transmission=np.radians(89.0), input_rocks=True)
+    said = d.checks["error"]
+    assert not np.isfinite(d.sse) and not d.checks["ok_found"]
+    for words in ("(--input-rocks)", "met in their order (--ordered)", "89 deg from a toggle", "(--min-transmission)"):
+        assert words in said, said
+    d = synthesise_rocking_path(t, 1e-3, False, arcs=arcs, windows=windows, min_transmission=np.radians(89.0))
+    assert "--input-rocks" not in d.checks["error"] and "--ordered" not in d.checks["error"]
