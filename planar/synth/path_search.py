@@ -207,7 +207,9 @@ class PathSearch:
             alg.stages = dict(self.stages)
             return alg, how, swing
         r, source, swing = self.searched()
-        gave = "; the targets' own curve equation gave no four-bar through them (see the curve equation docs)"
+        # "within the tolerance": with a looser one the same four-bar may come from the equation (a trial's drawn foot
+        # path: this line at the default tolerance, the equation's four-bar at 0.01)
+        gave = "; the targets' own curve equation gave no four-bar within the tolerance (see the curve equation docs)"
         return self.off_toggle(r, source + gave, swing)
 
     def off_toggle(self, r: Any, source: str, swing: tuple[float, float] | None) -> Found:
