@@ -959,7 +959,9 @@ def add_parser(sub: Any) -> None:
         "--points",
         type=int,
         default=None,
-        help="points at equal arc lengths along an SVG target, drawing (x, y) read as (x, -y) (12; SVG only)",
+        help="points at equal arc lengths along an SVG target, drawing (x, y) read as (x, -y) (12; SVG only); a "
+        "design whose coupler path strays over 0.25 of the targets' size from the drawing between them is written "
+        "and exits 3 (more points hold the search to more of the drawing)",
     )
     p.add_argument("--deg", action="store_true", help="the theta column is in degrees")
     p.add_argument(
