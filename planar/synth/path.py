@@ -145,15 +145,17 @@ def best_fourbar(
     atlas: Any = None,
     ordered: bool = False,
     tolerance: float = DEFAULT_TOLERANCE,
+    full_turn: bool = False,
 ) -> Any:
     """The search of :func:`synthesise_path` on targets ``t`` already normalised (centroid 0, size 1; ``cons``
-    normalised with them): a :class:`planar.synth.search.SearchResult`."""
+    normalised with them): a :class:`planar.synth.search.SearchResult`.  ``full_turn``: only a four-bar whose
+    input turns fully (the rocking arcs are not tried)."""
     from threadpoolctl import threadpool_limits
 
     if not isinstance(budget, str) or budget not in BUDGETS:
         raise InputError("budget", budget, f"one of {', '.join(BUDGETS)}")
     with threadpool_limits(1):
-        return PathSearch(t, cons, budget, seed, tolerance, atlas, ordered).run(theta)[0]
+        return PathSearch(t, cons, budget, seed, tolerance, atlas, ordered, full_turn=full_turn).run(theta)[0]
 
 
 def unboxed_error(targets: Array, cons: Constraints, atlas: Any = None, budget: str = "normal") -> float:
@@ -480,8 +482,8 @@ def _rocking_asked(ordered: bool, min_transmission: float, input_rocks: bool) ->
     else:
         asked.append(f"keeping the transmission angle {TOGGLE_FLOOR_DEG:g} deg from a toggle over that swing (the floor)")
     return (
-        "the rocking search found no four-bar " + ", ".join(asked[:-1]) + " and " + asked[-1] + ": relaxing one of "
-        "them, or more --points along the arc, may let one through"
+        "the rocking search found no four-bar " + ", ".join(asked[:-1]) + " and " + asked[-1] + ": none it found "
+        "is all of these; relaxing one of them may let one through"
     )
 
 

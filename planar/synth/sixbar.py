@@ -316,15 +316,18 @@ def _fourbar_seed(
 ) -> tuple[Array, Array] | None:
     """A Stephenson six-bar tracing the best four-bar's coupler curve, and its crank angles at the targets.
 
-    The four-bar is the one ``planar synth path`` finds (:func:`planar.synth.path.best_fourbar`: the atlas
-    and, when that is not within the tolerance, the global search); the tracer sits on ``E``, the coupler
+    The four-bar is the one ``planar synth path`` finds with an input that turns fully
+    (:func:`planar.synth.path.best_fourbar` with ``full_turn``: the atlas and, when that is not within the
+    tolerance, the global search; a rocking input's four-bar, which plain ``synth path`` may return, does not
+    close over the six-bar's turn, and a trial's drawn paw lost its seed so: 0.239 of the size off where the
+    full-turn four-bar was 0.0418); the tracer sits on ``E``, the coupler
     point, so the six-bar's tracer path is the four-bar's.  The second dyad ``E - F - O6`` (``l5 = l6``,
     at least 0.55 of ``O6``'s farthest distance from the curve: it closes over the whole turn with a margin)
     is the one of a grid of ``O6`` in the bounds and lengths that breaks the constraints least.  None when
     the four-bar breaks them or cannot close over the turn."""
     from planar.synth.path import best_fourbar
 
-    r = best_fourbar(t, th, cons, budget, seed, atlas, ordered, tolerance)
+    r = best_fourbar(t, th, cons, budget, seed, atlas, ordered, tolerance, full_turn=True)
     if not r.feasible:
         return None
     turn = np.linspace(0, 2 * np.pi, 720, endpoint=False)
