@@ -324,6 +324,8 @@ def _cmd_path(args: argparse.Namespace) -> int:
     _unit_mm(args)  # refused before the search, not after it
     if args.topology is not None and args.type != "sixbar":
         raise InputError("--topology", args.topology, "--topology only with --type sixbar")
+    if args.rocking and args.type == "sixbar":  # the six-bar search has no rocking input: refused, not dropped
+        raise InputError("--rocking", True, "--type fourbar (the rocking search finds four-bars only)")
     if args.input_rocks and not args.rocking:
         raise InputError("--input-rocks", True, "--rocking with it (it asks the rocking search for a rocking input link)")
     if args.points is not None and not 3 <= args.points <= MAX_TARGETS:
@@ -883,7 +885,8 @@ def _min_transmission_parent() -> argparse.ArgumentParser:
         help="keep the transmission angle (between the coupler and the output link) at least this far from 0 and 180 (a toggle) "
         "over the motion (path: the crank's whole turn, or with --rocking the input's swing), degrees (0; never "
         "accepted nearer than 1 deg). path: a "
-        "constraint of the search; motion: chooses among the four-bars through the poses; when the best found does "
+        "constraint of the search (with --rocking, a four-bar not keeping it is not returned: nothing is written "
+        "when none does); motion: chooses among the four-bars through the poses; when the best found does "
         "not keep it, it is written and exits 3 naming the angle and where",
     )
     parent.add_argument(

@@ -95,8 +95,8 @@ def drawing_cautions(gaps: dict[str, float], tolerance: float, rocks: bool) -> l
     off = gaps.get("path_max_distance", 0.0)
     if off > tolerance and closed:
         out.append(
-            f"the coupler path leaves the closed drawing by up to {off:.3g} of the targets' size: a loop or detour the "
-            "drawing does not have"
+            f"the coupler path leaves the closed drawing by up to {off:.3g} of the targets' size ({off / tolerance:.3g} "
+            "times the tolerance; planar render shows where)"
         )
     elif off > tolerance and not rocks:
         out.append(
@@ -107,8 +107,7 @@ def drawing_cautions(gaps: dict[str, float], tolerance: float, rocks: bool) -> l
     elif off > tolerance:  # an input that swings over the targets' span: the path should follow the open drawing
         out.append(
             f"between the targets the coupler path leaves the drawing by up to {off:.3g} of their size ({off / tolerance:.3g} "
-            "times the tolerance): a loop or detour the drawing does not have (planar render shows it; more --points "
-            "hold the search to more of the drawing)"
+            "times the tolerance; planar render shows where, and more --points hold the search to more of the drawing)"
         )
     return out
 

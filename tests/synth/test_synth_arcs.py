@@ -95,6 +95,16 @@ def test_rocking_refuses_timed_targets(tmp_path, capsys):
     assert "--rocking" in capsys.readouterr().err and not out.exists()
 
 
+def test_rocking_refuses_a_six_bar_rather_than_dropping_it(tmp_path, capsys):
+    # a trial's --rocking --type sixbar ran the six-bar search with a crank, saying nothing of --rocking
+    f = tmp_path / "t.csv"
+    f.write_text("x,y\n0,0\n1,0.2\n2,0.1\n3,0.5\n")
+    out = tmp_path / "o.toml"
+    assert main(["synth", "path", str(f), "--rocking", "--type", "sixbar", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "--rocking" in err and "--type fourbar" in err and len(err.strip().splitlines()) == 1 and not out.exists()
+
+
 def test_geodesic_lm_follows_rosenbrocks_curved_valley():
     # Rosenbrock's function as least squares (r = 10 (y - x^2), 1 - x): a long curved valley to its one minimum
     # (1, 1), known in closed form; from the classical start (-1.2, 1) the damped steps must reach it
