@@ -291,6 +291,19 @@ def test_refined_start_takes_short_arcs_past_where_the_lengths_stall():
     assert steps >= 6 and steps >= lengths_only + 2, (steps, lengths_only)
 
 
+def _rebuilt(kind: str, seed: int, index: int) -> tuple[dict, np.ndarray]:
+    """The rocking problem at 12 targets ``index`` of ``kind`` drawn from ``seed`` (as the bench and the measurements
+    draw them), and its targets normalised (centroid 0, size 1)."""
+    from planar.bench.synthesis_rocking import rocking_problem
+    from planar.synth.path import normalisation
+
+    rng = np.random.default_rng([seed, 12, 0 if kind == "double" else 1])
+    for _ in range(index + 1):
+        pr = rocking_problem(rng, kind, 12)
+    c, s = normalisation(pr["targets"])
+    return pr, (pr["targets"] - c) / s
+
+
 #: rocking problems at 12 targets (``rocking_problem``: kind, seed, index) that the search with the closed-curve
 #: search's start (``refined_start``) missed; on random ones both starts do as well
 MISSED = (("triple", 20261248, 13), ("double", 20261250, 18), ("triple", 20261250, 7), ("double", 20261252, 8))
@@ -302,19 +315,13 @@ def test_an_arc_start_from_the_four_bars_own_arc_reaches_it_where_the_lengths_st
     # lookup places an atlas entry (only float32 rounding and the resampling between it and the truth).  The
     # rocking search's start (joints' positions from angles assigned on a sampled curve) comes within 1e-6 of the
     # size; the closed-curve search's (steps in the lengths first), from the same start, mostly does not
-    from planar.bench.synthesis_rocking import rocking_problem
     from planar.synth.arcs import Arcs, arc_candidates, arc_start, described_windows
-    from planar.synth.path import normalisation
     from planar.synth.search import Constraints, PathObjective, default_bounds, max_distance, refined_start
 
     cons = Constraints(full_turn=False, max_ratio=10.0)
     arc = lengths_first = 0
     for kind, seed, index in MISSED:
-        rng = np.random.default_rng([seed, 12, 0 if kind == "double" else 1])
-        for _ in range(index + 1):
-            pr = rocking_problem(rng, kind, 12)
-        c, s = normalisation(pr["targets"])
-        t = (pr["targets"] - c) / s
+        pr, t = _rebuilt(kind, seed, index)
         g, a, b, r, u, v = pr["fourbar"][:6]
         own = np.array([[a / g, b / g, r / g, u / g, v / g, pr["circuit"]]])
         window = (np.array([pr["theta"].min()]), np.array([pr["theta"].max()]))
@@ -336,9 +343,7 @@ REQUERIED = (("double", 20261270, 8), ("double", 20261270, 30), ("triple", 20261
 def test_the_requery_from_a_near_miss_own_arc_finds_the_four_bar_the_rounds_before_missed(monkeypatch):
     # the rounds before the requery end with a near miss (beyond 1e-6 of the size, within 1e-3); looking up the near
     # miss's own arc over the targets and refining its neighbours finds a four-bar within 1e-6 on one swing, in order
-    from planar.bench.synthesis_rocking import rocking_problem
     from planar.synth import arcs as arcs_mod
-    from planar.synth.path import normalisation
     from planar.synth.search import Constraints, PathObjective, max_distance
 
     arcs = build_arcs(20_000, seed=0)
@@ -354,11 +359,7 @@ def test_the_requery_from_a_near_miss_own_arc_finds_the_four_bar_the_rounds_befo
     monkeypatch.setattr(arcs_mod._Rounds, "requery_round", recorded)
     rescued = 0
     for kind, seed, index in REQUERIED:
-        rng = np.random.default_rng([seed, 12, 0 if kind == "double" else 1])
-        for _ in range(index + 1):
-            pr = rocking_problem(rng, kind, 12)
-        c, s = normalisation(pr["targets"])
-        t = (pr["targets"] - c) / s
+        _, t = _rebuilt(kind, seed, index)
         seen.clear()
         cons = Constraints(full_turn=False)
         r, swing = arcs_mod.search_arcs(t, arcs, cons, ordered=True)
