@@ -603,6 +603,16 @@ def test_a_double_rockers_arc_is_found_in_the_curve_windows_through_its_crank_co
     assert rocking_range(r[:9], tt) == swing  # an input that rocks: the refined crank's cognate
 
 
+def _middle_of_swing(seed: int, n: int) -> np.ndarray:
+    """``n`` targets ``(n, 2)`` at even input angles over the middle 60 % of the swing of a random double-rocker
+    (``_double_rocker`` drawn from ``seed``; coupler point (0.3, 0.2), open circuit)."""
+    L, lo, hi = _double_rocker(np.random.default_rng(seed))
+    p = np.array([1.0, *L, 0.3, 0.2, 0.0, 0.0, 0.1])
+    th = np.linspace(lo + 0.2 * (hi - lo), hi - 0.2 * (hi - lo), n)
+    x, y, _ = coupler_points(p[None], th[None], np.array([1.0]))
+    return np.column_stack([x[0], y[0]])
+
+
 def test_the_curve_window_round_runs_when_the_first_round_leaves_nothing_within_the_basin(monkeypatch):
     # the rounds' order: the rocking arcs, then (windows given, nothing within the basin) the curve windows, with
     # input_rocks too (a refined crank's cognate whose input rocks replaces it), then (a near miss) more rocking arcs,
@@ -610,12 +620,7 @@ def test_the_curve_window_round_runs_when_the_first_round_leaves_nothing_within_
     from planar.synth import arcs as arcs_mod
     from planar.synth.search import Constraints
 
-    rng = np.random.default_rng(20261246)
-    L, lo, hi = _double_rocker(rng)
-    true = np.array([1.0, *L, 0.3, 0.2, 0.0, 0.0, 0.1])
-    th = np.linspace(lo + 0.2 * (hi - lo), hi - 0.2 * (hi - lo), 12)
-    x, y, _ = coupler_points(true[None], th[None], np.array([1.0]))
-    t = np.column_stack([x[0], y[0]])
+    t = _middle_of_swing(20261246, 12)
     t = (t - t.mean(axis=0)) / np.sqrt(np.mean(np.sum((t - t.mean(axis=0)) ** 2, axis=1)))
     arcs = build_arcs(arcs_mod.QUICK_FOURBARS, seed=0)
     calls: list[str] = []
@@ -664,12 +669,7 @@ def test_when_nothing_is_found_the_rocking_search_says_what_it_asked_with_each_o
     from planar.synth.path import synthesise_rocking_path
     from planar.synth.windows import build_windows
 
-    rng = np.random.default_rng(20261290)
-    L, lo, hi = _double_rocker(rng)
-    p = np.array([1.0, *L, 0.3, 0.2, 0.0, 0.0, 0.1])
-    th = np.linspace(lo + 0.2 * (hi - lo), hi - 0.2 * (hi - lo), 9)
-    x, y, _ = coupler_points(p[None], th[None], np.array([1.0]))
-    t = np.column_stack([x[0], y[0]])
+    t = _middle_of_swing(20261290, 9)
     arcs, windows = build_arcs(500, seed=0), build_windows(500, seed=0)
     d = synthesise_rocking_path(t, 1e-3, True, arcs=arcs, windows=windows, min_transmission=np.radians(89.0), input_rocks=True)
     said = d.checks["error"]
