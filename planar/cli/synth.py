@@ -232,8 +232,9 @@ def _unreachable(d: Any, kind: str = "four-bar", box: str = "", budget: str = "n
     deg, at = _sharpest_turn(d.targets)
     if deg >= 60:
         why = (
-            f"the targets turn by {deg:.0f} deg at target {at}, a sharp corner, and a coupler curve is smooth: "
-            "it rounds corners (round them in the drawing, or accept a larger --tolerance)"
+            f"the targets turn by {deg:.0f} deg at target {at}: a sharp corner, or a tight bend with few targets on it, "
+            "and a coupler curve is smooth: it rounds corners (round them in the drawing, sample a bend with more "
+            "--points, or accept a larger --tolerance)"
         )
     elif box:
         why = box
