@@ -284,14 +284,15 @@ def _angles_comment(d: Any) -> str:
     return f"{word} angle at each target (rad from the ground line, {where}): " + ", ".join(repr(float(t)) for t in theta)
 
 
-def _unusable(d: Any, kind: str, region: bool) -> str | None:
-    """Why a design is no valid linkage at all (a constraint broken, or it misses a target's crank angle)."""
+def _unusable(d: Any, kind: str, region: bool, rocking: bool = False) -> str | None:
+    """Why a design is no valid linkage at all (a constraint broken, or it misses a target's crank angle; with
+    ``rocking``, the rocking search's own words for finding none: what it asked of every four-bar)."""
     if d.checks.get("constraint_failures"):
         what = f"no {kind} keeping the constraints" + (" (every ground pivot in the --pivots box)" if region else "")
         return f"{what} reaches the targets; the best found: " + "; ".join(d.checks["constraint_failures"])
     if not math.isfinite(d.sse):
-        if d.checks.get("rocking_error"):  # the rocking search's own words: what it asked of every four-bar
-            return str(d.checks["rocking_error"])
+        if rocking and d.checks.get("error"):
+            return str(d.checks["error"])
         return f"no {kind} found that can be assembled at every target's crank angle" + (
             f" ({d.checks['error']})" if d.checks.get("error") else ""
         )
@@ -422,7 +423,7 @@ def _path_result(args: argparse.Namespace, d: Any, targets: np.ndarray, kind: st
     """The end of ``synth path`` for any design ``d`` of ``kind``: no design (nothing written, exit 3) when it is
     unusable, else its scene written (``scene()``: the text and the design in a few words) and reported, with
     each failed check (``box()``: what a ``--pivots`` box costs, in words)."""
-    why = _unusable(d, kind, args.pivots is not None)
+    why = _unusable(d, kind, args.pivots is not None, bool(getattr(args, "rocking", False)))
     if why is not None:
         return _no_design(args, "synth path", {"targets": len(targets)}, why)
     asked = tuple(

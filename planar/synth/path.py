@@ -552,8 +552,7 @@ def synthesise_rocking_path(
         )
     if r is None or swing is None:
         d = FourBarDesign(1.0, 1.0, 1.0, 1.0, (0.0, 0.0), "open", (0.0, 0.0, 0.0), np.zeros(len(t)), math.inf, t, False, 0.0)
-        said = _rocking_asked(ordered, cons.min_transmission, input_rocks)
-        d.checks = {"error": said, "rocking_error": said, "ok_found": False}
+        d.checks = {"error": _rocking_asked(ordered, cons.min_transmission, input_rocks), "ok_found": False}
         return d
     d, p = design_from(r, c, s, t, False, time.perf_counter() - t0)
     source = "the rocking-arc atlas lookup and refinement" if "arcs_s" in r.stages else EQUATION_SOURCE
