@@ -408,9 +408,11 @@ def input_swing(row: Array, theta: Array) -> tuple[float, float] | None:
 
 #: lookup and refinement effort: neighbours per query, and starts refined (:func:`arc_start`)
 SEARCH_K, SEARCH_REFINE = 64, 32
-#: a looked-up start's refinement (:func:`arc_start`): at most this many iterations in the joints' positions, ended
-#: sooner after this many refused steps in a row (:func:`planar.synth.positions.geodesic_lm`'s ``patience``)
-ARC_START_ITERS, ARC_START_PATIENCE = 300, 15
+#: a looked-up start's refinement (:func:`arc_start`): at most this many iterations in the joints' positions
+ARC_START_ITERS = 300
+#: a start's refinement and the final polish (:func:`_polished`) end after this many refused steps in a row
+#: (:func:`planar.synth.positions.geodesic_lm`'s ``patience``)
+REFINE_PATIENCE = 15
 #: the rounds of :func:`search_arcs`: neighbours per query, and how many starts may have been refined by the round's
 #: end (its own and the rounds' before); a later round runs only when the best so far is a near miss: beyond
 #: :data:`BASIN` but within ``NEAR_MISS`` (the targets' size 1).  Drawn or noisy targets, which no four-bar meets,
@@ -418,7 +420,7 @@ ARC_START_ITERS, ARC_START_PATIENCE = 300, 15
 ROUNDS = ((SEARCH_K, SEARCH_REFINE), (256, 128))
 NEAR_MISS = 1e-3
 #: the final polish (:func:`planar.synth.positions.polish_positions`): iterations per start (ended, as a start's, after
-#: :data:`ARC_START_PATIENCE` refused steps in a row), and how many of the best refined starts (each on one swing) it
+#: :data:`REFINE_PATIENCE` refused steps in a row), and how many of the best refined starts (each on one swing) it
 #: is tried on, best first, until one is within the search's stop or :data:`BASIN`
 POLISH_ITERS, POLISH_STARTS = 600, 8
 #: a start this near (largest distance over the targets' size) ends the trying of further starts: only it is
@@ -491,7 +493,7 @@ def arc_start(obj: Any, row: Array, max_ratio: float, floor: float = 0.0) -> tup
     angles assigned on its curve (:func:`planar.synth.search.assign_theta`), then at most :data:`ARC_START_ITERS`
     iterations in the joints' positions (:func:`planar.synth.positions.polish_positions`, keeping the link ratio
     ``max_ratio`` and the transmission angle at the targets ``floor`` rad from a toggle when above 0), ended after
-    :data:`ARC_START_PATIENCE` refused steps in a row.  Returns the row and its input angles at the targets (the
+    :data:`REFINE_PATIENCE` refused steps in a row.  Returns the row and its input angles at the targets (the
     start's own when nothing nearer is found).
 
     The closed-curve search's start (:func:`planar.synth.search.refined_start`) first takes 10 evaluations of
@@ -504,7 +506,7 @@ def arc_start(obj: Any, row: Array, max_ratio: float, floor: float = 0.0) -> tup
     from planar.synth.search import assign_theta
 
     theta = assign_theta(obj, row)
-    return polish_positions(obj.targets, row, theta, ARC_START_ITERS, max_ratio, floor, ARC_START_PATIENCE)
+    return polish_positions(obj.targets, row, theta, ARC_START_ITERS, max_ratio, floor, REFINE_PATIENCE)
 
 
 #: a rocking start's outcome: largest distance (the targets' size 1), refined row, input angles at the targets, swing
@@ -551,7 +553,7 @@ def _polished(
     found = sorted(found, key=lambda c: c[0])
     best = found[0]
     for _, r0, tt0, _ in found[: 1 if best[0] <= basin else POLISH_STARTS] if best[0] > stop else []:
-        r, tt = polish_positions(obj.targets, r0, tt0, POLISH_ITERS, max_ratio, floor, ARC_START_PATIENCE)
+        r, tt = polish_positions(obj.targets, r0, tt0, POLISH_ITERS, max_ratio, floor, REFINE_PATIENCE)
         swing = usable(r, tt)
         e = max_distance(obj, r, tt) if swing is not None else math.inf
         if swing is not None and e < best[0]:
